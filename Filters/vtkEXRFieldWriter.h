@@ -1,0 +1,76 @@
+/**
+ * @class   vtkEXRFieldWriter
+ * @brief   Writes point arrays of a 2-D image as one multi-channel EXR.
+ *
+ * Each chosen point array becomes a channel of the same name (a 3-component
+ * array NAME becomes NAME.x, NAME.y, NAME.z; other multi-component arrays
+ * NAME.0, NAME.1, ...). Values are stored as 32-bit float (default) or half.
+ * Row 0 of the image (south) is the last scanline of the file, so other
+ * EXR tools show north up. The input must be a vtkImageData with one point
+ * in z.
+ */
+#ifndef vtkEXRFieldWriter_h
+#define vtkEXRFieldWriter_h
+
+#include "GraupelFiltersModule.h"
+#include "vtkWriter.h"
+
+#include <string>
+#include <vector>
+
+class vtkImageData;
+
+class GRAUPELFILTERS_EXPORT vtkEXRFieldWriter : public vtkWriter
+{
+public:
+  static vtkEXRFieldWriter* New();
+  vtkTypeMacro(vtkEXRFieldWriter, vtkWriter);
+  void PrintSelf(ostream& os, vtkIndent indent) override;
+
+  enum PixelTypes
+  {
+    HALF = 1,
+    FLOAT = 2
+  };
+
+  ///@{
+  /** The .exr file to write. */
+  vtkSetStringMacro(FileName);
+  vtkGetStringMacro(FileName);
+  ///@}
+
+  ///@{
+  /** Storage of every channel: 1 half, 2 float (default). */
+  vtkSetClampMacro(PixelType, int, 1, 2);
+  vtkGetMacro(PixelType, int);
+  ///@}
+
+  ///@{
+  /**
+   * Point arrays to write. With none chosen, every point array is written.
+   */
+  void AddArrayName(const char* name);
+  void ClearArrayNames();
+  int GetNumberOfArrayNames() const;
+  const char* GetArrayName(int i) const;
+  ///@}
+
+  vtkImageData* GetInput();
+
+protected:
+  vtkEXRFieldWriter();
+  ~vtkEXRFieldWriter() override;
+
+  void WriteData() override;
+  int FillInputPortInformation(int port, vtkInformation* info) override;
+
+  char* FileName = nullptr;
+  int PixelType = FLOAT;
+  std::vector<std::string> ArrayNames;
+
+private:
+  vtkEXRFieldWriter(const vtkEXRFieldWriter&) = delete;
+  void operator=(const vtkEXRFieldWriter&) = delete;
+};
+
+#endif

@@ -1,0 +1,245 @@
+#include "vtkEXRHeightFieldReader.h"
+
+#include "vtkFloatArray.h"
+#include "vtkImageData.h"
+#include "vtkInformation.h"
+#include "vtkInformationVector.h"
+#include "vtkNew.h"
+#include "vtkObjectFactory.h"
+#include "vtkPointData.h"
+#include "vtkStreamingDemandDrivenPipeline.h"
+
+#include "graupel/exr_io.h"
+
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <string>
+#include <sys/stat.h>
+#include <vector>
+
+vtkStandardNewMacro(vtkEXRHeightFieldReader);
+
+// The image most recently read, kept until the file or its time stamp
+// changes, so RequestInformation and RequestData read the file once.
+struct vtkEXRHeightFieldReader::Cache
+{
+  std::string path;
+  long long mtime = 0;
+  long long size = 0;
+  gr_exr_image image{};
+  Cache() = default;
+  Cache(const Cache&) = delete;
+  Cache& operator=(const Cache&) = delete;
+  ~Cache() { gr_exr_image_free(&this->image); }
+};
+
+vtkEXRHeightFieldReader::vtkEXRHeightFieldReader()
+{
+  this->SetNumberOfInputPorts(0);
+}
+
+vtkEXRHeightFieldReader::~vtkEXRHeightFieldReader()
+{
+  this->SetFileName(nullptr);
+}
+
+int vtkEXRHeightFieldReader::CanReadFile(const char* filename)
+{
+  if (!filename)
+  {
+    return 0;
+  }
+  FILE* f = std::fopen(filename, "rb");
+  if (!f)
+  {
+    return 0;
+  }
+  unsigned char magic[4] = { 0, 0, 0, 0 };
+  size_t n = std::fread(magic, 1, 4, f);
+  std::fclose(f);
+  return n == 4 && magic[0] == 0x76 && magic[1] == 0x2f && magic[2] == 0x31 && magic[3] == 0x01;
+}
+
+bool vtkEXRHeightFieldReader::Load()
+{
+  if (!this->FileName || !*this->FileName)
+  {
+    vtkErrorMacro("EXR Height Field Reader: no FileName was set; give the path of an .exr file.");
+    return false;
+  }
+  struct stat st;
+  if (stat(this->FileName, &st) != 0)
+  {
+    vtkErrorMacro("EXR Height Field Reader: the file '" << this->FileName
+                                                        << "' does not exist or cannot be accessed.");
+    this->Loaded.reset();
+    return false;
+  }
+  long long mtime = static_cast<long long>(st.st_mtime);
+  if (this->Loaded && this->Loaded->path == this->FileName && this->Loaded->mtime == mtime &&
+    this->Loaded->size == static_cast<long long>(st.st_size))
+  {
+    return true;
+  }
+  std::unique_ptr<Cache> cache(new Cache);
+  char err[1024] = "";
+  gr_status status = gr_exr_read(this->FileName, &cache->image, err, sizeof(err));
+  if (status != GR_OK)
+  {
+    vtkErrorMacro("EXR Height Field Reader: " << err);
+    this->Loaded.reset();
+    return false;
+  }
+  cache->path = this->FileName;
+  cache->mtime = mtime;
+  cache->size = static_cast<long long>(st.st_size);
+  this->Loaded = std::move(cache);
+  return true;
+}
+
+int vtkEXRHeightFieldReader::RequestInformation(
+  vtkInformation*, vtkInformationVector**, vtkInformationVector* outputVector)
+{
+  if (!(this->Spacing[0] > 0.0) || !(this->Spacing[1] > 0.0))
+  {
+    vtkErrorMacro("EXR Height Field Reader: Spacing must be above 0 m in x and y; got "
+      << this->Spacing[0] << " " << this->Spacing[1] << ".");
+    return 0;
+  }
+  if (!this->Load())
+  {
+    return 0;
+  }
+  const gr_exr_image& img = this->Loaded->image;
+  vtkInformation* outInfo = outputVector->GetInformationObject(0);
+  int extent[6] = { 0, img.width - 1, 0, img.height - 1, 0, 0 };
+  double spacing[3] = { this->Spacing[0], this->Spacing[1], 1.0 };
+  outInfo->Set(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT(), extent, 6);
+  outInfo->Set(vtkDataObject::SPACING(), spacing, 3);
+  outInfo->Set(vtkDataObject::ORIGIN(), this->Origin, 3);
+  vtkDataObject::SetPointDataActiveScalarInfo(outInfo, VTK_FLOAT, 1);
+  return 1;
+}
+
+namespace
+{
+// "velocity.x" -> base "velocity", component 0; anything else -> -1.
+int VectorComponent(const std::string& name, std::string& base)
+{
+  static const char* suffixes[3] = { ".x", ".y", ".z" };
+  for (int c = 0; c < 3; ++c)
+  {
+    size_t n = name.size();
+    if (n > 2 && name.compare(n - 2, 2, suffixes[c]) == 0)
+    {
+      base = name.substr(0, n - 2);
+      return c;
+    }
+  }
+  return -1;
+}
+}
+
+int vtkEXRHeightFieldReader::RequestData(
+  vtkInformation*, vtkInformationVector**, vtkInformationVector* outputVector)
+{
+  vtkImageData* output = vtkImageData::GetData(outputVector);
+  output->Initialize();
+  if (!this->Load())
+  {
+    return 0;
+  }
+  const gr_exr_image& img = this->Loaded->image;
+  const vtkIdType n = static_cast<vtkIdType>(img.width) * img.height;
+
+  std::vector<vtkSmartPointer<vtkFloatArray>> arrays;
+  std::vector<bool> used(img.nchannels, false);
+  // Vectors first: NAME.x, NAME.y and NAME.z together make one array.
+  for (int c = 0; c < img.nchannels; ++c)
+  {
+    std::string base;
+    if (VectorComponent(img.names[c], base) != 0)
+    {
+      continue;
+    }
+    int comp[3] = { c, gr_exr_find_channel(&img, (base + ".y").c_str()),
+      gr_exr_find_channel(&img, (base + ".z").c_str()) };
+    if (comp[1] < 0 || comp[2] < 0)
+    {
+      continue;
+    }
+    vtkNew<vtkFloatArray> a;
+    a->SetName(base.c_str());
+    a->SetNumberOfComponents(3);
+    a->SetNumberOfTuples(n);
+    float* dst = a->GetPointer(0);
+    for (vtkIdType k = 0; k < n; ++k)
+    {
+      for (int d = 0; d < 3; ++d)
+      {
+        dst[3 * k + d] = img.data[comp[d]][k];
+      }
+    }
+    for (int d = 0; d < 3; ++d)
+    {
+      used[comp[d]] = true;
+    }
+    arrays.emplace_back(a.Get());
+  }
+  for (int c = 0; c < img.nchannels; ++c)
+  {
+    if (used[c])
+    {
+      continue;
+    }
+    vtkNew<vtkFloatArray> a;
+    // A lone channel is a height map (its name is often "Y" or "R"), unless
+    // it already carries one of Graupel's field names, which is kept.
+    bool keep = img.nchannels > 1 || gr_field_from_name(img.names[c]) >= 0;
+    a->SetName(keep ? img.names[c] : "elevation");
+    a->SetNumberOfTuples(n);
+    std::memcpy(a->GetPointer(0), img.data[c], sizeof(float) * static_cast<size_t>(n));
+    arrays.emplace_back(a.Get());
+  }
+
+  output->SetExtent(0, img.width - 1, 0, img.height - 1, 0, 0);
+  output->SetSpacing(this->Spacing[0], this->Spacing[1], 1.0);
+  output->SetOrigin(this->Origin);
+  vtkIdType nonFinite = 0;
+  for (auto& a : arrays)
+  {
+    if (std::strcmp(a->GetName(), "elevation") == 0)
+    {
+      float* v = a->GetPointer(0);
+      for (vtkIdType k = 0; k < n; ++k)
+      {
+        v[k] = static_cast<float>(v[k] * this->HeightScale);
+        nonFinite += std::isfinite(v[k]) ? 0 : 1;
+      }
+      output->GetPointData()->SetScalars(a);
+    }
+    else
+    {
+      output->GetPointData()->AddArray(a);
+    }
+  }
+  if (nonFinite > 0)
+  {
+    vtkWarningMacro("EXR Height Field Reader: '" << this->FileName << "' has " << nonFinite
+                                                 << " elevation values that are NaN or infinite"
+                                                    " (no-data cells); simulations will refuse"
+                                                    " them.");
+  }
+  return 1;
+}
+
+void vtkEXRHeightFieldReader::PrintSelf(ostream& os, vtkIndent indent)
+{
+  this->Superclass::PrintSelf(os, indent);
+  os << indent << "FileName: " << (this->FileName ? this->FileName : "(none)") << "\n";
+  os << indent << "Spacing: " << this->Spacing[0] << " " << this->Spacing[1] << "\n";
+  os << indent << "Origin: " << this->Origin[0] << " " << this->Origin[1] << " "
+     << this->Origin[2] << "\n";
+  os << indent << "HeightScale: " << this->HeightScale << "\n";
+}

@@ -1,0 +1,128 @@
+#include "vtkProceduralTerrainSource.h"
+
+#include "vtkFloatArray.h"
+#include "vtkImageData.h"
+#include "vtkInformation.h"
+#include "vtkInformationVector.h"
+#include "vtkNew.h"
+#include "vtkObjectFactory.h"
+#include "vtkPointData.h"
+#include "vtkStreamingDemandDrivenPipeline.h"
+
+#include "graupel/terrain_noise.h"
+
+vtkStandardNewMacro(vtkProceduralTerrainSource);
+
+vtkProceduralTerrainSource::vtkProceduralTerrainSource()
+{
+  this->SetNumberOfInputPorts(0);
+}
+
+int vtkProceduralTerrainSource::RequestInformation(
+  vtkInformation*, vtkInformationVector**, vtkInformationVector* outputVector)
+{
+  vtkInformation* outInfo = outputVector->GetInformationObject(0);
+  if (this->Dimensions[0] < 1 || this->Dimensions[1] < 1 || !(this->Spacing > 0.0))
+  {
+    vtkErrorMacro("Procedural Terrain needs Dimensions of at least 1 x 1 and a Spacing above 0 m;"
+                  " got "
+      << this->Dimensions[0] << " x " << this->Dimensions[1] << " and " << this->Spacing
+      << " m.");
+    return 0;
+  }
+  int extent[6] = { 0, this->Dimensions[0] - 1, 0, this->Dimensions[1] - 1, 0, 0 };
+  double spacing[3] = { this->Spacing, this->Spacing, 1.0 };
+  outInfo->Set(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT(), extent, 6);
+  outInfo->Set(vtkDataObject::SPACING(), spacing, 3);
+  outInfo->Set(vtkDataObject::ORIGIN(), this->Origin, 3);
+  // Noise depends on world position only, so any piece can be computed alone.
+  outInfo->Set(vtkAlgorithm::CAN_PRODUCE_SUB_EXTENT(), 1);
+  vtkDataObject::SetPointDataActiveScalarInfo(outInfo, VTK_FLOAT, 1);
+  return 1;
+}
+
+int vtkProceduralTerrainSource::RequestData(
+  vtkInformation*, vtkInformationVector**, vtkInformationVector* outputVector)
+{
+  vtkInformation* outInfo = outputVector->GetInformationObject(0);
+  vtkImageData* output = vtkImageData::GetData(outInfo);
+  int extent[6];
+  outInfo->Get(vtkStreamingDemandDrivenPipeline::UPDATE_EXTENT(), extent);
+  output->Initialize();
+
+  gr_terrain_noise_params p;
+  gr_terrain_noise_params_init(&p);
+  p.seed = this->Seed;
+  p.type = static_cast<gr_noise_type>(this->NoiseType);
+  p.octaves = this->Octaves;
+  p.frequency = this->Frequency;
+  p.lacunarity = this->Lacunarity;
+  p.persistence = this->Persistence;
+  p.offset = this->Offset;
+  p.gain = this->Gain;
+  p.h = this->SpectralExponent;
+  p.invert = this->Invert ? 1 : 0;
+  p.height_scale = this->HeightScale;
+  char msg[256];
+  if (gr_terrain_noise_params_validate(&p, msg, sizeof(msg)) != GR_OK)
+  {
+    vtkErrorMacro("Procedural Terrain: " << msg);
+    return 0;
+  }
+
+  gr_grid grid = {};
+  grid.nx = extent[1] - extent[0] + 1;
+  grid.ny = extent[3] - extent[2] + 1;
+  grid.dx = grid.dy = this->Spacing;
+  grid.x0 = this->Origin[0];
+  grid.y0 = this->Origin[1];
+  grid.i0 = extent[0];
+  grid.j0 = extent[2];
+  if (grid.nx < 1 || grid.ny < 1)
+  {
+    return 1; // an empty piece (more MPI ranks than rows) is a valid answer
+  }
+
+  gr_context* ctx = this->GetContext();
+  if (!ctx)
+  {
+    return 0;
+  }
+  this->UpdateProgress(0.0);
+  vtkNew<vtkFloatArray> elevation;
+  elevation->SetName("elevation");
+  elevation->SetNumberOfTuples(static_cast<vtkIdType>(grid.nx) * grid.ny);
+  gr_status st = gr_terrain_noise_generate(ctx, &grid, &p, elevation->GetPointer(0));
+  if (st != GR_OK)
+  {
+    return this->ReportFailure(st, "Procedural Terrain could not compute the noise");
+  }
+
+  output->SetExtent(extent[0], extent[1], extent[2], extent[3], 0, 0);
+  output->SetSpacing(this->Spacing, this->Spacing, 1.0);
+  output->SetOrigin(this->Origin);
+  output->GetPointData()->SetScalars(elevation);
+  this->AddDeviceFieldData(output);
+  this->UpdateProgress(1.0);
+  return 1;
+}
+
+void vtkProceduralTerrainSource::PrintSelf(ostream& os, vtkIndent indent)
+{
+  this->Superclass::PrintSelf(os, indent);
+  os << indent << "Dimensions: " << this->Dimensions[0] << " " << this->Dimensions[1] << "\n";
+  os << indent << "Spacing: " << this->Spacing << "\n";
+  os << indent << "Origin: " << this->Origin[0] << " " << this->Origin[1] << " "
+     << this->Origin[2] << "\n";
+  os << indent << "Seed: " << this->Seed << "\n";
+  os << indent << "NoiseType: " << this->NoiseType << "\n";
+  os << indent << "Octaves: " << this->Octaves << "\n";
+  os << indent << "Frequency: " << this->Frequency << "\n";
+  os << indent << "Lacunarity: " << this->Lacunarity << "\n";
+  os << indent << "Persistence: " << this->Persistence << "\n";
+  os << indent << "Offset: " << this->Offset << "\n";
+  os << indent << "Gain: " << this->Gain << "\n";
+  os << indent << "SpectralExponent: " << this->SpectralExponent << "\n";
+  os << indent << "Invert: " << this->Invert << "\n";
+  os << indent << "HeightScale: " << this->HeightScale << "\n";
+}

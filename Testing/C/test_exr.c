@@ -1,0 +1,1200 @@
+/* EXR I/O tests: FLOAT and HALF round trips in odd sizes, row orientation
+ * (row 0 south in memory, north first in the file), tiled and offset inputs
+ * written with OpenEXR's C API, hostile and broken files, and argument
+ * errors. Every failure must be a sentence naming the file, and must leave
+ * the output image untouched.
+ *
+ * Usage: test_exr SCRATCH_DIR   (an existing, writable directory) */
+#include "gr_test.h"
+#include "graupel/exr_io.h"
+
+#include <openexr.h>
+
+#include <math.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+static const char *g_dir = ".";
+
+/* ------------------------------------------------------------------------ */
+/* Small helpers                                                            */
+/* ------------------------------------------------------------------------ */
+
+static void scratch_path(char *buf, size_t len, const char *name) {
+  snprintf(buf, len, "%s/%s", g_dir, name);
+}
+
+/* A sentence: starts with a capital letter, ends with a period, names the
+ * file. */
+static int is_sentence_with(const char *s, const char *path) {
+  size_t n = strlen(s);
+  return n > 10 && s[0] >= 'A' && s[0] <= 'Z' && s[n - 1] == '.' &&
+         (path == NULL || strstr(s, path) != NULL);
+}
+
+static unsigned char *load_bytes(const char *path, size_t *n) {
+  FILE *f = fopen(path, "rb");
+  unsigned char *buf = NULL;
+  long sz;
+  *n = 0;
+  if (f == NULL)
+    return NULL;
+  if (fseek(f, 0, SEEK_END) == 0 && (sz = ftell(f)) > 0 &&
+      fseek(f, 0, SEEK_SET) == 0) {
+    buf = (unsigned char *)malloc((size_t)sz);
+    if (buf != NULL && fread(buf, 1, (size_t)sz, f) == (size_t)sz) {
+      *n = (size_t)sz;
+    } else {
+      free(buf);
+      buf = NULL;
+    }
+  }
+  fclose(f);
+  return buf;
+}
+
+static int save_bytes(const char *path, const void *buf, size_t n) {
+  FILE *f = fopen(path, "wb");
+  int ok;
+  if (f == NULL)
+    return 0;
+  ok = n == 0 || fwrite(buf, 1, n, f) == n;
+  ok = (fclose(f) == 0) && ok;
+  return ok;
+}
+
+static int file_exists(const char *path) {
+  FILE *f = fopen(path, "rb");
+  if (f == NULL)
+    return 0;
+  fclose(f);
+  return 1;
+}
+
+static uint32_t lcg(uint32_t *s) {
+  *s = *s * 1664525u + 1013904223u;
+  return *s >> 8;
+}
+
+/* Reference float -> half, round to nearest even (independent of OpenEXR). */
+static uint16_t ref_f2h(float f) {
+  uint32_t x, ax, mant, h, rem;
+  uint16_t sign;
+  memcpy(&x, &f, sizeof x);
+  sign = (uint16_t)((x >> 16) & 0x8000u);
+  ax = x & 0x7fffffffu;
+  if (ax >= 0x7f800000u)
+    return (uint16_t)(sign | (ax > 0x7f800000u ? 0x7e00u : 0x7c00u));
+  if (ax >= 0x477ff000u) /* >= 65520 rounds to infinity */
+    return (uint16_t)(sign | 0x7c00u);
+  if (ax < 0x38800000u) { /* below 2^-14: subnormal half or zero */
+    double q = rint(fabs((double)f) * 16777216.0); /* units of 2^-24 */
+    return (uint16_t)(sign | (uint16_t)q);
+  }
+  mant = ax & 0x7fffffu;
+  h = ((((ax >> 23) - 127u + 15u)) << 10) | (mant >> 13);
+  rem = mant & 0x1fffu;
+  if (rem > 0x1000u || (rem == 0x1000u && (h & 1u)))
+    ++h;
+  return (uint16_t)(sign | h);
+}
+
+static float ref_h2f(uint16_t h) {
+  int e = (h >> 10) & 31, m = h & 1023;
+  double v;
+  if (e == 0)
+    v = ldexp((double)m, -24);
+  else if (e == 31)
+    v = m ? NAN : INFINITY;
+  else
+    v = ldexp((double)(1024 + m), e - 25);
+  return (float)((h & 0x8000u) ? -v : v);
+}
+
+static float to_half_precision(float f) { return ref_h2f(ref_f2h(f)); }
+
+static int same_bits(float a, float b) { return memcmp(&a, &b, sizeof a) == 0; }
+
+/* A sentinel image: a failed read must leave it exactly as it was. */
+static void sentinel(gr_exr_image *img) {
+  memset(img, 0, sizeof *img);
+  img->width = -7;
+  img->height = -9;
+  img->nchannels = 12345;
+}
+
+static int is_sentinel(const gr_exr_image *img) {
+  return img->width == -7 && img->height == -9 && img->nchannels == 12345 &&
+         img->names == NULL && img->types == NULL && img->data == NULL;
+}
+
+/* ------------------------------------------------------------------------ */
+/* Writing and reading with OpenEXR's C API directly                        */
+/* ------------------------------------------------------------------------ */
+
+static void quiet_handler(exr_const_context_t ctxt, exr_result_t code,
+                          const char *msg) {
+  (void)ctxt;
+  (void)code;
+  (void)msg;
+}
+
+/* Value of channel c at absolute file pixel (x, y) on mip level lvl. */
+static float capi_value(int c, int x, int y, int lvl) {
+  if (lvl > 0)
+    return -1000.0f - (float)lvl;
+  return (float)(c * 10000 + y * 100 + x) + 0.25f;
+}
+
+typedef struct capi_spec {
+  exr_storage_t storage;
+  exr_attr_box2i_t dw;
+  exr_lineorder_t lineorder;
+  exr_compression_t compression;
+  uint32_t tile_w, tile_h;
+  exr_tile_level_mode_t levels;
+  int nchannels;
+  const char *names[4];
+  exr_pixel_type_t types[4];
+  int xsamp; /* sampling of every channel (1 normally) */
+} capi_spec;
+
+static capi_spec capi_default(void) {
+  capi_spec s;
+  memset(&s, 0, sizeof s);
+  s.storage = EXR_STORAGE_SCANLINE;
+  s.dw.min.x = 0;
+  s.dw.min.y = 0;
+  s.dw.max.x = 7;
+  s.dw.max.y = 5;
+  s.lineorder = EXR_LINEORDER_INCREASING_Y;
+  s.compression = EXR_COMPRESSION_ZIP;
+  s.tile_w = 16;
+  s.tile_h = 8;
+  s.levels = EXR_TILE_ONE_LEVEL;
+  s.nchannels = 1;
+  s.names[0] = "h";
+  s.types[0] = EXR_PIXEL_FLOAT;
+  s.xsamp = 1;
+  return s;
+}
+
+/* Fills and encodes one chunk whose first pixel is (x0, y0) of level lvl. */
+static exr_result_t capi_encode_chunk(exr_context_t ctxt,
+                                      const exr_chunk_info_t *ci,
+                                      exr_encode_pipeline_t *enc, int *live,
+                                      const capi_spec *s, int x0, int y0,
+                                      int lvl, unsigned char *buf) {
+  exr_result_t rv;
+  int c, i, j;
+  size_t plane = (size_t)ci->width * (size_t)ci->height * 4u;
+  if (!*live) {
+    rv = exr_encoding_initialize(ctxt, 0, ci, enc);
+    if (rv != EXR_ERR_SUCCESS)
+      return rv;
+    *live = 1;
+  } else {
+    rv = exr_encoding_update(ctxt, 0, ci, enc);
+    if (rv != EXR_ERR_SUCCESS)
+      return rv;
+  }
+  for (c = 0; c < enc->channel_count; ++c) {
+    exr_coding_channel_info_t *ch = &enc->channels[c];
+    int k;
+    unsigned char *dst = buf + (size_t)c * plane;
+    for (k = 0; k < s->nchannels; ++k)
+      if (strcmp(s->names[k], ch->channel_name) == 0)
+        break;
+    for (j = 0; j < ch->height; ++j) {
+      for (i = 0; i < ch->width; ++i) {
+        float v = capi_value(k, x0 + i * s->xsamp, y0 + j * s->xsamp, lvl);
+        if (s->types[k] == EXR_PIXEL_UINT) {
+          uint32_t u = (uint32_t)(v < 0 ? 0 : v);
+          memcpy(dst + ((size_t)j * (size_t)ch->width + (size_t)i) * 4u, &u, 4);
+        } else {
+          memcpy(dst + ((size_t)j * (size_t)ch->width + (size_t)i) * 4u, &v, 4);
+        }
+      }
+    }
+    ch->encode_from_ptr = dst;
+    ch->user_pixel_stride = 4;
+    ch->user_line_stride = ch->width * 4;
+    ch->user_bytes_per_element = 4;
+    ch->user_data_type =
+        s->types[k] == EXR_PIXEL_UINT ? EXR_PIXEL_UINT : EXR_PIXEL_FLOAT;
+  }
+  rv = exr_encoding_choose_default_routines(ctxt, 0, enc);
+  if (rv == EXR_ERR_SUCCESS)
+    rv = exr_encoding_run(ctxt, 0, enc);
+  return rv;
+}
+
+/* Writes a file described by s; returns 1 on success. */
+static int capi_write(const char *path, const capi_spec *s) {
+  exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
+  exr_context_t ctxt = NULL;
+  exr_encode_pipeline_t enc;
+  exr_result_t rv;
+  int live = 0, part = 0, c;
+  int w = s->dw.max.x - s->dw.min.x + 1, h = s->dw.max.y - s->dw.min.y + 1;
+  unsigned char *buf = NULL;
+  memset(&enc, 0, sizeof enc);
+  init.error_handler_fn = &quiet_handler;
+  rv = exr_start_write(&ctxt, path, EXR_WRITE_FILE_DIRECTLY, &init);
+  if (rv == EXR_ERR_SUCCESS)
+    rv = exr_add_part(ctxt, NULL, s->storage, &part);
+  if (rv == EXR_ERR_SUCCESS)
+    rv = exr_initialize_required_attr_simple(ctxt, part, w, h, s->compression);
+  if (rv == EXR_ERR_SUCCESS)
+    rv = exr_set_data_window(ctxt, part, &s->dw);
+  if (rv == EXR_ERR_SUCCESS)
+    rv = exr_set_display_window(ctxt, part, &s->dw);
+  if (rv == EXR_ERR_SUCCESS)
+    rv = exr_set_lineorder(ctxt, part, s->lineorder);
+  if (rv == EXR_ERR_SUCCESS && s->storage == EXR_STORAGE_TILED)
+    rv = exr_set_tile_descriptor(ctxt, part, s->tile_w, s->tile_h, s->levels,
+                                 EXR_TILE_ROUND_DOWN);
+  for (c = 0; c < s->nchannels && rv == EXR_ERR_SUCCESS; ++c)
+    rv = exr_add_channel(ctxt, part, s->names[c], s->types[c],
+                         EXR_PERCEPTUALLY_LINEAR, s->xsamp, s->xsamp);
+  if (rv == EXR_ERR_SUCCESS)
+    rv = exr_write_header(ctxt);
+  if (rv == EXR_ERR_SUCCESS) {
+    size_t cap = (size_t)(w + 64) * (size_t)(h + 64) * 4u * 4u;
+    buf = (unsigned char *)malloc(cap);
+    if (buf == NULL)
+      rv = EXR_ERR_OUT_OF_MEMORY;
+  }
+  if (rv == EXR_ERR_SUCCESS && s->storage == EXR_STORAGE_SCANLINE) {
+    int32_t lines = 1, nchunks, k;
+    rv = exr_get_scanlines_per_chunk(ctxt, part, &lines);
+    nchunks = (h + lines - 1) / lines;
+    for (k = 0; k < nchunks && rv == EXR_ERR_SUCCESS; ++k) {
+      exr_chunk_info_t ci;
+      int y = s->dw.min.y + k * lines;
+      rv = exr_write_scanline_chunk_info(ctxt, part, y, &ci);
+      if (rv == EXR_ERR_SUCCESS)
+        rv = capi_encode_chunk(ctxt, &ci, &enc, &live, s, s->dw.min.x, y, 0,
+                               buf);
+    }
+  } else if (rv == EXR_ERR_SUCCESS) {
+    int32_t nlx = 1, nly = 1, lvl;
+    rv = exr_get_tile_levels(ctxt, part, &nlx, &nly);
+    for (lvl = 0; lvl < nlx && rv == EXR_ERR_SUCCESS; ++lvl) {
+      int32_t lw = 0, lh = 0, tx, ty, ntx, nty;
+      rv = exr_get_level_sizes(ctxt, part, lvl, lvl, &lw, &lh);
+      ntx = (lw + (int32_t)s->tile_w - 1) / (int32_t)s->tile_w;
+      nty = (lh + (int32_t)s->tile_h - 1) / (int32_t)s->tile_h;
+      for (ty = 0; ty < nty && rv == EXR_ERR_SUCCESS; ++ty) {
+        for (tx = 0; tx < ntx && rv == EXR_ERR_SUCCESS; ++tx) {
+          exr_chunk_info_t ci;
+          rv = exr_write_tile_chunk_info(ctxt, part, tx, ty, lvl, lvl, &ci);
+          if (rv == EXR_ERR_SUCCESS)
+            rv = capi_encode_chunk(ctxt, &ci, &enc, &live, s,
+                                   s->dw.min.x + tx * (int)s->tile_w,
+                                   s->dw.min.y + ty * (int)s->tile_h, lvl, buf);
+        }
+      }
+    }
+  }
+  if (live)
+    exr_encoding_destroy(ctxt, &enc);
+  if (ctxt != NULL) {
+    exr_result_t frv = exr_finish(&ctxt);
+    if (rv == EXR_ERR_SUCCESS)
+      rv = frv;
+  }
+  free(buf);
+  if (rv != EXR_ERR_SUCCESS)
+    fprintf(stderr, "capi_write(%s): %s\n", path,
+            exr_get_default_error_message(rv));
+  return rv == EXR_ERR_SUCCESS;
+}
+
+/* Decodes channel 0 of the file's first scanline chunk, the first scanline
+ * stored in the file, into row[0..w). Returns the data window width, or -1. */
+static int capi_first_scanline(const char *path, float *row, int maxw) {
+  exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
+  exr_context_t ctxt = NULL;
+  exr_decode_pipeline_t dec;
+  exr_attr_box2i_t dw;
+  exr_chunk_info_t ci;
+  exr_result_t rv;
+  int live = 0, w = -1, c;
+  float *buf = NULL;
+  memset(&dec, 0, sizeof dec);
+  init.error_handler_fn = &quiet_handler;
+  rv = exr_start_read(&ctxt, path, &init);
+  if (rv == EXR_ERR_SUCCESS)
+    rv = exr_get_data_window(ctxt, 0, &dw);
+  if (rv == EXR_ERR_SUCCESS)
+    rv = exr_read_scanline_chunk_info(ctxt, 0, dw.min.y, &ci);
+  if (rv == EXR_ERR_SUCCESS)
+    rv = exr_decoding_initialize(ctxt, 0, &ci, &dec);
+  if (rv == EXR_ERR_SUCCESS) {
+    live = 1;
+    w = ci.width;
+    buf = (float *)calloc((size_t)ci.width * (size_t)ci.height, sizeof(float));
+    if (buf == NULL || w > maxw)
+      rv = EXR_ERR_OUT_OF_MEMORY;
+  }
+  for (c = 0; c < dec.channel_count && rv == EXR_ERR_SUCCESS; ++c) {
+    exr_coding_channel_info_t *ch = &dec.channels[c];
+    ch->decode_to_ptr = c == 0 ? (uint8_t *)buf : NULL;
+    ch->user_pixel_stride = 4;
+    ch->user_line_stride = ci.width * 4;
+    ch->user_bytes_per_element = 4;
+    ch->user_data_type = EXR_PIXEL_FLOAT;
+  }
+  if (rv == EXR_ERR_SUCCESS)
+    rv = exr_decoding_choose_default_routines(ctxt, 0, &dec);
+  if (rv == EXR_ERR_SUCCESS)
+    rv = exr_decoding_run(ctxt, 0, &dec);
+  if (rv == EXR_ERR_SUCCESS)
+    memcpy(row, buf, (size_t)w * sizeof(float));
+  if (live)
+    exr_decoding_destroy(ctxt, &dec);
+  if (ctxt != NULL)
+    exr_finish(&ctxt);
+  free(buf);
+  return rv == EXR_ERR_SUCCESS ? w : -1;
+}
+
+/* Offset of the first byte after the header's attribute list (the start of
+ * the chunk offset table) in a single-part file, or 0. */
+static size_t header_end(const unsigned char *b, size_t n) {
+  size_t p = 8;
+  while (p < n) {
+    size_t name = p, type;
+    uint32_t sz;
+    while (p < n && b[p] != 0)
+      ++p;
+    if (p >= n)
+      return 0;
+    if (p == name)
+      return p + 1;
+    type = ++p;
+    while (p < n && b[p] != 0)
+      ++p;
+    if (p >= n || p == type || p + 5 > n)
+      return 0;
+    ++p;
+    sz = (uint32_t)b[p] | ((uint32_t)b[p + 1] << 8) |
+         ((uint32_t)b[p + 2] << 16) | ((uint32_t)b[p + 3] << 24);
+    p += 4 + (size_t)sz;
+  }
+  return 0;
+}
+
+static size_t find_bytes(const unsigned char *b, size_t n, const void *pat,
+                         size_t m) {
+  size_t i;
+  for (i = 0; i + m <= n; ++i)
+    if (memcmp(b + i, pat, m) == 0)
+      return i;
+  return (size_t)-1;
+}
+
+static void put_i32(unsigned char *p, int32_t v) {
+  uint32_t u = (uint32_t)v;
+  p[0] = (unsigned char)(u & 0xff);
+  p[1] = (unsigned char)((u >> 8) & 0xff);
+  p[2] = (unsigned char)((u >> 16) & 0xff);
+  p[3] = (unsigned char)((u >> 24) & 0xff);
+}
+
+/* Reads path expecting a failure: GR_ERR_FORMAT or GR_ERR_IO, the output
+ * untouched, and a sentence naming the file. */
+static void expect_bad(const char *path, const char *what) {
+  gr_exr_image img;
+  char err[1024];
+  gr_status st;
+  sentinel(&img);
+  err[0] = '\0';
+  st = gr_exr_read(path, &img, err, sizeof err);
+  CHECK_MSG(st == GR_ERR_FORMAT || st == GR_ERR_IO, "%s: status %s (%d)", what,
+            gr_status_string(st), (int)st);
+  CHECK_MSG(is_sentinel(&img), "%s: output was modified", what);
+  CHECK_MSG(is_sentence_with(err, path), "%s: error '%s'", what, err);
+  if (st == GR_OK)
+    gr_exr_image_free(&img);
+}
+
+/* ------------------------------------------------------------------------ */
+/* Round trips                                                              */
+/* ------------------------------------------------------------------------ */
+
+static float field_value(int c, int i, int j, int w, int h) {
+  switch (c) {
+  case 0: /* smooth terrain-like, many magnitudes */
+    return (float)(sin(0.37 * i + 1.3 * j) * 1234.5 + 0.001 * (i * h + j));
+  case 1: /* exactly representable in half: multiples of 1/4 below 512 */
+    return (float)((i * 7 + j * 3) % 2048) * 0.25f - 100.0f;
+  case 2: /* row index: orientation */
+    (void)w;
+    return (float)j;
+  default: /* tiny (half subnormal) to large values, both signs */
+    return (float)(ldexp(1.0 + 0.01 * (i % 100), (j % 30) - 20) *
+                   ((i + j) % 2 ? -1 : 1));
+  }
+}
+
+static void test_roundtrip(int w, int h, int nch, gr_exr_pixel_type type) {
+  static const char *all_names[4] = {"elevation", "snow_depth", "row", "Z"};
+  const char *names[4];
+  float *data[4] = {NULL, NULL, NULL, NULL};
+  char path[1024], fname[128], err[1024];
+  gr_exr_image img;
+  gr_status st;
+  int c, i, j, bad = 0;
+
+  snprintf(fname, sizeof fname, "rt_%dx%d_%d_%s.exr", w, h, nch,
+           type == GR_EXR_HALF ? "half" : "float");
+  scratch_path(path, sizeof path, fname);
+  /* One channel: the orientation channel, so every size checks it. */
+  for (c = 0; c < nch; ++c) {
+    int f = nch == 1 ? 2 : c;
+    names[c] = all_names[f];
+    data[c] = (float *)malloc((size_t)w * (size_t)h * sizeof(float));
+    if (data[c] == NULL) {
+      CHECK(!"out of memory");
+      goto done;
+    }
+    for (j = 0; j < h; ++j)
+      for (i = 0; i < w; ++i)
+        data[c][(size_t)j * w + i] = field_value(f, i, j, w, h);
+  }
+  err[0] = '\0';
+  st = gr_exr_write(path, w, h, nch, names, (const float *const *)data, type,
+                    err, sizeof err);
+  CHECK_MSG(st == GR_OK, "write %s: %s", fname, err);
+  memset(&img, 0, sizeof img);
+  st = gr_exr_read(path, &img, err, sizeof err);
+  CHECK_MSG(st == GR_OK, "read %s: %s", fname, err);
+  if (st != GR_OK)
+    goto done;
+  CHECK(img.width == w && img.height == h && img.nchannels == nch);
+  for (c = 0; c < nch && img.nchannels == nch; ++c) {
+    int k = gr_exr_find_channel(&img, names[c]);
+    int f = nch == 1 ? 2 : c;
+    CHECK_MSG(k >= 0, "%s: channel '%s' missing", fname, names[c]);
+    if (k < 0)
+      continue;
+    CHECK(img.types[k] == type);
+    for (j = 0; j < h; ++j) {
+      for (i = 0; i < w; ++i) {
+        float v = data[c][(size_t)j * w + i];
+        float got = img.data[k][(size_t)j * w + i];
+        int ok;
+        if (type == GR_EXR_FLOAT) {
+          ok = same_bits(got, v);
+        } else {
+          float ref = to_half_precision(v);
+          double tol = fabs(v) >= 6.103515625e-05 ? fabs(v) * ldexp(1, -11)
+                                                  : ldexp(1, -25);
+          ok = same_bits(got, ref) && fabs((double)got - v) <= tol;
+          if (f == 1 || f == 2) /* exactly representable in half */
+            ok = ok && got == v;
+        }
+        if (!ok && bad++ < 5)
+          CHECK_MSG(0, "%s: channel %s (%d,%d): wrote %.9g, read %.9g", fname,
+                    names[c], i, j, v, got);
+      }
+    }
+    if (f == 2) { /* orientation: memory row 0 is south, value 0 */
+      CHECK(img.data[k][0] == 0.0f);
+      CHECK(img.data[k][(size_t)(h - 1) * w] == (float)(h - 1));
+    }
+  }
+  CHECK_MSG(bad == 0, "%s: %d values differ", fname, bad);
+  gr_exr_image_free(&img);
+  CHECK(img.data == NULL && img.names == NULL && img.nchannels == 0);
+done:
+  for (c = 0; c < nch; ++c)
+    free(data[c]);
+}
+
+static void test_roundtrips(void) {
+  static const int sizes[][2] = {{1, 1},     {3, 5},  {37, 19},
+                                 {257, 129}, {1, 40}, {40, 1}};
+  size_t s;
+  int nch;
+  for (s = 0; s < sizeof sizes / sizeof sizes[0]; ++s)
+    for (nch = 1; nch <= 4; nch += 3) {
+      test_roundtrip(sizes[s][0], sizes[s][1], nch, GR_EXR_FLOAT);
+      test_roundtrip(sizes[s][0], sizes[s][1], nch, GR_EXR_HALF);
+    }
+}
+
+/* The file's first scanline is the northern edge (highest j). */
+static void test_file_orientation(void) {
+  enum { H = 21 };
+  float col[H], row[4];
+  const char *names[1] = {"elevation"};
+  const float *data[1] = {col};
+  char path[1024], err[512];
+  gr_exr_image img;
+  int j, w;
+  gr_exr_pixel_type t;
+  for (j = 0; j < H; ++j)
+    col[j] = (float)j;
+  for (t = GR_EXR_HALF; t <= GR_EXR_FLOAT; t = (gr_exr_pixel_type)(t + 1)) {
+    scratch_path(path, sizeof path, "column.exr");
+    CHECK(gr_exr_write(path, 1, H, 1, names, data, t, err, sizeof err) ==
+          GR_OK);
+    row[0] = -1.0f;
+    w = capi_first_scanline(path, row, 4);
+    CHECK(w == 1);
+    CHECK_NEAR(row[0], H - 1, 0.0);
+    memset(&img, 0, sizeof img);
+    CHECK(gr_exr_read(path, &img, err, sizeof err) == GR_OK);
+    if (img.data != NULL) {
+      for (j = 0; j < H; ++j)
+        CHECK_NEAR(img.data[0][j], j, 0.0);
+    }
+    gr_exr_image_free(&img);
+  }
+}
+
+/* Half rounding: ties to even, overflow to infinity, subnormals, NaN. */
+static void test_half_rounding(void) {
+  static const float in[] = {
+      1.0f + 0x1p-11f,        /* tie -> 1 */
+      1.0f + 3.0f * 0x1p-11f, /* tie -> 1 + 2^-9 */
+      2049.0f,                /* tie -> 2048 */
+      2051.0f,                /* tie -> 2052 */
+      65504.0f,               /* largest half */
+      65519.0f,               /* -> 65504 */
+      65520.0f,               /* -> inf */
+      1.0e6f,                 /* -> inf */
+      -1.0e6f,                /* -> -inf */
+      0x1p-24f,               /* smallest subnormal */
+      0x1p-25f,               /* tie -> 0 */
+      3.0f * 0x1p-25f,        /* tie -> 2^-23 */
+      0x1p-14f,               /* smallest normal */
+      -0.0f,
+      0.1f,
+      -3.14159265f,
+  };
+  enum { N = sizeof in / sizeof in[0] };
+  float expect[N];
+  const char *names[1] = {"v"};
+  const float *data[1] = {in};
+  char path[1024], err[512];
+  gr_exr_image img;
+  int k;
+  expect[0] = 1.0f;
+  expect[1] = 1.0f + 0x1p-9f;
+  expect[2] = 2048.0f;
+  expect[3] = 2052.0f;
+  expect[4] = 65504.0f;
+  expect[5] = 65504.0f;
+  expect[6] = INFINITY;
+  expect[7] = INFINITY;
+  expect[8] = -INFINITY;
+  expect[9] = 0x1p-24f;
+  expect[10] = 0.0f;
+  expect[11] = 0x1p-23f;
+  expect[12] = 0x1p-14f;
+  expect[13] = -0.0f;
+  expect[14] = 0.0999755859375f;
+  expect[15] = -3.140625f;
+  scratch_path(path, sizeof path, "half_rounding.exr");
+  CHECK(gr_exr_write(path, N, 1, 1, names, data, GR_EXR_HALF, err,
+                     sizeof err) == GR_OK);
+  memset(&img, 0, sizeof img);
+  CHECK_MSG(gr_exr_read(path, &img, err, sizeof err) == GR_OK, "%s", err);
+  if (img.data != NULL && img.width == N) {
+    for (k = 0; k < N; ++k) {
+      CHECK_MSG(same_bits(img.data[0][k], expect[k]),
+                "half of %.9g: got %.9g, want %.9g", in[k], img.data[0][k],
+                expect[k]);
+      CHECK(same_bits(expect[k], to_half_precision(in[k])));
+    }
+  }
+  gr_exr_image_free(&img);
+
+  /* FLOAT keeps special values bit for bit. */
+  {
+    float sp[6];
+    sp[0] = NAN;
+    sp[1] = INFINITY;
+    sp[2] = -INFINITY;
+    sp[3] = -0.0f;
+    sp[4] = 1e-40f; /* subnormal float */
+    sp[5] = 3.4028235e38f;
+    data[0] = sp;
+    scratch_path(path, sizeof path, "float_special.exr");
+    CHECK(gr_exr_write(path, 6, 1, 1, names, data, GR_EXR_FLOAT, err,
+                       sizeof err) == GR_OK);
+    memset(&img, 0, sizeof img);
+    CHECK(gr_exr_read(path, &img, err, sizeof err) == GR_OK);
+    if (img.data != NULL && img.width == 6) {
+      CHECK(isnan(img.data[0][0]));
+      for (k = 1; k < 6; ++k)
+        CHECK(same_bits(img.data[0][k], sp[k]));
+    }
+    gr_exr_image_free(&img);
+    /* HALF keeps NaN a NaN. */
+    CHECK(gr_exr_write(path, 6, 1, 1, names, data, GR_EXR_HALF, err,
+                       sizeof err) == GR_OK);
+    memset(&img, 0, sizeof img);
+    CHECK(gr_exr_read(path, &img, err, sizeof err) == GR_OK);
+    if (img.data != NULL && img.width == 6) {
+      CHECK(isnan(img.data[0][0]));
+      CHECK(img.data[0][1] == INFINITY && img.data[0][2] == -INFINITY);
+      CHECK(same_bits(img.data[0][4], 0.0f));
+      CHECK(img.data[0][5] == INFINITY);
+    }
+    gr_exr_image_free(&img);
+  }
+}
+
+/* A chunk whose ZIP data is exactly as long as its raw data must be stored
+ * raw: the reader takes packed size == unpacked size for "not compressed".
+ * OpenEXRCore 3.1 writes the compressed bytes in that case; gr_exr_write must
+ * not. A 1x40 FLOAT column of 0..39 hits it: its last chunk is 8 rows, 32
+ * bytes raw, and zlib makes 32 bytes of it. */
+static void test_equal_size_chunk(void) {
+  float col[40];
+  const char *names[1] = {"row"};
+  const float *data[1] = {col};
+  char path[1024], err[512];
+  exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
+  exr_context_t ctxt = NULL;
+  exr_chunk_info_t ci;
+  gr_exr_image img;
+  int j;
+  for (j = 0; j < 40; ++j)
+    col[j] = (float)j;
+  scratch_path(path, sizeof path, "equal_size_chunk.exr");
+  CHECK(gr_exr_write(path, 1, 40, 1, names, data, GR_EXR_FLOAT, err,
+                     sizeof err) == GR_OK);
+  init.error_handler_fn = &quiet_handler;
+  CHECK(exr_start_read(&ctxt, path, &init) == EXR_ERR_SUCCESS);
+  memset(&ci, 0, sizeof ci);
+  CHECK(exr_read_scanline_chunk_info(ctxt, 0, 32, &ci) == EXR_ERR_SUCCESS);
+  CHECK(ci.unpacked_size == 32 && ci.packed_size == 32);
+  exr_finish(&ctxt);
+  memset(&img, 0, sizeof img);
+  CHECK(gr_exr_read(path, &img, err, sizeof err) == GR_OK);
+  if (img.data != NULL && img.height == 40)
+    for (j = 0; j < 40; ++j)
+      CHECK_NEAR(img.data[0][j], j, 0.0);
+  gr_exr_image_free(&img);
+}
+
+/* Long names (over EXR's 31-character short limit) round trip; the order of
+ * channels read is EXR's sorted order. */
+static void test_names_roundtrip(void) {
+  char longname[201];
+  const char *names[3];
+  float a[6] = {1, 2, 3, 4, 5, 6}, b[6] = {7, 8, 9, 10, 11, 12},
+        c[6] = {0, 0, 0, 0, 0, 1};
+  const float *data[3] = {a, b, c};
+  char path[1024], err[512];
+  gr_exr_image img;
+  memset(longname, 'q', 200);
+  longname[200] = '\0';
+  names[0] = "zeta";
+  names[1] = longname;
+  names[2] = "alpha.beta";
+  scratch_path(path, sizeof path, "names.exr");
+  CHECK_MSG(gr_exr_write(path, 3, 2, 3, names, data, GR_EXR_FLOAT, err,
+                         sizeof err) == GR_OK,
+            "%s", err);
+  memset(&img, 0, sizeof img);
+  CHECK_MSG(gr_exr_read(path, &img, err, sizeof err) == GR_OK, "%s", err);
+  CHECK(img.nchannels == 3);
+  if (img.nchannels == 3) {
+    CHECK(strcmp(img.names[0], "alpha.beta") == 0);
+    CHECK(strcmp(img.names[1], longname) == 0);
+    CHECK(strcmp(img.names[2], "zeta") == 0);
+    CHECK(gr_exr_find_channel(&img, "zeta") == 2);
+    CHECK(gr_exr_find_channel(&img, longname) == 1);
+    CHECK(img.data[2][0] == 1.0f && img.data[2][5] == 6.0f);
+    CHECK(img.data[1][4] == 11.0f);
+    CHECK(img.data[0][5] == 1.0f);
+  }
+  gr_exr_image_free(&img);
+}
+
+/* ------------------------------------------------------------------------ */
+/* Inputs written with the C API: tiled, offset data windows, line order    */
+/* ------------------------------------------------------------------------ */
+
+/* Checks img against capi_value over the data window of s. */
+static void check_capi_image(const gr_exr_image *img, const capi_spec *s,
+                             const char *what) {
+  int w = s->dw.max.x - s->dw.min.x + 1, h = s->dw.max.y - s->dw.min.y + 1;
+  int c, i, j, bad = 0;
+  CHECK_MSG(img->width == w && img->height == h, "%s: %dx%d, want %dx%d", what,
+            img->width, img->height, w, h);
+  CHECK_MSG(img->nchannels == s->nchannels, "%s: %d channels", what,
+            img->nchannels);
+  if (img->width != w || img->height != h || img->nchannels != s->nchannels)
+    return;
+  for (c = 0; c < s->nchannels; ++c) {
+    int k = gr_exr_find_channel(img, s->names[c]);
+    CHECK_MSG(k >= 0, "%s: channel %s missing", what, s->names[c]);
+    if (k < 0)
+      continue;
+    CHECK(img->types[k] ==
+          (s->types[c] == EXR_PIXEL_HALF ? GR_EXR_HALF : GR_EXR_FLOAT));
+    for (j = 0; j < h; ++j) {
+      for (i = 0; i < w; ++i) {
+        /* memory row j is file row h-1-j */
+        float want =
+            capi_value(c, s->dw.min.x + i, s->dw.min.y + (h - 1 - j), 0);
+        float got = img->data[k][(size_t)j * w + i];
+        if (s->types[c] == EXR_PIXEL_HALF)
+          want = to_half_precision(want);
+        if (!same_bits(got, want) && bad++ < 5)
+          CHECK_MSG(0, "%s: %s (%d,%d) = %.9g, want %.9g", what, s->names[c], i,
+                    j, got, want);
+      }
+    }
+  }
+  CHECK_MSG(bad == 0, "%s: %d values differ", what, bad);
+}
+
+static void read_capi_case(const capi_spec *s, const char *fname) {
+  char path[1024], err[1024];
+  gr_exr_image img;
+  gr_status st;
+  scratch_path(path, sizeof path, fname);
+  CHECK_MSG(capi_write(path, s), "could not write %s with the C API", fname);
+  memset(&img, 0, sizeof img);
+  err[0] = '\0';
+  st = gr_exr_read(path, &img, err, sizeof err);
+  CHECK_MSG(st == GR_OK, "%s: %s", fname, err);
+  if (st == GR_OK)
+    check_capi_image(&img, s, fname);
+  gr_exr_image_free(&img);
+}
+
+static void test_capi_inputs(void) {
+  capi_spec s;
+
+  /* Tiled FLOAT, 37x19 with 16x8 tiles (partial edge tiles), data window
+   * starting at (3, -5). */
+  s = capi_default();
+  s.storage = EXR_STORAGE_TILED;
+  s.dw.min.x = 3;
+  s.dw.min.y = -5;
+  s.dw.max.x = 3 + 37 - 1;
+  s.dw.max.y = -5 + 19 - 1;
+  s.nchannels = 2;
+  s.names[0] = "height";
+  s.types[0] = EXR_PIXEL_FLOAT;
+  s.names[1] = "b";
+  s.types[1] = EXR_PIXEL_FLOAT;
+  read_capi_case(&s, "tiled_float.exr");
+
+  /* Tiled, one tile larger than the image, uncompressed, HALF + FLOAT. */
+  s.compression = EXR_COMPRESSION_NONE;
+  s.tile_w = 64;
+  s.tile_h = 64;
+  s.types[1] = EXR_PIXEL_HALF;
+  read_capi_case(&s, "tiled_one_tile.exr");
+
+  /* Mipmapped tiled: only level 0 is read. */
+  s = capi_default();
+  s.storage = EXR_STORAGE_TILED;
+  s.dw.max.x = 20;
+  s.dw.max.y = 12;
+  s.tile_w = 8;
+  s.tile_h = 4;
+  s.levels = EXR_TILE_MIPMAP_LEVELS;
+  read_capi_case(&s, "tiled_mipmap.exr");
+
+  /* Scanline, offset data window, decreasing line order, PIZ. */
+  s = capi_default();
+  s.dw.min.x = -10;
+  s.dw.min.y = 100;
+  s.dw.max.x = -10 + 23 - 1;
+  s.dw.max.y = 100 + 45 - 1;
+  s.lineorder = EXR_LINEORDER_DECREASING_Y;
+  s.compression = EXR_COMPRESSION_PIZ;
+  s.nchannels = 2;
+  s.names[0] = "B";
+  s.types[0] = EXR_PIXEL_HALF;
+  s.names[1] = "A";
+  s.types[1] = EXR_PIXEL_FLOAT;
+  read_capi_case(&s, "scan_offset_decreasing.exr");
+
+  /* Scanline, RLE and uncompressed. */
+  s = capi_default();
+  s.dw.max.x = 30;
+  s.dw.max.y = 2;
+  s.compression = EXR_COMPRESSION_RLE;
+  read_capi_case(&s, "scan_rle.exr");
+  s.compression = EXR_COMPRESSION_NONE;
+  read_capi_case(&s, "scan_none.exr");
+}
+
+/* ------------------------------------------------------------------------ */
+/* Broken and hostile files                                                 */
+/* ------------------------------------------------------------------------ */
+
+static void test_bad_files(void) {
+  char path[1024], good[1024], err[1024];
+  unsigned char *bytes = NULL, *copy = NULL;
+  size_t n = 0, k, off;
+  uint32_t seed = 12345u;
+  capi_spec s;
+  gr_exr_image img;
+  gr_status st;
+  int t, bad_trunc = 0;
+  float vals[37 * 19 * 2];
+  const float *data[2] = {vals, vals + 37 * 19};
+  const char *names[2] = {"elevation", "snow_depth"};
+
+  /* Missing file. */
+  scratch_path(path, sizeof path, "does_not_exist.exr");
+  remove(path);
+  expect_bad(path, "missing file");
+  {
+    /* Missing file with no error buffer, and with a zero-length one. */
+    char small[8];
+    sentinel(&img);
+    CHECK(gr_exr_read(path, &img, NULL, 0) == GR_ERR_IO);
+    CHECK(is_sentinel(&img));
+    memcpy(small, "xxxxxxx", 8);
+    CHECK(gr_exr_read(path, &img, small, 0) == GR_ERR_IO);
+    CHECK(memcmp(small, "xxxxxxx", 8) == 0);
+    CHECK(gr_exr_read(path, &img, small, sizeof small) == GR_ERR_IO);
+    CHECK(strlen(small) == sizeof small - 1);
+    CHECK(is_sentinel(&img));
+  }
+  /* A directory. */
+  expect_bad(g_dir, "a directory");
+
+  /* Empty file. */
+  scratch_path(path, sizeof path, "empty.exr");
+  CHECK(save_bytes(path, "", 0));
+  expect_bad(path, "empty file");
+
+  /* A text file. */
+  scratch_path(path, sizeof path, "text.exr");
+  {
+    static const char text[] =
+        "This is not an image.\nIt is a text file pretending to be one.\n";
+    CHECK(save_bytes(path, text, sizeof text - 1));
+  }
+  expect_bad(path, "text file");
+
+  /* A valid file to break. Sine data does not compress much, so most of the
+   * file is pixel data. */
+  for (k = 0; k < 37 * 19 * 2; ++k)
+    vals[k] = (float)sin((double)k * 0.7) * 100.0f;
+  scratch_path(good, sizeof good, "good.exr");
+  CHECK(gr_exr_write(good, 37, 19, 2, names, data, GR_EXR_FLOAT, err,
+                     sizeof err) == GR_OK);
+  bytes = load_bytes(good, &n);
+  CHECK(bytes != NULL && n > 1000);
+  if (bytes == NULL || n <= 1000)
+    goto done;
+  copy = (unsigned char *)malloc(n);
+  if (copy == NULL)
+    goto done;
+
+  /* Truncated at named lengths, then at every length. */
+  scratch_path(path, sizeof path, "truncated.exr");
+  {
+    size_t lens[6];
+    lens[0] = 10;
+    lens[1] = 4;
+    lens[2] = header_end(bytes, n);
+    lens[3] = n / 2;
+    lens[4] = n - 8;
+    lens[5] = n - 1;
+    CHECK(lens[2] > 8 && lens[2] < n);
+    for (t = 0; t < 6; ++t) {
+      char what[64];
+      snprintf(what, sizeof what, "truncated to %zu of %zu bytes", lens[t], n);
+      CHECK(save_bytes(path, bytes, lens[t]));
+      expect_bad(path, what);
+    }
+  }
+  /* Every length through the header and offset table and near the end;
+   * every 7th through the pixel data. */
+  for (k = 0; k < n; ++k) {
+    if (k > header_end(bytes, n) + 64 && k + 64 < n && k % 7 != 0)
+      continue;
+    CHECK(save_bytes(path, bytes, k));
+    sentinel(&img);
+    st = gr_exr_read(path, &img, err, sizeof err);
+    if (st == GR_OK || !is_sentinel(&img)) {
+      if (bad_trunc++ < 5)
+        CHECK_MSG(0, "truncated to %zu of %zu bytes: status %d", k, n, (int)st);
+      if (st == GR_OK)
+        gr_exr_image_free(&img);
+    }
+  }
+  CHECK_MSG(bad_trunc == 0, "%d truncated lengths were accepted", bad_trunc);
+
+  /* Random bytes after a valid magic number (and version). */
+  scratch_path(path, sizeof path, "random.exr");
+  for (t = 0; t < 40; ++t) {
+    size_t len = 16 + (size_t)(lcg(&seed) % 2000u);
+    memcpy(copy, bytes, 8 < n ? 8 : n);
+    for (k = t % 2 ? 8 : 4; k < len && k < n; ++k)
+      copy[k] = (unsigned char)(lcg(&seed) & 0xff);
+    CHECK(save_bytes(path, copy, len < n ? len : n));
+    expect_bad(path, "random bytes after the magic number");
+  }
+
+  /* Random bytes over the pixel data (after the offset table). */
+  off = header_end(bytes, n);
+  if (off > 8) {
+    size_t table_end = off + 8u * (size_t)((19 + 15) / 16);
+    memcpy(copy, bytes, n);
+    for (k = table_end + 8; k < n; ++k)
+      copy[k] = (unsigned char)(lcg(&seed) & 0xff);
+    CHECK(save_bytes(path, copy, n));
+    sentinel(&img);
+    st = gr_exr_read(path, &img, err, sizeof err);
+    /* The first chunk is stored raw (sine data does not compress), so its
+     * noise reads as numbers; the second is ZIP, and noise cannot inflate to
+     * the right size. */
+    CHECK_MSG(st == GR_ERR_FORMAT && is_sentinel(&img) &&
+                  is_sentence_with(err, path),
+              "noise pixels: %d '%s'", (int)st, err);
+    if (st == GR_OK)
+      gr_exr_image_free(&img);
+
+    /* Offset table entries pointing past the end, and into the header. */
+    memcpy(copy, bytes, n);
+    memset(copy + off, 0x7f, 8);
+    CHECK(save_bytes(path, copy, n));
+    expect_bad(path, "chunk offset past the end");
+    memcpy(copy, bytes, n);
+    memset(copy + off, 0, 8);
+    copy[off] = 8;
+    CHECK(save_bytes(path, copy, n));
+    expect_bad(path, "chunk offset into the header");
+  }
+
+  /* Absurd dimensions in the dataWindow attribute. */
+  {
+    static const char tag[] = "dataWindow\0box2i\0";
+    size_t at = find_bytes(bytes, n, tag, sizeof tag - 1);
+    static const int32_t boxes[][4] = {
+        {0, 0, (1 << 30) - 1, 18}, /* 2^30 wide */
+        {0, 0, 36, (1 << 30) - 1}, /* 2^30 tall */
+        {0, 0, 65536, 18},         /* one more than GR_EXR_MAX_DIM */
+        {-(1 << 30), -(1 << 30), (1 << 30), (1 << 30)},
+        {INT32_MIN, 0, INT32_MAX, 18}, /* width overflows int32 */
+        {10, 0, 9, 18},                /* empty */
+        {0, 0, 36, -5},                /* negative height */
+        {0, 0, 36, 20},                /* 2 more rows than the file holds */
+        {0, 0, 65535, 65535},          /* 2^32 samples: over the limit */
+        {0, 0, 65535, 16383},          /* 2^30 samples: allowed, not there */
+    };
+    CHECK(at != (size_t)-1 && at + (sizeof tag - 1) + 4 + 16 <= n);
+    if (at != (size_t)-1 && at + (sizeof tag - 1) + 4 + 16 <= n) {
+      unsigned char *box = copy + at + (sizeof tag - 1) + 4;
+      for (t = 0; t < (int)(sizeof boxes / sizeof boxes[0]); ++t) {
+        char what[96];
+        int q;
+        memcpy(copy, bytes, n);
+        for (q = 0; q < 4; ++q)
+          put_i32(box + 4 * q, boxes[t][q]);
+        CHECK(save_bytes(path, copy, n));
+        snprintf(what, sizeof what, "dataWindow (%d,%d)-(%d,%d)",
+                 (int)boxes[t][0], (int)boxes[t][1], (int)boxes[t][2],
+                 (int)boxes[t][3]);
+        expect_bad(path, what);
+      }
+    }
+  }
+
+  /* Only channel is UINT. */
+  s = capi_default();
+  s.types[0] = EXR_PIXEL_UINT;
+  scratch_path(path, sizeof path, "uint.exr");
+  CHECK(capi_write(path, &s));
+  expect_bad(path, "UINT channel");
+  sentinel(&img);
+  CHECK(gr_exr_read(path, &img, err, sizeof err) == GR_ERR_FORMAT);
+  CHECK_MSG(strstr(err, "UINT") != NULL, "'%s'", err);
+  /* A FLOAT channel beside a UINT one. */
+  s.nchannels = 2;
+  s.names[1] = "g";
+  s.types[1] = EXR_PIXEL_FLOAT;
+  CHECK(capi_write(path, &s));
+  expect_bad(path, "FLOAT and UINT channels");
+  /* Subsampled channel. */
+  s = capi_default();
+  s.dw.max.x = 7;
+  s.dw.max.y = 7;
+  s.xsamp = 2;
+  scratch_path(path, sizeof path, "subsampled.exr");
+  if (capi_write(path, &s)) {
+    expect_bad(path, "subsampled channel");
+  }
+
+done:
+  free(bytes);
+  free(copy);
+}
+
+/* ------------------------------------------------------------------------ */
+/* Writer argument errors                                                   */
+/* ------------------------------------------------------------------------ */
+
+static void expect_write_error(gr_status want, const char *path, int w, int h,
+                               int nch, const char *const *names,
+                               const float *const *data, gr_exr_pixel_type t,
+                               const char *what) {
+  char err[1024];
+  gr_status st;
+  err[0] = '\0';
+  st = gr_exr_write(path, w, h, nch, names, data, t, err, sizeof err);
+  CHECK_MSG(st == want, "%s: status %s, want %s", what, gr_status_string(st),
+            gr_status_string(want));
+  CHECK_MSG(is_sentence_with(err, path != NULL && path[0] ? path : NULL),
+            "%s: error '%s'", what, err);
+}
+
+static void test_write_errors(void) {
+  float v[12] = {0};
+  const float *d2[2] = {v, v};
+  const float *dnull[2] = {v, NULL};
+  const char *ok2[2] = {"a", "b"};
+  const char *dup[2] = {"a", "a"};
+  const char *empty[2] = {"a", ""};
+  const char *nulln[2] = {NULL, "b"};
+  const char *toolong[1];
+  char longname[GR_EXR_MAX_NAME + 2];
+  char path[1024], bad[1024], err[64];
+  const gr_status A = GR_ERR_INVALID_ARGUMENT;
+
+  memset(longname, 'x', sizeof longname - 1);
+  longname[sizeof longname - 1] = '\0';
+  toolong[0] = longname;
+  scratch_path(path, sizeof path, "write_errors.exr");
+  remove(path);
+  expect_write_error(A, path, 3, 2, 2, NULL, d2, GR_EXR_FLOAT, "NULL names");
+  expect_write_error(A, path, 3, 2, 2, ok2, NULL, GR_EXR_FLOAT, "NULL data");
+  expect_write_error(A, path, 3, 2, 2, nulln, d2, GR_EXR_FLOAT, "NULL name");
+  expect_write_error(A, path, 3, 2, 2, empty, d2, GR_EXR_FLOAT, "empty name");
+  expect_write_error(A, path, 3, 2, 2, dup, d2, GR_EXR_HALF, "duplicate name");
+  expect_write_error(A, path, 3, 2, 2, ok2, dnull, GR_EXR_FLOAT, "NULL plane");
+  expect_write_error(A, path, 3, 2, 1, toolong, d2, GR_EXR_FLOAT, "long name");
+  expect_write_error(A, path, 3, 2, 0, ok2, d2, GR_EXR_FLOAT, "0 channels");
+  expect_write_error(A, path, 3, 2, -1, ok2, d2, GR_EXR_FLOAT, "-1 channels");
+  expect_write_error(A, path, 0, 2, 2, ok2, d2, GR_EXR_FLOAT, "width 0");
+  expect_write_error(A, path, 3, 0, 2, ok2, d2, GR_EXR_FLOAT, "height 0");
+  expect_write_error(A, path, -3, 2, 2, ok2, d2, GR_EXR_FLOAT, "width -3");
+  expect_write_error(A, path, GR_EXR_MAX_DIM + 1, 1, 2, ok2, d2, GR_EXR_FLOAT,
+                     "width too large");
+  expect_write_error(A, path, 3, 2, 2, ok2, d2, (gr_exr_pixel_type)7,
+                     "pixel type 7");
+  expect_write_error(A, NULL, 3, 2, 2, ok2, d2, GR_EXR_FLOAT, "NULL path");
+  expect_write_error(A, "", 3, 2, 2, ok2, d2, GR_EXR_FLOAT, "empty path");
+  CHECK(!file_exists(path));
+
+  /* A directory that does not exist. */
+  scratch_path(bad, sizeof bad, "no_such_dir/sub/x.exr");
+  expect_write_error(GR_ERR_IO, bad, 3, 2, 2, ok2, d2, GR_EXR_FLOAT,
+                     "unwritable path");
+  CHECK(!file_exists(bad));
+  /* A directory in place of the file. */
+  expect_write_error(GR_ERR_IO, g_dir, 3, 2, 2, ok2, d2, GR_EXR_FLOAT,
+                     "directory as path");
+
+  /* NULL and short error buffers are fine. */
+  CHECK(gr_exr_write(path, 0, 2, 2, ok2, d2, GR_EXR_FLOAT, NULL, 0) == A);
+  CHECK(gr_exr_write(path, 0, 2, 2, ok2, d2, GR_EXR_FLOAT, err, sizeof err) ==
+        A);
+  CHECK(strlen(err) < sizeof err);
+
+  /* Read argument errors. */
+  {
+    gr_exr_image img;
+    char e2[256];
+    sentinel(&img);
+    CHECK(gr_exr_read(NULL, &img, e2, sizeof e2) == A);
+    CHECK(is_sentence_with(e2, NULL));
+    CHECK(gr_exr_read("", &img, e2, sizeof e2) == A);
+    CHECK(is_sentinel(&img));
+    CHECK(gr_exr_read(path, NULL, e2, sizeof e2) == A);
+  }
+}
+
+/* ------------------------------------------------------------------------ */
+/* gr_exr_find_channel and gr_exr_image_free                                */
+/* ------------------------------------------------------------------------ */
+
+static void test_helpers(void) {
+  gr_exr_image img;
+  char n0[] = "elevation", n1[] = "snow_depth";
+  char *names[2];
+  names[0] = n0;
+  names[1] = n1;
+  memset(&img, 0, sizeof img);
+  CHECK(gr_exr_find_channel(&img, "elevation") == -1);
+  CHECK(gr_exr_find_channel(NULL, "elevation") == -1);
+  gr_exr_image_free(&img);
+  gr_exr_image_free(&img);
+  gr_exr_image_free(NULL);
+  CHECK(img.width == 0 && img.data == NULL);
+
+  img.nchannels = 2;
+  img.names = names;
+  CHECK(gr_exr_find_channel(&img, "elevation") == 0);
+  CHECK(gr_exr_find_channel(&img, "snow_depth") == 1);
+  CHECK(gr_exr_find_channel(&img, "snow") == -1);
+  CHECK(gr_exr_find_channel(&img, "") == -1);
+  CHECK(gr_exr_find_channel(&img, NULL) == -1);
+
+  /* A real image, freed twice. */
+  {
+    float v[2] = {1.5f, -2.5f};
+    const float *data[1] = {v};
+    const char *wn[1] = {"x"};
+    char path[1024], err[256];
+    gr_exr_image r;
+    scratch_path(path, sizeof path, "helpers.exr");
+    CHECK(gr_exr_write(path, 2, 1, 1, wn, data, GR_EXR_FLOAT, err,
+                       sizeof err) == GR_OK);
+    memset(&r, 0, sizeof r);
+    CHECK(gr_exr_read(path, &r, err, sizeof err) == GR_OK);
+    CHECK(gr_exr_find_channel(&r, "x") == 0);
+    CHECK(gr_exr_find_channel(&r, "y") == -1);
+    gr_exr_image_free(&r);
+    CHECK(r.width == 0 && r.height == 0 && r.nchannels == 0 &&
+          r.names == NULL && r.types == NULL && r.data == NULL);
+    gr_exr_image_free(&r);
+  }
+}
+
+int main(int argc, char **argv) {
+  char probe[1024];
+  if (argc != 2) {
+    fprintf(stderr, "usage: %s SCRATCH_DIR\n", argv[0]);
+    return 2;
+  }
+  g_dir = argv[1];
+  scratch_path(probe, sizeof probe, "probe.tmp");
+  if (!save_bytes(probe, "x", 1)) {
+    fprintf(stderr, "cannot write into the scratch directory '%s'\n", g_dir);
+    return 2;
+  }
+  remove(probe);
+
+  test_roundtrips();
+  test_file_orientation();
+  test_half_rounding();
+  test_equal_size_chunk();
+  test_names_roundtrip();
+  test_capi_inputs();
+  test_bad_files();
+  test_write_errors();
+  test_helpers();
+  return GR_TEST_RESULT();
+}

@@ -1,0 +1,423 @@
+/* Procedural terrain tests: an independent double-precision reference of the
+ * documented noise (graupel/terrain_noise.h), determinism, seeds, octave
+ * energy, linear height scale, bounds, tiling by origin, inversion, every
+ * device agreeing with the first, and parameter errors. */
+#include "graupel/cl_runtime.h"
+#include "graupel/terrain_noise.h"
+#include "gr_test.h"
+
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* ---- reference (the same definition as terrain_noise.cl, in double) ---- */
+
+static uint32_t ref_hash(uint32_t x) {
+  x ^= x >> 16;
+  x *= 0x7feb352dU;
+  x ^= x >> 15;
+  x *= 0x846ca68bU;
+  x ^= x >> 16;
+  return x;
+}
+static uint32_t ref_hash3(int32_t a, int32_t b, uint32_t c) {
+  uint32_t h = ref_hash((uint32_t)a * 0x9e3779b1U);
+  h = ref_hash(h ^ ((uint32_t)b * 0x85ebca77U));
+  return ref_hash(h ^ (c * 0xc2b2ae3dU));
+}
+static double ref_fade(double t) {
+  return t * t * t * (t * (t * 6 - 15) + 10);
+}
+static double ref_corner(int64_t ix, int64_t iy, uint32_t seed, double fx,
+                         double fy) {
+  double ang = (double)(ref_hash3((int32_t)ix, (int32_t)iy, seed) & 15U) *
+               (3.14159265358979323846 / 8.0);
+  return cos(ang) * fx + sin(ang) * fy;
+}
+static double ref_gradient(double x, double y, uint32_t seed) {
+  double flx = floor(x), fly = floor(y);
+  int64_t ix = (int64_t)flx, iy = (int64_t)fly;
+  double fx = x - flx, fy = y - fly, u = ref_fade(fx), v = ref_fade(fy);
+  double n00 = ref_corner(ix, iy, seed, fx, fy);
+  double n10 = ref_corner(ix + 1, iy, seed, fx - 1, fy);
+  double n01 = ref_corner(ix, iy + 1, seed, fx, fy - 1);
+  double n11 = ref_corner(ix + 1, iy + 1, seed, fx - 1, fy - 1);
+  double a = n00 + u * (n10 - n00), b = n01 + u * (n11 - n01);
+  double n = (a + v * (b - a)) * sqrt(2.0);
+  return n < -1 ? -1 : n > 1 ? 1 : n;
+}
+static double ref_elevation(const gr_terrain_noise_params *p, double x,
+                            double y) {
+  double f = p->frequency / 1000.0, m = 1.0, amp = 1.0, w = 1.0;
+  double sum = 0, norm = 0;
+  for (int o = 0; o < p->octaves; ++o) {
+    double g = ref_gradient(x * f * m, y * f * m, (uint32_t)p->seed + (uint32_t)o);
+    if (p->type == GR_NOISE_RIDGED) {
+      double s = p->offset - fabs(g);
+      s = s * s * w;
+      w = s * p->gain;
+      w = w < 0 ? 0 : w > 1 ? 1 : w;
+      sum += s * amp;
+      norm += p->offset * p->offset * amp;
+      amp *= pow(p->lacunarity, -p->h);
+    } else {
+      sum += (p->type == GR_NOISE_BILLOW ? 2 * fabs(g) - 1 : g) * amp;
+      norm += amp;
+      amp *= p->persistence;
+    }
+    m *= p->lacunarity;
+  }
+  double n = p->type == GR_NOISE_RIDGED ? sum / norm : 0.5 * (sum / norm + 1);
+  if (p->type == GR_NOISE_RIDGED && p->invert)
+    n = 1 - n;
+  return p->height_scale * (n < 0 ? 0 : n > 1 ? 1 : n);
+}
+
+/* ---------------------------------------------------------------- helpers */
+
+static gr_context *ctx;
+
+static float *make(const gr_grid *g, const gr_terrain_noise_params *p) {
+  float *h = malloc(sizeof(float) * (size_t)g->nx * (size_t)g->ny);
+  gr_status st = gr_terrain_noise_generate(ctx, g, p, h);
+  CHECK_MSG(st == GR_OK, "%s", gr_last_error(ctx));
+  if (st != GR_OK) {
+    free(h);
+    return NULL;
+  }
+  return h;
+}
+
+static double variance(const float *h, int n) {
+  double m = 0, v = 0;
+  for (int i = 0; i < n; ++i)
+    m += h[i];
+  m /= n;
+  for (int i = 0; i < n; ++i)
+    v += (h[i] - m) * (h[i] - m);
+  return v / n;
+}
+
+/* Mean squared 5-point Laplacian over the interior: high-frequency energy. */
+static double laplacian_energy(const float *h, int nx, int ny) {
+  double e = 0;
+  for (int j = 1; j < ny - 1; ++j)
+    for (int i = 1; i < nx - 1; ++i) {
+      double l = h[j * nx + i - 1] + h[j * nx + i + 1] + h[(j - 1) * nx + i] +
+                 h[(j + 1) * nx + i] - 4.0 * h[j * nx + i];
+      e += l * l;
+    }
+  return e / ((double)(nx - 2) * (ny - 2));
+}
+
+/* ------------------------------------------------------------------ tests */
+
+static void test_reference(void) {
+  gr_grid g = {48, 40, 7.0, 5.0, -123.0, 4567.0};
+  for (int type = 0; type < 3; ++type)
+    for (int inv = 0; inv < 2; ++inv) {
+      gr_terrain_noise_params p;
+      gr_terrain_noise_params_init(&p);
+      p.type = (gr_noise_type)type;
+      p.invert = inv;
+      p.seed = 1234 + type;
+      p.frequency = 9.0;
+      p.lacunarity = 2.1;
+      float *h = make(&g, &p);
+      if (!h)
+        return;
+      double worst = 0;
+      for (int j = 0; j < g.ny; ++j)
+        for (int i = 0; i < g.nx; ++i) {
+          double r = ref_elevation(&p, g.x0 + i * g.dx, g.y0 + j * g.dy);
+          double d = fabs(r - h[j * g.nx + i]);
+          worst = d > worst ? d : worst;
+        }
+      /* float32 evaluation of the same formula: well under a millimetre
+       * on a 120 m terrain. */
+      CHECK_MSG(worst < 1e-4 * p.height_scale, "type %d invert %d: %.3g m",
+                type, inv, worst);
+      free(h);
+    }
+}
+
+static void test_determinism_and_seeds(void) {
+  gr_grid g = {200, 150, 2.0, 2.0, 0.0, 0.0};
+  gr_terrain_noise_params p;
+  gr_terrain_noise_params_init(&p);
+  float *a = make(&g, &p), *b = make(&g, &p);
+  p.seed = 1;
+  float *c = make(&g, &p);
+  if (!a || !b || !c)
+    return;
+  int n = g.nx * g.ny;
+  CHECK(memcmp(a, b, sizeof(float) * (size_t)n) == 0);
+  double diff = 0;
+  for (int i = 0; i < n; ++i)
+    diff += (a[i] - c[i]) * (a[i] - c[i]);
+  diff = sqrt(diff / n);
+  /* Different seeds are unrelated fields: their RMS difference is of the
+   * order of the fields' own spread. */
+  CHECK_MSG(diff > 0.5 * sqrt(variance(a, n)), "rms diff %.3g", diff);
+  free(a);
+  free(b);
+  free(c);
+}
+
+static void test_octaves_energy(void) {
+  gr_grid g = {256, 256, 2.0, 2.0, 0.0, 0.0};
+  for (int type = 0; type < 3; ++type) {
+    gr_terrain_noise_params p;
+    gr_terrain_noise_params_init(&p);
+    p.type = (gr_noise_type)type;
+    p.octaves = 1;
+    float *h1 = make(&g, &p);
+    p.octaves = 6;
+    float *h6 = make(&g, &p);
+    if (!h1 || !h6)
+      return;
+    int n = g.nx * g.ny;
+    double r1 = laplacian_energy(h1, g.nx, g.ny) / variance(h1, n);
+    double r6 = laplacian_energy(h6, g.nx, g.ny) / variance(h6, n);
+    CHECK_MSG(r6 > 4.0 * r1, "type %d: relative HF energy %.3g vs %.3g", type,
+              r6, r1);
+    free(h1);
+    free(h6);
+  }
+}
+
+static void test_height_scale_and_bounds(void) {
+  gr_grid g = {128, 96, 3.0, 3.0, 50.0, -70.0};
+  gr_terrain_noise_params p;
+  gr_terrain_noise_params_init(&p);
+  float *a = make(&g, &p);
+  p.height_scale = 30.0;
+  float *b = make(&g, &p);
+  if (!a || !b)
+    return;
+  int n = g.nx * g.ny;
+  double worst = 0;
+  for (int i = 0; i < n; ++i) {
+    double d = fabs(b[i] - a[i] * 0.25);
+    worst = d > worst ? d : worst;
+  }
+  CHECK_MSG(worst <= 1e-6 * 120.0, "HeightScale not linear: %.3g", worst);
+  free(a);
+  free(b);
+
+  /* 0 <= elevation <= HeightScale for every type, extreme parameters too,
+   * and the default terrain uses a good part of that range. */
+  const double gains[] = {0.0, 2.0, 16.0}, offsets[] = {0.25, 1.0, 4.0};
+  for (int type = 0; type < 3; ++type)
+    for (int k = 0; k < 3; ++k) {
+      gr_terrain_noise_params q;
+      gr_terrain_noise_params_init(&q);
+      q.type = (gr_noise_type)type;
+      q.gain = gains[k];
+      q.offset = offsets[k];
+      q.persistence = k * 0.5;
+      q.octaves = 1 + 5 * k;
+      float *h = make(&g, &q);
+      if (!h)
+        return;
+      float lo = h[0], hi = h[0];
+      for (int i = 0; i < n; ++i) {
+        lo = h[i] < lo ? h[i] : lo;
+        hi = h[i] > hi ? h[i] : hi;
+      }
+      CHECK_MSG(lo >= 0.0f && hi <= (float)q.height_scale,
+                "type %d k %d: [%g, %g]", type, k, lo, hi);
+      if (k == 1)
+        CHECK_MSG(hi - lo > 0.2 * q.height_scale, "type %d: range %g", type,
+                  hi - lo);
+      free(h);
+    }
+}
+
+static void test_tiling_and_inversion(void) {
+  /* A grid whose origin is k cells further east is the same terrain shifted:
+   * tiles (and MPI pieces) join without seams. */
+  gr_grid g = {100, 80, 2.0, 2.0, 1000.0, 2000.0};
+  gr_grid s = g;
+  s.x0 += 30 * g.dx;
+  s.y0 += 10 * g.dy;
+  gr_terrain_noise_params p;
+  gr_terrain_noise_params_init(&p);
+  float *a = make(&g, &p), *b = make(&s, &p);
+  if (!a || !b)
+    return;
+  double worst = 0;
+  for (int j = 0; j < g.ny - 10; ++j)
+    for (int i = 0; i < g.nx - 30; ++i) {
+      double d = fabs(a[(j + 10) * g.nx + i + 30] - b[j * g.nx + i]);
+      worst = d > worst ? d : worst;
+    }
+  CHECK_MSG(worst < 1e-4 * p.height_scale, "tile seam %.3g m", worst);
+  free(b);
+
+  /* A piece of the grid (global index offset i0, j0, the whole grid's
+   * origin) is bit for bit that part of the whole: MPI ranks agree. */
+  gr_grid piece = g;
+  piece.nx = 37;
+  piece.ny = 21;
+  piece.i0 = 30;
+  piece.j0 = 10;
+  b = make(&piece, &p);
+  if (!b)
+    return;
+  int mismatched = 0;
+  for (int j = 0; j < piece.ny; ++j)
+    for (int i = 0; i < piece.nx; ++i)
+      mismatched += b[j * piece.nx + i] != a[(j + 10) * g.nx + i + 30];
+  CHECK_MSG(mismatched == 0, "%d piece values differ from the whole", mismatched);
+  free(b);
+
+  /* Inverted ridged is exactly HeightScale minus the plain ridged field. */
+  p.invert = 0;
+  b = make(&g, &p);
+  if (!b)
+    return;
+  worst = 0;
+  for (int i = 0; i < g.nx * g.ny; ++i) {
+    double d = fabs((double)a[i] + (double)b[i] - p.height_scale);
+    worst = d > worst ? d : worst;
+  }
+  CHECK_MSG(worst < 1e-5 * p.height_scale, "inversion %.3g", worst);
+  free(a);
+  free(b);
+
+  /* Far from the origin the terrain is as detailed as near it. */
+  gr_grid far = {64, 64, 2.0, 2.0, 3.0e6, -2.0e6};
+  float *h = make(&far, &p);
+  if (!h)
+    return;
+  double worst_ref = 0;
+  for (int j = 0; j < far.ny; j += 7)
+    for (int i = 0; i < far.nx; i += 5) {
+      double r = ref_elevation(&p, far.x0 + i * far.dx, far.y0 + j * far.dy);
+      double d = fabs(r - h[j * far.nx + i]);
+      worst_ref = d > worst_ref ? d : worst_ref;
+    }
+  CHECK_MSG(worst_ref < 1e-3 * p.height_scale, "far tile %.3g m", worst_ref);
+  free(h);
+}
+
+static void test_devices_agree(void) {
+  int count = 0;
+  gr_device_info infos[8];
+  if (gr_device_list(infos, 8, &count) != GR_OK || count < 2) {
+    printf("one OpenCL device: cross-device agreement not tested here\n");
+    return;
+  }
+  gr_grid g = {300, 200, 2.0, 2.0, -500.0, 800.0};
+  gr_terrain_noise_params p;
+  gr_terrain_noise_params_init(&p);
+  float *first = NULL;
+  for (int d = 0; d < count && d < 8; ++d) {
+    gr_context_options opt;
+    gr_context_options_init(&opt);
+    opt.device = infos[d].name;
+    gr_context *c = NULL;
+    CHECK(gr_context_create(&opt, &c) == GR_OK);
+    float *h = malloc(sizeof(float) * 300 * 200);
+    CHECK(gr_terrain_noise_generate(c, &g, &p, h) == GR_OK);
+    if (!first) {
+      first = h;
+    } else {
+      double worst = 0;
+      for (int i = 0; i < 300 * 200; ++i) {
+        double r = fabs((double)h[i] - first[i]) / p.height_scale;
+        worst = r > worst ? r : worst;
+      }
+      printf("%s vs %s: max difference %.3g of HeightScale\n", infos[d].name,
+             infos[0].name, worst);
+      CHECK_MSG(worst <= 1e-5, "%s disagrees: %.3g", infos[d].name, worst);
+      free(h);
+    }
+    gr_context_release(c);
+  }
+  free(first);
+}
+
+static void test_errors(void) {
+  char msg[256];
+  gr_terrain_noise_params p;
+  gr_terrain_noise_params_init(&p);
+  CHECK(gr_terrain_noise_params_validate(&p, msg, sizeof(msg)) == GR_OK);
+  /* Each out-of-range parameter is refused with its name in the sentence. */
+  gr_terrain_noise_params q;
+#define BAD(field, value, word)                                                \
+  do {                                                                         \
+    q = p;                                                                     \
+    q.field = value;                                                           \
+    CHECK(gr_terrain_noise_params_validate(&q, msg, sizeof(msg)) ==            \
+          GR_ERR_INVALID_ARGUMENT);                                            \
+    CHECK_MSG(strstr(msg, word) != NULL, "'%s' lacks '%s'", msg, word);        \
+  } while (0)
+  BAD(octaves, 0, "Octaves");
+  BAD(octaves, 17, "Octaves");
+  BAD(frequency, 0.0, "Frequency");
+  BAD(frequency, NAN, "Frequency");
+  BAD(lacunarity, 0.5, "Lacunarity");
+  BAD(persistence, 1.5, "Persistence");
+  BAD(offset, -1.0, "Offset");
+  BAD(offset, 0.0, "Offset");
+  BAD(gain, INFINITY, "Gain");
+  BAD(h, -0.1, "H");
+  BAD(height_scale, -1.0, "HeightScale");
+  BAD(type, (gr_noise_type)7, "NoiseType");
+#undef BAD
+
+  gr_grid g = {16, 16, 1.0, 1.0, 0.0, 0.0};
+  gr_terrain_noise *t = NULL;
+  q = p;
+  q.octaves = 0;
+  CHECK(gr_terrain_noise_create(ctx, &g, &q, &t) == GR_ERR_INVALID_ARGUMENT);
+  CHECK(t == NULL && strstr(gr_last_error(ctx), "Octaves") != NULL);
+  g.dy = -1.0;
+  CHECK(gr_terrain_noise_create(ctx, &g, &p, &t) == GR_ERR_INVALID_ARGUMENT);
+  CHECK(strstr(gr_last_error(ctx), "spacing") != NULL);
+  g.dy = 1.0;
+  g.x0 = 1e14; /* lattice coordinates would overflow */
+  CHECK(gr_terrain_noise_create(ctx, &g, &p, &t) == GR_ERR_INVALID_ARGUMENT);
+  CHECK(strstr(gr_last_error(ctx), "Origin") != NULL);
+  g.x0 = 0.0;
+
+  /* set_params refuses bad values and keeps the generator working. */
+  CHECK(gr_terrain_noise_create(ctx, &g, &p, &t) == GR_OK);
+  float before[256], after[256];
+  CHECK(gr_terrain_noise_compute(t) == GR_OK);
+  CHECK(gr_terrain_noise_get_field(t, GR_FIELD_ELEVATION, before) == GR_OK);
+  CHECK(gr_terrain_noise_set_params(t, &q) == GR_ERR_INVALID_ARGUMENT);
+  CHECK(gr_terrain_noise_compute(t) == GR_OK);
+  CHECK(gr_terrain_noise_get_field(t, GR_FIELD_ELEVATION, after) == GR_OK);
+  CHECK(memcmp(before, after, sizeof(before)) == 0);
+  q = p;
+  q.seed = 99;
+  CHECK(gr_terrain_noise_set_params(t, &q) == GR_OK);
+  CHECK(gr_terrain_noise_compute(t) == GR_OK);
+  CHECK(gr_terrain_noise_get_field(t, GR_FIELD_ELEVATION, after) == GR_OK);
+  CHECK(memcmp(before, after, sizeof(before)) != 0);
+  CHECK(gr_terrain_noise_get_field(t, GR_FIELD_SNOW_DEPTH, after) ==
+        GR_ERR_INVALID_ARGUMENT);
+  CHECK(strstr(gr_last_error(ctx), "snow_depth") != NULL);
+  gr_terrain_noise_destroy(t);
+  gr_terrain_noise_destroy(NULL);
+}
+
+int main(void) {
+  if (gr_context_create(NULL, &ctx) != GR_OK) {
+    fprintf(stderr, "no OpenCL context: %s\n", gr_last_error(NULL));
+    return 1;
+  }
+  printf("device: %s\n", gr_context_device_name(ctx));
+  test_reference();
+  test_determinism_and_seeds();
+  test_octaves_energy();
+  test_height_scale_and_bounds();
+  test_tiling_and_inversion();
+  test_devices_agree();
+  test_errors();
+  gr_context_release(ctx);
+  return GR_TEST_RESULT();
+}

@@ -1,0 +1,64 @@
+"""Small helpers shared by Graupel's Python tests: argument parsing, checks
+that count failures instead of stopping at the first, and error capture."""
+import argparse
+import sys
+
+_failures = []
+_checks = [0]
+
+
+def args(extra=None):
+    p = argparse.ArgumentParser()
+    p.add_argument("--plugin", default=None)
+    p.add_argument("--data", required=True)
+    p.add_argument("--scratch", required=True)
+    p.add_argument("--baseline", default=None)
+    p.add_argument("--expect-vtk", default=None)
+    p.add_argument("--generate-baseline", action="store_true")
+    if extra:
+        extra(p)
+    a, _ = p.parse_known_args()
+    return a
+
+
+def check(cond, what):
+    _checks[0] += 1
+    if not cond:
+        _failures.append(what)
+        print("CHECK failed: " + what, file=sys.stderr)
+
+
+def near(a, b, tol, what):
+    check(abs(a - b) <= tol, "%s: %r vs %r (tol %g)" % (what, a, b, tol))
+
+
+def finish():
+    """Prints the tally; exits non-zero on failure. On success the script
+    simply ends, so that pvbatch under MPI shuts its ranks down in order."""
+    print("%d passed, %d failed" % (_checks[0] - len(_failures), len(_failures)))
+    if _failures:
+        sys.exit(1)
+
+
+class ErrorCatcher:
+    """Collects the error sentences an algorithm reports (ErrorEvent)."""
+
+    def __init__(self, *objects):
+        from vtkmodules.util.misc import calldata_type
+        from vtkmodules.util.vtkConstants import VTK_STRING
+
+        self.messages = []
+
+        @calldata_type(VTK_STRING)
+        def on_error(obj, event, data):
+            self.messages.append(str(data))
+
+        self._cb = on_error
+        for o in objects:
+            o.AddObserver("ErrorEvent", on_error)
+
+    def text(self):
+        return "\n".join(self.messages)
+
+    def clear(self):
+        self.messages = []

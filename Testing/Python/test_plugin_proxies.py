@@ -1,0 +1,88 @@
+"""pvbatch: the plugin loads, every proxy is declared as documented (menu,
+defaults, reader and writer found by extension) and runs."""
+import os
+import sys
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import gr_check as T  # noqa: E402
+
+a = T.args()
+
+from paraview import servermanager  # noqa: E402
+from paraview.simple import *  # noqa: E402,F401,F403
+
+LoadPlugin(a.plugin, ns=globals())
+pxm = servermanager.ProxyManager()
+
+# Declarations: menu category, documentation on every property.
+for group, name in (("sources", "ProceduralTerrain"), ("sources", "EXRHeightFieldReader"),
+                    ("writers", "EXRFieldWriter")):
+    proto = pxm.GetPrototypeProxy(group, name)
+    T.check(proto is not None, "proxy %s/%s is registered" % (group, name))
+    if proto is None:
+        continue
+    it = proto.NewPropertyIterator()
+    it.Begin()
+    while not it.IsAtEnd():
+        prop = it.GetProperty()
+        if not prop.GetInformationOnly() and prop.GetPanelVisibility() != "never":
+            doc = prop.GetDocumentation()
+            T.check(doc is not None and len(doc.GetDescription().strip()) > 10,
+                    "%s.%s has documentation" % (name, it.GetKey()))
+        it.Next()
+    if group == "sources":
+        hints = proto.GetHints()
+        menu = hints.FindNestedElementByName("ShowInMenu") if hints else None
+        T.check(menu is not None and menu.GetAttribute("category") == "Graupel",
+                "%s is in the Graupel menu" % name)
+
+# The terrain with its documented defaults.
+t = ProceduralTerrain()
+T.check(list(t.Dimensions) == [512, 512], "Dimensions default")
+T.check(t.Spacing[0] == 2.0 if hasattr(t.Spacing, "__len__") else t.Spacing == 2.0, "Spacing default")
+T.check(t.NoiseType == "Ridged Multifractal", "NoiseType default %r" % t.NoiseType)
+T.check(t.Octaves == 6 and t.Lacunarity == 2.0 and t.Persistence == 0.5, "octave defaults")
+T.check(t.Offset == 1.0 and t.Gain == 2.0 and t.HeightScale == 120.0, "ridged defaults")
+t.UpdatePipeline()
+info = t.GetDataInformation()
+T.check(info.GetNumberOfPoints() == 512 * 512, "512 x 512 points")
+lo, hi = t.PointData["elevation"].GetRange()
+T.check(0.0 <= lo and hi <= 120.0 and hi - lo > 30.0, "elevation range %g..%g" % (lo, hi))
+T.check(tuple(info.GetBounds()) == (0.0, 1022.0, 0.0, 1022.0, 0.0, 0.0), "bounds %s" % (info.GetBounds(),))
+
+# Same seed, same data; another seed, other data (fetched to the client).
+from vtkmodules.util.numpy_support import vtk_to_numpy  # noqa: E402
+
+t.Dimensions = [128, 96]
+t.Seed = 7
+e1 = vtk_to_numpy(servermanager.Fetch(t).GetPointData().GetArray("elevation")).copy()
+t.Seed = 8
+e2 = vtk_to_numpy(servermanager.Fetch(t).GetPointData().GetArray("elevation")).copy()
+t.Seed = 7
+e3 = vtk_to_numpy(servermanager.Fetch(t).GetPointData().GetArray("elevation")).copy()
+T.check((e1 == e3).all(), "Seed 7 twice gives the same field")
+T.check(not (e1 == e2).all(), "Seed 8 differs from Seed 7")
+t.NoiseType = "fBm"
+e4 = vtk_to_numpy(servermanager.Fetch(t).GetPointData().GetArray("elevation")).copy()
+T.check(not (e4 == e1).all(), "NoiseType changes the field")
+
+# Reader and writer are found by extension.
+path = os.path.join(a.scratch, "proxies.exr")
+SaveData(path, proxy=t)
+with open(path, "rb") as f:
+    T.check(f.read(4) == b"\x76\x2f\x31\x01", "SaveData('.exr') wrote an EXR")
+r = OpenDataFile(path)
+T.check(r is not None and r.GetXMLName() == "EXRHeightFieldReader",
+        "OpenDataFile('.exr') picks the EXR reader (%s)" % (r and r.GetXMLName()))
+r.Spacing = [2.0, 2.0]
+r.UpdatePipeline()
+T.check(r.GetDataInformation().GetNumberOfPoints() == 128 * 96, "reader output size")
+T.check(r.PointData["elevation"].GetRange() == t.PointData["elevation"].GetRange(),
+        "reader range equals source range")
+
+dem = OpenDataFile(os.path.join(a.data, "jacksboro_fault_dem.exr"))
+dem.Spacing = [74.5, 92.1]
+dem.UpdatePipeline()
+T.check(dem.PointData["elevation"].GetRange() == (236.0, 1076.0), "real DEM range")
+
+T.finish()

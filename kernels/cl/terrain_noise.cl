@@ -1,0 +1,93 @@
+/* Procedural terrain (seed 001, notes/001_003.md A.2.1): 2-D gradient noise
+ * summed over octaves as fBm, billow or (inverted) ridged multifractal. The
+ * normalisation is documented in graupel/terrain_noise.h. */
+#include "common.h"
+
+/* 16 unit gradients at multiples of 22.5 degrees. */
+__constant float2 gr_gradients[16] = {
+    (float2)(1.0f, 0.0f),           (float2)(0.9238795f, 0.3826834f),
+    (float2)(0.7071068f, 0.7071068f), (float2)(0.3826834f, 0.9238795f),
+    (float2)(0.0f, 1.0f),           (float2)(-0.3826834f, 0.9238795f),
+    (float2)(-0.7071068f, 0.7071068f), (float2)(-0.9238795f, 0.3826834f),
+    (float2)(-1.0f, 0.0f),          (float2)(-0.9238795f, -0.3826834f),
+    (float2)(-0.7071068f, -0.7071068f), (float2)(-0.3826834f, -0.9238795f),
+    (float2)(0.0f, -1.0f),          (float2)(0.3826834f, -0.9238795f),
+    (float2)(0.7071068f, -0.7071068f), (float2)(0.9238795f, -0.3826834f)};
+
+inline float gr_fade(float t) {
+  /* 6t^5 - 15t^4 + 10t^3: C2-continuous interpolation weight. */
+  return t * t * t * (t * (t * 6.0f - 15.0f) + 10.0f);
+}
+
+inline float gr_corner(int ix, int iy, uint seed, float fx, float fy) {
+  float2 g = gr_gradients[gr_hash3(ix, iy, seed) & 15U];
+  return g.x * fx + g.y * fy;
+}
+
+/* Gradient noise at lattice cell (ix, iy) with fractional position (fx, fy)
+ * in [0, 1); scaled by sqrt(2) so that |result| <= 1. */
+inline float gr_gradient_noise(int ix, int iy, float fx, float fy,
+                               uint seed) {
+  float u = gr_fade(fx), v = gr_fade(fy);
+  float n00 = gr_corner(ix, iy, seed, fx, fy);
+  float n10 = gr_corner(ix + 1, iy, seed, fx - 1.0f, fy);
+  float n01 = gr_corner(ix, iy + 1, seed, fx, fy - 1.0f);
+  float n11 = gr_corner(ix + 1, iy + 1, seed, fx - 1.0f, fy - 1.0f);
+  float a = n00 + u * (n10 - n00);
+  float b = n01 + u * (n11 - n01);
+  float n = (a + v * (b - a)) * 1.41421356f;
+  return clamp(n, -1.0f, 1.0f);
+}
+
+/* Per-octave set-up computed by the host in double (graupel/terrain_noise.h):
+ * for octave o, point i of a piece starting at global index i0 lies at
+ * lattice coordinate lat_o + frac_o + (i0 + i)*step_o,
+ * where lat_o is the integer part of the grid origin in that octave's lattice
+ * units and frac_o its fraction. Splitting the origin this way keeps full
+ * float precision far from (0, 0), so distant tiles are as detailed as near
+ * ones. table[o] = (frac_x, frac_y, step_x, step_y), amp[o] = octave weight
+ * (p^o, or lambda^(-oH) for ridged), lattice[o] = (lat_x, lat_y). */
+__kernel void terrain_noise_generate(__global float *elevation, int nx, int ny,
+                                     int i0, int j0,
+                                     __global const float4 *table,
+                                     __global const float *amp,
+                                     __global const int2 *lattice, uint seed,
+                                     int kind, int octaves, float offset,
+                                     float gain, int invert,
+                                     float height_scale) {
+  int i = get_global_id(0), j = get_global_id(1);
+  if (!gr_inside(i, j, nx, ny))
+    return;
+  float sum = 0.0f, norm = 0.0f;
+  float weight = 1.0f; /* ridged: the previous octave's weight */
+  for (int o = 0; o < octaves; ++o) {
+    float4 t = table[o];
+    int2 lat = lattice[o];
+    float x = t.x + (float)(i0 + i) * t.z;
+    float y = t.y + (float)(j0 + j) * t.w;
+    float fx = floor(x), fy = floor(y);
+    float g = gr_gradient_noise(lat.x + (int)fx, lat.y + (int)fy, x - fx,
+                                y - fy, seed + (uint)o);
+    float a = amp[o];
+    if (kind == 0) {
+      float s = offset - fabs(g);
+      s = s * s * weight;
+      weight = clamp(s * gain, 0.0f, 1.0f);
+      sum += s * a;
+      norm += offset * offset * a;
+    } else {
+      float v = kind == 2 ? 2.0f * fabs(g) - 1.0f : g;
+      sum += v * a;
+      norm += a;
+    }
+  }
+  float n;
+  if (kind == 0) {
+    n = norm > 0.0f ? sum / norm : 0.0f;
+    if (invert)
+      n = 1.0f - n;
+  } else {
+    n = norm > 0.0f ? 0.5f * (sum / norm + 1.0f) : 0.5f;
+  }
+  elevation[gr_idx(i, j, nx)] = height_scale * clamp(n, 0.0f, 1.0f);
+}

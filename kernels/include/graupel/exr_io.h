@@ -1,0 +1,74 @@
+/**
+ * @file exr_io.h
+ * @brief Height fields and named fields in OpenEXR files (OpenEXR's C API).
+ *
+ * Reads single- or multi-channel scanline or tiled EXR images whose channels
+ * are HALF or FLOAT, and writes any set of named float fields as one
+ * multi-channel FLOAT EXR. A hostile or broken file gives GR_ERR_FORMAT or
+ * GR_ERR_IO with a sentence, never a crash.
+ *
+ * Orientation: EXR stores rows top (y min of the data window) to bottom; a
+ * height map's first row is its northern edge. gr_exr_image fields are
+ * row-major with row 0 the SOUTHERN edge (the gr_grid convention), so the
+ * reader flips rows and the writer flips them back: a round trip through
+ * other EXR tools keeps north up.
+ */
+#ifndef GRAUPEL_EXR_IO_H
+#define GRAUPEL_EXR_IO_H
+
+#include "graupel/graupel.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/** Largest width or height accepted by the reader (a hostile header guard). */
+#define GR_EXR_MAX_DIM 65536
+/** Largest number of samples (width*height*channels) the reader allocates. */
+#define GR_EXR_MAX_SAMPLES ((size_t)1 << 31)
+/** Longest channel name kept (longer names are an error). */
+#define GR_EXR_MAX_NAME 255
+
+typedef enum gr_exr_pixel_type {
+  GR_EXR_HALF = 1,
+  GR_EXR_FLOAT = 2
+} gr_exr_pixel_type;
+
+/** An image read from an EXR file: nchannels planes of width*height floats. */
+typedef struct gr_exr_image {
+  int width, height;
+  int nchannels;
+  char **names;           /**< channel names, as in the file (sorted by EXR) */
+  gr_exr_pixel_type *types; /**< the stored type of each channel */
+  float **data;           /**< data[c][j*width + i], row 0 = south */
+} gr_exr_image;
+
+/**
+ * Reads every HALF or FLOAT channel of an EXR file. UINT channels are an error.
+ * Channels with x/y sampling other than 1 are an error. On failure *out is
+ * untouched and err (if given) holds a sentence naming the file and the fault.
+ */
+GR_API gr_status gr_exr_read(const char *path, gr_exr_image *out, char *err,
+                             size_t err_len);
+
+/** Frees what gr_exr_read allocated; zeroes the struct. NULL is fine. */
+GR_API void gr_exr_image_free(gr_exr_image *img);
+
+/** Index of a channel by name, or -1. */
+GR_API int gr_exr_find_channel(const gr_exr_image *img, const char *name);
+
+/**
+ * Writes nchannels fields of width*height floats (row 0 = south) as one
+ * scanline EXR with ZIP compression. type selects HALF or FLOAT storage for
+ * every channel. Names must be distinct and non-empty.
+ */
+GR_API gr_status gr_exr_write(const char *path, int width, int height,
+                              int nchannels, const char *const *names,
+                              const float *const *data, gr_exr_pixel_type type,
+                              char *err, size_t err_len);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif

@@ -1,0 +1,97 @@
+/**
+ * @file terrain_noise.h
+ * @brief Procedural terrain (seed 001): ridged multifractal, fBm and billow
+ * noise computed by an OpenCL kernel.
+ *
+ * The noise is a function of world position, so a grid that is shifted by k
+ * cells gives the same values shifted by k cells (tiles of a larger terrain
+ * join seamlessly, and an MPI split needs no exchange).
+ *
+ * Normalisation (so that 0 <= elevation <= height_scale holds exactly):
+ * - the gradient noise g is scaled to [-1, 1] (2-D Perlin's bound is
+ *   sqrt(2)/2; g is multiplied by sqrt(2) and clamped against rounding);
+ * - fBm: n = (sum_o p^o g_o / sum_o p^o + 1) / 2;
+ * - billow: as fBm with g_o replaced by 2|g_o| - 1;
+ * - ridged multifractal (libnoise's recurrence, notes/001_003.md A.2.1):
+ *   s_o = (offset - |g_o|)^2 * w_o,  w_0 = 1,  w_{o+1} = clamp(s_o*gain, 0, 1),
+ *   r = sum_o s_o lambda^(-o H) / sum_o offset^2 lambda^(-o H)  in [0, 1];
+ *   inverted (seed 001's choice: rounded hills and river valleys instead of
+ *   sharp crests) n = 1 - r, else n = r.
+ * elevation = height_scale * n, in metres.
+ */
+#ifndef GRAUPEL_TERRAIN_NOISE_H
+#define GRAUPEL_TERRAIN_NOISE_H
+
+#include "graupel/runtime.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef enum gr_noise_type {
+  GR_NOISE_RIDGED = 0, /**< ridged multifractal (inverted by default) */
+  GR_NOISE_FBM = 1,    /**< fractional Brownian motion (Perlin sum) */
+  GR_NOISE_BILLOW = 2  /**< sum of |noise| octaves: puffy hills */
+} gr_noise_type;
+
+#define GR_TERRAIN_NOISE_OCTAVES_MIN 1
+#define GR_TERRAIN_NOISE_OCTAVES_MAX 16
+
+typedef struct gr_terrain_noise_params {
+  int seed;             /**< any integer; equal seeds give equal fields */
+  gr_noise_type type;   /**< default GR_NOISE_RIDGED */
+  int octaves;          /**< 1..16, default 6 */
+  double frequency;     /**< base-octave cycles per km, (0, 1e4], default 4 */
+  double lacunarity;    /**< frequency ratio of octaves, [1, 8], default 2 */
+  double persistence;   /**< amplitude ratio (fBm, billow), [0, 1], default 0.5 */
+  double offset;        /**< ridged offset, [0, 4], default 1 */
+  double gain;          /**< ridged weight gain, [0, 16], default 2 */
+  double h;             /**< ridged spectral exponent H, [0, 4], default 1 */
+  int invert;           /**< ridged only: 1 (default) flips the ridges */
+  double height_scale;  /**< metres, [0, 1e5], default 120 */
+} gr_terrain_noise_params;
+
+/** The defaults listed above. */
+GR_API void gr_terrain_noise_params_init(gr_terrain_noise_params *p);
+
+/** Checks every parameter against its range; a sentence goes to msg. */
+GR_API gr_status gr_terrain_noise_params_validate(
+    const gr_terrain_noise_params *p, char *msg, size_t msg_len);
+
+typedef struct gr_terrain_noise gr_terrain_noise;
+
+/**
+ * A terrain generator for one grid: validates the grid and the parameters,
+ * builds the kernel and allocates the elevation buffer on the device.
+ */
+GR_API gr_status gr_terrain_noise_create(gr_context *ctx, const gr_grid *grid,
+                                         const gr_terrain_noise_params *p,
+                                         gr_terrain_noise **out);
+
+/** New parameters for the next compute (validated). */
+GR_API gr_status gr_terrain_noise_set_params(gr_terrain_noise *t,
+                                             const gr_terrain_noise_params *p);
+
+/** Enqueues the noise kernel; does not wait. */
+GR_API gr_status gr_terrain_noise_compute(gr_terrain_noise *t);
+
+/**
+ * Reads a field back (waits for the device). Only GR_FIELD_ELEVATION exists;
+ * host must hold nx*ny floats.
+ */
+GR_API gr_status gr_terrain_noise_get_field(gr_terrain_noise *t, gr_field f,
+                                            float *host);
+
+/** Frees the generator; NULL is fine. */
+GR_API void gr_terrain_noise_destroy(gr_terrain_noise *t);
+
+/** One call: create, compute, read elevation into host (nx*ny floats), free. */
+GR_API gr_status gr_terrain_noise_generate(gr_context *ctx, const gr_grid *grid,
+                                           const gr_terrain_noise_params *p,
+                                           float *host);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif

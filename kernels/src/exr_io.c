@@ -1,0 +1,785 @@
+/*
+ * exr_io.c - height fields and named fields in OpenEXR files, through
+ * OpenEXR's C API (OpenEXRCore).
+ *
+ * Reading: part 0 of a scanline or tiled file (level 0 only for multi-level
+ * tiled files); every channel must be HALF or FLOAT with sampling 1. The
+ * library decodes each chunk straight into the output planes as float (it
+ * widens half to float itself), rows in file order; the planes are flipped at
+ * the end so that row 0 is the southern edge.
+ *
+ * Writing: one scanline part, ZIP compression, every channel HALF or FLOAT.
+ * Each chunk's rows are copied, flipped, into a float staging buffer; the
+ * library packs (and for HALF storage rounds to nearest even) from it.
+ *
+ * The library's error messages are caught by an error handler that finds its
+ * buffer through the context's user data, so nothing is printed and there is
+ * no global state.
+ */
+#include "graupel/exr_io.h"
+
+#include <openexr.h>
+
+#include <stdarg.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* ------------------------------------------------------------------------ */
+/* Error text                                                               */
+/* ------------------------------------------------------------------------ */
+
+/* The first message OpenEXR reported for a context (later ones are usually
+ * consequences of the first). */
+typedef struct exr_msg {
+  char text[512];
+  int have;
+} exr_msg;
+
+static void exr_capture_error(exr_const_context_t ctxt, exr_result_t code,
+                              const char *msg) {
+  void *ud = NULL;
+  exr_msg *m;
+  (void)code;
+  if (ctxt == NULL || exr_get_user_data(ctxt, &ud) != EXR_ERR_SUCCESS ||
+      ud == NULL)
+    return;
+  m = (exr_msg *)ud;
+  if (m->have || msg == NULL)
+    return;
+  snprintf(m->text, sizeof m->text, "%s", msg);
+  /* A sentence ends with our own period; drop trailing dots and newlines. */
+  {
+    size_t n = strlen(m->text);
+    while (n > 0 && (m->text[n - 1] == '.' || m->text[n - 1] == '\n' ||
+                     m->text[n - 1] == ' '))
+      m->text[--n] = '\0';
+  }
+  m->have = 1;
+}
+
+static void set_err(char *err, size_t err_len, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 3, 4)))
+#endif
+    ;
+
+static void set_err(char *err, size_t err_len, const char *fmt, ...) {
+  va_list ap;
+  if (err == NULL || err_len == 0)
+    return;
+  va_start(ap, fmt);
+  vsnprintf(err, err_len, fmt, ap);
+  va_end(ap);
+}
+
+/* The library's own words for a failure: the captured message, or the
+ * generic text of the code. */
+static const char *exr_detail(const exr_msg *m, exr_result_t rv) {
+  if (m->have)
+    return m->text;
+  return exr_get_default_error_message(rv);
+}
+
+/* Status for a failed OpenEXR call while reading. */
+static gr_status read_status(exr_result_t rv) {
+  switch (rv) {
+  case EXR_ERR_OUT_OF_MEMORY:
+    return GR_ERR_OUT_OF_MEMORY;
+  case EXR_ERR_FILE_ACCESS:
+    return GR_ERR_IO;
+  default:
+    return GR_ERR_FORMAT;
+  }
+}
+
+static const char *pixel_type_name(exr_pixel_type_t t) {
+  switch (t) {
+  case EXR_PIXEL_UINT:
+    return "UINT";
+  case EXR_PIXEL_HALF:
+    return "HALF";
+  case EXR_PIXEL_FLOAT:
+    return "FLOAT";
+  default:
+    return "unknown";
+  }
+}
+
+/* ------------------------------------------------------------------------ */
+/* Image helpers                                                            */
+/* ------------------------------------------------------------------------ */
+
+void gr_exr_image_free(gr_exr_image *img) {
+  int c;
+  if (img == NULL)
+    return;
+  if (img->names != NULL) {
+    for (c = 0; c < img->nchannels; ++c)
+      free(img->names[c]);
+  }
+  if (img->data != NULL) {
+    for (c = 0; c < img->nchannels; ++c)
+      free(img->data[c]);
+  }
+  free(img->names);
+  free(img->types);
+  free(img->data);
+  memset(img, 0, sizeof *img);
+}
+
+int gr_exr_find_channel(const gr_exr_image *img, const char *name) {
+  int c;
+  if (img == NULL || name == NULL || img->names == NULL)
+    return -1;
+  for (c = 0; c < img->nchannels; ++c) {
+    if (img->names[c] != NULL && strcmp(img->names[c], name) == 0)
+      return c;
+  }
+  return -1;
+}
+
+static void flip_rows(float *plane, size_t width, size_t height) {
+  size_t top, bottom, i;
+  if (height < 2)
+    return;
+  for (top = 0, bottom = height - 1; top < bottom; ++top, --bottom) {
+    float *a = plane + top * width;
+    float *b = plane + bottom * width;
+    for (i = 0; i < width; ++i) {
+      float t = a[i];
+      a[i] = b[i];
+      b[i] = t;
+    }
+  }
+}
+
+/* ------------------------------------------------------------------------ */
+/* Reading                                                                  */
+/* ------------------------------------------------------------------------ */
+
+/* Layout of part 0's level-0 chunks. */
+typedef struct chunk_layout {
+  exr_context_t ctxt;
+  int tiled;
+  exr_attr_box2i_t dw;
+  int64_t width, height;
+  int64_t lines;    /* scanlines per chunk (scanline parts) */
+  int64_t tw, th;   /* tile size (tiled parts) */
+  int64_t ntx, nty; /* tile counts at level 0 */
+} chunk_layout;
+
+/* Points each decoder channel at its plane; (x, y) is the chunk's first pixel
+ * relative to the data window's corner. */
+static int bind_decode_channels(exr_decode_pipeline_t *dec,
+                                const gr_exr_image *img, int64_t x, int64_t y) {
+  int c;
+  for (c = 0; c < dec->channel_count; ++c) {
+    exr_coding_channel_info_t *ch = &dec->channels[c];
+    int k = gr_exr_find_channel(img, ch->channel_name);
+    if (k < 0)
+      return 0;
+    ch->decode_to_ptr =
+        (uint8_t *)(img->data[k] + (size_t)y * (size_t)img->width + (size_t)x);
+    ch->user_pixel_stride = (int32_t)sizeof(float);
+    ch->user_line_stride = (int32_t)((size_t)img->width * sizeof(float));
+    ch->user_bytes_per_element = (int16_t)sizeof(float);
+    ch->user_data_type = EXR_PIXEL_FLOAT;
+  }
+  return 1;
+}
+
+/* Decodes one chunk into img at pixel (x, y) of the data window. */
+static exr_result_t decode_chunk(exr_context_t ctxt,
+                                 const exr_chunk_info_t *cinfo,
+                                 exr_decode_pipeline_t *dec, int *dec_live,
+                                 const gr_exr_image *img, int64_t x,
+                                 int64_t y) {
+  exr_result_t rv;
+  if (!*dec_live) {
+    rv = exr_decoding_initialize(ctxt, 0, cinfo, dec);
+    if (rv != EXR_ERR_SUCCESS)
+      return rv;
+    *dec_live = 1;
+  } else {
+    rv = exr_decoding_update(ctxt, 0, cinfo, dec);
+    if (rv != EXR_ERR_SUCCESS)
+      return rv;
+  }
+  if (!bind_decode_channels(dec, img, x, y))
+    return EXR_ERR_INCORRECT_CHUNK;
+  rv = exr_decoding_choose_default_routines(ctxt, 0, dec);
+  if (rv != EXR_ERR_SUCCESS)
+    return rv;
+  return exr_decoding_run(ctxt, 0, dec);
+}
+
+/* Visits every level-0 chunk in order. With img NULL it only reads and checks
+ * each chunk's description (offset, size and extent against the file), which
+ * catches truncated and inconsistent files before any image is allocated;
+ * otherwise it decodes the chunk into img, rows in file order. On failure
+ * *fx, *fy name the chunk (tile indices, or the first scanline). */
+static exr_result_t walk_chunks(const chunk_layout *L, const gr_exr_image *img,
+                                exr_decode_pipeline_t *dec, int *dec_live,
+                                int64_t *fx, int64_t *fy) {
+  exr_result_t rv = EXR_ERR_SUCCESS;
+  exr_chunk_info_t cinfo;
+  if (!L->tiled) {
+    int64_t y;
+    for (y = L->dw.min.y; y <= (int64_t)L->dw.max.y; y += L->lines) {
+      int64_t expect_h = (int64_t)L->dw.max.y - y + 1;
+      if (expect_h > L->lines)
+        expect_h = L->lines;
+      *fx = 0;
+      *fy = y;
+      memset(&cinfo, 0, sizeof cinfo);
+      rv = exr_read_scanline_chunk_info(L->ctxt, 0, (int)y, &cinfo);
+      if (rv == EXR_ERR_SUCCESS &&
+          ((int64_t)cinfo.start_y != y || (int64_t)cinfo.height != expect_h ||
+           (int64_t)cinfo.width != L->width))
+        rv = EXR_ERR_INCORRECT_CHUNK;
+      if (rv == EXR_ERR_SUCCESS && img != NULL)
+        rv = decode_chunk(L->ctxt, &cinfo, dec, dec_live, img, 0,
+                          y - L->dw.min.y);
+      if (rv != EXR_ERR_SUCCESS)
+        return rv;
+    }
+  } else {
+    int64_t tx, ty;
+    for (ty = 0; ty < L->nty; ++ty) {
+      for (tx = 0; tx < L->ntx; ++tx) {
+        int64_t x0 = tx * L->tw, y0 = ty * L->th;
+        int64_t ew = L->width - x0 < L->tw ? L->width - x0 : L->tw;
+        int64_t eh = L->height - y0 < L->th ? L->height - y0 : L->th;
+        *fx = tx;
+        *fy = ty;
+        memset(&cinfo, 0, sizeof cinfo);
+        rv = exr_read_tile_chunk_info(L->ctxt, 0, (int)tx, (int)ty, 0, 0,
+                                      &cinfo);
+        if (rv == EXR_ERR_SUCCESS &&
+            ((int64_t)cinfo.width != ew || (int64_t)cinfo.height != eh))
+          rv = EXR_ERR_INCORRECT_CHUNK;
+        if (rv == EXR_ERR_SUCCESS && img != NULL)
+          rv = decode_chunk(L->ctxt, &cinfo, dec, dec_live, img, x0, y0);
+        if (rv != EXR_ERR_SUCCESS)
+          return rv;
+      }
+    }
+  }
+  return rv;
+}
+
+gr_status gr_exr_read(const char *path, gr_exr_image *out, char *err,
+                      size_t err_len) {
+  gr_status st = GR_OK;
+  exr_result_t rv;
+  exr_context_t ctxt = NULL;
+  exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
+  exr_decode_pipeline_t dec;
+  int dec_live = 0;
+  exr_msg msg;
+  exr_storage_t storage = EXR_STORAGE_LAST_TYPE;
+  const exr_attr_chlist_t *chlist = NULL;
+  chunk_layout L;
+  int64_t fx = 0, fy = 0;
+  size_t npix, c;
+  int nparts = 0, pass;
+  gr_exr_image img;
+
+  memset(&img, 0, sizeof img);
+  memset(&dec, 0, sizeof dec);
+  memset(&msg, 0, sizeof msg);
+  memset(&L, 0, sizeof L);
+
+  if (path == NULL || path[0] == '\0' || out == NULL) {
+    set_err(err, err_len,
+            "The path and output image given to gr_exr_read must not be NULL "
+            "or empty.");
+    return GR_ERR_INVALID_ARGUMENT;
+  }
+
+  init.error_handler_fn = &exr_capture_error;
+  init.user_data = &msg;
+  init.max_image_width = GR_EXR_MAX_DIM;
+  init.max_image_height = GR_EXR_MAX_DIM;
+  init.flags = EXR_CONTEXT_FLAG_DISABLE_CHUNK_RECONSTRUCTION;
+
+  rv = exr_start_read(&ctxt, path, &init);
+  if (rv != EXR_ERR_SUCCESS) {
+    st = read_status(rv);
+    if (rv == EXR_ERR_FILE_ACCESS)
+      set_err(err, err_len,
+              "Cannot read '%s': the file cannot be opened (OpenEXR: %s).",
+              path, exr_detail(&msg, rv));
+    else
+      set_err(err, err_len,
+              "Cannot read '%s': it is not a valid OpenEXR file (OpenEXR: %s).",
+              path, exr_detail(&msg, rv));
+    goto cleanup;
+  }
+  L.ctxt = ctxt;
+
+  rv = exr_get_count(ctxt, &nparts);
+  if (rv == EXR_ERR_SUCCESS && nparts < 1)
+    rv = EXR_ERR_FILE_BAD_HEADER;
+  if (rv == EXR_ERR_SUCCESS)
+    rv = exr_get_storage(ctxt, 0, &storage);
+  if (rv == EXR_ERR_SUCCESS)
+    rv = exr_get_data_window(ctxt, 0, &L.dw);
+  if (rv == EXR_ERR_SUCCESS)
+    rv = exr_get_channels(ctxt, 0, &chlist);
+  if (rv == EXR_ERR_SUCCESS && chlist == NULL)
+    rv = EXR_ERR_MISSING_REQ_ATTR;
+  if (rv != EXR_ERR_SUCCESS) {
+    st = read_status(rv);
+    set_err(err, err_len,
+            "Cannot read '%s': its header is incomplete (OpenEXR: %s).", path,
+            exr_detail(&msg, rv));
+    goto cleanup;
+  }
+  if (storage != EXR_STORAGE_SCANLINE && storage != EXR_STORAGE_TILED) {
+    st = GR_ERR_FORMAT;
+    set_err(err, err_len,
+            "Cannot read '%s': it holds deep data, which is not supported.",
+            path);
+    goto cleanup;
+  }
+
+  /* Size guards, before anything is allocated. */
+  L.width = (int64_t)L.dw.max.x - (int64_t)L.dw.min.x + 1;
+  L.height = (int64_t)L.dw.max.y - (int64_t)L.dw.min.y + 1;
+  if (L.width < 1 || L.height < 1 || L.width > GR_EXR_MAX_DIM ||
+      L.height > GR_EXR_MAX_DIM) {
+    st = GR_ERR_FORMAT;
+    set_err(err, err_len,
+            "Cannot read '%s': its data window is %lld by %lld pixels, outside "
+            "1 to %d.",
+            path, (long long)L.width, (long long)L.height, GR_EXR_MAX_DIM);
+    goto cleanup;
+  }
+  if (chlist->num_channels < 1 || chlist->entries == NULL) {
+    st = GR_ERR_FORMAT;
+    set_err(err, err_len, "Cannot read '%s': it has no channels.", path);
+    goto cleanup;
+  }
+  npix = (size_t)L.width * (size_t)L.height;
+  if (npix > GR_EXR_MAX_SAMPLES / (size_t)chlist->num_channels ||
+      npix > SIZE_MAX / sizeof(float)) {
+    st = GR_ERR_FORMAT;
+    set_err(err, err_len,
+            "Cannot read '%s': %lld by %lld pixels in %d channels is more than "
+            "the %llu samples allowed.",
+            path, (long long)L.width, (long long)L.height, chlist->num_channels,
+            (unsigned long long)GR_EXR_MAX_SAMPLES);
+    goto cleanup;
+  }
+  for (c = 0; c < (size_t)chlist->num_channels; ++c) {
+    const exr_attr_chlist_entry_t *e = &chlist->entries[c];
+    const char *nm = e->name.str != NULL ? e->name.str : "";
+    if (e->pixel_type != EXR_PIXEL_HALF && e->pixel_type != EXR_PIXEL_FLOAT) {
+      st = GR_ERR_FORMAT;
+      set_err(err, err_len,
+              "Cannot read '%s': channel '%s' is %s, and only HALF and FLOAT "
+              "channels are supported.",
+              path, nm, pixel_type_name(e->pixel_type));
+      goto cleanup;
+    }
+    if (e->x_sampling != 1 || e->y_sampling != 1) {
+      st = GR_ERR_FORMAT;
+      set_err(err, err_len,
+              "Cannot read '%s': channel '%s' is subsampled (%d by %d), which "
+              "is not supported.",
+              path, nm, (int)e->x_sampling, (int)e->y_sampling);
+      goto cleanup;
+    }
+    if (nm[0] == '\0' || strlen(nm) > GR_EXR_MAX_NAME) {
+      st = GR_ERR_FORMAT;
+      set_err(err, err_len,
+              "Cannot read '%s': channel %d has an empty or over-long name.",
+              path, (int)c);
+      goto cleanup;
+    }
+  }
+
+  /* Chunk layout: scanlines per chunk, or level-0 tiles. */
+  if (storage == EXR_STORAGE_SCANLINE) {
+    int32_t lines = 0;
+    rv = exr_get_scanlines_per_chunk(ctxt, 0, &lines);
+    if (rv != EXR_ERR_SUCCESS || lines < 1) {
+      st = GR_ERR_FORMAT;
+      set_err(
+          err, err_len,
+          "Cannot read '%s': its compression is not understood (OpenEXR: %s).",
+          path, exr_detail(&msg, rv));
+      goto cleanup;
+    }
+    L.lines = lines;
+  } else {
+    uint32_t tw = 0, th = 0;
+    exr_tile_level_mode_t lmode;
+    exr_tile_round_mode_t rmode;
+    rv = exr_get_tile_descriptor(ctxt, 0, &tw, &th, &lmode, &rmode);
+    if (rv != EXR_ERR_SUCCESS || tw < 1 || th < 1 || tw > INT32_MAX ||
+        th > INT32_MAX) {
+      st = GR_ERR_FORMAT;
+      set_err(
+          err, err_len,
+          "Cannot read '%s': its tile description is not valid (OpenEXR: %s).",
+          path, exr_detail(&msg, rv));
+      goto cleanup;
+    }
+    L.tiled = 1;
+    L.tw = (int64_t)tw;
+    L.th = (int64_t)th;
+    L.ntx = (L.width + L.tw - 1) / L.tw;
+    L.nty = (L.height + L.th - 1) / L.th;
+  }
+
+  /* Pass 0 checks every chunk's description against the file; pass 1
+   * allocates the image and decodes. */
+  for (pass = 0; pass < 2; ++pass) {
+    if (pass == 1) {
+      img.width = (int)L.width;
+      img.height = (int)L.height;
+      img.names = (char **)calloc((size_t)chlist->num_channels, sizeof(char *));
+      img.types = (gr_exr_pixel_type *)calloc((size_t)chlist->num_channels,
+                                              sizeof(gr_exr_pixel_type));
+      img.data =
+          (float **)calloc((size_t)chlist->num_channels, sizeof(float *));
+      if (img.names == NULL || img.types == NULL || img.data == NULL) {
+        st = GR_ERR_OUT_OF_MEMORY;
+        set_err(err, err_len, "Cannot read '%s': out of memory.", path);
+        goto cleanup;
+      }
+      img.nchannels = chlist->num_channels;
+      for (c = 0; c < (size_t)img.nchannels; ++c) {
+        const exr_attr_chlist_entry_t *e = &chlist->entries[c];
+        size_t len = strlen(e->name.str);
+        img.names[c] = (char *)malloc(len + 1);
+        img.data[c] = (float *)malloc(npix * sizeof(float));
+        if (img.names[c] == NULL || img.data[c] == NULL) {
+          st = GR_ERR_OUT_OF_MEMORY;
+          set_err(err, err_len,
+                  "Cannot read '%s': out of memory for %lld by %lld pixels in "
+                  "%d channels.",
+                  path, (long long)L.width, (long long)L.height, img.nchannels);
+          goto cleanup;
+        }
+        memcpy(img.names[c], e->name.str, len + 1);
+        img.types[c] =
+            e->pixel_type == EXR_PIXEL_HALF ? GR_EXR_HALF : GR_EXR_FLOAT;
+      }
+      for (c = 0; c < (size_t)img.nchannels; ++c) {
+        if (gr_exr_find_channel(&img, img.names[c]) != (int)c) {
+          st = GR_ERR_FORMAT;
+          set_err(err, err_len, "Cannot read '%s': channel '%s' appears twice.",
+                  path, img.names[c]);
+          goto cleanup;
+        }
+      }
+    }
+    rv = walk_chunks(&L, pass == 1 ? &img : NULL, &dec, &dec_live, &fx, &fy);
+    if (rv != EXR_ERR_SUCCESS) {
+      st = read_status(rv);
+      if (L.tiled)
+        set_err(err, err_len,
+                "Cannot read '%s': the file is truncated or corrupt at tile "
+                "(%lld, %lld) (OpenEXR: %s).",
+                path, (long long)fx, (long long)fy, exr_detail(&msg, rv));
+      else
+        set_err(err, err_len,
+                "Cannot read '%s': the file is truncated or corrupt at "
+                "scanline %lld (OpenEXR: %s).",
+                path, (long long)fy, exr_detail(&msg, rv));
+      goto cleanup;
+    }
+  }
+
+  /* File rows run north to south; memory row 0 is south. */
+  for (c = 0; c < (size_t)img.nchannels; ++c)
+    flip_rows(img.data[c], (size_t)img.width, (size_t)img.height);
+
+cleanup:
+  if (dec_live)
+    exr_decoding_destroy(ctxt, &dec);
+  if (ctxt != NULL)
+    exr_finish(&ctxt);
+  if (st == GR_OK)
+    *out = img;
+  else
+    gr_exr_image_free(&img);
+  return st;
+}
+
+/* ------------------------------------------------------------------------ */
+/* Writing                                                                  */
+/* ------------------------------------------------------------------------ */
+
+/* OpenEXRCore 3.1.5's compressors keep the compressed bytes of a chunk when
+ * they are exactly as many as the raw bytes (they fall back to raw only when
+ * compression makes the chunk larger). Every reader, OpenEXR's own included,
+ * takes packed size == unpacked size to mean "stored raw", so such a chunk
+ * reads back as garbage (a 1x40 FLOAT image of 0..39 does it: its last chunk
+ * is 32 bytes raw and 32 bytes deflated). This wraps the library's compressor
+ * and stores the raw bytes whenever compression does not make the chunk
+ * strictly smaller. */
+typedef struct compress_hook {
+  exr_result_t (*compress)(exr_encode_pipeline_t *enc);
+} compress_hook;
+
+static exr_result_t compress_or_store(exr_encode_pipeline_t *enc) {
+  const compress_hook *hook = (const compress_hook *)enc->encoding_user_data;
+  exr_result_t rv;
+  if (hook == NULL || hook->compress == NULL)
+    return EXR_ERR_INVALID_ARGUMENT;
+  rv = hook->compress(enc);
+  if (rv != EXR_ERR_SUCCESS)
+    return rv;
+  if (enc->compressed_bytes >= enc->packed_bytes &&
+      enc->compressed_buffer != enc->packed_buffer) {
+    if (enc->compressed_buffer == NULL || enc->packed_buffer == NULL ||
+        enc->compressed_alloc_size < enc->packed_bytes)
+      return EXR_ERR_INVALID_ARGUMENT;
+    memcpy(enc->compressed_buffer, enc->packed_buffer,
+           (size_t)enc->packed_bytes);
+    enc->compressed_bytes = (size_t)enc->packed_bytes;
+  }
+  return EXR_ERR_SUCCESS;
+}
+
+gr_status gr_exr_write(const char *path, int width, int height, int nchannels,
+                       const char *const *names, const float *const *data,
+                       gr_exr_pixel_type type, char *err, size_t err_len) {
+  gr_status st = GR_OK;
+  exr_result_t rv = EXR_ERR_SUCCESS;
+  exr_context_t ctxt = NULL;
+  exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
+  exr_encode_pipeline_t enc;
+  compress_hook hook;
+  int enc_live = 0;
+  int file_created = 0;
+  exr_msg msg;
+  int part = 0, c, longnames = 0;
+  int32_t lines = 0;
+  float *stage = NULL;
+  size_t stage_plane;
+  exr_pixel_type_t ptype;
+  int y;
+
+  memset(&enc, 0, sizeof enc);
+  memset(&msg, 0, sizeof msg);
+  hook.compress = NULL;
+
+  if (path == NULL || path[0] == '\0') {
+    set_err(err, err_len,
+            "The path given to gr_exr_write must not be NULL or empty.");
+    return GR_ERR_INVALID_ARGUMENT;
+  }
+  if (width < 1 || height < 1 || width > GR_EXR_MAX_DIM ||
+      height > GR_EXR_MAX_DIM) {
+    set_err(err, err_len,
+            "Cannot write '%s': the image is %d by %d pixels, outside 1 to %d.",
+            path, width, height, GR_EXR_MAX_DIM);
+    return GR_ERR_INVALID_ARGUMENT;
+  }
+  if (nchannels < 1 || nchannels > INT16_MAX) {
+    set_err(
+        err, err_len,
+        "Cannot write '%s': %d channels were given, and 1 to %d are allowed.",
+        path, nchannels, INT16_MAX);
+    return GR_ERR_INVALID_ARGUMENT;
+  }
+  if (type != GR_EXR_HALF && type != GR_EXR_FLOAT) {
+    set_err(err, err_len,
+            "Cannot write '%s': the pixel type %d is neither HALF nor FLOAT.",
+            path, (int)type);
+    return GR_ERR_INVALID_ARGUMENT;
+  }
+  if (names == NULL || data == NULL) {
+    set_err(err, err_len,
+            "Cannot write '%s': the channel names or data are missing.", path);
+    return GR_ERR_INVALID_ARGUMENT;
+  }
+  for (c = 0; c < nchannels; ++c) {
+    int k;
+    size_t len;
+    if (names[c] == NULL || names[c][0] == '\0') {
+      set_err(err, err_len, "Cannot write '%s': channel %d has no name.", path,
+              c);
+      return GR_ERR_INVALID_ARGUMENT;
+    }
+    len = strlen(names[c]);
+    if (len > GR_EXR_MAX_NAME) {
+      set_err(err, err_len,
+              "Cannot write '%s': the name of channel %d is %zu characters "
+              "long, and at most %d are allowed.",
+              path, c, len, GR_EXR_MAX_NAME);
+      return GR_ERR_INVALID_ARGUMENT;
+    }
+    if (len > 31)
+      longnames = 1;
+    if (data[c] == NULL) {
+      set_err(err, err_len, "Cannot write '%s': channel '%s' has no data.",
+              path, names[c]);
+      return GR_ERR_INVALID_ARGUMENT;
+    }
+    for (k = 0; k < c; ++k) {
+      if (strcmp(names[k], names[c]) == 0) {
+        set_err(err, err_len,
+                "Cannot write '%s': the channel name '%s' is given twice.",
+                path, names[c]);
+        return GR_ERR_INVALID_ARGUMENT;
+      }
+    }
+  }
+  if ((size_t)width * (size_t)height > GR_EXR_MAX_SAMPLES / (size_t)nchannels) {
+    set_err(err, err_len,
+            "Cannot write '%s': %d by %d pixels in %d channels is more than "
+            "the %llu samples allowed.",
+            path, width, height, nchannels,
+            (unsigned long long)GR_EXR_MAX_SAMPLES);
+    return GR_ERR_INVALID_ARGUMENT;
+  }
+  ptype = type == GR_EXR_HALF ? EXR_PIXEL_HALF : EXR_PIXEL_FLOAT;
+
+  init.error_handler_fn = &exr_capture_error;
+  init.user_data = &msg;
+
+  rv = exr_start_write(&ctxt, path, EXR_WRITE_FILE_DIRECTLY, &init);
+  if (rv != EXR_ERR_SUCCESS) {
+    st = rv == EXR_ERR_OUT_OF_MEMORY ? GR_ERR_OUT_OF_MEMORY : GR_ERR_IO;
+    set_err(err, err_len,
+            "Cannot write '%s': the file cannot be created (OpenEXR: %s).",
+            path, exr_detail(&msg, rv));
+    goto cleanup;
+  }
+  file_created = 1;
+
+  if (longnames)
+    rv = exr_set_longname_support(ctxt, 1);
+  if (rv == EXR_ERR_SUCCESS)
+    rv = exr_add_part(ctxt, NULL, EXR_STORAGE_SCANLINE, &part);
+  if (rv == EXR_ERR_SUCCESS)
+    rv = exr_initialize_required_attr_simple(ctxt, part, width, height,
+                                             EXR_COMPRESSION_ZIP);
+  for (c = 0; c < nchannels && rv == EXR_ERR_SUCCESS; ++c)
+    rv = exr_add_channel(ctxt, part, names[c], ptype, EXR_PERCEPTUALLY_LINEAR,
+                         1, 1);
+  if (rv == EXR_ERR_SUCCESS)
+    rv = exr_write_header(ctxt);
+  if (rv == EXR_ERR_SUCCESS)
+    rv = exr_get_scanlines_per_chunk(ctxt, part, &lines);
+  if (rv == EXR_ERR_SUCCESS && lines < 1)
+    rv = EXR_ERR_INVALID_ARGUMENT;
+  if (rv != EXR_ERR_SUCCESS) {
+    st = rv == EXR_ERR_OUT_OF_MEMORY ? GR_ERR_OUT_OF_MEMORY : GR_ERR_IO;
+    set_err(err, err_len,
+            "Cannot write '%s': the header could not be written (OpenEXR: %s).",
+            path, exr_detail(&msg, rv));
+    goto cleanup;
+  }
+
+  /* Float staging for one chunk: nchannels planes of width by at most
+   * lines rows. */
+  stage_plane = (size_t)width * (size_t)(lines < height ? lines : height);
+  if (stage_plane > SIZE_MAX / sizeof(float) / (size_t)nchannels) {
+    st = GR_ERR_OUT_OF_MEMORY;
+    set_err(err, err_len, "Cannot write '%s': out of memory.", path);
+    goto cleanup;
+  }
+  stage = (float *)malloc(stage_plane * (size_t)nchannels * sizeof(float));
+  if (stage == NULL) {
+    st = GR_ERR_OUT_OF_MEMORY;
+    set_err(err, err_len, "Cannot write '%s': out of memory.", path);
+    goto cleanup;
+  }
+
+  for (y = 0; y < height; y += lines) {
+    exr_chunk_info_t cinfo;
+    int nrows = height - y < lines ? height - y : lines;
+    int r;
+    memset(&cinfo, 0, sizeof cinfo);
+    rv = exr_write_scanline_chunk_info(ctxt, part, y, &cinfo);
+    if (rv == EXR_ERR_SUCCESS &&
+        (cinfo.height != nrows || cinfo.width != width))
+      rv = EXR_ERR_INCORRECT_CHUNK;
+    if (rv == EXR_ERR_SUCCESS) {
+      if (!enc_live) {
+        rv = exr_encoding_initialize(ctxt, part, &cinfo, &enc);
+        if (rv == EXR_ERR_SUCCESS)
+          enc_live = 1;
+      } else {
+        rv = exr_encoding_update(ctxt, part, &cinfo, &enc);
+      }
+    }
+    if (rv == EXR_ERR_SUCCESS && enc.channel_count != nchannels)
+      rv = EXR_ERR_INCORRECT_CHUNK;
+    /* File row y + r is memory row height - 1 - (y + r). */
+    for (c = 0; c < enc.channel_count && rv == EXR_ERR_SUCCESS; ++c) {
+      exr_coding_channel_info_t *ch = &enc.channels[c];
+      float *dst = stage + (size_t)c * stage_plane;
+      int k;
+      for (k = 0; k < nchannels; ++k) {
+        if (strcmp(names[k], ch->channel_name) == 0)
+          break;
+      }
+      if (k == nchannels) {
+        rv = EXR_ERR_INCORRECT_CHUNK;
+        break;
+      }
+      for (r = 0; r < nrows; ++r) {
+        size_t j = (size_t)(height - 1 - (y + r));
+        memcpy(dst + (size_t)r * (size_t)width, data[k] + j * (size_t)width,
+               (size_t)width * sizeof(float));
+      }
+      ch->encode_from_ptr = (const uint8_t *)dst;
+      ch->user_pixel_stride = (int32_t)sizeof(float);
+      ch->user_line_stride = (int32_t)((size_t)width * sizeof(float));
+      ch->user_bytes_per_element = (int16_t)sizeof(float);
+      ch->user_data_type = EXR_PIXEL_FLOAT;
+    }
+    if (rv == EXR_ERR_SUCCESS)
+      rv = exr_encoding_choose_default_routines(ctxt, part, &enc);
+    if (rv == EXR_ERR_SUCCESS && enc.compress_fn != NULL &&
+        enc.compress_fn != &compress_or_store) {
+      hook.compress = enc.compress_fn;
+      enc.encoding_user_data = &hook;
+      enc.compress_fn = &compress_or_store;
+    }
+    if (rv == EXR_ERR_SUCCESS)
+      rv = exr_encoding_run(ctxt, part, &enc);
+    if (rv != EXR_ERR_SUCCESS) {
+      st = rv == EXR_ERR_OUT_OF_MEMORY ? GR_ERR_OUT_OF_MEMORY : GR_ERR_IO;
+      set_err(err, err_len,
+              "Cannot write '%s': scanlines %d to %d could not be written "
+              "(OpenEXR: %s).",
+              path, y, y + nrows - 1, exr_detail(&msg, rv));
+      goto cleanup;
+    }
+  }
+
+  if (enc_live) {
+    exr_encoding_destroy(ctxt, &enc);
+    enc_live = 0;
+  }
+  /* exr_finish writes the chunk offset table. */
+  rv = exr_finish(&ctxt);
+  if (rv != EXR_ERR_SUCCESS) {
+    st = GR_ERR_IO;
+    set_err(err, err_len,
+            "Cannot write '%s': the file could not be completed (OpenEXR: %s).",
+            path, exr_detail(&msg, rv));
+    goto cleanup;
+  }
+
+cleanup:
+  if (enc_live)
+    exr_encoding_destroy(ctxt, &enc);
+  if (ctxt != NULL)
+    exr_finish(&ctxt);
+  free(stage);
+  if (st != GR_OK && file_created)
+    remove(path);
+  return st;
+}

@@ -1,0 +1,821 @@
+/* OpenCL runtime of the Graupel core: device choice, the shared context,
+ * checked program/kernel/buffer helpers, and error reporting. */
+#include "graupel/cl_runtime.h"
+
+#include <ctype.h>
+#include <pthread.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define GR_ERROR_LEN 16384
+#define GR_MAX_PROGRAMS 32
+#define GR_MAX_SHARED 8
+
+typedef struct gr_program_entry {
+  char *key; /* name + '\n' + options */
+  cl_program program;
+} gr_program_entry;
+
+struct gr_context {
+  int refcount; /* guarded by gr_shared_lock */
+  int shared;
+  cl_platform_id platform;
+  cl_device_id device;
+  cl_context cl;
+  cl_command_queue queue;
+  char device_name[128];
+  char platform_name[128];
+  int is_gpu;
+  cl_ulong max_alloc, global_mem;
+  gr_log_fn log;
+  void *log_user;
+  pthread_mutex_t lock; /* guards programs and error */
+  gr_program_entry programs[GR_MAX_PROGRAMS];
+  int nprograms;
+  char error[GR_ERROR_LEN];
+};
+
+/* The only global mutable state: the table of shared contexts (one per
+ * device), and the per-thread text of errors that have no context. */
+static pthread_mutex_t gr_shared_lock = PTHREAD_MUTEX_INITIALIZER;
+static gr_context *gr_shared[GR_MAX_SHARED];
+static _Thread_local char gr_thread_error[GR_ERROR_LEN];
+
+const char *gr_status_string(gr_status st) {
+  switch (st) {
+  case GR_OK: return "GR_OK";
+  case GR_ERR_INVALID_ARGUMENT: return "GR_ERR_INVALID_ARGUMENT";
+  case GR_ERR_NO_PLATFORM: return "GR_ERR_NO_PLATFORM";
+  case GR_ERR_NO_DEVICE: return "GR_ERR_NO_DEVICE";
+  case GR_ERR_OPENCL: return "GR_ERR_OPENCL";
+  case GR_ERR_BUILD: return "GR_ERR_BUILD";
+  case GR_ERR_OUT_OF_MEMORY: return "GR_ERR_OUT_OF_MEMORY";
+  case GR_ERR_TOO_LARGE: return "GR_ERR_TOO_LARGE";
+  case GR_ERR_IO: return "GR_ERR_IO";
+  case GR_ERR_FORMAT: return "GR_ERR_FORMAT";
+  case GR_ERR_ABORTED: return "GR_ERR_ABORTED";
+  }
+  return "GR_ERR_UNKNOWN";
+}
+
+const char *gr_version_string(void) {
+#define GR_STR2(x) #x
+#define GR_STR(x) GR_STR2(x)
+  return GR_STR(GRAUPEL_VERSION_MAJOR) "." GR_STR(
+      GRAUPEL_VERSION_MINOR) "." GR_STR(GRAUPEL_VERSION_PATCH);
+}
+
+static const char *const gr_field_names[GR_FIELD_COUNT] = {
+    "elevation",     "snow_depth", "snow_density", "snow_surface",
+    "overlap",       "exposure",   "water_depth",  "water_surface",
+    "velocity",      "discharge",  "infiltrated",  "permeability",
+    "rain_rate"};
+
+const char *gr_field_name(gr_field f) {
+  return (f >= 0 && f < GR_FIELD_COUNT) ? gr_field_names[f] : NULL;
+}
+
+int gr_field_from_name(const char *name) {
+  if (!name)
+    return -1;
+  for (int i = 0; i < GR_FIELD_COUNT; ++i)
+    if (strcmp(name, gr_field_names[i]) == 0)
+      return i;
+  return -1;
+}
+
+int gr_field_components(gr_field f) { return f == GR_FIELD_VELOCITY ? 3 : 1; }
+
+gr_status gr_grid_validate(const gr_grid *g, char *msg, size_t msg_len) {
+  const char *why = NULL;
+  if (!g)
+    why = "no grid was given";
+  else if (g->nx < 1 || g->ny < 1)
+    why = "the grid needs at least one point in x and in y";
+  else if (!(g->dx > 0.0) || !(g->dy > 0.0) || g->dx > 1e12 || g->dy > 1e12)
+    why = "the grid spacing must be a positive, finite number of metres";
+  else if (!(g->x0 > -1e15 && g->x0 < 1e15 && g->y0 > -1e15 && g->y0 < 1e15))
+    why = "the grid origin must be finite";
+  else if ((double)g->nx * (double)g->ny > 4.0e9)
+    why = "the grid has more than 4e9 points";
+  else if (g->i0 < 0 || g->j0 < 0 || (double)g->i0 + g->nx > 2147483647.0 ||
+           (double)g->j0 + g->ny > 2147483647.0)
+    why = "the piece offset (i0, j0) must be non-negative and fit in int";
+  if (!why)
+    return GR_OK;
+  if (msg && msg_len)
+    snprintf(msg, msg_len, "Invalid grid: %s.", why);
+  return GR_ERR_INVALID_ARGUMENT;
+}
+
+/* ------------------------------------------------------------------ errors */
+
+static void gr_log(const gr_context *ctx, gr_log_level level, const char *msg) {
+  if (ctx && ctx->log)
+    ctx->log(ctx->log_user, level, msg);
+}
+
+gr_status gr_set_error(const gr_context *cctx, gr_status st, const char *fmt,
+                       ...) {
+  /* The error text is the one mutable part of a const context. */
+  gr_context *ctx = (gr_context *)cctx;
+  char *dst = ctx ? ctx->error : gr_thread_error;
+  va_list ap;
+  if (ctx)
+    pthread_mutex_lock(&ctx->lock);
+  va_start(ap, fmt);
+  vsnprintf(dst, GR_ERROR_LEN, fmt, ap);
+  va_end(ap);
+  if (ctx)
+    pthread_mutex_unlock(&ctx->lock);
+  if (ctx)
+    gr_log(ctx, GR_LOG_WARNING, dst);
+  return st;
+}
+
+const char *gr_last_error(const gr_context *ctx) {
+  return ctx ? ctx->error : gr_thread_error;
+}
+
+const char *gr_cl_error_name(cl_int err) {
+  switch (err) {
+#define GR_CASE(e)                                                             \
+  case e: return #e;
+    GR_CASE(CL_SUCCESS)
+    GR_CASE(CL_DEVICE_NOT_FOUND)
+    GR_CASE(CL_DEVICE_NOT_AVAILABLE)
+    GR_CASE(CL_COMPILER_NOT_AVAILABLE)
+    GR_CASE(CL_MEM_OBJECT_ALLOCATION_FAILURE)
+    GR_CASE(CL_OUT_OF_RESOURCES)
+    GR_CASE(CL_OUT_OF_HOST_MEMORY)
+    GR_CASE(CL_PROFILING_INFO_NOT_AVAILABLE)
+    GR_CASE(CL_MEM_COPY_OVERLAP)
+    GR_CASE(CL_IMAGE_FORMAT_MISMATCH)
+    GR_CASE(CL_IMAGE_FORMAT_NOT_SUPPORTED)
+    GR_CASE(CL_BUILD_PROGRAM_FAILURE)
+    GR_CASE(CL_MAP_FAILURE)
+    GR_CASE(CL_MISALIGNED_SUB_BUFFER_OFFSET)
+    GR_CASE(CL_EXEC_STATUS_ERROR_FOR_EVENTS_IN_WAIT_LIST)
+    GR_CASE(CL_COMPILE_PROGRAM_FAILURE)
+    GR_CASE(CL_LINKER_NOT_AVAILABLE)
+    GR_CASE(CL_LINK_PROGRAM_FAILURE)
+    GR_CASE(CL_DEVICE_PARTITION_FAILED)
+    GR_CASE(CL_KERNEL_ARG_INFO_NOT_AVAILABLE)
+    GR_CASE(CL_INVALID_VALUE)
+    GR_CASE(CL_INVALID_DEVICE_TYPE)
+    GR_CASE(CL_INVALID_PLATFORM)
+    GR_CASE(CL_INVALID_DEVICE)
+    GR_CASE(CL_INVALID_CONTEXT)
+    GR_CASE(CL_INVALID_QUEUE_PROPERTIES)
+    GR_CASE(CL_INVALID_COMMAND_QUEUE)
+    GR_CASE(CL_INVALID_HOST_PTR)
+    GR_CASE(CL_INVALID_MEM_OBJECT)
+    GR_CASE(CL_INVALID_IMAGE_FORMAT_DESCRIPTOR)
+    GR_CASE(CL_INVALID_IMAGE_SIZE)
+    GR_CASE(CL_INVALID_SAMPLER)
+    GR_CASE(CL_INVALID_BINARY)
+    GR_CASE(CL_INVALID_BUILD_OPTIONS)
+    GR_CASE(CL_INVALID_PROGRAM)
+    GR_CASE(CL_INVALID_PROGRAM_EXECUTABLE)
+    GR_CASE(CL_INVALID_KERNEL_NAME)
+    GR_CASE(CL_INVALID_KERNEL_DEFINITION)
+    GR_CASE(CL_INVALID_KERNEL)
+    GR_CASE(CL_INVALID_ARG_INDEX)
+    GR_CASE(CL_INVALID_ARG_VALUE)
+    GR_CASE(CL_INVALID_ARG_SIZE)
+    GR_CASE(CL_INVALID_KERNEL_ARGS)
+    GR_CASE(CL_INVALID_WORK_DIMENSION)
+    GR_CASE(CL_INVALID_WORK_GROUP_SIZE)
+    GR_CASE(CL_INVALID_WORK_ITEM_SIZE)
+    GR_CASE(CL_INVALID_GLOBAL_OFFSET)
+    GR_CASE(CL_INVALID_EVENT_WAIT_LIST)
+    GR_CASE(CL_INVALID_EVENT)
+    GR_CASE(CL_INVALID_OPERATION)
+    GR_CASE(CL_INVALID_GL_OBJECT)
+    GR_CASE(CL_INVALID_BUFFER_SIZE)
+    GR_CASE(CL_INVALID_MIP_LEVEL)
+    GR_CASE(CL_INVALID_GLOBAL_WORK_SIZE)
+    GR_CASE(CL_INVALID_PROPERTY)
+#undef GR_CASE
+  case -1001: return "CL_PLATFORM_NOT_FOUND_KHR";
+  }
+  return "an unknown OpenCL error";
+}
+
+gr_status gr_cl_check(const gr_context *ctx, cl_int err, const char *what) {
+  if (err == CL_SUCCESS)
+    return GR_OK;
+  gr_status st = (err == CL_MEM_OBJECT_ALLOCATION_FAILURE ||
+                  err == CL_OUT_OF_HOST_MEMORY || err == CL_OUT_OF_RESOURCES)
+                     ? GR_ERR_OUT_OF_MEMORY
+                     : GR_ERR_OPENCL;
+  return gr_set_error(ctx, st, "%s failed: %s (%d).", what,
+                      gr_cl_error_name(err), (int)err);
+}
+
+/* ----------------------------------------------------------------- devices */
+
+static void gr_device_string(cl_device_id d, cl_device_info what, char *buf,
+                             size_t len) {
+  buf[0] = '\0';
+  if (clGetDeviceInfo(d, what, len, buf, NULL) != CL_SUCCESS)
+    buf[0] = '\0';
+  buf[len - 1] = '\0';
+}
+
+static void gr_fill_device_info(cl_platform_id p, cl_device_id d,
+                                gr_device_info *info) {
+  cl_device_type type = 0;
+  cl_uint cu = 0;
+  cl_ulong mem = 0, alloc = 0;
+  memset(info, 0, sizeof(*info));
+  gr_device_string(d, CL_DEVICE_NAME, info->name, sizeof(info->name));
+  gr_device_string(d, CL_DEVICE_VENDOR, info->vendor, sizeof(info->vendor));
+  gr_device_string(d, CL_DEVICE_VERSION, info->version, sizeof(info->version));
+  if (clGetPlatformInfo(p, CL_PLATFORM_NAME, sizeof(info->platform),
+                        info->platform, NULL) != CL_SUCCESS)
+    info->platform[0] = '\0';
+  info->platform[sizeof(info->platform) - 1] = '\0';
+  clGetDeviceInfo(d, CL_DEVICE_TYPE, sizeof(type), &type, NULL);
+  clGetDeviceInfo(d, CL_DEVICE_MAX_COMPUTE_UNITS, sizeof(cu), &cu, NULL);
+  clGetDeviceInfo(d, CL_DEVICE_GLOBAL_MEM_SIZE, sizeof(mem), &mem, NULL);
+  clGetDeviceInfo(d, CL_DEVICE_MAX_MEM_ALLOC_SIZE, sizeof(alloc), &alloc,
+                  NULL);
+  info->is_gpu = (type & CL_DEVICE_TYPE_GPU) != 0;
+  info->is_cpu = (type & CL_DEVICE_TYPE_CPU) != 0;
+  info->compute_units = (int)cu;
+  info->global_mem_bytes = mem;
+  info->max_alloc_bytes = alloc;
+}
+
+/* Visits every device of every platform; stops when visit returns nonzero. */
+typedef int (*gr_device_visit)(void *user, cl_platform_id p, cl_device_id d);
+
+static gr_status gr_for_each_device(gr_device_visit visit, void *user) {
+  cl_uint np = 0;
+  cl_int err = clGetPlatformIDs(0, NULL, &np);
+  if (err == -1001 /* CL_PLATFORM_NOT_FOUND_KHR */ || (err == CL_SUCCESS && np == 0))
+    return gr_set_error(NULL, GR_ERR_NO_PLATFORM,
+                        "No OpenCL platform is installed: install an OpenCL "
+                        "driver (for the CPU, Debian's pocl-opencl-icd) and "
+                        "check that /etc/OpenCL/vendors lists it.");
+  if (err != CL_SUCCESS)
+    return gr_cl_check(NULL, err, "Listing the OpenCL platforms");
+  cl_platform_id plats[16];
+  if (np > 16)
+    np = 16;
+  err = clGetPlatformIDs(np, plats, NULL);
+  if (err != CL_SUCCESS)
+    return gr_cl_check(NULL, err, "Listing the OpenCL platforms");
+  for (cl_uint p = 0; p < np; ++p) {
+    cl_uint nd = 0;
+    if (clGetDeviceIDs(plats[p], CL_DEVICE_TYPE_ALL, 0, NULL, &nd) !=
+            CL_SUCCESS ||
+        nd == 0)
+      continue;
+    cl_device_id devs[32];
+    if (nd > 32)
+      nd = 32;
+    if (clGetDeviceIDs(plats[p], CL_DEVICE_TYPE_ALL, nd, devs, NULL) !=
+        CL_SUCCESS)
+      continue;
+    for (cl_uint d = 0; d < nd; ++d)
+      if (visit(user, plats[p], devs[d]))
+        return GR_OK;
+  }
+  return GR_OK;
+}
+
+typedef struct gr_list_state {
+  gr_device_info *infos;
+  int max, count;
+} gr_list_state;
+
+static int gr_list_visit(void *user, cl_platform_id p, cl_device_id d) {
+  gr_list_state *s = user;
+  if (s->count < s->max)
+    gr_fill_device_info(p, d, &s->infos[s->count]);
+  s->count++;
+  return 0;
+}
+
+gr_status gr_device_list(gr_device_info *infos, int max, int *count) {
+  if (!count || max < 0 || (max > 0 && !infos))
+    return gr_set_error(NULL, GR_ERR_INVALID_ARGUMENT,
+                        "gr_device_list needs a count pointer and room for "
+                        "max entries.");
+  gr_list_state s = {infos, max, 0};
+  gr_status st = gr_for_each_device(gr_list_visit, &s);
+  *count = s.count;
+  return st;
+}
+
+/* Device choice: the request is "gpu", "cpu", "auto" or a name substring. */
+typedef struct gr_pick_state {
+  const char *want; /* normalised request */
+  cl_platform_id first_gpu_p, first_cpu_p, first_any_p, match_p;
+  cl_device_id first_gpu, first_cpu, first_any, match;
+} gr_pick_state;
+
+static int gr_contains_nocase(const char *hay, const char *needle) {
+  size_t n = strlen(needle);
+  for (; *hay; ++hay) {
+    size_t i = 0;
+    while (i < n && hay[i] &&
+           tolower((unsigned char)hay[i]) == tolower((unsigned char)needle[i]))
+      ++i;
+    if (i == n)
+      return 1;
+  }
+  return n == 0;
+}
+
+static int gr_pick_visit(void *user, cl_platform_id p, cl_device_id d) {
+  gr_pick_state *s = user;
+  gr_device_info info;
+  gr_fill_device_info(p, d, &info);
+  if (!s->first_any) {
+    s->first_any = d;
+    s->first_any_p = p;
+  }
+  if (info.is_gpu && !s->first_gpu) {
+    s->first_gpu = d;
+    s->first_gpu_p = p;
+  }
+  if (info.is_cpu && !s->first_cpu) {
+    s->first_cpu = d;
+    s->first_cpu_p = p;
+  }
+  if (!s->match && s->want[0] &&
+      (gr_contains_nocase(info.name, s->want) ||
+       gr_contains_nocase(info.platform, s->want))) {
+    s->match = d;
+    s->match_p = p;
+  }
+  return 0;
+}
+
+static const char *gr_effective_request(const gr_context_options *opt) {
+  const char *req = opt ? opt->device : NULL;
+  if (!req || !req[0] || strcmp(req, "auto") == 0) {
+    req = getenv("GRAUPEL_DEVICE");
+    if (!req || !req[0])
+      req = "auto";
+  }
+  return req;
+}
+
+static gr_status gr_pick_device(const gr_context_options *opt,
+                                cl_platform_id *pp, cl_device_id *pd) {
+  const char *req = gr_effective_request(opt);
+  gr_pick_state s;
+  memset(&s, 0, sizeof(s));
+  s.want = "";
+  int want_gpu = strcmp(req, "gpu") == 0 || strcmp(req, "GPU") == 0;
+  int want_cpu = strcmp(req, "cpu") == 0 || strcmp(req, "CPU") == 0;
+  int want_auto = strcmp(req, "auto") == 0;
+  if (!want_gpu && !want_cpu && !want_auto)
+    s.want = req;
+  gr_status st = gr_for_each_device(gr_pick_visit, &s);
+  if (st != GR_OK)
+    return st;
+  if (want_gpu) {
+    *pd = s.first_gpu;
+    *pp = s.first_gpu_p;
+  } else if (want_cpu) {
+    *pd = s.first_cpu;
+    *pp = s.first_cpu_p;
+  } else if (want_auto) {
+    *pd = s.first_gpu ? s.first_gpu : s.first_cpu ? s.first_cpu : s.first_any;
+    *pp = s.first_gpu ? s.first_gpu_p
+          : s.first_cpu ? s.first_cpu_p
+                        : s.first_any_p;
+  } else {
+    *pd = s.match;
+    *pp = s.match_p;
+  }
+  if (!*pd)
+    return gr_set_error(
+        NULL, GR_ERR_NO_DEVICE,
+        "No OpenCL device matches the request '%s' (from %s): use 'gpu', "
+        "'cpu', 'auto' or part of a device name that clinfo -l shows.",
+        req, (opt && opt->device && opt->device[0] && strcmp(opt->device, "auto"))
+                 ? "the device option"
+                 : "GRAUPEL_DEVICE");
+  return GR_OK;
+}
+
+/* ---------------------------------------------------------------- contexts */
+
+void gr_context_options_init(gr_context_options *opt) {
+  if (opt)
+    memset(opt, 0, sizeof(*opt));
+}
+
+static void gr_context_free(gr_context *ctx) {
+  for (int i = 0; i < ctx->nprograms; ++i) {
+    clReleaseProgram(ctx->programs[i].program);
+    free(ctx->programs[i].key);
+  }
+  if (ctx->queue)
+    clReleaseCommandQueue(ctx->queue);
+  if (ctx->cl)
+    clReleaseContext(ctx->cl);
+  pthread_mutex_destroy(&ctx->lock);
+  free(ctx);
+}
+
+static gr_status gr_context_open(const gr_context_options *opt,
+                                 cl_platform_id p, cl_device_id d,
+                                 gr_context **out) {
+  cl_int err = CL_SUCCESS;
+  gr_context *ctx = calloc(1, sizeof(*ctx));
+  if (!ctx)
+    return gr_set_error(NULL, GR_ERR_OUT_OF_MEMORY,
+                        "Out of host memory while creating a context.");
+  pthread_mutex_init(&ctx->lock, NULL);
+  ctx->refcount = 1;
+  ctx->platform = p;
+  ctx->device = d;
+  if (opt) {
+    ctx->log = opt->log;
+    ctx->log_user = opt->log_user;
+  }
+  gr_device_info info;
+  gr_fill_device_info(p, d, &info);
+  snprintf(ctx->device_name, sizeof(ctx->device_name), "%s", info.name);
+  snprintf(ctx->platform_name, sizeof(ctx->platform_name), "%s", info.platform);
+  ctx->is_gpu = info.is_gpu;
+  ctx->max_alloc = info.max_alloc_bytes;
+  ctx->global_mem = info.global_mem_bytes;
+
+  cl_context_properties props[] = {CL_CONTEXT_PLATFORM,
+                                   (cl_context_properties)p, 0};
+  ctx->cl = clCreateContext(props, 1, &d, NULL, NULL, &err);
+  if (err != CL_SUCCESS) {
+    gr_status st = gr_cl_check(NULL, err, "Creating the OpenCL context");
+    gr_context_free(ctx);
+    return st;
+  }
+  /* clCreateCommandQueue is deprecated in 2.0 but is what 1.2 devices have. */
+#if defined(__GNUC__)
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wdeprecated-declarations"
+#endif
+  ctx->queue = clCreateCommandQueue(ctx->cl, d, 0, &err);
+#if defined(__GNUC__)
+#pragma GCC diagnostic pop
+#endif
+  if (err != CL_SUCCESS) {
+    gr_status st = gr_cl_check(NULL, err, "Creating the OpenCL command queue");
+    gr_context_free(ctx);
+    return st;
+  }
+  char line[400];
+  snprintf(line, sizeof(line), "Graupel uses OpenCL device '%s' (%s).",
+           ctx->device_name, ctx->platform_name);
+  gr_log(ctx, GR_LOG_INFO, line);
+  *out = ctx;
+  return GR_OK;
+}
+
+gr_status gr_context_create(const gr_context_options *opt, gr_context **out) {
+  if (!out)
+    return gr_set_error(NULL, GR_ERR_INVALID_ARGUMENT,
+                        "gr_context_create needs a place for the context.");
+  *out = NULL;
+  cl_platform_id p = NULL;
+  cl_device_id d = NULL;
+  gr_status st = gr_pick_device(opt, &p, &d);
+  if (st != GR_OK)
+    return st;
+  return gr_context_open(opt, p, d, out);
+}
+
+gr_status gr_context_acquire(const gr_context_options *opt, gr_context **out) {
+  if (!out)
+    return gr_set_error(NULL, GR_ERR_INVALID_ARGUMENT,
+                        "gr_context_acquire needs a place for the context.");
+  *out = NULL;
+  cl_platform_id p = NULL;
+  cl_device_id d = NULL;
+  gr_status st = gr_pick_device(opt, &p, &d);
+  if (st != GR_OK)
+    return st;
+  pthread_mutex_lock(&gr_shared_lock);
+  for (int i = 0; i < GR_MAX_SHARED; ++i)
+    if (gr_shared[i] && gr_shared[i]->device == d) {
+      gr_shared[i]->refcount++;
+      *out = gr_shared[i];
+      pthread_mutex_unlock(&gr_shared_lock);
+      return GR_OK;
+    }
+  int slot = -1;
+  for (int i = 0; i < GR_MAX_SHARED && slot < 0; ++i)
+    if (!gr_shared[i])
+      slot = i;
+  if (slot < 0) {
+    pthread_mutex_unlock(&gr_shared_lock);
+    return gr_set_error(NULL, GR_ERR_TOO_LARGE,
+                        "More than %d OpenCL devices are in use at once.",
+                        GR_MAX_SHARED);
+  }
+  st = gr_context_open(opt, p, d, out);
+  if (st == GR_OK) {
+    (*out)->shared = 1;
+    gr_shared[slot] = *out;
+  }
+  pthread_mutex_unlock(&gr_shared_lock);
+  return st;
+}
+
+gr_context *gr_context_retain(gr_context *ctx) {
+  if (ctx) {
+    pthread_mutex_lock(&gr_shared_lock);
+    ctx->refcount++;
+    pthread_mutex_unlock(&gr_shared_lock);
+  }
+  return ctx;
+}
+
+void gr_context_release(gr_context *ctx) {
+  if (!ctx)
+    return;
+  pthread_mutex_lock(&gr_shared_lock);
+  int last = --ctx->refcount == 0;
+  if (last && ctx->shared)
+    for (int i = 0; i < GR_MAX_SHARED; ++i)
+      if (gr_shared[i] == ctx)
+        gr_shared[i] = NULL;
+  pthread_mutex_unlock(&gr_shared_lock);
+  if (last)
+    gr_context_free(ctx);
+}
+
+int gr_context_refcount(const gr_context *ctx) {
+  if (!ctx)
+    return 0;
+  pthread_mutex_lock(&gr_shared_lock);
+  int n = ctx->refcount;
+  pthread_mutex_unlock(&gr_shared_lock);
+  return n;
+}
+
+const char *gr_context_device_name(const gr_context *ctx) {
+  return ctx ? ctx->device_name : "";
+}
+const char *gr_context_platform_name(const gr_context *ctx) {
+  return ctx ? ctx->platform_name : "";
+}
+int gr_context_is_gpu(const gr_context *ctx) { return ctx ? ctx->is_gpu : 0; }
+cl_context gr_context_cl(const gr_context *ctx) { return ctx ? ctx->cl : NULL; }
+cl_command_queue gr_context_queue(const gr_context *ctx) {
+  return ctx ? ctx->queue : NULL;
+}
+cl_device_id gr_context_device(const gr_context *ctx) {
+  return ctx ? ctx->device : NULL;
+}
+
+gr_status gr_context_device_info(const gr_context *ctx, gr_device_info *info) {
+  if (!ctx || !info)
+    return gr_set_error(ctx, GR_ERR_INVALID_ARGUMENT,
+                        "gr_context_device_info needs a context and an info.");
+  gr_fill_device_info(ctx->platform, ctx->device, info);
+  return GR_OK;
+}
+
+/* ---------------------------------------------------------------- programs */
+
+static gr_status gr_build(gr_context *ctx, const char *label,
+                          const char *source, const char *options,
+                          cl_program *out) {
+  cl_int err = CL_SUCCESS;
+  const char *src[1] = {source};
+  cl_program prog = clCreateProgramWithSource(ctx->cl, 1, src, NULL, &err);
+  if (err != CL_SUCCESS)
+    return gr_cl_check(ctx, err, "Creating an OpenCL program");
+  /* FP_CONTRACT stays off inside the sources; -cl-std pins the language. */
+  char opts[1024];
+  snprintf(opts, sizeof(opts), "-cl-std=CL1.2 %s", options ? options : "");
+  err = clBuildProgram(prog, 1, &ctx->device, opts, NULL, NULL);
+  if (err != CL_SUCCESS) {
+    size_t len = 0;
+    char *log = NULL;
+    clGetProgramBuildInfo(prog, ctx->device, CL_PROGRAM_BUILD_LOG, 0, NULL,
+                          &len);
+    if (len > 0 && (log = malloc(len + 1)) != NULL) {
+      if (clGetProgramBuildInfo(prog, ctx->device, CL_PROGRAM_BUILD_LOG, len,
+                                log, NULL) != CL_SUCCESS)
+        log[0] = '\0';
+      log[len] = '\0';
+    }
+    gr_status st = gr_set_error(
+        ctx, GR_ERR_BUILD,
+        "The OpenCL program '%s' failed to build on '%s' (%s). Build log:\n%s",
+        label, ctx->device_name, gr_cl_error_name(err),
+        log && log[0] ? log : "(the driver gave no log)");
+    free(log);
+    clReleaseProgram(prog);
+    return st;
+  }
+  *out = prog;
+  return GR_OK;
+}
+
+gr_status gr_program_build_source(gr_context *ctx, const char *source,
+                                  const char *options, cl_program *out) {
+  if (!ctx || !source || !out)
+    return gr_set_error(ctx, GR_ERR_INVALID_ARGUMENT,
+                        "gr_program_build_source needs a context, a source "
+                        "and a place for the program.");
+  *out = NULL;
+  return gr_build(ctx, "(user source)", source, options, out);
+}
+
+gr_status gr_program_get(gr_context *ctx, const char *name,
+                         const char *options, cl_program *out) {
+  if (!ctx || !name || !out)
+    return gr_set_error(ctx, GR_ERR_INVALID_ARGUMENT,
+                        "gr_program_get needs a context, a name and a place "
+                        "for the program.");
+  *out = NULL;
+  const char *source = gr_kernel_source_find(name);
+  if (!source)
+    return gr_set_error(ctx, GR_ERR_INVALID_ARGUMENT,
+                        "No kernel source named '%s' is built into Graupel.",
+                        name);
+  if (!options)
+    options = "";
+  size_t klen = strlen(name) + strlen(options) + 2;
+  char *key = malloc(klen);
+  if (!key)
+    return gr_set_error(ctx, GR_ERR_OUT_OF_MEMORY, "Out of host memory.");
+  snprintf(key, klen, "%s\n%s", name, options);
+
+  /* Build under the lock so two filters don't build the same program. */
+  pthread_mutex_lock(&ctx->lock);
+  for (int i = 0; i < ctx->nprograms; ++i)
+    if (strcmp(ctx->programs[i].key, key) == 0) {
+      *out = ctx->programs[i].program;
+      pthread_mutex_unlock(&ctx->lock);
+      free(key);
+      return GR_OK;
+    }
+  pthread_mutex_unlock(&ctx->lock);
+
+  cl_program prog = NULL;
+  gr_status st = gr_build(ctx, name, source, options, &prog);
+  if (st != GR_OK) {
+    free(key);
+    return st;
+  }
+  pthread_mutex_lock(&ctx->lock);
+  for (int i = 0; i < ctx->nprograms; ++i)
+    if (strcmp(ctx->programs[i].key, key) == 0) { /* another thread won */
+      *out = ctx->programs[i].program;
+      pthread_mutex_unlock(&ctx->lock);
+      clReleaseProgram(prog);
+      free(key);
+      return GR_OK;
+    }
+  if (ctx->nprograms == GR_MAX_PROGRAMS) {
+    pthread_mutex_unlock(&ctx->lock);
+    clReleaseProgram(prog);
+    free(key);
+    return gr_set_error(ctx, GR_ERR_TOO_LARGE,
+                        "More than %d program variants were built on one "
+                        "context.",
+                        GR_MAX_PROGRAMS);
+  }
+  ctx->programs[ctx->nprograms].key = key;
+  ctx->programs[ctx->nprograms].program = prog;
+  ctx->nprograms++;
+  pthread_mutex_unlock(&ctx->lock);
+  *out = prog;
+  return GR_OK;
+}
+
+gr_status gr_kernel_create(gr_context *ctx, cl_program prog, const char *name,
+                           cl_kernel *out) {
+  cl_int err = CL_SUCCESS;
+  if (!ctx || !prog || !name || !out)
+    return gr_set_error(ctx, GR_ERR_INVALID_ARGUMENT,
+                        "gr_kernel_create needs a context, a program and a "
+                        "kernel name.");
+  *out = clCreateKernel(prog, name, &err);
+  if (err != CL_SUCCESS) {
+    *out = NULL;
+    return gr_set_error(ctx, GR_ERR_OPENCL,
+                        "The kernel '%s' could not be created: %s.", name,
+                        gr_cl_error_name(err));
+  }
+  return GR_OK;
+}
+
+gr_status gr_kernel_args(gr_context *ctx, cl_kernel k, ...) {
+  va_list ap;
+  va_start(ap, k);
+  for (cl_uint i = 0;; ++i) {
+    size_t size = va_arg(ap, size_t);
+    if (size == 0)
+      break;
+    const void *value = va_arg(ap, const void *);
+    cl_int err = clSetKernelArg(k, i, size, value);
+    if (err != CL_SUCCESS) {
+      va_end(ap);
+      char kname[128] = "";
+      clGetKernelInfo(k, CL_KERNEL_FUNCTION_NAME, sizeof(kname), kname, NULL);
+      kname[sizeof(kname) - 1] = '\0';
+      return gr_set_error(ctx, GR_ERR_OPENCL,
+                          "Setting argument %u of kernel '%s' failed: %s.", i,
+                          kname, gr_cl_error_name(err));
+    }
+  }
+  va_end(ap);
+  return GR_OK;
+}
+
+gr_status gr_enqueue_2d(gr_context *ctx, cl_kernel k, size_t nx, size_t ny,
+                        const size_t *local) {
+  size_t global[2] = {nx, ny};
+  if (local) {
+    global[0] = (nx + local[0] - 1) / local[0] * local[0];
+    global[1] = (ny + local[1] - 1) / local[1] * local[1];
+  }
+  cl_int err = clEnqueueNDRangeKernel(ctx->queue, k, 2, NULL, global, local, 0,
+                                      NULL, NULL);
+  return gr_cl_check(ctx, err, "Enqueueing a kernel");
+}
+
+gr_status gr_finish(gr_context *ctx) {
+  return gr_cl_check(ctx, clFinish(ctx->queue), "Waiting for the device");
+}
+
+/* ------------------------------------------------------- embedded sources */
+
+/* Generated at build time from the files in cl/ by EmbedKernels.cmake. */
+extern const gr_kernel_source gr_embedded_kernels[];
+extern const int gr_embedded_kernel_count;
+
+int gr_kernel_source_count(void) { return gr_embedded_kernel_count; }
+
+const gr_kernel_source *gr_kernel_source_at(int i) {
+  return (i >= 0 && i < gr_embedded_kernel_count) ? &gr_embedded_kernels[i]
+                                                  : NULL;
+}
+
+const char *gr_kernel_source_find(const char *name) {
+  for (int i = 0; name && i < gr_embedded_kernel_count; ++i)
+    if (strcmp(gr_embedded_kernels[i].name, name) == 0)
+      return gr_embedded_kernels[i].text;
+  return NULL;
+}
+
+/* ----------------------------------------------------------------- buffers */
+
+gr_status gr_buffer_create(gr_context *ctx, cl_mem_flags flags, size_t size,
+                           const void *host, cl_mem *out) {
+  if (!ctx || !out || size == 0)
+    return gr_set_error(ctx, GR_ERR_INVALID_ARGUMENT,
+                        "A device buffer needs a context and a size above 0.");
+  *out = NULL;
+  if ((cl_ulong)size > ctx->max_alloc || (cl_ulong)size > ctx->global_mem)
+    return gr_set_error(
+        ctx, GR_ERR_TOO_LARGE,
+        "The grid needs a buffer of %.1f MiB but the device '%s' allows at "
+        "most %.1f MiB per buffer: use a smaller grid or another device.",
+        (double)size / 1048576.0, ctx->device_name,
+        (double)ctx->max_alloc / 1048576.0);
+  cl_int err = CL_SUCCESS;
+  if (host)
+    flags |= CL_MEM_COPY_HOST_PTR;
+  *out = clCreateBuffer(ctx->cl, flags, size, (void *)host, &err);
+  if (err != CL_SUCCESS) {
+    *out = NULL;
+    return gr_cl_check(ctx, err, "Allocating a device buffer");
+  }
+  return GR_OK;
+}
+
+gr_status gr_buffer_write(gr_context *ctx, cl_mem buf, size_t offset,
+                          size_t size, const void *host) {
+  cl_int err = clEnqueueWriteBuffer(ctx->queue, buf, CL_TRUE, offset, size,
+                                    host, 0, NULL, NULL);
+  return gr_cl_check(ctx, err, "Uploading a field to the device");
+}
+
+gr_status gr_buffer_read(gr_context *ctx, cl_mem buf, size_t offset,
+                         size_t size, void *host) {
+  cl_int err = clEnqueueReadBuffer(ctx->queue, buf, CL_TRUE, offset, size,
+                                   host, 0, NULL, NULL);
+  return gr_cl_check(ctx, err, "Reading a field back from the device");
+}
+
+void gr_buffer_release(cl_mem *buf) {
+  if (buf && *buf) {
+    clReleaseMemObject(*buf);
+    *buf = NULL;
+  }
+}
