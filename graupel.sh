@@ -65,7 +65,10 @@ ensure_vtk_deps() {
 configure_and_build() { # dir, source, extra cmake args...
   local dir=$1 src=$2; shift 2
   if [ ! -f "$dir/CMakeCache.txt" ]; then
-    cmake -S "$src" -B "$dir" -DCMAKE_BUILD_TYPE=Release -DGRAUPEL_WERROR=ON "$@"
+    # Debian's python3 (the one pvpython and python3-vtk9 use), not whatever
+    # python3 comes first on PATH.
+    cmake -S "$src" -B "$dir" -DCMAKE_BUILD_TYPE=Release -DGRAUPEL_WERROR=ON \
+      -DPython3_EXECUTABLE=/usr/bin/python3 "$@"
   fi
   cmake --build "$dir" -j"$JOBS"
 }
