@@ -1,5 +1,5 @@
-"""The plugin loads in the ParaView GUI: starts `paraview` under Xvfb with
-PV_PLUGIN_PATH set, lets it run gui_plugin_script.py and exit, and checks what
+"""The plugin loads in the ParaView GUI: starts `paraview` (on the test
+session's Xvfb) with PV_PLUGIN_PATH set, lets it run gui_plugin_script.py and exit, and checks what
 the script recorded."""
 import os
 import subprocess
@@ -11,7 +11,7 @@ result = os.path.join(scratch, "gui_result.txt")
 if os.path.exists(result):
     os.remove(result)
 env = dict(os.environ, GRAUPEL_GUI_RESULT=result)
-cmd = ["xvfb-run", "-a", "-s", "-screen 0 1280x1024x24", "paraview",
+cmd = ["paraview",
        "--script=" + os.path.join(here, "gui_plugin_script.py"), "--exit"]
 proc = subprocess.run(cmd, env=env, timeout=240)
 text = open(result).read().strip() if os.path.exists(result) else ""

@@ -3,30 +3,32 @@
  * normalisation is documented in graupel/terrain_noise.h. */
 #include "common.h"
 
-/* 16 unit gradients at multiples of 22.5 degrees. */
-__constant float2 gr_gradients[16] = {
-    (float2)(1.0f, 0.0f),           (float2)(0.9238795f, 0.3826834f),
-    (float2)(0.7071068f, 0.7071068f), (float2)(0.3826834f, 0.9238795f),
-    (float2)(0.0f, 1.0f),           (float2)(-0.3826834f, 0.9238795f),
-    (float2)(-0.7071068f, 0.7071068f), (float2)(-0.9238795f, 0.3826834f),
-    (float2)(-1.0f, 0.0f),          (float2)(-0.9238795f, -0.3826834f),
-    (float2)(-0.7071068f, -0.7071068f), (float2)(-0.3826834f, -0.9238795f),
-    (float2)(0.0f, -1.0f),          (float2)(0.3826834f, -0.9238795f),
-    (float2)(0.7071068f, -0.7071068f), (float2)(0.9238795f, -0.3826834f)};
+/* 16 unit gradients at multiples of 22.5 degrees, as separate x and y
+ * tables: scalar loads keep the kernel vectorisable on CPUs. */
+__constant float gr_grad_x[16] = {
+    1.0f,        0.9238795f,  0.7071068f,  0.3826834f,
+    0.0f,        -0.3826834f, -0.7071068f, -0.9238795f,
+    -1.0f,       -0.9238795f, -0.7071068f, -0.3826834f,
+    0.0f,        0.3826834f,  0.7071068f,  0.9238795f};
+__constant float gr_grad_y[16] = {
+    0.0f,        0.3826834f,  0.7071068f,  0.9238795f,
+    1.0f,        0.9238795f,  0.7071068f,  0.3826834f,
+    0.0f,        -0.3826834f, -0.7071068f, -0.9238795f,
+    -1.0f,       -0.9238795f, -0.7071068f, -0.3826834f};
 
-inline float gr_fade(float t) {
+GR_INLINE float gr_fade(float t) {
   /* 6t^5 - 15t^4 + 10t^3: C2-continuous interpolation weight. */
   return t * t * t * (t * (t * 6.0f - 15.0f) + 10.0f);
 }
 
-inline float gr_corner(int ix, int iy, uint seed, float fx, float fy) {
-  float2 g = gr_gradients[gr_hash3(ix, iy, seed) & 15U];
-  return g.x * fx + g.y * fy;
+GR_INLINE float gr_corner(int ix, int iy, uint seed, float fx, float fy) {
+  uint k = gr_hash3(ix, iy, seed) & 15U;
+  return gr_grad_x[k] * fx + gr_grad_y[k] * fy;
 }
 
 /* Gradient noise at lattice cell (ix, iy) with fractional position (fx, fy)
  * in [0, 1); scaled by sqrt(2) so that |result| <= 1. */
-inline float gr_gradient_noise(int ix, int iy, float fx, float fy,
+GR_INLINE float gr_gradient_noise(int ix, int iy, float fx, float fy,
                                uint seed) {
   float u = gr_fade(fx), v = gr_fade(fy);
   float n00 = gr_corner(ix, iy, seed, fx, fy);
@@ -45,29 +47,43 @@ inline float gr_gradient_noise(int ix, int iy, float fx, float fy,
  * where lat_o is the integer part of the grid origin in that octave's lattice
  * units and frac_o its fraction. Splitting the origin this way keeps full
  * float precision far from (0, 0), so distant tiles are as detailed as near
- * ones. table[o] = (frac_x, frac_y, step_x, step_y), amp[o] = octave weight
- * (p^o, or lambda^(-oH) for ridged), lattice[o] = (lat_x, lat_y). */
-__kernel void terrain_noise_generate(__global float *elevation, int nx, int ny,
-                                     int i0, int j0,
-                                     __global const float4 *table,
-                                     __global const float *amp,
-                                     __global const int2 *lattice, uint seed,
+ * ones. table[4o..4o+3] = (frac_x, frac_y, step_x, step_y), amp[o] = octave
+ * weight (p^o, or lambda^(-oH) for ridged), lattice[2o..2o+1] = (lat_x,
+ * lat_y). Scalar arrays rather than float4/int2: vector-typed values inside
+ * the work-item loop stop PoCL's vectoriser. */
+__kernel void terrain_noise_generate(__global float *restrict elevation,
+                                     int nx, int ny, int i0, int j0,
+                                     __global const float *restrict table,
+                                     __global const float *restrict amp,
+                                     __global const int *restrict lattice,
+                                     uint seed,
                                      int kind, int octaves, float offset,
                                      float gain, int invert,
                                      float height_scale) {
   int i = get_global_id(0), j = get_global_id(1);
   if (!gr_inside(i, j, nx, ny))
     return;
+  /* The host compiles one variant per noise type and octave count, so the
+   * loop below has a constant trip count: unrolled, it is straight-line code
+   * that CPU compilers (PoCL) vectorise across work-items. */
+#ifdef GR_TERRAIN_OCTAVES
+  octaves = GR_TERRAIN_OCTAVES;
+#endif
+#ifdef GR_TERRAIN_KIND
+  kind = GR_TERRAIN_KIND;
+#endif
   float sum = 0.0f, norm = 0.0f;
   float weight = 1.0f; /* ridged: the previous octave's weight */
+#ifdef GR_TERRAIN_OCTAVES
+#pragma unroll
+#endif
   for (int o = 0; o < octaves; ++o) {
-    float4 t = table[o];
-    int2 lat = lattice[o];
-    float x = t.x + (float)(i0 + i) * t.z;
-    float y = t.y + (float)(j0 + j) * t.w;
+    float x = table[4 * o] + (float)(i0 + i) * table[4 * o + 2];
+    float y = table[4 * o + 1] + (float)(j0 + j) * table[4 * o + 3];
     float fx = floor(x), fy = floor(y);
-    float g = gr_gradient_noise(lat.x + (int)fx, lat.y + (int)fy, x - fx,
-                                y - fy, seed + (uint)o);
+    float g = gr_gradient_noise(lattice[2 * o] + (int)fx,
+                                lattice[2 * o + 1] + (int)fy, x - fx, y - fy,
+                                seed + (uint)o);
     float a = amp[o];
     if (kind == 0) {
       float s = offset - fabs(g);

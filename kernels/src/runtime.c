@@ -10,7 +10,6 @@
 #include <string.h>
 
 #define GR_ERROR_LEN 16384
-#define GR_MAX_PROGRAMS 32
 #define GR_MAX_SHARED 8
 
 typedef struct gr_program_entry {
@@ -32,8 +31,8 @@ struct gr_context {
   gr_log_fn log;
   void *log_user;
   pthread_mutex_t lock; /* guards programs and error */
-  gr_program_entry programs[GR_MAX_PROGRAMS];
-  int nprograms;
+  gr_program_entry *programs; /* grows: one entry per (source, options) */
+  int nprograms, capacity;
   char error[GR_ERROR_LEN];
 };
 
@@ -419,6 +418,7 @@ static void gr_context_free(gr_context *ctx) {
     clReleaseProgram(ctx->programs[i].program);
     free(ctx->programs[i].key);
   }
+  free(ctx->programs);
   if (ctx->queue)
     clReleaseCommandQueue(ctx->queue);
   if (ctx->cl)
@@ -680,14 +680,18 @@ gr_status gr_program_get(gr_context *ctx, const char *name,
       free(key);
       return GR_OK;
     }
-  if (ctx->nprograms == GR_MAX_PROGRAMS) {
-    pthread_mutex_unlock(&ctx->lock);
-    clReleaseProgram(prog);
-    free(key);
-    return gr_set_error(ctx, GR_ERR_TOO_LARGE,
-                        "More than %d program variants were built on one "
-                        "context.",
-                        GR_MAX_PROGRAMS);
+  if (ctx->nprograms == ctx->capacity) {
+    int cap = ctx->capacity ? 2 * ctx->capacity : 16;
+    gr_program_entry *grown =
+        realloc(ctx->programs, (size_t)cap * sizeof(*grown));
+    if (!grown) {
+      pthread_mutex_unlock(&ctx->lock);
+      clReleaseProgram(prog);
+      free(key);
+      return gr_set_error(ctx, GR_ERR_OUT_OF_MEMORY, "Out of host memory.");
+    }
+    ctx->programs = grown;
+    ctx->capacity = cap;
   }
   ctx->programs[ctx->nprograms].key = key;
   ctx->programs[ctx->nprograms].program = prog;

@@ -143,7 +143,10 @@ gr_status gr_terrain_noise_create(gr_context *ctx, const gr_grid *grid,
   t->params = *p;
   cl_program prog = NULL;
   size_t bytes = (size_t)grid->nx * (size_t)grid->ny * sizeof(cl_float);
-  gr_status st = gr_program_get(ctx, "terrain_noise", NULL, &prog);
+  char options[96];
+  snprintf(options, sizeof(options), "-DGR_TERRAIN_OCTAVES=%d -DGR_TERRAIN_KIND=%d",
+           p->octaves, (int)p->type);
+  gr_status st = gr_program_get(ctx, "terrain_noise", options, &prog);
   if (st == GR_OK)
     st = gr_kernel_create(ctx, prog, "terrain_noise_generate", &t->kernel);
   if (st == GR_OK)

@@ -30,8 +30,21 @@ int main(int argc, char **argv) {
       fprintf(stderr, "graupel-clc: %s\n", gr_last_error(ctx));
       failed = 1;
     } else {
-      printf("graupel-clc: %s.cl compiles on %s\n", src->name,
-             gr_context_device_name(ctx));
+      /* A clean build has an empty log: show whatever the compiler said, and
+       * treat warnings as errors so they are fixed, not scrolled past. */
+      char log[8192] = "";
+      cl_device_id dev = gr_context_device(ctx);
+      clGetProgramBuildInfo(prog, dev, CL_PROGRAM_BUILD_LOG, sizeof(log), log,
+                            NULL);
+      log[sizeof(log) - 1] = '\0';
+      if (strstr(log, "warning")) {
+        fprintf(stderr, "graupel-clc: %s.cl has warnings:\n%s\n", src->name,
+                log);
+        failed = 1;
+      } else {
+        printf("graupel-clc: %s.cl compiles on %s\n", src->name,
+               gr_context_device_name(ctx));
+      }
     }
   }
   gr_context_release(ctx);
