@@ -16,7 +16,7 @@ JOBS=$(nproc 2>/dev/null || echo 2)
 PACKAGES=(
   paraview paraview-dev python3-paraview python3-numpy
   pocl-opencl-icd ocl-icd-opencl-dev opencl-headers clinfo
-  libopenexr-dev libglm-dev xvfb xauth cmake g++ make
+  libopenexr-dev libglm-dev xvfb xauth cmake g++ make clang-format
   qtbase5-dev libqt5svg5-dev qttools5-dev qtxmlpatterns5-dev-tools
   libqt5x11extras5-dev libqt5opengl5-dev
   # find_package(ParaView) also needs these development files:

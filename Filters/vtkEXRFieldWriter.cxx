@@ -15,65 +15,53 @@ vtkStandardNewMacro(vtkEXRFieldWriter);
 
 vtkEXRFieldWriter::vtkEXRFieldWriter() = default;
 
-vtkEXRFieldWriter::~vtkEXRFieldWriter()
-{
+vtkEXRFieldWriter::~vtkEXRFieldWriter() {
   this->SetFileName(nullptr);
 }
 
-void vtkEXRFieldWriter::AddArrayName(const char* name)
-{
+void vtkEXRFieldWriter::AddArrayName(const char *name) {
   if (name && *name &&
-    std::find(this->ArrayNames.begin(), this->ArrayNames.end(), name) == this->ArrayNames.end())
-  {
+      std::find(this->ArrayNames.begin(), this->ArrayNames.end(), name) == this->ArrayNames.end()) {
     this->ArrayNames.emplace_back(name);
     this->Modified();
   }
 }
 
-void vtkEXRFieldWriter::ClearArrayNames()
-{
-  if (!this->ArrayNames.empty())
-  {
+void vtkEXRFieldWriter::ClearArrayNames() {
+  if (!this->ArrayNames.empty()) {
     this->ArrayNames.clear();
     this->Modified();
   }
 }
 
-int vtkEXRFieldWriter::GetNumberOfArrayNames() const
-{
+int vtkEXRFieldWriter::GetNumberOfArrayNames() const {
   return static_cast<int>(this->ArrayNames.size());
 }
 
-const char* vtkEXRFieldWriter::GetArrayName(int i) const
-{
+const char *vtkEXRFieldWriter::GetArrayName(int i) const {
   return (i >= 0 && i < static_cast<int>(this->ArrayNames.size())) ? this->ArrayNames[i].c_str()
-                                                                    : nullptr;
+                                                                   : nullptr;
 }
 
-vtkImageData* vtkEXRFieldWriter::GetInput()
-{
+vtkImageData *vtkEXRFieldWriter::GetInput() {
   return vtkImageData::SafeDownCast(this->Superclass::GetInput());
 }
 
-int vtkEXRFieldWriter::FillInputPortInformation(int, vtkInformation* info)
-{
+int vtkEXRFieldWriter::FillInputPortInformation(int, vtkInformation *info) {
   info->Set(vtkAlgorithm::INPUT_REQUIRED_DATA_TYPE(), "vtkImageData");
   return 1;
 }
 
-void vtkEXRFieldWriter::WriteData()
-{
-  vtkImageData* input = this->GetInput();
-  if (!this->FileName || !*this->FileName)
-  {
+void vtkEXRFieldWriter::WriteData() {
+  vtkImageData *input = this->GetInput();
+  if (!this->FileName || !*this->FileName) {
     vtkErrorMacro("EXR Field Writer: no FileName was set; give the path of the .exr to write.");
     this->SetErrorCode(vtkErrorCode::NoFileNameError);
     return;
   }
   int dims[3];
   input->GetDimensions(dims);
-  if (dims[2] != 1 || dims[0] < 1 || dims[1] < 1)
-  {
+  if (dims[2] != 1 || dims[0] < 1 || dims[1] < 1) {
     vtkErrorMacro("EXR Field Writer: the input image is " << dims[0] << " x " << dims[1] << " x "
                                                           << dims[2]
                                                           << "; only 2-D images (one point in z)"
@@ -81,35 +69,27 @@ void vtkEXRFieldWriter::WriteData()
     this->SetErrorCode(vtkErrorCode::UserError);
     return;
   }
-  vtkPointData* pd = input->GetPointData();
-  std::vector<vtkDataArray*> chosen;
-  if (this->ArrayNames.empty())
-  {
-    for (int a = 0; a < pd->GetNumberOfArrays(); ++a)
-    {
-      if (vtkDataArray* arr = pd->GetArray(a))
-      {
+  vtkPointData *pd = input->GetPointData();
+  std::vector<vtkDataArray *> chosen;
+  if (this->ArrayNames.empty()) {
+    for (int a = 0; a < pd->GetNumberOfArrays(); ++a) {
+      if (vtkDataArray *arr = pd->GetArray(a)) {
         chosen.push_back(arr);
       }
     }
-  }
-  else
-  {
-    for (const std::string& name : this->ArrayNames)
-    {
-      vtkDataArray* arr = pd->GetArray(name.c_str());
-      if (!arr)
-      {
+  } else {
+    for (const std::string &name : this->ArrayNames) {
+      vtkDataArray *arr = pd->GetArray(name.c_str());
+      if (!arr) {
         vtkErrorMacro("EXR Field Writer: the input has no numeric point array '"
-          << name << "'; choose among the arrays the input has.");
+                      << name << "'; choose among the arrays the input has.");
         this->SetErrorCode(vtkErrorCode::UserError);
         return;
       }
       chosen.push_back(arr);
     }
   }
-  if (chosen.empty())
-  {
+  if (chosen.empty()) {
     vtkErrorMacro("EXR Field Writer: the input has no numeric point arrays to write.");
     this->SetErrorCode(vtkErrorCode::UserError);
     return;
@@ -118,56 +98,46 @@ void vtkEXRFieldWriter::WriteData()
   const vtkIdType n = static_cast<vtkIdType>(dims[0]) * dims[1];
   std::vector<std::string> names;
   std::vector<std::vector<float>> planes;
-  for (vtkDataArray* arr : chosen)
-  {
+  for (vtkDataArray *arr : chosen) {
     const int nc = arr->GetNumberOfComponents();
     const std::string base = arr->GetName() ? arr->GetName() : "unnamed";
-    for (int c = 0; c < nc; ++c)
-    {
+    for (int c = 0; c < nc; ++c) {
       std::string name = base;
-      if (nc == 3)
-      {
+      if (nc == 3) {
         name += std::string(".") + "xyz"[c];
-      }
-      else if (nc > 1)
-      {
+      } else if (nc > 1) {
         name += "." + std::to_string(c);
       }
       std::vector<float> plane(static_cast<size_t>(n));
-      for (vtkIdType k = 0; k < n; ++k)
-      {
+      for (vtkIdType k = 0; k < n; ++k) {
         plane[static_cast<size_t>(k)] = static_cast<float>(arr->GetComponent(k, c));
       }
       names.push_back(name);
       planes.push_back(std::move(plane));
     }
   }
-  std::vector<const char*> namePtrs;
-  std::vector<const float*> dataPtrs;
-  for (size_t c = 0; c < names.size(); ++c)
-  {
+  std::vector<const char *> namePtrs;
+  std::vector<const float *> dataPtrs;
+  for (size_t c = 0; c < names.size(); ++c) {
     namePtrs.push_back(names[c].c_str());
     dataPtrs.push_back(planes[c].data());
   }
   char err[1024] = "";
-  gr_status st = gr_exr_write(this->FileName, dims[0], dims[1], static_cast<int>(names.size()),
-    namePtrs.data(), dataPtrs.data(),
-    this->PixelType == HALF ? GR_EXR_HALF : GR_EXR_FLOAT, err, sizeof(err));
-  if (st != GR_OK)
-  {
+  gr_status st = gr_exr_write(
+      this->FileName, dims[0], dims[1], static_cast<int>(names.size()), namePtrs.data(),
+      dataPtrs.data(), this->PixelType == HALF ? GR_EXR_HALF : GR_EXR_FLOAT, err, sizeof(err));
+  if (st != GR_OK) {
     vtkErrorMacro("EXR Field Writer: " << err);
     this->SetErrorCode(vtkErrorCode::CannotOpenFileError);
   }
 }
 
-void vtkEXRFieldWriter::PrintSelf(ostream& os, vtkIndent indent)
-{
+void vtkEXRFieldWriter::PrintSelf(ostream &os, vtkIndent indent) {
   this->Superclass::PrintSelf(os, indent);
   os << indent << "FileName: " << (this->FileName ? this->FileName : "(none)") << "\n";
   os << indent << "PixelType: " << (this->PixelType == HALF ? "half" : "float") << "\n";
   os << indent << "ArrayNames:";
-  for (const std::string& name : this->ArrayNames)
-  {
+  for (const std::string &name : this->ArrayNames) {
     os << " " << name;
   }
   os << "\n";

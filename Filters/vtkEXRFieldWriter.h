@@ -20,18 +20,13 @@
 
 class vtkImageData;
 
-class GRAUPELFILTERS_EXPORT vtkEXRFieldWriter : public vtkWriter
-{
+class GRAUPELFILTERS_EXPORT vtkEXRFieldWriter : public vtkWriter {
 public:
-  static vtkEXRFieldWriter* New();
+  static vtkEXRFieldWriter *New();
   vtkTypeMacro(vtkEXRFieldWriter, vtkWriter);
-  void PrintSelf(ostream& os, vtkIndent indent) override;
+  void PrintSelf(ostream &os, vtkIndent indent) override;
 
-  enum PixelTypes
-  {
-    HALF = 1,
-    FLOAT = 2
-  };
+  enum PixelTypes { HALF = 1, FLOAT = 2 };
 
   ///@{
   /** The .exr file to write. */
@@ -49,28 +44,28 @@ public:
   /**
    * Point arrays to write. With none chosen, every point array is written.
    */
-  void AddArrayName(const char* name);
+  void AddArrayName(const char *name);
   void ClearArrayNames();
   int GetNumberOfArrayNames() const;
-  const char* GetArrayName(int i) const;
+  const char *GetArrayName(int i) const;
   ///@}
 
-  vtkImageData* GetInput();
+  vtkImageData *GetInput();
 
 protected:
   vtkEXRFieldWriter();
   ~vtkEXRFieldWriter() override;
 
   void WriteData() override;
-  int FillInputPortInformation(int port, vtkInformation* info) override;
+  int FillInputPortInformation(int port, vtkInformation *info) override;
 
-  char* FileName = nullptr;
+  char *FileName = nullptr;
   int PixelType = FLOAT;
   std::vector<std::string> ArrayNames;
 
 private:
-  vtkEXRFieldWriter(const vtkEXRFieldWriter&) = delete;
-  void operator=(const vtkEXRFieldWriter&) = delete;
+  vtkEXRFieldWriter(const vtkEXRFieldWriter &) = delete;
+  void operator=(const vtkEXRFieldWriter &) = delete;
 };
 
 #endif

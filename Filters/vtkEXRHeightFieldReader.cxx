@@ -22,71 +22,60 @@ vtkStandardNewMacro(vtkEXRHeightFieldReader);
 
 // The image most recently read, kept until the file or its time stamp
 // changes, so RequestInformation and RequestData read the file once.
-struct vtkEXRHeightFieldReader::Cache
-{
+struct vtkEXRHeightFieldReader::Cache {
   std::string path;
   long long mtime = 0;
   long long size = 0;
   gr_exr_image image{};
   Cache() = default;
-  Cache(const Cache&) = delete;
-  Cache& operator=(const Cache&) = delete;
+  Cache(const Cache &) = delete;
+  Cache &operator=(const Cache &) = delete;
   ~Cache() { gr_exr_image_free(&this->image); }
 };
 
-vtkEXRHeightFieldReader::vtkEXRHeightFieldReader()
-{
+vtkEXRHeightFieldReader::vtkEXRHeightFieldReader() {
   this->SetNumberOfInputPorts(0);
 }
 
-vtkEXRHeightFieldReader::~vtkEXRHeightFieldReader()
-{
+vtkEXRHeightFieldReader::~vtkEXRHeightFieldReader() {
   this->SetFileName(nullptr);
 }
 
-int vtkEXRHeightFieldReader::CanReadFile(const char* filename)
-{
-  if (!filename)
-  {
+int vtkEXRHeightFieldReader::CanReadFile(const char *filename) {
+  if (!filename) {
     return 0;
   }
-  FILE* f = std::fopen(filename, "rb");
-  if (!f)
-  {
+  FILE *f = std::fopen(filename, "rb");
+  if (!f) {
     return 0;
   }
-  unsigned char magic[4] = { 0, 0, 0, 0 };
+  unsigned char magic[4] = {0, 0, 0, 0};
   size_t n = std::fread(magic, 1, 4, f);
   std::fclose(f);
   return n == 4 && magic[0] == 0x76 && magic[1] == 0x2f && magic[2] == 0x31 && magic[3] == 0x01;
 }
 
-bool vtkEXRHeightFieldReader::Load()
-{
-  if (!this->FileName || !*this->FileName)
-  {
+bool vtkEXRHeightFieldReader::Load() {
+  if (!this->FileName || !*this->FileName) {
     vtkErrorMacro("EXR Height Field Reader: no FileName was set; give the path of an .exr file.");
     return false;
   }
   struct stat st;
-  if (stat(this->FileName, &st) != 0)
-  {
-    vtkErrorMacro("EXR Height Field Reader: the file '" << this->FileName
-                                                        << "' does not exist or cannot be accessed.");
+  if (stat(this->FileName, &st) != 0) {
+    vtkErrorMacro("EXR Height Field Reader: the file '"
+                  << this->FileName << "' does not exist or cannot be accessed.");
     this->Loaded.reset();
     return false;
   }
   long long mtime = static_cast<long long>(st.st_mtime);
   if (this->Loaded && this->Loaded->path == this->FileName && this->Loaded->mtime == mtime &&
-    this->Loaded->size == static_cast<long long>(st.st_size))
-  {
+      this->Loaded->size == static_cast<long long>(st.st_size)) {
     return true;
   }
   std::unique_ptr<Cache> cache(new Cache);
   char err[1024] = "";
   gr_status status = gr_exr_read(this->FileName, &cache->image, err, sizeof(err));
-  if (status != GR_OK)
-  {
+  if (status != GR_OK) {
     vtkErrorMacro("EXR Height Field Reader: " << err);
     this->Loaded.reset();
     return false;
@@ -98,23 +87,20 @@ bool vtkEXRHeightFieldReader::Load()
   return true;
 }
 
-int vtkEXRHeightFieldReader::RequestInformation(
-  vtkInformation*, vtkInformationVector**, vtkInformationVector* outputVector)
-{
-  if (!(this->Spacing[0] > 0.0) || !(this->Spacing[1] > 0.0))
-  {
+int vtkEXRHeightFieldReader::RequestInformation(vtkInformation *, vtkInformationVector **,
+                                                vtkInformationVector *outputVector) {
+  if (!(this->Spacing[0] > 0.0) || !(this->Spacing[1] > 0.0)) {
     vtkErrorMacro("EXR Height Field Reader: Spacing must be above 0 m in x and y; got "
-      << this->Spacing[0] << " " << this->Spacing[1] << ".");
+                  << this->Spacing[0] << " " << this->Spacing[1] << ".");
     return 0;
   }
-  if (!this->Load())
-  {
+  if (!this->Load()) {
     return 0;
   }
-  const gr_exr_image& img = this->Loaded->image;
-  vtkInformation* outInfo = outputVector->GetInformationObject(0);
-  int extent[6] = { 0, img.width - 1, 0, img.height - 1, 0, 0 };
-  double spacing[3] = { this->Spacing[0], this->Spacing[1], 1.0 };
+  const gr_exr_image &img = this->Loaded->image;
+  vtkInformation *outInfo = outputVector->GetInformationObject(0);
+  int extent[6] = {0, img.width - 1, 0, img.height - 1, 0, 0};
+  double spacing[3] = {this->Spacing[0], this->Spacing[1], 1.0};
   outInfo->Set(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT(), extent, 6);
   outInfo->Set(vtkDataObject::SPACING(), spacing, 3);
   outInfo->Set(vtkDataObject::ORIGIN(), this->Origin, 3);
@@ -122,75 +108,61 @@ int vtkEXRHeightFieldReader::RequestInformation(
   return 1;
 }
 
-namespace
-{
+namespace {
 // "velocity.x" -> base "velocity", component 0; anything else -> -1.
-int VectorComponent(const std::string& name, std::string& base)
-{
-  static const char* suffixes[3] = { ".x", ".y", ".z" };
-  for (int c = 0; c < 3; ++c)
-  {
+int VectorComponent(const std::string &name, std::string &base) {
+  static const char *suffixes[3] = {".x", ".y", ".z"};
+  for (int c = 0; c < 3; ++c) {
     size_t n = name.size();
-    if (n > 2 && name.compare(n - 2, 2, suffixes[c]) == 0)
-    {
+    if (n > 2 && name.compare(n - 2, 2, suffixes[c]) == 0) {
       base = name.substr(0, n - 2);
       return c;
     }
   }
   return -1;
 }
-}
+} // namespace
 
-int vtkEXRHeightFieldReader::RequestData(
-  vtkInformation*, vtkInformationVector**, vtkInformationVector* outputVector)
-{
-  vtkImageData* output = vtkImageData::GetData(outputVector);
+int vtkEXRHeightFieldReader::RequestData(vtkInformation *, vtkInformationVector **,
+                                         vtkInformationVector *outputVector) {
+  vtkImageData *output = vtkImageData::GetData(outputVector);
   output->Initialize();
-  if (!this->Load())
-  {
+  if (!this->Load()) {
     return 0;
   }
-  const gr_exr_image& img = this->Loaded->image;
+  const gr_exr_image &img = this->Loaded->image;
   const vtkIdType n = static_cast<vtkIdType>(img.width) * img.height;
 
   std::vector<vtkSmartPointer<vtkFloatArray>> arrays;
   std::vector<bool> used(img.nchannels, false);
   // Vectors first: NAME.x, NAME.y and NAME.z together make one array.
-  for (int c = 0; c < img.nchannels; ++c)
-  {
+  for (int c = 0; c < img.nchannels; ++c) {
     std::string base;
-    if (VectorComponent(img.names[c], base) != 0)
-    {
+    if (VectorComponent(img.names[c], base) != 0) {
       continue;
     }
-    int comp[3] = { c, gr_exr_find_channel(&img, (base + ".y").c_str()),
-      gr_exr_find_channel(&img, (base + ".z").c_str()) };
-    if (comp[1] < 0 || comp[2] < 0)
-    {
+    int comp[3] = {c, gr_exr_find_channel(&img, (base + ".y").c_str()),
+                   gr_exr_find_channel(&img, (base + ".z").c_str())};
+    if (comp[1] < 0 || comp[2] < 0) {
       continue;
     }
     vtkNew<vtkFloatArray> a;
     a->SetName(base.c_str());
     a->SetNumberOfComponents(3);
     a->SetNumberOfTuples(n);
-    float* dst = a->GetPointer(0);
-    for (vtkIdType k = 0; k < n; ++k)
-    {
-      for (int d = 0; d < 3; ++d)
-      {
+    float *dst = a->GetPointer(0);
+    for (vtkIdType k = 0; k < n; ++k) {
+      for (int d = 0; d < 3; ++d) {
         dst[3 * k + d] = img.data[comp[d]][k];
       }
     }
-    for (int d = 0; d < 3; ++d)
-    {
+    for (int d = 0; d < 3; ++d) {
       used[comp[d]] = true;
     }
     arrays.emplace_back(a.Get());
   }
-  for (int c = 0; c < img.nchannels; ++c)
-  {
-    if (used[c])
-    {
+  for (int c = 0; c < img.nchannels; ++c) {
+    if (used[c]) {
       continue;
     }
     vtkNew<vtkFloatArray> a;
@@ -207,25 +179,19 @@ int vtkEXRHeightFieldReader::RequestData(
   output->SetSpacing(this->Spacing[0], this->Spacing[1], 1.0);
   output->SetOrigin(this->Origin);
   vtkIdType nonFinite = 0;
-  for (auto& a : arrays)
-  {
-    if (std::strcmp(a->GetName(), "elevation") == 0)
-    {
-      float* v = a->GetPointer(0);
-      for (vtkIdType k = 0; k < n; ++k)
-      {
+  for (auto &a : arrays) {
+    if (std::strcmp(a->GetName(), "elevation") == 0) {
+      float *v = a->GetPointer(0);
+      for (vtkIdType k = 0; k < n; ++k) {
         v[k] = static_cast<float>(v[k] * this->HeightScale);
         nonFinite += std::isfinite(v[k]) ? 0 : 1;
       }
       output->GetPointData()->SetScalars(a);
-    }
-    else
-    {
+    } else {
       output->GetPointData()->AddArray(a);
     }
   }
-  if (nonFinite > 0)
-  {
+  if (nonFinite > 0) {
     vtkWarningMacro("EXR Height Field Reader: '" << this->FileName << "' has " << nonFinite
                                                  << " elevation values that are NaN or infinite"
                                                     " (no-data cells); simulations will refuse"
@@ -234,12 +200,11 @@ int vtkEXRHeightFieldReader::RequestData(
   return 1;
 }
 
-void vtkEXRHeightFieldReader::PrintSelf(ostream& os, vtkIndent indent)
-{
+void vtkEXRHeightFieldReader::PrintSelf(ostream &os, vtkIndent indent) {
   this->Superclass::PrintSelf(os, indent);
   os << indent << "FileName: " << (this->FileName ? this->FileName : "(none)") << "\n";
   os << indent << "Spacing: " << this->Spacing[0] << " " << this->Spacing[1] << "\n";
-  os << indent << "Origin: " << this->Origin[0] << " " << this->Origin[1] << " "
-     << this->Origin[2] << "\n";
+  os << indent << "Origin: " << this->Origin[0] << " " << this->Origin[1] << " " << this->Origin[2]
+     << "\n";
   os << indent << "HeightScale: " << this->HeightScale << "\n";
 }

@@ -17,11 +17,10 @@
 struct gr_context;
 class vtkDataObject;
 
-class GRAUPELFILTERS_EXPORT vtkGraupelAlgorithm : public vtkImageAlgorithm
-{
+class GRAUPELFILTERS_EXPORT vtkGraupelAlgorithm : public vtkImageAlgorithm {
 public:
   vtkTypeMacro(vtkGraupelAlgorithm, vtkImageAlgorithm);
-  void PrintSelf(ostream& os, vtkIndent indent) override;
+  void PrintSelf(ostream &os, vtkIndent indent) override;
 
   ///@{
   /**
@@ -29,12 +28,12 @@ public:
    * the first CPU), "gpu", "cpu", or part of a device name as `clinfo -l`
    * lists it. Changing it moves the next update to that device.
    */
-  virtual void SetDevice(const char* device);
+  virtual void SetDevice(const char *device);
   vtkGetStringMacro(Device);
   ///@}
 
   /** Name of the device the last update ran on ("" before the first). */
-  const char* GetDeviceName() const;
+  const char *GetDeviceName() const;
 
 protected:
   vtkGraupelAlgorithm();
@@ -44,24 +43,24 @@ protected:
    * The shared context for the chosen device, acquired on first use.
    * nullptr after reporting the reason with vtkErrorMacro.
    */
-  gr_context* GetContext();
+  gr_context *GetContext();
 
   /**
    * Reports a failed core call as one error sentence ("<what>: <detail>")
    * and returns 0, the value RequestData returns on failure.
    */
-  int ReportFailure(int status, const char* what);
+  int ReportFailure(int status, const char *what);
 
   /** Adds the `graupel_device` string to the output's field data. */
-  void AddDeviceFieldData(vtkDataObject* output);
+  void AddDeviceFieldData(vtkDataObject *output);
 
-  char* Device = nullptr;
+  char *Device = nullptr;
 
 private:
-  vtkGraupelAlgorithm(const vtkGraupelAlgorithm&) = delete;
-  void operator=(const vtkGraupelAlgorithm&) = delete;
+  vtkGraupelAlgorithm(const vtkGraupelAlgorithm &) = delete;
+  void operator=(const vtkGraupelAlgorithm &) = delete;
 
-  gr_context* Context = nullptr;
+  gr_context *Context = nullptr;
 };
 
 #endif

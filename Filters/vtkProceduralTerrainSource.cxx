@@ -13,25 +13,22 @@
 
 vtkStandardNewMacro(vtkProceduralTerrainSource);
 
-vtkProceduralTerrainSource::vtkProceduralTerrainSource()
-{
+vtkProceduralTerrainSource::vtkProceduralTerrainSource() {
   this->SetNumberOfInputPorts(0);
 }
 
-int vtkProceduralTerrainSource::RequestInformation(
-  vtkInformation*, vtkInformationVector**, vtkInformationVector* outputVector)
-{
-  vtkInformation* outInfo = outputVector->GetInformationObject(0);
-  if (this->Dimensions[0] < 1 || this->Dimensions[1] < 1 || !(this->Spacing > 0.0))
-  {
+int vtkProceduralTerrainSource::RequestInformation(vtkInformation *, vtkInformationVector **,
+                                                   vtkInformationVector *outputVector) {
+  vtkInformation *outInfo = outputVector->GetInformationObject(0);
+  if (this->Dimensions[0] < 1 || this->Dimensions[1] < 1 || !(this->Spacing > 0.0)) {
     vtkErrorMacro("Procedural Terrain needs Dimensions of at least 1 x 1 and a Spacing above 0 m;"
                   " got "
-      << this->Dimensions[0] << " x " << this->Dimensions[1] << " and " << this->Spacing
-      << " m.");
+                  << this->Dimensions[0] << " x " << this->Dimensions[1] << " and " << this->Spacing
+                  << " m.");
     return 0;
   }
-  int extent[6] = { 0, this->Dimensions[0] - 1, 0, this->Dimensions[1] - 1, 0, 0 };
-  double spacing[3] = { this->Spacing, this->Spacing, 1.0 };
+  int extent[6] = {0, this->Dimensions[0] - 1, 0, this->Dimensions[1] - 1, 0, 0};
+  double spacing[3] = {this->Spacing, this->Spacing, 1.0};
   outInfo->Set(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT(), extent, 6);
   outInfo->Set(vtkDataObject::SPACING(), spacing, 3);
   outInfo->Set(vtkDataObject::ORIGIN(), this->Origin, 3);
@@ -41,11 +38,10 @@ int vtkProceduralTerrainSource::RequestInformation(
   return 1;
 }
 
-int vtkProceduralTerrainSource::RequestData(
-  vtkInformation*, vtkInformationVector**, vtkInformationVector* outputVector)
-{
-  vtkInformation* outInfo = outputVector->GetInformationObject(0);
-  vtkImageData* output = vtkImageData::GetData(outInfo);
+int vtkProceduralTerrainSource::RequestData(vtkInformation *, vtkInformationVector **,
+                                            vtkInformationVector *outputVector) {
+  vtkInformation *outInfo = outputVector->GetInformationObject(0);
+  vtkImageData *output = vtkImageData::GetData(outInfo);
   int extent[6];
   outInfo->Get(vtkStreamingDemandDrivenPipeline::UPDATE_EXTENT(), extent);
   output->Initialize();
@@ -64,8 +60,7 @@ int vtkProceduralTerrainSource::RequestData(
   p.invert = this->Invert ? 1 : 0;
   p.height_scale = this->HeightScale;
   char msg[256];
-  if (gr_terrain_noise_params_validate(&p, msg, sizeof(msg)) != GR_OK)
-  {
+  if (gr_terrain_noise_params_validate(&p, msg, sizeof(msg)) != GR_OK) {
     vtkErrorMacro("Procedural Terrain: " << msg);
     return 0;
   }
@@ -78,14 +73,12 @@ int vtkProceduralTerrainSource::RequestData(
   grid.y0 = this->Origin[1];
   grid.i0 = extent[0];
   grid.j0 = extent[2];
-  if (grid.nx < 1 || grid.ny < 1)
-  {
+  if (grid.nx < 1 || grid.ny < 1) {
     return 1; // an empty piece (more MPI ranks than rows) is a valid answer
   }
 
-  gr_context* ctx = this->GetContext();
-  if (!ctx)
-  {
+  gr_context *ctx = this->GetContext();
+  if (!ctx) {
     return 0;
   }
   this->UpdateProgress(0.0);
@@ -93,8 +86,7 @@ int vtkProceduralTerrainSource::RequestData(
   elevation->SetName("elevation");
   elevation->SetNumberOfTuples(static_cast<vtkIdType>(grid.nx) * grid.ny);
   gr_status st = gr_terrain_noise_generate(ctx, &grid, &p, elevation->GetPointer(0));
-  if (st != GR_OK)
-  {
+  if (st != GR_OK) {
     return this->ReportFailure(st, "Procedural Terrain could not compute the noise");
   }
 
@@ -107,13 +99,12 @@ int vtkProceduralTerrainSource::RequestData(
   return 1;
 }
 
-void vtkProceduralTerrainSource::PrintSelf(ostream& os, vtkIndent indent)
-{
+void vtkProceduralTerrainSource::PrintSelf(ostream &os, vtkIndent indent) {
   this->Superclass::PrintSelf(os, indent);
   os << indent << "Dimensions: " << this->Dimensions[0] << " " << this->Dimensions[1] << "\n";
   os << indent << "Spacing: " << this->Spacing << "\n";
-  os << indent << "Origin: " << this->Origin[0] << " " << this->Origin[1] << " "
-     << this->Origin[2] << "\n";
+  os << indent << "Origin: " << this->Origin[0] << " " << this->Origin[1] << " " << this->Origin[2]
+     << "\n";
   os << indent << "Seed: " << this->Seed << "\n";
   os << indent << "NoiseType: " << this->NoiseType << "\n";
   os << indent << "Octaves: " << this->Octaves << "\n";

@@ -18,19 +18,13 @@
 #include "GraupelFiltersModule.h"
 #include "vtkGraupelAlgorithm.h"
 
-class GRAUPELFILTERS_EXPORT vtkProceduralTerrainSource : public vtkGraupelAlgorithm
-{
+class GRAUPELFILTERS_EXPORT vtkProceduralTerrainSource : public vtkGraupelAlgorithm {
 public:
-  static vtkProceduralTerrainSource* New();
+  static vtkProceduralTerrainSource *New();
   vtkTypeMacro(vtkProceduralTerrainSource, vtkGraupelAlgorithm);
-  void PrintSelf(ostream& os, vtkIndent indent) override;
+  void PrintSelf(ostream &os, vtkIndent indent) override;
 
-  enum NoiseTypes
-  {
-    RIDGED_MULTIFRACTAL = 0,
-    FBM = 1,
-    BILLOW = 2
-  };
+  enum NoiseTypes { RIDGED_MULTIFRACTAL = 0, FBM = 1, BILLOW = 2 };
 
   ///@{
   /** Number of points in x and y (default 512 512). */
@@ -121,12 +115,13 @@ protected:
   vtkProceduralTerrainSource();
   ~vtkProceduralTerrainSource() override = default;
 
-  int RequestInformation(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
-  int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
+  int RequestInformation(vtkInformation *, vtkInformationVector **,
+                         vtkInformationVector *) override;
+  int RequestData(vtkInformation *, vtkInformationVector **, vtkInformationVector *) override;
 
-  int Dimensions[2] = { 512, 512 };
+  int Dimensions[2] = {512, 512};
   double Spacing = 2.0;
-  double Origin[3] = { 0.0, 0.0, 0.0 };
+  double Origin[3] = {0.0, 0.0, 0.0};
   int Seed = 0;
   int NoiseType = RIDGED_MULTIFRACTAL;
   int Octaves = 6;
@@ -140,8 +135,8 @@ protected:
   double HeightScale = 120.0;
 
 private:
-  vtkProceduralTerrainSource(const vtkProceduralTerrainSource&) = delete;
-  void operator=(const vtkProceduralTerrainSource&) = delete;
+  vtkProceduralTerrainSource(const vtkProceduralTerrainSource &) = delete;
+  void operator=(const vtkProceduralTerrainSource &) = delete;
 };
 
 #endif

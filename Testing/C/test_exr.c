@@ -41,8 +41,7 @@ static unsigned char *load_bytes(const char *path, size_t *n) {
   *n = 0;
   if (f == NULL)
     return NULL;
-  if (fseek(f, 0, SEEK_END) == 0 && (sz = ftell(f)) > 0 &&
-      fseek(f, 0, SEEK_SET) == 0) {
+  if (fseek(f, 0, SEEK_END) == 0 && (sz = ftell(f)) > 0 && fseek(f, 0, SEEK_SET) == 0) {
     buf = (unsigned char *)malloc((size_t)sz);
     if (buf != NULL && fread(buf, 1, (size_t)sz, f) == (size_t)sz) {
       *n = (size_t)sz;
@@ -89,7 +88,7 @@ static uint16_t ref_f2h(float f) {
     return (uint16_t)(sign | (ax > 0x7f800000u ? 0x7e00u : 0x7c00u));
   if (ax >= 0x477ff000u) /* >= 65520 rounds to infinity */
     return (uint16_t)(sign | 0x7c00u);
-  if (ax < 0x38800000u) { /* below 2^-14: subnormal half or zero */
+  if (ax < 0x38800000u) {                          /* below 2^-14: subnormal half or zero */
     double q = rint(fabs((double)f) * 16777216.0); /* units of 2^-24 */
     return (uint16_t)(sign | (uint16_t)q);
   }
@@ -113,9 +112,13 @@ static float ref_h2f(uint16_t h) {
   return (float)((h & 0x8000u) ? -v : v);
 }
 
-static float to_half_precision(float f) { return ref_h2f(ref_f2h(f)); }
+static float to_half_precision(float f) {
+  return ref_h2f(ref_f2h(f));
+}
 
-static int same_bits(float a, float b) { return memcmp(&a, &b, sizeof a) == 0; }
+static int same_bits(float a, float b) {
+  return memcmp(&a, &b, sizeof a) == 0;
+}
 
 /* A sentinel image: a failed read must leave it exactly as it was. */
 static void sentinel(gr_exr_image *img) {
@@ -126,16 +129,15 @@ static void sentinel(gr_exr_image *img) {
 }
 
 static int is_sentinel(const gr_exr_image *img) {
-  return img->width == -7 && img->height == -9 && img->nchannels == 12345 &&
-         img->names == NULL && img->types == NULL && img->data == NULL;
+  return img->width == -7 && img->height == -9 && img->nchannels == 12345 && img->names == NULL &&
+         img->types == NULL && img->data == NULL;
 }
 
 /* ------------------------------------------------------------------------ */
 /* Writing and reading with OpenEXR's C API directly                        */
 /* ------------------------------------------------------------------------ */
 
-static void quiet_handler(exr_const_context_t ctxt, exr_result_t code,
-                          const char *msg) {
+static void quiet_handler(exr_const_context_t ctxt, exr_result_t code, const char *msg) {
   (void)ctxt;
   (void)code;
   (void)msg;
@@ -182,11 +184,9 @@ static capi_spec capi_default(void) {
 }
 
 /* Fills and encodes one chunk whose first pixel is (x0, y0) of level lvl. */
-static exr_result_t capi_encode_chunk(exr_context_t ctxt,
-                                      const exr_chunk_info_t *ci,
-                                      exr_encode_pipeline_t *enc, int *live,
-                                      const capi_spec *s, int x0, int y0,
-                                      int lvl, unsigned char *buf) {
+static exr_result_t capi_encode_chunk(exr_context_t ctxt, const exr_chunk_info_t *ci,
+                                      exr_encode_pipeline_t *enc, int *live, const capi_spec *s,
+                                      int x0, int y0, int lvl, unsigned char *buf) {
   exr_result_t rv;
   int c, i, j;
   size_t plane = (size_t)ci->width * (size_t)ci->height * 4u;
@@ -222,8 +222,7 @@ static exr_result_t capi_encode_chunk(exr_context_t ctxt,
     ch->user_pixel_stride = 4;
     ch->user_line_stride = ch->width * 4;
     ch->user_bytes_per_element = 4;
-    ch->user_data_type =
-        s->types[k] == EXR_PIXEL_UINT ? EXR_PIXEL_UINT : EXR_PIXEL_FLOAT;
+    ch->user_data_type = s->types[k] == EXR_PIXEL_UINT ? EXR_PIXEL_UINT : EXR_PIXEL_FLOAT;
   }
   rv = exr_encoding_choose_default_routines(ctxt, 0, enc);
   if (rv == EXR_ERR_SUCCESS)
@@ -254,11 +253,10 @@ static int capi_write(const char *path, const capi_spec *s) {
   if (rv == EXR_ERR_SUCCESS)
     rv = exr_set_lineorder(ctxt, part, s->lineorder);
   if (rv == EXR_ERR_SUCCESS && s->storage == EXR_STORAGE_TILED)
-    rv = exr_set_tile_descriptor(ctxt, part, s->tile_w, s->tile_h, s->levels,
-                                 EXR_TILE_ROUND_DOWN);
+    rv = exr_set_tile_descriptor(ctxt, part, s->tile_w, s->tile_h, s->levels, EXR_TILE_ROUND_DOWN);
   for (c = 0; c < s->nchannels && rv == EXR_ERR_SUCCESS; ++c)
-    rv = exr_add_channel(ctxt, part, s->names[c], s->types[c],
-                         EXR_PERCEPTUALLY_LINEAR, s->xsamp, s->xsamp);
+    rv = exr_add_channel(ctxt, part, s->names[c], s->types[c], EXR_PERCEPTUALLY_LINEAR, s->xsamp,
+                         s->xsamp);
   if (rv == EXR_ERR_SUCCESS)
     rv = exr_write_header(ctxt);
   if (rv == EXR_ERR_SUCCESS) {
@@ -276,8 +274,7 @@ static int capi_write(const char *path, const capi_spec *s) {
       int y = s->dw.min.y + k * lines;
       rv = exr_write_scanline_chunk_info(ctxt, part, y, &ci);
       if (rv == EXR_ERR_SUCCESS)
-        rv = capi_encode_chunk(ctxt, &ci, &enc, &live, s, s->dw.min.x, y, 0,
-                               buf);
+        rv = capi_encode_chunk(ctxt, &ci, &enc, &live, s, s->dw.min.x, y, 0, buf);
     }
   } else if (rv == EXR_ERR_SUCCESS) {
     int32_t nlx = 1, nly = 1, lvl;
@@ -292,8 +289,7 @@ static int capi_write(const char *path, const capi_spec *s) {
           exr_chunk_info_t ci;
           rv = exr_write_tile_chunk_info(ctxt, part, tx, ty, lvl, lvl, &ci);
           if (rv == EXR_ERR_SUCCESS)
-            rv = capi_encode_chunk(ctxt, &ci, &enc, &live, s,
-                                   s->dw.min.x + tx * (int)s->tile_w,
+            rv = capi_encode_chunk(ctxt, &ci, &enc, &live, s, s->dw.min.x + tx * (int)s->tile_w,
                                    s->dw.min.y + ty * (int)s->tile_h, lvl, buf);
         }
       }
@@ -308,8 +304,7 @@ static int capi_write(const char *path, const capi_spec *s) {
   }
   free(buf);
   if (rv != EXR_ERR_SUCCESS)
-    fprintf(stderr, "capi_write(%s): %s\n", path,
-            exr_get_default_error_message(rv));
+    fprintf(stderr, "capi_write(%s): %s\n", path, exr_get_default_error_message(rv));
   return rv == EXR_ERR_SUCCESS;
 }
 
@@ -381,15 +376,14 @@ static size_t header_end(const unsigned char *b, size_t n) {
     if (p >= n || p == type || p + 5 > n)
       return 0;
     ++p;
-    sz = (uint32_t)b[p] | ((uint32_t)b[p + 1] << 8) |
-         ((uint32_t)b[p + 2] << 16) | ((uint32_t)b[p + 3] << 24);
+    sz = (uint32_t)b[p] | ((uint32_t)b[p + 1] << 8) | ((uint32_t)b[p + 2] << 16) |
+         ((uint32_t)b[p + 3] << 24);
     p += 4 + (size_t)sz;
   }
   return 0;
 }
 
-static size_t find_bytes(const unsigned char *b, size_t n, const void *pat,
-                         size_t m) {
+static size_t find_bytes(const unsigned char *b, size_t n, const void *pat, size_t m) {
   size_t i;
   for (i = 0; i + m <= n; ++i)
     if (memcmp(b + i, pat, m) == 0)
@@ -436,8 +430,7 @@ static float field_value(int c, int i, int j, int w, int h) {
     (void)w;
     return (float)j;
   default: /* tiny (half subnormal) to large values, both signs */
-    return (float)(ldexp(1.0 + 0.01 * (i % 100), (j % 30) - 20) *
-                   ((i + j) % 2 ? -1 : 1));
+    return (float)(ldexp(1.0 + 0.01 * (i % 100), (j % 30) - 20) * ((i + j) % 2 ? -1 : 1));
   }
 }
 
@@ -467,8 +460,7 @@ static void test_roundtrip(int w, int h, int nch, gr_exr_pixel_type type) {
         data[c][(size_t)j * w + i] = field_value(f, i, j, w, h);
   }
   err[0] = '\0';
-  st = gr_exr_write(path, w, h, nch, names, (const float *const *)data, type,
-                    err, sizeof err);
+  st = gr_exr_write(path, w, h, nch, names, (const float *const *)data, type, err, sizeof err);
   CHECK_MSG(st == GR_OK, "write %s: %s", fname, err);
   memset(&img, 0, sizeof img);
   st = gr_exr_read(path, &img, err, sizeof err);
@@ -492,15 +484,14 @@ static void test_roundtrip(int w, int h, int nch, gr_exr_pixel_type type) {
           ok = same_bits(got, v);
         } else {
           float ref = to_half_precision(v);
-          double tol = fabs(v) >= 6.103515625e-05 ? fabs(v) * ldexp(1, -11)
-                                                  : ldexp(1, -25);
+          double tol = fabs(v) >= 6.103515625e-05 ? fabs(v) * ldexp(1, -11) : ldexp(1, -25);
           ok = same_bits(got, ref) && fabs((double)got - v) <= tol;
           if (f == 1 || f == 2) /* exactly representable in half */
             ok = ok && got == v;
         }
         if (!ok && bad++ < 5)
-          CHECK_MSG(0, "%s: channel %s (%d,%d): wrote %.9g, read %.9g", fname,
-                    names[c], i, j, v, got);
+          CHECK_MSG(0, "%s: channel %s (%d,%d): wrote %.9g, read %.9g", fname, names[c], i, j, v,
+                    got);
       }
     }
     if (f == 2) { /* orientation: memory row 0 is south, value 0 */
@@ -517,8 +508,7 @@ done:
 }
 
 static void test_roundtrips(void) {
-  static const int sizes[][2] = {{1, 1},     {3, 5},  {37, 19},
-                                 {257, 129}, {1, 40}, {40, 1}};
+  static const int sizes[][2] = {{1, 1}, {3, 5}, {37, 19}, {257, 129}, {1, 40}, {40, 1}};
   size_t s;
   int nch;
   for (s = 0; s < sizeof sizes / sizeof sizes[0]; ++s)
@@ -542,8 +532,7 @@ static void test_file_orientation(void) {
     col[j] = (float)j;
   for (t = GR_EXR_HALF; t <= GR_EXR_FLOAT; t = (gr_exr_pixel_type)(t + 1)) {
     scratch_path(path, sizeof path, "column.exr");
-    CHECK(gr_exr_write(path, 1, H, 1, names, data, t, err, sizeof err) ==
-          GR_OK);
+    CHECK(gr_exr_write(path, 1, H, 1, names, data, t, err, sizeof err) == GR_OK);
     row[0] = -1.0f;
     w = capi_first_scanline(path, row, 4);
     CHECK(w == 1);
@@ -602,15 +591,13 @@ static void test_half_rounding(void) {
   expect[14] = 0.0999755859375f;
   expect[15] = -3.140625f;
   scratch_path(path, sizeof path, "half_rounding.exr");
-  CHECK(gr_exr_write(path, N, 1, 1, names, data, GR_EXR_HALF, err,
-                     sizeof err) == GR_OK);
+  CHECK(gr_exr_write(path, N, 1, 1, names, data, GR_EXR_HALF, err, sizeof err) == GR_OK);
   memset(&img, 0, sizeof img);
   CHECK_MSG(gr_exr_read(path, &img, err, sizeof err) == GR_OK, "%s", err);
   if (img.data != NULL && img.width == N) {
     for (k = 0; k < N; ++k) {
-      CHECK_MSG(same_bits(img.data[0][k], expect[k]),
-                "half of %.9g: got %.9g, want %.9g", in[k], img.data[0][k],
-                expect[k]);
+      CHECK_MSG(same_bits(img.data[0][k], expect[k]), "half of %.9g: got %.9g, want %.9g", in[k],
+                img.data[0][k], expect[k]);
       CHECK(same_bits(expect[k], to_half_precision(in[k])));
     }
   }
@@ -627,8 +614,7 @@ static void test_half_rounding(void) {
     sp[5] = 3.4028235e38f;
     data[0] = sp;
     scratch_path(path, sizeof path, "float_special.exr");
-    CHECK(gr_exr_write(path, 6, 1, 1, names, data, GR_EXR_FLOAT, err,
-                       sizeof err) == GR_OK);
+    CHECK(gr_exr_write(path, 6, 1, 1, names, data, GR_EXR_FLOAT, err, sizeof err) == GR_OK);
     memset(&img, 0, sizeof img);
     CHECK(gr_exr_read(path, &img, err, sizeof err) == GR_OK);
     if (img.data != NULL && img.width == 6) {
@@ -638,8 +624,7 @@ static void test_half_rounding(void) {
     }
     gr_exr_image_free(&img);
     /* HALF keeps NaN a NaN. */
-    CHECK(gr_exr_write(path, 6, 1, 1, names, data, GR_EXR_HALF, err,
-                       sizeof err) == GR_OK);
+    CHECK(gr_exr_write(path, 6, 1, 1, names, data, GR_EXR_HALF, err, sizeof err) == GR_OK);
     memset(&img, 0, sizeof img);
     CHECK(gr_exr_read(path, &img, err, sizeof err) == GR_OK);
     if (img.data != NULL && img.width == 6) {
@@ -670,8 +655,7 @@ static void test_equal_size_chunk(void) {
   for (j = 0; j < 40; ++j)
     col[j] = (float)j;
   scratch_path(path, sizeof path, "equal_size_chunk.exr");
-  CHECK(gr_exr_write(path, 1, 40, 1, names, data, GR_EXR_FLOAT, err,
-                     sizeof err) == GR_OK);
+  CHECK(gr_exr_write(path, 1, 40, 1, names, data, GR_EXR_FLOAT, err, sizeof err) == GR_OK);
   init.error_handler_fn = &quiet_handler;
   CHECK(exr_start_read(&ctxt, path, &init) == EXR_ERR_SUCCESS);
   memset(&ci, 0, sizeof ci);
@@ -691,8 +675,7 @@ static void test_equal_size_chunk(void) {
 static void test_names_roundtrip(void) {
   char longname[201];
   const char *names[3];
-  float a[6] = {1, 2, 3, 4, 5, 6}, b[6] = {7, 8, 9, 10, 11, 12},
-        c[6] = {0, 0, 0, 0, 0, 1};
+  float a[6] = {1, 2, 3, 4, 5, 6}, b[6] = {7, 8, 9, 10, 11, 12}, c[6] = {0, 0, 0, 0, 0, 1};
   const float *data[3] = {a, b, c};
   char path[1024], err[512];
   gr_exr_image img;
@@ -702,9 +685,8 @@ static void test_names_roundtrip(void) {
   names[1] = longname;
   names[2] = "alpha.beta";
   scratch_path(path, sizeof path, "names.exr");
-  CHECK_MSG(gr_exr_write(path, 3, 2, 3, names, data, GR_EXR_FLOAT, err,
-                         sizeof err) == GR_OK,
-            "%s", err);
+  CHECK_MSG(gr_exr_write(path, 3, 2, 3, names, data, GR_EXR_FLOAT, err, sizeof err) == GR_OK, "%s",
+            err);
   memset(&img, 0, sizeof img);
   CHECK_MSG(gr_exr_read(path, &img, err, sizeof err) == GR_OK, "%s", err);
   CHECK(img.nchannels == 3);
@@ -726,14 +708,12 @@ static void test_names_roundtrip(void) {
 /* ------------------------------------------------------------------------ */
 
 /* Checks img against capi_value over the data window of s. */
-static void check_capi_image(const gr_exr_image *img, const capi_spec *s,
-                             const char *what) {
+static void check_capi_image(const gr_exr_image *img, const capi_spec *s, const char *what) {
   int w = s->dw.max.x - s->dw.min.x + 1, h = s->dw.max.y - s->dw.min.y + 1;
   int c, i, j, bad = 0;
-  CHECK_MSG(img->width == w && img->height == h, "%s: %dx%d, want %dx%d", what,
-            img->width, img->height, w, h);
-  CHECK_MSG(img->nchannels == s->nchannels, "%s: %d channels", what,
-            img->nchannels);
+  CHECK_MSG(img->width == w && img->height == h, "%s: %dx%d, want %dx%d", what, img->width,
+            img->height, w, h);
+  CHECK_MSG(img->nchannels == s->nchannels, "%s: %d channels", what, img->nchannels);
   if (img->width != w || img->height != h || img->nchannels != s->nchannels)
     return;
   for (c = 0; c < s->nchannels; ++c) {
@@ -741,19 +721,16 @@ static void check_capi_image(const gr_exr_image *img, const capi_spec *s,
     CHECK_MSG(k >= 0, "%s: channel %s missing", what, s->names[c]);
     if (k < 0)
       continue;
-    CHECK(img->types[k] ==
-          (s->types[c] == EXR_PIXEL_HALF ? GR_EXR_HALF : GR_EXR_FLOAT));
+    CHECK(img->types[k] == (s->types[c] == EXR_PIXEL_HALF ? GR_EXR_HALF : GR_EXR_FLOAT));
     for (j = 0; j < h; ++j) {
       for (i = 0; i < w; ++i) {
         /* memory row j is file row h-1-j */
-        float want =
-            capi_value(c, s->dw.min.x + i, s->dw.min.y + (h - 1 - j), 0);
+        float want = capi_value(c, s->dw.min.x + i, s->dw.min.y + (h - 1 - j), 0);
         float got = img->data[k][(size_t)j * w + i];
         if (s->types[c] == EXR_PIXEL_HALF)
           want = to_half_precision(want);
         if (!same_bits(got, want) && bad++ < 5)
-          CHECK_MSG(0, "%s: %s (%d,%d) = %.9g, want %.9g", what, s->names[c], i,
-                    j, got, want);
+          CHECK_MSG(0, "%s: %s (%d,%d) = %.9g, want %.9g", what, s->names[c], i, j, got, want);
       }
     }
   }
@@ -880,8 +857,7 @@ static void test_bad_files(void) {
   /* A text file. */
   scratch_path(path, sizeof path, "text.exr");
   {
-    static const char text[] =
-        "This is not an image.\nIt is a text file pretending to be one.\n";
+    static const char text[] = "This is not an image.\nIt is a text file pretending to be one.\n";
     CHECK(save_bytes(path, text, sizeof text - 1));
   }
   expect_bad(path, "text file");
@@ -891,8 +867,7 @@ static void test_bad_files(void) {
   for (k = 0; k < 37 * 19 * 2; ++k)
     vals[k] = (float)sin((double)k * 0.7) * 100.0f;
   scratch_path(good, sizeof good, "good.exr");
-  CHECK(gr_exr_write(good, 37, 19, 2, names, data, GR_EXR_FLOAT, err,
-                     sizeof err) == GR_OK);
+  CHECK(gr_exr_write(good, 37, 19, 2, names, data, GR_EXR_FLOAT, err, sizeof err) == GR_OK);
   bytes = load_bytes(good, &n);
   CHECK(bytes != NULL && n > 1000);
   if (bytes == NULL || n <= 1000)
@@ -960,8 +935,7 @@ static void test_bad_files(void) {
     /* The first chunk is stored raw (sine data does not compress), so its
      * noise reads as numbers; the second is ZIP, and noise cannot inflate to
      * the right size. */
-    CHECK_MSG(st == GR_ERR_FORMAT && is_sentinel(&img) &&
-                  is_sentence_with(err, path),
+    CHECK_MSG(st == GR_ERR_FORMAT && is_sentinel(&img) && is_sentence_with(err, path),
               "noise pixels: %d '%s'", (int)st, err);
     if (st == GR_OK)
       gr_exr_image_free(&img);
@@ -1004,9 +978,8 @@ static void test_bad_files(void) {
         for (q = 0; q < 4; ++q)
           put_i32(box + 4 * q, boxes[t][q]);
         CHECK(save_bytes(path, copy, n));
-        snprintf(what, sizeof what, "dataWindow (%d,%d)-(%d,%d)",
-                 (int)boxes[t][0], (int)boxes[t][1], (int)boxes[t][2],
-                 (int)boxes[t][3]);
+        snprintf(what, sizeof what, "dataWindow (%d,%d)-(%d,%d)", (int)boxes[t][0],
+                 (int)boxes[t][1], (int)boxes[t][2], (int)boxes[t][3]);
         expect_bad(path, what);
       }
     }
@@ -1046,18 +1019,17 @@ done:
 /* Writer argument errors                                                   */
 /* ------------------------------------------------------------------------ */
 
-static void expect_write_error(gr_status want, const char *path, int w, int h,
-                               int nch, const char *const *names,
-                               const float *const *data, gr_exr_pixel_type t,
-                               const char *what) {
+static void expect_write_error(gr_status want, const char *path, int w, int h, int nch,
+                               const char *const *names, const float *const *data,
+                               gr_exr_pixel_type t, const char *what) {
   char err[1024];
   gr_status st;
   err[0] = '\0';
   st = gr_exr_write(path, w, h, nch, names, data, t, err, sizeof err);
   CHECK_MSG(st == want, "%s: status %s, want %s", what, gr_status_string(st),
             gr_status_string(want));
-  CHECK_MSG(is_sentence_with(err, path != NULL && path[0] ? path : NULL),
-            "%s: error '%s'", what, err);
+  CHECK_MSG(is_sentence_with(err, path != NULL && path[0] ? path : NULL), "%s: error '%s'", what,
+            err);
 }
 
 static void test_write_errors(void) {
@@ -1090,27 +1062,22 @@ static void test_write_errors(void) {
   expect_write_error(A, path, 0, 2, 2, ok2, d2, GR_EXR_FLOAT, "width 0");
   expect_write_error(A, path, 3, 0, 2, ok2, d2, GR_EXR_FLOAT, "height 0");
   expect_write_error(A, path, -3, 2, 2, ok2, d2, GR_EXR_FLOAT, "width -3");
-  expect_write_error(A, path, GR_EXR_MAX_DIM + 1, 1, 2, ok2, d2, GR_EXR_FLOAT,
-                     "width too large");
-  expect_write_error(A, path, 3, 2, 2, ok2, d2, (gr_exr_pixel_type)7,
-                     "pixel type 7");
+  expect_write_error(A, path, GR_EXR_MAX_DIM + 1, 1, 2, ok2, d2, GR_EXR_FLOAT, "width too large");
+  expect_write_error(A, path, 3, 2, 2, ok2, d2, (gr_exr_pixel_type)7, "pixel type 7");
   expect_write_error(A, NULL, 3, 2, 2, ok2, d2, GR_EXR_FLOAT, "NULL path");
   expect_write_error(A, "", 3, 2, 2, ok2, d2, GR_EXR_FLOAT, "empty path");
   CHECK(!file_exists(path));
 
   /* A directory that does not exist. */
   scratch_path(bad, sizeof bad, "no_such_dir/sub/x.exr");
-  expect_write_error(GR_ERR_IO, bad, 3, 2, 2, ok2, d2, GR_EXR_FLOAT,
-                     "unwritable path");
+  expect_write_error(GR_ERR_IO, bad, 3, 2, 2, ok2, d2, GR_EXR_FLOAT, "unwritable path");
   CHECK(!file_exists(bad));
   /* A directory in place of the file. */
-  expect_write_error(GR_ERR_IO, g_dir, 3, 2, 2, ok2, d2, GR_EXR_FLOAT,
-                     "directory as path");
+  expect_write_error(GR_ERR_IO, g_dir, 3, 2, 2, ok2, d2, GR_EXR_FLOAT, "directory as path");
 
   /* NULL and short error buffers are fine. */
   CHECK(gr_exr_write(path, 0, 2, 2, ok2, d2, GR_EXR_FLOAT, NULL, 0) == A);
-  CHECK(gr_exr_write(path, 0, 2, 2, ok2, d2, GR_EXR_FLOAT, err, sizeof err) ==
-        A);
+  CHECK(gr_exr_write(path, 0, 2, 2, ok2, d2, GR_EXR_FLOAT, err, sizeof err) == A);
   CHECK(strlen(err) < sizeof err);
 
   /* Read argument errors. */
@@ -1160,15 +1127,14 @@ static void test_helpers(void) {
     char path[1024], err[256];
     gr_exr_image r;
     scratch_path(path, sizeof path, "helpers.exr");
-    CHECK(gr_exr_write(path, 2, 1, 1, wn, data, GR_EXR_FLOAT, err,
-                       sizeof err) == GR_OK);
+    CHECK(gr_exr_write(path, 2, 1, 1, wn, data, GR_EXR_FLOAT, err, sizeof err) == GR_OK);
     memset(&r, 0, sizeof r);
     CHECK(gr_exr_read(path, &r, err, sizeof err) == GR_OK);
     CHECK(gr_exr_find_channel(&r, "x") == 0);
     CHECK(gr_exr_find_channel(&r, "y") == -1);
     gr_exr_image_free(&r);
-    CHECK(r.width == 0 && r.height == 0 && r.nchannels == 0 &&
-          r.names == NULL && r.types == NULL && r.data == NULL);
+    CHECK(r.width == 0 && r.height == 0 && r.nchannels == 0 && r.names == NULL && r.types == NULL &&
+          r.data == NULL);
     gr_exr_image_free(&r);
   }
 }

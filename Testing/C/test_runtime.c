@@ -29,16 +29,13 @@ static void test_no_platform(void) {
 
 static void test_names(void) {
   /* Status values are pinned: they are part of the ABI. */
-  CHECK(GR_OK == 0 && GR_ERR_INVALID_ARGUMENT == -1 && GR_ERR_BUILD == -5 &&
-        GR_ERR_ABORTED == -10);
+  CHECK(GR_OK == 0 && GR_ERR_INVALID_ARGUMENT == -1 && GR_ERR_BUILD == -5 && GR_ERR_ABORTED == -10);
   for (int a = GR_ERR_ABORTED; a <= GR_OK; ++a)
     for (int b = a + 1; b <= GR_OK; ++b)
-      CHECK(strcmp(gr_status_string((gr_status)a),
-                   gr_status_string((gr_status)b)) != 0);
+      CHECK(strcmp(gr_status_string((gr_status)a), gr_status_string((gr_status)b)) != 0);
   CHECK(strcmp(gr_status_string(GR_ERR_BUILD), "GR_ERR_BUILD") == 0);
   CHECK(strcmp(gr_status_string((gr_status)-99), "GR_ERR_UNKNOWN") == 0);
-  CHECK(strcmp(gr_cl_error_name(CL_BUILD_PROGRAM_FAILURE),
-               "CL_BUILD_PROGRAM_FAILURE") == 0);
+  CHECK(strcmp(gr_cl_error_name(CL_BUILD_PROGRAM_FAILURE), "CL_BUILD_PROGRAM_FAILURE") == 0);
   for (int f = 0; f < GR_FIELD_COUNT; ++f)
     CHECK(gr_field_from_name(gr_field_name((gr_field)f)) == f);
   CHECK(strcmp(gr_field_name(GR_FIELD_SNOW_DEPTH), "snow_depth") == 0);
@@ -170,8 +167,7 @@ static void test_kernels(void) {
   CHECK(gr_program_get(ctx, "terrain_noise", NULL, &p1) == GR_OK);
   CHECK(gr_program_get(ctx, "terrain_noise", "", &p2) == GR_OK);
   CHECK(p1 != NULL && p1 == p2);
-  CHECK(gr_program_get(ctx, "unknown_core", NULL, &p2) ==
-        GR_ERR_INVALID_ARGUMENT);
+  CHECK(gr_program_get(ctx, "unknown_core", NULL, &p2) == GR_ERR_INVALID_ARGUMENT);
   CHECK(is_sentence(gr_last_error(ctx)));
 
   /* A trivial kernel computes what it should. */
@@ -187,13 +183,11 @@ static void test_kernels(void) {
   for (int i = 0; i < N; ++i)
     host[i] = (float)i;
   cl_mem buf = NULL;
-  CHECK(gr_buffer_create(ctx, CL_MEM_READ_WRITE, sizeof(host), host, &buf) ==
-        GR_OK);
+  CHECK(gr_buffer_create(ctx, CL_MEM_READ_WRITE, sizeof(host), host, &buf) == GR_OK);
   cl_float a = 2.0f, b = -3.0f;
   cl_int n = N;
-  CHECK(gr_kernel_args(ctx, k, sizeof(cl_mem), &buf, sizeof(cl_float), &a,
-                       sizeof(cl_float), &b, sizeof(cl_int), &n,
-                       (size_t)0) == GR_OK);
+  CHECK(gr_kernel_args(ctx, k, sizeof(cl_mem), &buf, sizeof(cl_float), &a, sizeof(cl_float), &b,
+                       sizeof(cl_int), &n, (size_t)0) == GR_OK);
   CHECK(gr_enqueue_2d(ctx, k, N, 1, NULL) == GR_OK);
   memset(host, 0, sizeof(host));
   CHECK(gr_buffer_read(ctx, buf, 0, sizeof(host), host) == GR_OK);
@@ -203,9 +197,8 @@ static void test_kernels(void) {
   CHECK_MSG(wrong == 0, "%d of %d values wrong", wrong, N);
 
   /* A wrong argument index is reported with the kernel's name. */
-  CHECK(gr_kernel_args(ctx, k, sizeof(cl_mem), &buf, sizeof(cl_float), &a,
-                       sizeof(cl_float), &b, sizeof(cl_int), &n,
-                       sizeof(cl_int), &n, (size_t)0) == GR_ERR_OPENCL);
+  CHECK(gr_kernel_args(ctx, k, sizeof(cl_mem), &buf, sizeof(cl_float), &a, sizeof(cl_float), &b,
+                       sizeof(cl_int), &n, sizeof(cl_int), &n, (size_t)0) == GR_ERR_OPENCL);
   CHECK(strstr(gr_last_error(ctx), "axpb") != NULL);
   CHECK(strstr(gr_last_error(ctx), "argument 4") != NULL);
   CHECK(gr_kernel_create(ctx, prog, "no_such_kernel", &k) == GR_ERR_OPENCL);
@@ -232,20 +225,17 @@ static void test_kernels(void) {
   CHECK(gr_context_device_info(ctx, &info) == GR_OK);
   cl_mem big = NULL;
   size_t too_big = (size_t)info.max_alloc_bytes + 4096;
-  CHECK(gr_buffer_create(ctx, CL_MEM_READ_WRITE, too_big, NULL, &big) ==
-        GR_ERR_TOO_LARGE);
+  CHECK(gr_buffer_create(ctx, CL_MEM_READ_WRITE, too_big, NULL, &big) == GR_ERR_TOO_LARGE);
   CHECK(big == NULL);
   CHECK(strstr(gr_last_error(ctx), "MiB") != NULL);
   CHECK(is_sentence(gr_last_error(ctx)));
-  CHECK(gr_buffer_create(ctx, CL_MEM_READ_WRITE, 0, NULL, &big) ==
-        GR_ERR_INVALID_ARGUMENT);
+  CHECK(gr_buffer_create(ctx, CL_MEM_READ_WRITE, 0, NULL, &big) == GR_ERR_INVALID_ARGUMENT);
 
   /* The detail can be set and read per context. */
   CHECK(gr_set_error(ctx, GR_ERR_IO, "Test sentence %d.", 7) == GR_ERR_IO);
   CHECK(strcmp(gr_last_error(ctx), "Test sentence 7.") == 0);
   CHECK(gr_cl_check(ctx, CL_SUCCESS, "nothing") == GR_OK);
-  CHECK(gr_cl_check(ctx, CL_OUT_OF_HOST_MEMORY, "Something") ==
-        GR_ERR_OUT_OF_MEMORY);
+  CHECK(gr_cl_check(ctx, CL_OUT_OF_HOST_MEMORY, "Something") == GR_ERR_OUT_OF_MEMORY);
   CHECK(strstr(gr_last_error(ctx), "CL_OUT_OF_HOST_MEMORY") != NULL);
   gr_context_release(ctx);
 }

@@ -28,10 +28,9 @@ static uint32_t ref_hash3(int32_t a, int32_t b, uint32_t c) {
 static double ref_fade(double t) {
   return t * t * t * (t * (t * 6 - 15) + 10);
 }
-static double ref_corner(int64_t ix, int64_t iy, uint32_t seed, double fx,
-                         double fy) {
-  double ang = (double)(ref_hash3((int32_t)ix, (int32_t)iy, seed) & 15U) *
-               (3.14159265358979323846 / 8.0);
+static double ref_corner(int64_t ix, int64_t iy, uint32_t seed, double fx, double fy) {
+  double ang =
+      (double)(ref_hash3((int32_t)ix, (int32_t)iy, seed) & 15U) * (3.14159265358979323846 / 8.0);
   return cos(ang) * fx + sin(ang) * fy;
 }
 static double ref_gradient(double x, double y, uint32_t seed) {
@@ -46,8 +45,7 @@ static double ref_gradient(double x, double y, uint32_t seed) {
   double n = (a + v * (b - a)) * sqrt(2.0);
   return n < -1 ? -1 : n > 1 ? 1 : n;
 }
-static double ref_elevation(const gr_terrain_noise_params *p, double x,
-                            double y) {
+static double ref_elevation(const gr_terrain_noise_params *p, double x, double y) {
   double f = p->frequency / 1000.0, m = 1.0, amp = 1.0, w = 1.0;
   double sum = 0, norm = 0;
   for (int o = 0; o < p->octaves; ++o) {
@@ -103,8 +101,8 @@ static double laplacian_energy(const float *h, int nx, int ny) {
   double e = 0;
   for (int j = 1; j < ny - 1; ++j)
     for (int i = 1; i < nx - 1; ++i) {
-      double l = h[j * nx + i - 1] + h[j * nx + i + 1] + h[(j - 1) * nx + i] +
-                 h[(j + 1) * nx + i] - 4.0 * h[j * nx + i];
+      double l = h[j * nx + i - 1] + h[j * nx + i + 1] + h[(j - 1) * nx + i] + h[(j + 1) * nx + i] -
+                 4.0 * h[j * nx + i];
       e += l * l;
     }
   return e / ((double)(nx - 2) * (ny - 2));
@@ -135,8 +133,7 @@ static void test_reference(void) {
         }
       /* float32 evaluation of the same formula: well under a millimetre
        * on a 120 m terrain. */
-      CHECK_MSG(worst < 1e-4 * p.height_scale, "type %d invert %d: %.3g m",
-                type, inv, worst);
+      CHECK_MSG(worst < 1e-4 * p.height_scale, "type %d invert %d: %.3g m", type, inv, worst);
       free(h);
     }
 }
@@ -179,8 +176,7 @@ static void test_octaves_energy(void) {
     int n = g.nx * g.ny;
     double r1 = laplacian_energy(h1, g.nx, g.ny) / variance(h1, n);
     double r6 = laplacian_energy(h6, g.nx, g.ny) / variance(h6, n);
-    CHECK_MSG(r6 > 4.0 * r1, "type %d: relative HF energy %.3g vs %.3g", type,
-              r6, r1);
+    CHECK_MSG(r6 > 4.0 * r1, "type %d: relative HF energy %.3g vs %.3g", type, r6, r1);
     free(h1);
     free(h6);
   }
@@ -225,11 +221,10 @@ static void test_height_scale_and_bounds(void) {
         lo = h[i] < lo ? h[i] : lo;
         hi = h[i] > hi ? h[i] : hi;
       }
-      CHECK_MSG(lo >= 0.0f && hi <= (float)q.height_scale,
-                "type %d k %d: [%g, %g]", type, k, lo, hi);
+      CHECK_MSG(lo >= 0.0f && hi <= (float)q.height_scale, "type %d k %d: [%g, %g]", type, k, lo,
+                hi);
       if (k == 1)
-        CHECK_MSG(hi - lo > 0.2 * q.height_scale, "type %d: range %g", type,
-                  hi - lo);
+        CHECK_MSG(hi - lo > 0.2 * q.height_scale, "type %d: range %g", type, hi - lo);
       free(h);
     }
 }
@@ -329,8 +324,7 @@ static void test_devices_agree(void) {
         double r = fabs((double)h[i] - first[i]) / p.height_scale;
         worst = r > worst ? r : worst;
       }
-      printf("%s vs %s: max difference %.3g of HeightScale\n", infos[d].name,
-             infos[0].name, worst);
+      printf("%s vs %s: max difference %.3g of HeightScale\n", infos[d].name, infos[0].name, worst);
       CHECK_MSG(worst <= 1e-5, "%s disagrees: %.3g", infos[d].name, worst);
       free(h);
     }
@@ -346,13 +340,12 @@ static void test_errors(void) {
   CHECK(gr_terrain_noise_params_validate(&p, msg, sizeof(msg)) == GR_OK);
   /* Each out-of-range parameter is refused with its name in the sentence. */
   gr_terrain_noise_params q;
-#define BAD(field, value, word)                                                \
-  do {                                                                         \
-    q = p;                                                                     \
-    q.field = value;                                                           \
-    CHECK(gr_terrain_noise_params_validate(&q, msg, sizeof(msg)) ==            \
-          GR_ERR_INVALID_ARGUMENT);                                            \
-    CHECK_MSG(strstr(msg, word) != NULL, "'%s' lacks '%s'", msg, word);        \
+#define BAD(field, value, word)                                                                    \
+  do {                                                                                             \
+    q = p;                                                                                         \
+    q.field = value;                                                                               \
+    CHECK(gr_terrain_noise_params_validate(&q, msg, sizeof(msg)) == GR_ERR_INVALID_ARGUMENT);      \
+    CHECK_MSG(strstr(msg, word) != NULL, "'%s' lacks '%s'", msg, word);                            \
   } while (0)
   BAD(octaves, 0, "Octaves");
   BAD(octaves, 17, "Octaves");
@@ -398,8 +391,7 @@ static void test_errors(void) {
   CHECK(gr_terrain_noise_compute(t) == GR_OK);
   CHECK(gr_terrain_noise_get_field(t, GR_FIELD_ELEVATION, after) == GR_OK);
   CHECK(memcmp(before, after, sizeof(before)) != 0);
-  CHECK(gr_terrain_noise_get_field(t, GR_FIELD_SNOW_DEPTH, after) ==
-        GR_ERR_INVALID_ARGUMENT);
+  CHECK(gr_terrain_noise_get_field(t, GR_FIELD_SNOW_DEPTH, after) == GR_ERR_INVALID_ARGUMENT);
   CHECK(strstr(gr_last_error(ctx), "snow_depth") != NULL);
   gr_terrain_noise_destroy(t);
   gr_terrain_noise_destroy(NULL);

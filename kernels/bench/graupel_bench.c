@@ -26,8 +26,7 @@ static double now_s(void) {
 
 /* Bytes per second of a device-to-device float4 copy of at least 64 MiB
  * (or the grid's size if larger), the best of several timed rounds. */
-static gr_status copy_bandwidth(gr_context *ctx, size_t min_bytes,
-                                double *bytes_per_s) {
+static gr_status copy_bandwidth(gr_context *ctx, size_t min_bytes, double *bytes_per_s) {
   size_t bytes = (size_t)64 << 20;
   if (min_bytes > bytes)
     bytes = min_bytes;
@@ -50,13 +49,13 @@ static gr_status copy_bandwidth(gr_context *ctx, size_t min_bytes,
   if (st == GR_OK) {
     const cl_float zero = 0.0f;
     st = gr_cl_check(ctx,
-                     clEnqueueFillBuffer(gr_context_queue(ctx), src, &zero,
-                                         sizeof(zero), 0, bytes, 0, NULL, NULL),
+                     clEnqueueFillBuffer(gr_context_queue(ctx), src, &zero, sizeof(zero), 0, bytes,
+                                         0, NULL, NULL),
                      "Filling the copy buffer");
   }
   if (st == GR_OK)
-    st = gr_kernel_args(ctx, k, sizeof(cl_mem), &src, sizeof(cl_mem), &dst,
-                        sizeof(cl_int), &n4, (size_t)0);
+    st = gr_kernel_args(ctx, k, sizeof(cl_mem), &src, sizeof(cl_mem), &dst, sizeof(cl_int), &n4,
+                        (size_t)0);
   double best = 0.0;
   size_t local = 256;
   size_t global = ((size_t)n4 + local - 1) / local * local;
@@ -65,13 +64,11 @@ static gr_status copy_bandwidth(gr_context *ctx, size_t min_bytes,
     st = gr_finish(ctx);
     double t0 = now_s();
     for (int r = 0; st == GR_OK && r < reps; ++r)
-      st = gr_cl_check(ctx,
-                       clEnqueueNDRangeKernel(gr_context_queue(ctx), k, 1, NULL,
-                                              &global,
-                                              gr_context_is_gpu(ctx) ? &local
-                                                                     : NULL,
-                                              0, NULL, NULL),
-                       "Enqueueing the copy kernel");
+      st =
+          gr_cl_check(ctx,
+                      clEnqueueNDRangeKernel(gr_context_queue(ctx), k, 1, NULL, &global,
+                                             gr_context_is_gpu(ctx) ? &local : NULL, 0, NULL, NULL),
+                      "Enqueueing the copy kernel");
     if (st == GR_OK)
       st = gr_finish(ctx);
     double dt = now_s() - t0;
@@ -110,11 +107,12 @@ static gr_status terrain_setup(gr_context *ctx, int n, void **state) {
 static gr_status terrain_step(void *state) {
   return gr_terrain_noise_compute(state);
 }
-static void terrain_teardown(void *state) { gr_terrain_noise_destroy(state); }
+static void terrain_teardown(void *state) {
+  gr_terrain_noise_destroy(state);
+}
 
 static const bench_core cores[] = {
-    {"terrain_noise",
-     "procedural terrain, 6-octave inverted ridged multifractal (seed 001)",
+    {"terrain_noise", "procedural terrain, 6-octave inverted ridged multifractal (seed 001)",
      terrain_setup, terrain_step, terrain_teardown, 4.0},
 };
 static const int ncores = (int)(sizeof(cores) / sizeof(cores[0]));
@@ -157,9 +155,8 @@ int main(int argc, char **argv) {
       return 1;
     }
     for (int i = 0; i < count && i < 16; ++i)
-      printf("%d: %s | %s | %s | %d CUs | %.0f MiB\n", i, infos[i].name,
-             infos[i].platform, infos[i].is_gpu ? "GPU" : "CPU",
-             infos[i].compute_units,
+      printf("%d: %s | %s | %s | %d CUs | %.0f MiB\n", i, infos[i].name, infos[i].platform,
+             infos[i].is_gpu ? "GPU" : "CPU", infos[i].compute_units,
              (double)infos[i].global_mem_bytes / 1048576.0);
     return 0;
   }
@@ -169,8 +166,7 @@ int main(int argc, char **argv) {
       core = &cores[i];
   if (!core || size < 1 || steps < 1) {
     fprintf(stderr, "graupel-bench: %s.\n",
-            !core ? "name a core with --core"
-                  : "--size and --steps must be positive");
+            !core ? "name a core with --core" : "--size and --steps must be positive");
     usage(stderr);
     return 2;
   }

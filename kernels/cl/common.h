@@ -13,7 +13,9 @@
 #define GR_INLINE inline __attribute__((always_inline))
 
 /* Row-major index of point (i, j) on an nx-wide grid (i fastest). */
-GR_INLINE int gr_idx(int i, int j, int nx) { return j * nx + i; }
+GR_INLINE int gr_idx(int i, int j, int nx) {
+  return j * nx + i;
+}
 
 /* True when the work-item (i, j) lies on the grid; kernels are launched over
  * sizes rounded up to the work-group size. */

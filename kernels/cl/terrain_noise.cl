@@ -6,15 +6,11 @@
 /* 16 unit gradients at multiples of 22.5 degrees, as separate x and y
  * tables: scalar loads keep the kernel vectorisable on CPUs. */
 __constant float gr_grad_x[16] = {
-    1.0f,        0.9238795f,  0.7071068f,  0.3826834f,
-    0.0f,        -0.3826834f, -0.7071068f, -0.9238795f,
-    -1.0f,       -0.9238795f, -0.7071068f, -0.3826834f,
-    0.0f,        0.3826834f,  0.7071068f,  0.9238795f};
+    1.0f,  0.9238795f,  0.7071068f,  0.3826834f,  0.0f, -0.3826834f, -0.7071068f, -0.9238795f,
+    -1.0f, -0.9238795f, -0.7071068f, -0.3826834f, 0.0f, 0.3826834f,  0.7071068f,  0.9238795f};
 __constant float gr_grad_y[16] = {
-    0.0f,        0.3826834f,  0.7071068f,  0.9238795f,
-    1.0f,        0.9238795f,  0.7071068f,  0.3826834f,
-    0.0f,        -0.3826834f, -0.7071068f, -0.9238795f,
-    -1.0f,       -0.9238795f, -0.7071068f, -0.3826834f};
+    0.0f, 0.3826834f,  0.7071068f,  0.9238795f,  1.0f,  0.9238795f,  0.7071068f,  0.3826834f,
+    0.0f, -0.3826834f, -0.7071068f, -0.9238795f, -1.0f, -0.9238795f, -0.7071068f, -0.3826834f};
 
 GR_INLINE float gr_fade(float t) {
   /* 6t^5 - 15t^4 + 10t^3: C2-continuous interpolation weight. */
@@ -28,8 +24,7 @@ GR_INLINE float gr_corner(int ix, int iy, uint seed, float fx, float fy) {
 
 /* Gradient noise at lattice cell (ix, iy) with fractional position (fx, fy)
  * in [0, 1); scaled by sqrt(2) so that |result| <= 1. */
-GR_INLINE float gr_gradient_noise(int ix, int iy, float fx, float fy,
-                               uint seed) {
+GR_INLINE float gr_gradient_noise(int ix, int iy, float fx, float fy, uint seed) {
   float u = gr_fade(fx), v = gr_fade(fy);
   float n00 = gr_corner(ix, iy, seed, fx, fy);
   float n10 = gr_corner(ix + 1, iy, seed, fx - 1.0f, fy);
@@ -51,21 +46,18 @@ GR_INLINE float gr_gradient_noise(int ix, int iy, float fx, float fy,
  * weight (p^o, or lambda^(-oH) for ridged), lattice[2o..2o+1] = (lat_x,
  * lat_y). Scalar arrays rather than float4/int2: vector-typed values inside
  * the work-item loop stop PoCL's vectoriser. */
-__kernel void terrain_noise_generate(__global float *restrict elevation,
-                                     int nx, int ny, int i0, int j0,
-                                     __global const float *restrict table,
+__kernel void terrain_noise_generate(__global float *restrict elevation, int nx, int ny, int i0,
+                                     int j0, __global const float *restrict table,
                                      __global const float *restrict amp,
-                                     __global const int *restrict lattice,
-                                     uint seed,
-                                     int kind, int octaves, float offset,
-                                     float gain, int invert,
+                                     __global const int *restrict lattice, uint seed, int kind,
+                                     int octaves, float offset, float gain, int invert,
                                      float height_scale) {
   int i = get_global_id(0), j = get_global_id(1);
   if (!gr_inside(i, j, nx, ny))
     return;
-  /* The host compiles one variant per noise type and octave count, so the
-   * loop below has a constant trip count: unrolled, it is straight-line code
-   * that CPU compilers (PoCL) vectorise across work-items. */
+    /* The host compiles one variant per noise type and octave count, so the
+     * loop below has a constant trip count: unrolled, it is straight-line code
+     * that CPU compilers (PoCL) vectorise across work-items. */
 #ifdef GR_TERRAIN_OCTAVES
   octaves = GR_TERRAIN_OCTAVES;
 #endif
@@ -81,9 +73,8 @@ __kernel void terrain_noise_generate(__global float *restrict elevation,
     float x = table[4 * o] + (float)(i0 + i) * table[4 * o + 2];
     float y = table[4 * o + 1] + (float)(j0 + j) * table[4 * o + 3];
     float fx = floor(x), fy = floor(y);
-    float g = gr_gradient_noise(lattice[2 * o] + (int)fx,
-                                lattice[2 * o + 1] + (int)fy, x - fx, y - fy,
-                                seed + (uint)o);
+    float g = gr_gradient_noise(lattice[2 * o] + (int)fx, lattice[2 * o + 1] + (int)fy, x - fx,
+                                y - fy, seed + (uint)o);
     float a = amp[o];
     if (kind == 0) {
       float s = offset - fabs(g);

@@ -37,13 +37,11 @@ typedef struct exr_msg {
   int have;
 } exr_msg;
 
-static void exr_capture_error(exr_const_context_t ctxt, exr_result_t code,
-                              const char *msg) {
+static void exr_capture_error(exr_const_context_t ctxt, exr_result_t code, const char *msg) {
   void *ud = NULL;
   exr_msg *m;
   (void)code;
-  if (ctxt == NULL || exr_get_user_data(ctxt, &ud) != EXR_ERR_SUCCESS ||
-      ud == NULL)
+  if (ctxt == NULL || exr_get_user_data(ctxt, &ud) != EXR_ERR_SUCCESS || ud == NULL)
     return;
   m = (exr_msg *)ud;
   if (m->have || msg == NULL)
@@ -52,8 +50,7 @@ static void exr_capture_error(exr_const_context_t ctxt, exr_result_t code,
   /* A sentence ends with our own period; drop trailing dots and newlines. */
   {
     size_t n = strlen(m->text);
-    while (n > 0 && (m->text[n - 1] == '.' || m->text[n - 1] == '\n' ||
-                     m->text[n - 1] == ' '))
+    while (n > 0 && (m->text[n - 1] == '.' || m->text[n - 1] == '\n' || m->text[n - 1] == ' '))
       m->text[--n] = '\0';
   }
   m->have = 1;
@@ -172,16 +169,15 @@ typedef struct chunk_layout {
 
 /* Points each decoder channel at its plane; (x, y) is the chunk's first pixel
  * relative to the data window's corner. */
-static int bind_decode_channels(exr_decode_pipeline_t *dec,
-                                const gr_exr_image *img, int64_t x, int64_t y) {
+static int bind_decode_channels(exr_decode_pipeline_t *dec, const gr_exr_image *img, int64_t x,
+                                int64_t y) {
   int c;
   for (c = 0; c < dec->channel_count; ++c) {
     exr_coding_channel_info_t *ch = &dec->channels[c];
     int k = gr_exr_find_channel(img, ch->channel_name);
     if (k < 0)
       return 0;
-    ch->decode_to_ptr =
-        (uint8_t *)(img->data[k] + (size_t)y * (size_t)img->width + (size_t)x);
+    ch->decode_to_ptr = (uint8_t *)(img->data[k] + (size_t)y * (size_t)img->width + (size_t)x);
     ch->user_pixel_stride = (int32_t)sizeof(float);
     ch->user_line_stride = (int32_t)((size_t)img->width * sizeof(float));
     ch->user_bytes_per_element = (int16_t)sizeof(float);
@@ -191,11 +187,9 @@ static int bind_decode_channels(exr_decode_pipeline_t *dec,
 }
 
 /* Decodes one chunk into img at pixel (x, y) of the data window. */
-static exr_result_t decode_chunk(exr_context_t ctxt,
-                                 const exr_chunk_info_t *cinfo,
-                                 exr_decode_pipeline_t *dec, int *dec_live,
-                                 const gr_exr_image *img, int64_t x,
-                                 int64_t y) {
+static exr_result_t decode_chunk(exr_context_t ctxt, const exr_chunk_info_t *cinfo,
+                                 exr_decode_pipeline_t *dec, int *dec_live, const gr_exr_image *img,
+                                 int64_t x, int64_t y) {
   exr_result_t rv;
   if (!*dec_live) {
     rv = exr_decoding_initialize(ctxt, 0, cinfo, dec);
@@ -221,8 +215,8 @@ static exr_result_t decode_chunk(exr_context_t ctxt,
  * otherwise it decodes the chunk into img, rows in file order. On failure
  * *fx, *fy name the chunk (tile indices, or the first scanline). */
 static exr_result_t walk_chunks(const chunk_layout *L, const gr_exr_image *img,
-                                exr_decode_pipeline_t *dec, int *dec_live,
-                                int64_t *fx, int64_t *fy) {
+                                exr_decode_pipeline_t *dec, int *dec_live, int64_t *fx,
+                                int64_t *fy) {
   exr_result_t rv = EXR_ERR_SUCCESS;
   exr_chunk_info_t cinfo;
   if (!L->tiled) {
@@ -240,8 +234,7 @@ static exr_result_t walk_chunks(const chunk_layout *L, const gr_exr_image *img,
            (int64_t)cinfo.width != L->width))
         rv = EXR_ERR_INCORRECT_CHUNK;
       if (rv == EXR_ERR_SUCCESS && img != NULL)
-        rv = decode_chunk(L->ctxt, &cinfo, dec, dec_live, img, 0,
-                          y - L->dw.min.y);
+        rv = decode_chunk(L->ctxt, &cinfo, dec, dec_live, img, 0, y - L->dw.min.y);
       if (rv != EXR_ERR_SUCCESS)
         return rv;
     }
@@ -255,10 +248,8 @@ static exr_result_t walk_chunks(const chunk_layout *L, const gr_exr_image *img,
         *fx = tx;
         *fy = ty;
         memset(&cinfo, 0, sizeof cinfo);
-        rv = exr_read_tile_chunk_info(L->ctxt, 0, (int)tx, (int)ty, 0, 0,
-                                      &cinfo);
-        if (rv == EXR_ERR_SUCCESS &&
-            ((int64_t)cinfo.width != ew || (int64_t)cinfo.height != eh))
+        rv = exr_read_tile_chunk_info(L->ctxt, 0, (int)tx, (int)ty, 0, 0, &cinfo);
+        if (rv == EXR_ERR_SUCCESS && ((int64_t)cinfo.width != ew || (int64_t)cinfo.height != eh))
           rv = EXR_ERR_INCORRECT_CHUNK;
         if (rv == EXR_ERR_SUCCESS && img != NULL)
           rv = decode_chunk(L->ctxt, &cinfo, dec, dec_live, img, x0, y0);
@@ -270,8 +261,7 @@ static exr_result_t walk_chunks(const chunk_layout *L, const gr_exr_image *img,
   return rv;
 }
 
-gr_status gr_exr_read(const char *path, gr_exr_image *out, char *err,
-                      size_t err_len) {
+gr_status gr_exr_read(const char *path, gr_exr_image *out, char *err, size_t err_len) {
   gr_status st = GR_OK;
   exr_result_t rv;
   exr_context_t ctxt = NULL;
@@ -309,13 +299,11 @@ gr_status gr_exr_read(const char *path, gr_exr_image *out, char *err,
   if (rv != EXR_ERR_SUCCESS) {
     st = read_status(rv);
     if (rv == EXR_ERR_FILE_ACCESS)
-      set_err(err, err_len,
-              "Cannot read '%s': the file cannot be opened (OpenEXR: %s).",
-              path, exr_detail(&msg, rv));
+      set_err(err, err_len, "Cannot read '%s': the file cannot be opened (OpenEXR: %s).", path,
+              exr_detail(&msg, rv));
     else
-      set_err(err, err_len,
-              "Cannot read '%s': it is not a valid OpenEXR file (OpenEXR: %s).",
-              path, exr_detail(&msg, rv));
+      set_err(err, err_len, "Cannot read '%s': it is not a valid OpenEXR file (OpenEXR: %s).", path,
+              exr_detail(&msg, rv));
     goto cleanup;
   }
   L.ctxt = ctxt;
@@ -333,24 +321,20 @@ gr_status gr_exr_read(const char *path, gr_exr_image *out, char *err,
     rv = EXR_ERR_MISSING_REQ_ATTR;
   if (rv != EXR_ERR_SUCCESS) {
     st = read_status(rv);
-    set_err(err, err_len,
-            "Cannot read '%s': its header is incomplete (OpenEXR: %s).", path,
+    set_err(err, err_len, "Cannot read '%s': its header is incomplete (OpenEXR: %s).", path,
             exr_detail(&msg, rv));
     goto cleanup;
   }
   if (storage != EXR_STORAGE_SCANLINE && storage != EXR_STORAGE_TILED) {
     st = GR_ERR_FORMAT;
-    set_err(err, err_len,
-            "Cannot read '%s': it holds deep data, which is not supported.",
-            path);
+    set_err(err, err_len, "Cannot read '%s': it holds deep data, which is not supported.", path);
     goto cleanup;
   }
 
   /* Size guards, before anything is allocated. */
   L.width = (int64_t)L.dw.max.x - (int64_t)L.dw.min.x + 1;
   L.height = (int64_t)L.dw.max.y - (int64_t)L.dw.min.y + 1;
-  if (L.width < 1 || L.height < 1 || L.width > GR_EXR_MAX_DIM ||
-      L.height > GR_EXR_MAX_DIM) {
+  if (L.width < 1 || L.height < 1 || L.width > GR_EXR_MAX_DIM || L.height > GR_EXR_MAX_DIM) {
     st = GR_ERR_FORMAT;
     set_err(err, err_len,
             "Cannot read '%s': its data window is %lld by %lld pixels, outside "
@@ -364,8 +348,7 @@ gr_status gr_exr_read(const char *path, gr_exr_image *out, char *err,
     goto cleanup;
   }
   npix = (size_t)L.width * (size_t)L.height;
-  if (npix > GR_EXR_MAX_SAMPLES / (size_t)chlist->num_channels ||
-      npix > SIZE_MAX / sizeof(float)) {
+  if (npix > GR_EXR_MAX_SAMPLES / (size_t)chlist->num_channels || npix > SIZE_MAX / sizeof(float)) {
     st = GR_ERR_FORMAT;
     set_err(err, err_len,
             "Cannot read '%s': %lld by %lld pixels in %d channels is more than "
@@ -395,9 +378,8 @@ gr_status gr_exr_read(const char *path, gr_exr_image *out, char *err,
     }
     if (nm[0] == '\0' || strlen(nm) > GR_EXR_MAX_NAME) {
       st = GR_ERR_FORMAT;
-      set_err(err, err_len,
-              "Cannot read '%s': channel %d has an empty or over-long name.",
-              path, (int)c);
+      set_err(err, err_len, "Cannot read '%s': channel %d has an empty or over-long name.", path,
+              (int)c);
       goto cleanup;
     }
   }
@@ -408,10 +390,8 @@ gr_status gr_exr_read(const char *path, gr_exr_image *out, char *err,
     rv = exr_get_scanlines_per_chunk(ctxt, 0, &lines);
     if (rv != EXR_ERR_SUCCESS || lines < 1) {
       st = GR_ERR_FORMAT;
-      set_err(
-          err, err_len,
-          "Cannot read '%s': its compression is not understood (OpenEXR: %s).",
-          path, exr_detail(&msg, rv));
+      set_err(err, err_len, "Cannot read '%s': its compression is not understood (OpenEXR: %s).",
+              path, exr_detail(&msg, rv));
       goto cleanup;
     }
     L.lines = lines;
@@ -420,13 +400,10 @@ gr_status gr_exr_read(const char *path, gr_exr_image *out, char *err,
     exr_tile_level_mode_t lmode;
     exr_tile_round_mode_t rmode;
     rv = exr_get_tile_descriptor(ctxt, 0, &tw, &th, &lmode, &rmode);
-    if (rv != EXR_ERR_SUCCESS || tw < 1 || th < 1 || tw > INT32_MAX ||
-        th > INT32_MAX) {
+    if (rv != EXR_ERR_SUCCESS || tw < 1 || th < 1 || tw > INT32_MAX || th > INT32_MAX) {
       st = GR_ERR_FORMAT;
-      set_err(
-          err, err_len,
-          "Cannot read '%s': its tile description is not valid (OpenEXR: %s).",
-          path, exr_detail(&msg, rv));
+      set_err(err, err_len, "Cannot read '%s': its tile description is not valid (OpenEXR: %s).",
+              path, exr_detail(&msg, rv));
       goto cleanup;
     }
     L.tiled = 1;
@@ -443,10 +420,9 @@ gr_status gr_exr_read(const char *path, gr_exr_image *out, char *err,
       img.width = (int)L.width;
       img.height = (int)L.height;
       img.names = (char **)calloc((size_t)chlist->num_channels, sizeof(char *));
-      img.types = (gr_exr_pixel_type *)calloc((size_t)chlist->num_channels,
-                                              sizeof(gr_exr_pixel_type));
-      img.data =
-          (float **)calloc((size_t)chlist->num_channels, sizeof(float *));
+      img.types =
+          (gr_exr_pixel_type *)calloc((size_t)chlist->num_channels, sizeof(gr_exr_pixel_type));
+      img.data = (float **)calloc((size_t)chlist->num_channels, sizeof(float *));
       if (img.names == NULL || img.types == NULL || img.data == NULL) {
         st = GR_ERR_OUT_OF_MEMORY;
         set_err(err, err_len, "Cannot read '%s': out of memory.", path);
@@ -467,14 +443,13 @@ gr_status gr_exr_read(const char *path, gr_exr_image *out, char *err,
           goto cleanup;
         }
         memcpy(img.names[c], e->name.str, len + 1);
-        img.types[c] =
-            e->pixel_type == EXR_PIXEL_HALF ? GR_EXR_HALF : GR_EXR_FLOAT;
+        img.types[c] = e->pixel_type == EXR_PIXEL_HALF ? GR_EXR_HALF : GR_EXR_FLOAT;
       }
       for (c = 0; c < (size_t)img.nchannels; ++c) {
         if (gr_exr_find_channel(&img, img.names[c]) != (int)c) {
           st = GR_ERR_FORMAT;
-          set_err(err, err_len, "Cannot read '%s': channel '%s' appears twice.",
-                  path, img.names[c]);
+          set_err(err, err_len, "Cannot read '%s': channel '%s' appears twice.", path,
+                  img.names[c]);
           goto cleanup;
         }
       }
@@ -536,21 +511,19 @@ static exr_result_t compress_or_store(exr_encode_pipeline_t *enc) {
   rv = hook->compress(enc);
   if (rv != EXR_ERR_SUCCESS)
     return rv;
-  if (enc->compressed_bytes >= enc->packed_bytes &&
-      enc->compressed_buffer != enc->packed_buffer) {
+  if (enc->compressed_bytes >= enc->packed_bytes && enc->compressed_buffer != enc->packed_buffer) {
     if (enc->compressed_buffer == NULL || enc->packed_buffer == NULL ||
         enc->compressed_alloc_size < enc->packed_bytes)
       return EXR_ERR_INVALID_ARGUMENT;
-    memcpy(enc->compressed_buffer, enc->packed_buffer,
-           (size_t)enc->packed_bytes);
+    memcpy(enc->compressed_buffer, enc->packed_buffer, (size_t)enc->packed_bytes);
     enc->compressed_bytes = (size_t)enc->packed_bytes;
   }
   return EXR_ERR_SUCCESS;
 }
 
 gr_status gr_exr_write(const char *path, int width, int height, int nchannels,
-                       const char *const *names, const float *const *data,
-                       gr_exr_pixel_type type, char *err, size_t err_len) {
+                       const char *const *names, const float *const *data, gr_exr_pixel_type type,
+                       char *err, size_t err_len) {
   gr_status st = GR_OK;
   exr_result_t rv = EXR_ERR_SUCCESS;
   exr_context_t ctxt = NULL;
@@ -572,41 +545,33 @@ gr_status gr_exr_write(const char *path, int width, int height, int nchannels,
   hook.compress = NULL;
 
   if (path == NULL || path[0] == '\0') {
-    set_err(err, err_len,
-            "The path given to gr_exr_write must not be NULL or empty.");
+    set_err(err, err_len, "The path given to gr_exr_write must not be NULL or empty.");
     return GR_ERR_INVALID_ARGUMENT;
   }
-  if (width < 1 || height < 1 || width > GR_EXR_MAX_DIM ||
-      height > GR_EXR_MAX_DIM) {
-    set_err(err, err_len,
-            "Cannot write '%s': the image is %d by %d pixels, outside 1 to %d.",
-            path, width, height, GR_EXR_MAX_DIM);
+  if (width < 1 || height < 1 || width > GR_EXR_MAX_DIM || height > GR_EXR_MAX_DIM) {
+    set_err(err, err_len, "Cannot write '%s': the image is %d by %d pixels, outside 1 to %d.", path,
+            width, height, GR_EXR_MAX_DIM);
     return GR_ERR_INVALID_ARGUMENT;
   }
   if (nchannels < 1 || nchannels > INT16_MAX) {
-    set_err(
-        err, err_len,
-        "Cannot write '%s': %d channels were given, and 1 to %d are allowed.",
-        path, nchannels, INT16_MAX);
+    set_err(err, err_len, "Cannot write '%s': %d channels were given, and 1 to %d are allowed.",
+            path, nchannels, INT16_MAX);
     return GR_ERR_INVALID_ARGUMENT;
   }
   if (type != GR_EXR_HALF && type != GR_EXR_FLOAT) {
-    set_err(err, err_len,
-            "Cannot write '%s': the pixel type %d is neither HALF nor FLOAT.",
-            path, (int)type);
+    set_err(err, err_len, "Cannot write '%s': the pixel type %d is neither HALF nor FLOAT.", path,
+            (int)type);
     return GR_ERR_INVALID_ARGUMENT;
   }
   if (names == NULL || data == NULL) {
-    set_err(err, err_len,
-            "Cannot write '%s': the channel names or data are missing.", path);
+    set_err(err, err_len, "Cannot write '%s': the channel names or data are missing.", path);
     return GR_ERR_INVALID_ARGUMENT;
   }
   for (c = 0; c < nchannels; ++c) {
     int k;
     size_t len;
     if (names[c] == NULL || names[c][0] == '\0') {
-      set_err(err, err_len, "Cannot write '%s': channel %d has no name.", path,
-              c);
+      set_err(err, err_len, "Cannot write '%s': channel %d has no name.", path, c);
       return GR_ERR_INVALID_ARGUMENT;
     }
     len = strlen(names[c]);
@@ -620,15 +585,13 @@ gr_status gr_exr_write(const char *path, int width, int height, int nchannels,
     if (len > 31)
       longnames = 1;
     if (data[c] == NULL) {
-      set_err(err, err_len, "Cannot write '%s': channel '%s' has no data.",
-              path, names[c]);
+      set_err(err, err_len, "Cannot write '%s': channel '%s' has no data.", path, names[c]);
       return GR_ERR_INVALID_ARGUMENT;
     }
     for (k = 0; k < c; ++k) {
       if (strcmp(names[k], names[c]) == 0) {
-        set_err(err, err_len,
-                "Cannot write '%s': the channel name '%s' is given twice.",
-                path, names[c]);
+        set_err(err, err_len, "Cannot write '%s': the channel name '%s' is given twice.", path,
+                names[c]);
         return GR_ERR_INVALID_ARGUMENT;
       }
     }
@@ -637,8 +600,7 @@ gr_status gr_exr_write(const char *path, int width, int height, int nchannels,
     set_err(err, err_len,
             "Cannot write '%s': %d by %d pixels in %d channels is more than "
             "the %llu samples allowed.",
-            path, width, height, nchannels,
-            (unsigned long long)GR_EXR_MAX_SAMPLES);
+            path, width, height, nchannels, (unsigned long long)GR_EXR_MAX_SAMPLES);
     return GR_ERR_INVALID_ARGUMENT;
   }
   ptype = type == GR_EXR_HALF ? EXR_PIXEL_HALF : EXR_PIXEL_FLOAT;
@@ -649,9 +611,8 @@ gr_status gr_exr_write(const char *path, int width, int height, int nchannels,
   rv = exr_start_write(&ctxt, path, EXR_WRITE_FILE_DIRECTLY, &init);
   if (rv != EXR_ERR_SUCCESS) {
     st = rv == EXR_ERR_OUT_OF_MEMORY ? GR_ERR_OUT_OF_MEMORY : GR_ERR_IO;
-    set_err(err, err_len,
-            "Cannot write '%s': the file cannot be created (OpenEXR: %s).",
-            path, exr_detail(&msg, rv));
+    set_err(err, err_len, "Cannot write '%s': the file cannot be created (OpenEXR: %s).", path,
+            exr_detail(&msg, rv));
     goto cleanup;
   }
   file_created = 1;
@@ -661,11 +622,9 @@ gr_status gr_exr_write(const char *path, int width, int height, int nchannels,
   if (rv == EXR_ERR_SUCCESS)
     rv = exr_add_part(ctxt, NULL, EXR_STORAGE_SCANLINE, &part);
   if (rv == EXR_ERR_SUCCESS)
-    rv = exr_initialize_required_attr_simple(ctxt, part, width, height,
-                                             EXR_COMPRESSION_ZIP);
+    rv = exr_initialize_required_attr_simple(ctxt, part, width, height, EXR_COMPRESSION_ZIP);
   for (c = 0; c < nchannels && rv == EXR_ERR_SUCCESS; ++c)
-    rv = exr_add_channel(ctxt, part, names[c], ptype, EXR_PERCEPTUALLY_LINEAR,
-                         1, 1);
+    rv = exr_add_channel(ctxt, part, names[c], ptype, EXR_PERCEPTUALLY_LINEAR, 1, 1);
   if (rv == EXR_ERR_SUCCESS)
     rv = exr_write_header(ctxt);
   if (rv == EXR_ERR_SUCCESS)
@@ -674,9 +633,8 @@ gr_status gr_exr_write(const char *path, int width, int height, int nchannels,
     rv = EXR_ERR_INVALID_ARGUMENT;
   if (rv != EXR_ERR_SUCCESS) {
     st = rv == EXR_ERR_OUT_OF_MEMORY ? GR_ERR_OUT_OF_MEMORY : GR_ERR_IO;
-    set_err(err, err_len,
-            "Cannot write '%s': the header could not be written (OpenEXR: %s).",
-            path, exr_detail(&msg, rv));
+    set_err(err, err_len, "Cannot write '%s': the header could not be written (OpenEXR: %s).", path,
+            exr_detail(&msg, rv));
     goto cleanup;
   }
 
@@ -701,8 +659,7 @@ gr_status gr_exr_write(const char *path, int width, int height, int nchannels,
     int r;
     memset(&cinfo, 0, sizeof cinfo);
     rv = exr_write_scanline_chunk_info(ctxt, part, y, &cinfo);
-    if (rv == EXR_ERR_SUCCESS &&
-        (cinfo.height != nrows || cinfo.width != width))
+    if (rv == EXR_ERR_SUCCESS && (cinfo.height != nrows || cinfo.width != width))
       rv = EXR_ERR_INCORRECT_CHUNK;
     if (rv == EXR_ERR_SUCCESS) {
       if (!enc_live) {
@@ -741,8 +698,7 @@ gr_status gr_exr_write(const char *path, int width, int height, int nchannels,
     }
     if (rv == EXR_ERR_SUCCESS)
       rv = exr_encoding_choose_default_routines(ctxt, part, &enc);
-    if (rv == EXR_ERR_SUCCESS && enc.compress_fn != NULL &&
-        enc.compress_fn != &compress_or_store) {
+    if (rv == EXR_ERR_SUCCESS && enc.compress_fn != NULL && enc.compress_fn != &compress_or_store) {
       hook.compress = enc.compress_fn;
       enc.encoding_user_data = &hook;
       enc.compress_fn = &compress_or_store;
@@ -767,9 +723,8 @@ gr_status gr_exr_write(const char *path, int width, int height, int nchannels,
   rv = exr_finish(&ctxt);
   if (rv != EXR_ERR_SUCCESS) {
     st = GR_ERR_IO;
-    set_err(err, err_len,
-            "Cannot write '%s': the file could not be completed (OpenEXR: %s).",
-            path, exr_detail(&msg, rv));
+    set_err(err, err_len, "Cannot write '%s': the file could not be completed (OpenEXR: %s).", path,
+            exr_detail(&msg, rv));
     goto cleanup;
   }
 

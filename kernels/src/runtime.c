@@ -30,7 +30,7 @@ struct gr_context {
   cl_ulong max_alloc, global_mem;
   gr_log_fn log;
   void *log_user;
-  pthread_mutex_t lock; /* guards programs and error */
+  pthread_mutex_t lock;       /* guards programs and error */
   gr_program_entry *programs; /* grows: one entry per (source, options) */
   int nprograms, capacity;
   char error[GR_ERROR_LEN];
@@ -44,17 +44,28 @@ static _Thread_local char gr_thread_error[GR_ERROR_LEN];
 
 const char *gr_status_string(gr_status st) {
   switch (st) {
-  case GR_OK: return "GR_OK";
-  case GR_ERR_INVALID_ARGUMENT: return "GR_ERR_INVALID_ARGUMENT";
-  case GR_ERR_NO_PLATFORM: return "GR_ERR_NO_PLATFORM";
-  case GR_ERR_NO_DEVICE: return "GR_ERR_NO_DEVICE";
-  case GR_ERR_OPENCL: return "GR_ERR_OPENCL";
-  case GR_ERR_BUILD: return "GR_ERR_BUILD";
-  case GR_ERR_OUT_OF_MEMORY: return "GR_ERR_OUT_OF_MEMORY";
-  case GR_ERR_TOO_LARGE: return "GR_ERR_TOO_LARGE";
-  case GR_ERR_IO: return "GR_ERR_IO";
-  case GR_ERR_FORMAT: return "GR_ERR_FORMAT";
-  case GR_ERR_ABORTED: return "GR_ERR_ABORTED";
+  case GR_OK:
+    return "GR_OK";
+  case GR_ERR_INVALID_ARGUMENT:
+    return "GR_ERR_INVALID_ARGUMENT";
+  case GR_ERR_NO_PLATFORM:
+    return "GR_ERR_NO_PLATFORM";
+  case GR_ERR_NO_DEVICE:
+    return "GR_ERR_NO_DEVICE";
+  case GR_ERR_OPENCL:
+    return "GR_ERR_OPENCL";
+  case GR_ERR_BUILD:
+    return "GR_ERR_BUILD";
+  case GR_ERR_OUT_OF_MEMORY:
+    return "GR_ERR_OUT_OF_MEMORY";
+  case GR_ERR_TOO_LARGE:
+    return "GR_ERR_TOO_LARGE";
+  case GR_ERR_IO:
+    return "GR_ERR_IO";
+  case GR_ERR_FORMAT:
+    return "GR_ERR_FORMAT";
+  case GR_ERR_ABORTED:
+    return "GR_ERR_ABORTED";
   }
   return "GR_ERR_UNKNOWN";
 }
@@ -62,15 +73,14 @@ const char *gr_status_string(gr_status st) {
 const char *gr_version_string(void) {
 #define GR_STR2(x) #x
 #define GR_STR(x) GR_STR2(x)
-  return GR_STR(GRAUPEL_VERSION_MAJOR) "." GR_STR(
-      GRAUPEL_VERSION_MINOR) "." GR_STR(GRAUPEL_VERSION_PATCH);
+  return GR_STR(GRAUPEL_VERSION_MAJOR) "." GR_STR(GRAUPEL_VERSION_MINOR) "." GR_STR(
+      GRAUPEL_VERSION_PATCH);
 }
 
 static const char *const gr_field_names[GR_FIELD_COUNT] = {
-    "elevation",     "snow_depth", "snow_density", "snow_surface",
-    "overlap",       "exposure",   "water_depth",  "water_surface",
-    "velocity",      "discharge",  "infiltrated",  "permeability",
-    "rain_rate"};
+    "elevation",   "snow_depth",   "snow_density",  "snow_surface", "overlap",
+    "exposure",    "water_depth",  "water_surface", "velocity",     "discharge",
+    "infiltrated", "permeability", "rain_rate"};
 
 const char *gr_field_name(gr_field f) {
   return (f >= 0 && f < GR_FIELD_COUNT) ? gr_field_names[f] : NULL;
@@ -85,7 +95,9 @@ int gr_field_from_name(const char *name) {
   return -1;
 }
 
-int gr_field_components(gr_field f) { return f == GR_FIELD_VELOCITY ? 3 : 1; }
+int gr_field_components(gr_field f) {
+  return f == GR_FIELD_VELOCITY ? 3 : 1;
+}
 
 gr_status gr_grid_validate(const gr_grid *g, char *msg, size_t msg_len) {
   const char *why = NULL;
@@ -116,8 +128,7 @@ static void gr_log(const gr_context *ctx, gr_log_level level, const char *msg) {
     ctx->log(ctx->log_user, level, msg);
 }
 
-gr_status gr_set_error(const gr_context *cctx, gr_status st, const char *fmt,
-                       ...) {
+gr_status gr_set_error(const gr_context *cctx, gr_status st, const char *fmt, ...) {
   /* The error text is the one mutable part of a const context. */
   gr_context *ctx = (gr_context *)cctx;
   char *dst = ctx ? ctx->error : gr_thread_error;
@@ -140,8 +151,9 @@ const char *gr_last_error(const gr_context *ctx) {
 
 const char *gr_cl_error_name(cl_int err) {
   switch (err) {
-#define GR_CASE(e)                                                             \
-  case e: return #e;
+#define GR_CASE(e)                                                                                 \
+  case e:                                                                                          \
+    return #e;
     GR_CASE(CL_SUCCESS)
     GR_CASE(CL_DEVICE_NOT_FOUND)
     GR_CASE(CL_DEVICE_NOT_AVAILABLE)
@@ -198,7 +210,8 @@ const char *gr_cl_error_name(cl_int err) {
     GR_CASE(CL_INVALID_GLOBAL_WORK_SIZE)
     GR_CASE(CL_INVALID_PROPERTY)
 #undef GR_CASE
-  case -1001: return "CL_PLATFORM_NOT_FOUND_KHR";
+  case -1001:
+    return "CL_PLATFORM_NOT_FOUND_KHR";
   }
   return "an unknown OpenCL error";
 }
@@ -206,26 +219,23 @@ const char *gr_cl_error_name(cl_int err) {
 gr_status gr_cl_check(const gr_context *ctx, cl_int err, const char *what) {
   if (err == CL_SUCCESS)
     return GR_OK;
-  gr_status st = (err == CL_MEM_OBJECT_ALLOCATION_FAILURE ||
-                  err == CL_OUT_OF_HOST_MEMORY || err == CL_OUT_OF_RESOURCES)
+  gr_status st = (err == CL_MEM_OBJECT_ALLOCATION_FAILURE || err == CL_OUT_OF_HOST_MEMORY ||
+                  err == CL_OUT_OF_RESOURCES)
                      ? GR_ERR_OUT_OF_MEMORY
                      : GR_ERR_OPENCL;
-  return gr_set_error(ctx, st, "%s failed: %s (%d).", what,
-                      gr_cl_error_name(err), (int)err);
+  return gr_set_error(ctx, st, "%s failed: %s (%d).", what, gr_cl_error_name(err), (int)err);
 }
 
 /* ----------------------------------------------------------------- devices */
 
-static void gr_device_string(cl_device_id d, cl_device_info what, char *buf,
-                             size_t len) {
+static void gr_device_string(cl_device_id d, cl_device_info what, char *buf, size_t len) {
   buf[0] = '\0';
   if (clGetDeviceInfo(d, what, len, buf, NULL) != CL_SUCCESS)
     buf[0] = '\0';
   buf[len - 1] = '\0';
 }
 
-static void gr_fill_device_info(cl_platform_id p, cl_device_id d,
-                                gr_device_info *info) {
+static void gr_fill_device_info(cl_platform_id p, cl_device_id d, gr_device_info *info) {
   cl_device_type type = 0;
   cl_uint cu = 0;
   cl_ulong mem = 0, alloc = 0;
@@ -233,15 +243,14 @@ static void gr_fill_device_info(cl_platform_id p, cl_device_id d,
   gr_device_string(d, CL_DEVICE_NAME, info->name, sizeof(info->name));
   gr_device_string(d, CL_DEVICE_VENDOR, info->vendor, sizeof(info->vendor));
   gr_device_string(d, CL_DEVICE_VERSION, info->version, sizeof(info->version));
-  if (clGetPlatformInfo(p, CL_PLATFORM_NAME, sizeof(info->platform),
-                        info->platform, NULL) != CL_SUCCESS)
+  if (clGetPlatformInfo(p, CL_PLATFORM_NAME, sizeof(info->platform), info->platform, NULL) !=
+      CL_SUCCESS)
     info->platform[0] = '\0';
   info->platform[sizeof(info->platform) - 1] = '\0';
   clGetDeviceInfo(d, CL_DEVICE_TYPE, sizeof(type), &type, NULL);
   clGetDeviceInfo(d, CL_DEVICE_MAX_COMPUTE_UNITS, sizeof(cu), &cu, NULL);
   clGetDeviceInfo(d, CL_DEVICE_GLOBAL_MEM_SIZE, sizeof(mem), &mem, NULL);
-  clGetDeviceInfo(d, CL_DEVICE_MAX_MEM_ALLOC_SIZE, sizeof(alloc), &alloc,
-                  NULL);
+  clGetDeviceInfo(d, CL_DEVICE_MAX_MEM_ALLOC_SIZE, sizeof(alloc), &alloc, NULL);
   info->is_gpu = (type & CL_DEVICE_TYPE_GPU) != 0;
   info->is_cpu = (type & CL_DEVICE_TYPE_CPU) != 0;
   info->compute_units = (int)cu;
@@ -270,15 +279,12 @@ static gr_status gr_for_each_device(gr_device_visit visit, void *user) {
     return gr_cl_check(NULL, err, "Listing the OpenCL platforms");
   for (cl_uint p = 0; p < np; ++p) {
     cl_uint nd = 0;
-    if (clGetDeviceIDs(plats[p], CL_DEVICE_TYPE_ALL, 0, NULL, &nd) !=
-            CL_SUCCESS ||
-        nd == 0)
+    if (clGetDeviceIDs(plats[p], CL_DEVICE_TYPE_ALL, 0, NULL, &nd) != CL_SUCCESS || nd == 0)
       continue;
     cl_device_id devs[32];
     if (nd > 32)
       nd = 32;
-    if (clGetDeviceIDs(plats[p], CL_DEVICE_TYPE_ALL, nd, devs, NULL) !=
-        CL_SUCCESS)
+    if (clGetDeviceIDs(plats[p], CL_DEVICE_TYPE_ALL, nd, devs, NULL) != CL_SUCCESS)
       continue;
     for (cl_uint d = 0; d < nd; ++d)
       if (visit(user, plats[p], devs[d]))
@@ -322,8 +328,7 @@ static int gr_contains_nocase(const char *hay, const char *needle) {
   size_t n = strlen(needle);
   for (; *hay; ++hay) {
     size_t i = 0;
-    while (i < n && hay[i] &&
-           tolower((unsigned char)hay[i]) == tolower((unsigned char)needle[i]))
+    while (i < n && hay[i] && tolower((unsigned char)hay[i]) == tolower((unsigned char)needle[i]))
       ++i;
     if (i == n)
       return 1;
@@ -348,8 +353,7 @@ static int gr_pick_visit(void *user, cl_platform_id p, cl_device_id d) {
     s->first_cpu_p = p;
   }
   if (!s->match && s->want[0] &&
-      (gr_contains_nocase(info.name, s->want) ||
-       gr_contains_nocase(info.platform, s->want))) {
+      (gr_contains_nocase(info.name, s->want) || gr_contains_nocase(info.platform, s->want))) {
     s->match = d;
     s->match_p = p;
   }
@@ -366,8 +370,8 @@ static const char *gr_effective_request(const gr_context_options *opt) {
   return req;
 }
 
-static gr_status gr_pick_device(const gr_context_options *opt,
-                                cl_platform_id *pp, cl_device_id *pd) {
+static gr_status gr_pick_device(const gr_context_options *opt, cl_platform_id *pp,
+                                cl_device_id *pd) {
   const char *req = gr_effective_request(opt);
   gr_pick_state s;
   memset(&s, 0, sizeof(s));
@@ -388,21 +392,19 @@ static gr_status gr_pick_device(const gr_context_options *opt,
     *pp = s.first_cpu_p;
   } else if (want_auto) {
     *pd = s.first_gpu ? s.first_gpu : s.first_cpu ? s.first_cpu : s.first_any;
-    *pp = s.first_gpu ? s.first_gpu_p
-          : s.first_cpu ? s.first_cpu_p
-                        : s.first_any_p;
+    *pp = s.first_gpu ? s.first_gpu_p : s.first_cpu ? s.first_cpu_p : s.first_any_p;
   } else {
     *pd = s.match;
     *pp = s.match_p;
   }
   if (!*pd)
-    return gr_set_error(
-        NULL, GR_ERR_NO_DEVICE,
-        "No OpenCL device matches the request '%s' (from %s): use 'gpu', "
-        "'cpu', 'auto' or part of a device name that clinfo -l shows.",
-        req, (opt && opt->device && opt->device[0] && strcmp(opt->device, "auto"))
-                 ? "the device option"
-                 : "GRAUPEL_DEVICE");
+    return gr_set_error(NULL, GR_ERR_NO_DEVICE,
+                        "No OpenCL device matches the request '%s' (from %s): use 'gpu', "
+                        "'cpu', 'auto' or part of a device name that clinfo -l shows.",
+                        req,
+                        (opt && opt->device && opt->device[0] && strcmp(opt->device, "auto"))
+                            ? "the device option"
+                            : "GRAUPEL_DEVICE");
   return GR_OK;
 }
 
@@ -427,14 +429,12 @@ static void gr_context_free(gr_context *ctx) {
   free(ctx);
 }
 
-static gr_status gr_context_open(const gr_context_options *opt,
-                                 cl_platform_id p, cl_device_id d,
+static gr_status gr_context_open(const gr_context_options *opt, cl_platform_id p, cl_device_id d,
                                  gr_context **out) {
   cl_int err = CL_SUCCESS;
   gr_context *ctx = calloc(1, sizeof(*ctx));
   if (!ctx)
-    return gr_set_error(NULL, GR_ERR_OUT_OF_MEMORY,
-                        "Out of host memory while creating a context.");
+    return gr_set_error(NULL, GR_ERR_OUT_OF_MEMORY, "Out of host memory while creating a context.");
   pthread_mutex_init(&ctx->lock, NULL);
   ctx->refcount = 1;
   ctx->platform = p;
@@ -451,8 +451,7 @@ static gr_status gr_context_open(const gr_context_options *opt,
   ctx->max_alloc = info.max_alloc_bytes;
   ctx->global_mem = info.global_mem_bytes;
 
-  cl_context_properties props[] = {CL_CONTEXT_PLATFORM,
-                                   (cl_context_properties)p, 0};
+  cl_context_properties props[] = {CL_CONTEXT_PLATFORM, (cl_context_properties)p, 0};
   ctx->cl = clCreateContext(props, 1, &d, NULL, NULL, &err);
   if (err != CL_SUCCESS) {
     gr_status st = gr_cl_check(NULL, err, "Creating the OpenCL context");
@@ -474,8 +473,8 @@ static gr_status gr_context_open(const gr_context_options *opt,
     return st;
   }
   char line[400];
-  snprintf(line, sizeof(line), "Graupel uses OpenCL device '%s' (%s).",
-           ctx->device_name, ctx->platform_name);
+  snprintf(line, sizeof(line), "Graupel uses OpenCL device '%s' (%s).", ctx->device_name,
+           ctx->platform_name);
   gr_log(ctx, GR_LOG_INFO, line);
   *out = ctx;
   return GR_OK;
@@ -518,8 +517,7 @@ gr_status gr_context_acquire(const gr_context_options *opt, gr_context **out) {
       slot = i;
   if (slot < 0) {
     pthread_mutex_unlock(&gr_shared_lock);
-    return gr_set_error(NULL, GR_ERR_TOO_LARGE,
-                        "More than %d OpenCL devices are in use at once.",
+    return gr_set_error(NULL, GR_ERR_TOO_LARGE, "More than %d OpenCL devices are in use at once.",
                         GR_MAX_SHARED);
   }
   st = gr_context_open(opt, p, d, out);
@@ -569,8 +567,12 @@ const char *gr_context_device_name(const gr_context *ctx) {
 const char *gr_context_platform_name(const gr_context *ctx) {
   return ctx ? ctx->platform_name : "";
 }
-int gr_context_is_gpu(const gr_context *ctx) { return ctx ? ctx->is_gpu : 0; }
-cl_context gr_context_cl(const gr_context *ctx) { return ctx ? ctx->cl : NULL; }
+int gr_context_is_gpu(const gr_context *ctx) {
+  return ctx ? ctx->is_gpu : 0;
+}
+cl_context gr_context_cl(const gr_context *ctx) {
+  return ctx ? ctx->cl : NULL;
+}
 cl_command_queue gr_context_queue(const gr_context *ctx) {
   return ctx ? ctx->queue : NULL;
 }
@@ -588,9 +590,8 @@ gr_status gr_context_device_info(const gr_context *ctx, gr_device_info *info) {
 
 /* ---------------------------------------------------------------- programs */
 
-static gr_status gr_build(gr_context *ctx, const char *label,
-                          const char *source, const char *options,
-                          cl_program *out) {
+static gr_status gr_build(gr_context *ctx, const char *label, const char *source,
+                          const char *options, cl_program *out) {
   cl_int err = CL_SUCCESS;
   const char *src[1] = {source};
   cl_program prog = clCreateProgramWithSource(ctx->cl, 1, src, NULL, &err);
@@ -603,17 +604,15 @@ static gr_status gr_build(gr_context *ctx, const char *label,
   if (err != CL_SUCCESS) {
     size_t len = 0;
     char *log = NULL;
-    clGetProgramBuildInfo(prog, ctx->device, CL_PROGRAM_BUILD_LOG, 0, NULL,
-                          &len);
+    clGetProgramBuildInfo(prog, ctx->device, CL_PROGRAM_BUILD_LOG, 0, NULL, &len);
     if (len > 0 && (log = malloc(len + 1)) != NULL) {
-      if (clGetProgramBuildInfo(prog, ctx->device, CL_PROGRAM_BUILD_LOG, len,
-                                log, NULL) != CL_SUCCESS)
+      if (clGetProgramBuildInfo(prog, ctx->device, CL_PROGRAM_BUILD_LOG, len, log, NULL) !=
+          CL_SUCCESS)
         log[0] = '\0';
       log[len] = '\0';
     }
     gr_status st = gr_set_error(
-        ctx, GR_ERR_BUILD,
-        "The OpenCL program '%s' failed to build on '%s' (%s). Build log:\n%s",
+        ctx, GR_ERR_BUILD, "The OpenCL program '%s' failed to build on '%s' (%s). Build log:\n%s",
         label, ctx->device_name, gr_cl_error_name(err),
         log && log[0] ? log : "(the driver gave no log)");
     free(log);
@@ -624,8 +623,8 @@ static gr_status gr_build(gr_context *ctx, const char *label,
   return GR_OK;
 }
 
-gr_status gr_program_build_source(gr_context *ctx, const char *source,
-                                  const char *options, cl_program *out) {
+gr_status gr_program_build_source(gr_context *ctx, const char *source, const char *options,
+                                  cl_program *out) {
   if (!ctx || !source || !out)
     return gr_set_error(ctx, GR_ERR_INVALID_ARGUMENT,
                         "gr_program_build_source needs a context, a source "
@@ -634,8 +633,7 @@ gr_status gr_program_build_source(gr_context *ctx, const char *source,
   return gr_build(ctx, "(user source)", source, options, out);
 }
 
-gr_status gr_program_get(gr_context *ctx, const char *name,
-                         const char *options, cl_program *out) {
+gr_status gr_program_get(gr_context *ctx, const char *name, const char *options, cl_program *out) {
   if (!ctx || !name || !out)
     return gr_set_error(ctx, GR_ERR_INVALID_ARGUMENT,
                         "gr_program_get needs a context, a name and a place "
@@ -644,8 +642,7 @@ gr_status gr_program_get(gr_context *ctx, const char *name,
   const char *source = gr_kernel_source_find(name);
   if (!source)
     return gr_set_error(ctx, GR_ERR_INVALID_ARGUMENT,
-                        "No kernel source named '%s' is built into Graupel.",
-                        name);
+                        "No kernel source named '%s' is built into Graupel.", name);
   if (!options)
     options = "";
   size_t klen = strlen(name) + strlen(options) + 2;
@@ -682,8 +679,7 @@ gr_status gr_program_get(gr_context *ctx, const char *name,
     }
   if (ctx->nprograms == ctx->capacity) {
     int cap = ctx->capacity ? 2 * ctx->capacity : 16;
-    gr_program_entry *grown =
-        realloc(ctx->programs, (size_t)cap * sizeof(*grown));
+    gr_program_entry *grown = realloc(ctx->programs, (size_t)cap * sizeof(*grown));
     if (!grown) {
       pthread_mutex_unlock(&ctx->lock);
       clReleaseProgram(prog);
@@ -701,8 +697,7 @@ gr_status gr_program_get(gr_context *ctx, const char *name,
   return GR_OK;
 }
 
-gr_status gr_kernel_create(gr_context *ctx, cl_program prog, const char *name,
-                           cl_kernel *out) {
+gr_status gr_kernel_create(gr_context *ctx, cl_program prog, const char *name, cl_kernel *out) {
   cl_int err = CL_SUCCESS;
   if (!ctx || !prog || !name || !out)
     return gr_set_error(ctx, GR_ERR_INVALID_ARGUMENT,
@@ -711,8 +706,7 @@ gr_status gr_kernel_create(gr_context *ctx, cl_program prog, const char *name,
   *out = clCreateKernel(prog, name, &err);
   if (err != CL_SUCCESS) {
     *out = NULL;
-    return gr_set_error(ctx, GR_ERR_OPENCL,
-                        "The kernel '%s' could not be created: %s.", name,
+    return gr_set_error(ctx, GR_ERR_OPENCL, "The kernel '%s' could not be created: %s.", name,
                         gr_cl_error_name(err));
   }
   return GR_OK;
@@ -732,8 +726,7 @@ gr_status gr_kernel_args(gr_context *ctx, cl_kernel k, ...) {
       char kname[128] = "";
       clGetKernelInfo(k, CL_KERNEL_FUNCTION_NAME, sizeof(kname), kname, NULL);
       kname[sizeof(kname) - 1] = '\0';
-      return gr_set_error(ctx, GR_ERR_OPENCL,
-                          "Setting argument %u of kernel '%s' failed: %s.", i,
+      return gr_set_error(ctx, GR_ERR_OPENCL, "Setting argument %u of kernel '%s' failed: %s.", i,
                           kname, gr_cl_error_name(err));
     }
   }
@@ -741,15 +734,13 @@ gr_status gr_kernel_args(gr_context *ctx, cl_kernel k, ...) {
   return GR_OK;
 }
 
-gr_status gr_enqueue_2d(gr_context *ctx, cl_kernel k, size_t nx, size_t ny,
-                        const size_t *local) {
+gr_status gr_enqueue_2d(gr_context *ctx, cl_kernel k, size_t nx, size_t ny, const size_t *local) {
   size_t global[2] = {nx, ny};
   if (local) {
     global[0] = (nx + local[0] - 1) / local[0] * local[0];
     global[1] = (ny + local[1] - 1) / local[1] * local[1];
   }
-  cl_int err = clEnqueueNDRangeKernel(ctx->queue, k, 2, NULL, global, local, 0,
-                                      NULL, NULL);
+  cl_int err = clEnqueueNDRangeKernel(ctx->queue, k, 2, NULL, global, local, 0, NULL, NULL);
   return gr_cl_check(ctx, err, "Enqueueing a kernel");
 }
 
@@ -763,11 +754,12 @@ gr_status gr_finish(gr_context *ctx) {
 extern const gr_kernel_source gr_embedded_kernels[];
 extern const int gr_embedded_kernel_count;
 
-int gr_kernel_source_count(void) { return gr_embedded_kernel_count; }
+int gr_kernel_source_count(void) {
+  return gr_embedded_kernel_count;
+}
 
 const gr_kernel_source *gr_kernel_source_at(int i) {
-  return (i >= 0 && i < gr_embedded_kernel_count) ? &gr_embedded_kernels[i]
-                                                  : NULL;
+  return (i >= 0 && i < gr_embedded_kernel_count) ? &gr_embedded_kernels[i] : NULL;
 }
 
 const char *gr_kernel_source_find(const char *name) {
@@ -779,19 +771,18 @@ const char *gr_kernel_source_find(const char *name) {
 
 /* ----------------------------------------------------------------- buffers */
 
-gr_status gr_buffer_create(gr_context *ctx, cl_mem_flags flags, size_t size,
-                           const void *host, cl_mem *out) {
+gr_status gr_buffer_create(gr_context *ctx, cl_mem_flags flags, size_t size, const void *host,
+                           cl_mem *out) {
   if (!ctx || !out || size == 0)
     return gr_set_error(ctx, GR_ERR_INVALID_ARGUMENT,
                         "A device buffer needs a context and a size above 0.");
   *out = NULL;
   if ((cl_ulong)size > ctx->max_alloc || (cl_ulong)size > ctx->global_mem)
-    return gr_set_error(
-        ctx, GR_ERR_TOO_LARGE,
-        "The grid needs a buffer of %.1f MiB but the device '%s' allows at "
-        "most %.1f MiB per buffer: use a smaller grid or another device.",
-        (double)size / 1048576.0, ctx->device_name,
-        (double)ctx->max_alloc / 1048576.0);
+    return gr_set_error(ctx, GR_ERR_TOO_LARGE,
+                        "The grid needs a buffer of %.1f MiB but the device '%s' allows at "
+                        "most %.1f MiB per buffer: use a smaller grid or another device.",
+                        (double)size / 1048576.0, ctx->device_name,
+                        (double)ctx->max_alloc / 1048576.0);
   cl_int err = CL_SUCCESS;
   if (host)
     flags |= CL_MEM_COPY_HOST_PTR;
@@ -803,17 +794,14 @@ gr_status gr_buffer_create(gr_context *ctx, cl_mem_flags flags, size_t size,
   return GR_OK;
 }
 
-gr_status gr_buffer_write(gr_context *ctx, cl_mem buf, size_t offset,
-                          size_t size, const void *host) {
-  cl_int err = clEnqueueWriteBuffer(ctx->queue, buf, CL_TRUE, offset, size,
-                                    host, 0, NULL, NULL);
+gr_status gr_buffer_write(gr_context *ctx, cl_mem buf, size_t offset, size_t size,
+                          const void *host) {
+  cl_int err = clEnqueueWriteBuffer(ctx->queue, buf, CL_TRUE, offset, size, host, 0, NULL, NULL);
   return gr_cl_check(ctx, err, "Uploading a field to the device");
 }
 
-gr_status gr_buffer_read(gr_context *ctx, cl_mem buf, size_t offset,
-                         size_t size, void *host) {
-  cl_int err = clEnqueueReadBuffer(ctx->queue, buf, CL_TRUE, offset, size,
-                                   host, 0, NULL, NULL);
+gr_status gr_buffer_read(gr_context *ctx, cl_mem buf, size_t offset, size_t size, void *host) {
+  cl_int err = clEnqueueReadBuffer(ctx->queue, buf, CL_TRUE, offset, size, host, 0, NULL, NULL);
   return gr_cl_check(ctx, err, "Reading a field back from the device");
 }
 

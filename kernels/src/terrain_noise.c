@@ -42,16 +42,14 @@ static int gr_in_range(double v, double lo, double hi) {
   return v >= lo && v <= hi; /* false for NaN */
 }
 
-gr_status gr_terrain_noise_params_validate(const gr_terrain_noise_params *p,
-                                           char *msg, size_t msg_len) {
+gr_status gr_terrain_noise_params_validate(const gr_terrain_noise_params *p, char *msg,
+                                           size_t msg_len) {
   const char *why = NULL;
   if (!p)
     why = "no parameters were given";
-  else if (p->type != GR_NOISE_RIDGED && p->type != GR_NOISE_FBM &&
-           p->type != GR_NOISE_BILLOW)
+  else if (p->type != GR_NOISE_RIDGED && p->type != GR_NOISE_FBM && p->type != GR_NOISE_BILLOW)
     why = "NoiseType must be 0 (ridged multifractal), 1 (fBm) or 2 (billow)";
-  else if (p->octaves < GR_TERRAIN_NOISE_OCTAVES_MIN ||
-           p->octaves > GR_TERRAIN_NOISE_OCTAVES_MAX)
+  else if (p->octaves < GR_TERRAIN_NOISE_OCTAVES_MIN || p->octaves > GR_TERRAIN_NOISE_OCTAVES_MAX)
     why = "Octaves must lie between 1 and 16";
   else if (!(p->frequency > 0.0) || p->frequency > 1e4)
     why = "Frequency must be above 0 and at most 10000 cycles per km";
@@ -95,13 +93,12 @@ static gr_status gr_terrain_noise_upload(gr_terrain_noise *t) {
     double ext_x = fabs(X) + ((double)g->i0 + g->nx) * g->dx * f * m;
     double ext_y = fabs(Y) + ((double)g->j0 + g->ny) * g->dy * f * m;
     if (ext_x > GR_LATTICE_LIMIT || ext_y > GR_LATTICE_LIMIT)
-      return gr_set_error(
-          t->ctx, GR_ERR_INVALID_ARGUMENT,
-          "Invalid terrain noise parameters: octave %d would need lattice "
-          "coordinates beyond %.0e (origin or extent times Frequency times "
-          "Lacunarity^%d is too large); lower Frequency, Octaves or move "
-          "the Origin closer to 0.",
-          o + 1, GR_LATTICE_LIMIT, o);
+      return gr_set_error(t->ctx, GR_ERR_INVALID_ARGUMENT,
+                          "Invalid terrain noise parameters: octave %d would need lattice "
+                          "coordinates beyond %.0e (origin or extent times Frequency times "
+                          "Lacunarity^%d is too large); lower Frequency, Octaves or move "
+                          "the Origin closer to 0.",
+                          o + 1, GR_LATTICE_LIMIT, o);
     double lx = floor(X), ly = floor(Y);
     table[o].s[0] = (cl_float)(X - lx);
     table[o].s[1] = (cl_float)(Y - ly);
@@ -122,8 +119,7 @@ static gr_status gr_terrain_noise_upload(gr_terrain_noise *t) {
 }
 
 gr_status gr_terrain_noise_create(gr_context *ctx, const gr_grid *grid,
-                                  const gr_terrain_noise_params *p,
-                                  gr_terrain_noise **out) {
+                                  const gr_terrain_noise_params *p, gr_terrain_noise **out) {
   char msg[256];
   if (!ctx || !out)
     return gr_set_error(ctx, GR_ERR_INVALID_ARGUMENT,
@@ -144,25 +140,22 @@ gr_status gr_terrain_noise_create(gr_context *ctx, const gr_grid *grid,
   cl_program prog = NULL;
   size_t bytes = (size_t)grid->nx * (size_t)grid->ny * sizeof(cl_float);
   char options[96];
-  snprintf(options, sizeof(options), "-DGR_TERRAIN_OCTAVES=%d -DGR_TERRAIN_KIND=%d",
-           p->octaves, (int)p->type);
+  snprintf(options, sizeof(options), "-DGR_TERRAIN_OCTAVES=%d -DGR_TERRAIN_KIND=%d", p->octaves,
+           (int)p->type);
   gr_status st = gr_program_get(ctx, "terrain_noise", options, &prog);
   if (st == GR_OK)
     st = gr_kernel_create(ctx, prog, "terrain_noise_generate", &t->kernel);
   if (st == GR_OK)
     st = gr_buffer_create(ctx, CL_MEM_WRITE_ONLY, bytes, NULL, &t->elevation);
   if (st == GR_OK)
-    st = gr_buffer_create(ctx, CL_MEM_READ_ONLY,
-                          GR_TERRAIN_NOISE_OCTAVES_MAX * sizeof(cl_float4),
+    st = gr_buffer_create(ctx, CL_MEM_READ_ONLY, GR_TERRAIN_NOISE_OCTAVES_MAX * sizeof(cl_float4),
                           NULL, &t->table);
   if (st == GR_OK)
-    st = gr_buffer_create(ctx, CL_MEM_READ_ONLY,
-                          GR_TERRAIN_NOISE_OCTAVES_MAX * sizeof(cl_float), NULL,
-                          &t->amp);
+    st = gr_buffer_create(ctx, CL_MEM_READ_ONLY, GR_TERRAIN_NOISE_OCTAVES_MAX * sizeof(cl_float),
+                          NULL, &t->amp);
   if (st == GR_OK)
-    st = gr_buffer_create(ctx, CL_MEM_READ_ONLY,
-                          GR_TERRAIN_NOISE_OCTAVES_MAX * sizeof(cl_int2), NULL,
-                          &t->lattice);
+    st = gr_buffer_create(ctx, CL_MEM_READ_ONLY, GR_TERRAIN_NOISE_OCTAVES_MAX * sizeof(cl_int2),
+                          NULL, &t->lattice);
   if (st == GR_OK)
     st = gr_terrain_noise_upload(t);
   if (st != GR_OK) {
@@ -173,8 +166,7 @@ gr_status gr_terrain_noise_create(gr_context *ctx, const gr_grid *grid,
   return GR_OK;
 }
 
-gr_status gr_terrain_noise_set_params(gr_terrain_noise *t,
-                                      const gr_terrain_noise_params *p) {
+gr_status gr_terrain_noise_set_params(gr_terrain_noise *t, const gr_terrain_noise_params *p) {
   char msg[256];
   if (!t)
     return gr_set_error(NULL, GR_ERR_INVALID_ARGUMENT,
@@ -202,13 +194,11 @@ gr_status gr_terrain_noise_compute(gr_terrain_noise *t) {
   cl_float offset = (cl_float)p->offset, gain = (cl_float)p->gain;
   cl_float hs = (cl_float)p->height_scale;
   gr_status st = gr_kernel_args(
-      t->ctx, t->kernel, sizeof(cl_mem), &t->elevation, sizeof(cl_int), &nx,
-      sizeof(cl_int), &ny, sizeof(cl_int), &i0, sizeof(cl_int), &j0,
-      sizeof(cl_mem), &t->table, sizeof(cl_mem), &t->amp,
-      sizeof(cl_mem), &t->lattice, sizeof(cl_uint), &seed, sizeof(cl_int),
-      &kind, sizeof(cl_int), &octaves, sizeof(cl_float), &offset,
-      sizeof(cl_float), &gain, sizeof(cl_int), &invert, sizeof(cl_float), &hs,
-      (size_t)0);
+      t->ctx, t->kernel, sizeof(cl_mem), &t->elevation, sizeof(cl_int), &nx, sizeof(cl_int), &ny,
+      sizeof(cl_int), &i0, sizeof(cl_int), &j0, sizeof(cl_mem), &t->table, sizeof(cl_mem), &t->amp,
+      sizeof(cl_mem), &t->lattice, sizeof(cl_uint), &seed, sizeof(cl_int), &kind, sizeof(cl_int),
+      &octaves, sizeof(cl_float), &offset, sizeof(cl_float), &gain, sizeof(cl_int), &invert,
+      sizeof(cl_float), &hs, (size_t)0);
   if (st != GR_OK)
     return st;
   const size_t local[2] = {16, 16};
@@ -216,8 +206,7 @@ gr_status gr_terrain_noise_compute(gr_terrain_noise *t) {
                        gr_context_is_gpu(t->ctx) ? local : NULL);
 }
 
-gr_status gr_terrain_noise_get_field(gr_terrain_noise *t, gr_field f,
-                                     float *host) {
+gr_status gr_terrain_noise_get_field(gr_terrain_noise *t, gr_field f, float *host) {
   if (!t || !host)
     return gr_set_error(t ? t->ctx : NULL, GR_ERR_INVALID_ARGUMENT,
                         "gr_terrain_noise_get_field needs a generator and "
@@ -245,8 +234,7 @@ void gr_terrain_noise_destroy(gr_terrain_noise *t) {
 }
 
 gr_status gr_terrain_noise_generate(gr_context *ctx, const gr_grid *grid,
-                                    const gr_terrain_noise_params *p,
-                                    float *host) {
+                                    const gr_terrain_noise_params *p, float *host) {
   gr_terrain_noise *t = NULL;
   if (!host)
     return gr_set_error(ctx, GR_ERR_INVALID_ARGUMENT,

@@ -34,16 +34,13 @@ int main(int argc, char **argv) {
        * treat warnings as errors so they are fixed, not scrolled past. */
       char log[8192] = "";
       cl_device_id dev = gr_context_device(ctx);
-      clGetProgramBuildInfo(prog, dev, CL_PROGRAM_BUILD_LOG, sizeof(log), log,
-                            NULL);
+      clGetProgramBuildInfo(prog, dev, CL_PROGRAM_BUILD_LOG, sizeof(log), log, NULL);
       log[sizeof(log) - 1] = '\0';
       if (strstr(log, "warning")) {
-        fprintf(stderr, "graupel-clc: %s.cl has warnings:\n%s\n", src->name,
-                log);
+        fprintf(stderr, "graupel-clc: %s.cl has warnings:\n%s\n", src->name, log);
         failed = 1;
       } else {
-        printf("graupel-clc: %s.cl compiles on %s\n", src->name,
-               gr_context_device_name(ctx));
+        printf("graupel-clc: %s.cl compiles on %s\n", src->name, gr_context_device_name(ctx));
       }
     }
   }

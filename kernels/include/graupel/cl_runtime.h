@@ -31,8 +31,7 @@ GR_API cl_device_id gr_context_device(const gr_context *ctx);
  * Records a formatted sentence as the context's last error and returns st.
  * ctx may be NULL (the per-thread error is set).
  */
-GR_API gr_status gr_set_error(const gr_context *ctx, gr_status st,
-                              const char *fmt, ...)
+GR_API gr_status gr_set_error(const gr_context *ctx, gr_status st, const char *fmt, ...)
 #if defined(__GNUC__)
     __attribute__((format(printf, 3, 4)))
 #endif
@@ -43,8 +42,7 @@ GR_API gr_status gr_set_error(const gr_context *ctx, gr_status st,
  * "<what> failed: <CL error name>." and returns GR_ERR_OPENCL (or
  * GR_ERR_OUT_OF_MEMORY for allocation failures).
  */
-GR_API gr_status gr_cl_check(const gr_context *ctx, cl_int err,
-                             const char *what);
+GR_API gr_status gr_cl_check(const gr_context *ctx, cl_int err, const char *what);
 
 /**
  * The program for an embedded kernel source ("terrain_noise", "bench", ...),
@@ -52,33 +50,33 @@ GR_API gr_status gr_cl_check(const gr_context *ctx, cl_int err,
  * owned by the context: do not release it. A failed build gives GR_ERR_BUILD
  * and the build log in gr_last_error.
  */
-GR_API gr_status gr_program_get(gr_context *ctx, const char *name,
-                                const char *options, cl_program *out);
+GR_API gr_status gr_program_get(gr_context *ctx, const char *name, const char *options,
+                                cl_program *out);
 
 /**
  * Builds a program from the given source (not cached; caller releases).
  * Used for user kernels and tests; the build log is in the error on failure.
  */
-GR_API gr_status gr_program_build_source(gr_context *ctx, const char *source,
-                                         const char *options, cl_program *out);
+GR_API gr_status gr_program_build_source(gr_context *ctx, const char *source, const char *options,
+                                         cl_program *out);
 
 /** A kernel by name from a program (caller releases with clReleaseKernel). */
-GR_API gr_status gr_kernel_create(gr_context *ctx, cl_program prog,
-                                  const char *name, cl_kernel *out);
+GR_API gr_status gr_kernel_create(gr_context *ctx, cl_program prog, const char *name,
+                                  cl_kernel *out);
 
 /**
  * A device buffer of size bytes, checked against the device's largest
  * allocation and global memory. host may be NULL; when given, the buffer is
  * initialised from it (CL_MEM_COPY_HOST_PTR).
  */
-GR_API gr_status gr_buffer_create(gr_context *ctx, cl_mem_flags flags,
-                                  size_t size, const void *host, cl_mem *out);
+GR_API gr_status gr_buffer_create(gr_context *ctx, cl_mem_flags flags, size_t size,
+                                  const void *host, cl_mem *out);
 
 /** Blocking write and read of a whole buffer region. */
-GR_API gr_status gr_buffer_write(gr_context *ctx, cl_mem buf, size_t offset,
-                                 size_t size, const void *host);
-GR_API gr_status gr_buffer_read(gr_context *ctx, cl_mem buf, size_t offset,
-                                size_t size, void *host);
+GR_API gr_status gr_buffer_write(gr_context *ctx, cl_mem buf, size_t offset, size_t size,
+                                 const void *host);
+GR_API gr_status gr_buffer_read(gr_context *ctx, cl_mem buf, size_t offset, size_t size,
+                                void *host);
 
 /** Releases a buffer and zeroes the handle; a zero handle is fine. */
 GR_API void gr_buffer_release(cl_mem *buf);
@@ -93,8 +91,8 @@ GR_API gr_status gr_kernel_args(gr_context *ctx, cl_kernel k, ...);
  * Enqueues a 2-D kernel over nx by ny work-items (rounded up to the local
  * size when local is non-NULL; kernels guard their own bounds). Does not wait.
  */
-GR_API gr_status gr_enqueue_2d(gr_context *ctx, cl_kernel k, size_t nx,
-                               size_t ny, const size_t *local);
+GR_API gr_status gr_enqueue_2d(gr_context *ctx, cl_kernel k, size_t nx, size_t ny,
+                               const size_t *local);
 
 /** Waits for the context's queue to drain. */
 GR_API gr_status gr_finish(gr_context *ctx);

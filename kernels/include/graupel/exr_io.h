@@ -29,18 +29,15 @@ extern "C" {
 /** Longest channel name kept (longer names are an error). */
 #define GR_EXR_MAX_NAME 255
 
-typedef enum gr_exr_pixel_type {
-  GR_EXR_HALF = 1,
-  GR_EXR_FLOAT = 2
-} gr_exr_pixel_type;
+typedef enum gr_exr_pixel_type { GR_EXR_HALF = 1, GR_EXR_FLOAT = 2 } gr_exr_pixel_type;
 
 /** An image read from an EXR file: nchannels planes of width*height floats. */
 typedef struct gr_exr_image {
   int width, height;
   int nchannels;
-  char **names;           /**< channel names, as in the file (sorted by EXR) */
+  char **names;             /**< channel names, as in the file (sorted by EXR) */
   gr_exr_pixel_type *types; /**< the stored type of each channel */
-  float **data;           /**< data[c][j*width + i], row 0 = south */
+  float **data;             /**< data[c][j*width + i], row 0 = south */
 } gr_exr_image;
 
 /**
@@ -48,8 +45,7 @@ typedef struct gr_exr_image {
  * Channels with x/y sampling other than 1 are an error. On failure *out is
  * untouched and err (if given) holds a sentence naming the file and the fault.
  */
-GR_API gr_status gr_exr_read(const char *path, gr_exr_image *out, char *err,
-                             size_t err_len);
+GR_API gr_status gr_exr_read(const char *path, gr_exr_image *out, char *err, size_t err_len);
 
 /** Frees what gr_exr_read allocated; zeroes the struct. NULL is fine. */
 GR_API void gr_exr_image_free(gr_exr_image *img);
@@ -62,10 +58,9 @@ GR_API int gr_exr_find_channel(const gr_exr_image *img, const char *name);
  * scanline EXR with ZIP compression. type selects HALF or FLOAT storage for
  * every channel. Names must be distinct and non-empty.
  */
-GR_API gr_status gr_exr_write(const char *path, int width, int height,
-                              int nchannels, const char *const *names,
-                              const float *const *data, gr_exr_pixel_type type,
-                              char *err, size_t err_len);
+GR_API gr_status gr_exr_write(const char *path, int width, int height, int nchannels,
+                              const char *const *names, const float *const *data,
+                              gr_exr_pixel_type type, char *err, size_t err_len);
 
 #ifdef __cplusplus
 }

@@ -14,9 +14,8 @@
 #define GRAUPEL_VERSION_MAJOR 0
 #define GRAUPEL_VERSION_MINOR 1
 #define GRAUPEL_VERSION_PATCH 0
-#define GRAUPEL_VERSION_NUMBER                                                 \
-  (GRAUPEL_VERSION_MAJOR * 10000 + GRAUPEL_VERSION_MINOR * 100 +              \
-   GRAUPEL_VERSION_PATCH)
+#define GRAUPEL_VERSION_NUMBER                                                                     \
+  (GRAUPEL_VERSION_MAJOR * 10000 + GRAUPEL_VERSION_MINOR * 100 + GRAUPEL_VERSION_PATCH)
 
 #if defined(_WIN32)
 #define GR_API __declspec(dllexport)

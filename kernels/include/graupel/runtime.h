@@ -38,16 +38,14 @@ typedef struct gr_context_options {
 GR_API void gr_context_options_init(gr_context_options *opt);
 
 /** Creates a private context (reference count 1). */
-GR_API gr_status gr_context_create(const gr_context_options *opt,
-                                   gr_context **out);
+GR_API gr_status gr_context_create(const gr_context_options *opt, gr_context **out);
 
 /**
  * Returns the process-wide context for the device the options select,
  * creating it on first use, with its reference count raised. Thread safe.
  * The log callback of the call that created it is kept.
  */
-GR_API gr_status gr_context_acquire(const gr_context_options *opt,
-                                    gr_context **out);
+GR_API gr_status gr_context_acquire(const gr_context_options *opt, gr_context **out);
 
 /** Adds a reference. */
 GR_API gr_context *gr_context_retain(gr_context *ctx);
@@ -89,8 +87,7 @@ typedef struct gr_device_info {
 GR_API gr_status gr_device_list(gr_device_info *infos, int max, int *count);
 
 /** The device behind a context. */
-GR_API gr_status gr_context_device_info(const gr_context *ctx,
-                                        gr_device_info *info);
+GR_API gr_status gr_context_device_info(const gr_context *ctx, gr_device_info *info);
 
 #ifdef __cplusplus
 }

@@ -38,25 +38,25 @@ typedef enum gr_noise_type {
 #define GR_TERRAIN_NOISE_OCTAVES_MAX 16
 
 typedef struct gr_terrain_noise_params {
-  int seed;             /**< any integer; equal seeds give equal fields */
-  gr_noise_type type;   /**< default GR_NOISE_RIDGED */
-  int octaves;          /**< 1..16, default 6 */
-  double frequency;     /**< base-octave cycles per km, (0, 1e4], default 4 */
-  double lacunarity;    /**< frequency ratio of octaves, [1, 8], default 2 */
-  double persistence;   /**< amplitude ratio (fBm, billow), [0, 1], default 0.5 */
-  double offset;        /**< ridged offset, [0, 4], default 1 */
-  double gain;          /**< ridged weight gain, [0, 16], default 2 */
-  double h;             /**< ridged spectral exponent H, [0, 4], default 1 */
-  int invert;           /**< ridged only: 1 (default) flips the ridges */
-  double height_scale;  /**< metres, [0, 1e5], default 120 */
+  int seed;            /**< any integer; equal seeds give equal fields */
+  gr_noise_type type;  /**< default GR_NOISE_RIDGED */
+  int octaves;         /**< 1..16, default 6 */
+  double frequency;    /**< base-octave cycles per km, (0, 1e4], default 4 */
+  double lacunarity;   /**< frequency ratio of octaves, [1, 8], default 2 */
+  double persistence;  /**< amplitude ratio (fBm, billow), [0, 1], default 0.5 */
+  double offset;       /**< ridged offset, [0, 4], default 1 */
+  double gain;         /**< ridged weight gain, [0, 16], default 2 */
+  double h;            /**< ridged spectral exponent H, [0, 4], default 1 */
+  int invert;          /**< ridged only: 1 (default) flips the ridges */
+  double height_scale; /**< metres, [0, 1e5], default 120 */
 } gr_terrain_noise_params;
 
 /** The defaults listed above. */
 GR_API void gr_terrain_noise_params_init(gr_terrain_noise_params *p);
 
 /** Checks every parameter against its range; a sentence goes to msg. */
-GR_API gr_status gr_terrain_noise_params_validate(
-    const gr_terrain_noise_params *p, char *msg, size_t msg_len);
+GR_API gr_status gr_terrain_noise_params_validate(const gr_terrain_noise_params *p, char *msg,
+                                                  size_t msg_len);
 
 typedef struct gr_terrain_noise gr_terrain_noise;
 
@@ -65,12 +65,10 @@ typedef struct gr_terrain_noise gr_terrain_noise;
  * builds the kernel and allocates the elevation buffer on the device.
  */
 GR_API gr_status gr_terrain_noise_create(gr_context *ctx, const gr_grid *grid,
-                                         const gr_terrain_noise_params *p,
-                                         gr_terrain_noise **out);
+                                         const gr_terrain_noise_params *p, gr_terrain_noise **out);
 
 /** New parameters for the next compute (validated). */
-GR_API gr_status gr_terrain_noise_set_params(gr_terrain_noise *t,
-                                             const gr_terrain_noise_params *p);
+GR_API gr_status gr_terrain_noise_set_params(gr_terrain_noise *t, const gr_terrain_noise_params *p);
 
 /** Enqueues the noise kernel; does not wait. */
 GR_API gr_status gr_terrain_noise_compute(gr_terrain_noise *t);
@@ -79,16 +77,14 @@ GR_API gr_status gr_terrain_noise_compute(gr_terrain_noise *t);
  * Reads a field back (waits for the device). Only GR_FIELD_ELEVATION exists;
  * host must hold nx*ny floats.
  */
-GR_API gr_status gr_terrain_noise_get_field(gr_terrain_noise *t, gr_field f,
-                                            float *host);
+GR_API gr_status gr_terrain_noise_get_field(gr_terrain_noise *t, gr_field f, float *host);
 
 /** Frees the generator; NULL is fine. */
 GR_API void gr_terrain_noise_destroy(gr_terrain_noise *t);
 
 /** One call: create, compute, read elevation into host (nx*ny floats), free. */
 GR_API gr_status gr_terrain_noise_generate(gr_context *ctx, const gr_grid *grid,
-                                           const gr_terrain_noise_params *p,
-                                           float *host);
+                                           const gr_terrain_noise_params *p, float *host);
 
 #ifdef __cplusplus
 }
