@@ -9,7 +9,10 @@
 #include "vtkPointData.h"
 #include "vtkStreamingDemandDrivenPipeline.h"
 
+#include "graupel/cl_runtime.h"
 #include "graupel/terrain_noise.h"
+
+#include <algorithm>
 
 vtkStandardNewMacro(vtkProceduralTerrainSource);
 
@@ -81,11 +84,49 @@ int vtkProceduralTerrainSource::RequestData(vtkInformation *, vtkInformationVect
   if (!ctx) {
     return 0;
   }
-  this->UpdateProgress(0.0);
+  // The generator checks the grid against the device's limits before any
+  // host memory is taken for the result.
+  gr_terrain_noise *noise = nullptr;
+  gr_status st = gr_terrain_noise_create(ctx, &grid, &p, &noise);
+  if (st != GR_OK) {
+    return this->ReportFailure(st, "Procedural Terrain could not set up the noise");
+  }
   vtkNew<vtkFloatArray> elevation;
   elevation->SetName("elevation");
-  elevation->SetNumberOfTuples(static_cast<vtkIdType>(grid.nx) * grid.ny);
-  gr_status st = gr_terrain_noise_generate(ctx, &grid, &p, elevation->GetPointer(0));
+  const vtkIdType npoints = static_cast<vtkIdType>(grid.nx) * grid.ny;
+  if (!elevation->Allocate(npoints)) {
+    gr_terrain_noise_destroy(noise);
+    vtkErrorMacro("Procedural Terrain: out of host memory for "
+                  << grid.nx << " x " << grid.ny << " points; use smaller Dimensions.");
+    return 0;
+  }
+  elevation->SetNumberOfTuples(npoints);
+  // Band by band (about 4 million points each), so that a large terrain
+  // reports progress and can be aborted between bands.
+  const int band = std::max(1, (1 << 22) / grid.nx);
+  this->UpdateProgress(0.0);
+  for (int row = 0; row < grid.ny && st == GR_OK; row += band) {
+    const int rows = std::min(band, grid.ny - row);
+    st = gr_terrain_noise_compute_rows(noise, row, rows);
+    if (st == GR_OK) {
+      st = gr_finish(ctx);
+    }
+    this->UpdateProgress(static_cast<double>(row + rows) / grid.ny);
+    if (st == GR_OK && this->GetAbortExecute()) {
+      gr_terrain_noise_destroy(noise);
+      vtkWarningMacro("Procedural Terrain: the update was aborted; the output is empty.");
+      // The abort is honoured: clear it, and mark the source modified so that
+      // the next update computes the terrain again instead of keeping the
+      // empty output.
+      this->SetAbortExecute(0);
+      this->Modified();
+      return 1;
+    }
+  }
+  if (st == GR_OK) {
+    st = gr_terrain_noise_get_field(noise, GR_FIELD_ELEVATION, elevation->GetPointer(0));
+  }
+  gr_terrain_noise_destroy(noise);
   if (st != GR_OK) {
     return this->ReportFailure(st, "Procedural Terrain could not compute the noise");
   }
@@ -95,7 +136,6 @@ int vtkProceduralTerrainSource::RequestData(vtkInformation *, vtkInformationVect
   output->SetOrigin(this->Origin);
   output->GetPointData()->SetScalars(elevation);
   this->AddDeviceFieldData(output);
-  this->UpdateProgress(1.0);
   return 1;
 }
 

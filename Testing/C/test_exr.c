@@ -1,8 +1,9 @@
 /* EXR I/O tests: FLOAT and HALF round trips in odd sizes, row orientation
  * (row 0 south in memory, north first in the file), tiled and offset inputs
  * written with OpenEXR's C API, hostile and broken files, and argument
- * errors. Every failure must be a sentence naming the file, and must leave
- * the output image untouched.
+ * errors; reads from memory equal reads from the file, and broken buffers
+ * fail as broken files do. Every failure must be a sentence naming the file
+ * (or the buffer's label), and must leave the output image untouched.
  *
  * Usage: test_exr SCRATCH_DIR   (an existing, writable directory) */
 #include "gr_test.h"
@@ -416,6 +417,70 @@ static void expect_bad(const char *path, const char *what) {
     gr_exr_image_free(&img);
 }
 
+/* Reads bytes[0..n) with gr_exr_read_memory expecting GR_ERR_FORMAT, the
+ * output untouched, and a sentence naming the label. */
+static void expect_bad_memory(const void *bytes, size_t n, const char *label, const char *what) {
+  gr_exr_image img;
+  char err[1024];
+  gr_status st;
+  sentinel(&img);
+  err[0] = '\0';
+  st = gr_exr_read_memory(bytes, n, label, &img, err, sizeof err);
+  CHECK_MSG(st == GR_ERR_FORMAT, "%s (memory): status %s (%d)", what, gr_status_string(st),
+            (int)st);
+  CHECK_MSG(is_sentinel(&img), "%s (memory): output was modified", what);
+  CHECK_MSG(is_sentence_with(err, label), "%s (memory): error '%s'", what, err);
+  if (st == GR_OK)
+    gr_exr_image_free(&img);
+}
+
+/* Two images are equal: sizes, names, types and every value bit for bit. */
+static int same_image(const gr_exr_image *a, const gr_exr_image *b) {
+  int c;
+  size_t npix;
+  if (a->width != b->width || a->height != b->height || a->nchannels != b->nchannels)
+    return 0;
+  npix = (size_t)a->width * (size_t)a->height;
+  for (c = 0; c < a->nchannels; ++c) {
+    if (strcmp(a->names[c], b->names[c]) != 0 || a->types[c] != b->types[c] ||
+        memcmp(a->data[c], b->data[c], npix * sizeof(float)) != 0)
+      return 0;
+  }
+  return 1;
+}
+
+/* gr_exr_read_memory of the bytes of path gives what gr_exr_read gives, and
+ * leaves the bytes as they were. The label is the path of no file at all. */
+static void check_memory_equals_file(const char *path) {
+  gr_exr_image from_file, from_mem;
+  unsigned char *bytes, *before;
+  size_t n = 0;
+  char err[1024];
+  gr_status st;
+  memset(&from_file, 0, sizeof from_file);
+  memset(&from_mem, 0, sizeof from_mem);
+  bytes = load_bytes(path, &n);
+  before = (unsigned char *)malloc(n > 0 ? n : 1);
+  CHECK_MSG(bytes != NULL && before != NULL, "%s: cannot load the file", path);
+  if (bytes == NULL || before == NULL)
+    goto done;
+  memcpy(before, bytes, n);
+  err[0] = '\0';
+  st = gr_exr_read(path, &from_file, err, sizeof err);
+  CHECK_MSG(st == GR_OK, "%s: %s", path, err);
+  err[0] = '\0';
+  st = gr_exr_read_memory(bytes, n, "no/such/file.exr", &from_mem, err, sizeof err);
+  CHECK_MSG(st == GR_OK, "%s (memory): %s", path, err);
+  CHECK_MSG(same_image(&from_file, &from_mem), "%s: the memory read differs from the file read",
+            path);
+  CHECK_MSG(memcmp(before, bytes, n) == 0, "%s: the memory read changed the buffer", path);
+done:
+  gr_exr_image_free(&from_file);
+  gr_exr_image_free(&from_mem);
+  free(bytes);
+  free(before);
+}
+
 /* ------------------------------------------------------------------------ */
 /* Round trips                                                              */
 /* ------------------------------------------------------------------------ */
@@ -502,6 +567,7 @@ static void test_roundtrip(int w, int h, int nch, gr_exr_pixel_type type) {
   CHECK_MSG(bad == 0, "%s: %d values differ", fname, bad);
   gr_exr_image_free(&img);
   CHECK(img.data == NULL && img.names == NULL && img.nchannels == 0);
+  check_memory_equals_file(path);
 done:
   for (c = 0; c < nch; ++c)
     free(data[c]);
@@ -750,6 +816,7 @@ static void read_capi_case(const capi_spec *s, const char *fname) {
   if (st == GR_OK)
     check_capi_image(&img, s, fname);
   gr_exr_image_free(&img);
+  check_memory_equals_file(path);
 }
 
 static void test_capi_inputs(void) {
@@ -1016,6 +1083,174 @@ done:
 }
 
 /* ------------------------------------------------------------------------ */
+/* Reading from memory                                                      */
+/* ------------------------------------------------------------------------ */
+
+static void test_memory_reads(void) {
+  static const char label[] = "in-memory terrain.exr";
+  char path[1024], other[1024], err[1024];
+  unsigned char *bytes = NULL, *copy = NULL;
+  size_t n = 0, k, hend;
+  uint32_t seed = 777u;
+  gr_exr_image img;
+  gr_status st;
+  int t, bad_trunc = 0;
+  float vals[37 * 19 * 2], ones[4] = {1, 1, 1, 1};
+  const float *data[2] = {vals, vals + 37 * 19};
+  const float *data1[1] = {ones};
+  const char *names[2] = {"elevation", "snow_depth"};
+  capi_spec s;
+
+  for (k = 0; k < 37 * 19 * 2; ++k)
+    vals[k] = (float)cos((double)k * 0.3) * 50.0f;
+  scratch_path(path, sizeof path, "memory_good.exr");
+  CHECK(gr_exr_write(path, 37, 19, 2, names, data, GR_EXR_FLOAT, err, sizeof err) == GR_OK);
+  bytes = load_bytes(path, &n);
+  CHECK(bytes != NULL && n > 1000);
+  if (bytes == NULL || n <= 1000)
+    goto done;
+  copy = (unsigned char *)malloc(n + 1);
+  if (copy == NULL)
+    goto done;
+  check_memory_equals_file(path);
+
+  /* The label is only a name: naming another, existing file reads the
+   * buffer all the same. */
+  scratch_path(other, sizeof other, "memory_other.exr");
+  CHECK(gr_exr_write(other, 2, 2, 1, names, data1, GR_EXR_HALF, err, sizeof err) == GR_OK);
+  memset(&img, 0, sizeof img);
+  CHECK(gr_exr_read_memory(bytes, n, other, &img, err, sizeof err) == GR_OK);
+  CHECK(img.width == 37 && img.height == 19 && img.nchannels == 2);
+  gr_exr_image_free(&img);
+  /* A buffer at an odd address. */
+  memcpy(copy + 1, bytes, n);
+  memset(&img, 0, sizeof img);
+  CHECK(gr_exr_read_memory(copy + 1, n, label, &img, err, sizeof err) == GR_OK);
+  CHECK(img.width == 37 && img.height == 19 && img.nchannels == 2);
+  if (img.nchannels == 2)
+    CHECK(memcmp(img.data[0] + 18 * 37, vals, 37 * sizeof(float)) == 0);
+  gr_exr_image_free(&img);
+
+  /* No bytes. */
+  expect_bad_memory(NULL, n, label, "NULL data");
+  expect_bad_memory(NULL, 0, label, "NULL data, size 0");
+  expect_bad_memory(bytes, 0, label, "size 0");
+  /* No label, or an empty one: the buffer is "<memory>". */
+  expect_bad_memory(bytes, 0, NULL, "NULL label");
+  sentinel(&img);
+  CHECK(gr_exr_read_memory(NULL, 0, NULL, &img, err, sizeof err) == GR_ERR_FORMAT);
+  CHECK_MSG(is_sentence_with(err, "<memory>"), "'%s'", err);
+  CHECK(gr_exr_read_memory(bytes, 4, "", &img, err, sizeof err) == GR_ERR_FORMAT);
+  CHECK_MSG(is_sentence_with(err, "<memory>"), "'%s'", err);
+  CHECK(is_sentinel(&img));
+  memset(&img, 0, sizeof img);
+  CHECK(gr_exr_read_memory(bytes, n, NULL, &img, err, sizeof err) == GR_OK);
+  gr_exr_image_free(&img);
+  /* No output image; no or a short error buffer. */
+  CHECK(gr_exr_read_memory(bytes, n, label, NULL, err, sizeof err) == GR_ERR_INVALID_ARGUMENT);
+  CHECK(is_sentence_with(err, NULL));
+  sentinel(&img);
+  CHECK(gr_exr_read_memory(bytes, 10, label, &img, NULL, 0) == GR_ERR_FORMAT);
+  CHECK(gr_exr_read_memory(bytes, 10, label, &img, err, 8) == GR_ERR_FORMAT);
+  CHECK(strlen(err) == 7);
+  CHECK(is_sentinel(&img));
+
+  /* Truncated: every length through the header and offset table and near
+   * the end, every 7th through the pixel data. Each is a fresh allocation
+   * of exactly that many bytes, so a read past the end would be caught by
+   * a sanitizer. */
+  hend = header_end(bytes, n);
+  CHECK(hend > 8 && hend < n);
+  expect_bad_memory(bytes, hend, label, "truncated after the header");
+  expect_bad_memory(bytes, n - 1, label, "truncated by one byte");
+  for (k = 1; k < n; ++k) {
+    unsigned char *part;
+    if (k > hend + 64 && k + 64 < n && k % 7 != 0)
+      continue;
+    part = (unsigned char *)malloc(k);
+    if (part == NULL)
+      break;
+    memcpy(part, bytes, k);
+    sentinel(&img);
+    err[0] = '\0';
+    st = gr_exr_read_memory(part, k, label, &img, err, sizeof err);
+    if (st != GR_ERR_FORMAT || !is_sentinel(&img) || !is_sentence_with(err, label)) {
+      if (bad_trunc++ < 5)
+        CHECK_MSG(0, "truncated to %zu of %zu bytes: status %d, '%s'", k, n, (int)st, err);
+      if (st == GR_OK)
+        gr_exr_image_free(&img);
+    }
+    free(part);
+  }
+  CHECK_MSG(bad_trunc == 0, "%d truncated buffers were accepted", bad_trunc);
+
+  /* A tiled file, truncated at every length. */
+  s = capi_default();
+  s.storage = EXR_STORAGE_TILED;
+  s.dw.max.x = 20;
+  s.dw.max.y = 12;
+  s.tile_w = 8;
+  s.tile_h = 4;
+  scratch_path(other, sizeof other, "memory_tiled.exr");
+  if (capi_write(other, &s)) {
+    size_t tn = 0;
+    unsigned char *tiled = load_bytes(other, &tn);
+    CHECK(tiled != NULL && tn > 100);
+    check_memory_equals_file(other);
+    bad_trunc = 0;
+    for (k = 1; tiled != NULL && k < tn; ++k) {
+      unsigned char *part = (unsigned char *)malloc(k);
+      if (part == NULL)
+        break;
+      memcpy(part, tiled, k);
+      sentinel(&img);
+      st = gr_exr_read_memory(part, k, label, &img, err, sizeof err);
+      if (st != GR_ERR_FORMAT || !is_sentinel(&img) || !is_sentence_with(err, label)) {
+        if (bad_trunc++ < 5)
+          CHECK_MSG(0, "tiled, truncated to %zu of %zu bytes: status %d", k, tn, (int)st);
+        if (st == GR_OK)
+          gr_exr_image_free(&img);
+      }
+      free(part);
+    }
+    CHECK_MSG(bad_trunc == 0, "%d truncated tiled buffers were accepted", bad_trunc);
+    free(tiled);
+  }
+
+  /* Garbage: text, zeros, the magic number alone, random bytes after the
+   * magic number (and version). */
+  {
+    static const char text[] = "This is not an image.\nIt is a text file pretending to be one.\n";
+    expect_bad_memory(text, sizeof text - 1, label, "text");
+    memset(copy, 0, n);
+    expect_bad_memory(copy, n, label, "zeros");
+    expect_bad_memory(bytes, 4, label, "magic number only");
+    expect_bad_memory(bytes, 8, label, "magic number and version only");
+  }
+  for (t = 0; t < 40; ++t) {
+    size_t len = 16 + (size_t)(lcg(&seed) % 2000u);
+    if (len > n)
+      len = n;
+    memcpy(copy, bytes, 8);
+    for (k = t % 2 ? 8 : 4; k < len; ++k)
+      copy[k] = (unsigned char)(lcg(&seed) & 0xff);
+    expect_bad_memory(copy, len, label, "random bytes after the magic number");
+  }
+  /* Chunk offsets past the end of the buffer, and into the header. */
+  memcpy(copy, bytes, n);
+  memset(copy + hend, 0x7f, 8);
+  expect_bad_memory(copy, n, label, "chunk offset past the end");
+  memcpy(copy, bytes, n);
+  memset(copy + hend, 0, 8);
+  copy[hend] = 8;
+  expect_bad_memory(copy, n, label, "chunk offset into the header");
+
+done:
+  free(bytes);
+  free(copy);
+}
+
+/* ------------------------------------------------------------------------ */
 /* Writer argument errors                                                   */
 /* ------------------------------------------------------------------------ */
 
@@ -1160,6 +1395,7 @@ int main(int argc, char **argv) {
   test_names_roundtrip();
   test_capi_inputs();
   test_bad_files();
+  test_memory_reads();
   test_write_errors();
   test_helpers();
   return GR_TEST_RESULT();

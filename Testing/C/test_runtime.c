@@ -188,7 +188,7 @@ static void test_kernels(void) {
   cl_int n = N;
   CHECK(gr_kernel_args(ctx, k, sizeof(cl_mem), &buf, sizeof(cl_float), &a, sizeof(cl_float), &b,
                        sizeof(cl_int), &n, (size_t)0) == GR_OK);
-  CHECK(gr_enqueue_2d(ctx, k, N, 1, NULL) == GR_OK);
+  CHECK(gr_enqueue_2d(ctx, k, 0, 0, N, 1, NULL) == GR_OK);
   memset(host, 0, sizeof(host));
   CHECK(gr_buffer_read(ctx, buf, 0, sizeof(host), host) == GR_OK);
   int wrong = 0;

@@ -106,6 +106,48 @@ far.Update()
 T.check("Origin" in errs.text() and far.GetOutput().GetNumberOfPoints() == 0,
         "absurd Origin refused with a sentence: %r" % errs.text())
 
+# A kernel that fails to build (bad GRAUPEL_CL_OPTIONS): one sentence with the
+# build log, an empty output; with the options fixed the next update works.
+os.environ["GRAUPEL_CL_OPTIONS"] = "-cl-no-such-option"
+broken = terrain(Octaves=3)
+errs = T.ErrorCatcher(broken)
+broken.Update()
+T.check("failed to build" in errs.text() and broken.GetOutput().GetNumberOfPoints() == 0,
+        "build failure reported with an empty output: %r" % errs.text()[:200])
+del os.environ["GRAUPEL_CL_OPTIONS"]
+broken.Modified()
+broken.Update()
+T.check(broken.GetOutput().GetNumberOfPoints() == 96 * 64, "works again once the options are fixed")
+
+# A grid larger than the device's largest buffer is refused before any host
+# memory is taken (PoCL here allows at most a few GiB per buffer).
+if "pthread" in s.GetDeviceName() or "cpu" in s.GetDeviceName().lower():
+    big = terrain(dims=(40000, 40000))
+    errs = T.ErrorCatcher(big)
+    big.Update()
+    T.check("MiB" in errs.text() and big.GetOutput().GetNumberOfPoints() == 0,
+            "too-large grid refused: %r" % errs.text()[:200])
+
+# Aborted mid-run (between bands): an empty output and a warning, and the next
+# update computes the whole terrain again.
+long_src = terrain(dims=(4096, 2048))
+aborted = {"n": 0}
+
+
+def abort_once(obj, event):
+    if 0.0 < obj.GetProgress() < 1.0 and aborted["n"] == 0:
+        aborted["n"] = 1
+        obj.SetAbortExecute(1)
+
+
+tag = long_src.AddObserver("ProgressEvent", abort_once)
+long_src.Update()
+T.check(aborted["n"] == 1 and long_src.GetOutput().GetNumberOfPoints() == 0,
+        "an aborted update leaves an empty output")
+long_src.RemoveObserver(tag)
+long_src.Update()
+T.check(long_src.GetOutput().GetNumberOfPoints() == 4096 * 2048, "the next update is whole")
+
 # ---- EXR: writer -> reader keeps every value and name -------------------------
 scratch = a.scratch
 os.makedirs(scratch, exist_ok=True)

@@ -6,7 +6,9 @@
  * tiled files); every channel must be HALF or FLOAT with sampling 1. The
  * library decodes each chunk straight into the output planes as float (it
  * widens half to float itself), rows in file order; the planes are flipped at
- * the end so that row 0 is the southern edge.
+ * the end so that row 0 is the southern edge. gr_exr_read opens a file;
+ * gr_exr_read_memory gives OpenEXR read and size callbacks over a buffer
+ * instead; everything after opening is the one function read_exr.
  *
  * Writing: one scanline part, ZIP compression, every channel HALF or FLOAT.
  * Each chunk's rows are copied, flipped, into a float staging buffer; the
@@ -261,14 +263,57 @@ static exr_result_t walk_chunks(const chunk_layout *L, const gr_exr_image *img,
   return rv;
 }
 
-gr_status gr_exr_read(const char *path, gr_exr_image *out, char *err, size_t err_len) {
+/* Where the bytes come from: a file (bytes NULL: OpenEXR opens the named
+ * file itself) or a caller's buffer. It is the context's user data, and msg
+ * comes first: exr_capture_error takes the user data for an exr_msg. */
+typedef struct read_source {
+  exr_msg msg;
+  const unsigned char *bytes;
+  size_t size;
+} read_source;
+
+/* pread semantics over the buffer: a read at or past the end returns 0
+ * bytes, one across it the bytes up to the end (OpenEXR turns a short read
+ * into EXR_ERR_READ_IO where it needed them all). Thread safe: it only reads. */
+static int64_t memory_read(exr_const_context_t ctxt, void *userdata, void *buffer, uint64_t sz,
+                           uint64_t offset, exr_stream_error_func_ptr_t error_cb) {
+  const read_source *src = (const read_source *)userdata;
+  uint64_t n;
+  (void)ctxt;
+  (void)error_cb;
+  if (src == NULL || src->bytes == NULL || (buffer == NULL && sz > 0))
+    return -1;
+  if (offset >= (uint64_t)src->size)
+    return 0;
+  n = (uint64_t)src->size - offset;
+  if (n > sz)
+    n = sz;
+  if (n > (uint64_t)INT64_MAX)
+    n = (uint64_t)INT64_MAX;
+  memcpy(buffer, src->bytes + offset, (size_t)n);
+  return (int64_t)n;
+}
+
+static int64_t memory_size(exr_const_context_t ctxt, void *userdata) {
+  const read_source *src = (const read_source *)userdata;
+  (void)ctxt;
+  if (src == NULL || src->bytes == NULL)
+    return -1;
+  return (uint64_t)src->size > (uint64_t)INT64_MAX ? INT64_MAX : (int64_t)src->size;
+}
+
+/* gr_exr_read and gr_exr_read_memory: opens the file or the buffer of src
+ * (label names it in every message: the path of a file), then parses, checks
+ * and decodes part 0. The arguments are checked by the callers. */
+static gr_status read_exr(const char *label, read_source *src, gr_exr_image *out, char *err,
+                          size_t err_len) {
   gr_status st = GR_OK;
   exr_result_t rv;
   exr_context_t ctxt = NULL;
   exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
   exr_decode_pipeline_t dec;
   int dec_live = 0;
-  exr_msg msg;
+  exr_msg *msg = &src->msg;
   exr_storage_t storage = EXR_STORAGE_LAST_TYPE;
   const exr_attr_chlist_t *chlist = NULL;
   chunk_layout L;
@@ -279,31 +324,29 @@ gr_status gr_exr_read(const char *path, gr_exr_image *out, char *err, size_t err
 
   memset(&img, 0, sizeof img);
   memset(&dec, 0, sizeof dec);
-  memset(&msg, 0, sizeof msg);
+  memset(msg, 0, sizeof *msg);
   memset(&L, 0, sizeof L);
 
-  if (path == NULL || path[0] == '\0' || out == NULL) {
-    set_err(err, err_len,
-            "The path and output image given to gr_exr_read must not be NULL "
-            "or empty.");
-    return GR_ERR_INVALID_ARGUMENT;
-  }
-
   init.error_handler_fn = &exr_capture_error;
-  init.user_data = &msg;
+  init.user_data = src;
   init.max_image_width = GR_EXR_MAX_DIM;
   init.max_image_height = GR_EXR_MAX_DIM;
   init.flags = EXR_CONTEXT_FLAG_DISABLE_CHUNK_RECONSTRUCTION;
+  if (src->bytes != NULL) {
+    /* The label is only a name: OpenEXR opens nothing when read_fn is set. */
+    init.read_fn = &memory_read;
+    init.size_fn = &memory_size;
+  }
 
-  rv = exr_start_read(&ctxt, path, &init);
+  rv = exr_start_read(&ctxt, label, &init);
   if (rv != EXR_ERR_SUCCESS) {
     st = read_status(rv);
     if (rv == EXR_ERR_FILE_ACCESS)
-      set_err(err, err_len, "Cannot read '%s': the file cannot be opened (OpenEXR: %s).", path,
-              exr_detail(&msg, rv));
+      set_err(err, err_len, "Cannot read '%s': the file cannot be opened (OpenEXR: %s).", label,
+              exr_detail(msg, rv));
     else
-      set_err(err, err_len, "Cannot read '%s': it is not a valid OpenEXR file (OpenEXR: %s).", path,
-              exr_detail(&msg, rv));
+      set_err(err, err_len, "Cannot read '%s': it is not a valid OpenEXR file (OpenEXR: %s).",
+              label, exr_detail(msg, rv));
     goto cleanup;
   }
   L.ctxt = ctxt;
@@ -321,13 +364,13 @@ gr_status gr_exr_read(const char *path, gr_exr_image *out, char *err, size_t err
     rv = EXR_ERR_MISSING_REQ_ATTR;
   if (rv != EXR_ERR_SUCCESS) {
     st = read_status(rv);
-    set_err(err, err_len, "Cannot read '%s': its header is incomplete (OpenEXR: %s).", path,
-            exr_detail(&msg, rv));
+    set_err(err, err_len, "Cannot read '%s': its header is incomplete (OpenEXR: %s).", label,
+            exr_detail(msg, rv));
     goto cleanup;
   }
   if (storage != EXR_STORAGE_SCANLINE && storage != EXR_STORAGE_TILED) {
     st = GR_ERR_FORMAT;
-    set_err(err, err_len, "Cannot read '%s': it holds deep data, which is not supported.", path);
+    set_err(err, err_len, "Cannot read '%s': it holds deep data, which is not supported.", label);
     goto cleanup;
   }
 
@@ -339,12 +382,12 @@ gr_status gr_exr_read(const char *path, gr_exr_image *out, char *err, size_t err
     set_err(err, err_len,
             "Cannot read '%s': its data window is %lld by %lld pixels, outside "
             "1 to %d.",
-            path, (long long)L.width, (long long)L.height, GR_EXR_MAX_DIM);
+            label, (long long)L.width, (long long)L.height, GR_EXR_MAX_DIM);
     goto cleanup;
   }
   if (chlist->num_channels < 1 || chlist->entries == NULL) {
     st = GR_ERR_FORMAT;
-    set_err(err, err_len, "Cannot read '%s': it has no channels.", path);
+    set_err(err, err_len, "Cannot read '%s': it has no channels.", label);
     goto cleanup;
   }
   npix = (size_t)L.width * (size_t)L.height;
@@ -353,7 +396,7 @@ gr_status gr_exr_read(const char *path, gr_exr_image *out, char *err, size_t err
     set_err(err, err_len,
             "Cannot read '%s': %lld by %lld pixels in %d channels is more than "
             "the %llu samples allowed.",
-            path, (long long)L.width, (long long)L.height, chlist->num_channels,
+            label, (long long)L.width, (long long)L.height, chlist->num_channels,
             (unsigned long long)GR_EXR_MAX_SAMPLES);
     goto cleanup;
   }
@@ -365,7 +408,7 @@ gr_status gr_exr_read(const char *path, gr_exr_image *out, char *err, size_t err
       set_err(err, err_len,
               "Cannot read '%s': channel '%s' is %s, and only HALF and FLOAT "
               "channels are supported.",
-              path, nm, pixel_type_name(e->pixel_type));
+              label, nm, pixel_type_name(e->pixel_type));
       goto cleanup;
     }
     if (e->x_sampling != 1 || e->y_sampling != 1) {
@@ -373,12 +416,12 @@ gr_status gr_exr_read(const char *path, gr_exr_image *out, char *err, size_t err
       set_err(err, err_len,
               "Cannot read '%s': channel '%s' is subsampled (%d by %d), which "
               "is not supported.",
-              path, nm, (int)e->x_sampling, (int)e->y_sampling);
+              label, nm, (int)e->x_sampling, (int)e->y_sampling);
       goto cleanup;
     }
     if (nm[0] == '\0' || strlen(nm) > GR_EXR_MAX_NAME) {
       st = GR_ERR_FORMAT;
-      set_err(err, err_len, "Cannot read '%s': channel %d has an empty or over-long name.", path,
+      set_err(err, err_len, "Cannot read '%s': channel %d has an empty or over-long name.", label,
               (int)c);
       goto cleanup;
     }
@@ -391,7 +434,7 @@ gr_status gr_exr_read(const char *path, gr_exr_image *out, char *err, size_t err
     if (rv != EXR_ERR_SUCCESS || lines < 1) {
       st = GR_ERR_FORMAT;
       set_err(err, err_len, "Cannot read '%s': its compression is not understood (OpenEXR: %s).",
-              path, exr_detail(&msg, rv));
+              label, exr_detail(msg, rv));
       goto cleanup;
     }
     L.lines = lines;
@@ -403,7 +446,7 @@ gr_status gr_exr_read(const char *path, gr_exr_image *out, char *err, size_t err
     if (rv != EXR_ERR_SUCCESS || tw < 1 || th < 1 || tw > INT32_MAX || th > INT32_MAX) {
       st = GR_ERR_FORMAT;
       set_err(err, err_len, "Cannot read '%s': its tile description is not valid (OpenEXR: %s).",
-              path, exr_detail(&msg, rv));
+              label, exr_detail(msg, rv));
       goto cleanup;
     }
     L.tiled = 1;
@@ -425,7 +468,7 @@ gr_status gr_exr_read(const char *path, gr_exr_image *out, char *err, size_t err
       img.data = (float **)calloc((size_t)chlist->num_channels, sizeof(float *));
       if (img.names == NULL || img.types == NULL || img.data == NULL) {
         st = GR_ERR_OUT_OF_MEMORY;
-        set_err(err, err_len, "Cannot read '%s': out of memory.", path);
+        set_err(err, err_len, "Cannot read '%s': out of memory.", label);
         goto cleanup;
       }
       img.nchannels = chlist->num_channels;
@@ -439,7 +482,7 @@ gr_status gr_exr_read(const char *path, gr_exr_image *out, char *err, size_t err
           set_err(err, err_len,
                   "Cannot read '%s': out of memory for %lld by %lld pixels in "
                   "%d channels.",
-                  path, (long long)L.width, (long long)L.height, img.nchannels);
+                  label, (long long)L.width, (long long)L.height, img.nchannels);
           goto cleanup;
         }
         memcpy(img.names[c], e->name.str, len + 1);
@@ -448,7 +491,7 @@ gr_status gr_exr_read(const char *path, gr_exr_image *out, char *err, size_t err
       for (c = 0; c < (size_t)img.nchannels; ++c) {
         if (gr_exr_find_channel(&img, img.names[c]) != (int)c) {
           st = GR_ERR_FORMAT;
-          set_err(err, err_len, "Cannot read '%s': channel '%s' appears twice.", path,
+          set_err(err, err_len, "Cannot read '%s': channel '%s' appears twice.", label,
                   img.names[c]);
           goto cleanup;
         }
@@ -461,12 +504,12 @@ gr_status gr_exr_read(const char *path, gr_exr_image *out, char *err, size_t err
         set_err(err, err_len,
                 "Cannot read '%s': the file is truncated or corrupt at tile "
                 "(%lld, %lld) (OpenEXR: %s).",
-                path, (long long)fx, (long long)fy, exr_detail(&msg, rv));
+                label, (long long)fx, (long long)fy, exr_detail(msg, rv));
       else
         set_err(err, err_len,
                 "Cannot read '%s': the file is truncated or corrupt at "
                 "scanline %lld (OpenEXR: %s).",
-                path, (long long)fy, exr_detail(&msg, rv));
+                label, (long long)fy, exr_detail(msg, rv));
       goto cleanup;
     }
   }
@@ -485,6 +528,38 @@ cleanup:
   else
     gr_exr_image_free(&img);
   return st;
+}
+
+gr_status gr_exr_read(const char *path, gr_exr_image *out, char *err, size_t err_len) {
+  read_source src;
+  if (path == NULL || path[0] == '\0' || out == NULL) {
+    set_err(err, err_len,
+            "The path and output image given to gr_exr_read must not be NULL "
+            "or empty.");
+    return GR_ERR_INVALID_ARGUMENT;
+  }
+  memset(&src, 0, sizeof src);
+  return read_exr(path, &src, out, err, err_len);
+}
+
+gr_status gr_exr_read_memory(const void *data, size_t size, const char *label, gr_exr_image *out,
+                             char *err, size_t err_len) {
+  read_source src;
+  if (label == NULL || label[0] == '\0')
+    label = "<memory>";
+  if (out == NULL) {
+    set_err(err, err_len, "The output image given to gr_exr_read_memory must not be NULL.");
+    return GR_ERR_INVALID_ARGUMENT;
+  }
+  if (data == NULL || size == 0) {
+    set_err(err, err_len, "Cannot read '%s': the buffer is empty, so it is not an OpenEXR file.",
+            label);
+    return GR_ERR_FORMAT;
+  }
+  memset(&src, 0, sizeof src);
+  src.bytes = (const unsigned char *)data;
+  src.size = size;
+  return read_exr(label, &src, out, err, err_len);
 }
 
 /* ------------------------------------------------------------------------ */

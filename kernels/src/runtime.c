@@ -590,6 +590,14 @@ gr_status gr_context_device_info(const gr_context *ctx, gr_device_info *info) {
 
 /* ---------------------------------------------------------------- programs */
 
+/* GRAUPEL_CL_OPTIONS adds build options to every program (for instance
+ * -cl-opt-disable while debugging a kernel); they are part of the program
+ * cache key, so changing them rebuilds. */
+static const char *gr_extra_build_options(void) {
+  const char *extra = getenv("GRAUPEL_CL_OPTIONS");
+  return extra ? extra : "";
+}
+
 static gr_status gr_build(gr_context *ctx, const char *label, const char *source,
                           const char *options, cl_program *out) {
   cl_int err = CL_SUCCESS;
@@ -598,8 +606,9 @@ static gr_status gr_build(gr_context *ctx, const char *label, const char *source
   if (err != CL_SUCCESS)
     return gr_cl_check(ctx, err, "Creating an OpenCL program");
   /* FP_CONTRACT stays off inside the sources; -cl-std pins the language. */
-  char opts[1024];
-  snprintf(opts, sizeof(opts), "-cl-std=CL1.2 %s", options ? options : "");
+  char opts[4096];
+  snprintf(opts, sizeof(opts), "-cl-std=CL1.2 %s %s", options ? options : "",
+           gr_extra_build_options());
   err = clBuildProgram(prog, 1, &ctx->device, opts, NULL, NULL);
   if (err != CL_SUCCESS) {
     size_t len = 0;
@@ -645,11 +654,12 @@ gr_status gr_program_get(gr_context *ctx, const char *name, const char *options,
                         "No kernel source named '%s' is built into Graupel.", name);
   if (!options)
     options = "";
-  size_t klen = strlen(name) + strlen(options) + 2;
+  const char *extra = gr_extra_build_options();
+  size_t klen = strlen(name) + strlen(options) + strlen(extra) + 3;
   char *key = malloc(klen);
   if (!key)
     return gr_set_error(ctx, GR_ERR_OUT_OF_MEMORY, "Out of host memory.");
-  snprintf(key, klen, "%s\n%s", name, options);
+  snprintf(key, klen, "%s\n%s\n%s", name, options, extra);
 
   /* Build under the lock so two filters don't build the same program. */
   pthread_mutex_lock(&ctx->lock);
@@ -734,13 +744,15 @@ gr_status gr_kernel_args(gr_context *ctx, cl_kernel k, ...) {
   return GR_OK;
 }
 
-gr_status gr_enqueue_2d(gr_context *ctx, cl_kernel k, size_t nx, size_t ny, const size_t *local) {
+gr_status gr_enqueue_2d(gr_context *ctx, cl_kernel k, size_t x0, size_t y0, size_t nx, size_t ny,
+                        const size_t *local) {
+  size_t offset[2] = {x0, y0};
   size_t global[2] = {nx, ny};
   if (local) {
     global[0] = (nx + local[0] - 1) / local[0] * local[0];
     global[1] = (ny + local[1] - 1) / local[1] * local[1];
   }
-  cl_int err = clEnqueueNDRangeKernel(ctx->queue, k, 2, NULL, global, local, 0, NULL, NULL);
+  cl_int err = clEnqueueNDRangeKernel(ctx->queue, k, 2, offset, global, local, 0, NULL, NULL);
   return gr_cl_check(ctx, err, "Enqueueing a kernel");
 }
 

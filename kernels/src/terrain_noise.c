@@ -187,8 +187,23 @@ gr_status gr_terrain_noise_compute(gr_terrain_noise *t) {
   if (!t)
     return gr_set_error(NULL, GR_ERR_INVALID_ARGUMENT,
                         "gr_terrain_noise_compute needs a generator.");
+  return gr_terrain_noise_compute_rows(t, 0, t->grid.ny);
+}
+
+gr_status gr_terrain_noise_compute_rows(gr_terrain_noise *t, int row0, int nrows) {
+  if (!t)
+    return gr_set_error(NULL, GR_ERR_INVALID_ARGUMENT,
+                        "gr_terrain_noise_compute_rows needs a generator.");
+  if (row0 < 0 || nrows < 0 || row0 > t->grid.ny - nrows)
+    return gr_set_error(t->ctx, GR_ERR_INVALID_ARGUMENT,
+                        "Rows %d to %d are not inside the grid's %d rows.", row0, row0 + nrows - 1,
+                        t->grid.ny);
+  if (nrows == 0)
+    return GR_OK;
   const gr_terrain_noise_params *p = &t->params;
-  cl_int nx = t->grid.nx, ny = t->grid.ny, i0 = t->grid.i0, j0 = t->grid.j0;
+  /* The kernel's row bound is the band's end, so rounding the launch up to
+   * the work-group size never spills into the next band. */
+  cl_int nx = t->grid.nx, ny = row0 + nrows, i0 = t->grid.i0, j0 = t->grid.j0;
   cl_uint seed = (cl_uint)p->seed;
   cl_int kind = (cl_int)p->type, octaves = p->octaves, invert = p->invert != 0;
   cl_float offset = (cl_float)p->offset, gain = (cl_float)p->gain;
@@ -202,7 +217,7 @@ gr_status gr_terrain_noise_compute(gr_terrain_noise *t) {
   if (st != GR_OK)
     return st;
   const size_t local[2] = {16, 16};
-  return gr_enqueue_2d(t->ctx, t->kernel, (size_t)nx, (size_t)ny,
+  return gr_enqueue_2d(t->ctx, t->kernel, 0, (size_t)row0, (size_t)nx, (size_t)nrows,
                        gr_context_is_gpu(t->ctx) ? local : NULL);
 }
 

@@ -88,11 +88,13 @@ GR_API void gr_buffer_release(cl_mem *buf);
 GR_API gr_status gr_kernel_args(gr_context *ctx, cl_kernel k, ...);
 
 /**
- * Enqueues a 2-D kernel over nx by ny work-items (rounded up to the local
- * size when local is non-NULL; kernels guard their own bounds). Does not wait.
+ * Enqueues a 2-D kernel over the nx by ny work-items starting at (x0, y0)
+ * (get_global_id includes the start; the size is rounded up to the local
+ * size when local is non-NULL, so kernels guard their own bounds). Does not
+ * wait.
  */
-GR_API gr_status gr_enqueue_2d(gr_context *ctx, cl_kernel k, size_t nx, size_t ny,
-                               const size_t *local);
+GR_API gr_status gr_enqueue_2d(gr_context *ctx, cl_kernel k, size_t x0, size_t y0, size_t nx,
+                               size_t ny, const size_t *local);
 
 /** Waits for the context's queue to drain. */
 GR_API gr_status gr_finish(gr_context *ctx);

@@ -47,7 +47,15 @@ typedef struct gr_exr_image {
  */
 GR_API gr_status gr_exr_read(const char *path, gr_exr_image *out, char *err, size_t err_len);
 
-/** Frees what gr_exr_read allocated; zeroes the struct. NULL is fine. */
+/**
+ * As gr_exr_read, from an in-memory copy of a file; label names it in errors.
+ * NULL or "" labels are "<memory>". NULL data or size 0 give GR_ERR_FORMAT
+ * (no bytes are no EXR file); data is only read, and not kept.
+ */
+GR_API gr_status gr_exr_read_memory(const void *data, size_t size, const char *label,
+                                    gr_exr_image *out, char *err, size_t err_len);
+
+/** Frees what gr_exr_read or gr_exr_read_memory allocated; zeroes the struct. NULL is fine. */
 GR_API void gr_exr_image_free(gr_exr_image *img);
 
 /** Index of a channel by name, or -1. */

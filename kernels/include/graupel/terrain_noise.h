@@ -70,8 +70,14 @@ GR_API gr_status gr_terrain_noise_create(gr_context *ctx, const gr_grid *grid,
 /** New parameters for the next compute (validated). */
 GR_API gr_status gr_terrain_noise_set_params(gr_terrain_noise *t, const gr_terrain_noise_params *p);
 
-/** Enqueues the noise kernel; does not wait. */
+/** Enqueues the noise kernel over the whole grid; does not wait. */
 GR_API gr_status gr_terrain_noise_compute(gr_terrain_noise *t);
+
+/**
+ * Enqueues the rows row0 .. row0+nrows-1 only; does not wait. A caller that
+ * reports progress or honours an abort computes a large grid band by band.
+ */
+GR_API gr_status gr_terrain_noise_compute_rows(gr_terrain_noise *t, int row0, int nrows);
 
 /**
  * Reads a field back (waits for the device). Only GR_FIELD_ELEVATION exists;
