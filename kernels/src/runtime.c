@@ -28,6 +28,7 @@ struct gr_context {
   char platform_name[128];
   int is_gpu;
   cl_ulong max_alloc, global_mem;
+  size_t local2d[2]; /* default work-group shape for 2-D kernels */
   gr_log_fn log;
   void *log_user;
   pthread_mutex_t lock;       /* guards programs and error */
@@ -449,6 +450,20 @@ static gr_status gr_context_open(const gr_context_options *opt, cl_platform_id p
   snprintf(ctx->platform_name, sizeof(ctx->platform_name), "%s", info.platform);
   ctx->is_gpu = info.is_gpu;
   ctx->max_alloc = info.max_alloc_bytes;
+  /* A fixed work-group shape for every 2-D launch. Left to the driver, PoCL
+   * picks one per global size and JIT-compiles and caches a work-group
+   * function for each: slow, and memory that grows with every new grid size.
+   * GPUs get square tiles, CPUs rows. */
+  size_t max_wg = 0;
+  clGetDeviceInfo(d, CL_DEVICE_MAX_WORK_GROUP_SIZE, sizeof(max_wg), &max_wg, NULL);
+  ctx->local2d[0] = info.is_gpu ? 16 : 64;
+  ctx->local2d[1] = info.is_gpu ? 16 : 1;
+  while (max_wg > 0 && ctx->local2d[0] * ctx->local2d[1] > max_wg) {
+    if (ctx->local2d[1] > 1)
+      ctx->local2d[1] /= 2;
+    else
+      ctx->local2d[0] /= 2;
+  }
   ctx->global_mem = info.global_mem_bytes;
 
   cl_context_properties props[] = {CL_CONTEXT_PLATFORM, (cl_context_properties)p, 0};
@@ -748,6 +763,8 @@ gr_status gr_enqueue_2d(gr_context *ctx, cl_kernel k, size_t x0, size_t y0, size
                         const size_t *local) {
   size_t offset[2] = {x0, y0};
   size_t global[2] = {nx, ny};
+  if (!local)
+    local = ctx->local2d;
   if (local) {
     global[0] = (nx + local[0] - 1) / local[0] * local[0];
     global[1] = (ny + local[1] - 1) / local[1] * local[1];

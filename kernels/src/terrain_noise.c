@@ -216,9 +216,7 @@ gr_status gr_terrain_noise_compute_rows(gr_terrain_noise *t, int row0, int nrows
       sizeof(cl_float), &hs, (size_t)0);
   if (st != GR_OK)
     return st;
-  const size_t local[2] = {16, 16};
-  return gr_enqueue_2d(t->ctx, t->kernel, 0, (size_t)row0, (size_t)nx, (size_t)nrows,
-                       gr_context_is_gpu(t->ctx) ? local : NULL);
+  return gr_enqueue_2d(t->ctx, t->kernel, 0, (size_t)row0, (size_t)nx, (size_t)nrows, NULL);
 }
 
 gr_status gr_terrain_noise_get_field(gr_terrain_noise *t, gr_field f, float *host) {

@@ -89,9 +89,9 @@ GR_API gr_status gr_kernel_args(gr_context *ctx, cl_kernel k, ...);
 
 /**
  * Enqueues a 2-D kernel over the nx by ny work-items starting at (x0, y0)
- * (get_global_id includes the start; the size is rounded up to the local
- * size when local is non-NULL, so kernels guard their own bounds). Does not
- * wait.
+ * (get_global_id includes the start). The work-group shape is local, or the
+ * context's default when local is NULL (16 x 16 on GPUs, 64 x 1 on CPUs); the
+ * size is rounded up to it, so kernels guard their own bounds. Does not wait.
  */
 GR_API gr_status gr_enqueue_2d(gr_context *ctx, cl_kernel k, size_t x0, size_t y0, size_t nx,
                                size_t ny, const size_t *local);
