@@ -4,10 +4,13 @@
 #   ./graupel.sh demo   install what is missing, build, run Examples/demo_terrain.py -> out/
 #   ./graupel.sh test   install what is missing, build all three configurations, run ctest
 #   ./graupel.sh build  install what is missing and build the plugin only
+#   ./graupel.sh soak   the long soak runs (ctest label "soak", kept out of "test")
 #
 # Builds: build/ (ParaView plugin + Python module), build-vtk/ (the VTK module alone
 # against Debian's VTK 9.1, for plain python3), build-core/ (kernels/ on its own, as on
-# a GPU machine without ParaView). Everything is incremental: a second run is quick.
+# a GPU machine without ParaView; its tests include valgrind memcheck), build-asan/
+# (kernels/ with clang, AddressSanitizer + UndefinedBehaviorSanitizer, and libFuzzer
+# harnesses). Everything is incremental: a second run is quick.
 set -euo pipefail
 cd "$(dirname "$(readlink -f "$0")")"
 ROOT=$PWD
@@ -17,6 +20,8 @@ PACKAGES=(
   paraview paraview-dev python3-paraview python3-numpy
   pocl-opencl-icd ocl-icd-opencl-dev opencl-headers clinfo
   libopenexr-dev libglm-dev xvfb xauth cmake g++ make clang-format
+  # hardening: sanitizers and libFuzzer (clang's runtime), valgrind
+  clang libclang-rt-14-dev valgrind
   qtbase5-dev libqt5svg5-dev qttools5-dev qtxmlpatterns5-dev-tools
   libqt5x11extras5-dev libqt5opengl5-dev
   # find_package(ParaView) also needs these development files:
@@ -81,6 +86,10 @@ build_vtk() {
     -DGRAUPEL_VTK_DEPS="$VTK_DEPS/root"
 }
 build_core() { configure_and_build build-core kernels ; }
+build_asan() {
+  CC=clang configure_and_build build-asan kernels -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+    -DGRAUPEL_SANITIZE=ON -DGRAUPEL_FUZZ=ON
+}
 
 cmd=${1:-}
 case "$cmd" in
@@ -101,12 +110,18 @@ case "$cmd" in
     build_plugin
     build_vtk
     build_core
+    build_asan
     status=0
-    for dir in build build-vtk build-core; do
+    for dir in build build-vtk build-core build-asan; do
       echo "graupel: ctest in $dir"
-      (cd "$dir" && ctest --output-on-failure -j"$JOBS" ${CTEST_ARGS:-}) || status=1
+      (cd "$dir" && ctest --output-on-failure -j"$JOBS" -LE soak ${CTEST_ARGS:-}) || status=1
     done
     exit $status
+    ;;
+  soak)
+    ensure_packages
+    build_core
+    cd build-core && ctest --output-on-failure -L soak ${CTEST_ARGS:-}
     ;;
   *)
     sed -n '2,12p' "$0" | sed 's/^# \{0,1\}//'

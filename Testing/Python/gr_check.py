@@ -41,9 +41,10 @@ def finish():
 
 
 class ErrorCatcher:
-    """Collects the error sentences an algorithm reports (ErrorEvent)."""
+    """Collects the sentences an algorithm reports (ErrorEvent, or the event
+    given, such as WarningEvent)."""
 
-    def __init__(self, *objects):
+    def __init__(self, *objects, event="ErrorEvent"):
         from vtkmodules.util.misc import calldata_type
         from vtkmodules.util.vtkConstants import VTK_STRING
 
@@ -55,7 +56,7 @@ class ErrorCatcher:
 
         self._cb = on_error
         for o in objects:
-            o.AddObserver("ErrorEvent", on_error)
+            o.AddObserver(event, on_error)
 
     def text(self):
         return "\n".join(self.messages)

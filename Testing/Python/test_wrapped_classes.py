@@ -257,6 +257,63 @@ for setup, word in ((lambda w: w.SetInputData(cube), "2-D"),
     T.check(w.GetErrorCode() != 0 and word in errs.text(), "writer error %r: %r" % (word, errs.text()))
 T.check(not os.path.exists(os.path.join(scratch, "never.exr")), "no file written on error")
 
+# Reader properties and writer inputs that are refused, each with a sentence.
+r = vtkEXRHeightFieldReader()
+errs = T.ErrorCatcher(r)
+r.Update()
+T.check("no FileName" in errs.text() and r.GetOutput().GetNumberOfPoints() == 0,
+        "reader without FileName: %r" % errs.text())
+r = vtkEXRHeightFieldReader()
+errs = T.ErrorCatcher(r)
+r.SetFileName(os.path.join(scratch, "wrapped_2.exr"))
+r.SetSpacing(0.0, 1.0)
+r.Update()
+T.check("Spacing" in errs.text() and r.GetOutput().GetNumberOfPoints() == 0,
+        "reader Spacing 0: %r" % errs.text())
+zero_spacing = terrain(Spacing=0.0)
+errs = T.ErrorCatcher(zero_spacing)
+zero_spacing.Update()
+T.check("Spacing" in errs.text() and zero_spacing.GetOutput().GetNumberOfPoints() == 0,
+        "terrain Spacing 0: %r" % errs.text())
+
+# NaN elevations (no-data cells) are read, with one warning that says so.
+nan_img = vtkImageData()
+nan_img.SetDimensions(4, 3, 1)
+nan_vals = np.arange(12, dtype=np.float32)
+nan_vals[[2, 7]] = np.nan
+nan_arr = numpy_to_vtk(nan_vals, deep=1)
+nan_arr.SetName("elevation")
+nan_img.GetPointData().AddArray(nan_arr)
+w = vtkEXRFieldWriter()
+w.SetInputData(nan_img)
+w.SetFileName(os.path.join(scratch, "nan.exr"))
+w.Write()
+r = vtkEXRHeightFieldReader()
+warns = T.ErrorCatcher(r, event="WarningEvent")
+r.SetFileName(os.path.join(scratch, "nan.exr"))
+r.Update()
+T.check("2 elevation values" in warns.text() and r.GetOutput().GetNumberOfPoints() == 12,
+        "NaN elevations read with a warning: %r" % warns.text())
+
+for setup, word in ((lambda w: w.SetInputData(img), "no FileName"),
+                    (lambda w: (w.SetInputData(vtkImageData()),
+                                w.SetFileName(os.path.join(scratch, "never3.exr"))), "2-D"),
+                    (lambda w: (w.SetInputData(img), w.SetFileName(
+                        os.path.join(scratch, "no-such-dir", "x.exr"))), "no-such-dir")):
+    w = vtkEXRFieldWriter()
+    errs = T.ErrorCatcher(w)
+    setup(w)
+    w.Write()
+    T.check(w.GetErrorCode() != 0 and word in errs.text(), "writer error %r: %r" % (word, errs.text()))
+empty_img = vtkImageData()
+empty_img.SetDimensions(3, 3, 1)
+w = vtkEXRFieldWriter()
+errs = T.ErrorCatcher(w)
+w.SetInputData(empty_img)
+w.SetFileName(os.path.join(scratch, "never2.exr"))
+w.Write()
+T.check("no numeric point arrays" in errs.text(), "writer with no arrays: %r" % errs.text())
+
 # ---- the real DEM in Data/ matches its source ---------------------------------
 dem = os.path.join(a.data, "jacksboro_fault_dem.exr")
 r = vtkEXRHeightFieldReader()
