@@ -167,7 +167,84 @@ typedef struct chunk_layout {
   int64_t lines;    /* scanlines per chunk (scanline parts) */
   int64_t tw, th;   /* tile size (tiled parts) */
   int64_t ntx, nty; /* tile counts at level 0 */
+  exr_compression_t compression;
+  int undecodable; /* compression the library cannot decompress */
+  uint64_t expand; /* most bytes one packed byte may unpack to (0: no bound) */
 } chunk_layout;
+
+/* Where walk_chunks stopped: the chunk (tile indices, or its first scanline)
+ * and, when its sizes were implausible, what it claimed. */
+typedef struct chunk_fault {
+  int64_t x, y;
+  int implausible;
+  uint64_t packed, unpacked;
+} chunk_fault;
+
+/* The most bytes one packed byte of a chunk can unpack to, by compression,
+ * about twice each method's own limit: zlib's 1032:1 (ZIP, ZIPS; PXR24 packs
+ * FLOAT into 3 bytes first), EXR's RLE 64:1, PIZ's Huffman run codes about
+ * 410:1, B44's 32 bytes in 3, DWA's RLE or DCT before zlib about 66000:1,
+ * twice that for FLOAT. OpenEXR allocates a chunk's unpacked size before it
+ * decompresses, and so does this reader for the image, so a chunk that
+ * claims more is rejected before anything is allocated: else a few hundred
+ * bytes could ask for gigabytes. 0: no bound known. */
+static const char *compression_name(exr_compression_t c) {
+  static const char *const names[] = {"NONE",  "RLE", "ZIPS", "ZIP",  "PIZ",
+                                      "PXR24", "B44", "B44A", "DWAA", "DWAB"};
+  if ((int)c >= 0 && (size_t)c < sizeof names / sizeof names[0])
+    return names[c];
+  return "unknown";
+}
+
+static uint64_t max_expansion(exr_compression_t c) {
+  switch (c) {
+  case EXR_COMPRESSION_NONE:
+    return 1;
+  case EXR_COMPRESSION_RLE:
+    return 128;
+  case EXR_COMPRESSION_ZIPS:
+  case EXR_COMPRESSION_ZIP:
+  case EXR_COMPRESSION_PXR24:
+    return 2048;
+  case EXR_COMPRESSION_PIZ:
+    return 1024;
+  case EXR_COMPRESSION_B44:
+  case EXR_COMPRESSION_B44A:
+    return 32;
+  case EXR_COMPRESSION_DWAA:
+  case EXR_COMPRESSION_DWAB:
+    return (uint64_t)1 << 18;
+  default:
+    return 0;
+  }
+}
+
+/* OpenEXRCore before 3.2 cannot decompress DWAA/DWAB ("not yet implemented
+ * in C"); only chunks stored raw in such files can be read. */
+static int core_decodes_dwa(void) {
+  int major = 0, minor = 0, patch = 0;
+  const char *extra = NULL;
+  exr_get_library_version(&major, &minor, &patch, &extra);
+  return major > 3 || (major == 3 && minor >= 2);
+}
+
+/* A chunk's packed bytes can hold its unpacked size under L's compression. */
+static int chunk_plausible(const chunk_layout *L, const exr_chunk_info_t *cinfo) {
+  if (L->expand == 0)
+    return 1;
+  if (cinfo->packed_size == 0)
+    return cinfo->unpacked_size == 0;
+  return cinfo->unpacked_size / cinfo->packed_size < L->expand ||
+         (cinfo->unpacked_size / cinfo->packed_size == L->expand &&
+          cinfo->unpacked_size % cinfo->packed_size == 0);
+}
+
+static exr_result_t implausible_chunk(chunk_fault *f, const exr_chunk_info_t *cinfo) {
+  f->implausible = 1;
+  f->packed = cinfo->packed_size;
+  f->unpacked = cinfo->unpacked_size;
+  return EXR_ERR_CORRUPT_CHUNK;
+}
 
 /* Points each decoder channel at its plane; (x, y) is the chunk's first pixel
  * relative to the data window's corner. */
@@ -212,13 +289,13 @@ static exr_result_t decode_chunk(exr_context_t ctxt, const exr_chunk_info_t *cin
 }
 
 /* Visits every level-0 chunk in order. With img NULL it only reads and checks
- * each chunk's description (offset, size and extent against the file), which
- * catches truncated and inconsistent files before any image is allocated;
- * otherwise it decodes the chunk into img, rows in file order. On failure
- * *fx, *fy name the chunk (tile indices, or the first scanline). */
+ * each chunk's description (offset, size and extent against the file, and
+ * its unpacked size against its packed size), which catches truncated,
+ * inconsistent and hostile files before any image is allocated; otherwise it
+ * decodes the chunk into img, rows in file order. On failure *f names the
+ * chunk. */
 static exr_result_t walk_chunks(const chunk_layout *L, const gr_exr_image *img,
-                                exr_decode_pipeline_t *dec, int *dec_live, int64_t *fx,
-                                int64_t *fy) {
+                                exr_decode_pipeline_t *dec, int *dec_live, chunk_fault *f) {
   exr_result_t rv = EXR_ERR_SUCCESS;
   exr_chunk_info_t cinfo;
   if (!L->tiled) {
@@ -227,14 +304,16 @@ static exr_result_t walk_chunks(const chunk_layout *L, const gr_exr_image *img,
       int64_t expect_h = (int64_t)L->dw.max.y - y + 1;
       if (expect_h > L->lines)
         expect_h = L->lines;
-      *fx = 0;
-      *fy = y;
+      f->x = 0;
+      f->y = y;
       memset(&cinfo, 0, sizeof cinfo);
       rv = exr_read_scanline_chunk_info(L->ctxt, 0, (int)y, &cinfo);
       if (rv == EXR_ERR_SUCCESS &&
           ((int64_t)cinfo.start_y != y || (int64_t)cinfo.height != expect_h ||
            (int64_t)cinfo.width != L->width))
         rv = EXR_ERR_INCORRECT_CHUNK;
+      if (rv == EXR_ERR_SUCCESS && !chunk_plausible(L, &cinfo))
+        rv = implausible_chunk(f, &cinfo);
       if (rv == EXR_ERR_SUCCESS && img != NULL)
         rv = decode_chunk(L->ctxt, &cinfo, dec, dec_live, img, 0, y - L->dw.min.y);
       if (rv != EXR_ERR_SUCCESS)
@@ -247,12 +326,14 @@ static exr_result_t walk_chunks(const chunk_layout *L, const gr_exr_image *img,
         int64_t x0 = tx * L->tw, y0 = ty * L->th;
         int64_t ew = L->width - x0 < L->tw ? L->width - x0 : L->tw;
         int64_t eh = L->height - y0 < L->th ? L->height - y0 : L->th;
-        *fx = tx;
-        *fy = ty;
+        f->x = tx;
+        f->y = ty;
         memset(&cinfo, 0, sizeof cinfo);
         rv = exr_read_tile_chunk_info(L->ctxt, 0, (int)tx, (int)ty, 0, 0, &cinfo);
         if (rv == EXR_ERR_SUCCESS && ((int64_t)cinfo.width != ew || (int64_t)cinfo.height != eh))
           rv = EXR_ERR_INCORRECT_CHUNK;
+        if (rv == EXR_ERR_SUCCESS && !chunk_plausible(L, &cinfo))
+          rv = implausible_chunk(f, &cinfo);
         if (rv == EXR_ERR_SUCCESS && img != NULL)
           rv = decode_chunk(L->ctxt, &cinfo, dec, dec_live, img, x0, y0);
         if (rv != EXR_ERR_SUCCESS)
@@ -317,7 +398,7 @@ static gr_status read_exr(const char *label, read_source *src, gr_exr_image *out
   exr_storage_t storage = EXR_STORAGE_LAST_TYPE;
   const exr_attr_chlist_t *chlist = NULL;
   chunk_layout L;
-  int64_t fx = 0, fy = 0;
+  chunk_fault fault;
   size_t npix, c;
   int nparts = 0, pass;
   gr_exr_image img;
@@ -326,6 +407,7 @@ static gr_status read_exr(const char *label, read_source *src, gr_exr_image *out
   memset(&dec, 0, sizeof dec);
   memset(msg, 0, sizeof *msg);
   memset(&L, 0, sizeof L);
+  memset(&fault, 0, sizeof fault);
 
   init.error_handler_fn = &exr_capture_error;
   init.user_data = src;
@@ -428,6 +510,25 @@ static gr_status read_exr(const char *label, read_source *src, gr_exr_image *out
   }
 
   /* Chunk layout: scanlines per chunk, or level-0 tiles. */
+  {
+    exr_compression_t comp = EXR_COMPRESSION_NONE;
+    rv = exr_get_compression(ctxt, 0, &comp);
+    if (rv != EXR_ERR_SUCCESS) {
+      st = GR_ERR_FORMAT;
+      set_err(err, err_len, "Cannot read '%s': its compression is not understood (OpenEXR: %s).",
+              label, exr_detail(msg, rv));
+      goto cleanup;
+    }
+    L.compression = comp;
+    L.expand = max_expansion(comp);
+    /* DWA the library cannot decode: allow only raw-stored chunks, so that a
+     * small hostile file cannot claim gigabytes (DWA packs about 66000:1)
+     * and be refused only after the image was allocated. */
+    L.undecodable =
+        (comp == EXR_COMPRESSION_DWAA || comp == EXR_COMPRESSION_DWAB) && !core_decodes_dwa();
+    if (L.undecodable)
+      L.expand = 1;
+  }
   if (storage == EXR_STORAGE_SCANLINE) {
     int32_t lines = 0;
     rv = exr_get_scanlines_per_chunk(ctxt, 0, &lines);
@@ -497,19 +598,33 @@ static gr_status read_exr(const char *label, read_source *src, gr_exr_image *out
         }
       }
     }
-    rv = walk_chunks(&L, pass == 1 ? &img : NULL, &dec, &dec_live, &fx, &fy);
+    rv = walk_chunks(&L, pass == 1 ? &img : NULL, &dec, &dec_live, &fault);
     if (rv != EXR_ERR_SUCCESS) {
+      char where[64];
       st = read_status(rv);
       if (L.tiled)
+        snprintf(where, sizeof where, "tile (%lld, %lld)", (long long)fault.x, (long long)fault.y);
+      else
+        snprintf(where, sizeof where, "scanline %lld", (long long)fault.y);
+      if (fault.implausible && L.undecodable)
         set_err(err, err_len,
-                "Cannot read '%s': the file is truncated or corrupt at tile "
-                "(%lld, %lld) (OpenEXR: %s).",
-                label, (long long)fx, (long long)fy, exr_detail(msg, rv));
+                "Cannot read '%s': the OpenEXR library in use cannot decode its %s compression "
+                "(at %s).",
+                label, compression_name(L.compression), where);
+      else if (fault.implausible)
+        set_err(err, err_len,
+                "Cannot read '%s': the chunk at %s claims %llu bytes of pixels from %llu "
+                "compressed bytes, more than its compression can hold; the file is corrupt.",
+                label, where, (unsigned long long)fault.unpacked, (unsigned long long)fault.packed);
+      else if (rv == EXR_ERR_FEATURE_NOT_IMPLEMENTED)
+        set_err(err, err_len,
+                "Cannot read '%s': the OpenEXR library in use cannot decode its %s compression "
+                "(at %s; OpenEXR: %s).",
+                label, compression_name(L.compression), where, exr_detail(msg, rv));
       else
         set_err(err, err_len,
-                "Cannot read '%s': the file is truncated or corrupt at "
-                "scanline %lld (OpenEXR: %s).",
-                label, (long long)fy, exr_detail(msg, rv));
+                "Cannot read '%s': the file is truncated or corrupt at %s (OpenEXR: %s).", label,
+                where, exr_detail(msg, rv));
       goto cleanup;
     }
   }

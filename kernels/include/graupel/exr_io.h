@@ -5,7 +5,10 @@
  * Reads single- or multi-channel scanline or tiled EXR images whose channels
  * are HALF or FLOAT, and writes any set of named float fields as one
  * multi-channel FLOAT EXR. A hostile or broken file gives GR_ERR_FORMAT or
- * GR_ERR_IO with a sentence, never a crash.
+ * GR_ERR_IO with a sentence, never a crash. Before anything is allocated,
+ * every chunk's size is checked against the file and against what its
+ * compressed bytes can hold (at most 2048 times as much; 2^18 for DWA), so a
+ * small file cannot make the reader allocate gigabytes.
  *
  * Orientation: EXR stores rows top (y min of the data window) to bottom; a
  * height map's first row is its northern edge. gr_exr_image fields are
