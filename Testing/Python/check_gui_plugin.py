@@ -10,8 +10,9 @@ scratch = sys.argv[sys.argv.index("--scratch") + 1]
 result = os.path.join(scratch, "gui_result.txt")
 if os.path.exists(result):
     os.remove(result)
-env = dict(os.environ, GRAUPEL_GUI_RESULT=result)
-cmd = ["paraview",
+plugin_dir = sys.argv[sys.argv.index("--plugin-dir") + 1]
+env = dict(os.environ, GRAUPEL_GUI_RESULT=result, PV_PLUGIN_PATH=plugin_dir)
+cmd = ["paraview", "--dr",
        "--script=" + os.path.join(here, "gui_plugin_script.py"), "--exit"]
 proc = subprocess.run(cmd, env=env, timeout=240)
 text = open(result).read().strip() if os.path.exists(result) else ""
