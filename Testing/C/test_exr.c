@@ -6,6 +6,7 @@
  * (or the buffer's label), and must leave the output image untouched.
  *
  * Usage: test_exr SCRATCH_DIR   (an existing, writable directory) */
+#include "gr_test_io.h"
 #include "gr_test.h"
 #include "graupel/exr_io.h"
 
@@ -33,26 +34,6 @@ static int is_sentence_with(const char *s, const char *path) {
   size_t n = strlen(s);
   return n > 10 && s[0] >= 'A' && s[0] <= 'Z' && s[n - 1] == '.' &&
          (path == NULL || strstr(s, path) != NULL);
-}
-
-static unsigned char *load_bytes(const char *path, size_t *n) {
-  FILE *f = fopen(path, "rb");
-  unsigned char *buf = NULL;
-  long sz;
-  *n = 0;
-  if (f == NULL)
-    return NULL;
-  if (fseek(f, 0, SEEK_END) == 0 && (sz = ftell(f)) > 0 && fseek(f, 0, SEEK_SET) == 0) {
-    buf = (unsigned char *)malloc((size_t)sz);
-    if (buf != NULL && fread(buf, 1, (size_t)sz, f) == (size_t)sz) {
-      *n = (size_t)sz;
-    } else {
-      free(buf);
-      buf = NULL;
-    }
-  }
-  fclose(f);
-  return buf;
 }
 
 static int save_bytes(const char *path, const void *buf, size_t n) {
@@ -459,7 +440,7 @@ static void check_memory_equals_file(const char *path) {
   gr_status st;
   memset(&from_file, 0, sizeof from_file);
   memset(&from_mem, 0, sizeof from_mem);
-  bytes = load_bytes(path, &n);
+  bytes = gr_test_load_file(path, &n);
   before = (unsigned char *)malloc(n > 0 ? n : 1);
   CHECK_MSG(bytes != NULL && before != NULL, "%s: cannot load the file", path);
   if (bytes == NULL || before == NULL)
@@ -935,7 +916,7 @@ static void test_bad_files(void) {
     vals[k] = (float)sin((double)k * 0.7) * 100.0f;
   scratch_path(good, sizeof good, "good.exr");
   CHECK(gr_exr_write(good, 37, 19, 2, names, data, GR_EXR_FLOAT, err, sizeof err) == GR_OK);
-  bytes = load_bytes(good, &n);
+  bytes = gr_test_load_file(good, &n);
   CHECK(bytes != NULL && n > 1000);
   if (bytes == NULL || n <= 1000)
     goto done;
@@ -1139,7 +1120,7 @@ static void test_implausible_chunks(void) {
   s.tile_h = 8;
   scratch_path(path, sizeof path, "huge_tile.exr");
   CHECK(capi_write(path, &s));
-  bytes = load_bytes(path, &n);
+  bytes = gr_test_load_file(path, &n);
   CHECK(bytes != NULL);
   if (bytes != NULL) {
     const int32_t tile[2] = {65536, 32768};
@@ -1160,7 +1141,7 @@ static void test_implausible_chunks(void) {
     const size_t nchunks = 32768 / 16;
     scratch_path(path, sizeof path, "one_byte_chunks.exr");
     CHECK(gr_exr_write(path, 3, 2, 1, names, data, GR_EXR_FLOAT, err, sizeof err) == GR_OK);
-    bytes = load_bytes(path, &n);
+    bytes = gr_test_load_file(path, &n);
     hend = bytes != NULL ? header_end(bytes, n) : 0;
     CHECK(hend > 8);
     hostile = (unsigned char *)malloc(hend + nchunks * (8 + 9));
@@ -1238,7 +1219,7 @@ static void test_undecodable_compression(void) {
     v[k] = (float)(k / 37);
   scratch_path(path, sizeof path, "relabelled_dwa.exr");
   CHECK(gr_exr_write(path, 37, 10, 1, names, data, GR_EXR_FLOAT, err, sizeof err) == GR_OK);
-  bytes = load_bytes(path, &n);
+  bytes = gr_test_load_file(path, &n);
   at = bytes != NULL ? find_bytes(bytes, n, tag, sizeof tag - 1) : (size_t)-1;
   CHECK(at != (size_t)-1 && at + sizeof tag - 1 + 5 <= n);
   if (at == (size_t)-1 || at + sizeof tag - 1 + 5 > n) {
@@ -1282,7 +1263,7 @@ static void test_memory_reads(void) {
     vals[k] = (float)cos((double)k * 0.3) * 50.0f;
   scratch_path(path, sizeof path, "memory_good.exr");
   CHECK(gr_exr_write(path, 37, 19, 2, names, data, GR_EXR_FLOAT, err, sizeof err) == GR_OK);
-  bytes = load_bytes(path, &n);
+  bytes = gr_test_load_file(path, &n);
   CHECK(bytes != NULL && n > 1000);
   if (bytes == NULL || n <= 1000)
     goto done;
@@ -1372,7 +1353,7 @@ static void test_memory_reads(void) {
   scratch_path(other, sizeof other, "memory_tiled.exr");
   if (capi_write(other, &s)) {
     size_t tn = 0;
-    unsigned char *tiled = load_bytes(other, &tn);
+    unsigned char *tiled = gr_test_load_file(other, &tn);
     CHECK(tiled != NULL && tn > 100);
     check_memory_equals_file(other);
     bad_trunc = 0;

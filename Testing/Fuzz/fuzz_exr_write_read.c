@@ -17,6 +17,7 @@
  * names: FLOAT bit for bit (any NaN for a NaN), HALF within half precision
  * (rounded to nearest, overflow to infinity, NaN stays NaN). The file is one
  * per process, made by mkstemp in /tmp and removed at exit. */
+#include "../C/gr_test_io.h"
 #include "graupel/exr_io.h"
 
 #include <math.h>
@@ -72,26 +73,6 @@ static uint8_t next_byte(reader *r) {
     --r->n;
   }
   return b;
-}
-
-static unsigned char *load_file(const char *path, size_t *n) {
-  FILE *f = fopen(path, "rb");
-  unsigned char *buf = NULL;
-  long sz;
-  *n = 0;
-  if (f == NULL)
-    return NULL;
-  if (fseek(f, 0, SEEK_END) == 0 && (sz = ftell(f)) > 0 && fseek(f, 0, SEEK_SET) == 0) {
-    buf = (unsigned char *)malloc((size_t)sz);
-    if (buf != NULL && fread(buf, 1, (size_t)sz, f) == (size_t)sz) {
-      *n = (size_t)sz;
-    } else {
-      free(buf);
-      buf = NULL;
-    }
-  }
-  fclose(f);
-  return buf;
 }
 
 /* got is what HALF storage of v may read back as. */
@@ -203,7 +184,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
   }
 
   /* The same bytes from memory read the same. */
-  bytes = load_file(path, &nbytes);
+  bytes = gr_test_load_file(path, &nbytes);
   REQUIRE(bytes != NULL);
   memset(&mem, 0, sizeof mem);
   st = gr_exr_read_memory(bytes, nbytes, "written", &mem, err, sizeof err);
