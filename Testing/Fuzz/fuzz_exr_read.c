@@ -6,6 +6,7 @@
  * and last samples can be read); on failure the status must be GR_ERR_FORMAT
  * (or GR_ERR_OUT_OF_MEMORY), the output untouched and the error a sentence
  * naming the label. A broken promise is __builtin_trap(). */
+#include "fuzz_common.h"
 #include "graupel/exr_io.h"
 
 #include <stddef.h>
@@ -13,14 +14,6 @@
 #include <string.h>
 
 #define LABEL "fuzz input"
-
-#define REQUIRE(cond)                                                                              \
-  do {                                                                                             \
-    if (!(cond))                                                                                   \
-      __builtin_trap();                                                                            \
-  } while (0)
-
-int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 
 static void check_image(const gr_exr_image *img) {
   size_t npix;

@@ -17,6 +17,7 @@
  * names: FLOAT bit for bit (any NaN for a NaN), HALF within half precision
  * (rounded to nearest, overflow to infinity, NaN stays NaN). The file is one
  * per process, made by mkstemp in /tmp and removed at exit. */
+#include "fuzz_common.h"
 #include "../C/gr_test_io.h"
 #include "graupel/exr_io.h"
 
@@ -27,17 +28,9 @@
 #include <string.h>
 #include <unistd.h>
 
-#define REQUIRE(cond)                                                                              \
-  do {                                                                                             \
-    if (!(cond))                                                                                   \
-      __builtin_trap();                                                                            \
-  } while (0)
-
 #define MAX_SIDE 64
 #define MAX_CHANNELS 4
 #define MAX_NAME_BYTES (127 * 3)
-
-int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 
 static char g_path[64];
 

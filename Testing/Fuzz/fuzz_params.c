@@ -18,6 +18,7 @@
  * ranges are accepted; an accepted grid has the documented dimensions,
  * spacing, origin and offsets; a short message buffer is never overrun and is
  * always terminated; the answer does not depend on the buffer. */
+#include "fuzz_common.h"
 #include "graupel/terrain_noise.h"
 
 #include <float.h>
@@ -26,14 +27,6 @@
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
-
-#define REQUIRE(cond)                                                                              \
-  do {                                                                                             \
-    if (!(cond))                                                                                   \
-      __builtin_trap();                                                                            \
-  } while (0)
-
-int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 
 typedef struct reader {
   const uint8_t *p;
