@@ -4,6 +4,13 @@
  *                            creation, use and release (private and shared)
  *   test_soak terrain N DIR  N terrain generations (random valid parameters)
  *                            and EXR round trips of the result through DIR
+ *   test_soak rain N         one rain runoff simulation stepped N times on a
+ *                            small random terrain, its parameters drawn anew
+ *                            every 5000 steps; every 1000 steps the depth and
+ *                            velocity must be finite (depth >= 0) and the
+ *                            water balance within 1e-4 of the water that came
+ *                            in; a second simulation is created, stepped and
+ *                            freed every 10^4 steps
  *
  * Memory is "flat" when the resident set after the last cycle exceeds the one
  * after the first tenth of the cycles by less than a small allowance (the
@@ -11,9 +18,11 @@
  * generated field is checked for NaN, infinity and its documented bounds. */
 #include "graupel/cl_runtime.h"
 #include "graupel/exr_io.h"
+#include "graupel/rain_runoff.h"
 #include "graupel/terrain_noise.h"
 #include "gr_test.h"
 
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
@@ -164,9 +173,114 @@ static void soak_terrain(long n, const char *dir) {
   gr_context_release(ctx);
 }
 
+static void random_rain_params(gr_rain_runoff_params *p) {
+  gr_rain_runoff_params_init(p);
+  /* Dry spells, drizzle and cloudbursts (up to 200 mm/h). */
+  p->rain_rate = uniform(0.0, 1.0) < 0.2 ? 0.0 : uniform(0.0, 200.0 / 3.6e6);
+  p->permeability = uniform(0.0, 1.0) < 0.3 ? 0.0 : uniform(0.0, 50.0 / 3.6e6);
+  p->manning_n = uniform(0.01, 0.2);
+  p->cfl = uniform(0.3, 0.9);
+  p->max_dt = uniform(0.05, 2.0);
+  p->boundary = uniform(0.0, 1.0) < 0.5 ? GR_BOUNDARY_OPEN : GR_BOUNDARY_CLOSED;
+}
+
+static void soak_rain(long n) {
+  gr_context *ctx = NULL;
+  if (gr_context_acquire(NULL, &ctx) != GR_OK) {
+    CHECK_MSG(0, "%s", gr_last_error(NULL));
+    return;
+  }
+  const gr_grid g = {48, 40, uniform(0.5, 5.0), uniform(0.5, 5.0), 0.0, 0.0, 0, 0};
+  const size_t cells = (size_t)g.nx * (size_t)g.ny;
+  float *b = malloc(cells * sizeof(float));
+  float *h = malloc(cells * sizeof(float));
+  float *v = malloc(3 * cells * sizeof(float));
+  gr_terrain_noise_params tp;
+  gr_terrain_noise_params_init(&tp);
+  tp.seed = 11;
+  tp.frequency = 40.0;
+  tp.height_scale = 5.0;
+  gr_rain_runoff_params p;
+  random_rain_params(&p);
+  gr_rain_runoff *sim = NULL;
+  gr_status st = gr_terrain_noise_generate(ctx, &g, &tp, b);
+  if (st == GR_OK)
+    st = gr_rain_runoff_create(ctx, &g, &p, &sim);
+  if (st == GR_OK)
+    st = gr_rain_runoff_set_field(sim, GR_FIELD_ELEVATION, b);
+  CHECK_MSG(st == GR_OK, "set-up: %s", gr_last_error(ctx));
+  long first = 0, done = 0;
+  double worst = 0.0, t0 = (double)clock();
+  const long chunk = 1000;
+  while (st == GR_OK && done < n) {
+    if (done % 5000 == 0) {
+      random_rain_params(&p);
+      st = gr_rain_runoff_set_params(sim, &p);
+    }
+    double dt = 0.0;
+    if (st == GR_OK)
+      st = gr_rain_runoff_stable_dt(sim, &dt);
+    int k = (int)(n - done < chunk ? n - done : chunk);
+    if (st == GR_OK)
+      st = gr_rain_runoff_step(sim, dt, k);
+    done += k;
+    gr_rain_runoff_ledger led;
+    if (st == GR_OK)
+      st = gr_rain_runoff_get_field(sim, GR_FIELD_WATER_DEPTH, h);
+    if (st == GR_OK)
+      st = gr_rain_runoff_get_field(sim, GR_FIELD_VELOCITY, v);
+    if (st == GR_OK)
+      st = gr_rain_runoff_ledger_get(sim, &led);
+    CHECK_MSG(st == GR_OK, "step %ld: %s", done, gr_last_error(ctx));
+    if (st != GR_OK)
+      break;
+    int bad = 0;
+    for (size_t i = 0; i < cells; ++i)
+      bad += !(h[i] >= 0.0f && h[i] < 1e30f); /* NaN, infinite or negative */
+    for (size_t i = 0; i < 3 * cells; ++i)
+      bad += !(v[i] > -1e30f && v[i] < 1e30f);
+    CHECK_MSG(bad == 0, "step %ld: %d depth or velocity values not finite or negative", done, bad);
+    const double in = led.initial_volume + led.rain_volume;
+    const double rel = in > 0.0 ? fabs(led.balance_error) / in : fabs(led.balance_error);
+    worst = rel > worst ? rel : worst;
+    CHECK_MSG(rel <= 1e-4, "step %ld: balance error %g of %g m^3 came in", done, led.balance_error,
+              in);
+    CHECK_MSG(led.steps == done, "ledger counts %lld steps, %ld were taken", led.steps, done);
+    if (done % 10000 == 0) {
+      /* Create, use and free a second simulation: nothing may stay behind. */
+      gr_rain_runoff *other = NULL;
+      gr_status so = gr_rain_runoff_create(ctx, &g, &p, &other);
+      if (so == GR_OK)
+        so = gr_rain_runoff_set_field(other, GR_FIELD_ELEVATION, b);
+      if (so == GR_OK)
+        so = gr_rain_runoff_advance(other, 10.0, NULL);
+      CHECK_MSG(so == GR_OK, "second simulation: %s", gr_last_error(ctx));
+      gr_rain_runoff_destroy(other);
+    }
+    if (done == n / 10)
+      first = rss_kib();
+    if (gr_test_failures > 10)
+      break;
+  }
+  long last = rss_kib();
+  gr_rain_runoff_ledger led;
+  if (sim && gr_rain_runoff_ledger_get(sim, &led) == GR_OK)
+    printf("rain soak: %ld steps (%.0f s simulated) in %.1f s CPU; worst balance error %.3g of "
+           "the water in; rain %.4g m^3, infiltrated %.4g, outflow %.4g, stored %.4g; resident "
+           "%ld KiB after %ld steps, %ld KiB at the end\n",
+           done, led.time, ((double)clock() - t0) / CLOCKS_PER_SEC, worst, led.rain_volume,
+           led.infiltrated_volume, led.outflow_volume, led.stored_volume, first, n / 10, last);
+  CHECK_MSG(last - first < GR_SOAK_SLACK_KIB, "resident memory grew by %ld KiB", last - first);
+  gr_rain_runoff_destroy(sim);
+  free(b);
+  free(h);
+  free(v);
+  gr_context_release(ctx);
+}
+
 int main(int argc, char **argv) {
   if (argc < 3) {
-    fprintf(stderr, "usage: test_soak runtime N | terrain N DIR\n");
+    fprintf(stderr, "usage: test_soak runtime N | terrain N DIR | rain N\n");
     return 2;
   }
   long n = atol(argv[2]);
@@ -178,8 +292,10 @@ int main(int argc, char **argv) {
     soak_runtime(n);
   else if (strcmp(argv[1], "terrain") == 0 && argc > 3)
     soak_terrain(n, argv[3]);
+  else if (strcmp(argv[1], "rain") == 0)
+    soak_rain(n);
   else {
-    fprintf(stderr, "usage: test_soak runtime N | terrain N DIR\n");
+    fprintf(stderr, "usage: test_soak runtime N | terrain N DIR | rain N\n");
     return 2;
   }
   return GR_TEST_RESULT();
