@@ -48,6 +48,15 @@ const char *vtkGraupelAlgorithm::GetDeviceName() const {
   return this->Context ? gr_context_device_name(this->Context) : "";
 }
 
+vtkTypeInt64 vtkGraupelAlgorithm::GetDeviceMaxBufferBytes() {
+  gr_device_info info;
+  gr_context *ctx = this->GetContext();
+  if (!ctx || gr_context_device_info(ctx, &info) != GR_OK) {
+    return 0;
+  }
+  return static_cast<vtkTypeInt64>(info.max_alloc_bytes);
+}
+
 gr_context *vtkGraupelAlgorithm::GetContext() {
   if (!this->Context) {
     gr_context_options opt;

@@ -35,6 +35,13 @@ public:
   /** Name of the device the last update ran on ("" before the first). */
   const char *GetDeviceName() const;
 
+  /**
+   * The largest buffer the chosen device allows, in bytes (0 when there is
+   * no such device): a grid of float fields must stay below it. Picks the
+   * device if no update has yet.
+   */
+  vtkTypeInt64 GetDeviceMaxBufferBytes();
+
 protected:
   vtkGraupelAlgorithm();
   ~vtkGraupelAlgorithm() override;

@@ -16,7 +16,7 @@ pxm = servermanager.ProxyManager()
 
 # Declarations: menu category, documentation on every property.
 for group, name in (("sources", "ProceduralTerrain"), ("sources", "EXRHeightFieldReader"),
-                    ("writers", "EXRFieldWriter")):
+                    ("writers", "EXRFieldWriter"), ("filters", "RainRunoff")):
     proto = pxm.GetPrototypeProxy(group, name)
     T.check(proto is not None, "proxy %s/%s is registered" % (group, name))
     if proto is None:
@@ -30,7 +30,7 @@ for group, name in (("sources", "ProceduralTerrain"), ("sources", "EXRHeightFiel
             T.check(doc is not None and len(doc.GetDescription().strip()) > 10,
                     "%s.%s has documentation" % (name, it.GetKey()))
         it.Next()
-    if group == "sources":
+    if group in ("sources", "filters"):
         hints = proto.GetHints()
         menu = hints.FindNestedElementByName("ShowInMenu") if hints else None
         T.check(menu is not None and menu.GetAttribute("category") == "Graupel",
@@ -84,5 +84,25 @@ dem = OpenDataFile(os.path.join(a.data, "jacksboro_fault_dem.exr"))
 dem.Spacing = [74.5, 92.1]
 dem.UpdatePipeline()
 T.check(dem.PointData["elevation"].GetRange() == (236.0, 1076.0), "real DEM range")
+
+# Rain Runoff on the DEM: a time source whose times the animation scene sees.
+rr = RainRunoff(Input=dem)
+T.check(rr.RainRate == 10.0 and rr.Permeability == 0.0 and rr.ManningN == 0.03
+        and rr.Boundary == "Open", "Rain Runoff defaults")
+rr.EndTime = 40.0
+rr.OutputInterval = 20.0
+rr.UpdatePipelineInformation()
+T.check(list(rr.TimestepValues) == [0.0, 20.0, 40.0], "TimestepValues %r" % (list(rr.TimestepValues),))
+scene = GetAnimationScene()
+scene.UpdateAnimationUsingDataTimeSteps()
+T.check(40.0 in list(scene.TimeKeeper.TimestepValues), "the time keeper knows the output times")
+rr.UpdatePipeline(40.0)
+out = servermanager.Fetch(rr)
+fd = out.GetFieldData()
+rain_in = fd.GetArray("rain_volume").GetValue(0)
+T.near(rain_in, 10.0 / 3.6e6 * 40.0 * (74.5 * 92.1) * out.GetNumberOfPoints(), 1e-6 * rain_in,
+       "rain_volume on the DEM")
+T.check(abs(fd.GetArray("balance_error").GetValue(0)) <= 1e-5 * rain_in, "DEM water balance")
+T.check(rr.PointData["water_depth"].GetRange()[1] > 0.0, "water on the DEM")
 
 T.finish()

@@ -1,0 +1,254 @@
+#include "vtkRainRunoffFilter.h"
+
+#include "vtkAlgorithmOutput.h"
+#include "vtkDoubleArray.h"
+#include "vtkFieldData.h"
+#include "vtkFloatArray.h"
+#include "vtkImageData.h"
+#include "vtkInformation.h"
+#include "vtkInformationVector.h"
+#include "vtkNew.h"
+#include "vtkObjectFactory.h"
+#include "vtkPointData.h"
+#include "vtkSmartPointer.h"
+
+#include "graupel/rain_runoff.h"
+
+#include <vector>
+
+vtkStandardNewMacro(vtkRainRunoffFilter);
+
+namespace {
+// User-facing intensities are in mm/h; the core speaks m/s.
+constexpr double MillimetresPerHour = 1.0 / 3.6e6;
+
+// The array as float32 (a copy when it is stored otherwise), or nullptr.
+vtkSmartPointer<vtkFloatArray> AsFloat(vtkDataArray *a) {
+  if (!a) {
+    return nullptr;
+  }
+  if (auto *f = vtkFloatArray::SafeDownCast(a)) {
+    return f;
+  }
+  auto f = vtkSmartPointer<vtkFloatArray>::New();
+  f->DeepCopy(a);
+  return f;
+}
+
+void AddValue(vtkFieldData *fd, const char *name, double value) {
+  vtkNew<vtkDoubleArray> a;
+  a->SetName(name);
+  a->InsertNextValue(value);
+  fd->AddArray(a);
+}
+} // namespace
+
+vtkRainRunoffFilter::vtkRainRunoffFilter() {
+  this->SetNumberOfInputPorts(2);
+}
+
+vtkRainRunoffFilter::~vtkRainRunoffFilter() {
+  this->ReleaseState();
+}
+
+void vtkRainRunoffFilter::SetPermeabilityMapConnection(vtkAlgorithmOutput *output) {
+  this->SetInputConnection(1, output);
+}
+
+int vtkRainRunoffFilter::FillInputPortInformation(int port, vtkInformation *info) {
+  info->Set(vtkAlgorithm::INPUT_REQUIRED_DATA_TYPE(), "vtkImageData");
+  if (port == 1) {
+    info->Set(vtkAlgorithm::INPUT_IS_OPTIONAL(), 1);
+  }
+  return 1;
+}
+
+int vtkRainRunoffFilter::SetUpState(vtkInformationVector **inputVector) {
+  vtkImageData *terrain = vtkImageData::GetData(inputVector[0]);
+  vtkImageData *map = inputVector[1]->GetNumberOfInformationObjects()
+                          ? vtkImageData::GetData(inputVector[1])
+                          : nullptr;
+  if (!terrain) {
+    vtkErrorMacro("Rain Runoff needs a terrain image on its Input.");
+    return 0;
+  }
+  int dims[3];
+  terrain->GetDimensions(dims);
+  double spacing[3];
+  terrain->GetSpacing(spacing);
+  if (dims[0] < 2 || dims[1] < 2 || dims[2] != 1) {
+    vtkErrorMacro("Rain Runoff needs a 2-D terrain of at least 2 x 2 points on its Input; it got "
+                  << dims[0] << " x " << dims[1] << " x " << dims[2]
+                  << ". Slice a volume or resample the terrain first.");
+    return 0;
+  }
+  if (!(spacing[0] > 0.0) || !(spacing[1] > 0.0)) {
+    vtkErrorMacro("Rain Runoff needs a terrain spacing above 0 m in x and y; the Input has "
+                  << spacing[0] << " x " << spacing[1] << " m. Set the spacing on the source.");
+    return 0;
+  }
+  vtkPointData *pd = terrain->GetPointData();
+  vtkDataArray *elevationArray = pd->GetArray("elevation");
+  if (!elevationArray) {
+    elevationArray = pd->GetScalars();
+  }
+  if (!elevationArray || elevationArray->GetNumberOfComponents() != 1) {
+    vtkErrorMacro("Rain Runoff's Input has no one-component point array 'elevation' (nor "
+                  "active scalars to use instead); give the terrain heights that name.");
+    return 0;
+  }
+
+  struct Upload {
+    gr_field field;
+    vtkSmartPointer<vtkFloatArray> values;
+    const char *where;
+  };
+  std::vector<Upload> uploads;
+  uploads.push_back({GR_FIELD_ELEVATION, AsFloat(elevationArray), "Input"});
+  if (vtkDataArray *depth = pd->GetArray("water_depth")) {
+    uploads.push_back({GR_FIELD_WATER_DEPTH, AsFloat(depth), "Input"});
+  }
+  if (vtkDataArray *rain = pd->GetArray("rain_rate")) {
+    uploads.push_back({GR_FIELD_RAIN_RATE, AsFloat(rain), "Input"});
+  }
+  if (map) {
+    int mdims[3];
+    map->GetDimensions(mdims);
+    vtkDataArray *k = map->GetPointData()->GetArray("permeability");
+    if (!k) {
+      vtkErrorMacro("Rain Runoff's PermeabilityMap has no point array 'permeability' (m/s); "
+                    "name the map's array so, or disconnect the map to use Permeability.");
+      return 0;
+    }
+    if (mdims[0] != dims[0] || mdims[1] != dims[1] || mdims[2] != dims[2]) {
+      vtkErrorMacro("Rain Runoff's PermeabilityMap has "
+                    << mdims[0] << " x " << mdims[1] << " x " << mdims[2]
+                    << " points but the terrain has " << dims[0] << " x " << dims[1] << " x "
+                    << dims[2] << "; resample the map onto the terrain's grid.");
+      return 0;
+    }
+    uploads.push_back({GR_FIELD_PERMEABILITY, AsFloat(k), "PermeabilityMap"});
+  }
+  const size_t npoints = static_cast<size_t>(dims[0]) * static_cast<size_t>(dims[1]);
+  char msg[512];
+  for (const Upload &u : uploads) {
+    if (u.values->GetNumberOfComponents() != 1 ||
+        static_cast<size_t>(u.values->GetNumberOfTuples()) != npoints) {
+      vtkErrorMacro("Rain Runoff's " << u.where << " array '" << gr_field_name(u.field)
+                                     << "' must have one value per point.");
+      return 0;
+    }
+    if (gr_rain_runoff_field_validate(u.field, u.values->GetPointer(0), npoints, msg,
+                                      sizeof(msg)) != GR_OK) {
+      vtkErrorMacro("Rain Runoff's " << u.where << ": " << msg);
+      return 0;
+    }
+  }
+
+  gr_rain_runoff_params p;
+  gr_rain_runoff_params_init(&p);
+  p.rain_rate = this->RainRate * MillimetresPerHour;
+  p.permeability = this->Permeability * MillimetresPerHour;
+  p.manning_n = this->ManningN;
+  p.cfl = this->CourantNumber;
+  p.max_dt = this->MaxTimeStep;
+  p.boundary = this->Boundary == CLOSED ? GR_BOUNDARY_CLOSED : GR_BOUNDARY_OPEN;
+  if (gr_rain_runoff_params_validate(&p, msg, sizeof(msg)) != GR_OK) {
+    vtkErrorMacro("Rain Runoff: " << msg);
+    return 0;
+  }
+
+  gr_grid grid = {};
+  grid.nx = dims[0];
+  grid.ny = dims[1];
+  grid.dx = spacing[0];
+  grid.dy = spacing[1];
+  grid.x0 = terrain->GetOrigin()[0];
+  grid.y0 = terrain->GetOrigin()[1];
+  gr_status st = gr_rain_runoff_create(this->GetContext(), &grid, &p, &this->Simulation);
+  if (st != GR_OK) {
+    return this->ReportFailure(st, "Rain Runoff could not set up the simulation");
+  }
+  for (const Upload &u : uploads) {
+    st = gr_rain_runoff_set_field(this->Simulation, u.field, u.values->GetPointer(0));
+    if (st != GR_OK) {
+      return this->ReportFailure(st, "Rain Runoff could not upload its inputs");
+    }
+  }
+  this->GridDimensions[0] = dims[0];
+  this->GridDimensions[1] = dims[1];
+  return 1;
+}
+
+int vtkRainRunoffFilter::ResetState() {
+  const gr_status st = gr_rain_runoff_reset(this->Simulation);
+  return st == GR_OK ? 1 : this->ReportFailure(st, "Rain Runoff could not restart");
+}
+
+int vtkRainRunoffFilter::AdvanceState(double seconds) {
+  const gr_status st = gr_rain_runoff_advance(this->Simulation, seconds, nullptr);
+  return st == GR_OK ? 1 : this->ReportFailure(st, "Rain Runoff could not advance");
+}
+
+int vtkRainRunoffFilter::FillOutput(vtkImageData *output, const int extent[6]) {
+  const vtkIdType n = static_cast<vtkIdType>(this->GridDimensions[0]) * this->GridDimensions[1];
+  // The whole grid's fields first (on the input's extent, which need not
+  // start at 0), cropped to the requested piece below.
+  vtkImageData *input = vtkImageData::GetData(this->GetInputInformation(0, 0));
+  vtkNew<vtkImageData> whole;
+  whole->SetExtent(input->GetExtent());
+  whole->SetOrigin(output->GetOrigin());
+  whole->SetSpacing(output->GetSpacing());
+  const gr_field fields[] = {GR_FIELD_WATER_DEPTH, GR_FIELD_WATER_SURFACE, GR_FIELD_VELOCITY,
+                             GR_FIELD_DISCHARGE,   GR_FIELD_INFILTRATED,   GR_FIELD_ELEVATION};
+  for (gr_field f : fields) {
+    vtkNew<vtkFloatArray> a;
+    a->SetName(gr_field_name(f));
+    a->SetNumberOfComponents(gr_field_components(f));
+    if (!a->Allocate(n * gr_field_components(f))) {
+      vtkErrorMacro("Rain Runoff: out of host memory for the output fields.");
+      return 0;
+    }
+    a->SetNumberOfTuples(n);
+    const gr_status st = gr_rain_runoff_get_field(this->Simulation, f, a->GetPointer(0));
+    if (st != GR_OK) {
+      return this->ReportFailure(st, "Rain Runoff could not read its fields back");
+    }
+    whole->GetPointData()->AddArray(a);
+  }
+  whole->GetPointData()->SetActiveScalars("water_depth");
+  output->ShallowCopy(whole);
+  output->Crop(extent);
+
+  gr_rain_runoff_ledger ledger;
+  const gr_status st = gr_rain_runoff_ledger_get(this->Simulation, &ledger);
+  if (st != GR_OK) {
+    return this->ReportFailure(st, "Rain Runoff could not read its ledger");
+  }
+  vtkFieldData *fd = output->GetFieldData();
+  AddValue(fd, "time", ledger.time);
+  AddValue(fd, "steps", static_cast<double>(ledger.steps));
+  AddValue(fd, "initial_volume", ledger.initial_volume);
+  AddValue(fd, "rain_volume", ledger.rain_volume);
+  AddValue(fd, "infiltrated_volume", ledger.infiltrated_volume);
+  AddValue(fd, "outflow_volume", ledger.outflow_volume);
+  AddValue(fd, "stored_volume", ledger.stored_volume);
+  AddValue(fd, "balance_error", ledger.balance_error);
+  AddValue(fd, "max_depth", ledger.max_depth);
+  return 1;
+}
+
+void vtkRainRunoffFilter::ReleaseState() {
+  gr_rain_runoff_destroy(this->Simulation);
+  this->Simulation = nullptr;
+}
+
+void vtkRainRunoffFilter::PrintSelf(ostream &os, vtkIndent indent) {
+  this->Superclass::PrintSelf(os, indent);
+  os << indent << "RainRate: " << this->RainRate << " mm/h\n";
+  os << indent << "Permeability: " << this->Permeability << " mm/h\n";
+  os << indent << "ManningN: " << this->ManningN << "\n";
+  os << indent << "Boundary: " << (this->Boundary == CLOSED ? "closed" : "open") << "\n";
+  os << indent << "MaxTimeStep: " << this->MaxTimeStep << " s\n";
+  os << indent << "CourantNumber: " << this->CourantNumber << "\n";
+}

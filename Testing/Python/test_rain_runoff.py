@@ -1,0 +1,267 @@
+"""vtkRainRunoffFilter in a pipeline (pvpython in the plugin build, plain
+python3 on Debian's VTK): advertised times, results independent of the order
+in which times are requested (a request going backwards restarts), the water
+ledger in field data, the permeability map, pieces, an aborted update, and
+error paths with an empty output."""
+import os
+import sys
+
+import numpy as np
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import gr_check as T  # noqa: E402
+
+a = T.args()
+
+from vtkmodules.util.numpy_support import vtk_to_numpy, numpy_to_vtk  # noqa: E402
+from vtkmodules.vtkCommonDataModel import vtkImageData  # noqa: E402
+from vtkmodules.vtkCommonExecutionModel import (  # noqa: E402
+    vtkStreamingDemandDrivenPipeline as SDDP,
+    vtkTrivialProducer,
+)
+
+from graupel import vtkRainRunoffFilter  # noqa: E402
+
+NX, NY, DX = 40, 32, 2.0
+MM_PER_H = 1.0 / 3.6e6
+
+
+def image(arrays, dims=(NX, NY), spacing=DX):
+    img = vtkImageData()
+    img.SetDimensions(dims[0], dims[1], 1)
+    img.SetSpacing(spacing, spacing, 1.0)
+    img.SetOrigin(100.0, -50.0, 0.0)
+    for name, values in arrays.items():
+        arr = numpy_to_vtk(np.ascontiguousarray(values, dtype=np.float32).reshape(-1), deep=1)
+        arr.SetName(name)
+        img.GetPointData().AddArray(arr)
+    return img
+
+
+_producers = []  # a vtkAlgorithmOutput does not keep its producer alive
+
+
+def producer(img):
+    p = vtkTrivialProducer()
+    p.SetOutput(img)
+    _producers.append(p)
+    return p
+
+
+j, i = np.mgrid[0:NY, 0:NX]
+x = (i - (NX - 1) / 2.0) * DX
+y = (j - (NY - 1) / 2.0) * DX
+bowl = 0.004 * (x * x + y * y)  # metres; deepest in the middle
+slope = 0.05 * i * DX           # rising to the east
+
+
+def rain(terrain, **kw):
+    f = vtkRainRunoffFilter()
+    f.SetInputConnection(producer(image({"elevation": terrain})).GetOutputPort())
+    f.SetEndTime(kw.pop("EndTime", 60.0))
+    f.SetOutputInterval(kw.pop("OutputInterval", 10.0))
+    for k, v in kw.items():
+        getattr(f, "Set" + k)(v)
+    return f
+
+
+def at(f, t):
+    f.UpdateTimeStep(t)
+    out = f.GetOutput()
+    if out.GetNumberOfPoints() == 0:
+        return None, out
+    nx, ny, _ = out.GetDimensions()
+    d = vtk_to_numpy(out.GetPointData().GetArray("water_depth")).reshape(ny, nx).copy()
+    return d, out
+
+
+def field(out, name):
+    return out.GetFieldData().GetArray(name).GetValue(0)
+
+
+# ---- defaults and advertised times ---------------------------------------------
+f = vtkRainRunoffFilter()
+T.check(f.GetRainRate() == 10.0 and f.GetPermeability() == 0.0 and f.GetManningN() == 0.03,
+        "defaults RainRate 10 mm/h, Permeability 0, ManningN 0.03")
+T.check(f.GetBoundary() == 0 and f.GetEndTime() == 600.0 and f.GetOutputInterval() == 10.0,
+        "defaults Boundary open, EndTime 600 s, OutputInterval 10 s")
+
+f = rain(bowl, EndTime=65.0, Boundary=1, RainRate=36.0)
+f.UpdateInformation()
+info = f.GetOutputInformation(0)
+steps = [info.Get(SDDP.TIME_STEPS(), k) for k in range(info.Length(SDDP.TIME_STEPS()))]
+T.check(steps == [0.0, 10.0, 20.0, 30.0, 40.0, 50.0, 60.0, 65.0],
+        "TIME_STEPS every 10 s up to EndTime 65: %r" % steps)
+T.check([info.Get(SDDP.TIME_RANGE(), k) for k in range(2)] == [0.0, 65.0], "TIME_RANGE")
+
+# ---- ledger: rain in, nothing out through a closed edge ------------------------
+d0, out = at(f, 0.0)
+T.check(d0 is not None and float(np.abs(d0).max()) == 0.0, "dry at t = 0")
+d65, out = at(f, 65.0)
+area = NX * NY * DX * DX  # one point, one cell of DX x DX
+rain_expected = 36.0 * MM_PER_H * 65.0 * area
+T.near(field(out, "time"), 65.0, 1e-9, "field data time")
+# The device adds the rate as a float32, and the ledger counts what it adds.
+T.near(field(out, "rain_volume"), rain_expected, 1e-7 * rain_expected, "rain_volume = rate t area")
+T.check(field(out, "outflow_volume") == 0.0, "closed edge: no outflow")
+T.near(field(out, "stored_volume"), rain_expected, 1e-5 * rain_expected,
+       "stored = rain (closed, sealed ground)")
+T.check(abs(field(out, "balance_error")) <= 1e-5 * rain_expected,
+        "balance_error %g within 1e-5 of the rain" % field(out, "balance_error"))
+T.check(out.GetInformation().Get(out.DATA_TIME_STEP()) == 65.0, "DATA_TIME_STEP 65")
+T.check(d65[NY // 2, NX // 2] > d65[0, 0], "water pools in the middle of the bowl")
+T.check(float(d65.min()) >= 0.0, "no negative depth")
+names = [out.GetPointData().GetArrayName(k) for k in range(out.GetPointData().GetNumberOfArrays())]
+for n in ("water_depth", "water_surface", "velocity", "discharge", "infiltrated", "elevation"):
+    T.check(n in names, "output array %s" % n)
+surf = vtk_to_numpy(out.GetPointData().GetArray("water_surface")).reshape(NY, NX)
+T.check(np.allclose(surf, bowl + d65, atol=1e-5), "water_surface = elevation + depth")
+T.check(out.GetPointData().GetArray("velocity").GetNumberOfComponents() == 3, "velocity 3-D")
+
+# ---- order of requests: backwards restarts, results identical -------------------
+fwd = rain(slope + bowl, RainRate=50.0)
+ref = {t: at(fwd, t)[0] for t in (0.0, 10.0, 20.0, 30.0, 40.0, 50.0, 60.0)}
+T.check(fwd.GetRestartCount() == 1, "forward requests set up once, never restart")
+mixed = rain(slope + bowl, RainRate=50.0)
+order = (50.0, 20.0, 60.0, 0.0, 30.0, 30.0, 10.0, 40.0)
+same = True
+for t in order:
+    d, _ = at(mixed, t)
+    same = same and d is not None and np.array_equal(d, ref[t])
+T.check(same, "every time equals the forward run bit for bit, whatever the order %r" % (order,))
+# 20 after 50, 0 after 60 and 10 after 30 go back: three restarts after the set-up.
+T.check(mixed.GetRestartCount() == 4,
+        "each request for an earlier time restarts once (1 + 3), got %d" % mixed.GetRestartCount())
+d, _ = at(mixed, 34.9)
+T.check(np.array_equal(d, ref[30.0]), "a time between outputs gives the output before it")
+d, _ = at(mixed, 1e9)
+T.check(np.array_equal(d, ref[60.0]), "a time after EndTime gives the last output")
+T.check(not np.array_equal(ref[60.0], ref[30.0]), "the field does change in time")
+
+# A changed property sets the simulation up again.
+mixed.SetRainRate(5.0)
+d, out = at(mixed, 60.0)
+T.check(mixed.GetRestartCount() == 6 and d.sum() < ref[60.0].sum(),
+        "less rain after RainRate changed: %g < %g" % (d.sum(), ref[60.0].sum()))
+
+# ---- open edge on a slope: water leaves at the low (west) edge -----------------
+op = rain(slope, RainRate=100.0, EndTime=120.0, OutputInterval=60.0)
+d, out = at(op, 120.0)
+T.check(field(out, "outflow_volume") > 0.0, "open edge: outflow > 0")
+T.check(d[:, 0].mean() > d[:, -1].mean(), "deeper at the low edge than at the high edge")
+stored, rin, outf = (field(out, k) for k in ("stored_volume", "rain_volume", "outflow_volume"))
+T.check(abs(rin - outf - stored) <= 1e-5 * rin, "stored = rain - outflow (%g %g %g)"
+        % (stored, rin, outf))
+
+# ---- permeability map ------------------------------------------------------------
+k = np.where(i < NX // 2, 0.0, 20.0 * MM_PER_H)  # the east half drinks 20 mm/h
+pm = rain(np.zeros((NY, NX)), RainRate=10.0, Boundary=1, EndTime=30.0)
+pm.SetPermeabilityMapConnection(producer(image({"permeability": k})).GetOutputPort())
+d, out = at(pm, 30.0)
+inf = vtk_to_numpy(out.GetPointData().GetArray("infiltrated")).reshape(NY, NX)
+T.check(float(inf[:, : NX // 2].max()) == 0.0, "sealed half infiltrates nothing")
+T.near(float(inf[:, NX // 2 + 2:].mean()), 10.0 * MM_PER_H * 30.0, 1e-3 * 10.0 * MM_PER_H * 30.0,
+       "permeable half takes all the rain (capacity 20 > rain 10 mm/h)")
+T.check(field(out, "infiltrated_volume") > 0.0, "infiltrated_volume > 0")
+wrong = rain(np.zeros((NY, NX)))
+wrong.SetPermeabilityMapConnection(
+    producer(image({"permeability": np.zeros((NY - 1, NX))}, dims=(NX, NY - 1))).GetOutputPort())
+errs = T.ErrorCatcher(wrong)
+d, out = at(wrong, 10.0)
+T.check(d is None and "PermeabilityMap" in errs.text() and "resample" in errs.text(),
+        "mismatched map refused with a sentence: %r" % errs.text()[:200])
+
+# ---- pieces: a requested sub-extent is that part of the whole ------------------
+pc = rain(slope + bowl, RainRate=50.0)
+pc.UpdateInformation()
+pc.GetOutputInformation(0).Set(SDDP.UPDATE_TIME_STEP(), 40.0)
+pc.UpdateExtent((5, 20, 3, 30, 0, 0))
+piece = pc.GetOutput()
+T.check(tuple(piece.GetExtent()) == (5, 20, 3, 30, 0, 0), "piece extent %r" % (piece.GetExtent(),))
+pd = vtk_to_numpy(piece.GetPointData().GetArray("water_depth")).reshape(28, 16)
+T.check(np.array_equal(pd, ref[40.0][3:31, 5:21]), "the piece equals that part of the whole")
+# A piece asked for by number (as MPI ranks do): the terrain must still be
+# read whole, or the simulation would run on the piece alone.
+pn = rain(slope + bowl, RainRate=50.0)
+pn.UpdateInformation()
+pn.GetOutputInformation(0).Set(SDDP.UPDATE_TIME_STEP(), 40.0)
+pn.UpdatePiece(1, 2, 0)
+e = pn.GetOutput().GetExtent()
+T.check(e[1] - e[0] + 1 < NX, "piece 1 of 2 is a part: %r" % (e,))
+pd = vtk_to_numpy(pn.GetOutput().GetPointData().GetArray("water_depth")).reshape(
+    e[3] - e[2] + 1, e[1] - e[0] + 1)
+T.check(np.array_equal(pd, ref[40.0][e[2]:e[3] + 1, e[0]:e[1] + 1]),
+        "piece 1 of 2 equals that part of the whole")
+
+# ---- an aborted update: empty output, then it goes on from where it stopped ----
+ab = rain(slope + bowl, RainRate=50.0)
+hits = {"n": 0}
+
+
+def abort_once(obj, event):
+    if 0.0 < obj.GetProgress() < 1.0 and hits["n"] == 0:
+        hits["n"] = 1
+        obj.SetAbortExecute(1)
+
+
+tag = ab.AddObserver("ProgressEvent", abort_once)
+warns = T.ErrorCatcher(ab, event="WarningEvent")
+d, out = at(ab, 60.0)
+T.check(hits["n"] == 1 and d is None, "an aborted update leaves an empty output")
+T.check("aborted" in warns.text(), "abort warning: %r" % warns.text())
+reached = ab.GetStateIndex()
+T.check(0 < reached < 6, "the state reached (%d) is kept" % reached)
+ab.RemoveObserver(tag)
+d, out = at(ab, 60.0)
+T.check(d is not None and np.array_equal(d, ref[60.0]), "the next update finishes, equal to a full run")
+T.check(ab.GetRestartCount() == 1, "going on after an abort needs no restart")
+
+# ---- bad input: one sentence, an empty output, the next good update works ------
+bad_elev = bowl.copy()
+bad_elev[3, 7] = np.nan
+cases = [
+    ({"elevation": bad_elev}, {}, "elevation"),
+    ({"height": bowl}, {}, "elevation"),  # no elevation, and no active scalars
+    ({"elevation": bowl, "water_depth": -np.ones((NY, NX))}, {}, "water_depth"),
+    ({"elevation": bowl}, {"RainRate": -1.0}, "RainRate"),
+    ({"elevation": bowl}, {"ManningN": 0.0}, "ManningN"),
+    ({"elevation": bowl}, {"OutputInterval": 0.0}, "OutputInterval"),
+    ({"elevation": bowl}, {"EndTime": float("nan")}, "EndTime"),
+]
+for arrays, props, word in cases:
+    g = vtkRainRunoffFilter()
+    src = image(arrays)
+    src.GetPointData().SetActiveScalars(None)
+    g.SetInputConnection(producer(src).GetOutputPort())
+    for kname, v in props.items():
+        getattr(g, "Set" + kname)(v)
+    errs = T.ErrorCatcher(g)
+    g.UpdateInformation()
+    g.Update()
+    out = g.GetOutput()
+    T.check(out.GetNumberOfPoints() == 0 and word in errs.text(),
+            "%s refused with a sentence naming it and an empty output: %r"
+            % (word, errs.text()[:160]))
+flat3d = vtkImageData()
+flat3d.SetDimensions(NX, NY, 2)
+arr = numpy_to_vtk(np.zeros(NX * NY * 2, np.float32), deep=1)
+arr.SetName("elevation")
+flat3d.GetPointData().AddArray(arr)
+g = vtkRainRunoffFilter()
+g.SetInputConnection(producer(flat3d).GetOutputPort())
+errs = T.ErrorCatcher(g)
+g.Update()
+T.check(g.GetOutput().GetNumberOfPoints() == 0 and "2-D" in errs.text(),
+        "a 3-D input refused: %r" % errs.text()[:160])
+
+# After a failure the same filter works once the input is fixed.
+g = rain(bad_elev)
+errs = T.ErrorCatcher(g)
+d, _ = at(g, 10.0)
+T.check(d is None and "elevation" in errs.text(), "NaN elevation refused")
+g.SetInputConnection(producer(image({"elevation": slope + bowl})).GetOutputPort())
+g.SetRainRate(50.0)
+d, _ = at(g, 10.0)
+T.check(d is not None and np.array_equal(d, ref[10.0]), "works again with a good terrain")
+
+T.finish()
