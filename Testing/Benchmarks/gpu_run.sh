@@ -1,0 +1,32 @@
+#!/usr/bin/env bash
+# On an NVIDIA GPU machine (../shared/gpu/README.md): unpack the OpenCL and
+# OpenEXR packages carried in .gpu/, build kernels/ alone, run the core tests
+# on the GPU, benchmark every core, and soak the simulations.
+#   Testing/Benchmarks/gpu_run.sh [OUT]      (OUT: where logs go, default ./gpu-out)
+set -uo pipefail
+cd "$(dirname "$(readlink -f "$0")")/../.."
+OUT=${1:-${OUT:-gpu-out}}
+mkdir -p "$OUT" /tmp/ocl /etc/OpenCL/vendors
+for f in .gpu/*.deb; do dpkg -x "$f" /tmp/ocl; done
+echo libnvidia-opencl.so.1 > /etc/OpenCL/vendors/nvidia.icd
+export CPATH=/tmp/ocl/usr/include LIBRARY_PATH=/tmp/ocl/usr/lib/x86_64-linux-gnu
+export LD_LIBRARY_PATH=/tmp/ocl/usr/lib/x86_64-linux-gnu:/usr/local/nvidia/lib64:${LD_LIBRARY_PATH:-}
+export CMAKE_PREFIX_PATH=/tmp/ocl/usr
+/tmp/ocl/usr/bin/clinfo -l | tee "$OUT/clinfo.txt"
+nvidia-smi --query-gpu=name,driver_version --format=csv,noheader | tee -a "$OUT/clinfo.txt"
+cmake -S kernels -B build-gpu -DCMAKE_BUILD_TYPE=Release >"$OUT/configure.log" 2>&1 &&
+  cmake --build build-gpu -j"$(nproc)" >"$OUT/build.log" 2>&1 || { tail -40 "$OUT/build.log"; exit 1; }
+# The core tests on the GPU (test_terrain also compares the GPU with PoCL).
+(cd build-gpu && GRAUPEL_DEVICE=gpu ctest -L core -LE memcheck --output-on-failure) \
+  >"$OUT/ctest_gpu.log" 2>&1; tail -15 "$OUT/ctest_gpu.log"
+for core in ${CORES:-terrain_noise rain_runoff}; do
+  for n in ${SIZES:-1024 2048 4096 8192}; do
+    GRAUPEL_DEVICE=gpu build-gpu/graupel-bench --core "$core" --size "$n" --steps ${STEPS:-50} \
+      2>&1 | tee -a "$OUT/bench_gpu.txt" | tail -1
+  done
+  GRAUPEL_DEVICE=cpu build-gpu/graupel-bench --core "$core" --size 1024 --steps 10 \
+    2>&1 | tee -a "$OUT/bench_pocl_host.txt" | tail -1
+done
+if [ -n "${SOAK:-}" ]; then
+  GRAUPEL_DEVICE=gpu build-gpu/Testing/C/test_soak rain "$SOAK" 2>&1 | tee "$OUT/soak_rain_gpu.txt" | tail -3
+fi
