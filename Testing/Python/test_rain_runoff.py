@@ -254,6 +254,19 @@ g.Update()
 T.check(g.GetOutput().GetNumberOfPoints() == 0 and "2-D" in errs.text(),
         "a 3-D input refused: %r" % errs.text()[:160])
 
+# A kernel that fails to build (bad GRAUPEL_CL_OPTIONS): one sentence with the
+# build log and an empty output; with the options fixed the next update works.
+os.environ["GRAUPEL_CL_OPTIONS"] = "-cl-no-such-option"
+g = rain(slope + bowl, RainRate=50.0)
+errs = T.ErrorCatcher(g)
+d, _ = at(g, 10.0)
+T.check(d is None and "rain_runoff" in errs.text() and "failed to build" in errs.text(),
+        "a failed kernel build is reported: %r" % errs.text()[:200])
+del os.environ["GRAUPEL_CL_OPTIONS"]
+g.Modified()
+d, _ = at(g, 10.0)
+T.check(d is not None and np.array_equal(d, ref[10.0]), "works again once the options are fixed")
+
 # After a failure the same filter works once the input is fixed.
 g = rain(bad_elev)
 errs = T.ErrorCatcher(g)
