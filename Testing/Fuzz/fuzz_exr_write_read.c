@@ -54,20 +54,6 @@ static const char *temp_path(void) {
   return g_path;
 }
 
-typedef struct reader {
-  const uint8_t *p;
-  size_t n;
-} reader;
-
-static uint8_t next_byte(reader *r) {
-  uint8_t b = 0;
-  if (r->n > 0) {
-    b = *r->p++;
-    --r->n;
-  }
-  return b;
-}
-
 /* got is what HALF storage of v may read back as. */
 static int half_ok(float v, float got) {
   double av = fabs((double)v), tol;
@@ -117,18 +103,18 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
 
   r.p = data;
   r.n = size;
-  w = next_byte(&r) % MAX_SIDE + 1;
-  h = next_byte(&r) % MAX_SIDE + 1;
+  w = take_byte(&r) % MAX_SIDE + 1;
+  h = take_byte(&r) % MAX_SIDE + 1;
   {
-    uint8_t b = next_byte(&r);
+    uint8_t b = take_byte(&r);
     nch = (b & 3) + 1;
     type = (b & 4) ? GR_EXR_HALF : GR_EXR_FLOAT;
   }
   for (c = 0; c < nch; ++c) {
-    uint8_t L = next_byte(&r);
+    uint8_t L = take_byte(&r);
     size_t len = L < 128 ? (size_t)(L % 40) : (size_t)(L - 128) * 3;
     for (i = 0; i < len; ++i)
-      name_buf[c][i] = (char)next_byte(&r);
+      name_buf[c][i] = (char)take_byte(&r);
     name_buf[c][len] = '\0';
     names[c] = name_buf[c];
   }

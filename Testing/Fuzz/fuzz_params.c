@@ -28,26 +28,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-typedef struct reader {
-  const uint8_t *p;
-  size_t n;
-} reader;
-
-/* Copies up to len bytes into dst, zero-filling what the input lacks. */
-static void take(reader *r, void *dst, size_t len) {
-  size_t k = r->n < len ? r->n : len;
-  memset(dst, 0, len);
-  memcpy(dst, r->p, k);
-  r->p += k;
-  r->n -= k;
-}
-
-static uint8_t take_byte(reader *r) {
-  uint8_t b;
-  take(r, &b, 1);
-  return b;
-}
-
 static const double edge_doubles[] = {0.0,    -0.0,  1.0,   -1.0, 0.5,   2.0,  4.0,  8.0,
                                       16.0,   3.9,   120.0, 1e4,  1e5,   1e12, 1e15, -1e15,
                                       1e-300, 1e300, -4.0,  7.99, 0.999, 1e-3, 1e13, 2.0e9};
@@ -181,15 +161,6 @@ static int grid_documented(const gr_grid *g) {
          isfinite(g->dy) && isfinite(g->x0) && isfinite(g->y0) &&
          (double)g->nx * (double)g->ny <= 4.0e9 && g->i0 >= 0 && g->j0 >= 0 &&
          (long long)g->i0 + g->nx <= INT_MAX && (long long)g->j0 + g->ny <= INT_MAX;
-}
-
-static void check_message(gr_status st, const char *msg) {
-  size_t n;
-  REQUIRE(st == GR_OK || st == GR_ERR_INVALID_ARGUMENT);
-  if (st == GR_OK)
-    return;
-  n = strlen(msg);
-  REQUIRE(n > 0 && msg[n - 1] == '.');
 }
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {

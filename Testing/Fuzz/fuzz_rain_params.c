@@ -24,25 +24,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-typedef struct reader {
-  const uint8_t *p;
-  size_t n;
-} reader;
-
-static void take(reader *r, void *dst, size_t len) {
-  size_t k = r->n < len ? r->n : len;
-  memset(dst, 0, len);
-  memcpy(dst, r->p, k);
-  r->p += k;
-  r->n -= k;
-}
-
-static uint8_t take_byte(reader *r) {
-  uint8_t b;
-  take(r, &b, 1);
-  return b;
-}
-
 static double edge_double(uint8_t b) {
   static const double table[] = {0.0,  -0.0, 1e-3,   1e-2, 0.005, 1.0,    3600.0, 2.7777e-6,
                                  0.03, 0.7,  -1e-12, 1e30, -1.0,  3601.0, 0.5,    2.0};
@@ -108,15 +89,6 @@ static int field_documented(gr_field f, const float *v, size_t n) {
 static int is_input(gr_field f) {
   return f == GR_FIELD_ELEVATION || f == GR_FIELD_WATER_DEPTH || f == GR_FIELD_PERMEABILITY ||
          f == GR_FIELD_RAIN_RATE;
-}
-
-static void check_message(gr_status st, const char *msg) {
-  size_t n;
-  REQUIRE(st == GR_OK || st == GR_ERR_INVALID_ARGUMENT);
-  if (st == GR_OK)
-    return;
-  n = strlen(msg);
-  REQUIRE(n > 0 && msg[n - 1] == '.');
 }
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {

@@ -63,3 +63,22 @@ class ErrorCatcher:
 
     def clear(self):
         self.messages = []
+
+
+class AbortOnce:
+    """Aborts an algorithm's update once, at its first progress report
+    strictly between 0 and 1 (as a user pressing Abort mid-run); `hits` says
+    whether it did."""
+
+    def __init__(self, algorithm):
+        self.hits = 0
+        self._algorithm = algorithm
+        self._tag = algorithm.AddObserver("ProgressEvent", self._on_progress)
+
+    def _on_progress(self, obj, event):
+        if 0.0 < obj.GetProgress() < 1.0 and self.hits == 0:
+            self.hits = 1
+            obj.SetAbortExecute(1)
+
+    def remove(self):
+        self._algorithm.RemoveObserver(self._tag)

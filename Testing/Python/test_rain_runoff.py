@@ -195,23 +195,14 @@ T.check(np.array_equal(pd, ref[40.0][e[2]:e[3] + 1, e[0]:e[1] + 1]),
 
 # ---- an aborted update: empty output, then it goes on from where it stopped ----
 ab = rain(slope + bowl, RainRate=50.0)
-hits = {"n": 0}
-
-
-def abort_once(obj, event):
-    if 0.0 < obj.GetProgress() < 1.0 and hits["n"] == 0:
-        hits["n"] = 1
-        obj.SetAbortExecute(1)
-
-
-tag = ab.AddObserver("ProgressEvent", abort_once)
+abort = T.AbortOnce(ab)
 warns = T.ErrorCatcher(ab, event="WarningEvent")
 d, out = at(ab, 60.0)
-T.check(hits["n"] == 1 and d is None, "an aborted update leaves an empty output")
+T.check(abort.hits == 1 and d is None, "an aborted update leaves an empty output")
 T.check("aborted" in warns.text(), "abort warning: %r" % warns.text())
 reached = ab.GetStateIndex()
 T.check(0 < reached < 6, "the state reached (%d) is kept" % reached)
-ab.RemoveObserver(tag)
+abort.remove()
 d, out = at(ab, 60.0)
 T.check(d is not None and np.array_equal(d, ref[60.0]), "the next update finishes, equal to a full run")
 T.check(ab.GetRestartCount() == 1, "going on after an abort needs no restart")

@@ -136,20 +136,11 @@ if side * side <= 4e9:  # beyond that the grid check refuses first (core.runtime
 # Aborted mid-run (between bands): an empty output and a warning, and the next
 # update computes the whole terrain again.
 long_src = terrain(dims=(4096, 2048))
-aborted = {"n": 0}
-
-
-def abort_once(obj, event):
-    if 0.0 < obj.GetProgress() < 1.0 and aborted["n"] == 0:
-        aborted["n"] = 1
-        obj.SetAbortExecute(1)
-
-
-tag = long_src.AddObserver("ProgressEvent", abort_once)
+abort = T.AbortOnce(long_src)
 long_src.Update()
-T.check(aborted["n"] == 1 and long_src.GetOutput().GetNumberOfPoints() == 0,
+T.check(abort.hits == 1 and long_src.GetOutput().GetNumberOfPoints() == 0,
         "an aborted update leaves an empty output")
-long_src.RemoveObserver(tag)
+abort.remove()
 long_src.Update()
 T.check(long_src.GetOutput().GetNumberOfPoints() == 4096 * 2048, "the next update is whole")
 
