@@ -4,6 +4,8 @@
 #ifndef GR_TEST_H
 #define GR_TEST_H
 
+#include "graupel/runtime.h"
+
 #include <math.h>
 #include <stdio.h>
 
@@ -40,5 +42,20 @@ static int gr_test_checks = 0;
 #define GR_TEST_RESULT()                                                                           \
   (printf("%d checks, %d failed\n", gr_test_checks, gr_test_failures),                             \
    gr_test_failures == 0 ? 0 : 1)
+
+/* A 65536-wide grid whose float field needs one row more than the device's
+ * largest buffer. 0 when that grid would pass the 4e9-point grid limit
+ * instead (a device allowing larger buffers than any valid grid needs). */
+static inline int gr_test_grid_beyond_device(const gr_context *ctx, gr_grid *g) {
+  gr_device_info info;
+  gr_status st = gr_context_device_info(ctx, &info);
+  CHECK(st == GR_OK);
+  if (st != GR_OK)
+    return 0;
+  gr_grid huge = {
+      65536, (int)((double)info.max_alloc_bytes / 4.0 / 65536.0) + 2, 1.0, 1.0, 0.0, 0.0, 0, 0};
+  *g = huge;
+  return (double)huge.nx * huge.ny <= 4.0e9;
+}
 
 #endif

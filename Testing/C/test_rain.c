@@ -1060,11 +1060,8 @@ static void test_errors(void) {
 
   /* A grid whose buffers exceed the device's limits is refused before
    * anything is allocated. */
-  gr_device_info info;
-  CHECK(gr_context_device_info(ctx, &info) == GR_OK);
-  double floats = (double)info.max_alloc_bytes / 4.0;
-  gr_grid huge = {65536, (int)(floats / 65536.0) + 2, 1.0, 1.0, 0.0, 0.0, 0, 0};
-  if ((double)huge.nx * huge.ny <= 4.0e9) {
+  gr_grid huge;
+  if (gr_test_grid_beyond_device(ctx, &huge)) {
     s = NULL;
     gr_status st = gr_rain_runoff_create(ctx, &huge, &p, &s);
     CHECK_MSG(st == GR_ERR_TOO_LARGE || st == GR_ERR_OUT_OF_MEMORY, "%s: %s", gr_status_string(st),
