@@ -10,7 +10,7 @@
 #include "vtkStreamingDemandDrivenPipeline.h"
 
 #include "graupel/cl_runtime.h"
-#include "graupel/terrain_noise.h"
+#include "graupel/procedural_terrain.h"
 
 #include <algorithm>
 
@@ -49,8 +49,8 @@ int vtkProceduralTerrainSource::RequestData(vtkInformation *, vtkInformationVect
   outInfo->Get(vtkStreamingDemandDrivenPipeline::UPDATE_EXTENT(), extent);
   output->Initialize();
 
-  gr_terrain_noise_params p;
-  gr_terrain_noise_params_init(&p);
+  gr_procedural_terrain_params p;
+  gr_procedural_terrain_params_init(&p);
   p.seed = this->Seed;
   p.type = static_cast<gr_noise_type>(this->NoiseType);
   p.octaves = this->Octaves;
@@ -63,7 +63,7 @@ int vtkProceduralTerrainSource::RequestData(vtkInformation *, vtkInformationVect
   p.invert = this->Invert ? 1 : 0;
   p.height_scale = this->HeightScale;
   char msg[256];
-  if (gr_terrain_noise_params_validate(&p, msg, sizeof(msg)) != GR_OK) {
+  if (gr_procedural_terrain_params_validate(&p, msg, sizeof(msg)) != GR_OK) {
     vtkErrorMacro("Procedural Terrain: " << msg);
     return 0;
   }
@@ -86,8 +86,8 @@ int vtkProceduralTerrainSource::RequestData(vtkInformation *, vtkInformationVect
   }
   // The generator checks the grid against the device's limits before any
   // host memory is taken for the result.
-  gr_terrain_noise *noise = nullptr;
-  gr_status st = gr_terrain_noise_create(ctx, &grid, &p, &noise);
+  gr_procedural_terrain *noise = nullptr;
+  gr_status st = gr_procedural_terrain_create(ctx, &grid, &p, &noise);
   if (st != GR_OK) {
     return this->ReportFailure(st, "Procedural Terrain could not set up the noise");
   }
@@ -95,7 +95,7 @@ int vtkProceduralTerrainSource::RequestData(vtkInformation *, vtkInformationVect
   elevation->SetName("elevation");
   const vtkIdType npoints = static_cast<vtkIdType>(grid.nx) * grid.ny;
   if (!elevation->Allocate(npoints)) {
-    gr_terrain_noise_destroy(noise);
+    gr_procedural_terrain_destroy(noise);
     vtkErrorMacro("Procedural Terrain: out of host memory for "
                   << grid.nx << " x " << grid.ny << " points; use smaller Dimensions.");
     return 0;
@@ -107,13 +107,13 @@ int vtkProceduralTerrainSource::RequestData(vtkInformation *, vtkInformationVect
   this->UpdateProgress(0.0);
   for (int row = 0; row < grid.ny && st == GR_OK; row += band) {
     const int rows = std::min(band, grid.ny - row);
-    st = gr_terrain_noise_compute_rows(noise, row, rows);
+    st = gr_procedural_terrain_compute_rows(noise, row, rows);
     if (st == GR_OK) {
       st = gr_finish(ctx);
     }
     this->UpdateProgress(static_cast<double>(row + rows) / grid.ny);
     if (st == GR_OK && this->GetAbortExecute()) {
-      gr_terrain_noise_destroy(noise);
+      gr_procedural_terrain_destroy(noise);
       vtkWarningMacro("Procedural Terrain: the update was aborted; the output is empty.");
       // The abort is honoured: clear it, and mark the source modified so that
       // the next update computes the terrain again instead of keeping the
@@ -124,9 +124,9 @@ int vtkProceduralTerrainSource::RequestData(vtkInformation *, vtkInformationVect
     }
   }
   if (st == GR_OK) {
-    st = gr_terrain_noise_get_field(noise, GR_FIELD_ELEVATION, elevation->GetPointer(0));
+    st = gr_procedural_terrain_get_field(noise, GR_FIELD_ELEVATION, elevation->GetPointer(0));
   }
-  gr_terrain_noise_destroy(noise);
+  gr_procedural_terrain_destroy(noise);
   if (st != GR_OK) {
     return this->ReportFailure(st, "Procedural Terrain could not compute the noise");
   }

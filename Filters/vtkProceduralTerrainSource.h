@@ -10,7 +10,7 @@
  *
  * NoiseType 0 is the inverted ridged multifractal that seed 001 uses for
  * snow landscapes (rounded hills, river valleys); 1 is fBm (mountain ranges),
- * 2 is billow. The normalisation is in kernels/include/graupel/terrain_noise.h.
+ * 2 is billow. The normalisation is in kernels/include/graupel/procedural_terrain.h.
  */
 #ifndef vtkProceduralTerrainSource_h
 #define vtkProceduralTerrainSource_h

@@ -16,10 +16,10 @@ export CMAKE_PREFIX_PATH=/tmp/ocl/usr
 nvidia-smi --query-gpu=name,driver_version --format=csv,noheader | tee -a "$OUT/clinfo.txt"
 cmake -S kernels -B build-gpu -DCMAKE_BUILD_TYPE=Release >"$OUT/configure.log" 2>&1 &&
   cmake --build build-gpu -j"$(nproc)" >"$OUT/build.log" 2>&1 || { tail -40 "$OUT/build.log"; exit 1; }
-# The core tests on the GPU (test_terrain also compares the GPU with PoCL).
+# The core tests on the GPU (test_procedural_terrain also compares the GPU with PoCL).
 (cd build-gpu && GRAUPEL_DEVICE=gpu ctest -L core -LE memcheck --output-on-failure) \
   >"$OUT/ctest_gpu.log" 2>&1; tail -15 "$OUT/ctest_gpu.log"
-for core in ${CORES:-terrain_noise rain_runoff}; do
+for core in ${CORES:-procedural_terrain rain_runoff}; do
   for n in ${SIZES:-1024 2048 4096 8192}; do
     GRAUPEL_DEVICE=gpu build-gpu/graupel-bench --core "$core" --size "$n" --steps ${STEPS:-50} \
       2>&1 | tee -a "$OUT/bench_gpu.txt" | tail -1
@@ -28,5 +28,5 @@ for core in ${CORES:-terrain_noise rain_runoff}; do
     2>&1 | tee -a "$OUT/bench_pocl_host.txt" | tail -1
 done
 if [ -n "${SOAK:-}" ]; then
-  GRAUPEL_DEVICE=gpu build-gpu/Testing/C/test_soak rain "$SOAK" 2>&1 | tee "$OUT/soak_rain_gpu.txt" | tail -3
+  GRAUPEL_DEVICE=gpu build-gpu/Testing/C/test_soak rain_runoff "$SOAK" 2>&1 | tee "$OUT/soak_rain_gpu.txt" | tail -3
 fi

@@ -155,7 +155,7 @@ static void test_kernels(void) {
 
   /* Embedded sources: the shared header is inlined. */
   CHECK(gr_kernel_source_count() >= 2);
-  const char *tn = gr_kernel_source_find("terrain_noise");
+  const char *tn = gr_kernel_source_find("procedural_terrain");
   CHECK(tn != NULL);
   CHECK(tn && strstr(tn, "#include") == NULL);
   CHECK(tn && strstr(tn, "gr_hash_u32") != NULL);
@@ -164,8 +164,8 @@ static void test_kernels(void) {
 
   /* Programs are built once per context. */
   cl_program p1 = NULL, p2 = NULL;
-  CHECK(gr_program_get(ctx, "terrain_noise", NULL, &p1) == GR_OK);
-  CHECK(gr_program_get(ctx, "terrain_noise", "", &p2) == GR_OK);
+  CHECK(gr_program_get(ctx, "procedural_terrain", NULL, &p1) == GR_OK);
+  CHECK(gr_program_get(ctx, "procedural_terrain", "", &p2) == GR_OK);
   CHECK(p1 != NULL && p1 == p2);
   CHECK(gr_program_get(ctx, "unknown_core", NULL, &p2) == GR_ERR_INVALID_ARGUMENT);
   CHECK(is_sentence(gr_last_error(ctx)));

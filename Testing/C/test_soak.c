@@ -2,9 +2,9 @@
  *
  *   test_soak runtime N      N cycles of context, program, kernel and buffer
  *                            creation, use and release (private and shared)
- *   test_soak terrain N DIR  N terrain generations (random valid parameters)
+ *   test_soak procedural_terrain N DIR  N terrain generations (random valid parameters)
  *                            and EXR round trips of the result through DIR
- *   test_soak rain N         one rain runoff simulation stepped N times on a
+ *   test_soak rain_runoff N         one rain runoff simulation stepped N times on a
  *                            small random terrain, its parameters drawn anew
  *                            every 5000 steps; every 1000 steps the depth and
  *                            velocity must be finite (depth >= 0) and the
@@ -19,7 +19,7 @@
 #include "graupel/cl_runtime.h"
 #include "graupel/exr_io.h"
 #include "graupel/rain_runoff.h"
-#include "graupel/terrain_noise.h"
+#include "graupel/procedural_terrain.h"
 #include "gr_test.h"
 
 #include <math.h>
@@ -105,7 +105,7 @@ static void soak_runtime(long n) {
   CHECK_MSG(last - first < GR_SOAK_SLACK_KIB, "resident memory grew by %ld KiB", last - first);
 }
 
-static void soak_terrain(long n, const char *dir) {
+static void soak_procedural_terrain(long n, const char *dir) {
   gr_context *ctx = NULL;
   if (gr_context_acquire(NULL, &ctx) != GR_OK) {
     CHECK_MSG(0, "%s", gr_last_error(NULL));
@@ -123,8 +123,8 @@ static void soak_terrain(long n, const char *dir) {
                  uniform(-1e5, 1e5),
                  0,
                  0};
-    gr_terrain_noise_params p;
-    gr_terrain_noise_params_init(&p);
+    gr_procedural_terrain_params p;
+    gr_procedural_terrain_params_init(&p);
     p.seed = (int)uniform(-1e9, 1e9);
     p.type = (gr_noise_type)(int)uniform(0, 3);
     p.octaves = 1 + (int)uniform(0, 8);
@@ -138,7 +138,7 @@ static void soak_terrain(long n, const char *dir) {
     p.height_scale = uniform(0.0, 500.0);
     size_t cells = (size_t)g.nx * (size_t)g.ny;
     float *h = malloc(cells * sizeof(float));
-    gr_status st = gr_terrain_noise_generate(ctx, &g, &p, h);
+    gr_status st = gr_procedural_terrain_generate(ctx, &g, &p, h);
     CHECK_MSG(st == GR_OK, "cycle %ld: %s", c, gr_last_error(ctx));
     int bad = 0;
     for (size_t i = 0; i < cells; ++i)
@@ -184,7 +184,7 @@ static void random_rain_params(gr_rain_runoff_params *p) {
   p->boundary = uniform(0.0, 1.0) < 0.5 ? GR_BOUNDARY_OPEN : GR_BOUNDARY_CLOSED;
 }
 
-static void soak_rain(long n) {
+static void soak_rain_runoff(long n) {
   gr_context *ctx = NULL;
   if (gr_context_acquire(NULL, &ctx) != GR_OK) {
     CHECK_MSG(0, "%s", gr_last_error(NULL));
@@ -195,15 +195,15 @@ static void soak_rain(long n) {
   float *b = malloc(cells * sizeof(float));
   float *h = malloc(cells * sizeof(float));
   float *v = malloc(3 * cells * sizeof(float));
-  gr_terrain_noise_params tp;
-  gr_terrain_noise_params_init(&tp);
+  gr_procedural_terrain_params tp;
+  gr_procedural_terrain_params_init(&tp);
   tp.seed = 11;
   tp.frequency = 40.0;
   tp.height_scale = 5.0;
   gr_rain_runoff_params p;
   random_rain_params(&p);
   gr_rain_runoff *sim = NULL;
-  gr_status st = gr_terrain_noise_generate(ctx, &g, &tp, b);
+  gr_status st = gr_procedural_terrain_generate(ctx, &g, &tp, b);
   if (st == GR_OK)
     st = gr_rain_runoff_create(ctx, &g, &p, &sim);
   if (st == GR_OK)
@@ -280,7 +280,7 @@ static void soak_rain(long n) {
 
 int main(int argc, char **argv) {
   if (argc < 3) {
-    fprintf(stderr, "usage: test_soak runtime N | terrain N DIR | rain N\n");
+    fprintf(stderr, "usage: test_soak runtime N | procedural_terrain N DIR | rain_runoff N\n");
     return 2;
   }
   long n = atol(argv[2]);
@@ -290,12 +290,12 @@ int main(int argc, char **argv) {
   }
   if (strcmp(argv[1], "runtime") == 0)
     soak_runtime(n);
-  else if (strcmp(argv[1], "terrain") == 0 && argc > 3)
-    soak_terrain(n, argv[3]);
-  else if (strcmp(argv[1], "rain") == 0)
-    soak_rain(n);
+  else if (strcmp(argv[1], "procedural_terrain") == 0 && argc > 3)
+    soak_procedural_terrain(n, argv[3]);
+  else if (strcmp(argv[1], "rain_runoff") == 0)
+    soak_rain_runoff(n);
   else {
-    fprintf(stderr, "usage: test_soak runtime N | terrain N DIR | rain N\n");
+    fprintf(stderr, "usage: test_soak runtime N | procedural_terrain N DIR | rain_runoff N\n");
     return 2;
   }
   return GR_TEST_RESULT();

@@ -10,7 +10,7 @@
  * clock stops after one clFinish. */
 #include "graupel/cl_runtime.h"
 #include "graupel/rain_runoff.h"
-#include "graupel/terrain_noise.h"
+#include "graupel/procedural_terrain.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -104,15 +104,15 @@ typedef struct bench_core {
 
 static gr_status terrain_setup(gr_context *ctx, int n, void **state) {
   gr_grid g = {n, n, 2.0, 2.0, 0.0, 0.0};
-  gr_terrain_noise_params p;
-  gr_terrain_noise_params_init(&p);
-  return gr_terrain_noise_create(ctx, &g, &p, (gr_terrain_noise **)state);
+  gr_procedural_terrain_params p;
+  gr_procedural_terrain_params_init(&p);
+  return gr_procedural_terrain_create(ctx, &g, &p, (gr_procedural_terrain **)state);
 }
 static gr_status terrain_step(void *state) {
-  return gr_terrain_noise_compute(state);
+  return gr_procedural_terrain_compute(state);
 }
 static void terrain_teardown(void *state) {
-  gr_terrain_noise_destroy(state);
+  gr_procedural_terrain_destroy(state);
 }
 
 /* Rain runoff: a bowl tilted towards x = 0 (5 m deep over the grid's
@@ -197,7 +197,7 @@ static gr_status rain_report(void *state, gr_context *ctx) {
 }
 
 static const bench_core cores[] = {
-    {"terrain_noise", "procedural terrain, 6-octave inverted ridged multifractal (seed 001)",
+    {"procedural_terrain", "procedural terrain, 6-octave inverted ridged multifractal (seed 001)",
      terrain_setup, terrain_step, terrain_teardown, 4.0, NULL},
     /* Per cell and step, each array once per launch (neighbours come from
      * cache): flux reads depth, elevation, the old discharges and the

@@ -32,30 +32,30 @@
 #include "common.h"
 
 /* A face shallower than this carries no flow (m). */
-#define GR_RAIN_DRY 1.0e-6f
+#define GR_RAIN_RUNOFF_DRY 1.0e-6f
 
 /* Velocities are reported where a cell holds at least this much (m): a cell
  * that a step has just drained holds a film whose depth says nothing of
  * the flow that passed through it, and q / h there would be meaningless. */
-#define GR_RAIN_VELOCITY_DEPTH 1.0e-4f
+#define GR_RAIN_RUNOFF_VELOCITY_DEPTH 1.0e-4f
 
 /* The limiter leaves a cell this fraction short of empty, so that the float
  * rounding of the depth update can never take it below zero. */
-#define GR_RAIN_KEEP 0.999999f
+#define GR_RAIN_RUNOFF_KEEP 0.999999f
 
-GR_INLINE float gr_rain_input(__global const float *restrict field, int use_field, float uniform,
-                              int c) {
+GR_INLINE float gr_rain_runoff_input(__global const float *restrict field, int use_field,
+                                     float uniform, int c) {
   return use_field ? field[c] : uniform;
 }
 
 /* Depth after rain gain (h + r dt) and infiltration (at most k dt, never more
  * than the water there). */
-GR_INLINE float gr_rain_wet(float h, float r, float k, float dt) {
+GR_INLINE float gr_rain_runoff_wet(float h, float r, float k, float dt) {
   float h1 = h + r * dt;
   return h1 - fmin(k * dt, h1);
 }
 
-GR_INLINE float gr_rain_infiltration(float h, float r, float k, float dt) {
+GR_INLINE float gr_rain_runoff_infiltration(float h, float r, float k, float dt) {
   float h1 = h + r * dt;
   return fmin(k * dt, h1);
 }
@@ -65,7 +65,7 @@ GR_INLINE float gr_rain_infiltration(float h, float r, float k, float dt) {
  * relative), to the seventh power. Plain multiplications, unlike a library
  * cbrt or pow, which PoCL calls per work-item (the flux kernel was seven
  * times slower with cbrt); and the same answer on every IEEE device. */
-GR_INLINE float gr_rain_pow_m73(float x) {
+GR_INLINE float gr_rain_runoff_pow_m73(float x) {
   float y = as_float(0x54a21d2au - as_uint(x) / 3u);
   y = y * (4.0f - x * y * y * y) * (1.0f / 3.0f);
   y = y * (4.0f - x * y * y * y) * (1.0f / 3.0f);
@@ -76,7 +76,7 @@ GR_INLINE float gr_rain_pow_m73(float x) {
 
 /* q' from q'(1 + kf |q'|) = m: the friction taken implicitly, solved
  * exactly (and without cancellation). */
-GR_INLINE float gr_rain_solve(float m, float kf) {
+GR_INLINE float gr_rain_runoff_solve(float m, float kf) {
   return 2.0f * m / (1.0f + sqrt(1.0f + 4.0f * kf * fabs(m)));
 }
 
@@ -92,22 +92,22 @@ GR_INLINE float gr_rain_solve(float m, float kf) {
  * Where q' would flow against the surface slope (momentum carried over from
  * the neighbouring faces, e.g. across a nearly dry cell), m takes the face's
  * own q instead, as LISFLOOD-FP does. */
-GR_INLINE float gr_rain_face(float hL, float hR, float bL, float bR, float smooth, float own,
-                             float dt, float g, float n2, float inv_d) {
+GR_INLINE float gr_rain_runoff_face(float hL, float hR, float bL, float bR, float smooth, float own,
+                                    float dt, float g, float n2, float inv_d) {
   float db = bR - bL;
   float hf = db >= 0.0f ? fmax(hR, hL - db) : fmax(hL, hR + db);
   float deta = db + (hR - hL);
   float push = g * hf * dt * (deta * inv_d);
-  float hs = fmax(hf, GR_RAIN_DRY);
-  float kf = g * dt * n2 * gr_rain_pow_m73(hs);
-  float q = gr_rain_solve(smooth - push, kf);
-  q = q * deta > 0.0f ? gr_rain_solve(own - push, kf) : q;
-  return hf < GR_RAIN_DRY ? 0.0f : q;
+  float hs = fmax(hf, GR_RAIN_RUNOFF_DRY);
+  float kf = g * dt * n2 * gr_rain_runoff_pow_m73(hs);
+  float q = gr_rain_runoff_solve(smooth - push, kf);
+  q = q * deta > 0.0f ? gr_rain_runoff_solve(own - push, kf) : q;
+  return hf < GR_RAIN_RUNOFF_DRY ? 0.0f : q;
 }
 
 /* The discharge that flowed through a face: q* scaled by the limiter of the
  * cell it leaves. */
-GR_INLINE float gr_rain_limited(float q, float k_low, float k_high) {
+GR_INLINE float gr_rain_runoff_limited(float q, float k_low, float k_high) {
   return q * (q > 0.0f ? k_low : k_high);
 }
 
@@ -117,7 +117,8 @@ GR_INLINE float gr_rain_limited(float q, float k_low, float k_high) {
  * of the limited discharges of the face and its two neighbours in line.
  * Without it the scheme keeps ripples a few cells long on deep, smooth water
  * indefinitely. The grid's edge faces keep their own discharge. */
-GR_INLINE float gr_rain_smooth(float own, float before, float after, float theta, bool edge) {
+GR_INLINE float gr_rain_runoff_smooth(float own, float before, float after, float theta,
+                                      bool edge) {
   float smooth = theta * own + (1.0f - theta) * 0.5f * (before + after);
   return edge ? own : smooth;
 }
@@ -148,8 +149,8 @@ __kernel void rain_runoff_flux(__global const float *restrict h, __global const 
     return;
   int c = gr_idx(i, j, nx);
   bool in_c = i < nx && j < ny;
-  float hc = in_c ? gr_rain_wet(h[c], gr_rain_input(rain, use_rain, rain_uniform, c),
-                                gr_rain_input(perm, use_perm, perm_uniform, c), dt)
+  float hc = in_c ? gr_rain_runoff_wet(h[c], gr_rain_runoff_input(rain, use_rain, rain_uniform, c),
+                                       gr_rain_runoff_input(perm, use_perm, perm_uniform, c), dt)
                   : 0.0f;
   float bc = in_c ? b[c] : 0.0f;
   float kc = in_c ? limit[c] : 1.0f;
@@ -157,20 +158,22 @@ __kernel void rain_runoff_flux(__global const float *restrict h, __global const 
     /* Cell (i-1, j) is L, cell (i, j) is R; at the edges one is the ghost. */
     int w = c - 1;
     bool in_w = i > 0;
-    float hw = in_w ? gr_rain_wet(h[w], gr_rain_input(rain, use_rain, rain_uniform, w),
-                                  gr_rain_input(perm, use_perm, perm_uniform, w), dt)
-                    : 0.0f;
+    float hw = in_w
+                   ? gr_rain_runoff_wet(h[w], gr_rain_runoff_input(rain, use_rain, rain_uniform, w),
+                                        gr_rain_runoff_input(perm, use_perm, perm_uniform, w), dt)
+                   : 0.0f;
     float bw = in_w ? b[w] : 0.0f;
     float kw = in_w ? limit[w] : 1.0f;
     float hL = i == 0 ? 0.0f : hw, bL = i == 0 ? bc : bw;
     float hR = i == nx ? 0.0f : hc, bR = i == nx ? bw : bc;
     int f = j * (nx + 1) + i;
-    float own = gr_rain_limited(qx_old[f], kw, kc);
-    float before = i > 0 ? gr_rain_limited(qx_old[f - 1], i > 1 ? limit[c - 2] : 1.0f, kw) : 0.0f;
+    float own = gr_rain_runoff_limited(qx_old[f], kw, kc);
+    float before =
+        i > 0 ? gr_rain_runoff_limited(qx_old[f - 1], i > 1 ? limit[c - 2] : 1.0f, kw) : 0.0f;
     float after =
-        i < nx ? gr_rain_limited(qx_old[f + 1], kc, i < nx - 1 ? limit[c + 1] : 1.0f) : 0.0f;
-    float prev = gr_rain_smooth(own, before, after, theta, i == 0 || i == nx);
-    float q = gr_rain_face(hL, hR, bL, bR, prev, own, dt, g, n2, inv_dx);
+        i < nx ? gr_rain_runoff_limited(qx_old[f + 1], kc, i < nx - 1 ? limit[c + 1] : 1.0f) : 0.0f;
+    float prev = gr_rain_runoff_smooth(own, before, after, theta, i == 0 || i == nx);
+    float q = gr_rain_runoff_face(hL, hR, bL, bR, prev, own, dt, g, n2, inv_dx);
     if (i == 0)
       q = closed ? 0.0f : fmin(q, 0.0f);
     if (i == nx)
@@ -180,21 +183,23 @@ __kernel void rain_runoff_flux(__global const float *restrict h, __global const 
   if (i < nx) {
     int s = c - nx;
     bool in_s = j > 0;
-    float hs = in_s ? gr_rain_wet(h[s], gr_rain_input(rain, use_rain, rain_uniform, s),
-                                  gr_rain_input(perm, use_perm, perm_uniform, s), dt)
-                    : 0.0f;
+    float hs = in_s
+                   ? gr_rain_runoff_wet(h[s], gr_rain_runoff_input(rain, use_rain, rain_uniform, s),
+                                        gr_rain_runoff_input(perm, use_perm, perm_uniform, s), dt)
+                   : 0.0f;
     float bs = in_s ? b[s] : 0.0f;
     float ks = in_s ? limit[s] : 1.0f;
     float hL = j == 0 ? 0.0f : hs, bL = j == 0 ? bc : bs;
     float hR = j == ny ? 0.0f : hc, bR = j == ny ? bs : bc;
     int f = c; /* y-faces are numbered like cells, with one more row */
-    float own = gr_rain_limited(qy_old[f], ks, kc);
+    float own = gr_rain_runoff_limited(qy_old[f], ks, kc);
     float before =
-        j > 0 ? gr_rain_limited(qy_old[f - nx], j > 1 ? limit[c - 2 * nx] : 1.0f, ks) : 0.0f;
+        j > 0 ? gr_rain_runoff_limited(qy_old[f - nx], j > 1 ? limit[c - 2 * nx] : 1.0f, ks) : 0.0f;
     float after =
-        j < ny ? gr_rain_limited(qy_old[f + nx], kc, j < ny - 1 ? limit[c + nx] : 1.0f) : 0.0f;
-    float prev = gr_rain_smooth(own, before, after, theta, j == 0 || j == ny);
-    float q = gr_rain_face(hL, hR, bL, bR, prev, own, dt, g, n2, inv_dy);
+        j < ny ? gr_rain_runoff_limited(qy_old[f + nx], kc, j < ny - 1 ? limit[c + nx] : 1.0f)
+               : 0.0f;
+    float prev = gr_rain_runoff_smooth(own, before, after, theta, j == 0 || j == ny);
+    float q = gr_rain_runoff_face(hL, hR, bL, bR, prev, own, dt, g, n2, inv_dy);
     if (j == 0)
       q = closed ? 0.0f : fmin(q, 0.0f);
     if (j == ny)
@@ -204,7 +209,7 @@ __kernel void rain_runoff_flux(__global const float *restrict h, __global const 
 }
 
 /* K = min(1, depth / outgoing depth in dt), a little less when limiting (see
- * GR_RAIN_KEEP). Outgoing terms are summed in mirror-symmetric pairs. */
+ * GR_RAIN_RUNOFF_KEEP). Outgoing terms are summed in mirror-symmetric pairs. */
 __kernel void rain_runoff_limit(__global const float *restrict h,
                                 __global const float *restrict rain,
                                 __global const float *restrict perm,
@@ -216,19 +221,19 @@ __kernel void rain_runoff_limit(__global const float *restrict h,
   if (!gr_inside(i, j, nx, ny))
     return;
   int c = gr_idx(i, j, nx);
-  float wet = gr_rain_wet(h[c], gr_rain_input(rain, use_rain, rain_uniform, c),
-                          gr_rain_input(perm, use_perm, perm_uniform, c), dt);
+  float wet = gr_rain_runoff_wet(h[c], gr_rain_runoff_input(rain, use_rain, rain_uniform, c),
+                                 gr_rain_runoff_input(perm, use_perm, perm_uniform, c), dt);
   float qw = qx[j * (nx + 1) + i], qe = qx[j * (nx + 1) + i + 1];
   float qs = qy[j * nx + i], qn = qy[(j + 1) * nx + i];
   float out = dt * ((fmax(-qw, 0.0f) + fmax(qe, 0.0f)) * inv_dx +
                     (fmax(-qs, 0.0f) + fmax(qn, 0.0f)) * inv_dy);
-  limit[c] = out > wet ? wet / out * GR_RAIN_KEEP : 1.0f;
+  limit[c] = out > wet ? wet / out * GR_RAIN_RUNOFF_KEEP : 1.0f;
 }
 
 /* Kahan summation: *sum + *comp carries the running total to about twice
  * float precision over 10^5 steps and more. */
-GR_INLINE void gr_rain_kahan(__global float *restrict sum, __global float *restrict comp, int c,
-                             float x) {
+GR_INLINE void gr_rain_runoff_kahan(__global float *restrict sum, __global float *restrict comp,
+                                    int c, float x) {
   float s = sum[c];
   float y = x - comp[c];
   float t = s + y;
@@ -255,19 +260,19 @@ rain_runoff_update(__global float *restrict h, __global float *restrict h_comp,
   if (!gr_inside(i, j, nx, ny))
     return;
   int c = gr_idx(i, j, nx);
-  float r = gr_rain_input(rain, use_rain, rain_uniform, c);
-  float k = gr_rain_input(perm, use_perm, perm_uniform, c);
+  float r = gr_rain_runoff_input(rain, use_rain, rain_uniform, c);
+  float k = gr_rain_runoff_input(perm, use_perm, perm_uniform, c);
   float h0 = h[c];
-  float inf = gr_rain_infiltration(h0, r, k, dt);
+  float inf = gr_rain_runoff_infiltration(h0, r, k, dt);
   float kc = limit[c];
   /* Masked, not clamped, neighbours (see rain_runoff_flux): an edge face
    * never uses the limiter beyond the grid. */
   float kw = i > 0 ? limit[c - 1] : 1.0f, ke = i < nx - 1 ? limit[c + 1] : 1.0f;
   float ks = j > 0 ? limit[c - nx] : 1.0f, kn = j < ny - 1 ? limit[c + nx] : 1.0f;
-  float fw = gr_rain_limited(qx[j * (nx + 1) + i], kw, kc);
-  float fe = gr_rain_limited(qx[j * (nx + 1) + i + 1], kc, ke);
-  float fs = gr_rain_limited(qy[j * nx + i], ks, kc);
-  float fn = gr_rain_limited(qy[(j + 1) * nx + i], kc, kn);
+  float fw = gr_rain_runoff_limited(qx[j * (nx + 1) + i], kw, kc);
+  float fe = gr_rain_runoff_limited(qx[j * (nx + 1) + i + 1], kc, ke);
+  float fs = gr_rain_runoff_limited(qy[j * nx + i], ks, kc);
+  float fn = gr_rain_runoff_limited(qy[(j + 1) * nx + i], kc, kn);
   float delta = (r * dt - inf) + dt * ((fw - fe) * inv_dx + (fs - fn) * inv_dy);
   float y = delta - h_comp[c];
   float t = h0 + y;
@@ -277,21 +282,21 @@ rain_runoff_update(__global float *restrict h, __global float *restrict h_comp,
   h[c] = t > 0.0f ? t : 0.0f;
   h_comp[c] = t > 0.0f ? comp : 0.0f;
   if (inf != 0.0f)
-    gr_rain_kahan(infiltrated, infiltrated_comp, c, inf);
+    gr_rain_runoff_kahan(infiltrated, infiltrated_comp, c, inf);
   if (i == 0 || j == 0 || i == nx - 1 || j == ny - 1) {
     /* Edge faces carry outflow only (0 when closed). */
     float ow = i == 0 ? -fw : 0.0f, oe = i == nx - 1 ? fe : 0.0f;
     float os = j == 0 ? -fs : 0.0f, on = j == ny - 1 ? fn : 0.0f;
     float out = dt * ((ow + oe) * inv_dx + (os + on) * inv_dy);
     if (out != 0.0f)
-      gr_rain_kahan(outflow, outflow_comp, c, out);
+      gr_rain_runoff_kahan(outflow, outflow_comp, c, out);
   }
 }
 
 /* Double-float arithmetic (Knuth's TwoSum): hi + lo holds a sum to about
  * twice float precision, so that the ledger's volumes agree with the Kahan
  * sums per cell. */
-GR_INLINE void gr_rain_add2(float *hi, float *lo, float x) {
+GR_INLINE void gr_rain_runoff_add2(float *hi, float *lo, float x) {
   float s = *hi + x;
   float bb = s - *hi;
   float e = (*hi - (s - bb)) + (x - bb);
@@ -299,16 +304,16 @@ GR_INLINE void gr_rain_add2(float *hi, float *lo, float x) {
   *lo += e;
 }
 
-GR_INLINE void gr_rain_merge2(__local float *a, __local const float *b) {
+GR_INLINE void gr_rain_runoff_merge2(__local float *a, __local const float *b) {
   float hi = a[0], lo = a[1] + b[1];
-  gr_rain_add2(&hi, &lo, b[0]);
+  gr_rain_runoff_add2(&hi, &lo, b[0]);
   /* Renormalise (Fast2Sum) so lo stays small against hi. */
   float s = hi + lo;
   a[1] = lo - (s - hi);
   a[0] = s;
 }
 
-#define GR_RAIN_SLOTS 7
+#define GR_RAIN_RUNOFF_SLOTS 7
 
 /* One pass over the grid, a 1-D launch of whole work-groups: every work-item
  * sums a fixed set of cells, the group combines in local memory, and
@@ -330,15 +335,15 @@ __kernel void rain_runoff_reduce(
   float hmax = 0.0f;
   for (int c = start + lid; c < end; c += wg) {
     float d = h[c];
-    gr_rain_add2(&s_hi, &s_lo, d);
-    gr_rain_add2(&s_hi, &s_lo, -h_comp[c]);
-    gr_rain_add2(&i_hi, &i_lo, infiltrated[c]);
-    gr_rain_add2(&i_hi, &i_lo, -infiltrated_comp[c]);
-    gr_rain_add2(&o_hi, &o_lo, outflow[c]);
-    gr_rain_add2(&o_hi, &o_lo, -outflow_comp[c]);
+    gr_rain_runoff_add2(&s_hi, &s_lo, d);
+    gr_rain_runoff_add2(&s_hi, &s_lo, -h_comp[c]);
+    gr_rain_runoff_add2(&i_hi, &i_lo, infiltrated[c]);
+    gr_rain_runoff_add2(&i_hi, &i_lo, -infiltrated_comp[c]);
+    gr_rain_runoff_add2(&o_hi, &o_lo, outflow[c]);
+    gr_rain_runoff_add2(&o_hi, &o_lo, -outflow_comp[c]);
     hmax = fmax(hmax, d);
   }
-  __local float *mine = scratch + GR_RAIN_SLOTS * lid;
+  __local float *mine = scratch + GR_RAIN_RUNOFF_SLOTS * lid;
   mine[0] = s_hi;
   mine[1] = s_lo;
   mine[2] = i_hi;
@@ -349,21 +354,21 @@ __kernel void rain_runoff_reduce(
   barrier(CLK_LOCAL_MEM_FENCE);
   for (int span = wg / 2; span > 0; span /= 2) {
     if (lid < span) {
-      __local const float *other = scratch + GR_RAIN_SLOTS * (lid + span);
-      gr_rain_merge2(mine, other);
-      gr_rain_merge2(mine + 2, other + 2);
-      gr_rain_merge2(mine + 4, other + 4);
+      __local const float *other = scratch + GR_RAIN_RUNOFF_SLOTS * (lid + span);
+      gr_rain_runoff_merge2(mine, other);
+      gr_rain_runoff_merge2(mine + 2, other + 2);
+      gr_rain_runoff_merge2(mine + 4, other + 4);
       mine[6] = fmax(mine[6], other[6]);
     }
     barrier(CLK_LOCAL_MEM_FENCE);
   }
   if (lid == 0)
-    for (int s = 0; s < GR_RAIN_SLOTS; ++s)
-      partial[GR_RAIN_SLOTS * get_group_id(0) + s] = scratch[s];
+    for (int s = 0; s < GR_RAIN_RUNOFF_SLOTS; ++s)
+      partial[GR_RAIN_RUNOFF_SLOTS * get_group_id(0) + s] = scratch[s];
 }
 
 /* Fields derived on read, per cell: 0 water surface (b + h), 1 velocity
- * (3 components, m/s, 0 below GR_RAIN_VELOCITY_DEPTH), 2 discharge |q|
+ * (3 components, m/s, 0 below GR_RAIN_RUNOFF_VELOCITY_DEPTH), 2 discharge |q|
  * (m^2/s, cell-centred average of the faces), 3 infiltrated (cumulative,
  * m). */
 __kernel void rain_runoff_derive(__global const float *restrict h, __global const float *restrict b,
@@ -386,18 +391,19 @@ __kernel void rain_runoff_derive(__global const float *restrict h, __global cons
     return;
   }
   float kc = limit[c];
-  float fw = gr_rain_limited(qx[j * (nx + 1) + i], limit[gr_idx(max(i - 1, 0), j, nx)], kc);
-  float fe =
-      gr_rain_limited(qx[j * (nx + 1) + i + 1], kc, limit[gr_idx(min(i + 1, nx - 1), j, nx)]);
-  float fs = gr_rain_limited(qy[j * nx + i], limit[gr_idx(i, max(j - 1, 0), nx)], kc);
-  float fn = gr_rain_limited(qy[(j + 1) * nx + i], kc, limit[gr_idx(i, min(j + 1, ny - 1), nx)]);
+  float fw = gr_rain_runoff_limited(qx[j * (nx + 1) + i], limit[gr_idx(max(i - 1, 0), j, nx)], kc);
+  float fe = gr_rain_runoff_limited(qx[j * (nx + 1) + i + 1], kc,
+                                    limit[gr_idx(min(i + 1, nx - 1), j, nx)]);
+  float fs = gr_rain_runoff_limited(qy[j * nx + i], limit[gr_idx(i, max(j - 1, 0), nx)], kc);
+  float fn =
+      gr_rain_runoff_limited(qy[(j + 1) * nx + i], kc, limit[gr_idx(i, min(j + 1, ny - 1), nx)]);
   float u = 0.5f * (fw + fe), v = 0.5f * (fs + fn);
   if (what == 2) {
     out[c] = sqrt(u * u + v * v);
     return;
   }
   float d = h[c];
-  int wet = d >= GR_RAIN_VELOCITY_DEPTH;
+  int wet = d >= GR_RAIN_RUNOFF_VELOCITY_DEPTH;
   out[3 * c] = wet ? u / d : 0.0f;
   out[3 * c + 1] = wet ? v / d : 0.0f;
   out[3 * c + 2] = 0.0f;

@@ -12,26 +12,26 @@
 #include <string.h>
 
 /* Floats per work-group in the reduction's output (see rain_runoff_reduce). */
-#define GR_RAIN_SLOTS 7
+#define GR_RAIN_RUNOFF_SLOTS 7
 /* Work-groups of the reduction: enough to fill a GPU, few enough that the
  * host's final sum is instant. */
-#define GR_RAIN_REDUCE_GROUPS 256
-#define GR_RAIN_REDUCE_LOCAL 64
+#define GR_RAIN_RUNOFF_REDUCE_GROUPS 256
+#define GR_RAIN_RUNOFF_REDUCE_LOCAL 64
 /* Kernels index cells and faces with int: (nx+1)*(ny+1), with room to
  * spare, must stay below INT_MAX. */
-#define GR_RAIN_MAX_FACES ((double)INT_MAX - 1048576.0)
+#define GR_RAIN_RUNOFF_MAX_FACES ((double)INT_MAX - 1048576.0)
 /* Physical sanity bounds set_field adds to field_validate's (finite, and in
  * the parameters' ranges): beyond them float differences overflow. */
-#define GR_RAIN_MAX_ELEVATION 1.0e6
-#define GR_RAIN_MAX_DEPTH 1.0e4
-#define GR_RAIN_MAX_DT 3600.0
-#define GR_RAIN_MIN_DT 1.0e-30
+#define GR_RAIN_RUNOFF_MAX_ELEVATION 1.0e6
+#define GR_RAIN_RUNOFF_MAX_DEPTH 1.0e4
+#define GR_RAIN_RUNOFF_MAX_DT 3600.0
+#define GR_RAIN_RUNOFF_MIN_DT 1.0e-30
 /* The weight of a face's own previous discharge against its neighbours'
  * (de Almeida et al. 2012; 1 is Bates et al. 2010 unchanged). */
-#define GR_RAIN_THETA 0.8
+#define GR_RAIN_RUNOFF_THETA 0.8
 /* advance re-reads the stable step after 4 to 64 steps. */
-#define GR_RAIN_CHUNK_MIN 4
-#define GR_RAIN_CHUNK_MAX 64
+#define GR_RAIN_RUNOFF_CHUNK_MIN 4
+#define GR_RAIN_RUNOFF_CHUNK_MAX 64
 
 struct gr_rain_runoff {
   gr_context *ctx;
@@ -84,7 +84,7 @@ gr_status gr_rain_runoff_params_validate(const gr_rain_runoff_params *p, char *m
     why = "ManningN must lie between 0.005 and 1 s/m^(1/3)";
   else if (!(p->cfl > 0.0) || p->cfl > 1.0)
     why = "CourantNumber (cfl) must be above 0 and at most 1";
-  else if (!(p->max_dt > 0.0) || p->max_dt > GR_RAIN_MAX_DT)
+  else if (!(p->max_dt > 0.0) || p->max_dt > GR_RAIN_RUNOFF_MAX_DT)
     why = "MaxTimeStep must be above 0 and at most 3600 s";
   else if (p->boundary != GR_BOUNDARY_OPEN && p->boundary != GR_BOUNDARY_CLOSED)
     why = "Boundary must be 0 (open) or 1 (closed)";
@@ -95,23 +95,23 @@ gr_status gr_rain_runoff_params_validate(const gr_rain_runoff_params *p, char *m
   return GR_ERR_INVALID_ARGUMENT;
 }
 
-static const char *gr_rain_field_label(gr_field f) {
+static const char *gr_rain_runoff_field_label(gr_field f) {
   const char *name = gr_field_name(f);
   return name ? name : "(unknown field)";
 }
 
 /* field_validate's checks; with nx > 0 the bad value is named by its cell
  * (i, j), otherwise by its index. strict adds set_field's sanity bounds. */
-static gr_status gr_rain_field_check(gr_field f, const float *values, size_t n, size_t nx,
-                                     int strict, char *msg, size_t msg_len) {
+static gr_status gr_rain_runoff_field_check(gr_field f, const float *values, size_t n, size_t nx,
+                                            int strict, char *msg, size_t msg_len) {
   const char *rule = NULL;
   double lo = -HUGE_VAL, hi = HUGE_VAL;
   switch (f) {
   case GR_FIELD_ELEVATION:
     rule = strict ? "elevations must be finite and within +-1e6 m" : "elevations must be finite";
     if (strict) {
-      lo = -GR_RAIN_MAX_ELEVATION;
-      hi = GR_RAIN_MAX_ELEVATION;
+      lo = -GR_RAIN_RUNOFF_MAX_ELEVATION;
+      hi = GR_RAIN_RUNOFF_MAX_ELEVATION;
     }
     break;
   case GR_FIELD_WATER_DEPTH:
@@ -119,7 +119,7 @@ static gr_status gr_rain_field_check(gr_field f, const float *values, size_t n, 
                   : "depths must be finite and at least 0 m";
     lo = 0.0;
     if (strict)
-      hi = GR_RAIN_MAX_DEPTH;
+      hi = GR_RAIN_RUNOFF_MAX_DEPTH;
     break;
   case GR_FIELD_PERMEABILITY:
     rule = "permeabilities must lie between 0 and 0.01 m/s, like Permeability";
@@ -136,12 +136,13 @@ static gr_status gr_rain_field_check(gr_field f, const float *values, size_t n, 
       snprintf(msg, msg_len,
                "The field '%s' is not an input of the rain runoff simulation; its inputs are "
                "elevation, water_depth, permeability and rain_rate.",
-               gr_rain_field_label(f));
+               gr_rain_runoff_field_label(f));
     return GR_ERR_INVALID_ARGUMENT;
   }
   if (!values) {
     if (msg && msg_len)
-      snprintf(msg, msg_len, "No values were given for the field '%s'.", gr_rain_field_label(f));
+      snprintf(msg, msg_len, "No values were given for the field '%s'.",
+               gr_rain_runoff_field_label(f));
     return GR_ERR_INVALID_ARGUMENT;
   }
   for (size_t c = 0; c < n; ++c) {
@@ -151,11 +152,11 @@ static gr_status gr_rain_field_check(gr_field f, const float *values, size_t n, 
     if (msg && msg_len) {
       if (nx > 0)
         snprintf(msg, msg_len, "The field '%s' has the value %g at cell (%zu, %zu): %s.",
-                 gr_rain_field_label(f), v, c % nx, c / nx, rule);
+                 gr_rain_runoff_field_label(f), v, c % nx, c / nx, rule);
       else
         snprintf(msg, msg_len,
                  "The field '%s' has the value %g at index %zu (row-major, x fastest): %s.",
-                 gr_rain_field_label(f), v, c, rule);
+                 gr_rain_runoff_field_label(f), v, c, rule);
     }
     return GR_ERR_INVALID_ARGUMENT;
   }
@@ -164,16 +165,16 @@ static gr_status gr_rain_field_check(gr_field f, const float *values, size_t n, 
 
 gr_status gr_rain_runoff_field_validate(gr_field f, const float *values, size_t n, char *msg,
                                         size_t msg_len) {
-  return gr_rain_field_check(f, values, n, 0, 0, msg, msg_len);
+  return gr_rain_runoff_field_check(f, values, n, 0, 0, msg, msg_len);
 }
 
 /* ----------------------------------------------------------- device state */
 
-static size_t gr_rain_cells(const gr_rain_runoff *s) {
+static size_t gr_rain_runoff_cells(const gr_rain_runoff *s) {
   return (size_t)s->grid.nx * (size_t)s->grid.ny;
 }
 
-static gr_status gr_rain_fill(gr_rain_runoff *s, cl_mem buf, float value, size_t bytes) {
+static gr_status gr_rain_runoff_fill(gr_rain_runoff *s, cl_mem buf, float value, size_t bytes) {
   return gr_cl_check(s->ctx,
                      clEnqueueFillBuffer(gr_context_queue(s->ctx), buf, &value, sizeof(value), 0,
                                          bytes, 0, NULL, NULL),
@@ -181,27 +182,27 @@ static gr_status gr_rain_fill(gr_rain_runoff *s, cl_mem buf, float value, size_t
 }
 
 /* Discharges none, limiters 1 (nothing was limited). */
-static gr_status gr_rain_clear_flow(gr_rain_runoff *s) {
+static gr_status gr_rain_runoff_clear_flow(gr_rain_runoff *s) {
   size_t nx = (size_t)s->grid.nx, ny = (size_t)s->grid.ny;
   gr_status st = GR_OK;
   for (int a = 0; a < 2 && st == GR_OK; ++a) {
-    st = gr_rain_fill(s, s->qx[a], 0.0f, (nx + 1) * ny * sizeof(float));
+    st = gr_rain_runoff_fill(s, s->qx[a], 0.0f, (nx + 1) * ny * sizeof(float));
     if (st == GR_OK)
-      st = gr_rain_fill(s, s->qy[a], 0.0f, nx * (ny + 1) * sizeof(float));
+      st = gr_rain_runoff_fill(s, s->qy[a], 0.0f, nx * (ny + 1) * sizeof(float));
   }
   if (st == GR_OK)
-    st = gr_rain_fill(s, s->k, 1.0f, nx * ny * sizeof(float));
+    st = gr_rain_runoff_fill(s, s->k, 1.0f, nx * ny * sizeof(float));
   return st;
 }
 
 /* Sums the stored, infiltrated and outflow depths over the cells (m, so
  * times dx dy for m^3) and finds the deepest cell. */
-static gr_status gr_rain_reduce(gr_rain_runoff *s, double sums[3], double *max_depth) {
-  cl_int n = (cl_int)gr_rain_cells(s);
+static gr_status gr_rain_runoff_reduce(gr_rain_runoff *s, double sums[3], double *max_depth) {
+  cl_int n = (cl_int)gr_rain_runoff_cells(s);
   const size_t m = sizeof(cl_mem);
   gr_status st = gr_kernel_args(s->ctx, s->reduce, m, &s->h, m, &s->h_c, m, &s->inf, m, &s->inf_c,
                                 m, &s->out, m, &s->out_c, m, &s->partial,
-                                s->reduce_local * GR_RAIN_SLOTS * sizeof(cl_float), NULL,
+                                s->reduce_local * GR_RAIN_RUNOFF_SLOTS * sizeof(cl_float), NULL,
                                 sizeof(cl_int), &n, (size_t)0);
   if (st != GR_OK)
     return st;
@@ -211,13 +212,14 @@ static gr_status gr_rain_reduce(gr_rain_runoff *s, double sums[3], double *max_d
                                           &s->reduce_local, 0, NULL, NULL),
                    "Enqueueing the rain runoff reduction");
   if (st == GR_OK)
-    st = gr_buffer_read(s->ctx, s->partial, 0, s->reduce_groups * GR_RAIN_SLOTS * sizeof(cl_float),
-                        s->partial_host);
+    st =
+        gr_buffer_read(s->ctx, s->partial, 0,
+                       s->reduce_groups * GR_RAIN_RUNOFF_SLOTS * sizeof(cl_float), s->partial_host);
   if (st != GR_OK)
     return st;
   double acc[3] = {0.0, 0.0, 0.0}, hmax = 0.0;
   for (size_t grp = 0; grp < s->reduce_groups; ++grp) {
-    const float *p = s->partial_host + GR_RAIN_SLOTS * grp;
+    const float *p = s->partial_host + GR_RAIN_RUNOFF_SLOTS * grp;
     for (int q = 0; q < 3; ++q)
       acc[q] += (double)p[2 * q] + (double)p[2 * q + 1];
     hmax = p[6] > hmax ? p[6] : hmax;
@@ -244,7 +246,7 @@ gr_status gr_rain_runoff_create(gr_context *ctx, const gr_grid *grid,
     return gr_set_error(ctx, GR_ERR_INVALID_ARGUMENT, "%s", msg);
 
   size_t nx = (size_t)grid->nx, ny = (size_t)grid->ny, cells = nx * ny;
-  if (((double)nx + 1.0) * ((double)ny + 1.0) > GR_RAIN_MAX_FACES)
+  if (((double)nx + 1.0) * ((double)ny + 1.0) > GR_RAIN_RUNOFF_MAX_FACES)
     return gr_set_error(ctx, GR_ERR_TOO_LARGE,
                         "The rain runoff grid of %zu x %zu points is too large: the kernels "
                         "address at most about 2.1e9 faces; split the domain or coarsen it.",
@@ -302,26 +304,28 @@ gr_status gr_rain_runoff_create(gr_context *ctx, const gr_grid *grid,
                                           CL_KERNEL_WORK_GROUP_SIZE, sizeof(kmax), &kmax, NULL);
     st = gr_cl_check(ctx, err, "Querying the reduction's work-group size");
     s->reduce_local = 1;
-    while (s->reduce_local * 2 <= GR_RAIN_REDUCE_LOCAL && s->reduce_local * 2 <= kmax)
+    while (s->reduce_local * 2 <= GR_RAIN_RUNOFF_REDUCE_LOCAL && s->reduce_local * 2 <= kmax)
       s->reduce_local *= 2;
     s->reduce_groups = (cells + s->reduce_local - 1) / s->reduce_local;
-    if (s->reduce_groups > GR_RAIN_REDUCE_GROUPS)
-      s->reduce_groups = GR_RAIN_REDUCE_GROUPS;
+    if (s->reduce_groups > GR_RAIN_RUNOFF_REDUCE_GROUPS)
+      s->reduce_groups = GR_RAIN_RUNOFF_REDUCE_GROUPS;
   }
   if (st == GR_OK)
     st = gr_buffer_create(ctx, CL_MEM_WRITE_ONLY,
-                          s->reduce_groups * GR_RAIN_SLOTS * sizeof(cl_float), NULL, &s->partial);
+                          s->reduce_groups * GR_RAIN_RUNOFF_SLOTS * sizeof(cl_float), NULL,
+                          &s->partial);
   if (st == GR_OK) {
-    s->partial_host = malloc(s->reduce_groups * GR_RAIN_SLOTS * sizeof(float));
+    s->partial_host = malloc(s->reduce_groups * GR_RAIN_RUNOFF_SLOTS * sizeof(float));
     if (!s->partial_host)
       st = gr_set_error(ctx, GR_ERR_OUT_OF_MEMORY, "Out of host memory.");
   }
   /* Dry, flat ground; nothing infiltrated or gone. */
   cl_mem *zeroed[] = {&s->h, &s->h_c, &s->b, &s->inf, &s->inf_c, &s->out, &s->out_c, &s->dummy};
   for (size_t i = 0; st == GR_OK && i < sizeof(zeroed) / sizeof(zeroed[0]); ++i)
-    st = gr_rain_fill(s, *zeroed[i], 0.0f, *zeroed[i] == s->dummy ? sizeof(cl_float) : bytes);
+    st =
+        gr_rain_runoff_fill(s, *zeroed[i], 0.0f, *zeroed[i] == s->dummy ? sizeof(cl_float) : bytes);
   if (st == GR_OK)
-    st = gr_rain_clear_flow(s);
+    st = gr_rain_runoff_clear_flow(s);
   if (st == GR_OK)
     st = gr_finish(ctx);
   if (st != GR_OK) {
@@ -361,8 +365,8 @@ gr_status gr_rain_runoff_set_params(gr_rain_runoff *s, const gr_rain_runoff_para
 }
 
 /* Uploads into *buf, allocating it on first use. */
-static gr_status gr_rain_upload(gr_rain_runoff *s, cl_mem *buf, const float *host) {
-  size_t bytes = gr_rain_cells(s) * sizeof(cl_float);
+static gr_status gr_rain_runoff_upload(gr_rain_runoff *s, cl_mem *buf, const float *host) {
+  size_t bytes = gr_rain_runoff_cells(s) * sizeof(cl_float);
   if (!*buf)
     return gr_buffer_create(s->ctx, CL_MEM_READ_WRITE, bytes, host, buf);
   return gr_buffer_write(s->ctx, *buf, 0, bytes, host);
@@ -373,8 +377,8 @@ gr_status gr_rain_runoff_set_field(gr_rain_runoff *s, gr_field f, const float *h
   if (!s || !host)
     return gr_set_error(s ? s->ctx : NULL, GR_ERR_INVALID_ARGUMENT,
                         "gr_rain_runoff_set_field needs a simulation and the field's values.");
-  size_t cells = gr_rain_cells(s);
-  if (gr_rain_field_check(f, host, cells, (size_t)s->grid.nx, 1, msg, sizeof(msg)) != GR_OK)
+  size_t cells = gr_rain_runoff_cells(s);
+  if (gr_rain_runoff_field_check(f, host, cells, (size_t)s->grid.nx, 1, msg, sizeof(msg)) != GR_OK)
     return gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT, "%s", msg);
   gr_status st = GR_OK;
   switch (f) {
@@ -382,7 +386,7 @@ gr_status gr_rain_runoff_set_field(gr_rain_runoff *s, gr_field f, const float *h
     st = gr_buffer_write(s->ctx, s->b, 0, cells * sizeof(cl_float), host);
     break;
   case GR_FIELD_PERMEABILITY:
-    st = gr_rain_upload(s, &s->perm, host);
+    st = gr_rain_runoff_upload(s, &s->perm, host);
     if (st == GR_OK)
       s->has_perm = 1;
     break;
@@ -390,7 +394,7 @@ gr_status gr_rain_runoff_set_field(gr_rain_runoff *s, gr_field f, const float *h
     double sum = 0.0;
     for (size_t c = 0; c < cells; ++c)
       sum += host[c];
-    st = gr_rain_upload(s, &s->rain, host);
+    st = gr_rain_runoff_upload(s, &s->rain, host);
     if (st == GR_OK) {
       s->has_rain = 1;
       s->rain_field_sum = sum;
@@ -403,15 +407,15 @@ gr_status gr_rain_runoff_set_field(gr_rain_runoff *s, gr_field f, const float *h
     double now[3], sum = 0.0;
     for (size_t c = 0; c < cells; ++c)
       sum += host[c];
-    st = gr_rain_reduce(s, now, NULL);
+    st = gr_rain_runoff_reduce(s, now, NULL);
     if (st == GR_OK)
-      st = gr_rain_upload(s, &s->h0, host);
+      st = gr_rain_runoff_upload(s, &s->h0, host);
     if (st == GR_OK)
       st = gr_buffer_write(s->ctx, s->h, 0, cells * sizeof(cl_float), host);
     if (st == GR_OK)
-      st = gr_rain_fill(s, s->h_c, 0.0f, cells * sizeof(cl_float));
+      st = gr_rain_runoff_fill(s, s->h_c, 0.0f, cells * sizeof(cl_float));
     if (st == GR_OK)
-      st = gr_rain_clear_flow(s);
+      st = gr_rain_runoff_clear_flow(s);
     if (st == GR_OK) {
       s->initial_sum = sum;
       s->initial_volume += (sum - now[0]) * s->grid.dx * s->grid.dy;
@@ -419,7 +423,7 @@ gr_status gr_rain_runoff_set_field(gr_rain_runoff *s, gr_field f, const float *h
     break;
   }
   default:
-    break; /* refused by gr_rain_field_check */
+    break; /* refused by gr_rain_runoff_field_check */
   }
   return st;
 }
@@ -429,7 +433,7 @@ gr_status gr_rain_runoff_set_field(gr_rain_runoff *s, gr_field f, const float *h
 gr_status gr_rain_runoff_step(gr_rain_runoff *s, double dt, int nsteps) {
   if (!s)
     return gr_set_error(NULL, GR_ERR_INVALID_ARGUMENT, "gr_rain_runoff_step needs a simulation.");
-  if (!(dt >= GR_RAIN_MIN_DT && dt <= GR_RAIN_MAX_DT))
+  if (!(dt >= GR_RAIN_RUNOFF_MIN_DT && dt <= GR_RAIN_RUNOFF_MAX_DT))
     return gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
                         "The time step dt must lie between 1e-30 and 3600 s (got %g s).", dt);
   if (nsteps < 0)
@@ -448,7 +452,7 @@ gr_status gr_rain_runoff_step(gr_rain_runoff *s, double dt, int nsteps) {
   cl_float rain_u = (cl_float)p->rain_rate, perm_u = (cl_float)p->permeability;
   cl_int closed = p->boundary == GR_BOUNDARY_CLOSED;
   cl_mem rain = s->has_rain ? s->rain : s->dummy, perm = s->has_perm ? s->perm : s->dummy;
-  cl_float theta = (cl_float)GR_RAIN_THETA;
+  cl_float theta = (cl_float)GR_RAIN_RUNOFF_THETA;
   const size_t m = sizeof(cl_mem), fl = sizeof(cl_float), in = sizeof(cl_int);
   /* Every argument but the alternating face arrays (set per step below). */
   gr_status st =
@@ -490,8 +494,8 @@ gr_status gr_rain_runoff_step(gr_rain_runoff *s, double dt, int nsteps) {
   }
   /* The ledger counts the steps whose launches were all enqueued, with the
    * rain the device added: the float dt it was given. */
-  double rain_sum =
-      s->has_rain ? s->rain_field_sum : (double)gr_rain_cells(s) * (double)(cl_float)p->rain_rate;
+  double rain_sum = s->has_rain ? s->rain_field_sum
+                                : (double)gr_rain_runoff_cells(s) * (double)(cl_float)p->rain_rate;
   s->rain_volume += rain_sum * gd->dx * gd->dy * (double)dtf * (double)done;
   s->time += dt * (double)done;
   s->steps += done;
@@ -503,7 +507,7 @@ gr_status gr_rain_runoff_stable_dt(gr_rain_runoff *s, double *dt) {
     return gr_set_error(s ? s->ctx : NULL, GR_ERR_INVALID_ARGUMENT,
                         "gr_rain_runoff_stable_dt needs a simulation and a place for dt.");
   double sums[3], hmax = 0.0;
-  gr_status st = gr_rain_reduce(s, sums, &hmax);
+  gr_status st = gr_rain_runoff_reduce(s, sums, &hmax);
   if (st != GR_OK)
     return st;
   /* The scheme's stability limit in 2-D for gravity waves, c = sqrt(g h)
@@ -517,7 +521,8 @@ gr_status gr_rain_runoff_stable_dt(gr_rain_runoff *s, double *dt) {
    * step has just drained would shrink the step for nothing. */
   double c = sqrt(GR_GRAVITY * hmax);
   double inv = sqrt(1.0 / (s->grid.dx * s->grid.dx) + 1.0 / (s->grid.dy * s->grid.dy));
-  double stable = c > 0.0 ? s->params.cfl * sqrt(GR_RAIN_THETA) / (c * inv) : s->params.max_dt;
+  double stable =
+      c > 0.0 ? s->params.cfl * sqrt(GR_RAIN_RUNOFF_THETA) / (c * inv) : s->params.max_dt;
   *dt = stable < s->params.max_dt ? stable : s->params.max_dt;
   return GR_OK;
 }
@@ -536,13 +541,13 @@ gr_status gr_rain_runoff_advance(gr_rain_runoff *s, double duration, int *steps_
   /* The stable step is read back again after a few steps, not once: rain
    * filling a dry bowl deepens it, and a step that was stable at the start
    * of a long advance is not by its end. The stretch between reads starts
-   * at GR_RAIN_CHUNK_MIN steps and doubles (to GR_RAIN_CHUNK_MAX) while the
+   * at GR_RAIN_RUNOFF_CHUNK_MIN steps and doubles (to GR_RAIN_RUNOFF_CHUNK_MAX) while the
    * stable step holds; the last stretch is split into equal steps that end
    * exactly at the duration. All of it depends on the state only, so the
    * same state and duration give the same steps. */
   double left = duration, last_dt = 0.0;
   long long taken = 0;
-  int chunk = GR_RAIN_CHUNK_MIN;
+  int chunk = GR_RAIN_RUNOFF_CHUNK_MIN;
   gr_status st = GR_OK;
   while (st == GR_OK && left > 0.0) {
     double dt = 0.0;
@@ -550,8 +555,9 @@ gr_status gr_rain_runoff_advance(gr_rain_runoff *s, double duration, int *steps_
     if (st != GR_OK)
       break;
     if (last_dt > 0.0)
-      chunk = dt >= 0.95 * last_dt ? (chunk * 2 < GR_RAIN_CHUNK_MAX ? chunk * 2 : GR_RAIN_CHUNK_MAX)
-                                   : GR_RAIN_CHUNK_MIN;
+      chunk = dt >= 0.95 * last_dt
+                  ? (chunk * 2 < GR_RAIN_RUNOFF_CHUNK_MAX ? chunk * 2 : GR_RAIN_RUNOFF_CHUNK_MAX)
+                  : GR_RAIN_RUNOFF_CHUNK_MIN;
     last_dt = dt;
     double n = ceil(left / dt);
     if (n < 1.0)
@@ -584,8 +590,8 @@ gr_status gr_rain_runoff_advance(gr_rain_runoff *s, double duration, int *steps_
 
 /* Runs the derive kernel (what: 0 surface, 1 velocity, 2 discharge, 3
  * infiltrated) into the scratch buffer and reads `floats` values back. */
-static gr_status gr_rain_derive(gr_rain_runoff *s, cl_int what, size_t floats, float *host) {
-  size_t cells = gr_rain_cells(s);
+static gr_status gr_rain_runoff_derive(gr_rain_runoff *s, cl_int what, size_t floats, float *host) {
+  size_t cells = gr_rain_runoff_cells(s);
   gr_status st = GR_OK;
   if (!s->scratch)
     st = gr_buffer_create(s->ctx, CL_MEM_READ_WRITE, 3 * cells * sizeof(cl_float), NULL,
@@ -607,7 +613,7 @@ gr_status gr_rain_runoff_get_field(gr_rain_runoff *s, gr_field f, float *host) {
   if (!s || !host)
     return gr_set_error(s ? s->ctx : NULL, GR_ERR_INVALID_ARGUMENT,
                         "gr_rain_runoff_get_field needs a simulation and room for the field.");
-  size_t cells = gr_rain_cells(s), bytes = cells * sizeof(cl_float);
+  size_t cells = gr_rain_runoff_cells(s), bytes = cells * sizeof(cl_float);
   switch (f) {
   case GR_FIELD_WATER_DEPTH:
     return gr_buffer_read(s->ctx, s->h, 0, bytes, host);
@@ -624,19 +630,19 @@ gr_status gr_rain_runoff_get_field(gr_rain_runoff *s, gr_field f, float *host) {
     return GR_OK;
   }
   case GR_FIELD_WATER_SURFACE:
-    return gr_rain_derive(s, 0, cells, host);
+    return gr_rain_runoff_derive(s, 0, cells, host);
   case GR_FIELD_VELOCITY:
-    return gr_rain_derive(s, 1, 3 * cells, host);
+    return gr_rain_runoff_derive(s, 1, 3 * cells, host);
   case GR_FIELD_DISCHARGE:
-    return gr_rain_derive(s, 2, cells, host);
+    return gr_rain_runoff_derive(s, 2, cells, host);
   case GR_FIELD_INFILTRATED:
-    return gr_rain_derive(s, 3, cells, host);
+    return gr_rain_runoff_derive(s, 3, cells, host);
   default:
     return gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
                         "The rain runoff simulation has no field '%s'; it has elevation, "
                         "water_depth, water_surface, velocity, discharge, infiltrated, "
                         "permeability and rain_rate.",
-                        gr_rain_field_label(f));
+                        gr_rain_runoff_field_label(f));
   }
 }
 
@@ -645,7 +651,7 @@ gr_status gr_rain_runoff_ledger_get(gr_rain_runoff *s, gr_rain_runoff_ledger *ou
     return gr_set_error(s ? s->ctx : NULL, GR_ERR_INVALID_ARGUMENT,
                         "gr_rain_runoff_ledger_get needs a simulation and a ledger to fill.");
   double sums[3], hmax = 0.0;
-  gr_status st = gr_rain_reduce(s, sums, &hmax);
+  gr_status st = gr_rain_runoff_reduce(s, sums, &hmax);
   if (st != GR_OK)
     return st;
   double area = s->grid.dx * s->grid.dy;
@@ -666,7 +672,7 @@ gr_status gr_rain_runoff_ledger_get(gr_rain_runoff *s, gr_rain_runoff_ledger *ou
 gr_status gr_rain_runoff_reset(gr_rain_runoff *s) {
   if (!s)
     return gr_set_error(NULL, GR_ERR_INVALID_ARGUMENT, "gr_rain_runoff_reset needs a simulation.");
-  size_t bytes = gr_rain_cells(s) * sizeof(cl_float);
+  size_t bytes = gr_rain_runoff_cells(s) * sizeof(cl_float);
   gr_status st;
   if (s->h0)
     st = gr_cl_check(
@@ -674,12 +680,12 @@ gr_status gr_rain_runoff_reset(gr_rain_runoff *s) {
         clEnqueueCopyBuffer(gr_context_queue(s->ctx), s->h0, s->h, 0, 0, bytes, 0, NULL, NULL),
         "Copying the initial water depth");
   else
-    st = gr_rain_fill(s, s->h, 0.0f, bytes);
+    st = gr_rain_runoff_fill(s, s->h, 0.0f, bytes);
   cl_mem zeroed[] = {s->h_c, s->inf, s->inf_c, s->out, s->out_c};
   for (size_t i = 0; st == GR_OK && i < sizeof(zeroed) / sizeof(zeroed[0]); ++i)
-    st = gr_rain_fill(s, zeroed[i], 0.0f, bytes);
+    st = gr_rain_runoff_fill(s, zeroed[i], 0.0f, bytes);
   if (st == GR_OK)
-    st = gr_rain_clear_flow(s);
+    st = gr_rain_runoff_clear_flow(s);
   if (st != GR_OK)
     return st;
   s->time = 0.0;

@@ -45,7 +45,7 @@ GR_API gr_status gr_set_error(const gr_context *ctx, gr_status st, const char *f
 GR_API gr_status gr_cl_check(const gr_context *ctx, cl_int err, const char *what);
 
 /**
- * The program for an embedded kernel source ("terrain_noise", "bench", ...),
+ * The program for an embedded kernel source ("procedural_terrain", "bench", ...),
  * built once per context and options and cached there. The program stays
  * owned by the context: do not release it. A failed build gives GR_ERR_BUILD
  * and the build log in gr_last_error.

@@ -1,6 +1,6 @@
 /* Procedural terrain (seed 001, notes/001_003.md A.2.1): 2-D gradient noise
  * summed over octaves as fBm, billow or (inverted) ridged multifractal. The
- * normalisation is documented in graupel/terrain_noise.h. */
+ * normalisation is documented in graupel/procedural_terrain.h. */
 #include "common.h"
 
 /* 16 unit gradients at multiples of 22.5 degrees, as separate x and y
@@ -36,7 +36,7 @@ GR_INLINE float gr_gradient_noise(int ix, int iy, float fx, float fy, uint seed)
   return clamp(n, -1.0f, 1.0f);
 }
 
-/* Per-octave set-up computed by the host in double (graupel/terrain_noise.h):
+/* Per-octave set-up computed by the host in double (graupel/procedural_terrain.h):
  * for octave o, point i of a piece starting at global index i0 lies at
  * lattice coordinate lat_o + frac_o + (i0 + i)*step_o,
  * where lat_o is the integer part of the grid origin in that octave's lattice
@@ -46,12 +46,12 @@ GR_INLINE float gr_gradient_noise(int ix, int iy, float fx, float fy, uint seed)
  * weight (p^o, or lambda^(-oH) for ridged), lattice[2o..2o+1] = (lat_x,
  * lat_y). Scalar arrays rather than float4/int2: vector-typed values inside
  * the work-item loop stop PoCL's vectoriser. */
-__kernel void terrain_noise_generate(__global float *restrict elevation, int nx, int ny, int i0,
-                                     int j0, __global const float *restrict table,
-                                     __global const float *restrict amp,
-                                     __global const int *restrict lattice, uint seed, int kind,
-                                     int octaves, float offset, float gain, int invert,
-                                     float height_scale) {
+__kernel void procedural_terrain_generate(__global float *restrict elevation, int nx, int ny,
+                                          int i0, int j0, __global const float *restrict table,
+                                          __global const float *restrict amp,
+                                          __global const int *restrict lattice, uint seed, int kind,
+                                          int octaves, float offset, float gain, int invert,
+                                          float height_scale) {
   int i = get_global_id(0), j = get_global_id(1);
   if (!gr_inside(i, j, nx, ny))
     return;

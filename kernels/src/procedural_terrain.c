@@ -1,5 +1,5 @@
-/* Procedural terrain core (seed 001): host side of terrain_noise.cl. */
-#include "graupel/terrain_noise.h"
+/* Procedural terrain core (seed 001): host side of procedural_terrain.cl. */
+#include "graupel/procedural_terrain.h"
 #include "graupel/cl_runtime.h"
 
 #include <math.h>
@@ -10,10 +10,10 @@
 /* Lattice coordinates must stay well inside int range in every octave. */
 #define GR_LATTICE_LIMIT 1.0e9
 
-struct gr_terrain_noise {
+struct gr_procedural_terrain {
   gr_context *ctx;
   gr_grid grid;
-  gr_terrain_noise_params params;
+  gr_procedural_terrain_params params;
   cl_kernel kernel;
   cl_mem elevation;
   cl_mem table;   /* float4 per octave: origin fraction and step, x and y */
@@ -21,7 +21,7 @@ struct gr_terrain_noise {
   cl_mem lattice; /* int2 per octave: origin lattice cell */
 };
 
-void gr_terrain_noise_params_init(gr_terrain_noise_params *p) {
+void gr_procedural_terrain_params_init(gr_procedural_terrain_params *p) {
   if (!p)
     return;
   memset(p, 0, sizeof(*p));
@@ -42,14 +42,15 @@ static int gr_in_range(double v, double lo, double hi) {
   return v >= lo && v <= hi; /* false for NaN */
 }
 
-gr_status gr_terrain_noise_params_validate(const gr_terrain_noise_params *p, char *msg,
-                                           size_t msg_len) {
+gr_status gr_procedural_terrain_params_validate(const gr_procedural_terrain_params *p, char *msg,
+                                                size_t msg_len) {
   const char *why = NULL;
   if (!p)
     why = "no parameters were given";
   else if (p->type != GR_NOISE_RIDGED && p->type != GR_NOISE_FBM && p->type != GR_NOISE_BILLOW)
     why = "NoiseType must be 0 (ridged multifractal), 1 (fBm) or 2 (billow)";
-  else if (p->octaves < GR_TERRAIN_NOISE_OCTAVES_MIN || p->octaves > GR_TERRAIN_NOISE_OCTAVES_MAX)
+  else if (p->octaves < GR_PROCEDURAL_TERRAIN_OCTAVES_MIN ||
+           p->octaves > GR_PROCEDURAL_TERRAIN_OCTAVES_MAX)
     why = "Octaves must lie between 1 and 16";
   else if (!(p->frequency > 0.0) || p->frequency > 1e4)
     why = "Frequency must be above 0 and at most 10000 cycles per km";
@@ -76,12 +77,12 @@ gr_status gr_terrain_noise_params_validate(const gr_terrain_noise_params *p, cha
 
 /* Fills the per-octave tables in double, so every device gets the same
  * float inputs. Fails when a lattice coordinate would leave int range. */
-static gr_status gr_terrain_noise_upload(gr_terrain_noise *t) {
-  const gr_terrain_noise_params *p = &t->params;
+static gr_status gr_procedural_terrain_upload(gr_procedural_terrain *t) {
+  const gr_procedural_terrain_params *p = &t->params;
   const gr_grid *g = &t->grid;
-  cl_float4 table[GR_TERRAIN_NOISE_OCTAVES_MAX];
-  cl_float amp[GR_TERRAIN_NOISE_OCTAVES_MAX];
-  cl_int2 lattice[GR_TERRAIN_NOISE_OCTAVES_MAX];
+  cl_float4 table[GR_PROCEDURAL_TERRAIN_OCTAVES_MAX];
+  cl_float amp[GR_PROCEDURAL_TERRAIN_OCTAVES_MAX];
+  cl_int2 lattice[GR_PROCEDURAL_TERRAIN_OCTAVES_MAX];
   memset(table, 0, sizeof(table));
   memset(amp, 0, sizeof(amp));
   memset(lattice, 0, sizeof(lattice));
@@ -118,20 +119,21 @@ static gr_status gr_terrain_noise_upload(gr_terrain_noise *t) {
   return st;
 }
 
-gr_status gr_terrain_noise_create(gr_context *ctx, const gr_grid *grid,
-                                  const gr_terrain_noise_params *p, gr_terrain_noise **out) {
+gr_status gr_procedural_terrain_create(gr_context *ctx, const gr_grid *grid,
+                                       const gr_procedural_terrain_params *p,
+                                       gr_procedural_terrain **out) {
   char msg[256];
   if (!ctx || !out)
     return gr_set_error(ctx, GR_ERR_INVALID_ARGUMENT,
-                        "gr_terrain_noise_create needs a context and a place "
+                        "gr_procedural_terrain_create needs a context and a place "
                         "for the generator.");
   *out = NULL;
   if (gr_grid_validate(grid, msg, sizeof(msg)) != GR_OK)
     return gr_set_error(ctx, GR_ERR_INVALID_ARGUMENT, "%s", msg);
-  if (gr_terrain_noise_params_validate(p, msg, sizeof(msg)) != GR_OK)
+  if (gr_procedural_terrain_params_validate(p, msg, sizeof(msg)) != GR_OK)
     return gr_set_error(ctx, GR_ERR_INVALID_ARGUMENT, "%s", msg);
 
-  gr_terrain_noise *t = calloc(1, sizeof(*t));
+  gr_procedural_terrain *t = calloc(1, sizeof(*t));
   if (!t)
     return gr_set_error(ctx, GR_ERR_OUT_OF_MEMORY, "Out of host memory.");
   t->ctx = gr_context_retain(ctx);
@@ -142,65 +144,66 @@ gr_status gr_terrain_noise_create(gr_context *ctx, const gr_grid *grid,
   char options[96];
   snprintf(options, sizeof(options), "-DGR_TERRAIN_OCTAVES=%d -DGR_TERRAIN_KIND=%d", p->octaves,
            (int)p->type);
-  gr_status st = gr_program_get(ctx, "terrain_noise", options, &prog);
+  gr_status st = gr_program_get(ctx, "procedural_terrain", options, &prog);
   if (st == GR_OK)
-    st = gr_kernel_create(ctx, prog, "terrain_noise_generate", &t->kernel);
+    st = gr_kernel_create(ctx, prog, "procedural_terrain_generate", &t->kernel);
   if (st == GR_OK)
     st = gr_buffer_create(ctx, CL_MEM_WRITE_ONLY, bytes, NULL, &t->elevation);
   if (st == GR_OK)
-    st = gr_buffer_create(ctx, CL_MEM_READ_ONLY, GR_TERRAIN_NOISE_OCTAVES_MAX * sizeof(cl_float4),
-                          NULL, &t->table);
+    st = gr_buffer_create(ctx, CL_MEM_READ_ONLY,
+                          GR_PROCEDURAL_TERRAIN_OCTAVES_MAX * sizeof(cl_float4), NULL, &t->table);
   if (st == GR_OK)
-    st = gr_buffer_create(ctx, CL_MEM_READ_ONLY, GR_TERRAIN_NOISE_OCTAVES_MAX * sizeof(cl_float),
-                          NULL, &t->amp);
+    st = gr_buffer_create(ctx, CL_MEM_READ_ONLY,
+                          GR_PROCEDURAL_TERRAIN_OCTAVES_MAX * sizeof(cl_float), NULL, &t->amp);
   if (st == GR_OK)
-    st = gr_buffer_create(ctx, CL_MEM_READ_ONLY, GR_TERRAIN_NOISE_OCTAVES_MAX * sizeof(cl_int2),
-                          NULL, &t->lattice);
+    st = gr_buffer_create(ctx, CL_MEM_READ_ONLY,
+                          GR_PROCEDURAL_TERRAIN_OCTAVES_MAX * sizeof(cl_int2), NULL, &t->lattice);
   if (st == GR_OK)
-    st = gr_terrain_noise_upload(t);
+    st = gr_procedural_terrain_upload(t);
   if (st != GR_OK) {
-    gr_terrain_noise_destroy(t);
+    gr_procedural_terrain_destroy(t);
     return st;
   }
   *out = t;
   return GR_OK;
 }
 
-gr_status gr_terrain_noise_set_params(gr_terrain_noise *t, const gr_terrain_noise_params *p) {
+gr_status gr_procedural_terrain_set_params(gr_procedural_terrain *t,
+                                           const gr_procedural_terrain_params *p) {
   char msg[256];
   if (!t)
     return gr_set_error(NULL, GR_ERR_INVALID_ARGUMENT,
-                        "gr_terrain_noise_set_params needs a generator.");
-  if (gr_terrain_noise_params_validate(p, msg, sizeof(msg)) != GR_OK)
+                        "gr_procedural_terrain_set_params needs a generator.");
+  if (gr_procedural_terrain_params_validate(p, msg, sizeof(msg)) != GR_OK)
     return gr_set_error(t->ctx, GR_ERR_INVALID_ARGUMENT, "%s", msg);
-  gr_terrain_noise_params old = t->params;
+  gr_procedural_terrain_params old = t->params;
   t->params = *p;
-  gr_status st = gr_terrain_noise_upload(t);
+  gr_status st = gr_procedural_terrain_upload(t);
   if (st != GR_OK) {
     t->params = old; /* keep the generator usable with its previous state */
-    gr_terrain_noise_upload(t);
+    gr_procedural_terrain_upload(t);
   }
   return st;
 }
 
-gr_status gr_terrain_noise_compute(gr_terrain_noise *t) {
+gr_status gr_procedural_terrain_compute(gr_procedural_terrain *t) {
   if (!t)
     return gr_set_error(NULL, GR_ERR_INVALID_ARGUMENT,
-                        "gr_terrain_noise_compute needs a generator.");
-  return gr_terrain_noise_compute_rows(t, 0, t->grid.ny);
+                        "gr_procedural_terrain_compute needs a generator.");
+  return gr_procedural_terrain_compute_rows(t, 0, t->grid.ny);
 }
 
-gr_status gr_terrain_noise_compute_rows(gr_terrain_noise *t, int row0, int nrows) {
+gr_status gr_procedural_terrain_compute_rows(gr_procedural_terrain *t, int row0, int nrows) {
   if (!t)
     return gr_set_error(NULL, GR_ERR_INVALID_ARGUMENT,
-                        "gr_terrain_noise_compute_rows needs a generator.");
+                        "gr_procedural_terrain_compute_rows needs a generator.");
   if (row0 < 0 || nrows < 0 || row0 > t->grid.ny - nrows)
     return gr_set_error(t->ctx, GR_ERR_INVALID_ARGUMENT,
                         "Rows %d to %d are not inside the grid's %d rows.", row0, row0 + nrows - 1,
                         t->grid.ny);
   if (nrows == 0)
     return GR_OK;
-  const gr_terrain_noise_params *p = &t->params;
+  const gr_procedural_terrain_params *p = &t->params;
   /* The kernel's row bound is the band's end, so rounding the launch up to
    * the work-group size never spills into the next band. */
   cl_int nx = t->grid.nx, ny = row0 + nrows, i0 = t->grid.i0, j0 = t->grid.j0;
@@ -219,10 +222,10 @@ gr_status gr_terrain_noise_compute_rows(gr_terrain_noise *t, int row0, int nrows
   return gr_enqueue_2d(t->ctx, t->kernel, 0, (size_t)row0, (size_t)nx, (size_t)nrows, NULL);
 }
 
-gr_status gr_terrain_noise_get_field(gr_terrain_noise *t, gr_field f, float *host) {
+gr_status gr_procedural_terrain_get_field(gr_procedural_terrain *t, gr_field f, float *host) {
   if (!t || !host)
     return gr_set_error(t ? t->ctx : NULL, GR_ERR_INVALID_ARGUMENT,
-                        "gr_terrain_noise_get_field needs a generator and "
+                        "gr_procedural_terrain_get_field needs a generator and "
                         "room for the field.");
   if (f != GR_FIELD_ELEVATION)
     return gr_set_error(t->ctx, GR_ERR_INVALID_ARGUMENT,
@@ -233,7 +236,7 @@ gr_status gr_terrain_noise_get_field(gr_terrain_noise *t, gr_field f, float *hos
   return gr_buffer_read(t->ctx, t->elevation, 0, bytes, host);
 }
 
-void gr_terrain_noise_destroy(gr_terrain_noise *t) {
+void gr_procedural_terrain_destroy(gr_procedural_terrain *t) {
   if (!t)
     return;
   if (t->kernel)
@@ -246,17 +249,17 @@ void gr_terrain_noise_destroy(gr_terrain_noise *t) {
   free(t);
 }
 
-gr_status gr_terrain_noise_generate(gr_context *ctx, const gr_grid *grid,
-                                    const gr_terrain_noise_params *p, float *host) {
-  gr_terrain_noise *t = NULL;
+gr_status gr_procedural_terrain_generate(gr_context *ctx, const gr_grid *grid,
+                                         const gr_procedural_terrain_params *p, float *host) {
+  gr_procedural_terrain *t = NULL;
   if (!host)
     return gr_set_error(ctx, GR_ERR_INVALID_ARGUMENT,
-                        "gr_terrain_noise_generate needs room for the field.");
-  gr_status st = gr_terrain_noise_create(ctx, grid, p, &t);
+                        "gr_procedural_terrain_generate needs room for the field.");
+  gr_status st = gr_procedural_terrain_create(ctx, grid, p, &t);
   if (st == GR_OK)
-    st = gr_terrain_noise_compute(t);
+    st = gr_procedural_terrain_compute(t);
   if (st == GR_OK)
-    st = gr_terrain_noise_get_field(t, GR_FIELD_ELEVATION, host);
-  gr_terrain_noise_destroy(t);
+    st = gr_procedural_terrain_get_field(t, GR_FIELD_ELEVATION, host);
+  gr_procedural_terrain_destroy(t);
   return st;
 }

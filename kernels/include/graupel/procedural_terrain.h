@@ -1,5 +1,5 @@
 /**
- * @file terrain_noise.h
+ * @file procedural_terrain.h
  * @brief Procedural terrain (seed 001): ridged multifractal, fBm and billow
  * noise computed by an OpenCL kernel.
  *
@@ -19,8 +19,8 @@
  *   sharp crests) n = 1 - r, else n = r.
  * elevation = height_scale * n, in metres.
  */
-#ifndef GRAUPEL_TERRAIN_NOISE_H
-#define GRAUPEL_TERRAIN_NOISE_H
+#ifndef GRAUPEL_PROCEDURAL_TERRAIN_H
+#define GRAUPEL_PROCEDURAL_TERRAIN_H
 
 #include "graupel/runtime.h"
 
@@ -34,10 +34,10 @@ typedef enum gr_noise_type {
   GR_NOISE_BILLOW = 2  /**< sum of |noise| octaves: puffy hills */
 } gr_noise_type;
 
-#define GR_TERRAIN_NOISE_OCTAVES_MIN 1
-#define GR_TERRAIN_NOISE_OCTAVES_MAX 16
+#define GR_PROCEDURAL_TERRAIN_OCTAVES_MIN 1
+#define GR_PROCEDURAL_TERRAIN_OCTAVES_MAX 16
 
-typedef struct gr_terrain_noise_params {
+typedef struct gr_procedural_terrain_params {
   int seed;            /**< any integer; equal seeds give equal fields */
   gr_noise_type type;  /**< default GR_NOISE_RIDGED */
   int octaves;         /**< 1..16, default 6 */
@@ -49,48 +49,50 @@ typedef struct gr_terrain_noise_params {
   double h;            /**< ridged spectral exponent H, [0, 4], default 1 */
   int invert;          /**< ridged only: 1 (default) flips the ridges */
   double height_scale; /**< metres, [0, 1e5], default 120 */
-} gr_terrain_noise_params;
+} gr_procedural_terrain_params;
 
 /** The defaults listed above. */
-GR_API void gr_terrain_noise_params_init(gr_terrain_noise_params *p);
+GR_API void gr_procedural_terrain_params_init(gr_procedural_terrain_params *p);
 
 /** Checks every parameter against its range; a sentence goes to msg. */
-GR_API gr_status gr_terrain_noise_params_validate(const gr_terrain_noise_params *p, char *msg,
-                                                  size_t msg_len);
+GR_API gr_status gr_procedural_terrain_params_validate(const gr_procedural_terrain_params *p,
+                                                       char *msg, size_t msg_len);
 
-typedef struct gr_terrain_noise gr_terrain_noise;
+typedef struct gr_procedural_terrain gr_procedural_terrain;
 
 /**
  * A terrain generator for one grid: validates the grid and the parameters,
  * builds the kernel and allocates the elevation buffer on the device.
  */
-GR_API gr_status gr_terrain_noise_create(gr_context *ctx, const gr_grid *grid,
-                                         const gr_terrain_noise_params *p, gr_terrain_noise **out);
+GR_API gr_status gr_procedural_terrain_create(gr_context *ctx, const gr_grid *grid,
+                                              const gr_procedural_terrain_params *p,
+                                              gr_procedural_terrain **out);
 
 /** New parameters for the next compute (validated). */
-GR_API gr_status gr_terrain_noise_set_params(gr_terrain_noise *t, const gr_terrain_noise_params *p);
+GR_API gr_status gr_procedural_terrain_set_params(gr_procedural_terrain *t,
+                                                  const gr_procedural_terrain_params *p);
 
 /** Enqueues the noise kernel over the whole grid; does not wait. */
-GR_API gr_status gr_terrain_noise_compute(gr_terrain_noise *t);
+GR_API gr_status gr_procedural_terrain_compute(gr_procedural_terrain *t);
 
 /**
  * Enqueues the rows row0 .. row0+nrows-1 only; does not wait. A caller that
  * reports progress or honours an abort computes a large grid band by band.
  */
-GR_API gr_status gr_terrain_noise_compute_rows(gr_terrain_noise *t, int row0, int nrows);
+GR_API gr_status gr_procedural_terrain_compute_rows(gr_procedural_terrain *t, int row0, int nrows);
 
 /**
  * Reads a field back (waits for the device). Only GR_FIELD_ELEVATION exists;
  * host must hold nx*ny floats.
  */
-GR_API gr_status gr_terrain_noise_get_field(gr_terrain_noise *t, gr_field f, float *host);
+GR_API gr_status gr_procedural_terrain_get_field(gr_procedural_terrain *t, gr_field f, float *host);
 
 /** Frees the generator; NULL is fine. */
-GR_API void gr_terrain_noise_destroy(gr_terrain_noise *t);
+GR_API void gr_procedural_terrain_destroy(gr_procedural_terrain *t);
 
 /** One call: create, compute, read elevation into host (nx*ny floats), free. */
-GR_API gr_status gr_terrain_noise_generate(gr_context *ctx, const gr_grid *grid,
-                                           const gr_terrain_noise_params *p, float *host);
+GR_API gr_status gr_procedural_terrain_generate(gr_context *ctx, const gr_grid *grid,
+                                                const gr_procedural_terrain_params *p, float *host);
 
 #ifdef __cplusplus
 }

@@ -1,12 +1,12 @@
-/* libFuzzer harness: gr_terrain_noise_params_validate and gr_grid_validate.
+/* libFuzzer harness: gr_procedural_terrain_params_validate and gr_grid_validate.
  * No OpenCL is touched.
  *
  * Input layout (missing bytes read as 0): byte 0 picks how the 19 fields
- * (11 of gr_terrain_noise_params, then 8 of gr_grid, in declaration order)
+ * (11 of gr_procedural_terrain_params, then 8 of gr_grid, in declaration order)
  * are made, byte 1 the length of a small message buffer, then:
  *   mode 0  every field from raw bytes (4 per int or enum, 8 per double), so
  *           NaN, infinities, subnormals and huge values appear;
- *   mode 1  the defaults (gr_terrain_noise_params_init; a 64 x 64 grid of
+ *   mode 1  the defaults (gr_procedural_terrain_params_init; a 64 x 64 grid of
  *           2 m) with the fields whose bit is set in the next 3 bytes read
  *           raw, as in mode 0;
  *   mode 2  one byte per field picks from a table of edge values (range
@@ -14,12 +14,12 @@
  *
  * Checks: the status is GR_OK or GR_ERR_INVALID_ARGUMENT; a failure comes
  * with a non-empty message ending in '.'; accepted parameters lie in the
- * ranges terrain_noise.h and the README document, and parameters in those
+ * ranges procedural_terrain.h and the README document, and parameters in those
  * ranges are accepted; an accepted grid has the documented dimensions,
  * spacing, origin and offsets; a short message buffer is never overrun and is
  * always terminated; the answer does not depend on the buffer. */
 #include "fuzz_common.h"
-#include "graupel/terrain_noise.h"
+#include "graupel/procedural_terrain.h"
 
 #include <float.h>
 #include <limits.h>
@@ -80,7 +80,7 @@ static int edge_int(uint8_t b) {
 /* Field kinds in order: 'i' int or enum, 'd' double. */
 static const char kinds[] = "iiiddddddid" /* params */ "iiddddii" /* grid */;
 
-static void *field_ptr(gr_terrain_noise_params *p, gr_grid *g, int f) {
+static void *field_ptr(gr_procedural_terrain_params *p, gr_grid *g, int f) {
   switch (f) {
   case 0:
     return &p->seed;
@@ -123,12 +123,12 @@ static void *field_ptr(gr_terrain_noise_params *p, gr_grid *g, int f) {
   }
 }
 
-static void set_raw(reader *r, gr_terrain_noise_params *p, gr_grid *g, int f) {
+static void set_raw(reader *r, gr_procedural_terrain_params *p, gr_grid *g, int f) {
   /* Raw bytes straight into the field: an enum gets any int bit pattern. */
   take(r, field_ptr(p, g, f), kinds[f] == 'd' ? sizeof(double) : sizeof(int));
 }
 
-static void set_edge(reader *r, gr_terrain_noise_params *p, gr_grid *g, int f) {
+static void set_edge(reader *r, gr_procedural_terrain_params *p, gr_grid *g, int f) {
   uint8_t b = take_byte(r);
   if (kinds[f] == 'd') {
     double v = edge_double(b);
@@ -143,13 +143,14 @@ static int in_range(double v, double lo, double hi) {
   return v >= lo && v <= hi;
 }
 
-/* terrain_noise.h's ranges, and the README's (0, 4] Offset for ridged. */
-static int params_documented(const gr_terrain_noise_params *p) {
+/* procedural_terrain.h's ranges, and the README's (0, 4] Offset for ridged. */
+static int params_documented(const gr_procedural_terrain_params *p) {
   int type;
   memcpy(&type, &p->type, sizeof type);
   return (type == GR_NOISE_RIDGED || type == GR_NOISE_FBM || type == GR_NOISE_BILLOW) &&
-         p->octaves >= GR_TERRAIN_NOISE_OCTAVES_MIN && p->octaves <= GR_TERRAIN_NOISE_OCTAVES_MAX &&
-         p->frequency > 0.0 && p->frequency <= 1e4 && in_range(p->lacunarity, 1.0, 8.0) &&
+         p->octaves >= GR_PROCEDURAL_TERRAIN_OCTAVES_MIN &&
+         p->octaves <= GR_PROCEDURAL_TERRAIN_OCTAVES_MAX && p->frequency > 0.0 &&
+         p->frequency <= 1e4 && in_range(p->lacunarity, 1.0, 8.0) &&
          in_range(p->persistence, 0.0, 1.0) && in_range(p->offset, 0.0, 4.0) &&
          in_range(p->gain, 0.0, 16.0) && in_range(p->h, 0.0, 4.0) &&
          in_range(p->height_scale, 0.0, 1e5) && (type != GR_NOISE_RIDGED || p->offset > 0.0);
@@ -164,7 +165,7 @@ static int grid_documented(const gr_grid *g) {
 }
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
-  gr_terrain_noise_params p;
+  gr_procedural_terrain_params p;
   gr_grid g;
   reader r;
   char msg[1024];
@@ -181,7 +182,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
   memset(&g, 0, sizeof g);
   if (mode == 1) {
     uint8_t bits[3];
-    gr_terrain_noise_params_init(&p);
+    gr_procedural_terrain_params_init(&p);
     g.nx = 64;
     g.ny = 64;
     g.dx = 2.0;
@@ -200,7 +201,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
   }
 
   msg[0] = '\0';
-  sp = gr_terrain_noise_params_validate(&p, msg, sizeof msg);
+  sp = gr_procedural_terrain_params_validate(&p, msg, sizeof msg);
   check_message(sp, msg);
   REQUIRE((sp == GR_OK) == params_documented(&p));
   msg[0] = '\0';
@@ -211,14 +212,14 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
 
   /* No buffer, and a short one on the heap (AddressSanitizer sees an
    * overrun): the same answers, and a terminated message. */
-  REQUIRE(gr_terrain_noise_params_validate(&p, NULL, 0) == sp);
-  REQUIRE(gr_terrain_noise_params_validate(&p, NULL, 64) == sp);
+  REQUIRE(gr_procedural_terrain_params_validate(&p, NULL, 0) == sp);
+  REQUIRE(gr_procedural_terrain_params_validate(&p, NULL, 64) == sp);
   REQUIRE(gr_grid_validate(&g, NULL, 0) == sg);
   small = (char *)malloc(small_len > 0 ? small_len : 1);
   REQUIRE(small != NULL);
   if (small_len > 0) {
     memset(small, 'x', small_len);
-    REQUIRE(gr_terrain_noise_params_validate(&p, small, small_len) == sp);
+    REQUIRE(gr_procedural_terrain_params_validate(&p, small, small_len) == sp);
     if (sp != GR_OK)
       REQUIRE(memchr(small, '\0', small_len) != NULL);
     memset(small, 'x', small_len);
@@ -230,7 +231,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
 
   /* No parameters and no grid at all. */
   msg[0] = '\0';
-  check_message(gr_terrain_noise_params_validate(NULL, msg, sizeof msg), msg);
+  check_message(gr_procedural_terrain_params_validate(NULL, msg, sizeof msg), msg);
   REQUIRE(msg[0] != '\0');
   msg[0] = '\0';
   check_message(gr_grid_validate(NULL, msg, sizeof msg), msg);

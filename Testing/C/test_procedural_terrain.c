@@ -1,16 +1,16 @@
 /* Procedural terrain tests: an independent double-precision reference of the
- * documented noise (graupel/terrain_noise.h), determinism, seeds, octave
+ * documented noise (graupel/procedural_terrain.h), determinism, seeds, octave
  * energy, linear height scale, bounds, tiling by origin, inversion, every
  * device agreeing with the first, and parameter errors. */
 #include "graupel/cl_runtime.h"
-#include "graupel/terrain_noise.h"
+#include "graupel/procedural_terrain.h"
 #include "gr_test.h"
 
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 
-/* ---- reference (the same definition as terrain_noise.cl, in double) ---- */
+/* ---- reference (the same definition as procedural_terrain.cl, in double) ---- */
 
 static uint32_t ref_hash(uint32_t x) {
   x ^= x >> 16;
@@ -45,7 +45,7 @@ static double ref_gradient(double x, double y, uint32_t seed) {
   double n = (a + v * (b - a)) * sqrt(2.0);
   return n < -1 ? -1 : n > 1 ? 1 : n;
 }
-static double ref_elevation(const gr_terrain_noise_params *p, double x, double y) {
+static double ref_elevation(const gr_procedural_terrain_params *p, double x, double y) {
   double f = p->frequency / 1000.0, m = 1.0, amp = 1.0, w = 1.0;
   double sum = 0, norm = 0;
   for (int o = 0; o < p->octaves; ++o) {
@@ -75,9 +75,9 @@ static double ref_elevation(const gr_terrain_noise_params *p, double x, double y
 
 static gr_context *ctx;
 
-static float *make(const gr_grid *g, const gr_terrain_noise_params *p) {
+static float *make(const gr_grid *g, const gr_procedural_terrain_params *p) {
   float *h = malloc(sizeof(float) * (size_t)g->nx * (size_t)g->ny);
-  gr_status st = gr_terrain_noise_generate(ctx, g, p, h);
+  gr_status st = gr_procedural_terrain_generate(ctx, g, p, h);
   CHECK_MSG(st == GR_OK, "%s", gr_last_error(ctx));
   if (st != GR_OK) {
     free(h);
@@ -114,8 +114,8 @@ static void test_reference(void) {
   gr_grid g = {48, 40, 7.0, 5.0, -123.0, 4567.0};
   for (int type = 0; type < 3; ++type)
     for (int inv = 0; inv < 2; ++inv) {
-      gr_terrain_noise_params p;
-      gr_terrain_noise_params_init(&p);
+      gr_procedural_terrain_params p;
+      gr_procedural_terrain_params_init(&p);
       p.type = (gr_noise_type)type;
       p.invert = inv;
       p.seed = 1234 + type;
@@ -140,8 +140,8 @@ static void test_reference(void) {
 
 static void test_determinism_and_seeds(void) {
   gr_grid g = {200, 150, 2.0, 2.0, 0.0, 0.0};
-  gr_terrain_noise_params p;
-  gr_terrain_noise_params_init(&p);
+  gr_procedural_terrain_params p;
+  gr_procedural_terrain_params_init(&p);
   float *a = make(&g, &p), *b = make(&g, &p);
   p.seed = 1;
   float *c = make(&g, &p);
@@ -164,8 +164,8 @@ static void test_determinism_and_seeds(void) {
 static void test_octaves_energy(void) {
   gr_grid g = {256, 256, 2.0, 2.0, 0.0, 0.0};
   for (int type = 0; type < 3; ++type) {
-    gr_terrain_noise_params p;
-    gr_terrain_noise_params_init(&p);
+    gr_procedural_terrain_params p;
+    gr_procedural_terrain_params_init(&p);
     p.type = (gr_noise_type)type;
     p.octaves = 1;
     float *h1 = make(&g, &p);
@@ -184,8 +184,8 @@ static void test_octaves_energy(void) {
 
 static void test_height_scale_and_bounds(void) {
   gr_grid g = {128, 96, 3.0, 3.0, 50.0, -70.0};
-  gr_terrain_noise_params p;
-  gr_terrain_noise_params_init(&p);
+  gr_procedural_terrain_params p;
+  gr_procedural_terrain_params_init(&p);
   float *a = make(&g, &p);
   p.height_scale = 30.0;
   float *b = make(&g, &p);
@@ -206,8 +206,8 @@ static void test_height_scale_and_bounds(void) {
   const double gains[] = {0.0, 2.0, 16.0}, offsets[] = {0.25, 1.0, 4.0};
   for (int type = 0; type < 3; ++type)
     for (int k = 0; k < 3; ++k) {
-      gr_terrain_noise_params q;
-      gr_terrain_noise_params_init(&q);
+      gr_procedural_terrain_params q;
+      gr_procedural_terrain_params_init(&q);
       q.type = (gr_noise_type)type;
       q.gain = gains[k];
       q.offset = offsets[k];
@@ -236,8 +236,8 @@ static void test_tiling_and_inversion(void) {
   gr_grid s = g;
   s.x0 += 30 * g.dx;
   s.y0 += 10 * g.dy;
-  gr_terrain_noise_params p;
-  gr_terrain_noise_params_init(&p);
+  gr_procedural_terrain_params p;
+  gr_procedural_terrain_params_init(&p);
   float *a = make(&g, &p), *b = make(&s, &p);
   if (!a || !b)
     return;
@@ -305,8 +305,8 @@ static void test_devices_agree(void) {
     return;
   }
   gr_grid g = {300, 200, 2.0, 2.0, -500.0, 800.0};
-  gr_terrain_noise_params p;
-  gr_terrain_noise_params_init(&p);
+  gr_procedural_terrain_params p;
+  gr_procedural_terrain_params_init(&p);
   float *first = NULL;
   for (int d = 0; d < count && d < 8; ++d) {
     gr_context_options opt;
@@ -315,7 +315,7 @@ static void test_devices_agree(void) {
     gr_context *c = NULL;
     CHECK(gr_context_create(&opt, &c) == GR_OK);
     float *h = malloc(sizeof(float) * 300 * 200);
-    CHECK(gr_terrain_noise_generate(c, &g, &p, h) == GR_OK);
+    CHECK(gr_procedural_terrain_generate(c, &g, &p, h) == GR_OK);
     if (!first) {
       first = h;
     } else {
@@ -335,16 +335,16 @@ static void test_devices_agree(void) {
 
 static void test_errors(void) {
   char msg[256];
-  gr_terrain_noise_params p;
-  gr_terrain_noise_params_init(&p);
-  CHECK(gr_terrain_noise_params_validate(&p, msg, sizeof(msg)) == GR_OK);
+  gr_procedural_terrain_params p;
+  gr_procedural_terrain_params_init(&p);
+  CHECK(gr_procedural_terrain_params_validate(&p, msg, sizeof(msg)) == GR_OK);
   /* Each out-of-range parameter is refused with its name in the sentence. */
-  gr_terrain_noise_params q;
+  gr_procedural_terrain_params q;
 #define BAD(field, value, word)                                                                    \
   do {                                                                                             \
     q = p;                                                                                         \
     q.field = value;                                                                               \
-    CHECK(gr_terrain_noise_params_validate(&q, msg, sizeof(msg)) == GR_ERR_INVALID_ARGUMENT);      \
+    CHECK(gr_procedural_terrain_params_validate(&q, msg, sizeof(msg)) == GR_ERR_INVALID_ARGUMENT); \
     CHECK_MSG(strstr(msg, word) != NULL, "'%s' lacks '%s'", msg, word);                            \
   } while (0)
   BAD(octaves, 0, "Octaves");
@@ -362,46 +362,46 @@ static void test_errors(void) {
 #undef BAD
 
   gr_grid g = {16, 16, 1.0, 1.0, 0.0, 0.0};
-  gr_terrain_noise *t = NULL;
+  gr_procedural_terrain *t = NULL;
   q = p;
   q.octaves = 0;
-  CHECK(gr_terrain_noise_create(ctx, &g, &q, &t) == GR_ERR_INVALID_ARGUMENT);
+  CHECK(gr_procedural_terrain_create(ctx, &g, &q, &t) == GR_ERR_INVALID_ARGUMENT);
   CHECK(t == NULL && strstr(gr_last_error(ctx), "Octaves") != NULL);
   g.dy = -1.0;
-  CHECK(gr_terrain_noise_create(ctx, &g, &p, &t) == GR_ERR_INVALID_ARGUMENT);
+  CHECK(gr_procedural_terrain_create(ctx, &g, &p, &t) == GR_ERR_INVALID_ARGUMENT);
   CHECK(strstr(gr_last_error(ctx), "spacing") != NULL);
   g.dy = 1.0;
   g.x0 = 1e14; /* lattice coordinates would overflow */
-  CHECK(gr_terrain_noise_create(ctx, &g, &p, &t) == GR_ERR_INVALID_ARGUMENT);
+  CHECK(gr_procedural_terrain_create(ctx, &g, &p, &t) == GR_ERR_INVALID_ARGUMENT);
   CHECK(strstr(gr_last_error(ctx), "Origin") != NULL);
   g.x0 = 0.0;
 
   /* set_params refuses bad values and keeps the generator working. */
-  CHECK(gr_terrain_noise_create(ctx, &g, &p, &t) == GR_OK);
+  CHECK(gr_procedural_terrain_create(ctx, &g, &p, &t) == GR_OK);
   float before[256], after[256];
-  CHECK(gr_terrain_noise_compute(t) == GR_OK);
-  CHECK(gr_terrain_noise_get_field(t, GR_FIELD_ELEVATION, before) == GR_OK);
-  CHECK(gr_terrain_noise_set_params(t, &q) == GR_ERR_INVALID_ARGUMENT);
-  CHECK(gr_terrain_noise_compute(t) == GR_OK);
-  CHECK(gr_terrain_noise_get_field(t, GR_FIELD_ELEVATION, after) == GR_OK);
+  CHECK(gr_procedural_terrain_compute(t) == GR_OK);
+  CHECK(gr_procedural_terrain_get_field(t, GR_FIELD_ELEVATION, before) == GR_OK);
+  CHECK(gr_procedural_terrain_set_params(t, &q) == GR_ERR_INVALID_ARGUMENT);
+  CHECK(gr_procedural_terrain_compute(t) == GR_OK);
+  CHECK(gr_procedural_terrain_get_field(t, GR_FIELD_ELEVATION, after) == GR_OK);
   CHECK(memcmp(before, after, sizeof(before)) == 0);
   q = p;
   q.seed = 99;
-  CHECK(gr_terrain_noise_set_params(t, &q) == GR_OK);
-  CHECK(gr_terrain_noise_compute(t) == GR_OK);
-  CHECK(gr_terrain_noise_get_field(t, GR_FIELD_ELEVATION, after) == GR_OK);
+  CHECK(gr_procedural_terrain_set_params(t, &q) == GR_OK);
+  CHECK(gr_procedural_terrain_compute(t) == GR_OK);
+  CHECK(gr_procedural_terrain_get_field(t, GR_FIELD_ELEVATION, after) == GR_OK);
   CHECK(memcmp(before, after, sizeof(before)) != 0);
-  CHECK(gr_terrain_noise_get_field(t, GR_FIELD_SNOW_DEPTH, after) == GR_ERR_INVALID_ARGUMENT);
+  CHECK(gr_procedural_terrain_get_field(t, GR_FIELD_SNOW_DEPTH, after) == GR_ERR_INVALID_ARGUMENT);
   CHECK(strstr(gr_last_error(ctx), "snow_depth") != NULL);
-  gr_terrain_noise_destroy(t);
-  gr_terrain_noise_destroy(NULL);
+  gr_procedural_terrain_destroy(t);
+  gr_procedural_terrain_destroy(NULL);
 
   /* A grid whose elevation buffer exceeds the device's largest allocation
    * is refused before anything is allocated, with the limit in the sentence. */
   gr_grid huge;
   if (gr_test_grid_beyond_device(ctx, &huge)) {
     t = NULL;
-    CHECK(gr_terrain_noise_create(ctx, &huge, &p, &t) == GR_ERR_TOO_LARGE);
+    CHECK(gr_procedural_terrain_create(ctx, &huge, &p, &t) == GR_ERR_TOO_LARGE);
     CHECK(t == NULL && strstr(gr_last_error(ctx), "MiB") != NULL);
   } else {
     printf("the device allows buffers beyond the grid limit: too-large case not reachable\n");
@@ -412,22 +412,22 @@ static void test_bands(void) {
   /* Computing band by band (as the VTK filter does, for progress and abort)
    * gives exactly the whole-grid result; bands outside the grid are refused. */
   gr_grid g = {70, 53, 2.0, 2.0, 10.0, 20.0, 0, 0};
-  gr_terrain_noise_params p;
-  gr_terrain_noise_params_init(&p);
+  gr_procedural_terrain_params p;
+  gr_procedural_terrain_params_init(&p);
   float *whole = make(&g, &p);
-  gr_terrain_noise *t = NULL;
-  CHECK(gr_terrain_noise_create(ctx, &g, &p, &t) == GR_OK);
+  gr_procedural_terrain *t = NULL;
+  CHECK(gr_procedural_terrain_create(ctx, &g, &p, &t) == GR_OK);
   if (!whole || !t)
     return;
   float *banded = calloc((size_t)g.nx * g.ny, sizeof(float));
   for (int row = 0; row < g.ny; row += 17)
-    CHECK(gr_terrain_noise_compute_rows(t, row, row + 17 <= g.ny ? 17 : g.ny - row) == GR_OK);
-  CHECK(gr_terrain_noise_get_field(t, GR_FIELD_ELEVATION, banded) == GR_OK);
+    CHECK(gr_procedural_terrain_compute_rows(t, row, row + 17 <= g.ny ? 17 : g.ny - row) == GR_OK);
+  CHECK(gr_procedural_terrain_get_field(t, GR_FIELD_ELEVATION, banded) == GR_OK);
   CHECK(memcmp(whole, banded, sizeof(float) * (size_t)g.nx * g.ny) == 0);
-  CHECK(gr_terrain_noise_compute_rows(t, 50, 4) == GR_ERR_INVALID_ARGUMENT);
-  CHECK(gr_terrain_noise_compute_rows(t, -1, 4) == GR_ERR_INVALID_ARGUMENT);
-  CHECK(gr_terrain_noise_compute_rows(t, 0, 0) == GR_OK);
-  gr_terrain_noise_destroy(t);
+  CHECK(gr_procedural_terrain_compute_rows(t, 50, 4) == GR_ERR_INVALID_ARGUMENT);
+  CHECK(gr_procedural_terrain_compute_rows(t, -1, 4) == GR_ERR_INVALID_ARGUMENT);
+  CHECK(gr_procedural_terrain_compute_rows(t, 0, 0) == GR_OK);
+  gr_procedural_terrain_destroy(t);
   free(banded);
   free(whole);
 }
@@ -436,17 +436,17 @@ static void test_build_failure(void) {
   /* A program that fails to build (here: bad options from GRAUPEL_CL_OPTIONS)
    * gives GR_ERR_BUILD and a sentence; once fixed, the next create works. */
   gr_grid g = {8, 8, 1.0, 1.0, 0.0, 0.0, 0, 0};
-  gr_terrain_noise_params p;
-  gr_terrain_noise_params_init(&p);
+  gr_procedural_terrain_params p;
+  gr_procedural_terrain_params_init(&p);
   p.octaves = 5; /* a variant not built yet in this context */
-  gr_terrain_noise *t = NULL;
+  gr_procedural_terrain *t = NULL;
   setenv("GRAUPEL_CL_OPTIONS", "-DGR_BROKEN_OPTION=( -cl-no-such-option", 1);
-  gr_status st = gr_terrain_noise_create(ctx, &g, &p, &t);
+  gr_status st = gr_procedural_terrain_create(ctx, &g, &p, &t);
   CHECK_MSG(st == GR_ERR_BUILD, "%s: %s", gr_status_string(st), gr_last_error(ctx));
-  CHECK(t == NULL && strstr(gr_last_error(ctx), "terrain_noise") != NULL);
+  CHECK(t == NULL && strstr(gr_last_error(ctx), "procedural_terrain") != NULL);
   unsetenv("GRAUPEL_CL_OPTIONS");
-  CHECK(gr_terrain_noise_create(ctx, &g, &p, &t) == GR_OK);
-  gr_terrain_noise_destroy(t);
+  CHECK(gr_procedural_terrain_create(ctx, &g, &p, &t) == GR_OK);
+  gr_procedural_terrain_destroy(t);
 }
 
 int main(void) {

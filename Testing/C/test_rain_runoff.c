@@ -4,10 +4,10 @@
  * determinism, the lake at rest, a spreading column, advance, reset, long
  * runs, and every error path.
  *
- *   test_rain             every test
- *   test_rain --memcheck  the host-code paths only, on tiny grids (for
+ *   test_rain_runoff             every test
+ *   test_rain_runoff --memcheck  the host-code paths only, on tiny grids (for
  *                         valgrind, where each kernel run is slow)
- *   test_rain NAME...     the named tests (see the table at the end) */
+ *   test_rain_runoff NAME...     the named tests (see the table at the end) */
 #include "graupel/cl_runtime.h"
 #include "graupel/rain_runoff.h"
 #include "gr_test.h"
@@ -1164,7 +1164,7 @@ int main(int argc, char **argv) {
     ++ran;
   }
   if (ran == 0) {
-    fprintf(stderr, "usage: test_rain [--memcheck | TEST...]\n");
+    fprintf(stderr, "usage: test_rain_runoff [--memcheck | TEST...]\n");
     gr_context_release(ctx);
     return 2;
   }
