@@ -8,6 +8,8 @@
 
 #include <math.h>
 #include <stdio.h>
+#include <string.h>
+#include <time.h>
 
 static int gr_test_failures = 0;
 static int gr_test_checks = 0;
@@ -56,6 +58,63 @@ static inline int gr_test_grid_beyond_device(const gr_context *ctx, gr_grid *g) 
       65536, (int)((double)info.max_alloc_bytes / 4.0 / 65536.0) + 2, 1.0, 1.0, 0.0, 0.0, 0, 0};
   *g = huge;
   return (double)huge.nx * huge.ny <= 4.0e9;
+}
+
+/* ctest's SKIP_RETURN_CODE: the test needs an OpenCL device and there is none. */
+#define GR_TEST_SKIP 77
+
+/* One named subtest of a test program. */
+typedef struct gr_subtest {
+  const char *name;
+  void (*run)(void);
+  int by_name_only; /* 1: left out of a run without names (long runs, memcheck subsets) */
+} gr_subtest;
+
+/* The one main of every C test program:
+ *   test_x              every subtest but the by-name-only ones
+ *   test_x NAME...      the named subtests
+ *   test_x --list       the names, one per line (ctest makes one test of each)
+ * setup (may be NULL) runs once before any subtest and returns 0 when there
+ * is no OpenCL device: the program then exits with GR_TEST_SKIP. teardown
+ * (may be NULL) runs after the last. */
+static inline int gr_test_main(int argc, char **argv, const gr_subtest *tests, int ntests,
+                               int (*setup)(void), void (*teardown)(void)) {
+  if (argc > 1 && strcmp(argv[1], "--list") == 0) {
+    for (int t = 0; t < ntests; ++t)
+      printf("%s\n", tests[t].name);
+    return 0;
+  }
+  for (int a = 1; a < argc; ++a) {
+    int known = 0;
+    for (int t = 0; t < ntests; ++t)
+      known |= strcmp(argv[a], tests[t].name) == 0;
+    if (!known) {
+      fprintf(stderr, "%s: no subtest '%s' (--list names them)\n", argv[0], argv[a]);
+      return 2;
+    }
+  }
+  if (setup && !setup()) {
+    fprintf(stderr, "%s: skipped: no OpenCL device (%s)\n", argv[0], gr_last_error(NULL));
+    return GR_TEST_SKIP;
+  }
+  for (int t = 0; t < ntests; ++t) {
+    int want = argc < 2 ? !tests[t].by_name_only : 0;
+    for (int a = 1; a < argc; ++a)
+      want |= strcmp(argv[a], tests[t].name) == 0;
+    if (!want)
+      continue;
+    struct timespec t0, t1;
+    clock_gettime(CLOCK_MONOTONIC, &t0);
+    int before = gr_test_failures;
+    tests[t].run();
+    clock_gettime(CLOCK_MONOTONIC, &t1);
+    printf("%-20s %s in %.2f s\n", tests[t].name, gr_test_failures == before ? "passed" : "FAILED",
+           (double)(t1.tv_sec - t0.tv_sec) + 1e-9 * (double)(t1.tv_nsec - t0.tv_nsec));
+    fflush(stdout);
+  }
+  if (teardown)
+    teardown();
+  return GR_TEST_RESULT();
 }
 
 #endif

@@ -1,10 +1,14 @@
 /* Runtime tests: device listing and choice, the shared context's reference
- * count, a trivial kernel, a failing build's log, buffer limits, and that
- * every error is a sentence. With --expect-no-platform (run with
- * OCL_ICD_VENDORS pointing at an empty folder) it checks the no-driver path. */
+ * count, a trivial kernel, kernel arguments by name, a failing build's log,
+ * buffer limits, per-thread errors, the embedded sources, the field table,
+ * mesh and point validation, and that every error is a sentence.
+ * `test_runtime --expect-no-platform` (the same as `test_runtime
+ * no_platform`; run with OCL_ICD_VENDORS pointing at an empty folder) checks
+ * the no-driver path. */
 #include "graupel/cl_runtime.h"
 #include "gr_test.h"
 
+#include <pthread.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -42,6 +46,18 @@ static void test_names(void) {
   CHECK(gr_field_from_name("nonsense") == -1);
   CHECK(gr_field_components(GR_FIELD_VELOCITY) == 3);
   CHECK(gr_field_components(GR_FIELD_ELEVATION) == 1);
+  CHECK(strcmp(gr_field_unit(GR_FIELD_SNOW_DENSITY), "kg/m^3") == 0);
+  CHECK(strcmp(gr_field_unit(GR_FIELD_DISCHARGE), "m^2/s") == 0);
+  CHECK(strcmp(gr_field_unit(GR_FIELD_VELOCITY), "m/s") == 0);
+  CHECK(strcmp(gr_field_unit(GR_FIELD_ELEVATION), "m") == 0);
+  CHECK(gr_field_unit(GR_FIELD_COUNT) == NULL && gr_field_name((gr_field)-1) == NULL);
+  CHECK(gr_field_components(GR_FIELD_COUNT) == 0);
+  /* Every field has a name, 1 or 3 components and a unit. */
+  for (int f = 0; f < GR_FIELD_COUNT; ++f) {
+    const char *u = gr_field_unit((gr_field)f);
+    int c = gr_field_components((gr_field)f);
+    CHECK_MSG(gr_field_name((gr_field)f) && u && u[0] && (c == 1 || c == 3), "field %d", f);
+  }
 
   char msg[256];
   gr_grid g = {4, 4, 1.0, 1.0, 0.0, 0.0};
@@ -147,20 +163,44 @@ static void test_shared(void) {
   gr_context_release(b);
 }
 
+static int count_of(const char *hay, const char *needle) {
+  int n = 0;
+  for (const char *p = hay; (p = strstr(p, needle)) != NULL; p += strlen(needle))
+    ++n;
+  return n;
+}
+
+static void test_embed(void) {
+  /* Every kernels/cl header a source includes is inlined, recursively, once:
+   * procedural_terrain.cl includes common.h and procedural_terrain_shared.h
+   * (not common.h), whose definitions must be in the embedded text. */
+  CHECK(gr_kernel_source_count() >= 3);
+  const char *tn = gr_kernel_source_find("procedural_terrain");
+  CHECK(tn != NULL);
+  if (!tn)
+    return;
+  CHECK(strstr(tn, "#include") == NULL);
+  CHECK(strstr(tn, "gr_hash_u32") != NULL);
+  CHECK_MSG(count_of(tn, "#define GR_PT_TABLE_STRIDE 4") == 1, "%d",
+            count_of(tn, "#define GR_PT_TABLE_STRIDE 4"));
+  CHECK(count_of(tn, "#define GR_PT_KIND_BILLOW 2") == 1);
+  for (int i = 0; i < gr_kernel_source_count(); ++i) {
+    const gr_kernel_source *src = gr_kernel_source_at(i);
+    /* No include of a kernels/cl header is left, and common.h comes once
+     * even where several headers include it. */
+    CHECK_MSG(strstr(src->text, "#include \"") == NULL, "%s keeps an include", src->name);
+    CHECK_MSG(count_of(src->text, "#define GRAUPEL_CL_COMMON_H") == 1, "%s has common.h %d times",
+              src->name, count_of(src->text, "#define GRAUPEL_CL_COMMON_H"));
+  }
+  CHECK(gr_kernel_source_find("nope") == NULL);
+  CHECK(gr_kernel_source_at(gr_kernel_source_count()) == NULL);
+}
+
 static void test_kernels(void) {
   gr_context *ctx = NULL;
   CHECK(gr_context_create(NULL, &ctx) == GR_OK);
   if (!ctx)
     return;
-
-  /* Embedded sources: the shared header is inlined. */
-  CHECK(gr_kernel_source_count() >= 2);
-  const char *tn = gr_kernel_source_find("procedural_terrain");
-  CHECK(tn != NULL);
-  CHECK(tn && strstr(tn, "#include") == NULL);
-  CHECK(tn && strstr(tn, "gr_hash_u32") != NULL);
-  CHECK(gr_kernel_source_find("nope") == NULL);
-  CHECK(gr_kernel_source_at(gr_kernel_source_count()) == NULL);
 
   /* Programs are built once per context. */
   cl_program p1 = NULL, p2 = NULL;
@@ -231,7 +271,7 @@ static void test_kernels(void) {
   CHECK(is_sentence(gr_last_error(ctx)));
   CHECK(gr_buffer_create(ctx, CL_MEM_READ_WRITE, 0, NULL, &big) == GR_ERR_INVALID_ARGUMENT);
 
-  /* The detail can be set and read per context. */
+  /* The detail can be set and read (it is the calling thread's). */
   CHECK(gr_set_error(ctx, GR_ERR_IO, "Test sentence %d.", 7) == GR_ERR_IO);
   CHECK(strcmp(gr_last_error(ctx), "Test sentence 7.") == 0);
   CHECK(gr_cl_check(ctx, CL_SUCCESS, "nothing") == GR_OK);
@@ -240,14 +280,282 @@ static void test_kernels(void) {
   gr_context_release(ctx);
 }
 
-int main(int argc, char **argv) {
-  if (argc > 1 && strcmp(argv[1], "--expect-no-platform") == 0) {
-    test_no_platform();
-    return GR_TEST_RESULT();
+/* Arguments by name: set in any order, checked by what the kernel computes. */
+static void test_kernel_arg(void) {
+  gr_context *ctx = NULL;
+  CHECK(gr_context_create(NULL, &ctx) == GR_OK);
+  if (!ctx)
+    return;
+  const char *src = "__kernel void axpb(__global float *x, float a, float b, int n) {"
+                    " int i = get_global_id(0); if (i < n) x[i] = a * x[i] + b; }\n"
+                    "__kernel void bxpa(int n, float b, float a, __global float *x) {"
+                    " int i = get_global_id(0); if (i < n) x[i] = b * x[i] + a; }";
+  cl_program prog = NULL;
+  CHECK(gr_program_build_source(ctx, src, NULL, &prog) == GR_OK);
+  if (!prog) {
+    gr_context_release(ctx);
+    return;
   }
-  test_names();
-  test_devices();
-  test_shared();
-  test_kernels();
-  return GR_TEST_RESULT();
+  enum { N = 257 };
+  float host[N];
+  for (int i = 0; i < N; ++i)
+    host[i] = (float)i;
+  cl_mem x = NULL;
+  CHECK(gr_buffer_create(ctx, CL_MEM_READ_WRITE, sizeof(host), host, &x) == GR_OK);
+  cl_float a = 2.0f, b = -3.0f;
+  cl_int n = N;
+  /* Kernels are created and released in turn so that a new kernel may get a
+   * released one's handle: the cached names must not leak across. */
+  for (int round = 0; round < 6; ++round) {
+    const char *name = round % 2 ? "bxpa" : "axpb";
+    cl_kernel k = NULL;
+    CHECK(gr_kernel_create(ctx, prog, name, &k) == GR_OK);
+    if (!k)
+      break;
+    CHECK(GR_KERNEL_ARG(ctx, k, n) == GR_OK);
+    CHECK(GR_KERNEL_ARG(ctx, k, b) == GR_OK);
+    CHECK(GR_KERNEL_ARG(ctx, k, x) == GR_OK);
+    CHECK(GR_KERNEL_ARG(ctx, k, a) == GR_OK);
+    CHECK(gr_buffer_write(ctx, x, 0, sizeof(host), host) == GR_OK);
+    CHECK(gr_enqueue_2d(ctx, k, 0, 0, N, 1, NULL) == GR_OK);
+    float out[N];
+    CHECK(gr_buffer_read(ctx, x, 0, sizeof(out), out) == GR_OK);
+    int wrong = 0;
+    for (int i = 0; i < N; ++i)
+      wrong += out[i] != (round % 2 ? b * (float)i + a : a * (float)i + b);
+    CHECK_MSG(wrong == 0, "%s, round %d: %d of %d values wrong", name, round, wrong, N);
+    a += 1.0f;
+    clReleaseKernel(k);
+  }
+
+  /* An unknown name and a wrong size give a sentence naming the kernel, the
+   * argument and (for the driver's refusal) the OpenCL error. */
+  cl_kernel k = NULL;
+  CHECK(gr_kernel_create(ctx, prog, "axpb", &k) == GR_OK);
+  cl_int nope = 1;
+  CHECK(GR_KERNEL_ARG(ctx, k, nope) == GR_ERR_INVALID_ARGUMENT);
+  const char *e = gr_last_error(ctx);
+  CHECK_MSG(strstr(e, "'axpb'") && strstr(e, "'nope'") && is_sentence(e), "'%s'", e);
+  double wide = 1.0;
+  CHECK(gr_kernel_arg(ctx, k, "n", sizeof(wide), &wide) == GR_ERR_OPENCL);
+  e = gr_last_error(ctx);
+  CHECK_MSG(strstr(e, "'axpb'") && strstr(e, "'n'") && strstr(e, "CL_INVALID_ARG_SIZE") &&
+                is_sentence(e),
+            "'%s'", e);
+  CHECK(gr_kernel_arg(ctx, NULL, "n", sizeof(n), &n) == GR_ERR_INVALID_ARGUMENT);
+  CHECK(gr_kernel_arg(ctx, k, NULL, sizeof(n), &n) == GR_ERR_INVALID_ARGUMENT);
+
+  /* More kernels than the cache holds: every one still finds its names. */
+  int failures = 0;
+  for (int i = 0; i < 100; ++i) {
+    cl_kernel ki = NULL;
+    if (gr_kernel_create(ctx, prog, i % 2 ? "bxpa" : "axpb", &ki) != GR_OK) {
+      ++failures;
+      continue;
+    }
+    failures += GR_KERNEL_ARG(ctx, ki, n) != GR_OK;
+    failures += GR_KERNEL_ARG(ctx, ki, x) != GR_OK;
+    clReleaseKernel(ki);
+  }
+  CHECK_MSG(failures == 0, "%d failures", failures);
+  clReleaseKernel(k);
+  clReleaseProgram(prog);
+  gr_buffer_release(&x);
+  gr_context_release(ctx);
+}
+
+static void *other_thread(void *arg) {
+  gr_set_error(NULL, GR_ERR_IO, "The other thread failed.");
+  snprintf((char *)arg, 64, "%s", gr_last_error(NULL));
+  return NULL;
+}
+
+static void test_errors_per_thread(void) {
+  gr_set_error(NULL, GR_ERR_BUILD, "The main thread failed.");
+  char seen[64] = "";
+  pthread_t th;
+  CHECK(pthread_create(&th, NULL, other_thread, seen) == 0);
+  pthread_join(th, NULL);
+  CHECK(strcmp(seen, "The other thread failed.") == 0);
+  CHECK(strcmp(gr_last_error(NULL), "The main thread failed.") == 0);
+
+  /* gr_error_keep copies the thread's sentence into a handle's buffer,
+   * truncated and terminated, and only for a failure. */
+  char keep[12];
+  memset(keep, 'x', sizeof(keep));
+  CHECK(gr_error_keep(keep, sizeof(keep), GR_ERR_BUILD) == GR_ERR_BUILD);
+  CHECK(strcmp(keep, "The main th") == 0);
+  gr_set_error(NULL, GR_ERR_IO, "Another.");
+  CHECK(gr_error_keep(keep, sizeof(keep), GR_OK) == GR_OK);
+  CHECK(strcmp(keep, "The main th") == 0);
+  CHECK(gr_error_keep(NULL, 0, GR_ERR_IO) == GR_ERR_IO);
+  /* A sentence may quote the one before it. */
+  gr_set_error(NULL, GR_ERR_IO, "Inner.");
+  gr_set_error(NULL, GR_ERR_IO, "Outer: %s", gr_last_error(NULL));
+  CHECK(strcmp(gr_last_error(NULL), "Outer: Inner.") == 0);
+}
+
+/* A unit cube, counter-clockwise seen from outside. */
+static const float cube_v[] = {0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1,    0, 0, 0,
+                               1, 1, 0, 1, 1, 1, 1, 0, 1, 1, 0.5f, 0, 0};
+static const int cube_t[] = {0, 2, 1, 0, 3, 2, 4, 5, 6, 4, 6, 7, 0, 1, 5, 0, 5, 4,
+                             2, 3, 7, 2, 7, 6, 0, 4, 7, 0, 7, 3, 1, 2, 6, 1, 6, 5};
+
+static gr_mesh cube(float *v, int *t) {
+  gr_mesh m;
+  memset(&m, 0, sizeof(m));
+  memcpy(v, cube_v, sizeof(cube_v));
+  memcpy(t, cube_t, sizeof(cube_t));
+  m.vertices = v;
+  m.nvertices = 8; /* the ninth, (0.5, 0, 0), only for the zero-area case */
+  m.triangles = t;
+  m.ntriangles = 12;
+  for (int i = 0; i < 4; ++i)
+    m.transform[5 * i] = 1.0;
+  m.transform[12] = 10.0; /* a translation */
+  return m;
+}
+
+static void test_mesh(void) {
+  float v[27];
+  int t[39];
+  char msg[512];
+  gr_mesh m = cube(v, t);
+  CHECK_MSG(gr_mesh_validate(&m, 1, msg, sizeof(msg)) == GR_OK, "%s", msg);
+
+  m.ntriangles = 11; /* (1, 6, 5) removed: its three edges are open */
+  CHECK(gr_mesh_validate(&m, 1, msg, sizeof(msg)) == GR_ERR_INVALID_ARGUMENT);
+  CHECK_MSG(strstr(msg, "open") && strstr(msg, "vertices 1 and 5") && is_sentence(msg), "'%s'",
+            msg);
+  CHECK(gr_mesh_validate(&m, 0, msg, sizeof(msg)) == GR_OK);
+
+  m = cube(v, t);
+  t[1] = 1, t[2] = 2; /* triangle 0 flipped */
+  CHECK(gr_mesh_validate(&m, 1, msg, sizeof(msg)) == GR_ERR_INVALID_ARGUMENT);
+  CHECK_MSG(strstr(msg, "winding") && strstr(msg, "triangles 0 and") && is_sentence(msg), "'%s'",
+            msg);
+  CHECK(gr_mesh_validate(&m, 0, msg, sizeof(msg)) == GR_OK);
+
+  m = cube(v, t);
+  v[3 * 3 + 1] = NAN;
+  CHECK(gr_mesh_validate(&m, 0, msg, sizeof(msg)) == GR_ERR_INVALID_ARGUMENT);
+  CHECK_MSG(strstr(msg, "vertex 3") && strstr(msg, "nan") && is_sentence(msg), "'%s'", msg);
+
+  m = cube(v, t);
+  t[3 * 7 + 2] = 8;
+  CHECK(gr_mesh_validate(&m, 0, msg, sizeof(msg)) == GR_ERR_INVALID_ARGUMENT);
+  CHECK_MSG(strstr(msg, "triangle 7") && strstr(msg, "vertex 8") && strstr(msg, "0 to 7"), "'%s'",
+            msg);
+  t[3 * 7 + 2] = -1;
+  CHECK(gr_mesh_validate(&m, 0, msg, sizeof(msg)) == GR_ERR_INVALID_ARGUMENT);
+
+  m = cube(v, t);
+  m.nvertices = 9;
+  t[36] = 0, t[37] = 8, t[38] = 1; /* collinear corners: zero area */
+  m.ntriangles = 13;
+  CHECK(gr_mesh_validate(&m, 0, msg, sizeof(msg)) == GR_ERR_INVALID_ARGUMENT);
+  CHECK_MSG(strstr(msg, "triangle 12") && strstr(msg, "zero area"), "'%s'", msg);
+  t[37] = 1, t[38] = 1; /* a repeated corner */
+  CHECK(gr_mesh_validate(&m, 0, msg, sizeof(msg)) == GR_ERR_INVALID_ARGUMENT);
+  CHECK(strstr(msg, "zero area") != NULL);
+  /* A tiny but proper triangle is not degenerate. */
+  float tiny[] = {0, 0, 0, 1e-6f, 0, 0, 0, 1e-6f, 0};
+  int tri[] = {0, 1, 2};
+  gr_mesh small = m;
+  small.vertices = tiny, small.nvertices = 3, small.triangles = tri, small.ntriangles = 1;
+  CHECK(gr_mesh_validate(&small, 0, msg, sizeof(msg)) == GR_OK);
+  CHECK(gr_mesh_validate(&small, 1, msg, sizeof(msg)) == GR_ERR_INVALID_ARGUMENT);
+
+  m = cube(v, t);
+  m.transform[10] = 0.0; /* z scaled to nothing */
+  CHECK(gr_mesh_validate(&m, 1, msg, sizeof(msg)) == GR_ERR_INVALID_ARGUMENT);
+  CHECK_MSG(strstr(msg, "singular") && is_sentence(msg), "'%s'", msg);
+  m.transform[10] = 1e-9; /* small but invertible: a scale, not a fault */
+  CHECK(gr_mesh_validate(&m, 1, msg, sizeof(msg)) == GR_OK);
+  m.transform[10] = 1.0;
+  m.transform[13] = INFINITY;
+  CHECK(gr_mesh_validate(&m, 1, msg, sizeof(msg)) == GR_ERR_INVALID_ARGUMENT);
+  CHECK_MSG(strstr(msg, "element 13") && strstr(msg, "finite"), "'%s'", msg);
+
+  m = cube(v, t);
+  m.ntriangles = 0;
+  CHECK(gr_mesh_validate(&m, 0, msg, sizeof(msg)) == GR_ERR_INVALID_ARGUMENT);
+  CHECK(gr_mesh_validate(NULL, 0, msg, sizeof(msg)) == GR_ERR_INVALID_ARGUMENT);
+  CHECK(gr_mesh_validate(NULL, 0, NULL, 0) == GR_ERR_INVALID_ARGUMENT);
+}
+
+static void test_points(void) {
+  float pos[] = {0, 0, 0, 1, 2, 3, 4, 5, 6};
+  float diameter[] = {1e-3f, 2e-3f, 3e-3f};
+  float velocity[] = {0, 0, -5, 0, 0, -6, 1, 0, -7};
+  gr_points_array arrays[2] = {{"diameter", 1, diameter}, {"velocity", 3, velocity}};
+  gr_points p = {pos, 3, arrays, 2};
+  char msg[512];
+  CHECK_MSG(gr_points_validate(&p, msg, sizeof(msg)) == GR_OK, "%s", msg);
+  gr_points none = {NULL, 0, NULL, 0};
+  CHECK(gr_points_validate(&none, msg, sizeof(msg)) == GR_OK);
+
+  pos[4] = NAN;
+  CHECK(gr_points_validate(&p, msg, sizeof(msg)) == GR_ERR_INVALID_ARGUMENT);
+  CHECK_MSG(strstr(msg, "point 1") && strstr(msg, "y = nan") && is_sentence(msg), "'%s'", msg);
+  pos[4] = 2;
+  arrays[1].name = "";
+  CHECK(gr_points_validate(&p, msg, sizeof(msg)) == GR_ERR_INVALID_ARGUMENT);
+  CHECK_MSG(strstr(msg, "array 1") && strstr(msg, "no name"), "'%s'", msg);
+  arrays[1].name = NULL;
+  CHECK(gr_points_validate(&p, msg, sizeof(msg)) == GR_ERR_INVALID_ARGUMENT);
+  arrays[1].name = "diameter";
+  CHECK(gr_points_validate(&p, msg, sizeof(msg)) == GR_ERR_INVALID_ARGUMENT);
+  CHECK_MSG(strstr(msg, "'diameter'") && strstr(msg, "distinct"), "'%s'", msg);
+  arrays[1].name = "velocity";
+  arrays[1].components = 0;
+  CHECK(gr_points_validate(&p, msg, sizeof(msg)) == GR_ERR_INVALID_ARGUMENT);
+  CHECK_MSG(strstr(msg, "'velocity'") && strstr(msg, "0 components"), "'%s'", msg);
+  arrays[1].components = 10;
+  CHECK(gr_points_validate(&p, msg, sizeof(msg)) == GR_ERR_INVALID_ARGUMENT);
+  CHECK(strstr(msg, "10 components") != NULL);
+  arrays[1].components = 3;
+  velocity[8] = INFINITY;
+  CHECK(gr_points_validate(&p, msg, sizeof(msg)) == GR_ERR_INVALID_ARGUMENT);
+  CHECK_MSG(strstr(msg, "'velocity'") && strstr(msg, "point 2") && strstr(msg, "component 2"),
+            "'%s'", msg);
+  velocity[8] = -7;
+  CHECK(gr_points_validate(&p, msg, sizeof(msg)) == GR_OK);
+  p.npoints = -1;
+  CHECK(gr_points_validate(&p, msg, sizeof(msg)) == GR_ERR_INVALID_ARGUMENT);
+  CHECK(gr_points_validate(NULL, NULL, 0) == GR_ERR_INVALID_ARGUMENT);
+}
+
+/* Without an OpenCL device the tests that need one are skipped (77). */
+static int have_device(void) {
+  gr_context *ctx = NULL;
+  if (gr_context_create(NULL, &ctx) != GR_OK)
+    return 0;
+  gr_context_release(ctx);
+  return 1;
+}
+
+static const gr_subtest tests[] = {
+    {"no_platform", test_no_platform, 1}, /* only with OCL_ICD_VENDORS at an empty folder */
+    {"names", test_names, 0},
+    {"devices", test_devices, 0},
+    {"shared", test_shared, 0},
+    {"embed", test_embed, 0},
+    {"kernels", test_kernels, 0},
+    {"kernel_arg", test_kernel_arg, 0},
+    {"errors_per_thread", test_errors_per_thread, 0},
+    {"mesh", test_mesh, 0},
+    {"points", test_points, 0},
+};
+
+int main(int argc, char **argv) {
+  int n = (int)(sizeof(tests) / sizeof(tests[0]));
+  /* The no-driver check runs without the device set-up, which would skip it. */
+  if (argc == 2 &&
+      (strcmp(argv[1], "--expect-no-platform") == 0 || strcmp(argv[1], "no_platform") == 0)) {
+    static char name[] = "no_platform";
+    char *args[] = {argv[0], name, NULL};
+    return gr_test_main(2, args, tests, n, NULL, NULL);
+  }
+  return gr_test_main(argc, argv, tests, n, have_device, NULL);
 }

@@ -3,6 +3,7 @@
 #include "graupel/cl_runtime.h"
 
 #include <ctype.h>
+#include <math.h>
 #include <pthread.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -11,11 +12,24 @@
 
 #define GR_ERROR_LEN 16384
 #define GR_MAX_SHARED 8
+/* Kernels whose argument names a context remembers; beyond this the oldest
+ * entry is reused, so a long session that creates kernels without end keeps
+ * a fixed amount of memory. */
+#define GR_ARG_CACHE 64
 
 typedef struct gr_program_entry {
   char *key; /* name + '\n' + options */
   cl_program program;
 } gr_program_entry;
+
+/* The argument names of one kernel, in index order. An entry is only a hint:
+ * a released kernel's handle may come back for another kernel, so a hit is
+ * confirmed by asking the kernel for the name at the cached index. */
+typedef struct gr_arg_entry {
+  cl_kernel kernel;
+  cl_uint nargs;
+  char **names; /* nargs strings in one allocation after the pointers */
+} gr_arg_entry;
 
 struct gr_context {
   int refcount; /* guarded by gr_shared_lock */
@@ -31,14 +45,17 @@ struct gr_context {
   size_t local2d[2]; /* default work-group shape for 2-D kernels */
   gr_log_fn log;
   void *log_user;
-  pthread_mutex_t lock;       /* guards programs and error */
+  pthread_mutex_t lock;       /* guards programs and the argument cache */
   gr_program_entry *programs; /* grows: one entry per (source, options) */
   int nprograms, capacity;
-  char error[GR_ERROR_LEN];
+  gr_arg_entry args[GR_ARG_CACHE];
+  int next_arg; /* the entry replaced when the cache is full */
 };
 
 /* The only global mutable state: the table of shared contexts (one per
- * device), and the per-thread text of errors that have no context. */
+ * device), and the per-thread text of the latest error. Error text is per
+ * thread, not per context, because filters share one context: a handle keeps
+ * its own copy with gr_error_keep. */
 static pthread_mutex_t gr_shared_lock = PTHREAD_MUTEX_INITIALIZER;
 static gr_context *gr_shared[GR_MAX_SHARED];
 static _Thread_local char gr_thread_error[GR_ERROR_LEN];
@@ -78,26 +95,56 @@ const char *gr_version_string(void) {
       GRAUPEL_VERSION_PATCH);
 }
 
-static const char *const gr_field_names[GR_FIELD_COUNT] = {
-    "elevation",   "snow_depth",   "snow_density",  "snow_surface", "overlap",
-    "exposure",    "water_depth",  "water_surface", "velocity",     "discharge",
-    "infiltrated", "permeability", "rain_rate"};
+/* The field vocabulary: array name, components and SI unit of every
+ * gr_field, in enum order. VTK arrays, EXR channels and the README use these
+ * names and units; "1" is dimensionless. */
+static const struct gr_field_row {
+  gr_field field; /* checked against the row's index by the tests */
+  const char *name;
+  int components;
+  const char *unit;
+} gr_fields[GR_FIELD_COUNT] = {
+    {GR_FIELD_ELEVATION, "elevation", 1, "m"},
+    {GR_FIELD_SNOW_DEPTH, "snow_depth", 1, "m"},
+    {GR_FIELD_SNOW_DENSITY, "snow_density", 1, "kg/m^3"},
+    {GR_FIELD_SNOW_SURFACE, "snow_surface", 1, "m"},
+    {GR_FIELD_OVERLAP, "overlap", 1, "m"},
+    {GR_FIELD_EXPOSURE, "exposure", 1, "1"},
+    {GR_FIELD_WATER_DEPTH, "water_depth", 1, "m"},
+    {GR_FIELD_WATER_SURFACE, "water_surface", 1, "m"},
+    {GR_FIELD_VELOCITY, "velocity", 3, "m/s"},
+    {GR_FIELD_DISCHARGE, "discharge", 1, "m^2/s"},
+    {GR_FIELD_INFILTRATED, "infiltrated", 1, "m"},
+    {GR_FIELD_PERMEABILITY, "permeability", 1, "m/s"},
+    {GR_FIELD_RAIN_RATE, "rain_rate", 1, "m/s"},
+};
+
+static const struct gr_field_row *gr_field_row_of(gr_field f) {
+  return ((int)f >= 0 && (int)f < GR_FIELD_COUNT) ? &gr_fields[f] : NULL;
+}
 
 const char *gr_field_name(gr_field f) {
-  return (f >= 0 && f < GR_FIELD_COUNT) ? gr_field_names[f] : NULL;
+  const struct gr_field_row *r = gr_field_row_of(f);
+  return r ? r->name : NULL;
 }
 
 int gr_field_from_name(const char *name) {
   if (!name)
     return -1;
   for (int i = 0; i < GR_FIELD_COUNT; ++i)
-    if (strcmp(name, gr_field_names[i]) == 0)
-      return i;
+    if (strcmp(name, gr_fields[i].name) == 0)
+      return (int)gr_fields[i].field;
   return -1;
 }
 
 int gr_field_components(gr_field f) {
-  return f == GR_FIELD_VELOCITY ? 3 : 1;
+  const struct gr_field_row *r = gr_field_row_of(f);
+  return r ? r->components : 0;
+}
+
+const char *gr_field_unit(gr_field f) {
+  const struct gr_field_row *r = gr_field_row_of(f);
+  return r ? r->unit : NULL;
 }
 
 gr_status gr_grid_validate(const gr_grid *g, char *msg, size_t msg_len) {
@@ -122,6 +169,235 @@ gr_status gr_grid_validate(const gr_grid *g, char *msg, size_t msg_len) {
   return GR_ERR_INVALID_ARGUMENT;
 }
 
+/* ------------------------------------------------------- meshes, points */
+
+static gr_status gr_invalid(char *msg, size_t msg_len, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 3, 4)))
+#endif
+    ;
+static gr_status gr_invalid(char *msg, size_t msg_len, const char *fmt, ...) {
+  if (msg && msg_len) {
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(msg, msg_len, fmt, ap);
+    va_end(ap);
+  }
+  return GR_ERR_INVALID_ARGUMENT;
+}
+
+static const char *const gr_axis[3] = {"x", "y", "z"};
+
+/* |det| of the 4x4 column-major m, and Hadamard's bound on it (the product
+ * of the column lengths): their ratio says how far m is from singular,
+ * whatever its scale. */
+static double gr_det4(const double *m, double *bound) {
+  double a[4][4];
+  *bound = 1.0;
+  for (int c = 0; c < 4; ++c) {
+    double len = 0.0;
+    for (int r = 0; r < 4; ++r) {
+      a[r][c] = m[4 * c + r];
+      len += a[r][c] * a[r][c];
+    }
+    *bound *= sqrt(len);
+  }
+  double det = 1.0;
+  for (int c = 0; c < 4; ++c) { /* Gaussian elimination, partial pivoting */
+    int piv = c;
+    for (int r = c + 1; r < 4; ++r)
+      if (fabs(a[r][c]) > fabs(a[piv][c]))
+        piv = r;
+    if (a[piv][c] == 0.0)
+      return 0.0;
+    if (piv != c) {
+      for (int k = 0; k < 4; ++k) {
+        double t = a[c][k];
+        a[c][k] = a[piv][k];
+        a[piv][k] = t;
+      }
+      det = -det;
+    }
+    det *= a[c][c];
+    for (int r = c + 1; r < 4; ++r) {
+      double f = a[r][c] / a[c][c];
+      for (int k = c; k < 4; ++k)
+        a[r][k] -= f * a[c][k];
+    }
+  }
+  return fabs(det);
+}
+
+/* A directed edge of a triangle, keyed by its undirected vertex pair. */
+typedef struct gr_edge {
+  int lo, hi;   /* vertex indices, lo < hi */
+  int forward;  /* 1 when the triangle runs lo -> hi */
+  int triangle; /* the triangle it belongs to */
+} gr_edge;
+
+static int gr_edge_cmp(const void *pa, const void *pb) {
+  const gr_edge *a = pa, *b = pb;
+  if (a->lo != b->lo)
+    return a->lo < b->lo ? -1 : 1;
+  if (a->hi != b->hi)
+    return a->hi < b->hi ? -1 : 1;
+  return (a->triangle > b->triangle) - (a->triangle < b->triangle);
+}
+
+gr_status gr_mesh_validate(const gr_mesh *m, int closed, char *msg, size_t msg_len) {
+  if (!m)
+    return gr_invalid(msg, msg_len, "Invalid mesh: no mesh was given.");
+  if (m->ntriangles < 1 || !m->triangles)
+    return gr_invalid(msg, msg_len,
+                      "Invalid mesh: it has %d triangles; give at least one triangle.",
+                      m->ntriangles);
+  if (m->nvertices < 3 || !m->vertices)
+    return gr_invalid(msg, msg_len,
+                      "Invalid mesh: it has %d vertices; a triangle needs at least three.",
+                      m->nvertices);
+  for (int v = 0; v < m->nvertices; ++v)
+    for (int a = 0; a < 3; ++a)
+      if (!isfinite(m->vertices[3 * v + a]))
+        return gr_invalid(msg, msg_len,
+                          "Invalid mesh: vertex %d has %s = %g; vertex coordinates must be "
+                          "finite metres.",
+                          v, gr_axis[a], (double)m->vertices[3 * v + a]);
+  for (int t = 0; t < m->ntriangles; ++t) {
+    const int *tri = m->triangles + 3 * t;
+    for (int k = 0; k < 3; ++k)
+      if (tri[k] < 0 || tri[k] >= m->nvertices)
+        return gr_invalid(msg, msg_len,
+                          "Invalid mesh: triangle %d refers to vertex %d, but the vertices are "
+                          "0 to %d.",
+                          t, tri[k], m->nvertices - 1);
+    const float *p0 = m->vertices + 3 * tri[0], *p1 = m->vertices + 3 * tri[1],
+                *p2 = m->vertices + 3 * tri[2];
+    double e1[3], e2[3];
+    for (int a = 0; a < 3; ++a) {
+      e1[a] = (double)p1[a] - p0[a];
+      e2[a] = (double)p2[a] - p0[a];
+    }
+    double cx = e1[1] * e2[2] - e1[2] * e2[1], cy = e1[2] * e2[0] - e1[0] * e2[2],
+           cz = e1[0] * e2[1] - e1[1] * e2[0];
+    double cross = sqrt(cx * cx + cy * cy + cz * cz);
+    double l1 = sqrt(e1[0] * e1[0] + e1[1] * e1[1] + e1[2] * e1[2]);
+    double l2 = sqrt(e2[0] * e2[0] + e2[1] * e2[1] + e2[2] * e2[2]);
+    /* Relative to the edge lengths: collinear corners, not small ones. */
+    if (!(cross > 1e-12 * l1 * l2))
+      return gr_invalid(msg, msg_len,
+                        "Invalid mesh: triangle %d (vertices %d, %d, %d) has zero area; remove "
+                        "it or move its corners apart.",
+                        t, tri[0], tri[1], tri[2]);
+  }
+  for (int k = 0; k < 16; ++k)
+    if (!isfinite(m->transform[k]))
+      return gr_invalid(msg, msg_len,
+                        "Invalid mesh: transform element %d (column %d, row %d) is %g; the "
+                        "transform must be finite.",
+                        k, k / 4, k % 4, m->transform[k]);
+  double bound = 0.0, det = gr_det4(m->transform, &bound);
+  if (!(det > 1e-12 * bound))
+    return gr_invalid(msg, msg_len,
+                      "Invalid mesh: the transform is singular (determinant %g); it must map the "
+                      "object's frame to the world invertibly (no zero scale).",
+                      det);
+  if (!closed)
+    return GR_OK;
+
+  size_t ne = 3 * (size_t)m->ntriangles;
+  gr_edge *edges = malloc(ne * sizeof(*edges));
+  if (!edges) {
+    if (msg && msg_len)
+      snprintf(msg, msg_len, "Out of host memory while checking a mesh of %d triangles.",
+               m->ntriangles);
+    return GR_ERR_OUT_OF_MEMORY;
+  }
+  for (int t = 0; t < m->ntriangles; ++t)
+    for (int k = 0; k < 3; ++k) {
+      int a = m->triangles[3 * t + k], b = m->triangles[3 * t + (k + 1) % 3];
+      gr_edge *e = &edges[3 * (size_t)t + k];
+      e->lo = a < b ? a : b;
+      e->hi = a < b ? b : a;
+      e->forward = a < b;
+      e->triangle = t;
+    }
+  qsort(edges, ne, sizeof(*edges), gr_edge_cmp);
+  gr_status st = GR_OK;
+  for (size_t i = 0; i < ne && st == GR_OK;) {
+    size_t n = 1;
+    while (i + n < ne && edges[i + n].lo == edges[i].lo && edges[i + n].hi == edges[i].hi)
+      ++n;
+    const gr_edge *e = &edges[i];
+    if (n == 1)
+      st = gr_invalid(msg, msg_len,
+                      "Invalid mesh: the edge between vertices %d and %d belongs to triangle %d "
+                      "only, so the surface is open there; close it (or check it as an open "
+                      "mesh).",
+                      e->lo, e->hi, e->triangle);
+    else if (n > 2)
+      st = gr_invalid(msg, msg_len,
+                      "Invalid mesh: the edge between vertices %d and %d is shared by %zu "
+                      "triangles (%d, %d, ...); a closed surface shares each edge between two.",
+                      e->lo, e->hi, n, e[0].triangle, e[1].triangle);
+    else if (e[0].forward == e[1].forward)
+      st = gr_invalid(msg, msg_len,
+                      "Invalid mesh: triangles %d and %d run the same way along their shared "
+                      "edge (vertices %d and %d): the winding is inconsistent; flip one so that "
+                      "every triangle is counter-clockwise seen from outside.",
+                      e[0].triangle, e[1].triangle, e->lo, e->hi);
+    i += n;
+  }
+  free(edges);
+  return st;
+}
+
+gr_status gr_points_validate(const gr_points *p, char *msg, size_t msg_len) {
+  if (!p)
+    return gr_invalid(msg, msg_len, "Invalid points: no points were given.");
+  if (p->npoints < 0)
+    return gr_invalid(msg, msg_len, "Invalid points: the count is %lld; it must be 0 or more.",
+                      p->npoints);
+  if (p->npoints > 0 && !p->positions)
+    return gr_invalid(msg, msg_len, "Invalid points: %lld points but no positions were given.",
+                      p->npoints);
+  if (p->narrays < 0 || (p->narrays > 0 && !p->arrays))
+    return gr_invalid(msg, msg_len,
+                      "Invalid points: %d arrays announced but none given; pass the arrays or "
+                      "set narrays to 0.",
+                      p->narrays);
+  for (long long i = 0; i < p->npoints; ++i)
+    for (int a = 0; a < 3; ++a)
+      if (!isfinite(p->positions[3 * i + a]))
+        return gr_invalid(msg, msg_len,
+                          "Invalid points: point %lld has %s = %g; positions must be finite "
+                          "metres.",
+                          i, gr_axis[a], (double)p->positions[3 * i + a]);
+  for (int k = 0; k < p->narrays; ++k) {
+    const gr_points_array *arr = &p->arrays[k];
+    if (!arr->name || !arr->name[0])
+      return gr_invalid(msg, msg_len, "Invalid points: array %d has no name; name every array.", k);
+    for (int j = 0; j < k; ++j)
+      if (p->arrays[j].name && strcmp(p->arrays[j].name, arr->name) == 0)
+        return gr_invalid(msg, msg_len,
+                          "Invalid points: arrays %d and %d are both named '%s'; array names "
+                          "must be distinct.",
+                          j, k, arr->name);
+    if (arr->components < 1 || arr->components > 9)
+      return gr_invalid(msg, msg_len, "Invalid points: array '%s' has %d components; give 1 to 9.",
+                        arr->name, arr->components);
+    if (p->npoints > 0 && !arr->values)
+      return gr_invalid(msg, msg_len, "Invalid points: array '%s' has no values.", arr->name);
+    for (long long i = 0; i < p->npoints; ++i)
+      for (int c = 0; c < arr->components; ++c)
+        if (!isfinite(arr->values[i * arr->components + c]))
+          return gr_invalid(msg, msg_len,
+                            "Invalid points: array '%s' has the value %g at point %lld "
+                            "(component %d); values must be finite.",
+                            arr->name, (double)arr->values[i * arr->components + c], i, c);
+  }
+  return GR_OK;
+}
+
 /* ------------------------------------------------------------------ errors */
 
 static void gr_log(const gr_context *ctx, gr_log_level level, const char *msg) {
@@ -129,25 +405,28 @@ static void gr_log(const gr_context *ctx, gr_log_level level, const char *msg) {
     ctx->log(ctx->log_user, level, msg);
 }
 
-gr_status gr_set_error(const gr_context *cctx, gr_status st, const char *fmt, ...) {
-  /* The error text is the one mutable part of a const context. */
-  gr_context *ctx = (gr_context *)cctx;
-  char *dst = ctx ? ctx->error : gr_thread_error;
+gr_status gr_set_error(const gr_context *ctx, gr_status st, const char *fmt, ...) {
+  /* Formatted aside first: callers may pass the current error as an argument
+   * ("%s", gr_last_error(ctx)) to add context to it. */
+  static _Thread_local char scratch[GR_ERROR_LEN];
   va_list ap;
-  if (ctx)
-    pthread_mutex_lock(&ctx->lock);
   va_start(ap, fmt);
-  vsnprintf(dst, GR_ERROR_LEN, fmt, ap);
+  vsnprintf(scratch, sizeof(scratch), fmt, ap);
   va_end(ap);
-  if (ctx)
-    pthread_mutex_unlock(&ctx->lock);
-  if (ctx)
-    gr_log(ctx, GR_LOG_WARNING, dst);
+  memcpy(gr_thread_error, scratch, sizeof(gr_thread_error));
+  gr_log(ctx, GR_LOG_WARNING, gr_thread_error);
+  return st;
+}
+
+gr_status gr_error_keep(char *dst, size_t len, gr_status st) {
+  if (st != GR_OK && dst && len > 0 && dst != gr_thread_error)
+    snprintf(dst, len, "%s", gr_thread_error);
   return st;
 }
 
 const char *gr_last_error(const gr_context *ctx) {
-  return ctx ? ctx->error : gr_thread_error;
+  (void)ctx; /* kept for compatibility: the text is the calling thread's */
+  return gr_thread_error;
 }
 
 const char *gr_cl_error_name(cl_int err) {
@@ -417,6 +696,8 @@ void gr_context_options_init(gr_context_options *opt) {
 }
 
 static void gr_context_free(gr_context *ctx) {
+  for (int i = 0; i < GR_ARG_CACHE; ++i)
+    free(ctx->args[i].names);
   for (int i = 0; i < ctx->nprograms; ++i) {
     clReleaseProgram(ctx->programs[i].program);
     free(ctx->programs[i].key);
@@ -622,7 +903,8 @@ static gr_status gr_build(gr_context *ctx, const char *label, const char *source
     return gr_cl_check(ctx, err, "Creating an OpenCL program");
   /* FP_CONTRACT stays off inside the sources; -cl-std pins the language. */
   char opts[4096];
-  snprintf(opts, sizeof(opts), "-cl-std=CL1.2 %s %s", options ? options : "",
+  /* -cl-kernel-arg-info: gr_kernel_arg finds arguments by their names. */
+  snprintf(opts, sizeof(opts), "-cl-std=CL1.2 -cl-kernel-arg-info %s %s", options ? options : "",
            gr_extra_build_options());
   err = clBuildProgram(prog, 1, &ctx->device, opts, NULL, NULL);
   if (err != CL_SUCCESS) {
@@ -737,6 +1019,13 @@ gr_status gr_kernel_create(gr_context *ctx, cl_program prog, const char *name, c
   return GR_OK;
 }
 
+static void gr_kernel_name(cl_kernel k, char *buf, size_t len) {
+  buf[0] = '\0';
+  if (clGetKernelInfo(k, CL_KERNEL_FUNCTION_NAME, len, buf, NULL) != CL_SUCCESS)
+    snprintf(buf, len, "(unnamed)");
+  buf[len - 1] = '\0';
+}
+
 gr_status gr_kernel_args(gr_context *ctx, cl_kernel k, ...) {
   va_list ap;
   va_start(ap, k);
@@ -748,15 +1037,135 @@ gr_status gr_kernel_args(gr_context *ctx, cl_kernel k, ...) {
     cl_int err = clSetKernelArg(k, i, size, value);
     if (err != CL_SUCCESS) {
       va_end(ap);
-      char kname[128] = "";
-      clGetKernelInfo(k, CL_KERNEL_FUNCTION_NAME, sizeof(kname), kname, NULL);
-      kname[sizeof(kname) - 1] = '\0';
+      char kname[128];
+      gr_kernel_name(k, kname, sizeof(kname));
       return gr_set_error(ctx, GR_ERR_OPENCL, "Setting argument %u of kernel '%s' failed: %s.", i,
                           kname, gr_cl_error_name(err));
     }
   }
   va_end(ap);
   return GR_OK;
+}
+
+/* The name of argument i of k into buf; a CL error code on failure. */
+static cl_int gr_arg_name(cl_kernel k, cl_uint i, char *buf, size_t len) {
+  size_t got = 0;
+  buf[0] = '\0';
+  cl_int err = clGetKernelArgInfo(k, i, CL_KERNEL_ARG_NAME, len, buf, &got);
+  buf[len - 1] = '\0';
+  return err;
+}
+
+/* Reads every argument name of k into a fresh entry (names NULL on failure). */
+static cl_int gr_arg_entry_read(cl_kernel k, gr_arg_entry *e) {
+  cl_uint n = 0;
+  e->kernel = k;
+  e->nargs = 0;
+  e->names = NULL;
+  cl_int err = clGetKernelInfo(k, CL_KERNEL_NUM_ARGS, sizeof(n), &n, NULL);
+  if (err != CL_SUCCESS)
+    return err;
+  size_t total = 0;
+  for (cl_uint i = 0; i < n; ++i) {
+    size_t len = 0;
+    err = clGetKernelArgInfo(k, i, CL_KERNEL_ARG_NAME, 0, NULL, &len);
+    if (err != CL_SUCCESS)
+      return err;
+    total += len + 1;
+  }
+  char **names = malloc((size_t)n * sizeof(char *) + total + 1);
+  if (!names)
+    return CL_OUT_OF_HOST_MEMORY;
+  char *p = (char *)(names + n);
+  for (cl_uint i = 0; i < n; ++i) {
+    size_t len = 0;
+    err = clGetKernelArgInfo(k, i, CL_KERNEL_ARG_NAME, 0, NULL, &len);
+    if (err == CL_SUCCESS)
+      err = clGetKernelArgInfo(k, i, CL_KERNEL_ARG_NAME, len + 1, p, NULL);
+    if (err != CL_SUCCESS) {
+      free(names);
+      return err;
+    }
+    p[len] = '\0';
+    names[i] = p;
+    p += len + 1;
+  }
+  e->nargs = n;
+  e->names = names;
+  return CL_SUCCESS;
+}
+
+static int gr_arg_entry_find(const gr_arg_entry *e, const char *name) {
+  for (cl_uint i = 0; e->names && i < e->nargs; ++i)
+    if (strcmp(e->names[i], name) == 0)
+      return (int)i;
+  return -1;
+}
+
+/* Index of the argument called name, or -1 (*err says why when it is an
+ * OpenCL failure rather than an unknown name). */
+static int gr_arg_index(gr_context *ctx, cl_kernel k, const char *name, cl_int *err) {
+  char check[256];
+  int index = -1;
+  *err = CL_SUCCESS;
+  pthread_mutex_lock(&ctx->lock);
+  for (int i = 0; i < GR_ARG_CACHE; ++i)
+    if (ctx->args[i].kernel == k && ctx->args[i].names) {
+      index = gr_arg_entry_find(&ctx->args[i], name);
+      break;
+    }
+  pthread_mutex_unlock(&ctx->lock);
+  if (index >= 0 && gr_arg_name(k, (cl_uint)index, check, sizeof(check)) == CL_SUCCESS &&
+      strcmp(check, name) == 0)
+    return index;
+
+  /* A miss, or a stale entry: read the kernel's names again. */
+  gr_arg_entry fresh;
+  *err = gr_arg_entry_read(k, &fresh);
+  if (*err != CL_SUCCESS)
+    return -1;
+  index = gr_arg_entry_find(&fresh, name);
+  pthread_mutex_lock(&ctx->lock);
+  int slot = -1;
+  for (int i = 0; i < GR_ARG_CACHE && slot < 0; ++i)
+    if (ctx->args[i].kernel == k || !ctx->args[i].names)
+      slot = i;
+  if (slot < 0) {
+    slot = ctx->next_arg;
+    ctx->next_arg = (ctx->next_arg + 1) % GR_ARG_CACHE;
+  }
+  free(ctx->args[slot].names);
+  ctx->args[slot] = fresh;
+  pthread_mutex_unlock(&ctx->lock);
+  return index;
+}
+
+gr_status gr_kernel_arg(gr_context *ctx, cl_kernel k, const char *name, size_t size,
+                        const void *value) {
+  if (!ctx || !k || !name)
+    return gr_set_error(ctx, GR_ERR_INVALID_ARGUMENT,
+                        "gr_kernel_arg needs a context, a kernel and an argument name.");
+  cl_int err = CL_SUCCESS;
+  int index = gr_arg_index(ctx, k, name, &err);
+  if (index >= 0) {
+    err = clSetKernelArg(k, (cl_uint)index, size, value);
+    if (err == CL_SUCCESS)
+      return GR_OK;
+  }
+  char kname[128];
+  gr_kernel_name(k, kname, sizeof(kname));
+  if (err == CL_KERNEL_ARG_INFO_NOT_AVAILABLE)
+    return gr_set_error(ctx, GR_ERR_OPENCL,
+                        "The kernel '%s' has no argument names (argument '%s' was asked for): "
+                        "build its program with -cl-kernel-arg-info, as gr_program_get does.",
+                        kname, name);
+  if (err != CL_SUCCESS)
+    return gr_set_error(ctx, GR_ERR_OPENCL, "Setting argument '%s' of kernel '%s' failed: %s (%d).",
+                        name, kname, gr_cl_error_name(err), (int)err);
+  return gr_set_error(ctx, GR_ERR_INVALID_ARGUMENT,
+                      "The kernel '%s' has no argument named '%s': use a name from the kernel's "
+                      "source.",
+                      kname, name);
 }
 
 gr_status gr_enqueue_2d(gr_context *ctx, cl_kernel k, size_t x0, size_t y0, size_t nx, size_t ny,

@@ -3,8 +3,9 @@
  * @brief Checked OpenCL helpers the cores are built on.
  *
  * For code that runs its own kernels on a Graupel context: the cores, the
- * benchmark and the tests. Every helper records a sentence in the context's
- * error (gr_last_error) when it fails.
+ * benchmark and the tests. Every helper records a sentence as the calling
+ * thread's latest error (gr_last_error) when it fails; a core copies it into
+ * its handle with gr_error_keep.
  */
 #ifndef GRAUPEL_CL_RUNTIME_H
 #define GRAUPEL_CL_RUNTIME_H
@@ -28,8 +29,9 @@ GR_API cl_command_queue gr_context_queue(const gr_context *ctx);
 GR_API cl_device_id gr_context_device(const gr_context *ctx);
 
 /**
- * Records a formatted sentence as the context's last error and returns st.
- * ctx may be NULL (the per-thread error is set).
+ * Records a formatted sentence as the calling thread's latest error, passes
+ * it to the context's log callback (when ctx has one; ctx may be NULL) and
+ * returns st. The arguments may include gr_last_error's own text.
  */
 GR_API gr_status gr_set_error(const gr_context *ctx, gr_status st, const char *fmt, ...)
 #if defined(__GNUC__)
@@ -82,6 +84,28 @@ GR_API gr_status gr_buffer_read(gr_context *ctx, cl_mem buf, size_t offset, size
 GR_API void gr_buffer_release(cl_mem *buf);
 
 /**
+ * Sets the argument of kernel k that the kernel's source calls name.
+ * Programs are built with -cl-kernel-arg-info and the name-to-index table is
+ * cached per kernel, so a lookup is cheap. An unknown name or a failed
+ * clSetKernelArg is reported with the kernel's and the argument's names and
+ * the OpenCL error name.
+ */
+GR_API gr_status gr_kernel_arg(gr_context *ctx, cl_kernel k, const char *name, size_t size,
+                               const void *value);
+/** gr_kernel_arg for an argument named like the variable: GR_KERNEL_ARG(ctx, k, nx). */
+#define GR_KERNEL_ARG(ctx, k, var) gr_kernel_arg((ctx), (k), #var, sizeof(var), &(var))
+
+/**
+ * Per-handle errors: gr_set_error records its sentence for the calling
+ * thread; a core's failing entry point ends with
+ *   return gr_error_keep(s->error, sizeof(s->error), st);
+ * which copies the thread's sentence into the handle's own buffer (so two
+ * handles on one shared context never see each other's messages) and
+ * returns st.
+ */
+GR_API gr_status gr_error_keep(char *dst, size_t len, gr_status st);
+
+/**
  * Sets a kernel's arguments in order: pairs of (size_t size, const void
  * *value), ended by a size of 0. Reports which argument failed.
  */
@@ -99,7 +123,10 @@ GR_API gr_status gr_enqueue_2d(gr_context *ctx, cl_kernel k, size_t x0, size_t y
 /** Waits for the context's queue to drain. */
 GR_API gr_status gr_finish(gr_context *ctx);
 
-/** The embedded kernel sources: name and text (with common.h inlined). */
+/**
+ * The embedded kernel sources: name and text, with every kernels/cl header
+ * they include inlined (recursively, each once per source).
+ */
 typedef struct gr_kernel_source {
   const char *name;
   const char *text;

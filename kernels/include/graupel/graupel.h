@@ -67,6 +67,17 @@ typedef struct gr_grid {
   double dx, dy; /**< spacing, m, > 0 */
   double x0, y0; /**< origin of the whole domain, m */
   int i0, j0;    /**< global index of this grid's first point (0 for a whole grid) */
+  /**
+   * The piece contract (all 0 for a whole grid). global_nx, global_ny: the
+   * whole domain's points (0 means nx, ny: this grid is the whole domain);
+   * the piece's points are i0 .. i0+nx-1 by j0 .. j0+ny-1 of it, and only
+   * the domain's own edges are boundaries. ghost: the width of the ring of
+   * points around the piece that a core keeps as copies of its neighbours'
+   * points (its halo), filled by the core's halo calls; the core's own
+   * header says how wide a ring it needs.
+   */
+  int global_nx, global_ny;
+  int ghost;
 } gr_grid;
 
 /** Checks dimensions and spacing; a sentence goes to msg when not valid. */
@@ -97,8 +108,88 @@ typedef enum gr_field {
 GR_API const char *gr_field_name(gr_field f);
 /** Field for an array name; -1 if the name is not one of gr_field_name's. */
 GR_API int gr_field_from_name(const char *name);
-/** Number of components (3 for velocity, 1 otherwise). */
+/** Number of components (3 for velocity, 1 otherwise; 0 if unknown). */
 GR_API int gr_field_components(gr_field f);
+/** SI unit of a field ("m", "kg/m^3", "m/s", "m^2/s", "1"); NULL if unknown. */
+GR_API const char *gr_field_unit(gr_field f);
+
+/**
+ * Progress of a long core call (an advance over many steps): called between
+ * steps with the simulated time reached, in seconds, at least every few
+ * tenths of a second of wall time. Return 0 to go on; anything else stops
+ * the call at a step boundary with GR_ERR_ABORTED and a valid state.
+ */
+typedef int (*gr_progress_fn)(void *user, double time);
+
+/** Operations of a global reduction over the pieces of a split domain. */
+typedef enum gr_reduce_op { GR_REDUCE_SUM = 0, GR_REDUCE_MAX = 1, GR_REDUCE_MIN = 2 } gr_reduce_op;
+
+/**
+ * A global reduction, in place: values[0..n-1] become the reduction over
+ * every piece of the domain (an MPI_Allreduce; in one process, the identity).
+ * Must combine in a fixed order so reruns match bit for bit.
+ */
+typedef gr_status (*gr_allreduce_fn)(void *user, double *values, int n, gr_reduce_op op);
+
+/**
+ * One row of a core's parameter table: the single source of a parameter's
+ * range that the core's validator, the filter's clamp, the XML domain and the
+ * README all follow (a ctest checks that they agree). Values are in the
+ * user's unit; the core's value is the user's times to_core.
+ */
+typedef struct gr_param_bound {
+  const char *property; /**< the filter property, e.g. "RainRate" */
+  const char *unit;     /**< the user's unit, e.g. "mm/h"; "" when none */
+  double min, max;      /**< the range, in the user's unit */
+  double default_value; /**< in the user's unit */
+  double to_core;       /**< core value = user value * to_core */
+  int min_open;         /**< 1: min itself is excluded, (min, max] */
+  int integer;          /**< 1 for whole-number properties */
+} gr_param_bound;
+
+/**
+ * A closed triangle mesh (an object: a wheel, a boot, a rock), as views of
+ * the caller's arrays. Vertices in the object's own frame, metres;
+ * triangles wound counter-clockwise seen from outside; transform maps the
+ * object's frame to the world (column-major 4x4, GLM's layout, z up).
+ */
+typedef struct gr_mesh {
+  const float *vertices; /**< 3 per vertex */
+  int nvertices;
+  const int *triangles; /**< 3 vertex indices per triangle */
+  int ntriangles;
+  double transform[16];
+} gr_mesh;
+
+/**
+ * Checks a mesh: at least one triangle, indices in range, finite vertices,
+ * no degenerate (zero-area) triangle, a finite invertible transform, and,
+ * when closed is 1, every edge shared by exactly two triangles of opposite
+ * direction (a watertight, consistently wound surface). A sentence naming
+ * the first fault goes to msg.
+ */
+GR_API gr_status gr_mesh_validate(const gr_mesh *m, int closed, char *msg, size_t msg_len);
+
+/** A named per-point array of a gr_points. */
+typedef struct gr_points_array {
+  const char *name;    /**< e.g. "diameter", "velocity" */
+  int components;      /**< 1 to 9 */
+  const float *values; /**< components per point */
+} gr_points_array;
+
+/**
+ * Points (rain drops, snowflakes) as views of the caller's arrays:
+ * positions in the world, metres, and named per-point arrays.
+ */
+typedef struct gr_points {
+  const float *positions; /**< 3 per point */
+  long long npoints;
+  const gr_points_array *arrays;
+  int narrays;
+} gr_points;
+
+/** Checks points: finite positions, arrays named, distinct, 1..9 components, values finite. */
+GR_API gr_status gr_points_validate(const gr_points *p, char *msg, size_t msg_len);
 
 #ifdef __cplusplus
 }

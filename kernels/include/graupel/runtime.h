@@ -55,10 +55,11 @@ GR_API void gr_context_release(gr_context *ctx);
 GR_API int gr_context_refcount(const gr_context *ctx);
 
 /**
- * Detail of the latest error on this context: the OpenCL error name, the
- * build log, the limit exceeded. For a failure that happened without a
- * context (gr_context_create itself failed), pass NULL: the text is kept per
- * thread. Never NULL; "" when there was none.
+ * Detail of the calling thread's latest error: the OpenCL error name, the
+ * build log, the limit exceeded. The text is per thread, whatever ctx is (ctx
+ * is kept for compatibility; NULL is fine), so that handles sharing one
+ * context never see each other's messages: a handle's own latest error comes
+ * from its core's gr_<core>_last_error. Never NULL; "" when there was none.
  */
 GR_API const char *gr_last_error(const gr_context *ctx);
 
