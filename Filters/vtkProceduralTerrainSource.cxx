@@ -13,11 +13,61 @@
 #include "graupel/procedural_terrain.h"
 
 #include <algorithm>
+#include <cstring>
+#include <string>
 
 vtkStandardNewMacro(vtkProceduralTerrainSource);
 
+namespace {
+// The property's row of the core's parameter table clamps the value, so the
+// class writes no range of its own. NaN passes through (as vtkSetClampMacro
+// lets it) and the core refuses it with a sentence.
+double ClampToTable(const char *property, double value) {
+  int n = 0;
+  const gr_param_bound *rows = gr_procedural_terrain_param_bounds(&n);
+  for (int i = 0; i < n; ++i) {
+    if (std::strcmp(rows[i].property, property) == 0) {
+      return value < rows[i].min ? rows[i].min : (value > rows[i].max ? rows[i].max : value);
+    }
+  }
+  return value;
+}
+} // namespace
+
+#define GR_TABLE_SETTER(name, type)                                                                \
+  void vtkProceduralTerrainSource::Set##name(type value) {                                         \
+    const type clamped = static_cast<type>(ClampToTable(#name, static_cast<double>(value)));       \
+    if (this->name != clamped) {                                                                   \
+      this->name = clamped;                                                                        \
+      this->Modified();                                                                            \
+    }                                                                                              \
+  }
+GR_TABLE_SETTER(NoiseType, int)
+GR_TABLE_SETTER(Octaves, int)
+GR_TABLE_SETTER(Frequency, double)
+GR_TABLE_SETTER(Lacunarity, double)
+GR_TABLE_SETTER(Persistence, double)
+GR_TABLE_SETTER(Offset, double)
+GR_TABLE_SETTER(Gain, double)
+GR_TABLE_SETTER(SpectralExponent, double)
+GR_TABLE_SETTER(HeightScale, double)
+#undef GR_TABLE_SETTER
+
 vtkProceduralTerrainSource::vtkProceduralTerrainSource() {
   this->SetNumberOfInputPorts(0);
+  gr_procedural_terrain_params p;
+  gr_procedural_terrain_params_init(&p);
+  this->Seed = p.seed;
+  this->NoiseType = static_cast<int>(p.type);
+  this->Octaves = p.octaves;
+  this->Frequency = p.frequency;
+  this->Lacunarity = p.lacunarity;
+  this->Persistence = p.persistence;
+  this->Offset = p.offset;
+  this->Gain = p.gain;
+  this->SpectralExponent = p.h;
+  this->Invert = p.invert != 0;
+  this->HeightScale = p.height_scale;
 }
 
 int vtkProceduralTerrainSource::RequestInformation(vtkInformation *, vtkInformationVector **,
@@ -89,7 +139,9 @@ int vtkProceduralTerrainSource::RequestData(vtkInformation *, vtkInformationVect
   gr_procedural_terrain *noise = nullptr;
   gr_status st = gr_procedural_terrain_create(ctx, &grid, &p, &noise);
   if (st != GR_OK) {
-    return this->ReportFailure(st, "Procedural Terrain could not set up the noise");
+    // No generator exists after a failed create: the sentence is this thread's.
+    return this->ReportFailure(st, "Procedural Terrain could not set up the noise",
+                               gr_procedural_terrain_last_error(nullptr));
   }
   vtkNew<vtkFloatArray> elevation;
   elevation->SetName("elevation");
@@ -126,10 +178,17 @@ int vtkProceduralTerrainSource::RequestData(vtkInformation *, vtkInformationVect
   if (st == GR_OK) {
     st = gr_procedural_terrain_get_field(noise, GR_FIELD_ELEVATION, elevation->GetPointer(0));
   }
-  gr_procedural_terrain_destroy(noise);
   if (st != GR_OK) {
-    return this->ReportFailure(st, "Procedural Terrain could not compute the noise");
+    // gr_finish is the context's, not the generator's: its sentence is this
+    // thread's latest error, which the generator's own text then repeats.
+    std::string why = gr_procedural_terrain_last_error(noise);
+    if (why.empty()) {
+      why = gr_last_error(ctx);
+    }
+    gr_procedural_terrain_destroy(noise);
+    return this->ReportFailure(st, "Procedural Terrain could not compute the noise", why.c_str());
   }
+  gr_procedural_terrain_destroy(noise);
 
   output->SetExtent(extent[0], extent[1], extent[2], extent[3], 0, 0);
   output->SetSpacing(this->Spacing, this->Spacing, 1.0);

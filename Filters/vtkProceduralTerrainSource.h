@@ -11,6 +11,11 @@
  * NoiseType 0 is the inverted ridged multifractal that seed 001 uses for
  * snow landscapes (rounded hills, river valleys); 1 is fBm (mountain ranges),
  * 2 is billow. The normalisation is in kernels/include/graupel/procedural_terrain.h.
+ *
+ * The noise properties' ranges and defaults are the core's parameter table
+ * (gr_procedural_terrain_param_bounds): each setter clamps to its row, and
+ * a value the table leaves out at an open end (Frequency or Offset of 0) is
+ * refused by the core with a sentence when the terrain is computed.
  */
 #ifndef vtkProceduralTerrainSource_h
 #define vtkProceduralTerrainSource_h
@@ -52,49 +57,49 @@ public:
 
   ///@{
   /** 0 ridged multifractal (inverted, default), 1 fBm, 2 billow. */
-  vtkSetClampMacro(NoiseType, int, 0, 2);
+  virtual void SetNoiseType(int value);
   vtkGetMacro(NoiseType, int);
   ///@}
 
   ///@{
-  /** Number of octaves, 1..16 (default 6). */
-  vtkSetClampMacro(Octaves, int, 1, 16);
+  /** Number of octaves (default 6). */
+  virtual void SetOctaves(int value);
   vtkGetMacro(Octaves, int);
   ///@}
 
   ///@{
   /** Base frequency in cycles per kilometre (default 4). */
-  vtkSetClampMacro(Frequency, double, 1e-6, 1e4);
+  virtual void SetFrequency(double value);
   vtkGetMacro(Frequency, double);
   ///@}
 
   ///@{
-  /** Frequency ratio between octaves, 1..8 (default 2). */
-  vtkSetClampMacro(Lacunarity, double, 1.0, 8.0);
+  /** Frequency ratio between octaves (default 2). */
+  virtual void SetLacunarity(double value);
   vtkGetMacro(Lacunarity, double);
   ///@}
 
   ///@{
-  /** Amplitude ratio between octaves for fBm and billow, 0..1 (default 0.5). */
-  vtkSetClampMacro(Persistence, double, 0.0, 1.0);
+  /** Amplitude ratio between octaves for fBm and billow (default 0.5). */
+  virtual void SetPersistence(double value);
   vtkGetMacro(Persistence, double);
   ///@}
 
   ///@{
-  /** Ridged multifractal offset, (0, 4] (default 1). */
-  vtkSetClampMacro(Offset, double, 1e-3, 4.0);
+  /** Ridged multifractal offset, above 0 (default 1). */
+  virtual void SetOffset(double value);
   vtkGetMacro(Offset, double);
   ///@}
 
   ///@{
-  /** Ridged multifractal gain, 0..16 (default 2). */
-  vtkSetClampMacro(Gain, double, 0.0, 16.0);
+  /** Ridged multifractal gain (default 2). */
+  virtual void SetGain(double value);
   vtkGetMacro(Gain, double);
   ///@}
 
   ///@{
-  /** Ridged spectral exponent H, 0..4 (default 1). */
-  vtkSetClampMacro(SpectralExponent, double, 0.0, 4.0);
+  /** Ridged spectral exponent H (default 1). */
+  virtual void SetSpectralExponent(double value);
   vtkGetMacro(SpectralExponent, double);
   ///@}
 
@@ -107,7 +112,7 @@ public:
 
   ///@{
   /** Elevation range in metres: elevation lies in [0, HeightScale] (default 120). */
-  vtkSetClampMacro(HeightScale, double, 0.0, 1e5);
+  virtual void SetHeightScale(double value);
   vtkGetMacro(HeightScale, double);
   ///@}
 
@@ -122,17 +127,18 @@ protected:
   int Dimensions[2] = {512, 512};
   double Spacing = 2.0;
   double Origin[3] = {0.0, 0.0, 0.0};
+  // The noise properties start at the core's defaults (the constructor).
   int Seed = 0;
   int NoiseType = RIDGED_MULTIFRACTAL;
-  int Octaves = 6;
-  double Frequency = 4.0;
-  double Lacunarity = 2.0;
-  double Persistence = 0.5;
-  double Offset = 1.0;
-  double Gain = 2.0;
-  double SpectralExponent = 1.0;
+  int Octaves = 0;
+  double Frequency = 0.0;
+  double Lacunarity = 0.0;
+  double Persistence = 0.0;
+  double Offset = 0.0;
+  double Gain = 0.0;
+  double SpectralExponent = 0.0;
   bool Invert = true;
-  double HeightScale = 120.0;
+  double HeightScale = 0.0;
 
 private:
   vtkProceduralTerrainSource(const vtkProceduralTerrainSource &) = delete;

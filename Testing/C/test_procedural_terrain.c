@@ -1,11 +1,14 @@
 /* Procedural terrain tests: an independent double-precision reference of the
  * documented noise (graupel/procedural_terrain.h), determinism, seeds, octave
  * energy, linear height scale, bounds, tiling by origin, inversion, every
- * device agreeing with the first, and parameter errors. */
+ * device agreeing with the first, parameter errors, the parameter table
+ * against the validator, per-generator errors on a shared context, and
+ * set_params across kernel variants. */
 #include "graupel/cl_runtime.h"
 #include "graupel/procedural_terrain.h"
 #include "gr_test.h"
 
+#include <limits.h>
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
@@ -449,21 +452,217 @@ static void test_build_failure(void) {
   gr_procedural_terrain_destroy(t);
 }
 
-int main(void) {
-  if (gr_context_create(NULL, &ctx) != GR_OK) {
-    fprintf(stderr, "no OpenCL context: %s\n", gr_last_error(NULL));
-    return 1;
+/* The parameter of a table row, by the row's property name. */
+static int set_by_name(gr_procedural_terrain_params *p, const char *property, double v) {
+  if (strcmp(property, "Seed") == 0)
+    p->seed = (int)v;
+  else if (strcmp(property, "NoiseType") == 0)
+    p->type = (gr_noise_type)(int)v;
+  else if (strcmp(property, "Octaves") == 0)
+    p->octaves = (int)v;
+  else if (strcmp(property, "Frequency") == 0)
+    p->frequency = v;
+  else if (strcmp(property, "Lacunarity") == 0)
+    p->lacunarity = v;
+  else if (strcmp(property, "Persistence") == 0)
+    p->persistence = v;
+  else if (strcmp(property, "Offset") == 0)
+    p->offset = v;
+  else if (strcmp(property, "Gain") == 0)
+    p->gain = v;
+  else if (strcmp(property, "SpectralExponent") == 0)
+    p->h = v;
+  else if (strcmp(property, "Invert") == 0)
+    p->invert = (int)v;
+  else if (strcmp(property, "HeightScale") == 0)
+    p->height_scale = v;
+  else
+    return 0;
+  return 1;
+}
+
+static double get_by_name(const gr_procedural_terrain_params *p, const char *property) {
+  static const char *const names[] = {
+      "Seed",   "NoiseType", "Octaves",          "Frequency", "Lacunarity", "Persistence",
+      "Offset", "Gain",      "SpectralExponent", "Invert",    "HeightScale"};
+  const double values[] = {p->seed,       p->type,        p->octaves,     p->frequency,
+                           p->lacunarity, p->persistence, p->offset,      p->gain,
+                           p->h,          p->invert,      p->height_scale};
+  for (int i = 0; i < 11; ++i)
+    if (strcmp(names[i], property) == 0)
+      return values[i];
+  return NAN;
+}
+
+static void test_param_table(void) {
+  int n = 0;
+  const gr_param_bound *rows = gr_procedural_terrain_param_bounds(&n);
+  static const char *const order[] = {
+      "Seed",   "NoiseType", "Octaves",          "Frequency", "Lacunarity", "Persistence",
+      "Offset", "Gain",      "SpectralExponent", "Invert",    "HeightScale"};
+  CHECK(rows != NULL && n == 11);
+  CHECK(gr_procedural_terrain_param_bounds(NULL) == rows);
+  if (!rows || n != 11)
+    return;
+  gr_procedural_terrain_params def;
+  gr_procedural_terrain_params_init(&def);
+  char msg[256];
+  for (int r = 0; r < n; ++r) {
+    const gr_param_bound *b = &rows[r];
+    CHECK_MSG(strcmp(b->property, order[r]) == 0, "row %d is %s", r, b->property);
+    CHECK(b->unit != NULL && b->min < b->max && b->to_core == 1.0);
+    /* The default lies in the range and is what params_init gives. */
+    CHECK_MSG(get_by_name(&def, b->property) == b->default_value, "%s default", b->property);
+    CHECK(b->default_value > b->min || (!b->min_open && b->default_value == b->min));
+    CHECK(b->default_value <= b->max);
+    gr_procedural_terrain_params q = def;
+    /* At the bounds: max accepted; min accepted unless the row says open. */
+    CHECK(set_by_name(&q, b->property, b->max));
+    CHECK_MSG(gr_procedural_terrain_params_validate(&q, msg, sizeof(msg)) == GR_OK, "%s at max: %s",
+              b->property, msg);
+    q = def;
+    set_by_name(&q, b->property, b->min);
+    gr_status at_min = gr_procedural_terrain_params_validate(&q, msg, sizeof(msg));
+    CHECK_MSG(at_min == (b->min_open ? GR_ERR_INVALID_ARGUMENT : GR_OK), "%s at min %g: %s",
+              b->property, b->min, msg);
+    if (b->min_open)
+      CHECK_MSG(strstr(msg, b->property) && strstr(msg, "above"), "'%s'", msg);
+    /* Just outside: refused with the property's name (whole numbers one
+     * step out, where int holds it; doubles one ulp out). */
+    double below = b->integer ? b->min - 1.0 : nextafter(b->min, -INFINITY);
+    double above = b->integer ? b->max + 1.0 : nextafter(b->max, INFINITY);
+    if (!b->integer || below >= (double)INT_MIN) {
+      q = def;
+      set_by_name(&q, b->property, below);
+      CHECK_MSG(gr_procedural_terrain_params_validate(&q, msg, sizeof(msg)) ==
+                        GR_ERR_INVALID_ARGUMENT &&
+                    strstr(msg, b->property) != NULL,
+                "%s below min: '%s'", b->property, msg);
+    }
+    if (!b->integer || above <= (double)INT_MAX) {
+      q = def;
+      set_by_name(&q, b->property, above);
+      CHECK_MSG(gr_procedural_terrain_params_validate(&q, msg, sizeof(msg)) ==
+                        GR_ERR_INVALID_ARGUMENT &&
+                    strstr(msg, b->property) != NULL,
+                "%s above max: '%s'", b->property, msg);
+    }
+    if (!b->integer) {
+      q = def;
+      set_by_name(&q, b->property, NAN);
+      CHECK(gr_procedural_terrain_params_validate(&q, msg, sizeof(msg)) == GR_ERR_INVALID_ARGUMENT);
+    }
   }
+  /* The octave macros are the table's Octaves row. */
+  CHECK(rows[2].min == GR_PROCEDURAL_TERRAIN_OCTAVES_MIN &&
+        rows[2].max == GR_PROCEDURAL_TERRAIN_OCTAVES_MAX);
+  /* Offset 0 is refused for every noise type (ridged noise vanishes there). */
+  for (int type = 0; type < 3; ++type) {
+    gr_procedural_terrain_params q = def;
+    q.type = (gr_noise_type)type;
+    q.offset = 0.0;
+    CHECK(gr_procedural_terrain_params_validate(&q, msg, sizeof(msg)) == GR_ERR_INVALID_ARGUMENT);
+  }
+}
+
+static void test_shared_context_errors(void) {
+  /* Two generators on one shared context (two filters) fail differently;
+   * each keeps its own sentence, whatever the other did later. */
+  gr_context *c1 = NULL, *c2 = NULL;
+  CHECK(gr_context_acquire(NULL, &c1) == GR_OK);
+  CHECK(gr_context_acquire(NULL, &c2) == GR_OK);
+  CHECK(c1 != NULL && c1 == c2);
+  if (!c1 || !c2)
+    return;
+  gr_grid g = {16, 16, 1.0, 1.0, 0.0, 0.0, 0, 0};
+  gr_procedural_terrain_params p;
+  gr_procedural_terrain_params_init(&p);
+  gr_procedural_terrain *a = NULL, *b = NULL;
+  CHECK(gr_procedural_terrain_create(c1, &g, &p, &a) == GR_OK);
+  CHECK(gr_procedural_terrain_create(c2, &g, &p, &b) == GR_OK);
+  if (a && b) {
+    CHECK(strcmp(gr_procedural_terrain_last_error(a), "") == 0);
+    CHECK(gr_procedural_terrain_compute_rows(a, 10, 10) == GR_ERR_INVALID_ARGUMENT);
+    float out[256];
+    CHECK(gr_procedural_terrain_get_field(b, GR_FIELD_SNOW_DEPTH, out) == GR_ERR_INVALID_ARGUMENT);
+    gr_procedural_terrain_params q = p;
+    q.gain = -1.0;
+    CHECK(gr_procedural_terrain_set_params(b, &q) == GR_ERR_INVALID_ARGUMENT);
+    const char *ea = gr_procedural_terrain_last_error(a), *eb = gr_procedural_terrain_last_error(b);
+    CHECK_MSG(strstr(ea, "Rows 10 to 19") && !strstr(ea, "Gain"), "a: '%s'", ea);
+    CHECK_MSG(strstr(eb, "Gain") && !strstr(eb, "Rows"), "b: '%s'", eb);
+    /* The thread's latest error is the last failure, b's. */
+    CHECK(strcmp(gr_last_error(c1), eb) == 0);
+    /* A later success does not erase a handle's last error. */
+    CHECK(gr_procedural_terrain_compute(a) == GR_OK);
+    CHECK(strstr(gr_procedural_terrain_last_error(a), "Rows 10 to 19") != NULL);
+  }
+  /* A failed create has no handle: NULL gives the thread's sentence. */
+  gr_procedural_terrain *none = NULL;
+  gr_procedural_terrain_params bad = p;
+  bad.octaves = 99;
+  CHECK(gr_procedural_terrain_create(c1, &g, &bad, &none) == GR_ERR_INVALID_ARGUMENT);
+  CHECK(none == NULL && strstr(gr_procedural_terrain_last_error(NULL), "Octaves is 99") != NULL);
+  gr_procedural_terrain_destroy(a);
+  gr_procedural_terrain_destroy(b);
+  gr_context_release(c1);
+  gr_context_release(c2);
+}
+
+static void test_set_params_variants(void) {
+  /* Octaves and NoiseType are compiled into the kernel: set_params with
+   * others gives exactly what a new generator with them gives. */
+  gr_grid g = {40, 30, 3.0, 3.0, 5.0, 7.0, 0, 0};
+  gr_procedural_terrain_params p;
+  gr_procedural_terrain_params_init(&p);
+  gr_procedural_terrain *t = NULL;
+  CHECK(gr_procedural_terrain_create(ctx, &g, &p, &t) == GR_OK);
+  if (!t)
+    return;
+  float got[40 * 30];
+  for (int k = 0; k < 3; ++k) {
+    gr_procedural_terrain_params q = p;
+    /* Variants other subtests build too (PoCL's cache keeps them). */
+    q.octaves = k == 0 ? 1 : 6;
+    q.type = (gr_noise_type)((k + 1) % 3);
+    q.seed = 11 * k;
+    float *want = make(&g, &q);
+    CHECK(gr_procedural_terrain_set_params(t, &q) == GR_OK);
+    CHECK(gr_procedural_terrain_compute(t) == GR_OK);
+    CHECK(gr_procedural_terrain_get_field(t, GR_FIELD_ELEVATION, got) == GR_OK);
+    CHECK_MSG(want && memcmp(want, got, sizeof(got)) == 0, "octaves %d type %d differ", q.octaves,
+              k);
+    free(want);
+  }
+  gr_procedural_terrain_destroy(t);
+}
+
+static int setup(void) {
+  if (gr_context_create(NULL, &ctx) != GR_OK)
+    return 0;
   printf("device: %s\n", gr_context_device_name(ctx));
-  test_reference();
-  test_determinism_and_seeds();
-  test_octaves_energy();
-  test_height_scale_and_bounds();
-  test_tiling_and_inversion();
-  test_devices_agree();
-  test_errors();
-  test_bands();
-  test_build_failure();
+  return 1;
+}
+
+static void teardown(void) {
   gr_context_release(ctx);
-  return GR_TEST_RESULT();
+}
+
+static const gr_subtest tests[] = {
+    {"reference", test_reference, 0},
+    {"determinism_and_seeds", test_determinism_and_seeds, 0},
+    {"octaves_energy", test_octaves_energy, 0},
+    {"height_scale_and_bounds", test_height_scale_and_bounds, 0},
+    {"tiling_and_inversion", test_tiling_and_inversion, 0},
+    {"devices_agree", test_devices_agree, 0},
+    {"errors", test_errors, 0},
+    {"param_table", test_param_table, 0},
+    {"shared_context_errors", test_shared_context_errors, 0},
+    {"set_params_variants", test_set_params_variants, 0},
+    {"bands", test_bands, 0},
+    {"build_failure", test_build_failure, 0},
+};
+
+int main(int argc, char **argv) {
+  return gr_test_main(argc, argv, tests, (int)(sizeof(tests) / sizeof(tests[0])), setup, teardown);
 }

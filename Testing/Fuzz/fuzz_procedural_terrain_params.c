@@ -14,7 +14,8 @@
  *
  * Checks: the status is GR_OK or GR_ERR_INVALID_ARGUMENT; a failure comes
  * with a non-empty message ending in '.'; accepted parameters lie in the
- * ranges procedural_terrain.h and the README document, and parameters in those
+ * ranges of the parameter table (gr_procedural_terrain_param_bounds, which
+ * the XML, the VTK clamps and the README follow), and parameters in those
  * ranges are accepted; an accepted grid has the documented dimensions,
  * spacing, origin and offsets; a short message buffer is never overrun and is
  * always terminated; the answer does not depend on the buffer. */
@@ -139,21 +140,50 @@ static void set_edge(reader *r, gr_procedural_terrain_params *p, gr_grid *g, int
   }
 }
 
-static int in_range(double v, double lo, double hi) {
-  return v >= lo && v <= hi;
-}
-
-/* procedural_terrain.h's ranges, and the README's (0, 4] Offset for ridged. */
-static int params_documented(const gr_procedural_terrain_params *p) {
+/* A parameter by its table row's property name, as the harness reads the
+ * struct (not through the core's own mapping). */
+static double param_value(const gr_procedural_terrain_params *p, const char *property) {
   int type;
   memcpy(&type, &p->type, sizeof type);
-  return (type == GR_NOISE_RIDGED || type == GR_NOISE_FBM || type == GR_NOISE_BILLOW) &&
-         p->octaves >= GR_PROCEDURAL_TERRAIN_OCTAVES_MIN &&
-         p->octaves <= GR_PROCEDURAL_TERRAIN_OCTAVES_MAX && p->frequency > 0.0 &&
-         p->frequency <= 1e4 && in_range(p->lacunarity, 1.0, 8.0) &&
-         in_range(p->persistence, 0.0, 1.0) && in_range(p->offset, 0.0, 4.0) &&
-         in_range(p->gain, 0.0, 16.0) && in_range(p->h, 0.0, 4.0) &&
-         in_range(p->height_scale, 0.0, 1e5) && (type != GR_NOISE_RIDGED || p->offset > 0.0);
+  if (strcmp(property, "Seed") == 0)
+    return p->seed;
+  if (strcmp(property, "NoiseType") == 0)
+    return type;
+  if (strcmp(property, "Octaves") == 0)
+    return p->octaves;
+  if (strcmp(property, "Frequency") == 0)
+    return p->frequency;
+  if (strcmp(property, "Lacunarity") == 0)
+    return p->lacunarity;
+  if (strcmp(property, "Persistence") == 0)
+    return p->persistence;
+  if (strcmp(property, "Offset") == 0)
+    return p->offset;
+  if (strcmp(property, "Gain") == 0)
+    return p->gain;
+  if (strcmp(property, "SpectralExponent") == 0)
+    return p->h;
+  if (strcmp(property, "Invert") == 0)
+    return p->invert;
+  if (strcmp(property, "HeightScale") == 0)
+    return p->height_scale;
+  return NAN; /* a row the harness does not know: refused below */
+}
+
+/* The parameter table (gr_procedural_terrain_param_bounds) is the documented
+ * range: every row's value in [min, max], or (min, max] where min_open. The
+ * table itself must cover the eleven parameters. */
+static int params_documented(const gr_procedural_terrain_params *p) {
+  int n = 0;
+  const gr_param_bound *rows = gr_procedural_terrain_param_bounds(&n);
+  REQUIRE(rows != NULL && n == 11);
+  for (int r = 0; r < n; ++r) {
+    double v = param_value(p, rows[r].property);
+    REQUIRE(rows[r].min < rows[r].max);
+    if (!(rows[r].min_open ? v > rows[r].min : v >= rows[r].min) || !(v <= rows[r].max))
+      return 0;
+  }
+  return 1;
 }
 
 /* gr_grid's documentation and gr_grid_validate's sentences. */

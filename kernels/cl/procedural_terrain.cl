@@ -2,6 +2,7 @@
  * summed over octaves as fBm, billow or (inverted) ridged multifractal. The
  * normalisation is documented in graupel/procedural_terrain.h. */
 #include "common.h"
+#include "procedural_terrain_shared.h"
 
 /* 16 unit gradients at multiples of 22.5 degrees, as separate x and y
  * tables: scalar loads keep the kernel vectorisable on CPUs. */
@@ -70,26 +71,28 @@ __kernel void procedural_terrain_generate(__global float *restrict elevation, in
 #pragma unroll
 #endif
   for (int o = 0; o < octaves; ++o) {
-    float x = table[4 * o] + (float)(i0 + i) * table[4 * o + 2];
-    float y = table[4 * o + 1] + (float)(j0 + j) * table[4 * o + 3];
+    __global const float *row = table + GR_PT_TABLE_STRIDE * o;
+    float x = row[0] + (float)(i0 + i) * row[2];
+    float y = row[1] + (float)(j0 + j) * row[3];
     float fx = floor(x), fy = floor(y);
-    float g = gr_gradient_noise(lattice[2 * o] + (int)fx, lattice[2 * o + 1] + (int)fy, x - fx,
-                                y - fy, seed + (uint)o);
+    __global const int *cell = lattice + GR_PT_LATTICE_STRIDE * o;
+    float g =
+        gr_gradient_noise(cell[0] + (int)fx, cell[1] + (int)fy, x - fx, y - fy, seed + (uint)o);
     float a = amp[o];
-    if (kind == 0) {
+    if (kind == GR_PT_KIND_RIDGED) {
       float s = offset - fabs(g);
       s = s * s * weight;
       weight = clamp(s * gain, 0.0f, 1.0f);
       sum += s * a;
       norm += offset * offset * a;
     } else {
-      float v = kind == 2 ? 2.0f * fabs(g) - 1.0f : g;
+      float v = kind == GR_PT_KIND_BILLOW ? 2.0f * fabs(g) - 1.0f : g;
       sum += v * a;
       norm += a;
     }
   }
   float n;
-  if (kind == 0) {
+  if (kind == GR_PT_KIND_RIDGED) {
     n = norm > 0.0f ? sum / norm : 0.0f;
     if (invert)
       n = 1.0f - n;

@@ -37,24 +37,34 @@ typedef enum gr_noise_type {
 #define GR_PROCEDURAL_TERRAIN_OCTAVES_MIN 1
 #define GR_PROCEDURAL_TERRAIN_OCTAVES_MAX 16
 
+/**
+ * The noise parameters. Ranges and defaults are the rows of
+ * gr_procedural_terrain_param_bounds (named after the filter's properties),
+ * the one place they are written; the README, the XML domains and the VTK
+ * clamps follow that table.
+ */
 typedef struct gr_procedural_terrain_params {
-  int seed;            /**< any integer; equal seeds give equal fields */
-  gr_noise_type type;  /**< default GR_NOISE_RIDGED */
-  int octaves;         /**< 1..16, default 6 */
-  double frequency;    /**< base-octave cycles per km, (0, 1e4], default 4 */
-  double lacunarity;   /**< frequency ratio of octaves, [1, 8], default 2 */
-  double persistence;  /**< amplitude ratio (fBm, billow), [0, 1], default 0.5 */
-  double offset;       /**< ridged offset, [0, 4], default 1 */
-  double gain;         /**< ridged weight gain, [0, 16], default 2 */
-  double h;            /**< ridged spectral exponent H, [0, 4], default 1 */
-  int invert;          /**< ridged only: 1 (default) flips the ridges */
-  double height_scale; /**< metres, [0, 1e5], default 120 */
+  int seed;            /**< Seed: any integer; equal seeds give equal fields */
+  gr_noise_type type;  /**< NoiseType */
+  int octaves;         /**< Octaves (GR_PROCEDURAL_TERRAIN_OCTAVES_MIN..MAX) */
+  double frequency;    /**< Frequency: base-octave cycles per km, above 0 */
+  double lacunarity;   /**< Lacunarity: frequency ratio of octaves */
+  double persistence;  /**< Persistence: amplitude ratio (fBm, billow) */
+  double offset;       /**< Offset: ridged offset, above 0 for every type */
+  double gain;         /**< Gain: ridged weight gain */
+  double h;            /**< SpectralExponent: ridged spectral exponent H */
+  int invert;          /**< Invert: ridged only, 1 flips the ridges */
+  double height_scale; /**< HeightScale: metres */
 } gr_procedural_terrain_params;
 
-/** The defaults listed above. */
+/** The table's defaults. */
 GR_API void gr_procedural_terrain_params_init(gr_procedural_terrain_params *p);
 
-/** Checks every parameter against its range; a sentence goes to msg. */
+/**
+ * Checks every parameter against its row of the table (min_open rows exclude
+ * their min); a sentence naming the property, the value and the range goes
+ * to msg.
+ */
 GR_API gr_status gr_procedural_terrain_params_validate(const gr_procedural_terrain_params *p,
                                                        char *msg, size_t msg_len);
 
@@ -68,7 +78,11 @@ GR_API gr_status gr_procedural_terrain_create(gr_context *ctx, const gr_grid *gr
                                               const gr_procedural_terrain_params *p,
                                               gr_procedural_terrain **out);
 
-/** New parameters for the next compute (validated). */
+/**
+ * New parameters for the next compute (validated). A new Octaves or
+ * NoiseType builds (or reuses) that kernel variant; on any failure the
+ * generator keeps its previous parameters.
+ */
 GR_API gr_status gr_procedural_terrain_set_params(gr_procedural_terrain *t,
                                                   const gr_procedural_terrain_params *p);
 
@@ -86,6 +100,21 @@ GR_API gr_status gr_procedural_terrain_compute_rows(gr_procedural_terrain *t, in
  * host must hold nx*ny floats.
  */
 GR_API gr_status gr_procedural_terrain_get_field(gr_procedural_terrain *t, gr_field f, float *host);
+
+/**
+ * The latest error of a call on this generator ("" when none), its own and
+ * never another generator's on the same shared context. Never NULL. For
+ * t == NULL (a create that failed has no generator), the calling thread's
+ * latest error.
+ */
+GR_API const char *gr_procedural_terrain_last_error(const gr_procedural_terrain *t);
+
+/**
+ * The parameter table (Seed, NoiseType, Octaves, Frequency, Lacunarity,
+ * Persistence, Offset, Gain, SpectralExponent, Invert, HeightScale) that
+ * gr_procedural_terrain_params_validate follows; *count gets the rows.
+ */
+GR_API const gr_param_bound *gr_procedural_terrain_param_bounds(int *count);
 
 /** Frees the generator; NULL is fine. */
 GR_API void gr_procedural_terrain_destroy(gr_procedural_terrain *t);
