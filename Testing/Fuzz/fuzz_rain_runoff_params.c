@@ -5,15 +5,17 @@
  * length of a small message buffer, byte 2 the field to validate, then:
  *   mode 0  the six parameters from raw bytes (8 per double, 4 for the
  *           boundary enum), so NaN, infinities and huge values appear;
- *   mode 1  one byte per parameter picks from a table of edge values (range
- *           ends, one ulp either side, 0, -0, NaN, infinities);
+ *   mode 1  one byte per parameter picks an edge value: a bound of any row
+ *           of the parameter table (gr_rain_runoff_param_bounds) in the
+ *           core's unit, one ulp either side, or 0, -0, NaN, infinities;
  * and the rest of the input is the field, as raw floats.
  *
  * Checks: the status is GR_OK or GR_ERR_INVALID_ARGUMENT; a failure comes with
  * a non-empty message ending in '.'; parameters are accepted exactly when they
- * lie in the ranges rain_runoff.h documents, fields exactly when every value
- * is finite and, for the depth, permeability and rain-rate inputs, within
- * their documented ranges; outputs-only fields are refused; a short message
+ * lie in the table's ranges (user bounds times to_core; open minimum and
+ * whole numbers where a row says so), fields exactly when every value is
+ * finite and, for the depth, permeability and rain-rate inputs, within the
+ * RainRate and Permeability rows' ranges; outputs-only fields are refused; a short message
  * buffer is never overrun and always terminated. */
 #include "fuzz_common.h"
 #include "graupel/rain_runoff.h"
@@ -24,11 +26,26 @@
 #include <stdlib.h>
 #include <string.h>
 
+/* The table's row for a property (every row exists: the harness checks). */
+static const gr_param_bound *row_of(const char *property) {
+  int n = 0;
+  const gr_param_bound *t = gr_rain_runoff_param_bounds(&n);
+  for (int r = 0; r < n; ++r)
+    if (strcmp(t[r].property, property) == 0)
+      return &t[r];
+  REQUIRE(!"a parameter is missing from the table");
+  return NULL;
+}
+
 static double edge_double(uint8_t b) {
-  static const double table[] = {0.0,  -0.0, 1e-3,   1e-2, 0.005, 1.0,    3600.0, 2.7777e-6,
-                                 0.03, 0.7,  -1e-12, 1e30, -1.0,  3601.0, 0.5,    2.0};
-  const size_t n = sizeof table / sizeof table[0];
-  switch (b % (n + 12)) {
+  static const double fixed[] = {0.0, -0.0, -1e-12, 1e30, -1.0, 0.5, 2.0, 7200.0};
+  const size_t nfixed = sizeof fixed / sizeof fixed[0];
+  int n = 0;
+  const gr_param_bound *t = gr_rain_runoff_param_bounds(&n);
+  /* Per row: min, max, the default, and one ulp either side of min and max. */
+  const size_t nrow = 7 * (size_t)n, special = 6;
+  size_t k = b % (special + nfixed + nrow);
+  switch (k) {
   case 0:
     return NAN;
   case 1:
@@ -40,35 +57,48 @@ static double edge_double(uint8_t b) {
   case 4:
     return nextafter(0.0, 1.0);
   case 5:
-    return nextafter(1e-3, 1.0);
-  case 6:
-    return nextafter(1e-2, 1.0);
-  case 7:
-    return nextafter(0.005, 0.0);
-  case 8:
-    return nextafter(1.0, 2.0);
-  case 9:
-    return nextafter(3600.0, 4000.0);
-  case 10:
-    return nextafter(0.0, -1.0);
-  case 11:
     return DBL_MIN;
   default:
-    return table[b % (n + 12) - 12];
+    break;
+  }
+  k -= special;
+  if (k < nfixed)
+    return fixed[k];
+  k -= nfixed;
+  const gr_param_bound *row = &t[k / 7];
+  const double lo = row->min * row->to_core, hi = row->max * row->to_core;
+  switch (k % 7) {
+  case 0:
+    return lo;
+  case 1:
+    return hi;
+  case 2:
+    return row->default_value * row->to_core;
+  case 3:
+    return nextafter(lo, -HUGE_VAL);
+  case 4:
+    return nextafter(lo, HUGE_VAL);
+  case 5:
+    return nextafter(hi, -HUGE_VAL);
+  default:
+    return nextafter(hi, HUGE_VAL);
   }
 }
 
-static int in_range(double v, double lo, double hi) {
-  return v >= lo && v <= hi;
+/* Accepted by a row of the table: within [min, max] times to_core (min
+ * excluded when open), a whole number when the row says so. */
+static int in_row(const char *property, double v) {
+  const gr_param_bound *row = row_of(property);
+  const double lo = row->min * row->to_core, hi = row->max * row->to_core;
+  return (row->min_open ? v > lo : v >= lo) && v <= hi && (!row->integer || v == floor(v));
 }
 
-/* rain_runoff.h's documented ranges. */
 static int params_documented(const gr_rain_runoff_params *p) {
   int boundary;
   memcpy(&boundary, &p->boundary, sizeof boundary);
-  return in_range(p->rain_rate, 0.0, 1e-3) && in_range(p->permeability, 0.0, 1e-2) &&
-         in_range(p->manning_n, 0.005, 1.0) && p->cfl > 0.0 && p->cfl <= 1.0 && p->max_dt > 0.0 &&
-         p->max_dt <= 3600.0 && (boundary == GR_BOUNDARY_OPEN || boundary == GR_BOUNDARY_CLOSED);
+  return in_row("RainRate", p->rain_rate) && in_row("Permeability", p->permeability) &&
+         in_row("ManningN", p->manning_n) && in_row("CourantNumber", p->cfl) &&
+         in_row("MaxTimeStep", p->max_dt) && in_row("Boundary", (double)boundary);
 }
 
 static int field_documented(gr_field f, const float *v, size_t n) {
@@ -78,9 +108,9 @@ static int field_documented(gr_field f, const float *v, size_t n) {
       return 0;
     if (f == GR_FIELD_WATER_DEPTH && !(x >= 0.0))
       return 0;
-    if (f == GR_FIELD_PERMEABILITY && !in_range(x, 0.0, 1e-2))
+    if (f == GR_FIELD_PERMEABILITY && !in_row("Permeability", x))
       return 0;
-    if (f == GR_FIELD_RAIN_RATE && !in_range(x, 0.0, 1e-3))
+    if (f == GR_FIELD_RAIN_RATE && !in_row("RainRate", x))
       return 0;
   }
   return 1;

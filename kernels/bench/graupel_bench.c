@@ -119,26 +119,26 @@ static void terrain_teardown(void *state) {
  * half-width, 1 % slope), 5 cm of water everywhere so that every face
  * flows from the first step, 50 mm/h of rain, 5 mm/h of infiltration, an
  * open boundary; a fixed stable step taken once at set-up. */
-typedef struct rain_bench {
+typedef struct rain_runoff_bench {
   gr_rain_runoff *sim;
   double dt;
-} rain_bench;
+} rain_runoff_bench;
 
-static void rain_teardown(void *state) {
-  rain_bench *r = state;
+static void rain_runoff_teardown(void *state) {
+  rain_runoff_bench *r = state;
   if (r)
     gr_rain_runoff_destroy(r->sim);
   free(r);
 }
 
-static gr_status rain_setup(gr_context *ctx, int n, void **state) {
+static gr_status rain_runoff_setup(gr_context *ctx, int n, void **state) {
   gr_grid g = {n, n, 2.0, 2.0, 0.0, 0.0, 0, 0};
   gr_rain_runoff_params p;
   gr_rain_runoff_params_init(&p);
   p.rain_rate = 50.0 / 3.6e6;
   p.permeability = 5.0 / 3.6e6;
   p.max_dt = 0.25; /* stays stable while the bowl fills during the run */
-  rain_bench *r = calloc(1, sizeof(*r));
+  rain_runoff_bench *r = calloc(1, sizeof(*r));
   size_t cells = (size_t)n * (size_t)n;
   float *b = malloc(cells * sizeof(float)), *d = malloc(cells * sizeof(float));
   if (!r || !b || !d) {
@@ -164,22 +164,22 @@ static gr_status rain_setup(gr_context *ctx, int n, void **state) {
   free(b);
   free(d);
   if (st != GR_OK) {
-    rain_teardown(r);
+    rain_runoff_teardown(r);
     return st;
   }
   *state = r;
   return GR_OK;
 }
 
-static gr_status rain_step(void *state) {
-  rain_bench *r = state;
+static gr_status rain_runoff_step(void *state) {
+  rain_runoff_bench *r = state;
   return gr_rain_runoff_step(r->sim, r->dt, 1);
 }
 
 /* What a caller pays besides the steps: the ledger (one reduction and its
  * read-back) and the stable step (the same reduction). */
-static gr_status rain_report(void *state, gr_context *ctx) {
-  rain_bench *r = state;
+static gr_status rain_runoff_report(void *state, gr_context *ctx) {
+  rain_runoff_bench *r = state;
   gr_rain_runoff_ledger l;
   gr_status st = gr_rain_runoff_ledger_get(r->sim, &l); /* warm-up */
   const int reps = 10;
@@ -207,7 +207,7 @@ static const bench_core cores[] = {
      * and writes depth, infiltrated and their compensations (44 B). */
     {"rain_runoff",
      "rain on a tilted bowl: local inertial runoff, infiltration, open boundary (seed 004)",
-     rain_setup, rain_step, rain_teardown, 88.0, rain_report},
+     rain_runoff_setup, rain_runoff_step, rain_runoff_teardown, 88.0, rain_runoff_report},
 };
 static const int ncores = (int)(sizeof(cores) / sizeof(cores[0]));
 

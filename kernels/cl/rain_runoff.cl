@@ -30,18 +30,8 @@
  * a cell's faces pair the mirrored terms: mirror-symmetric inputs give
  * mirror-symmetric fields bit for bit. */
 #include "common.h"
-
-/* A face shallower than this carries no flow (m). */
-#define GR_RAIN_RUNOFF_DRY 1.0e-6f
-
-/* Velocities are reported where a cell holds at least this much (m): a cell
- * that a step has just drained holds a film whose depth says nothing of
- * the flow that passed through it, and q / h there would be meaningless. */
-#define GR_RAIN_RUNOFF_VELOCITY_DEPTH 1.0e-4f
-
-/* The limiter leaves a cell this fraction short of empty, so that the float
- * rounding of the depth update can never take it below zero. */
-#define GR_RAIN_RUNOFF_KEEP 0.999999f
+#include "rain_runoff_shared.h"
+#include "reduce.h"
 
 GR_INLINE float gr_rain_runoff_input(__global const float *restrict field, int use_field,
                                      float uniform, int c) {
@@ -230,17 +220,6 @@ __kernel void rain_runoff_limit(__global const float *restrict h,
   limit[c] = out > wet ? wet / out * GR_RAIN_RUNOFF_KEEP : 1.0f;
 }
 
-/* Kahan summation: *sum + *comp carries the running total to about twice
- * float precision over 10^5 steps and more. */
-GR_INLINE void gr_rain_runoff_kahan(__global float *restrict sum, __global float *restrict comp,
-                                    int c, float x) {
-  float s = sum[c];
-  float y = x - comp[c];
-  float t = s + y;
-  comp[c] = (t - s) - y;
-  sum[c] = t;
-}
-
 /* The new depth from rain, infiltration and the four faces' limited
  * discharges; edge cells of an open grid book what left through the edge.
  * The depth is Kahan-summed too (h - h_comp is the water to about twice
@@ -282,68 +261,48 @@ rain_runoff_update(__global float *restrict h, __global float *restrict h_comp,
   h[c] = t > 0.0f ? t : 0.0f;
   h_comp[c] = t > 0.0f ? comp : 0.0f;
   if (inf != 0.0f)
-    gr_rain_runoff_kahan(infiltrated, infiltrated_comp, c, inf);
+    gr_kahan_add(infiltrated, infiltrated_comp, c, inf);
   if (i == 0 || j == 0 || i == nx - 1 || j == ny - 1) {
     /* Edge faces carry outflow only (0 when closed). */
     float ow = i == 0 ? -fw : 0.0f, oe = i == nx - 1 ? fe : 0.0f;
     float os = j == 0 ? -fs : 0.0f, on = j == ny - 1 ? fn : 0.0f;
     float out = dt * ((ow + oe) * inv_dx + (os + on) * inv_dy);
     if (out != 0.0f)
-      gr_rain_runoff_kahan(outflow, outflow_comp, c, out);
+      gr_kahan_add(outflow, outflow_comp, c, out);
   }
 }
 
-/* Double-float arithmetic (Knuth's TwoSum): hi + lo holds a sum to about
- * twice float precision, so that the ledger's volumes agree with the Kahan
- * sums per cell. */
-GR_INLINE void gr_rain_runoff_add2(float *hi, float *lo, float x) {
-  float s = *hi + x;
-  float bb = s - *hi;
-  float e = (*hi - (s - bb)) + (x - bb);
-  *hi = s;
-  *lo += e;
-}
-
-GR_INLINE void gr_rain_runoff_merge2(__local float *a, __local const float *b) {
-  float hi = a[0], lo = a[1] + b[1];
-  gr_rain_runoff_add2(&hi, &lo, b[0]);
-  /* Renormalise (Fast2Sum) so lo stays small against hi. */
-  float s = hi + lo;
-  a[1] = lo - (s - hi);
-  a[0] = s;
-}
-
-#define GR_RAIN_RUNOFF_SLOTS 7
-
-/* One pass over the grid, a 1-D launch of whole work-groups: every work-item
- * sums a fixed set of cells, the group combines in local memory, and
- * group g writes partial[7g .. 7g+6] = stored (hi, lo), infiltrated (hi,
- * lo), outflow (hi, lo) in metres of depth summed over cells, and the
- * deepest cell. The host adds the groups in order in double: the same sums
- * on every run. */
+/* One pass over the grid for the ledger (reduce.h): per work-group the
+ * stored, infiltrated and outflow depths (double-float, metres summed over
+ * cells) and the deepest cell; masked: only the cells [own_x0, own_x1) x
+ * [own_y0, own_y1) of the row-wide local array (a piece without its ring). */
 __kernel void rain_runoff_reduce(
     __global const float *restrict h, __global const float *restrict h_comp,
     __global const float *restrict infiltrated, __global const float *restrict infiltrated_comp,
     __global const float *restrict outflow, __global const float *restrict outflow_comp,
-    __global float *restrict partial, __local float *restrict scratch, int n) {
-  int lid = get_local_id(0), wg = get_local_size(0), groups = get_num_groups(0);
-  /* Group g sums one contiguous block of cells (cache-friendly on CPUs),
-   * its work-items interleaved within it (coalesced on GPUs). */
-  int per_group = (n + groups - 1) / groups;
-  int start = get_group_id(0) * per_group, end = min(n, start + per_group);
+    __global float *restrict partial, __local float *restrict scratch, int n, int row, int own_x0,
+    int own_x1, int own_y0, int own_y1, int masked) {
+  int lid = get_local_id(0), wg = get_local_size(0), start, end;
+  gr_reduce_block(n, &start, &end);
   float s_hi = 0.0f, s_lo = 0.0f, i_hi = 0.0f, i_lo = 0.0f, o_hi = 0.0f, o_lo = 0.0f;
   float hmax = 0.0f;
   for (int c = start + lid; c < end; c += wg) {
+    if (masked) {
+      /* A piece sums its own cells only: its ring belongs to a neighbour. */
+      int i = c % row, j = c / row;
+      if (i < own_x0 || i >= own_x1 || j < own_y0 || j >= own_y1)
+        continue;
+    }
     float d = h[c];
-    gr_rain_runoff_add2(&s_hi, &s_lo, d);
-    gr_rain_runoff_add2(&s_hi, &s_lo, -h_comp[c]);
-    gr_rain_runoff_add2(&i_hi, &i_lo, infiltrated[c]);
-    gr_rain_runoff_add2(&i_hi, &i_lo, -infiltrated_comp[c]);
-    gr_rain_runoff_add2(&o_hi, &o_lo, outflow[c]);
-    gr_rain_runoff_add2(&o_hi, &o_lo, -outflow_comp[c]);
+    gr_df_add(&s_hi, &s_lo, d);
+    gr_df_add(&s_hi, &s_lo, -h_comp[c]);
+    gr_df_add(&i_hi, &i_lo, infiltrated[c]);
+    gr_df_add(&i_hi, &i_lo, -infiltrated_comp[c]);
+    gr_df_add(&o_hi, &o_lo, outflow[c]);
+    gr_df_add(&o_hi, &o_lo, -outflow_comp[c]);
     hmax = fmax(hmax, d);
   }
-  __local float *mine = scratch + GR_RAIN_RUNOFF_SLOTS * lid;
+  __local float *mine = gr_reduce_slots(scratch, GR_RAIN_RUNOFF_SUMS, GR_RAIN_RUNOFF_MAXES);
   mine[0] = s_hi;
   mine[1] = s_lo;
   mine[2] = i_hi;
@@ -351,20 +310,7 @@ __kernel void rain_runoff_reduce(
   mine[4] = o_hi;
   mine[5] = o_lo;
   mine[6] = hmax;
-  barrier(CLK_LOCAL_MEM_FENCE);
-  for (int span = wg / 2; span > 0; span /= 2) {
-    if (lid < span) {
-      __local const float *other = scratch + GR_RAIN_RUNOFF_SLOTS * (lid + span);
-      gr_rain_runoff_merge2(mine, other);
-      gr_rain_runoff_merge2(mine + 2, other + 2);
-      gr_rain_runoff_merge2(mine + 4, other + 4);
-      mine[6] = fmax(mine[6], other[6]);
-    }
-    barrier(CLK_LOCAL_MEM_FENCE);
-  }
-  if (lid == 0)
-    for (int s = 0; s < GR_RAIN_RUNOFF_SLOTS; ++s)
-      partial[GR_RAIN_RUNOFF_SLOTS * get_group_id(0) + s] = scratch[s];
+  gr_reduce_group(scratch, GR_RAIN_RUNOFF_SUMS, GR_RAIN_RUNOFF_MAXES, partial);
 }
 
 /* Fields derived on read, per cell: 0 water surface (b + h), 1 velocity

@@ -1,22 +1,20 @@
 /* Rain runoff core (seed 004's water simulation): host side of
  * rain_runoff.cl. The model, the step order and the book-keeping are
  * documented in graupel/rain_runoff.h; the kernels' data layout in
- * rain_runoff.cl. */
+ * rain_runoff.cl; the constants both sides share in rain_runoff_shared.h. */
 #include "graupel/rain_runoff.h"
 #include "graupel/cl_runtime.h"
+#include "graupel/reduce.h"
+#include "rain_runoff_shared.h"
 
 #include <limits.h>
 #include <math.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
-/* Floats per work-group in the reduction's output (see rain_runoff_reduce). */
-#define GR_RAIN_RUNOFF_SLOTS 7
-/* Work-groups of the reduction: enough to fill a GPU, few enough that the
- * host's final sum is instant. */
-#define GR_RAIN_RUNOFF_REDUCE_GROUPS 256
-#define GR_RAIN_RUNOFF_REDUCE_LOCAL 64
 /* Kernels index cells and faces with int: (nx+1)*(ny+1), with room to
  * spare, must stay below INT_MAX. */
 #define GR_RAIN_RUNOFF_MAX_FACES ((double)INT_MAX - 1048576.0)
@@ -24,21 +22,64 @@
  * the parameters' ranges): beyond them float differences overflow. */
 #define GR_RAIN_RUNOFF_MAX_ELEVATION 1.0e6
 #define GR_RAIN_RUNOFF_MAX_DEPTH 1.0e4
-#define GR_RAIN_RUNOFF_MAX_DT 3600.0
 #define GR_RAIN_RUNOFF_MIN_DT 1.0e-30
-/* The weight of a face's own previous discharge against its neighbours'
- * (de Almeida et al. 2012; 1 is Bates et al. 2010 unchanged). */
-#define GR_RAIN_RUNOFF_THETA 0.8
 /* advance re-reads the stable step after 4 to 64 steps. */
 #define GR_RAIN_RUNOFF_CHUNK_MIN 4
 #define GR_RAIN_RUNOFF_CHUNK_MAX 64
+/* With a progress callback, advance waits on the queue after a batch of
+ * steps that takes about this long (s), and calls the callback when at least
+ * GR_RAIN_RUNOFF_PROGRESS_EVERY has passed since the last call. */
+#define GR_RAIN_RUNOFF_BATCH_S 0.08
+#define GR_RAIN_RUNOFF_PROGRESS_EVERY 0.1
+/* Checkpoints: "GRR1" and the layout's version. */
+#define GR_RAIN_RUNOFF_STATE_MAGIC 0x31525247u
+#define GR_RAIN_RUNOFF_STATE_VERSION 1u
+/* Per-cell arrays of a checkpoint: h, h_c, k, inf, inf_c, out, out_c. */
+#define GR_RAIN_RUNOFF_HALO_ARRAYS 4 /* per halo cell: h, k, west and south faces */
+#define GR_RAIN_RUNOFF_STATE_CELL_ARRAYS 7
+
+/* The parameter table's rows, in gr_rain_runoff_param_bounds' order. */
+enum {
+  GR_RAIN_RUNOFF_P_RAIN_RATE,
+  GR_RAIN_RUNOFF_P_PERMEABILITY,
+  GR_RAIN_RUNOFF_P_MANNING_N,
+  GR_RAIN_RUNOFF_P_MAX_DT,
+  GR_RAIN_RUNOFF_P_CFL,
+  GR_RAIN_RUNOFF_P_BOUNDARY,
+  GR_RAIN_RUNOFF_P_COUNT
+};
+
+/* The one place each range is written: the validator, the field checks, the
+ * filter's clamps, the XML domains and the README follow it. */
+static const gr_param_bound gr_rain_runoff_bounds[GR_RAIN_RUNOFF_P_COUNT] = {
+    {"RainRate", "mm/h", 0.0, 3600.0, 10.0, 1.0 / 3.6e6, 0, 0},
+    {"Permeability", "mm/h", 0.0, 36000.0, 0.0, 1.0 / 3.6e6, 0, 0},
+    {"ManningN", "s/m^(1/3)", 0.005, 1.0, 0.03, 1.0, 0, 0},
+    {"MaxTimeStep", "s", 0.0, 3600.0, 1.0, 1.0, 1, 0},
+    {"CourantNumber", "", 0.0, 1.0, 0.7, 1.0, 1, 0},
+    {"Boundary", "", 0.0, 1.0, 0.0, 1.0, 0, 1},
+};
+
+/* A row's range in the core's unit: exactly the products a caller gets from
+ * the user's bounds times to_core, so the user's own bounds are accepted. */
+static double gr_rain_runoff_core_min(int row) {
+  return gr_rain_runoff_bounds[row].min * gr_rain_runoff_bounds[row].to_core;
+}
+static double gr_rain_runoff_core_max(int row) {
+  return gr_rain_runoff_bounds[row].max * gr_rain_runoff_bounds[row].to_core;
+}
 
 struct gr_rain_runoff {
   gr_context *ctx;
   gr_grid grid;
+  /* The local arrays: the piece's own nx x ny cells and its ring, ring[side]
+   * cells wide on each side that has a neighbour (0 at the domain's edges;
+   * both 0 for a whole grid). Every device array is nxl x nyl cells. */
+  int nxl, nyl;
+  int ring[4]; /* gr_rain_runoff_side order: west, east, south, north */
   gr_rain_runoff_params params;
   cl_kernel flux, limit, update, reduce, derive;
-  cl_mem h, h_c, b, k, inf, inf_c, out, out_c, partial;
+  cl_mem h, h_c, b, k, inf, inf_c, out, out_c;
   cl_mem qx[2], qy[2]; /* discharges; [cur] is the latest, the other the next */
   int cur;
   cl_mem h0;      /* initial depth, once WATER_DEPTH was set */
@@ -51,48 +92,103 @@ struct gr_rain_runoff {
   double initial_sum;    /* sum of the initial depth's floats, m */
   double initial_volume, rain_volume, time;
   long long steps;
-  size_t reduce_local, reduce_groups;
-  float *partial_host;
+  gr_reduction ledger; /* the reduction behind the ledger and the stable step */
+  /* The step kernels' arguments other than the alternating face arrays are
+   * set again only when they change: the parameters, the input fields or
+   * dt (steps_dt). */
+  int args_set;
+  cl_float args_dt;
+  gr_progress_fn progress;
+  void *progress_user;
+  gr_allreduce_fn allreduce; /* NULL: this simulation is the whole domain's only piece */
+  void *allreduce_user;
+  char error[1024]; /* this handle's latest error (gr_error_keep) */
 };
+
+/* Every failing public entry point with a handle ends here. */
+#define GR_RAIN_RUNOFF_KEEP_ERROR(s, st) gr_error_keep((s)->error, sizeof((s)->error), (st))
+
+const gr_param_bound *gr_rain_runoff_param_bounds(int *count) {
+  if (count)
+    *count = GR_RAIN_RUNOFF_P_COUNT;
+  return gr_rain_runoff_bounds;
+}
+
+const char *gr_rain_runoff_last_error(const gr_rain_runoff *s) {
+  return s ? s->error : "";
+}
 
 void gr_rain_runoff_params_init(gr_rain_runoff_params *p) {
   if (!p)
     return;
   memset(p, 0, sizeof(*p));
-  p->rain_rate = 10.0 / 3.6e6; /* 10 mm/h */
-  p->permeability = 0.0;
-  p->manning_n = 0.03;
-  p->cfl = 0.7;
-  p->max_dt = 1.0;
-  p->boundary = GR_BOUNDARY_OPEN;
+  const gr_param_bound *t = gr_rain_runoff_bounds;
+  p->rain_rate =
+      t[GR_RAIN_RUNOFF_P_RAIN_RATE].default_value * t[GR_RAIN_RUNOFF_P_RAIN_RATE].to_core;
+  p->permeability =
+      t[GR_RAIN_RUNOFF_P_PERMEABILITY].default_value * t[GR_RAIN_RUNOFF_P_PERMEABILITY].to_core;
+  p->manning_n = t[GR_RAIN_RUNOFF_P_MANNING_N].default_value;
+  p->max_dt = t[GR_RAIN_RUNOFF_P_MAX_DT].default_value;
+  p->cfl = t[GR_RAIN_RUNOFF_P_CFL].default_value;
+  p->boundary = (gr_boundary)(int)t[GR_RAIN_RUNOFF_P_BOUNDARY].default_value;
 }
 
-static int gr_in_range(double v, double lo, double hi) {
-  return v >= lo && v <= hi; /* false for NaN */
+/* The core's value of row `row` in p. */
+static double gr_rain_runoff_param_value(const gr_rain_runoff_params *p, int row) {
+  switch (row) {
+  case GR_RAIN_RUNOFF_P_RAIN_RATE:
+    return p->rain_rate;
+  case GR_RAIN_RUNOFF_P_PERMEABILITY:
+    return p->permeability;
+  case GR_RAIN_RUNOFF_P_MANNING_N:
+    return p->manning_n;
+  case GR_RAIN_RUNOFF_P_MAX_DT:
+    return p->max_dt;
+  case GR_RAIN_RUNOFF_P_CFL:
+    return p->cfl;
+  default: {
+    int b; /* any bit pattern the enum may hold */
+    memcpy(&b, &p->boundary, sizeof(b));
+    return (double)b;
+  }
+  }
 }
 
 gr_status gr_rain_runoff_params_validate(const gr_rain_runoff_params *p, char *msg,
                                          size_t msg_len) {
-  const char *why = NULL;
-  if (!p)
-    why = "no parameters were given";
-  else if (!gr_in_range(p->rain_rate, 0.0, 1e-3))
-    why = "RainRate must lie between 0 and 0.001 m/s (3600 mm/h)";
-  else if (!gr_in_range(p->permeability, 0.0, 1e-2))
-    why = "Permeability must lie between 0 and 0.01 m/s (36000 mm/h)";
-  else if (!gr_in_range(p->manning_n, 0.005, 1.0))
-    why = "ManningN must lie between 0.005 and 1 s/m^(1/3)";
-  else if (!(p->cfl > 0.0) || p->cfl > 1.0)
-    why = "CourantNumber (cfl) must be above 0 and at most 1";
-  else if (!(p->max_dt > 0.0) || p->max_dt > GR_RAIN_RUNOFF_MAX_DT)
-    why = "MaxTimeStep must be above 0 and at most 3600 s";
-  else if (p->boundary != GR_BOUNDARY_OPEN && p->boundary != GR_BOUNDARY_CLOSED)
-    why = "Boundary must be 0 (open) or 1 (closed)";
-  if (!why)
-    return GR_OK;
-  if (msg && msg_len)
-    snprintf(msg, msg_len, "Invalid rain runoff parameters: %s.", why);
-  return GR_ERR_INVALID_ARGUMENT;
+  if (!p) {
+    if (msg && msg_len)
+      snprintf(msg, msg_len, "Invalid rain runoff parameters: no parameters were given.");
+    return GR_ERR_INVALID_ARGUMENT;
+  }
+  for (int row = 0; row < GR_RAIN_RUNOFF_P_COUNT; ++row) {
+    const gr_param_bound *r = &gr_rain_runoff_bounds[row];
+    double v = gr_rain_runoff_param_value(p, row);
+    double lo = gr_rain_runoff_core_min(row), hi = gr_rain_runoff_core_max(row);
+    int ok = (r->min_open ? v > lo : v >= lo) && v <= hi && (!r->integer || v == floor(v));
+    if (ok)
+      continue; /* NaN fails every comparison above */
+    if (msg && msg_len) {
+      const char *sp = r->unit[0] ? " " : "";
+      double user = v / r->to_core;
+      if (r->integer)
+        snprintf(msg, msg_len,
+                 "Invalid rain runoff parameters: %s must be a whole number from %g to %g (got "
+                 "%g).",
+                 r->property, r->min, r->max, user);
+      else if (r->min_open)
+        snprintf(msg, msg_len,
+                 "Invalid rain runoff parameters: %s must be above %g and at most %g%s%s (got "
+                 "%g%s%s).",
+                 r->property, r->min, r->max, sp, r->unit, user, sp, r->unit);
+      else
+        snprintf(msg, msg_len,
+                 "Invalid rain runoff parameters: %s must lie between %g and %g%s%s (got %g%s%s).",
+                 r->property, r->min, r->max, sp, r->unit, user, sp, r->unit);
+    }
+    return GR_ERR_INVALID_ARGUMENT;
+  }
+  return GR_OK;
 }
 
 static const char *gr_rain_runoff_field_label(gr_field f) {
@@ -105,6 +201,7 @@ static const char *gr_rain_runoff_field_label(gr_field f) {
 static gr_status gr_rain_runoff_field_check(gr_field f, const float *values, size_t n, size_t nx,
                                             int strict, char *msg, size_t msg_len) {
   const char *rule = NULL;
+  char rule_text[160];
   double lo = -HUGE_VAL, hi = HUGE_VAL;
   switch (f) {
   case GR_FIELD_ELEVATION:
@@ -122,15 +219,19 @@ static gr_status gr_rain_runoff_field_check(gr_field f, const float *values, siz
       hi = GR_RAIN_RUNOFF_MAX_DEPTH;
     break;
   case GR_FIELD_PERMEABILITY:
-    rule = "permeabilities must lie between 0 and 0.01 m/s, like Permeability";
-    lo = 0.0;
-    hi = 1e-2;
+  case GR_FIELD_RAIN_RATE: {
+    /* The maps replace the uniform parameters: the same range, in m/s. */
+    int row = f == GR_FIELD_RAIN_RATE ? GR_RAIN_RUNOFF_P_RAIN_RATE : GR_RAIN_RUNOFF_P_PERMEABILITY;
+    lo = gr_rain_runoff_core_min(row);
+    hi = gr_rain_runoff_core_max(row);
+    snprintf(rule_text, sizeof(rule_text),
+             "%s must lie between %g and %g m/s (%g to %g %s), like %s",
+             f == GR_FIELD_RAIN_RATE ? "rain rates" : "permeabilities", lo, hi,
+             gr_rain_runoff_bounds[row].min, gr_rain_runoff_bounds[row].max,
+             gr_rain_runoff_bounds[row].unit, gr_rain_runoff_bounds[row].property);
+    rule = rule_text;
     break;
-  case GR_FIELD_RAIN_RATE:
-    rule = "rain rates must lie between 0 and 0.001 m/s, like RainRate";
-    lo = 0.0;
-    hi = 1e-3;
-    break;
+  }
   default:
     if (msg && msg_len)
       snprintf(msg, msg_len,
@@ -170,9 +271,48 @@ gr_status gr_rain_runoff_field_validate(gr_field f, const float *values, size_t 
 
 /* ----------------------------------------------------------- device state */
 
+/* Cells of the local arrays (the piece and its ring). */
 static size_t gr_rain_runoff_cells(const gr_rain_runoff *s) {
+  return (size_t)s->nxl * (size_t)s->nyl;
+}
+
+/* Cells the piece owns: those of the ledger and of get_field. */
+static size_t gr_rain_runoff_own_cells(const gr_rain_runoff *s) {
   return (size_t)s->grid.nx * (size_t)s->grid.ny;
 }
+
+static int gr_rain_runoff_has_ring(const gr_rain_runoff *s) {
+  return s->ring[0] || s->ring[1] || s->ring[2] || s->ring[3];
+}
+
+/* The sum of a local-array field's floats over the owned cells, in
+ * row-major order (for a whole grid: every cell, in order). */
+static double gr_rain_runoff_own_sum(const gr_rain_runoff *s, const float *host) {
+  double sum = 0.0;
+  for (int j = s->ring[2]; j < s->nyl - s->ring[3]; ++j)
+    for (int i = s->ring[0]; i < s->nxl - s->ring[1]; ++i)
+      sum += host[(size_t)j * (size_t)s->nxl + (size_t)i];
+  return sum;
+}
+
+/* One kernel argument by its name in the kernel's source. */
+typedef struct gr_rain_runoff_arg {
+  const char *name;
+  size_t size;
+  const void *value;
+} gr_rain_runoff_arg;
+
+/* Sets the arguments in `args` of kernel k by name; the first failure names
+ * the kernel and the argument. */
+static gr_status gr_rain_runoff_args(gr_rain_runoff *s, cl_kernel k, const gr_rain_runoff_arg *args,
+                                     size_t n) {
+  gr_status st = GR_OK;
+  for (size_t i = 0; st == GR_OK && i < n; ++i)
+    st = gr_kernel_arg(s->ctx, k, args[i].name, args[i].size, args[i].value);
+  return st;
+}
+#define GR_RAIN_RUNOFF_ARGS(s, k, args)                                                            \
+  gr_rain_runoff_args((s), (k), (args), sizeof(args) / sizeof((args)[0]))
 
 static gr_status gr_rain_runoff_fill(gr_rain_runoff *s, cl_mem buf, float value, size_t bytes) {
   return gr_cl_check(s->ctx,
@@ -183,7 +323,7 @@ static gr_status gr_rain_runoff_fill(gr_rain_runoff *s, cl_mem buf, float value,
 
 /* Discharges none, limiters 1 (nothing was limited). */
 static gr_status gr_rain_runoff_clear_flow(gr_rain_runoff *s) {
-  size_t nx = (size_t)s->grid.nx, ny = (size_t)s->grid.ny;
+  size_t nx = (size_t)s->nxl, ny = (size_t)s->nyl;
   gr_status st = GR_OK;
   for (int a = 0; a < 2 && st == GR_OK; ++a) {
     st = gr_rain_runoff_fill(s, s->qx[a], 0.0f, (nx + 1) * ny * sizeof(float));
@@ -195,43 +335,115 @@ static gr_status gr_rain_runoff_clear_flow(gr_rain_runoff *s) {
   return st;
 }
 
+/* Copies the floats of cells [x0, x0+w) x [y0, y0+h) of a local array with
+ * `comps` floats per cell and rows of `pitch` cells between the device and
+ * a packed host block (w * comps floats per row); waits. */
+static gr_status gr_rain_runoff_rect(gr_rain_runoff *s, cl_mem buf, size_t pitch, size_t comps,
+                                     size_t x0, size_t y0, size_t w, size_t h, void *host,
+                                     int write) {
+  const size_t f = sizeof(cl_float) * comps;
+  size_t origin[3] = {x0 * f, y0, 0}, host_origin[3] = {0, 0, 0}, region[3] = {w * f, h, 1};
+  cl_command_queue q = gr_context_queue(s->ctx);
+  cl_int err = write ? clEnqueueWriteBufferRect(q, buf, CL_TRUE, origin, host_origin, region,
+                                                pitch * f, 0, w * f, 0, host, 0, NULL, NULL)
+                     : clEnqueueReadBufferRect(q, buf, CL_TRUE, origin, host_origin, region,
+                                               pitch * f, 0, w * f, 0, host, 0, NULL, NULL);
+  return gr_cl_check(s->ctx, err,
+                     write ? "Writing a halo strip to the device"
+                           : "Reading part of a field back from the device");
+}
+
+/* Reads the owned cells of a local array (comps floats per cell): the whole
+ * array for a grid without a ring. */
+static gr_status gr_rain_runoff_read_own(gr_rain_runoff *s, cl_mem buf, size_t comps, float *host) {
+  if (!gr_rain_runoff_has_ring(s))
+    return gr_buffer_read(s->ctx, buf, 0, gr_rain_runoff_cells(s) * comps * sizeof(cl_float), host);
+  return gr_rain_runoff_rect(s, buf, (size_t)s->nxl, comps, (size_t)s->ring[0], (size_t)s->ring[2],
+                             (size_t)s->grid.nx, (size_t)s->grid.ny, host, 0);
+}
+
 /* Sums the stored, infiltrated and outflow depths over the cells (m, so
  * times dx dy for m^3) and finds the deepest cell. */
-static gr_status gr_rain_runoff_reduce(gr_rain_runoff *s, double sums[3], double *max_depth) {
+static gr_status gr_rain_runoff_reduce(gr_rain_runoff *s, double sums[GR_RAIN_RUNOFF_SUMS],
+                                       double *max_depth) {
   cl_int n = (cl_int)gr_rain_runoff_cells(s);
-  const size_t m = sizeof(cl_mem);
-  gr_status st = gr_kernel_args(s->ctx, s->reduce, m, &s->h, m, &s->h_c, m, &s->inf, m, &s->inf_c,
-                                m, &s->out, m, &s->out_c, m, &s->partial,
-                                s->reduce_local * GR_RAIN_RUNOFF_SLOTS * sizeof(cl_float), NULL,
-                                sizeof(cl_int), &n, (size_t)0);
-  if (st != GR_OK)
-    return st;
-  size_t global = s->reduce_groups * s->reduce_local;
-  st = gr_cl_check(s->ctx,
-                   clEnqueueNDRangeKernel(gr_context_queue(s->ctx), s->reduce, 1, NULL, &global,
-                                          &s->reduce_local, 0, NULL, NULL),
-                   "Enqueueing the rain runoff reduction");
+  /* The owned cells of the local arrays (masked only where there is a ring). */
+  cl_int row = s->nxl, own_x0 = s->ring[0], own_x1 = s->nxl - s->ring[1];
+  cl_int own_y0 = s->ring[2], own_y1 = s->nyl - s->ring[3];
+  cl_int masked = gr_rain_runoff_has_ring(s);
+  const gr_rain_runoff_arg args[] = {
+      {"h", sizeof(cl_mem), &s->h},
+      {"h_comp", sizeof(cl_mem), &s->h_c},
+      {"infiltrated", sizeof(cl_mem), &s->inf},
+      {"infiltrated_comp", sizeof(cl_mem), &s->inf_c},
+      {"outflow", sizeof(cl_mem), &s->out},
+      {"outflow_comp", sizeof(cl_mem), &s->out_c},
+      {"n", sizeof(n), &n},
+      {"row", sizeof(row), &row},
+      {"own_x0", sizeof(own_x0), &own_x0},
+      {"own_x1", sizeof(own_x1), &own_x1},
+      {"own_y0", sizeof(own_y0), &own_y0},
+      {"own_y1", sizeof(own_y1), &own_y1},
+      {"masked", sizeof(masked), &masked},
+  };
+  double maxes[GR_RAIN_RUNOFF_MAXES];
+  gr_status st = GR_RAIN_RUNOFF_ARGS(s, s->reduce, args);
   if (st == GR_OK)
-    st =
-        gr_buffer_read(s->ctx, s->partial, 0,
-                       s->reduce_groups * GR_RAIN_RUNOFF_SLOTS * sizeof(cl_float), s->partial_host);
-  if (st != GR_OK)
-    return st;
-  double acc[3] = {0.0, 0.0, 0.0}, hmax = 0.0;
-  for (size_t grp = 0; grp < s->reduce_groups; ++grp) {
-    const float *p = s->partial_host + GR_RAIN_RUNOFF_SLOTS * grp;
-    for (int q = 0; q < 3; ++q)
-      acc[q] += (double)p[2 * q] + (double)p[2 * q + 1];
-    hmax = p[6] > hmax ? p[6] : hmax;
-  }
-  for (int q = 0; q < 3; ++q)
-    sums[q] = acc[q];
-  if (max_depth)
-    *max_depth = hmax;
-  return GR_OK;
+    st = gr_reduction_run(s->ctx, &s->ledger, s->reduce, sums, maxes);
+  if (st == GR_OK && max_depth)
+    *max_depth = maxes[0];
+  return st;
 }
 
 /* ------------------------------------------------------------- life cycle */
+
+/* The piece contract (graupel.h, rain_runoff.h): which sides have a
+ * neighbour, and so a ring of GR_RAIN_RUNOFF_GHOST cells. */
+static gr_status gr_rain_runoff_piece(const gr_grid *g, int ring[4], char *msg, size_t len) {
+  long long gnx = g->global_nx > 0 ? g->global_nx : g->nx;
+  long long gny = g->global_ny > 0 ? g->global_ny : g->ny;
+  int whole_x = g->global_nx <= 0, whole_y = g->global_ny <= 0;
+  memset(ring, 0, 4 * sizeof(int));
+  if (g->global_nx < 0 || g->global_ny < 0 || g->ghost < 0) {
+    snprintf(msg, len,
+             "Invalid grid: global_nx, global_ny and ghost must be 0 or more (got %d, %d, %d).",
+             g->global_nx, g->global_ny, g->ghost);
+    return GR_ERR_INVALID_ARGUMENT;
+  }
+  if ((!whole_x && (long long)g->i0 + g->nx > gnx) ||
+      (!whole_y && (long long)g->j0 + g->ny > gny)) {
+    snprintf(msg, len,
+             "Invalid grid: the piece of %d x %d points at (%d, %d) reaches beyond the domain of "
+             "%lld x %lld points; give global_nx and global_ny of the whole domain.",
+             g->nx, g->ny, g->i0, g->j0, gnx, gny);
+    return GR_ERR_INVALID_ARGUMENT;
+  }
+  if (!whole_x) {
+    ring[0] = g->i0 > 0 ? GR_RAIN_RUNOFF_GHOST : 0;
+    ring[1] = (long long)g->i0 + g->nx < gnx ? GR_RAIN_RUNOFF_GHOST : 0;
+  }
+  if (!whole_y) {
+    ring[2] = g->j0 > 0 ? GR_RAIN_RUNOFF_GHOST : 0;
+    ring[3] = (long long)g->j0 + g->ny < gny ? GR_RAIN_RUNOFF_GHOST : 0;
+  }
+  int any = ring[0] || ring[1] || ring[2] || ring[3];
+  if (any && g->ghost != GR_RAIN_RUNOFF_GHOST) {
+    snprintf(msg, len,
+             "Invalid grid: a rain runoff piece with neighbours needs a ghost ring of %d points "
+             "(got ghost = %d); set grid.ghost to %d.",
+             GR_RAIN_RUNOFF_GHOST, g->ghost, GR_RAIN_RUNOFF_GHOST);
+    return GR_ERR_INVALID_ARGUMENT;
+  }
+  if (((ring[0] || ring[1]) && g->nx < GR_RAIN_RUNOFF_GHOST) ||
+      ((ring[2] || ring[3]) && g->ny < GR_RAIN_RUNOFF_GHOST)) {
+    snprintf(msg, len,
+             "Invalid grid: a rain runoff piece of %d x %d points is narrower than its ghost ring "
+             "of %d toward a neighbour; split the domain into fewer pieces.",
+             g->nx, g->ny, GR_RAIN_RUNOFF_GHOST);
+    return GR_ERR_INVALID_ARGUMENT;
+  }
+  return GR_OK;
+}
 
 gr_status gr_rain_runoff_create(gr_context *ctx, const gr_grid *grid,
                                 const gr_rain_runoff_params *p, gr_rain_runoff **out) {
@@ -244,8 +456,12 @@ gr_status gr_rain_runoff_create(gr_context *ctx, const gr_grid *grid,
     return gr_set_error(ctx, GR_ERR_INVALID_ARGUMENT, "%s", msg);
   if (gr_rain_runoff_params_validate(p, msg, sizeof(msg)) != GR_OK)
     return gr_set_error(ctx, GR_ERR_INVALID_ARGUMENT, "%s", msg);
+  int ring[4];
+  if (gr_rain_runoff_piece(grid, ring, msg, sizeof(msg)) != GR_OK)
+    return gr_set_error(ctx, GR_ERR_INVALID_ARGUMENT, "%s", msg);
 
-  size_t nx = (size_t)grid->nx, ny = (size_t)grid->ny, cells = nx * ny;
+  size_t nx = (size_t)grid->nx + (size_t)ring[0] + (size_t)ring[1];
+  size_t ny = (size_t)grid->ny + (size_t)ring[2] + (size_t)ring[3], cells = nx * ny;
   if (((double)nx + 1.0) * ((double)ny + 1.0) > GR_RAIN_RUNOFF_MAX_FACES)
     return gr_set_error(ctx, GR_ERR_TOO_LARGE,
                         "The rain runoff grid of %zu x %zu points is too large: the kernels "
@@ -271,6 +487,9 @@ gr_status gr_rain_runoff_create(gr_context *ctx, const gr_grid *grid,
     return gr_set_error(ctx, GR_ERR_OUT_OF_MEMORY, "Out of host memory.");
   s->ctx = gr_context_retain(ctx);
   s->grid = *grid;
+  s->nxl = (int)nx;
+  s->nyl = (int)ny;
+  memcpy(s->ring, ring, sizeof(ring));
   s->params = *p;
   cl_program prog = NULL;
   size_t bytes = cells * sizeof(cl_float);
@@ -297,28 +516,9 @@ gr_status gr_rain_runoff_create(gr_context *ctx, const gr_grid *grid,
   }
   if (st == GR_OK)
     st = gr_buffer_create(ctx, CL_MEM_READ_ONLY, sizeof(cl_float), NULL, &s->dummy);
-  if (st == GR_OK) {
-    /* The reduction's work-group: a power of two the kernel allows. */
-    size_t kmax = 0;
-    cl_int err = clGetKernelWorkGroupInfo(s->reduce, gr_context_device(ctx),
-                                          CL_KERNEL_WORK_GROUP_SIZE, sizeof(kmax), &kmax, NULL);
-    st = gr_cl_check(ctx, err, "Querying the reduction's work-group size");
-    s->reduce_local = 1;
-    while (s->reduce_local * 2 <= GR_RAIN_RUNOFF_REDUCE_LOCAL && s->reduce_local * 2 <= kmax)
-      s->reduce_local *= 2;
-    s->reduce_groups = (cells + s->reduce_local - 1) / s->reduce_local;
-    if (s->reduce_groups > GR_RAIN_RUNOFF_REDUCE_GROUPS)
-      s->reduce_groups = GR_RAIN_RUNOFF_REDUCE_GROUPS;
-  }
   if (st == GR_OK)
-    st = gr_buffer_create(ctx, CL_MEM_WRITE_ONLY,
-                          s->reduce_groups * GR_RAIN_RUNOFF_SLOTS * sizeof(cl_float), NULL,
-                          &s->partial);
-  if (st == GR_OK) {
-    s->partial_host = malloc(s->reduce_groups * GR_RAIN_RUNOFF_SLOTS * sizeof(float));
-    if (!s->partial_host)
-      st = gr_set_error(ctx, GR_ERR_OUT_OF_MEMORY, "Out of host memory.");
-  }
+    st = gr_reduction_init(ctx, s->reduce, cells, GR_RAIN_RUNOFF_SUMS, GR_RAIN_RUNOFF_MAXES,
+                           &s->ledger);
   /* Dry, flat ground; nothing infiltrated or gone. */
   cl_mem *zeroed[] = {&s->h, &s->h_c, &s->b, &s->inf, &s->inf_c, &s->out, &s->out_c, &s->dummy};
   for (size_t i = 0; st == GR_OK && i < sizeof(zeroed) / sizeof(zeroed[0]); ++i)
@@ -343,12 +543,12 @@ void gr_rain_runoff_destroy(gr_rain_runoff *s) {
   for (size_t i = 0; i < sizeof(kernels) / sizeof(kernels[0]); ++i)
     if (kernels[i])
       clReleaseKernel(kernels[i]);
-  cl_mem *bufs[] = {&s->h,       &s->h_c, &s->b,    &s->qx[0], &s->qy[0],   &s->qx[1],
-                    &s->qy[1],   &s->k,   &s->inf,  &s->inf_c, &s->out,     &s->out_c,
-                    &s->partial, &s->h0,  &s->rain, &s->perm,  &s->scratch, &s->dummy};
+  cl_mem *bufs[] = {&s->h,     &s->h_c,  &s->b,    &s->qx[0],   &s->qy[0], &s->qx[1],
+                    &s->qy[1], &s->k,    &s->inf,  &s->inf_c,   &s->out,   &s->out_c,
+                    &s->h0,    &s->rain, &s->perm, &s->scratch, &s->dummy};
   for (size_t i = 0; i < sizeof(bufs) / sizeof(bufs[0]); ++i)
     gr_buffer_release(bufs[i]);
-  free(s->partial_host);
+  gr_reduction_release(&s->ledger);
   gr_context_release(s->ctx);
   free(s);
 }
@@ -359,8 +559,9 @@ gr_status gr_rain_runoff_set_params(gr_rain_runoff *s, const gr_rain_runoff_para
     return gr_set_error(NULL, GR_ERR_INVALID_ARGUMENT,
                         "gr_rain_runoff_set_params needs a simulation.");
   if (gr_rain_runoff_params_validate(p, msg, sizeof(msg)) != GR_OK)
-    return gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT, "%s", msg);
+    return GR_RAIN_RUNOFF_KEEP_ERROR(s, gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT, "%s", msg));
   s->params = *p;
+  s->args_set = 0;
   return GR_OK;
 }
 
@@ -372,15 +573,13 @@ static gr_status gr_rain_runoff_upload(gr_rain_runoff *s, cl_mem *buf, const flo
   return gr_buffer_write(s->ctx, *buf, 0, bytes, host);
 }
 
-gr_status gr_rain_runoff_set_field(gr_rain_runoff *s, gr_field f, const float *host) {
+static gr_status gr_rain_runoff_set_field_impl(gr_rain_runoff *s, gr_field f, const float *host) {
   char msg[320];
-  if (!s || !host)
-    return gr_set_error(s ? s->ctx : NULL, GR_ERR_INVALID_ARGUMENT,
-                        "gr_rain_runoff_set_field needs a simulation and the field's values.");
   size_t cells = gr_rain_runoff_cells(s);
-  if (gr_rain_runoff_field_check(f, host, cells, (size_t)s->grid.nx, 1, msg, sizeof(msg)) != GR_OK)
+  if (gr_rain_runoff_field_check(f, host, cells, (size_t)s->nxl, 1, msg, sizeof(msg)) != GR_OK)
     return gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT, "%s", msg);
   gr_status st = GR_OK;
+  s->args_set = 0; /* a field allocated now is bound at the next step */
   switch (f) {
   case GR_FIELD_ELEVATION:
     st = gr_buffer_write(s->ctx, s->b, 0, cells * sizeof(cl_float), host);
@@ -391,9 +590,7 @@ gr_status gr_rain_runoff_set_field(gr_rain_runoff *s, gr_field f, const float *h
       s->has_perm = 1;
     break;
   case GR_FIELD_RAIN_RATE: {
-    double sum = 0.0;
-    for (size_t c = 0; c < cells; ++c)
-      sum += host[c];
+    double sum = gr_rain_runoff_own_sum(s, host);
     st = gr_rain_runoff_upload(s, &s->rain, host);
     if (st == GR_OK) {
       s->has_rain = 1;
@@ -404,9 +601,7 @@ gr_status gr_rain_runoff_set_field(gr_rain_runoff *s, gr_field f, const float *h
   case GR_FIELD_WATER_DEPTH: {
     /* The new water replaces what is there now: the ledger counts the
      * difference as initial water, so the balance still closes. */
-    double now[3], sum = 0.0;
-    for (size_t c = 0; c < cells; ++c)
-      sum += host[c];
+    double now[GR_RAIN_RUNOFF_SUMS], sum = gr_rain_runoff_own_sum(s, host);
     st = gr_rain_runoff_reduce(s, now, NULL);
     if (st == GR_OK)
       st = gr_rain_runoff_upload(s, &s->h0, host);
@@ -428,86 +623,306 @@ gr_status gr_rain_runoff_set_field(gr_rain_runoff *s, gr_field f, const float *h
   return st;
 }
 
+gr_status gr_rain_runoff_set_field(gr_rain_runoff *s, gr_field f, const float *host) {
+  if (!s)
+    return gr_set_error(NULL, GR_ERR_INVALID_ARGUMENT,
+                        "gr_rain_runoff_set_field needs a simulation and the field's values.");
+  if (!host)
+    return GR_RAIN_RUNOFF_KEEP_ERROR(
+        s, gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
+                        "gr_rain_runoff_set_field needs a simulation and the field's values."));
+  return GR_RAIN_RUNOFF_KEEP_ERROR(s, gr_rain_runoff_set_field_impl(s, f, host));
+}
+
+/* ------------------------------------------------------ pieces and halos */
+
+void gr_rain_runoff_set_allreduce(gr_rain_runoff *s, gr_allreduce_fn fn, void *user) {
+  if (!s)
+    return;
+  s->allreduce = fn;
+  s->allreduce_user = fn ? user : NULL;
+}
+
+static gr_status gr_rain_runoff_allreduce(gr_rain_runoff *s, double *values, int n,
+                                          gr_reduce_op op) {
+  gr_status st = s->allreduce(s->allreduce_user, values, n, op);
+  if (st != GR_OK && st != GR_ERR_ABORTED)
+    return gr_set_error(s->ctx, st,
+                        "The rain runoff simulation's global reduction (the allreduce callback) "
+                        "failed: %s.",
+                        gr_status_string(st));
+  return st;
+}
+
+/* The cells of a halo strip on `side`: GR_RAIN_RUNOFF_GHOST columns by the
+ * local array's rows (west, east), or its columns by GR_RAIN_RUNOFF_GHOST
+ * rows (south, north); 0 where the side has no neighbour. */
+static size_t gr_rain_runoff_strip_cells(const gr_rain_runoff *s, int side, size_t *w, size_t *h) {
+  if (side < 0 || side > 3 || !s->ring[side])
+    return 0;
+  *w = side < 2 ? (size_t)GR_RAIN_RUNOFF_GHOST : (size_t)s->nxl;
+  *h = side < 2 ? (size_t)s->nyl : (size_t)GR_RAIN_RUNOFF_GHOST;
+  return *w * *h;
+}
+
+gr_status gr_rain_runoff_halo_size(const gr_rain_runoff *s, int side, size_t *bytes) {
+  if (!s || !bytes)
+    return gr_set_error(s ? s->ctx : NULL, GR_ERR_INVALID_ARGUMENT,
+                        "gr_rain_runoff_halo_size needs a simulation and a place for the size.");
+  size_t w = 0, h = 0;
+  *bytes =
+      GR_RAIN_RUNOFF_HALO_ARRAYS * gr_rain_runoff_strip_cells(s, side, &w, &h) * sizeof(cl_float);
+  return GR_OK;
+}
+
+/* Copies one side's strip between the device and host: from the owned
+ * cells next to the side (get), or into the ring on that side (set). */
+static gr_status gr_rain_runoff_halo_copy(gr_rain_runoff *s, int side, void *host, size_t bytes,
+                                          int set) {
+  size_t w = 0, h = 0, cells = gr_rain_runoff_strip_cells(s, side, &w, &h);
+  if (cells == 0)
+    return gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
+                        "The rain runoff piece has no neighbour on side %d (0 west, 1 east, 2 "
+                        "south, 3 north): only sides with a ring exchange a halo.",
+                        side);
+  size_t need = GR_RAIN_RUNOFF_HALO_ARRAYS * cells * sizeof(cl_float);
+  if (bytes != need)
+    return gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
+                        "The halo buffer has %zu bytes but side %d's strip has %zu: size it with "
+                        "gr_rain_runoff_halo_size.",
+                        bytes, side, need);
+  const size_t g = GR_RAIN_RUNOFF_GHOST, nxl = (size_t)s->nxl, nyl = (size_t)s->nyl;
+  size_t x0 = 0, y0 = 0;
+  switch (side) {
+  case 0:
+    x0 = set ? 0 : g;
+    break;
+  case 1:
+    x0 = set ? nxl - g : nxl - 2 * g;
+    break;
+  case 2:
+    y0 = set ? 0 : g;
+    break;
+  default:
+    y0 = set ? nyl - g : nyl - 2 * g;
+    break;
+  }
+  /* Per cell: depth, limiter, its west x-face and its south y-face (the
+   * faces are numbered from the cell's corner: x-face rows are nxl + 1
+   * wide, y-faces like cells). */
+  const cl_mem bufs[GR_RAIN_RUNOFF_HALO_ARRAYS] = {s->h, s->k, s->qx[s->cur], s->qy[s->cur]};
+  const size_t pitch[GR_RAIN_RUNOFF_HALO_ARRAYS] = {nxl, nxl, nxl + 1, nxl};
+  unsigned char *at = host;
+  gr_status st = GR_OK;
+  for (int a = 0; st == GR_OK && a < GR_RAIN_RUNOFF_HALO_ARRAYS; ++a) {
+    st = gr_rain_runoff_rect(s, bufs[a], pitch[a], 1, x0, y0, w, h, at, set);
+    at += cells * sizeof(cl_float);
+  }
+  return st;
+}
+
+gr_status gr_rain_runoff_halo_get(gr_rain_runoff *s, int side, void *host, size_t bytes) {
+  if (!s)
+    return gr_set_error(NULL, GR_ERR_INVALID_ARGUMENT,
+                        "gr_rain_runoff_halo_get needs a simulation and a buffer.");
+  if (!host)
+    return GR_RAIN_RUNOFF_KEEP_ERROR(
+        s, gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
+                        "gr_rain_runoff_halo_get needs a simulation and a buffer."));
+  return GR_RAIN_RUNOFF_KEEP_ERROR(s, gr_rain_runoff_halo_copy(s, side, host, bytes, 0));
+}
+
+gr_status gr_rain_runoff_halo_set(gr_rain_runoff *s, int side, const void *host, size_t bytes) {
+  if (!s)
+    return gr_set_error(NULL, GR_ERR_INVALID_ARGUMENT,
+                        "gr_rain_runoff_halo_set needs a simulation and a buffer.");
+  if (!host)
+    return GR_RAIN_RUNOFF_KEEP_ERROR(
+        s, gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
+                        "gr_rain_runoff_halo_set needs a simulation and a buffer."));
+  /* The copy only reads host (write = 1). */
+  return GR_RAIN_RUNOFF_KEEP_ERROR(s, gr_rain_runoff_halo_copy(s, side, (void *)host, bytes, 1));
+}
+
 /* --------------------------------------------------------------- stepping */
 
-gr_status gr_rain_runoff_step(gr_rain_runoff *s, double dt, int nsteps) {
-  if (!s)
-    return gr_set_error(NULL, GR_ERR_INVALID_ARGUMENT, "gr_rain_runoff_step needs a simulation.");
-  if (!(dt >= GR_RAIN_RUNOFF_MIN_DT && dt <= GR_RAIN_RUNOFF_MAX_DT))
+static double gr_rain_runoff_now(void) {
+  struct timespec ts;
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+/* advance's watch over the queue for its progress callback: it waits on the
+ * queue after every `batch` steps, sized so a batch takes about
+ * GR_RAIN_RUNOFF_BATCH_S, and calls the callback when enough wall time has
+ * passed. Waiting changes when the host blocks, never what is computed. */
+typedef struct gr_rain_runoff_watch {
+  double last_call, last_wait;
+  int batch, since;
+} gr_rain_runoff_watch;
+
+/* Called after each enqueued step; `time` is the simulated time it reaches.
+ * *stop becomes 1 when the callback asks to stop. */
+static gr_status gr_rain_runoff_watch_step(gr_rain_runoff *s, gr_rain_runoff_watch *w, double time,
+                                           int *stop) {
+  if (++w->since < w->batch)
+    return GR_OK;
+  gr_status st = gr_finish(s->ctx);
+  if (st != GR_OK)
+    return st;
+  double now = gr_rain_runoff_now(), span = now - w->last_wait;
+  if (span < 0.5 * GR_RAIN_RUNOFF_BATCH_S && w->batch < (1 << 20))
+    w->batch *= 2;
+  else if (span > GR_RAIN_RUNOFF_BATCH_S && w->batch > 1)
+    w->batch /= 2;
+  w->since = 0;
+  w->last_wait = now;
+  if (now - w->last_call >= GR_RAIN_RUNOFF_PROGRESS_EVERY) {
+    w->last_call = now;
+    if (s->progress(s->progress_user, time) != 0)
+      *stop = 1;
+  }
+  return GR_OK;
+}
+
+/* Binds every step-kernel argument but the alternating face arrays, when
+ * something they hold has changed since the last step. */
+static gr_status gr_rain_runoff_bind(gr_rain_runoff *s, cl_float dt) {
+  if (s->args_set && s->args_dt == dt)
+    return GR_OK;
+  const gr_rain_runoff_params *p = &s->params;
+  const gr_grid *gd = &s->grid;
+  cl_int nx = s->nxl, ny = s->nyl;
+  cl_float inv_dx = (cl_float)(1.0 / gd->dx), inv_dy = (cl_float)(1.0 / gd->dy);
+  cl_float g = (cl_float)GR_GRAVITY;
+  cl_float n2 = (cl_float)(p->manning_n * p->manning_n);
+  cl_int use_rain = s->has_rain, use_perm = s->has_perm;
+  cl_float rain_uniform = (cl_float)p->rain_rate, perm_uniform = (cl_float)p->permeability;
+  cl_int closed = p->boundary == GR_BOUNDARY_CLOSED;
+  cl_mem rain = s->has_rain ? s->rain : s->dummy, perm = s->has_perm ? s->perm : s->dummy;
+  cl_float theta = (cl_float)GR_RAIN_RUNOFF_THETA;
+  const size_t m = sizeof(cl_mem);
+  /* Arguments the three step kernels share (each takes those it has). */
+  const gr_rain_runoff_arg common[] = {
+      {"h", m, &s->h},
+      {"rain", m, &rain},
+      {"perm", m, &perm},
+      {"limit", m, &s->k},
+      {"nx", sizeof(nx), &nx},
+      {"ny", sizeof(ny), &ny},
+      {"dt", sizeof(dt), &dt},
+      {"inv_dx", sizeof(inv_dx), &inv_dx},
+      {"inv_dy", sizeof(inv_dy), &inv_dy},
+      {"use_rain", sizeof(use_rain), &use_rain},
+      {"rain_uniform", sizeof(rain_uniform), &rain_uniform},
+      {"use_perm", sizeof(use_perm), &use_perm},
+      {"perm_uniform", sizeof(perm_uniform), &perm_uniform},
+  };
+  const gr_rain_runoff_arg flux[] = {
+      {"b", m, &s->b},
+      {"g", sizeof(g), &g},
+      {"n2", sizeof(n2), &n2},
+      {"theta", sizeof(theta), &theta},
+      {"closed", sizeof(closed), &closed},
+  };
+  const gr_rain_runoff_arg update[] = {
+      {"h_comp", m, &s->h_c},  {"infiltrated", m, &s->inf},    {"infiltrated_comp", m, &s->inf_c},
+      {"outflow", m, &s->out}, {"outflow_comp", m, &s->out_c},
+  };
+  cl_kernel kernels[] = {s->flux, s->limit, s->update};
+  gr_status st = GR_OK;
+  for (int i = 0; st == GR_OK && i < 3; ++i)
+    st = GR_RAIN_RUNOFF_ARGS(s, kernels[i], common);
+  if (st == GR_OK)
+    st = GR_RAIN_RUNOFF_ARGS(s, s->flux, flux);
+  if (st == GR_OK)
+    st = GR_RAIN_RUNOFF_ARGS(s, s->update, update);
+  s->args_set = st == GR_OK;
+  s->args_dt = dt;
+  return st;
+}
+
+/* Enqueues up to nsteps steps of dt; *done gets the steps enqueued. With a
+ * watch (advance with a progress callback) it may stop early at a step
+ * boundary: *stop becomes 1. */
+static gr_status gr_rain_runoff_enqueue(gr_rain_runoff *s, double dt, int nsteps,
+                                        gr_rain_runoff_watch *w, int *done_out, int *stop) {
+  const gr_grid *gd = &s->grid;
+  cl_float dtf = (cl_float)dt;
+  const size_t m = sizeof(cl_mem);
+  gr_status st = gr_rain_runoff_bind(s, dtf);
+  int done = 0;
+  while (st == GR_OK && done < nsteps && !*stop) {
+    int old = s->cur, now = 1 - s->cur;
+    const gr_rain_runoff_arg flux[] = {
+        {"qx_old", m, &s->qx[old]},
+        {"qy_old", m, &s->qy[old]},
+        {"qx", m, &s->qx[now]},
+        {"qy", m, &s->qy[now]},
+    };
+    const gr_rain_runoff_arg faces[] = {{"qx", m, &s->qx[now]}, {"qy", m, &s->qy[now]}};
+    st = GR_RAIN_RUNOFF_ARGS(s, s->flux, flux);
+    if (st == GR_OK)
+      st = GR_RAIN_RUNOFF_ARGS(s, s->limit, faces);
+    if (st == GR_OK)
+      st = GR_RAIN_RUNOFF_ARGS(s, s->update, faces);
+    if (st == GR_OK)
+      st = gr_enqueue_2d(s->ctx, s->flux, 0, 0, (size_t)s->nxl + 1, (size_t)s->nyl + 1, NULL);
+    if (st == GR_OK)
+      s->cur = now; /* the flux kernel is enqueued: the new faces are current */
+    if (st == GR_OK)
+      st = gr_enqueue_2d(s->ctx, s->limit, 0, 0, (size_t)s->nxl, (size_t)s->nyl, NULL);
+    if (st == GR_OK)
+      st = gr_enqueue_2d(s->ctx, s->update, 0, 0, (size_t)s->nxl, (size_t)s->nyl, NULL);
+    if (st == GR_OK)
+      ++done;
+    if (st == GR_OK && w)
+      st = gr_rain_runoff_watch_step(s, w, s->time + dt * (double)done, stop);
+  }
+  /* The ledger counts the steps whose launches were all enqueued, with the
+   * rain the device added: the float dt it was given. */
+  double rain_sum =
+      s->has_rain ? s->rain_field_sum
+                  : (double)gr_rain_runoff_own_cells(s) * (double)(cl_float)s->params.rain_rate;
+  s->rain_volume += rain_sum * gd->dx * gd->dy * (double)dtf * (double)done;
+  s->time += dt * (double)done;
+  s->steps += done;
+  *done_out = done;
+  return st;
+}
+
+static gr_status gr_rain_runoff_step_impl(gr_rain_runoff *s, double dt, int nsteps) {
+  double max_dt = gr_rain_runoff_core_max(GR_RAIN_RUNOFF_P_MAX_DT);
+  if (!(dt >= GR_RAIN_RUNOFF_MIN_DT && dt <= max_dt))
     return gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
-                        "The time step dt must lie between 1e-30 and 3600 s (got %g s).", dt);
+                        "The time step dt must lie between %g and %g s (got %g s).",
+                        GR_RAIN_RUNOFF_MIN_DT, max_dt, dt);
   if (nsteps < 0)
     return gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
                         "The number of steps must be 0 or more (got %d).", nsteps);
   if (nsteps == 0)
     return GR_OK;
-  const gr_rain_runoff_params *p = &s->params;
-  const gr_grid *gd = &s->grid;
-  cl_int nx = gd->nx, ny = gd->ny;
-  cl_float dtf = (cl_float)dt;
-  cl_float inv_dx = (cl_float)(1.0 / gd->dx), inv_dy = (cl_float)(1.0 / gd->dy);
-  cl_float g = (cl_float)GR_GRAVITY;
-  cl_float n2 = (cl_float)(p->manning_n * p->manning_n);
-  cl_int use_rain = s->has_rain, use_perm = s->has_perm;
-  cl_float rain_u = (cl_float)p->rain_rate, perm_u = (cl_float)p->permeability;
-  cl_int closed = p->boundary == GR_BOUNDARY_CLOSED;
-  cl_mem rain = s->has_rain ? s->rain : s->dummy, perm = s->has_perm ? s->perm : s->dummy;
-  cl_float theta = (cl_float)GR_RAIN_RUNOFF_THETA;
-  const size_t m = sizeof(cl_mem), fl = sizeof(cl_float), in = sizeof(cl_int);
-  /* Every argument but the alternating face arrays (set per step below). */
-  gr_status st =
-      gr_kernel_args(s->ctx, s->flux, m, &s->h, m, &s->b, m, &rain, m, &perm, m, &s->qx[0], m,
-                     &s->qy[0], m, &s->qx[1], m, &s->qy[1], m, &s->k, in, &nx, in, &ny, fl, &dtf,
-                     fl, &inv_dx, fl, &inv_dy, fl, &g, fl, &n2, fl, &theta, in, &use_rain, fl,
-                     &rain_u, in, &use_perm, fl, &perm_u, in, &closed, (size_t)0);
-  if (st == GR_OK)
-    st = gr_kernel_args(s->ctx, s->limit, m, &s->h, m, &rain, m, &perm, m, &s->qx[0], m, &s->qy[0],
-                        m, &s->k, in, &nx, in, &ny, fl, &dtf, fl, &inv_dx, fl, &inv_dy, in,
-                        &use_rain, fl, &rain_u, in, &use_perm, fl, &perm_u, (size_t)0);
-  if (st == GR_OK)
-    st = gr_kernel_args(s->ctx, s->update, m, &s->h, m, &s->h_c, m, &rain, m, &perm, m, &s->qx[0],
-                        m, &s->qy[0], m, &s->k, m, &s->inf, m, &s->inf_c, m, &s->out, m, &s->out_c,
-                        in, &nx, in, &ny, fl, &dtf, fl, &inv_dx, fl, &inv_dy, in, &use_rain, fl,
-                        &rain_u, in, &use_perm, fl, &perm_u, (size_t)0);
-  int done = 0;
-  while (st == GR_OK && done < nsteps) {
-    int old = s->cur, now = 1 - s->cur;
-    cl_int err = clSetKernelArg(s->flux, 4, m, &s->qx[old]);
-    err |= clSetKernelArg(s->flux, 5, m, &s->qy[old]);
-    err |= clSetKernelArg(s->flux, 6, m, &s->qx[now]);
-    err |= clSetKernelArg(s->flux, 7, m, &s->qy[now]);
-    err |= clSetKernelArg(s->limit, 3, m, &s->qx[now]);
-    err |= clSetKernelArg(s->limit, 4, m, &s->qy[now]);
-    err |= clSetKernelArg(s->update, 4, m, &s->qx[now]);
-    err |= clSetKernelArg(s->update, 5, m, &s->qy[now]);
-    st = gr_cl_check(s->ctx, err, "Setting the rain runoff face arrays");
-    if (st == GR_OK)
-      st = gr_enqueue_2d(s->ctx, s->flux, 0, 0, (size_t)nx + 1, (size_t)ny + 1, NULL);
-    if (st == GR_OK)
-      s->cur = now; /* the flux kernel is enqueued: the new faces are current */
-    if (st == GR_OK)
-      st = gr_enqueue_2d(s->ctx, s->limit, 0, 0, (size_t)nx, (size_t)ny, NULL);
-    if (st == GR_OK)
-      st = gr_enqueue_2d(s->ctx, s->update, 0, 0, (size_t)nx, (size_t)ny, NULL);
-    if (st == GR_OK)
-      ++done;
-  }
-  /* The ledger counts the steps whose launches were all enqueued, with the
-   * rain the device added: the float dt it was given. */
-  double rain_sum = s->has_rain ? s->rain_field_sum
-                                : (double)gr_rain_runoff_cells(s) * (double)(cl_float)p->rain_rate;
-  s->rain_volume += rain_sum * gd->dx * gd->dy * (double)dtf * (double)done;
-  s->time += dt * (double)done;
-  s->steps += done;
-  return st;
+  if (nsteps > 1 && gr_rain_runoff_has_ring(s))
+    return gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
+                        "A rain runoff piece with neighbours takes one step per call (got %d): "
+                        "exchange its halo between steps.",
+                        nsteps);
+  int done = 0, stop = 0;
+  return gr_rain_runoff_enqueue(s, dt, nsteps, NULL, &done, &stop);
 }
 
-gr_status gr_rain_runoff_stable_dt(gr_rain_runoff *s, double *dt) {
-  if (!s || !dt)
-    return gr_set_error(s ? s->ctx : NULL, GR_ERR_INVALID_ARGUMENT,
-                        "gr_rain_runoff_stable_dt needs a simulation and a place for dt.");
-  double sums[3], hmax = 0.0;
+gr_status gr_rain_runoff_step(gr_rain_runoff *s, double dt, int nsteps) {
+  if (!s)
+    return gr_set_error(NULL, GR_ERR_INVALID_ARGUMENT, "gr_rain_runoff_step needs a simulation.");
+  return GR_RAIN_RUNOFF_KEEP_ERROR(s, gr_rain_runoff_step_impl(s, dt, nsteps));
+}
+
+static gr_status gr_rain_runoff_stable_dt_impl(gr_rain_runoff *s, double *dt) {
+  double sums[GR_RAIN_RUNOFF_SUMS], hmax = 0.0;
   gr_status st = gr_rain_runoff_reduce(s, sums, &hmax);
+  /* The deepest cell of the whole domain: every piece takes the same step. */
+  if (st == GR_OK && s->allreduce)
+    st = gr_rain_runoff_allreduce(s, &hmax, 1, GR_REDUCE_MAX);
   if (st != GR_OK)
     return st;
   /* The scheme's stability limit in 2-D for gravity waves, c = sqrt(g h)
@@ -527,31 +942,46 @@ gr_status gr_rain_runoff_stable_dt(gr_rain_runoff *s, double *dt) {
   return GR_OK;
 }
 
-gr_status gr_rain_runoff_advance(gr_rain_runoff *s, double duration, int *steps_taken) {
-  if (steps_taken)
-    *steps_taken = 0;
+gr_status gr_rain_runoff_stable_dt(gr_rain_runoff *s, double *dt) {
   if (!s)
     return gr_set_error(NULL, GR_ERR_INVALID_ARGUMENT,
-                        "gr_rain_runoff_advance needs a simulation.");
+                        "gr_rain_runoff_stable_dt needs a simulation and a place for dt.");
+  if (!dt)
+    return GR_RAIN_RUNOFF_KEEP_ERROR(
+        s, gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
+                        "gr_rain_runoff_stable_dt needs a simulation and a place for dt."));
+  return GR_RAIN_RUNOFF_KEEP_ERROR(s, gr_rain_runoff_stable_dt_impl(s, dt));
+}
+
+static gr_status gr_rain_runoff_advance_impl(gr_rain_runoff *s, double duration,
+                                             long long *taken_out) {
   if (!(duration >= 0.0 && duration < HUGE_VAL))
     return gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
                         "The duration to advance must be a finite number of seconds, 0 or more "
                         "(got %g).",
                         duration);
+  if (gr_rain_runoff_has_ring(s))
+    return gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
+                        "A rain runoff piece with neighbours cannot advance on its own: step it "
+                        "with gr_rain_runoff_step and gr_rain_runoff_stable_dt, exchanging its "
+                        "halo between steps.");
   /* The stable step is read back again after a few steps, not once: rain
    * filling a dry bowl deepens it, and a step that was stable at the start
    * of a long advance is not by its end. The stretch between reads starts
    * at GR_RAIN_RUNOFF_CHUNK_MIN steps and doubles (to GR_RAIN_RUNOFF_CHUNK_MAX) while the
    * stable step holds; the last stretch is split into equal steps that end
    * exactly at the duration. All of it depends on the state only, so the
-   * same state and duration give the same steps. */
+   * same state and duration give the same steps; the progress watch only
+   * adds waits. */
   double left = duration, last_dt = 0.0;
-  long long taken = 0;
-  int chunk = GR_RAIN_RUNOFF_CHUNK_MIN;
+  int chunk = GR_RAIN_RUNOFF_CHUNK_MIN, stop = 0;
+  gr_rain_runoff_watch watch = {0.0, 0.0, 1, 0};
+  watch.last_call = watch.last_wait = gr_rain_runoff_now();
+  gr_rain_runoff_watch *w = s->progress ? &watch : NULL;
   gr_status st = GR_OK;
-  while (st == GR_OK && left > 0.0) {
+  while (st == GR_OK && left > 0.0 && !stop) {
     double dt = 0.0;
-    st = gr_rain_runoff_stable_dt(s, &dt);
+    st = gr_rain_runoff_stable_dt_impl(s, &dt);
     if (st != GR_OK)
       break;
     if (last_dt > 0.0)
@@ -562,81 +992,112 @@ gr_status gr_rain_runoff_advance(gr_rain_runoff *s, double duration, int *steps_
     double n = ceil(left / dt);
     if (n < 1.0)
       n = 1.0;
-    if ((double)taken + n > (double)INT_MAX) {
+    if ((double)*taken_out + n > (double)INT_MAX) {
       st = gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
                         "Advancing by %g s takes more than %d steps (the stable step is %g s "
                         "with %g s left): advance in parts.",
                         duration, INT_MAX, dt, left);
       break;
     }
+    int done = 0;
     if (n <= chunk) {
-      st = gr_rain_runoff_step(s, left / n, (int)n);
-      if (st == GR_OK)
-        taken += (long long)n;
+      st = gr_rain_runoff_enqueue(s, left / n, (int)n, w, &done, &stop);
+      *taken_out += done;
       break;
     }
-    st = gr_rain_runoff_step(s, dt, chunk);
-    if (st == GR_OK) {
-      taken += chunk;
+    st = gr_rain_runoff_enqueue(s, dt, chunk, w, &done, &stop);
+    *taken_out += done;
+    if (st == GR_OK)
       left -= chunk * dt;
-    }
   }
+  if (st == GR_OK && stop)
+    st = gr_set_error(s->ctx, GR_ERR_ABORTED,
+                      "The rain runoff advance was stopped by its progress callback at %g s of "
+                      "simulated time; the state is valid there and may be advanced further.",
+                      s->time);
+  return st;
+}
+
+gr_status gr_rain_runoff_advance(gr_rain_runoff *s, double duration, int *steps_taken) {
+  if (steps_taken)
+    *steps_taken = 0;
+  if (!s)
+    return gr_set_error(NULL, GR_ERR_INVALID_ARGUMENT,
+                        "gr_rain_runoff_advance needs a simulation.");
+  long long taken = 0;
+  gr_status st = gr_rain_runoff_advance_impl(s, duration, &taken);
   if (steps_taken)
     *steps_taken = (int)taken;
-  return st;
+  return GR_RAIN_RUNOFF_KEEP_ERROR(s, st);
+}
+
+void gr_rain_runoff_set_progress(gr_rain_runoff *s, gr_progress_fn fn, void *user) {
+  if (!s)
+    return;
+  s->progress = fn;
+  s->progress_user = fn ? user : NULL;
 }
 
 /* ---------------------------------------------------------------- reading */
 
 /* Runs the derive kernel (what: 0 surface, 1 velocity, 2 discharge, 3
- * infiltrated) into the scratch buffer and reads `floats` values back. */
-static gr_status gr_rain_runoff_derive(gr_rain_runoff *s, cl_int what, size_t floats, float *host) {
+ * infiltrated) into the scratch buffer and reads the owned cells' `comps`
+ * floats each back. */
+static gr_status gr_rain_runoff_derive(gr_rain_runoff *s, cl_int what, size_t comps, float *host) {
   size_t cells = gr_rain_runoff_cells(s);
   gr_status st = GR_OK;
   if (!s->scratch)
     st = gr_buffer_create(s->ctx, CL_MEM_READ_WRITE, 3 * cells * sizeof(cl_float), NULL,
                           &s->scratch);
-  cl_int nx = s->grid.nx, ny = s->grid.ny;
-  const size_t m = sizeof(cl_mem), in = sizeof(cl_int);
+  cl_int nx = s->nxl, ny = s->nyl;
+  const size_t m = sizeof(cl_mem);
+  const gr_rain_runoff_arg args[] = {
+      {"h", m, &s->h},
+      {"b", m, &s->b},
+      {"qx", m, &s->qx[s->cur]},
+      {"qy", m, &s->qy[s->cur]},
+      {"limit", m, &s->k},
+      {"infiltrated", m, &s->inf},
+      {"infiltrated_comp", m, &s->inf_c},
+      {"out", m, &s->scratch},
+      {"nx", sizeof(nx), &nx},
+      {"ny", sizeof(ny), &ny},
+      {"what", sizeof(what), &what},
+  };
   if (st == GR_OK)
-    st = gr_kernel_args(s->ctx, s->derive, m, &s->h, m, &s->b, m, &s->qx[s->cur], m, &s->qy[s->cur],
-                        m, &s->k, m, &s->inf, m, &s->inf_c, m, &s->scratch, in, &nx, in, &ny, in,
-                        &what, (size_t)0);
+    st = GR_RAIN_RUNOFF_ARGS(s, s->derive, args);
   if (st == GR_OK)
     st = gr_enqueue_2d(s->ctx, s->derive, 0, 0, (size_t)nx, (size_t)ny, NULL);
   if (st == GR_OK)
-    st = gr_buffer_read(s->ctx, s->scratch, 0, floats * sizeof(cl_float), host);
+    st = gr_rain_runoff_read_own(s, s->scratch, comps, host);
   return st;
 }
 
-gr_status gr_rain_runoff_get_field(gr_rain_runoff *s, gr_field f, float *host) {
-  if (!s || !host)
-    return gr_set_error(s ? s->ctx : NULL, GR_ERR_INVALID_ARGUMENT,
-                        "gr_rain_runoff_get_field needs a simulation and room for the field.");
-  size_t cells = gr_rain_runoff_cells(s), bytes = cells * sizeof(cl_float);
+static gr_status gr_rain_runoff_get_field_impl(gr_rain_runoff *s, gr_field f, float *host) {
+  size_t cells = gr_rain_runoff_own_cells(s);
   switch (f) {
   case GR_FIELD_WATER_DEPTH:
-    return gr_buffer_read(s->ctx, s->h, 0, bytes, host);
+    return gr_rain_runoff_read_own(s, s->h, 1, host);
   case GR_FIELD_ELEVATION:
-    return gr_buffer_read(s->ctx, s->b, 0, bytes, host);
+    return gr_rain_runoff_read_own(s, s->b, 1, host);
   case GR_FIELD_PERMEABILITY:
   case GR_FIELD_RAIN_RATE: {
     int field = f == GR_FIELD_RAIN_RATE ? s->has_rain : s->has_perm;
     if (field)
-      return gr_buffer_read(s->ctx, f == GR_FIELD_RAIN_RATE ? s->rain : s->perm, 0, bytes, host);
+      return gr_rain_runoff_read_own(s, f == GR_FIELD_RAIN_RATE ? s->rain : s->perm, 1, host);
     float v = (float)(f == GR_FIELD_RAIN_RATE ? s->params.rain_rate : s->params.permeability);
     for (size_t c = 0; c < cells; ++c)
       host[c] = v;
     return GR_OK;
   }
   case GR_FIELD_WATER_SURFACE:
-    return gr_rain_runoff_derive(s, 0, cells, host);
+    return gr_rain_runoff_derive(s, 0, 1, host);
   case GR_FIELD_VELOCITY:
-    return gr_rain_runoff_derive(s, 1, 3 * cells, host);
+    return gr_rain_runoff_derive(s, 1, 3, host);
   case GR_FIELD_DISCHARGE:
-    return gr_rain_runoff_derive(s, 2, cells, host);
+    return gr_rain_runoff_derive(s, 2, 1, host);
   case GR_FIELD_INFILTRATED:
-    return gr_rain_runoff_derive(s, 3, cells, host);
+    return gr_rain_runoff_derive(s, 3, 1, host);
   default:
     return gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
                         "The rain runoff simulation has no field '%s'; it has elevation, "
@@ -646,32 +1107,54 @@ gr_status gr_rain_runoff_get_field(gr_rain_runoff *s, gr_field f, float *host) {
   }
 }
 
+gr_status gr_rain_runoff_get_field(gr_rain_runoff *s, gr_field f, float *host) {
+  if (!s)
+    return gr_set_error(NULL, GR_ERR_INVALID_ARGUMENT,
+                        "gr_rain_runoff_get_field needs a simulation and room for the field.");
+  if (!host)
+    return GR_RAIN_RUNOFF_KEEP_ERROR(
+        s, gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
+                        "gr_rain_runoff_get_field needs a simulation and room for the field."));
+  return GR_RAIN_RUNOFF_KEEP_ERROR(s, gr_rain_runoff_get_field_impl(s, f, host));
+}
+
 gr_status gr_rain_runoff_ledger_get(gr_rain_runoff *s, gr_rain_runoff_ledger *out) {
-  if (!s || !out)
-    return gr_set_error(s ? s->ctx : NULL, GR_ERR_INVALID_ARGUMENT,
+  if (!s)
+    return gr_set_error(NULL, GR_ERR_INVALID_ARGUMENT,
                         "gr_rain_runoff_ledger_get needs a simulation and a ledger to fill.");
-  double sums[3], hmax = 0.0;
+  if (!out)
+    return GR_RAIN_RUNOFF_KEEP_ERROR(
+        s, gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
+                        "gr_rain_runoff_ledger_get needs a simulation and a ledger to fill."));
+  double sums[GR_RAIN_RUNOFF_SUMS], hmax = 0.0;
   gr_status st = gr_rain_runoff_reduce(s, sums, &hmax);
+  /* Over every piece of the domain: the device's sums and the host's. */
+  double all[GR_RAIN_RUNOFF_SUMS + 2];
+  memcpy(all, sums, sizeof(sums));
+  all[GR_RAIN_RUNOFF_SUMS] = s->rain_volume;
+  all[GR_RAIN_RUNOFF_SUMS + 1] = s->initial_volume;
+  if (st == GR_OK && s->allreduce)
+    st = gr_rain_runoff_allreduce(s, all, GR_RAIN_RUNOFF_SUMS + 2, GR_REDUCE_SUM);
+  if (st == GR_OK && s->allreduce)
+    st = gr_rain_runoff_allreduce(s, &hmax, 1, GR_REDUCE_MAX);
   if (st != GR_OK)
-    return st;
+    return GR_RAIN_RUNOFF_KEEP_ERROR(s, st);
   double area = s->grid.dx * s->grid.dy;
   memset(out, 0, sizeof(*out));
   out->time = s->time;
   out->steps = s->steps;
-  out->initial_volume = s->initial_volume;
-  out->rain_volume = s->rain_volume;
-  out->stored_volume = sums[0] * area;
-  out->infiltrated_volume = sums[1] * area;
-  out->outflow_volume = sums[2] * area;
+  out->initial_volume = all[GR_RAIN_RUNOFF_SUMS + 1];
+  out->rain_volume = all[GR_RAIN_RUNOFF_SUMS];
+  out->stored_volume = all[0] * area;
+  out->infiltrated_volume = all[1] * area;
+  out->outflow_volume = all[2] * area;
   out->balance_error = out->initial_volume + out->rain_volume - out->infiltrated_volume -
                        out->outflow_volume - out->stored_volume;
   out->max_depth = hmax;
   return GR_OK;
 }
 
-gr_status gr_rain_runoff_reset(gr_rain_runoff *s) {
-  if (!s)
-    return gr_set_error(NULL, GR_ERR_INVALID_ARGUMENT, "gr_rain_runoff_reset needs a simulation.");
+static gr_status gr_rain_runoff_reset_impl(gr_rain_runoff *s) {
   size_t bytes = gr_rain_runoff_cells(s) * sizeof(cl_float);
   gr_status st;
   if (s->h0)
@@ -693,4 +1176,164 @@ gr_status gr_rain_runoff_reset(gr_rain_runoff *s) {
   s->rain_volume = 0.0;
   s->initial_volume = s->initial_sum * s->grid.dx * s->grid.dy;
   return GR_OK;
+}
+
+gr_status gr_rain_runoff_reset(gr_rain_runoff *s) {
+  if (!s)
+    return gr_set_error(NULL, GR_ERR_INVALID_ARGUMENT, "gr_rain_runoff_reset needs a simulation.");
+  return GR_RAIN_RUNOFF_KEEP_ERROR(s, gr_rain_runoff_reset_impl(s));
+}
+
+/* ------------------------------------------------------------ checkpoints */
+
+/* The checkpoint's header; the arrays follow it: the per-cell h, h_c, k,
+ * inf, inf_c, out, out_c, then the current x- and y-faces (the other face
+ * set is rewritten whole by the next step before it is read). */
+typedef struct gr_rain_runoff_state_header {
+  uint32_t magic, version;
+  int32_t nx, ny;
+  int64_t steps;
+  double time, rain_volume, initial_volume;
+} gr_rain_runoff_state_header;
+
+static size_t gr_rain_runoff_xfaces(const gr_rain_runoff *s) {
+  return ((size_t)s->nxl + 1) * (size_t)s->nyl;
+}
+static size_t gr_rain_runoff_yfaces(const gr_rain_runoff *s) {
+  return (size_t)s->nxl * ((size_t)s->nyl + 1);
+}
+
+static size_t gr_rain_runoff_state_bytes(const gr_rain_runoff *s) {
+  return sizeof(gr_rain_runoff_state_header) +
+         sizeof(float) * (GR_RAIN_RUNOFF_STATE_CELL_ARRAYS * gr_rain_runoff_cells(s) +
+                          gr_rain_runoff_xfaces(s) + gr_rain_runoff_yfaces(s));
+}
+
+gr_status gr_rain_runoff_state_size(const gr_rain_runoff *s, size_t *bytes) {
+  if (!s || !bytes)
+    return gr_set_error(s ? s->ctx : NULL, GR_ERR_INVALID_ARGUMENT,
+                        "gr_rain_runoff_state_size needs a simulation and a place for the size.");
+  *bytes = gr_rain_runoff_state_bytes(s);
+  return GR_OK;
+}
+
+/* The state's device arrays in checkpoint order, with their sizes. */
+static int gr_rain_runoff_state_arrays(gr_rain_runoff *s, int cur, cl_mem *bufs, size_t *sizes) {
+  cl_mem cells[GR_RAIN_RUNOFF_STATE_CELL_ARRAYS] = {s->h,     s->h_c, s->k,    s->inf,
+                                                    s->inf_c, s->out, s->out_c};
+  int n = 0;
+  for (int i = 0; i < GR_RAIN_RUNOFF_STATE_CELL_ARRAYS; ++i, ++n) {
+    bufs[n] = cells[i];
+    sizes[n] = gr_rain_runoff_cells(s) * sizeof(float);
+  }
+  bufs[n] = s->qx[cur];
+  sizes[n++] = gr_rain_runoff_xfaces(s) * sizeof(float);
+  bufs[n] = s->qy[cur];
+  sizes[n++] = gr_rain_runoff_yfaces(s) * sizeof(float);
+  return n;
+}
+
+static gr_status gr_rain_runoff_state_save_impl(gr_rain_runoff *s, void *host, size_t bytes) {
+  size_t need = gr_rain_runoff_state_bytes(s);
+  if (bytes != need)
+    return gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
+                        "The buffer for the rain runoff state has %zu bytes but this %d x %d "
+                        "simulation's state has %zu: size it with gr_rain_runoff_state_size.",
+                        bytes, s->nxl, s->nyl, need);
+  gr_rain_runoff_state_header hd;
+  memset(&hd, 0, sizeof(hd));
+  hd.magic = GR_RAIN_RUNOFF_STATE_MAGIC;
+  hd.version = GR_RAIN_RUNOFF_STATE_VERSION;
+  hd.nx = s->nxl;
+  hd.ny = s->nyl;
+  hd.steps = s->steps;
+  hd.time = s->time;
+  hd.rain_volume = s->rain_volume;
+  hd.initial_volume = s->initial_volume;
+  unsigned char *at = host;
+  memcpy(at, &hd, sizeof(hd));
+  at += sizeof(hd);
+  cl_mem bufs[GR_RAIN_RUNOFF_STATE_CELL_ARRAYS + 2];
+  size_t sizes[GR_RAIN_RUNOFF_STATE_CELL_ARRAYS + 2];
+  int n = gr_rain_runoff_state_arrays(s, s->cur, bufs, sizes);
+  gr_status st = GR_OK;
+  for (int i = 0; st == GR_OK && i < n; ++i) {
+    st = gr_buffer_read(s->ctx, bufs[i], 0, sizes[i], at);
+    at += sizes[i];
+  }
+  return st;
+}
+
+gr_status gr_rain_runoff_state_save(gr_rain_runoff *s, void *host, size_t bytes) {
+  if (!s)
+    return gr_set_error(NULL, GR_ERR_INVALID_ARGUMENT,
+                        "gr_rain_runoff_state_save needs a simulation and a buffer.");
+  if (!host)
+    return GR_RAIN_RUNOFF_KEEP_ERROR(
+        s, gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
+                        "gr_rain_runoff_state_save needs a simulation and a buffer."));
+  return GR_RAIN_RUNOFF_KEEP_ERROR(s, gr_rain_runoff_state_save_impl(s, host, bytes));
+}
+
+static gr_status gr_rain_runoff_state_load_impl(gr_rain_runoff *s, const void *host, size_t bytes) {
+  size_t need = gr_rain_runoff_state_bytes(s);
+  gr_rain_runoff_state_header hd;
+  if (bytes < sizeof(hd))
+    return gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
+                        "The rain runoff state has %zu bytes, fewer than its header: pass the "
+                        "bytes gr_rain_runoff_state_save wrote.",
+                        bytes);
+  memcpy(&hd, host, sizeof(hd));
+  if (hd.magic != GR_RAIN_RUNOFF_STATE_MAGIC || hd.version != GR_RAIN_RUNOFF_STATE_VERSION)
+    return gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
+                        "The bytes given are not a rain runoff state of this version (magic "
+                        "0x%08x, version %u; expected 0x%08x, version %u): pass the bytes "
+                        "gr_rain_runoff_state_save wrote.",
+                        (unsigned)hd.magic, (unsigned)hd.version, GR_RAIN_RUNOFF_STATE_MAGIC,
+                        GR_RAIN_RUNOFF_STATE_VERSION);
+  if (hd.nx != s->nxl || hd.ny != s->nyl)
+    return gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
+                        "The rain runoff state is of a %d x %d grid but this simulation's grid "
+                        "is %d x %d: load it into a simulation of the grid it was saved from.",
+                        (int)hd.nx, (int)hd.ny, s->nxl, s->nyl);
+  if (bytes != need)
+    return gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
+                        "The rain runoff state has %zu bytes but a %d x %d simulation's state "
+                        "has %zu: pass the whole buffer gr_rain_runoff_state_save filled.",
+                        bytes, s->nxl, s->nyl, need);
+  if (!(hd.time >= 0.0 && hd.time < HUGE_VAL) || hd.steps < 0 || !isfinite(hd.rain_volume) ||
+      !isfinite(hd.initial_volume))
+    return gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
+                        "The rain runoff state's header is damaged (time %g s, %lld steps): "
+                        "pass the bytes gr_rain_runoff_state_save wrote.",
+                        hd.time, (long long)hd.steps);
+  /* Into face set 0, which becomes current. */
+  const unsigned char *at = (const unsigned char *)host + sizeof(hd);
+  cl_mem bufs[GR_RAIN_RUNOFF_STATE_CELL_ARRAYS + 2];
+  size_t sizes[GR_RAIN_RUNOFF_STATE_CELL_ARRAYS + 2];
+  int n = gr_rain_runoff_state_arrays(s, 0, bufs, sizes);
+  gr_status st = GR_OK;
+  for (int i = 0; st == GR_OK && i < n; ++i) {
+    st = gr_buffer_write(s->ctx, bufs[i], 0, sizes[i], at);
+    at += sizes[i];
+  }
+  if (st != GR_OK)
+    return st;
+  s->cur = 0;
+  s->steps = hd.steps;
+  s->time = hd.time;
+  s->rain_volume = hd.rain_volume;
+  s->initial_volume = hd.initial_volume;
+  return GR_OK;
+}
+
+gr_status gr_rain_runoff_state_load(gr_rain_runoff *s, const void *host, size_t bytes) {
+  if (!s)
+    return gr_set_error(NULL, GR_ERR_INVALID_ARGUMENT,
+                        "gr_rain_runoff_state_load needs a simulation and the saved bytes.");
+  if (!host)
+    return GR_RAIN_RUNOFF_KEEP_ERROR(
+        s, gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
+                        "gr_rain_runoff_state_load needs a simulation and the saved bytes."));
+  return GR_RAIN_RUNOFF_KEEP_ERROR(s, gr_rain_runoff_state_load_impl(s, host, bytes));
 }

@@ -71,19 +71,28 @@ typedef enum gr_boundary {
 /** Standard gravity, m/s^2. */
 #define GR_GRAVITY 9.80665
 
+/**
+ * The parameters, in the core's units. Their ranges and defaults are the
+ * rows of gr_rain_runoff_param_bounds (in the user's units, with the factor
+ * to these), written nowhere else.
+ */
 typedef struct gr_rain_runoff_params {
-  double rain_rate;     /**< m/s, [0, 1e-3], default 10 mm/h = 2.7778e-6 */
-  double permeability;  /**< infiltration capacity, m/s, [0, 1e-2], default 0 */
-  double manning_n;     /**< Manning roughness, s/m^(1/3), [0.005, 1], default 0.03 */
-  double cfl;           /**< Courant number of the adaptive step, (0, 1], default 0.7 */
-  double max_dt;        /**< longest step, s, (0, 3600], default 1 */
-  gr_boundary boundary; /**< default GR_BOUNDARY_OPEN */
+  double rain_rate;     /**< m/s (row RainRate, mm/h) */
+  double permeability;  /**< infiltration capacity, m/s (row Permeability, mm/h) */
+  double manning_n;     /**< Manning roughness, s/m^(1/3) (row ManningN) */
+  double cfl;           /**< Courant number of the adaptive step (row CourantNumber) */
+  double max_dt;        /**< longest step, s (row MaxTimeStep) */
+  gr_boundary boundary; /**< row Boundary: 0 open, 1 closed */
 } gr_rain_runoff_params;
 
-/** The defaults listed above. */
+/** The table's defaults. */
 GR_API void gr_rain_runoff_params_init(gr_rain_runoff_params *p);
 
-/** Checks every parameter against its range; a sentence goes to msg. */
+/**
+ * Checks every parameter against its row of gr_rain_runoff_param_bounds
+ * (the user's bounds times to_core); the sentence in msg speaks the user's
+ * unit: "RainRate must lie between 0 and 3600 mm/h (got 7200 mm/h)".
+ */
 GR_API gr_status gr_rain_runoff_params_validate(const gr_rain_runoff_params *p, char *msg,
                                                 size_t msg_len);
 
@@ -131,7 +140,9 @@ GR_API gr_status gr_rain_runoff_create(gr_context *ctx, const gr_grid *grid,
 GR_API gr_status gr_rain_runoff_set_params(gr_rain_runoff *s, const gr_rain_runoff_params *p);
 
 /**
- * Uploads an input field (nx*ny floats) after gr_rain_runoff_field_validate
+ * Uploads an input field (nx*ny floats; for a piece with neighbours its
+ * local array, ring included: see "Pieces of a split domain") after
+ * gr_rain_runoff_field_validate
  * (whose sentence then names the bad cell as (i, j)), which set_field
  * tightens with two bounds beyond which float differences overflow:
  * elevations within +-1e6 m and depths up to 1e4 m. A refused field leaves
@@ -170,7 +181,7 @@ GR_API gr_status gr_rain_runoff_stable_dt(gr_rain_runoff *s, double *dt);
  */
 GR_API gr_status gr_rain_runoff_advance(gr_rain_runoff *s, double duration, int *steps_taken);
 
-/** Reads a field back (waits): nx*ny floats, 3*nx*ny for VELOCITY. */
+/** Reads a field back (waits): nx*ny floats, 3*nx*ny for VELOCITY (a piece: its own cells). */
 GR_API gr_status gr_rain_runoff_get_field(gr_rain_runoff *s, gr_field f, float *host);
 
 /** The ledger now (waits; reduces the volumes on the device). */
@@ -181,6 +192,101 @@ GR_API gr_status gr_rain_runoff_ledger_get(gr_rain_runoff *s, gr_rain_runoff_led
  * no discharge, nothing infiltrated, ledger zeroed. Inputs are kept.
  */
 GR_API gr_status gr_rain_runoff_reset(gr_rain_runoff *s);
+
+/**
+ * Progress and abort for gr_rain_runoff_advance (see gr_progress_fn); NULL
+ * removes it. After GR_ERR_ABORTED the state is valid at a step boundary
+ * inside the advance (the ledger's time says where).
+ */
+GR_API void gr_rain_runoff_set_progress(gr_rain_runoff *s, gr_progress_fn fn, void *user);
+
+/**
+ * Checkpoints: the whole evolving state (depths, discharges, limiter,
+ * cumulative fields, their compensations, time, steps, ledger) as bytes on
+ * the host. Loading a saved state into a simulation of the same grid and
+ * inputs makes every later step bit-identical to the steps that followed
+ * the save. Inputs (elevation, maps) and parameters are not part of it.
+ */
+GR_API gr_status gr_rain_runoff_state_size(const gr_rain_runoff *s, size_t *bytes);
+GR_API gr_status gr_rain_runoff_state_save(gr_rain_runoff *s, void *host, size_t bytes);
+GR_API gr_status gr_rain_runoff_state_load(gr_rain_runoff *s, const void *host, size_t bytes);
+
+/**
+ * @name Pieces of a split domain
+ *
+ * A simulation may hold one piece of a domain split among processes (the
+ * gr_grid piece fields: i0, j0, global_nx, global_ny, ghost). Only the
+ * domain's own edges are boundaries. On every side where the piece has a
+ * neighbour it keeps a ring of GR_RAIN_RUNOFF_GHOST cells, copies of the
+ * neighbour's cells; grid.ghost must then be GR_RAIN_RUNOFF_GHOST, and the
+ * piece at least that many cells wide toward the neighbour. At the domain's
+ * edges there is no ring.
+ *
+ * Why 3: a step reads up to 2 cells away in three launches (a face's
+ * smoothing reads the limiter 2 cells away and the neighbouring faces'
+ * discharges; the limiter reads a cell's faces; the update reads the
+ * neighbours' limiters), so every kernel runs over the whole local array,
+ * ring included, and with a ring of 3 every owned cell's new depth, limiter
+ * and faces are computed from valid values only, the very floats the whole
+ * grid computes. So the halo is exchanged once per step, after it:
+ *   per ring cell the depth, the limiter, its west x-face and its south
+ *   y-face (gr_rain_runoff_halo_get on the sending piece, the owned cells
+ *   next to the side; gr_rain_runoff_halo_set on the receiving one);
+ *   x sides (west, east) first, then y sides (south, north): an x strip spans
+ *   the local array's rows and a y strip its columns, ring included, so
+ *   corner cells travel through the x neighbour.
+ * A piece with a ring therefore steps one step per gr_rain_runoff_step call
+ * and cannot advance on its own (refused with a sentence); the stable step
+ * and the ledger are global through the allreduce callback (the deepest cell
+ * by GR_REDUCE_MAX; the stored, infiltrated, outflow, rain and initial
+ * volumes by GR_REDUCE_SUM), so every piece takes the same dt and the same
+ * steps as the whole grid, which makes every owned cell bit-identical to the
+ * whole grid's. Input fields (set_field) of a piece cover its local array,
+ * ring included: (nx + rings) x (ny + rings) floats, row-major; get_field
+ * returns the owned nx x ny cells. A checkpoint holds the local arrays.
+ * @{
+ */
+
+/** Ring width of a piece toward each neighbour, cells. */
+#define GR_RAIN_RUNOFF_GHOST 3
+
+/** Sides of a piece, for the halo calls. */
+typedef enum gr_rain_runoff_side {
+  GR_RAIN_RUNOFF_WEST = 0,  /**< toward i0 - 1 */
+  GR_RAIN_RUNOFF_EAST = 1,  /**< toward i0 + nx */
+  GR_RAIN_RUNOFF_SOUTH = 2, /**< toward j0 - 1 */
+  GR_RAIN_RUNOFF_NORTH = 3  /**< toward j0 + ny */
+} gr_rain_runoff_side;
+
+/**
+ * The global reduction over the pieces (see gr_allreduce_fn); NULL (the
+ * default) for a simulation that is the whole domain or the only piece.
+ */
+GR_API void gr_rain_runoff_set_allreduce(gr_rain_runoff *s, gr_allreduce_fn fn, void *user);
+
+/** Bytes of the halo strip on `side` (a gr_rain_runoff_side); 0 where there is no neighbour. */
+GR_API gr_status gr_rain_runoff_halo_size(const gr_rain_runoff *s, int side, size_t *bytes);
+
+/** Copies the owned cells next to `side` out (for the neighbour on that side); waits. */
+GR_API gr_status gr_rain_runoff_halo_get(gr_rain_runoff *s, int side, void *host, size_t bytes);
+
+/** Copies the neighbour's strip into the ring on `side`; waits. */
+GR_API gr_status gr_rain_runoff_halo_set(gr_rain_runoff *s, int side, const void *host,
+                                         size_t bytes);
+/** @} */
+
+/**
+ * The latest error of a call on this simulation ("" when there was none):
+ * its own, never another handle's on the same context. Never NULL.
+ */
+GR_API const char *gr_rain_runoff_last_error(const gr_rain_runoff *s);
+
+/**
+ * The parameter table (RainRate mm/h, Permeability mm/h, ManningN,
+ * MaxTimeStep s, CourantNumber, Boundary) that gr_rain_runoff_params_validate
+ * follows; *count gets the number of rows.
+ */
+GR_API const gr_param_bound *gr_rain_runoff_param_bounds(int *count);
 
 /** Frees the simulation; NULL is fine. */
 GR_API void gr_rain_runoff_destroy(gr_rain_runoff *s);

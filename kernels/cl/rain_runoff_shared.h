@@ -1,0 +1,30 @@
+/* Constants of the rain runoff core that the host (rain_runoff.c) and the
+ * device (rain_runoff.cl) must agree on: written once here, included by both.
+ * Plain preprocessor definitions only, valid C11 and OpenCL C. */
+#ifndef GRAUPEL_CL_RAIN_RUNOFF_SHARED_H
+#define GRAUPEL_CL_RAIN_RUNOFF_SHARED_H
+
+/* The weight of a face's own previous discharge against its neighbours'
+ * (de Almeida et al. 2012; 1 is Bates et al. 2010 unchanged). The device
+ * gets it as the float argument theta; the host's stable step uses it too. */
+#define GR_RAIN_RUNOFF_THETA 0.8
+
+/* A face shallower than this carries no flow (m). */
+#define GR_RAIN_RUNOFF_DRY 1.0e-6f
+
+/* Velocities are reported where a cell holds at least this much (m): a cell
+ * that a step has just drained holds a film whose depth says nothing of
+ * the flow that passed through it, and q / h there would be meaningless. */
+#define GR_RAIN_RUNOFF_VELOCITY_DEPTH 1.0e-4f
+
+/* The limiter leaves a cell this fraction short of empty, so that the float
+ * rounding of the depth update can never take it below zero. */
+#define GR_RAIN_RUNOFF_KEEP 0.999999f
+
+/* The ledger's reduction (reduce.h): three double-float sums (stored,
+ * infiltrated, outflow, in metres of depth over cells) and one maximum (the
+ * deepest cell) per work-group. */
+#define GR_RAIN_RUNOFF_SUMS 3
+#define GR_RAIN_RUNOFF_MAXES 1
+
+#endif

@@ -1,0 +1,88 @@
+/* Deterministic sums on the device, shared by every core that keeps a water
+ * (or mass, or energy) ledger: Kahan sums per cell, double-float (TwoSum)
+ * accumulation per work-item and a fixed-shape work-group combine. The host
+ * side (graupel/reduce.h, src/reduce.c) launches the reduction and adds the
+ * groups' partials in order in double, so every run gives the same bits.
+ *
+ * A reduction kernel is a 1-D launch of whole work-groups with the arguments
+ * `__global float *partial` and `__local float *scratch` (set by
+ * gr_reduction_run) and its own inputs. Each work-item sums the cells
+ * gr_reduce_block gives it into nsum (hi, lo) pairs and nmax maxima, stores
+ * them at gr_reduce_slots(scratch, ...) (the pairs first, then the maxima)
+ * and calls gr_reduce_group. */
+#ifndef GRAUPEL_CL_REDUCE_H
+#define GRAUPEL_CL_REDUCE_H
+
+/* Kahan summation into per-cell arrays: sum[c] - comp[c] carries a running
+ * total to about twice float precision over 10^5 steps and more. */
+GR_INLINE void gr_kahan_add(__global float *restrict sum, __global float *restrict comp, int c,
+                            float x) {
+  float s = sum[c];
+  float y = x - comp[c];
+  float t = s + y;
+  comp[c] = (t - s) - y;
+  sum[c] = t;
+}
+
+/* Double-float arithmetic (Knuth's TwoSum): hi + lo holds a sum to about
+ * twice float precision, so that a ledger's volumes agree with the Kahan sums
+ * per cell. */
+GR_INLINE void gr_df_add(float *hi, float *lo, float x) {
+  float s = *hi + x;
+  float bb = s - *hi;
+  float e = (*hi - (s - bb)) + (x - bb);
+  *hi = s;
+  *lo += e;
+}
+
+/* a += b for double-floats in local memory, renormalised (Fast2Sum) so that
+ * lo stays small against hi. */
+GR_INLINE void gr_df_merge(__local float *a, __local const float *b) {
+  float hi = a[0], lo = a[1] + b[1];
+  gr_df_add(&hi, &lo, b[0]);
+  float s = hi + lo;
+  a[1] = lo - (s - hi);
+  a[0] = s;
+}
+
+/* The cells [*start, *end) of n that this work-item's group sums: one
+ * contiguous block per group (cache-friendly on CPUs), its work-items
+ * interleaved within it (coalesced on GPUs): a work-item takes
+ * *start + lid, *start + lid + wg, ... */
+GR_INLINE void gr_reduce_block(int n, int *start, int *end) {
+  int groups = get_num_groups(0);
+  int per_group = (n + groups - 1) / groups;
+  *start = get_group_id(0) * per_group;
+  *end = min(n, *start + per_group);
+}
+
+/* This work-item's 2 nsum + nmax slots in scratch. */
+GR_INLINE __local float *gr_reduce_slots(__local float *scratch, int nsum, int nmax) {
+  return scratch + (2 * nsum + nmax) * get_local_id(0);
+}
+
+/* Combines the work-items' slots in a fixed binary tree (the work-group size
+ * is a power of two) and writes the group's 2 nsum + nmax floats to
+ * partial[(2 nsum + nmax) * group ...]. Every work-item of the group must
+ * call it. */
+GR_INLINE void gr_reduce_group(__local float *scratch, int nsum, int nmax,
+                               __global float *restrict partial) {
+  int lid = get_local_id(0), wg = get_local_size(0), slots = 2 * nsum + nmax;
+  __local float *mine = scratch + slots * lid;
+  barrier(CLK_LOCAL_MEM_FENCE);
+  for (int span = wg / 2; span > 0; span /= 2) {
+    if (lid < span) {
+      __local const float *other = scratch + slots * (lid + span);
+      for (int q = 0; q < nsum; ++q)
+        gr_df_merge(mine + 2 * q, other + 2 * q);
+      for (int q = 2 * nsum; q < slots; ++q)
+        mine[q] = fmax(mine[q], other[q]);
+    }
+    barrier(CLK_LOCAL_MEM_FENCE);
+  }
+  if (lid == 0)
+    for (int q = 0; q < slots; ++q)
+      partial[slots * get_group_id(0) + q] = scratch[q];
+}
+
+#endif

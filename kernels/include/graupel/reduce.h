@@ -1,0 +1,53 @@
+/**
+ * @file reduce.h
+ * @brief Deterministic device reductions for the cores that keep a ledger.
+ *
+ * The device half is kernels/cl/reduce.h: a reduction kernel sums its cells
+ * into nsum double-float (hi, lo) pairs and nmax maxima per work-group. This
+ * half picks the launch, runs it and adds the groups' partials in group order
+ * in double, so the same state gives the same sums on every run.
+ */
+#ifndef GRAUPEL_REDUCE_H
+#define GRAUPEL_REDUCE_H
+
+#include "graupel/cl_runtime.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/** Most sums and maxima one reduction returns. */
+#define GR_REDUCTION_MAX_SLOTS 32
+
+/** One reduction's launch and buffers (zero-initialise before init). */
+typedef struct gr_reduction {
+  int nsum, nmax;       /**< double-float sums and maxima per group */
+  size_t local, groups; /**< work-group size (a power of two) and count */
+  cl_mem partial;       /**< (2 nsum + nmax) floats per group */
+  float *host;          /**< the partials, read back */
+} gr_reduction;
+
+/**
+ * Chooses the launch of kernel k over `items` cells (a power-of-two group
+ * size of at most 64 that k allows, at most 256 groups) and allocates the
+ * partials. 2 nsum + nmax must be 1 to GR_REDUCTION_MAX_SLOTS.
+ */
+GR_API gr_status gr_reduction_init(gr_context *ctx, cl_kernel k, size_t items, int nsum, int nmax,
+                                   gr_reduction *r);
+
+/**
+ * Runs k (its own arguments already set; this sets `partial` and `scratch`
+ * by name), waits, and returns sums[0..nsum-1] (hi + lo of every group, added
+ * in group order in double) and maxes[0..nmax-1] (NULL when nmax is 0).
+ */
+GR_API gr_status gr_reduction_run(gr_context *ctx, gr_reduction *r, cl_kernel k, double *sums,
+                                  double *maxes);
+
+/** Frees the buffers; a zeroed or released reduction is fine. */
+GR_API void gr_reduction_release(gr_reduction *r);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif
