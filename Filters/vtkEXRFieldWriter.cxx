@@ -2,10 +2,12 @@
 
 #include "vtkDataArray.h"
 #include "vtkErrorCode.h"
+#include "vtkFieldData.h"
 #include "vtkImageData.h"
 #include "vtkInformation.h"
 #include "vtkObjectFactory.h"
 #include "vtkPointData.h"
+#include "vtkStringArray.h"
 
 #include "graupel/exr_io.h"
 
@@ -122,10 +124,78 @@ void vtkEXRFieldWriter::WriteData() {
     namePtrs.push_back(names[c].c_str());
     dataPtrs.push_back(planes[c].data());
   }
+  // Geometry and field data (the ledger, the device name) travel in the
+  // header, so a reopened file is where it was and keeps its record.
+  gr_exr_meta meta{};
+  double spacing[3], origin[3];
+  input->GetSpacing(spacing);
+  input->GetOrigin(origin);
+  meta.has_spacing = 1;
+  meta.spacing[0] = spacing[0];
+  meta.spacing[1] = spacing[1];
+  meta.has_origin = 1;
+  std::copy(origin, origin + 3, meta.origin);
+  struct Field {
+    std::string name;
+    std::vector<double> numbers;
+    std::vector<std::string> strings;
+    std::vector<char *> stringPtrs;
+    int ncomponents = 1;
+    bool isString = false;
+  };
+  std::vector<Field> fields;
+  vtkFieldData *fd = input->GetFieldData();
+  for (int a = 0; fd && a < fd->GetNumberOfArrays(); ++a) {
+    vtkAbstractArray *arr = fd->GetAbstractArray(a);
+    const vtkIdType nv = arr ? arr->GetNumberOfValues() : 0;
+    // Unnamed, empty and oversized arrays have no place in a header.
+    if (!arr || !arr->GetName() || !*arr->GetName() || nv < 1 || nv > GR_EXR_MAX_META_VALUES) {
+      continue;
+    }
+    Field f;
+    f.name = arr->GetName();
+    if (auto *da = vtkDataArray::SafeDownCast(arr)) {
+      f.ncomponents = da->GetNumberOfComponents();
+      for (vtkIdType k = 0; k < nv; ++k) {
+        f.numbers.push_back(
+            da->GetComponent(k / f.ncomponents, static_cast<int>(k % f.ncomponents)));
+      }
+    } else if (auto *sa = vtkStringArray::SafeDownCast(arr)) {
+      f.isString = true;
+      for (vtkIdType k = 0; k < nv; ++k) {
+        f.strings.push_back(sa->GetValue(k));
+      }
+    } else {
+      continue;
+    }
+    fields.push_back(std::move(f));
+  }
+  std::vector<gr_exr_meta_field> metaFields;
+  for (Field &f : fields) {
+    gr_exr_meta_field m{};
+    m.name = const_cast<char *>(f.name.c_str());
+    m.is_string = f.isString ? 1 : 0;
+    m.ncomponents = f.ncomponents;
+    if (f.isString) {
+      for (std::string &v : f.strings) {
+        f.stringPtrs.push_back(const_cast<char *>(v.c_str()));
+      }
+      m.count = static_cast<int>(f.strings.size());
+      m.strings = f.stringPtrs.data();
+    } else {
+      m.count = static_cast<int>(f.numbers.size());
+      m.numbers = f.numbers.data();
+    }
+    metaFields.push_back(m);
+  }
+  meta.nfields = static_cast<int>(metaFields.size());
+  meta.fields = metaFields.empty() ? nullptr : metaFields.data();
+
   char err[1024] = "";
-  gr_status st = gr_exr_write(
-      this->FileName, dims[0], dims[1], static_cast<int>(names.size()), namePtrs.data(),
-      dataPtrs.data(), this->PixelType == HALF ? GR_EXR_HALF : GR_EXR_FLOAT, err, sizeof(err));
+  gr_status st = gr_exr_write_meta(this->FileName, dims[0], dims[1], static_cast<int>(names.size()),
+                                   namePtrs.data(), dataPtrs.data(),
+                                   this->PixelType == HALF ? GR_EXR_HALF : GR_EXR_FLOAT, &meta, err,
+                                   sizeof(err));
   if (st != GR_OK) {
     vtkErrorMacro("EXR Field Writer: " << err);
     this->SetErrorCode(vtkErrorCode::CannotOpenFileError);

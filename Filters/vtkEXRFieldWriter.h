@@ -8,6 +8,13 @@
  * Row 0 of the image (south) is the last scanline of the file, so other
  * EXR tools show north up. The input must be a vtkImageData with one point
  * in z.
+ *
+ * The header also keeps the image's geometry and field data (see exr_io.h):
+ * `graupel.spacing` (v2d, x and y), `graupel.origin` (v3d) and, for each
+ * named numeric or string field-data array of 1 to 65536 values (a ledger's
+ * `rain_volume`, `time`, ..., `graupel_device`), `graupel.field.NAME`
+ * (double for one value, graupelDoubles for more, string or stringvector).
+ * vtkEXRHeightFieldReader restores them.
  */
 #ifndef vtkEXRFieldWriter_h
 #define vtkEXRFieldWriter_h

@@ -1,5 +1,7 @@
 #include "vtkEXRHeightFieldReader.h"
 
+#include "vtkDoubleArray.h"
+#include "vtkFieldData.h"
 #include "vtkFloatArray.h"
 #include "vtkImageData.h"
 #include "vtkInformation.h"
@@ -8,9 +10,11 @@
 #include "vtkObjectFactory.h"
 #include "vtkPointData.h"
 #include "vtkStreamingDemandDrivenPipeline.h"
+#include "vtkStringArray.h"
 
 #include "graupel/exr_io.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -87,23 +91,45 @@ bool vtkEXRHeightFieldReader::Load() {
   return true;
 }
 
+void vtkEXRHeightFieldReader::Geometry(double spacing[3], double origin[3]) const {
+  const gr_exr_meta &meta = this->Loaded->image.meta;
+  const bool fileSpacing = this->GeometryFromFile && meta.has_spacing;
+  const bool fileOrigin = this->GeometryFromFile && meta.has_origin;
+  spacing[0] = fileSpacing ? meta.spacing[0] : this->Spacing[0];
+  spacing[1] = fileSpacing ? meta.spacing[1] : this->Spacing[1];
+  spacing[2] = 1.0;
+  for (int d = 0; d < 3; ++d) {
+    origin[d] = fileOrigin ? meta.origin[d] : this->Origin[d];
+  }
+}
+
 int vtkEXRHeightFieldReader::RequestInformation(vtkInformation *, vtkInformationVector **,
                                                 vtkInformationVector *outputVector) {
-  if (!(this->Spacing[0] > 0.0) || !(this->Spacing[1] > 0.0)) {
-    vtkErrorMacro("EXR Height Field Reader: Spacing must be above 0 m in x and y; got "
-                  << this->Spacing[0] << " " << this->Spacing[1] << ".");
+  // A failure here skips RequestData: empty the output so that an earlier
+  // result does not stay in place of the failed one.
+  vtkImageData *previous = vtkImageData::GetData(outputVector);
+  if (!this->Load()) {
+    if (previous) {
+      previous->Initialize();
+    }
     return 0;
   }
-  if (!this->Load()) {
+  double spacing[3], origin[3];
+  this->Geometry(spacing, origin);
+  if (!(spacing[0] > 0.0) || !(spacing[1] > 0.0)) {
+    vtkErrorMacro("EXR Height Field Reader: Spacing must be above 0 m in x and y; got "
+                  << spacing[0] << " " << spacing[1] << ".");
+    if (previous) {
+      previous->Initialize();
+    }
     return 0;
   }
   const gr_exr_image &img = this->Loaded->image;
   vtkInformation *outInfo = outputVector->GetInformationObject(0);
   int extent[6] = {0, img.width - 1, 0, img.height - 1, 0, 0};
-  double spacing[3] = {this->Spacing[0], this->Spacing[1], 1.0};
   outInfo->Set(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT(), extent, 6);
   outInfo->Set(vtkDataObject::SPACING(), spacing, 3);
-  outInfo->Set(vtkDataObject::ORIGIN(), this->Origin, 3);
+  outInfo->Set(vtkDataObject::ORIGIN(), origin, 3);
   vtkDataObject::SetPointDataActiveScalarInfo(outInfo, VTK_FLOAT, 1);
   return 1;
 }
@@ -175,9 +201,30 @@ int vtkEXRHeightFieldReader::RequestData(vtkInformation *, vtkInformationVector 
     arrays.emplace_back(a.Get());
   }
 
+  double spacing[3], origin[3];
+  this->Geometry(spacing, origin);
   output->SetExtent(0, img.width - 1, 0, img.height - 1, 0, 0);
-  output->SetSpacing(this->Spacing[0], this->Spacing[1], 1.0);
-  output->SetOrigin(this->Origin);
+  output->SetSpacing(spacing);
+  output->SetOrigin(origin);
+  for (int f = 0; f < img.meta.nfields; ++f) {
+    const gr_exr_meta_field &m = img.meta.fields[f];
+    if (m.is_string) {
+      vtkNew<vtkStringArray> a;
+      a->SetName(m.name);
+      a->SetNumberOfValues(m.count);
+      for (int k = 0; k < m.count; ++k) {
+        a->SetValue(k, m.strings[k]);
+      }
+      output->GetFieldData()->AddArray(a);
+    } else {
+      vtkNew<vtkDoubleArray> a;
+      a->SetName(m.name);
+      a->SetNumberOfComponents(m.ncomponents);
+      a->SetNumberOfTuples(m.count / m.ncomponents);
+      std::copy(m.numbers, m.numbers + m.count, a->GetPointer(0));
+      output->GetFieldData()->AddArray(a);
+    }
+  }
   vtkIdType nonFinite = 0;
   for (auto &a : arrays) {
     if (std::strcmp(a->GetName(), "elevation") == 0) {
@@ -207,4 +254,5 @@ void vtkEXRHeightFieldReader::PrintSelf(ostream &os, vtkIndent indent) {
   os << indent << "Origin: " << this->Origin[0] << " " << this->Origin[1] << " " << this->Origin[2]
      << "\n";
   os << indent << "HeightScale: " << this->HeightScale << "\n";
+  os << indent << "GeometryFromFile: " << this->GeometryFromFile << "\n";
 }

@@ -5,7 +5,11 @@
  * fail as broken files do. Every failure must be a sentence naming the file
  * (or the buffer's label), and must leave the output image untouched.
  *
- * Usage: test_exr SCRATCH_DIR   (an existing, writable directory) */
+ * Header attributes: spacing, origin and field data round trip bit for bit,
+ * and hostile values fail with a sentence.
+ *
+ * Usage: test_exr --scratch DIR [SUBTEST...]   (DIR existing and writable;
+ * `test_exr DIR` as before; --list names the subtests) */
 #include "gr_test_io.h"
 #include "gr_test.h"
 #include "graupel/exr_io.h"
@@ -143,6 +147,9 @@ typedef struct capi_spec {
   const char *names[4];
   exr_pixel_type_t types[4];
   int xsamp; /* sampling of every channel (1 normally) */
+  /* Adds header attributes before the header is written (NULL: none). */
+  exr_result_t (*attrs)(exr_context_t ctxt, int part, int which);
+  int which;
 } capi_spec;
 
 static capi_spec capi_default(void) {
@@ -239,6 +246,10 @@ static int capi_write(const char *path, const capi_spec *s) {
   for (c = 0; c < s->nchannels && rv == EXR_ERR_SUCCESS; ++c)
     rv = exr_add_channel(ctxt, part, s->names[c], s->types[c], EXR_PERCEPTUALLY_LINEAR, s->xsamp,
                          s->xsamp);
+  if (rv == EXR_ERR_SUCCESS && s->attrs != NULL)
+    rv = exr_set_longname_support(ctxt, 1);
+  if (rv == EXR_ERR_SUCCESS && s->attrs != NULL)
+    rv = s->attrs(ctxt, part, s->which);
   if (rv == EXR_ERR_SUCCESS)
     rv = exr_write_header(ctxt);
   if (rv == EXR_ERR_SUCCESS) {
@@ -1533,31 +1544,329 @@ static void test_helpers(void) {
   }
 }
 
+/* ------------------------------------------------------------------------ */
+/* Geometry and field data in the header                                    */
+/* ------------------------------------------------------------------------ */
+
+static int same_double_bits(double a, double b) {
+  return memcmp(&a, &b, sizeof a) == 0;
+}
+
+static const gr_exr_meta_field *find_meta_field(const gr_exr_meta *m, const char *name) {
+  int f;
+  for (f = 0; f < m->nfields; ++f)
+    if (strcmp(m->fields[f].name, name) == 0)
+      return &m->fields[f];
+  return NULL;
+}
+
+/* A DEM with spacing 74.5 x 92.1, origin (100, 200, 0) and a ledger comes
+ * back with exactly that geometry and ledger, from a file and from memory;
+ * a file written without meta has none. */
+static void test_meta_roundtrip(void) {
+  char path[1024], err[512] = "";
+  const int w = 5, h = 4;
+  float plane[20];
+  const char *names[1] = {"elevation"};
+  const float *data[1] = {plane};
+  double rain = 1234.5678901234567, time = 1800.0, steps = 421.0;
+  double vec[6] = {-0.0, 1e-300, 3.0, -4.5, 1e300, 2.0 / 3.0};
+  double nan_value = NAN;
+  char *dev[1] = {"pthread-skylake (Portable Computing Language)"};
+  char *tags[3] = {"a", "", "r\xc3\xa9seau"};
+  gr_exr_meta_field fields[7];
+  gr_exr_meta meta;
+  gr_exr_image img, mem;
+  gr_status st;
+  int k;
+  memset(fields, 0, sizeof fields);
+  memset(&meta, 0, sizeof meta);
+  for (k = 0; k < w * h; ++k)
+    plane[k] = (float)k * 0.5f;
+  fields[0] = (gr_exr_meta_field){"rain_volume", 0, 1, 1, &rain, NULL};
+  fields[1] = (gr_exr_meta_field){"time", 0, 1, 1, &time, NULL};
+  fields[2] = (gr_exr_meta_field){"infiltrated_volume_long_name", 0, 1, 1, &steps, NULL};
+  fields[3] = (gr_exr_meta_field){"pairs", 0, 2, 6, vec, NULL};
+  fields[4] = (gr_exr_meta_field){"graupel_device", 1, 1, 1, NULL, dev};
+  fields[5] = (gr_exr_meta_field){"tags", 1, 1, 3, NULL, tags};
+  fields[6] = (gr_exr_meta_field){"balance_error", 0, 1, 1, &nan_value, NULL};
+  meta.has_spacing = 1;
+  meta.spacing[0] = 74.5;
+  meta.spacing[1] = 92.1;
+  meta.has_origin = 1;
+  meta.origin[0] = 100.0;
+  meta.origin[1] = 200.0;
+  meta.origin[2] = 0.0;
+  meta.nfields = 7;
+  meta.fields = fields;
+  scratch_path(path, sizeof path, "meta.exr");
+  st = gr_exr_write_meta(path, w, h, 1, names, data, GR_EXR_FLOAT, &meta, err, sizeof err);
+  CHECK_MSG(st == GR_OK, "%s", err);
+  memset(&img, 0, sizeof img);
+  st = gr_exr_read(path, &img, err, sizeof err);
+  CHECK_MSG(st == GR_OK, "%s", err);
+  if (st == GR_OK) {
+    const gr_exr_meta *m = &img.meta;
+    const gr_exr_meta_field *f;
+    CHECK(img.width == w && img.height == h && img.nchannels == 1);
+    CHECK(img.nchannels == 1 && img.data[0][7] == 3.5f);
+    CHECK(m->has_spacing && m->spacing[0] == 74.5 && m->spacing[1] == 92.1);
+    CHECK(m->has_origin && m->origin[0] == 100.0 && m->origin[1] == 200.0 && m->origin[2] == 0.0);
+    CHECK_MSG(m->nfields == 7, "%d fields", m->nfields);
+    f = find_meta_field(m, "rain_volume");
+    CHECK(f && !f->is_string && f->count == 1 && same_double_bits(f->numbers[0], rain));
+    f = find_meta_field(m, "time");
+    CHECK(f && f->count == 1 && f->numbers[0] == 1800.0);
+    f = find_meta_field(m, "infiltrated_volume_long_name");
+    CHECK(f && f->count == 1 && f->numbers[0] == 421.0);
+    f = find_meta_field(m, "pairs");
+    CHECK(f && !f->is_string && f->ncomponents == 2 && f->count == 6);
+    for (k = 0; f && f->count == 6 && k < 6; ++k)
+      CHECK_MSG(same_double_bits(f->numbers[k], vec[k]), "pairs[%d] %.17g", k, f->numbers[k]);
+    f = find_meta_field(m, "graupel_device");
+    CHECK(f && f->is_string && f->count == 1 && strcmp(f->strings[0], dev[0]) == 0);
+    f = find_meta_field(m, "tags");
+    CHECK(f && f->is_string && f->count == 3 && strcmp(f->strings[0], "a") == 0 &&
+          f->strings[1][0] == '\0' && strcmp(f->strings[2], tags[2]) == 0);
+    f = find_meta_field(m, "balance_error");
+    CHECK(f && f->count == 1 && isnan(f->numbers[0]));
+  }
+  /* The same from memory. */
+  {
+    FILE *fp = fopen(path, "rb");
+    unsigned char *bytes = (unsigned char *)malloc(1 << 16);
+    size_t n = fp && bytes ? fread(bytes, 1, 1 << 16, fp) : 0;
+    if (fp)
+      fclose(fp);
+    memset(&mem, 0, sizeof mem);
+    st = gr_exr_read_memory(bytes, n, "meta", &mem, err, sizeof err);
+    CHECK_MSG(st == GR_OK, "%s", err);
+    CHECK(mem.meta.has_spacing && mem.meta.spacing[1] == 92.1 && mem.meta.nfields == 7);
+    gr_exr_image_free(&mem);
+    free(bytes);
+  }
+  gr_exr_meta_free(&img.meta);
+  CHECK(img.meta.nfields == 0 && img.meta.fields == NULL && !img.meta.has_spacing);
+  gr_exr_image_free(&img);
+  gr_exr_meta_free(NULL);
+
+  /* Without meta: no graupel attributes, the old behaviour. */
+  scratch_path(path, sizeof path, "meta_none.exr");
+  st = gr_exr_write(path, w, h, 1, names, data, GR_EXR_FLOAT, err, sizeof err);
+  CHECK_MSG(st == GR_OK, "%s", err);
+  memset(&img, 0, sizeof img);
+  st = gr_exr_read(path, &img, err, sizeof err);
+  CHECK(st == GR_OK && !img.meta.has_spacing && !img.meta.has_origin && img.meta.nfields == 0);
+  gr_exr_image_free(&img);
+}
+
+/* The writer refuses bad meta with a sentence and writes nothing. */
+static void expect_meta_write_error(const gr_exr_meta *meta, const char *what) {
+  char path[1024], err[512] = "";
+  float plane[4] = {1, 2, 3, 4};
+  const char *names[1] = {"elevation"};
+  const float *data[1] = {plane};
+  gr_status st;
+  scratch_path(path, sizeof path, "meta_bad_write.exr");
+  remove(path);
+  st = gr_exr_write_meta(path, 2, 2, 1, names, data, GR_EXR_FLOAT, meta, err, sizeof err);
+  CHECK_MSG(st == GR_ERR_INVALID_ARGUMENT, "%s: status %d", what, (int)st);
+  CHECK_MSG(is_sentence_with(err, path), "%s: '%s'", what, err);
+  CHECK_MSG(!file_exists(path), "%s: a file was written", what);
+}
+
+/* Hostile headers written with OpenEXR's C API, one per `which`. */
+enum {
+  BAD_SPACING_NAN,
+  BAD_SPACING_ZERO,
+  BAD_SPACING_NEGATIVE,
+  BAD_SPACING_HUGE,
+  BAD_SPACING_TYPE,
+  BAD_ORIGIN_INF,
+  BAD_ORIGIN_TYPE,
+  BAD_FIELD_NO_NAME,
+  BAD_FIELD_TYPE,
+  BAD_DOUBLES_SIZE,
+  BAD_DOUBLES_TUPLES,
+  BAD_DOUBLES_COUNT,
+  BAD_TOO_MANY_FIELDS,
+  BAD_COUNT
+};
+
+static exr_result_t hostile_attrs(exr_context_t ctxt, int part, int which) {
+  exr_attr_v2d_t sp = {74.5, 92.1};
+  exr_attr_v3d_t org = {100.0, 200.0, 0.0};
+  exr_attr_v2f_t spf = {1.0f, 1.0f};
+  unsigned char blob[4 + 8 * 6];
+  exr_result_t rv = EXR_ERR_SUCCESS;
+  int k;
+  memset(blob, 0, sizeof blob);
+  blob[0] = 2;
+  switch (which) {
+  case BAD_SPACING_NAN:
+    sp.x = NAN;
+    return exr_attr_set_v2d(ctxt, part, "graupel.spacing", &sp);
+  case BAD_SPACING_ZERO:
+    sp.y = 0.0;
+    return exr_attr_set_v2d(ctxt, part, "graupel.spacing", &sp);
+  case BAD_SPACING_NEGATIVE:
+    sp.x = -3.0;
+    return exr_attr_set_v2d(ctxt, part, "graupel.spacing", &sp);
+  case BAD_SPACING_HUGE:
+    sp.x = 1e300;
+    return exr_attr_set_v2d(ctxt, part, "graupel.spacing", &sp);
+  case BAD_SPACING_TYPE:
+    return exr_attr_set_v2f(ctxt, part, "graupel.spacing", &spf);
+  case BAD_ORIGIN_INF:
+    org.z = INFINITY;
+    return exr_attr_set_v3d(ctxt, part, "graupel.origin", &org);
+  case BAD_ORIGIN_TYPE:
+    return exr_attr_set_double(ctxt, part, "graupel.origin", 5.0);
+  case BAD_FIELD_NO_NAME:
+    return exr_attr_set_double(ctxt, part, "graupel.field.", 5.0);
+  case BAD_FIELD_TYPE:
+    return exr_attr_set_int(ctxt, part, "graupel.field.steps", 5);
+  case BAD_DOUBLES_SIZE:
+    return exr_attr_set_user(ctxt, part, "graupel.field.v", GR_EXR_DOUBLES_TYPE, 4 + 8 * 2 + 3,
+                             blob);
+  case BAD_DOUBLES_TUPLES:
+    blob[0] = 4; /* 6 values are not whole tuples of 4 */
+    return exr_attr_set_user(ctxt, part, "graupel.field.v", GR_EXR_DOUBLES_TYPE,
+                             (int32_t)sizeof blob, blob);
+  case BAD_DOUBLES_COUNT: {
+    /* One value more than allowed. */
+    size_t size = 4 + 8 * ((size_t)GR_EXR_MAX_META_VALUES + 1);
+    unsigned char *big = (unsigned char *)calloc(size, 1);
+    if (big == NULL)
+      return EXR_ERR_OUT_OF_MEMORY;
+    big[0] = 1;
+    rv = exr_attr_set_user(ctxt, part, "graupel.field.v", GR_EXR_DOUBLES_TYPE, (int32_t)size, big);
+    free(big);
+    return rv;
+  }
+  case BAD_TOO_MANY_FIELDS:
+    for (k = 0; k <= GR_EXR_MAX_META_FIELDS && rv == EXR_ERR_SUCCESS; ++k) {
+      char name[64];
+      snprintf(name, sizeof name, "graupel.field.f%d", k);
+      rv = exr_attr_set_double(ctxt, part, name, (double)k);
+    }
+    return rv;
+  default:
+    return EXR_ERR_INVALID_ARGUMENT;
+  }
+}
+
+static void test_meta_bad_values(void) {
+  static const char *const what[BAD_COUNT] = {
+      "spacing NaN",    "spacing 0",     "spacing -3",           "spacing 1e300", "spacing v2f",
+      "origin inf",     "origin double", "field without a name", "field int",     "doubles size",
+      "doubles tuples", "doubles count", "1025 fields"};
+  const double nan_value = NAN;
+  double one = 1.0;
+  gr_exr_meta_field f[2];
+  gr_exr_meta m;
+  int which;
+
+  /* Writer. */
+  memset(&m, 0, sizeof m);
+  m.has_spacing = 1;
+  m.spacing[0] = nan_value;
+  m.spacing[1] = 1.0;
+  expect_meta_write_error(&m, "write: spacing NaN");
+  m.spacing[0] = 0.0;
+  expect_meta_write_error(&m, "write: spacing 0");
+  m.spacing[0] = -74.5;
+  expect_meta_write_error(&m, "write: spacing negative");
+  m.spacing[0] = INFINITY;
+  expect_meta_write_error(&m, "write: spacing inf");
+  memset(&m, 0, sizeof m);
+  m.has_origin = 1;
+  m.origin[1] = nan_value;
+  expect_meta_write_error(&m, "write: origin NaN");
+  memset(&m, 0, sizeof m);
+  memset(f, 0, sizeof f);
+  m.fields = f;
+  m.nfields = 1;
+  f[0] = (gr_exr_meta_field){"", 0, 1, 1, &one, NULL};
+  expect_meta_write_error(&m, "write: empty name");
+  f[0] = (gr_exr_meta_field){"x", 0, 1, 0, &one, NULL};
+  expect_meta_write_error(&m, "write: no values");
+  f[0] = (gr_exr_meta_field){"x", 0, 1, GR_EXR_MAX_META_VALUES + 1, &one, NULL};
+  expect_meta_write_error(&m, "write: too many values");
+  f[0] = (gr_exr_meta_field){"x", 0, 2, 3, &one, NULL};
+  expect_meta_write_error(&m, "write: not whole tuples");
+  f[0] = (gr_exr_meta_field){"x", 1, 1, 1, NULL, NULL};
+  expect_meta_write_error(&m, "write: no strings");
+  f[0] = (gr_exr_meta_field){"x", 0, 1, 1, &one, NULL};
+  f[1] = (gr_exr_meta_field){"x", 0, 1, 1, &one, NULL};
+  m.nfields = 2;
+  expect_meta_write_error(&m, "write: a name twice");
+  m.nfields = GR_EXR_MAX_META_FIELDS + 1;
+  expect_meta_write_error(&m, "write: too many fields");
+
+  /* Reader: every hostile header fails with a sentence naming the file and
+   * leaves the output untouched. */
+  for (which = 0; which < BAD_COUNT; ++which) {
+    char path[1024], name[64], err[512] = "";
+    capi_spec s = capi_default();
+    gr_exr_image img;
+    gr_status st;
+    s.attrs = &hostile_attrs;
+    s.which = which;
+    snprintf(name, sizeof name, "meta_bad_%d.exr", which);
+    scratch_path(path, sizeof path, name);
+    CHECK_MSG(capi_write(path, &s), "%s: could not write", what[which]);
+    sentinel(&img);
+    st = gr_exr_read(path, &img, err, sizeof err);
+    CHECK_MSG(st == GR_ERR_FORMAT, "%s: status %d", what[which], (int)st);
+    CHECK_MSG(is_sentence_with(err, path), "%s: '%s'", what[which], err);
+    CHECK_MSG(is_sentinel(&img), "%s: output touched", what[which]);
+    printf("  %-20s %s\n", what[which], err);
+    if (st == GR_OK)
+      gr_exr_image_free(&img);
+  }
+}
+
+static const gr_subtest tests[] = {
+    {"roundtrips", test_roundtrips, 0},
+    {"file_orientation", test_file_orientation, 0},
+    {"half_rounding", test_half_rounding, 0},
+    {"equal_size_chunk", test_equal_size_chunk, 0},
+    {"names_roundtrip", test_names_roundtrip, 0},
+    {"capi_inputs", test_capi_inputs, 0},
+    {"bad_files", test_bad_files, 0},
+    {"implausible_chunks", test_implausible_chunks, 0},
+    {"undecodable_compression", test_undecodable_compression, 0},
+    {"memory_reads", test_memory_reads, 0},
+    {"write_errors", test_write_errors, 0},
+    {"helpers", test_helpers, 0},
+    {"meta_roundtrip", test_meta_roundtrip, 0},
+    {"meta_bad_values", test_meta_bad_values, 0},
+};
+
+/* test_exr [--scratch DIR | DIR] [--list | SUBTEST...]: the scratch
+ * directory must exist and be writable (default: the current directory); a
+ * bare first argument with a '/' is taken as the directory, as before. */
 int main(int argc, char **argv) {
   char probe[1024];
-  if (argc != 2) {
-    fprintf(stderr, "usage: %s SCRATCH_DIR\n", argv[0]);
-    return 2;
+  if (argc > 2 && strcmp(argv[1], "--scratch") == 0) {
+    g_dir = argv[2];
+    argv[2] = argv[0];
+    argc -= 2;
+    argv += 2;
+  } else if (argc > 1 && strchr(argv[1], '/') != NULL) {
+    g_dir = argv[1];
+    argv[1] = argv[0];
+    argc -= 1;
+    argv += 1;
   }
-  g_dir = argv[1];
-  scratch_path(probe, sizeof probe, "probe.tmp");
-  if (!save_bytes(probe, "x", 1)) {
-    fprintf(stderr, "cannot write into the scratch directory '%s'\n", g_dir);
-    return 2;
+  if (!(argc > 1 && strcmp(argv[1], "--list") == 0)) {
+    scratch_path(probe, sizeof probe, "probe.tmp");
+    if (!save_bytes(probe, "x", 1)) {
+      fprintf(stderr, "cannot write into the scratch directory '%s'\n", g_dir);
+      return 2;
+    }
+    remove(probe);
   }
-  remove(probe);
-
-  test_roundtrips();
-  test_file_orientation();
-  test_half_rounding();
-  test_equal_size_chunk();
-  test_names_roundtrip();
-  test_capi_inputs();
-  test_bad_files();
-  test_implausible_chunks();
-  test_undecodable_compression();
-  test_memory_reads();
-  test_write_errors();
-  test_helpers();
-  return GR_TEST_RESULT();
+  return gr_test_main(argc, argv, tests, (int)(sizeof tests / sizeof tests[0]), NULL, NULL);
 }

@@ -175,6 +175,10 @@ for pixel, tol in ((2, 0.0), (1, 2.0 ** -11)):
     out = r.GetOutput()
     T.check(tuple(out.GetDimensions()) == (nx, ny, 1), "read dimensions")
     T.check(tuple(out.GetOrigin()) == (10.0, 20.0, 5.0), "read origin")
+    T.check(tuple(out.GetSpacing()) == (3.0, 3.0, 1.0), "read spacing")
+    dev = out.GetFieldData().GetAbstractArray("graupel_device")
+    T.check(dev is not None and dev.GetValue(0) == s.GetDeviceName(),
+            "graupel_device kept in the file")
     pd = out.GetPointData()
     names = sorted(pd.GetArrayName(i) for i in range(pd.GetNumberOfArrays()))
     T.check(names == ["elevation", "snow_depth", "velocity"], "array names %s" % names)
@@ -263,6 +267,11 @@ r = vtkEXRHeightFieldReader()
 errs = T.ErrorCatcher(r)
 r.SetFileName(os.path.join(scratch, "wrapped_2.exr"))
 r.SetSpacing(0.0, 1.0)
+r.Update()
+# The file's own spacing (3 3, kept by the writer) wins while GeometryFromFile is on.
+T.check(r.GetGeometryFromFile() == 1 and r.GetOutput().GetSpacing() == (3.0, 3.0, 1.0)
+        and not errs.text(), "file spacing wins: %s %r" % (r.GetOutput().GetSpacing(), errs.text()))
+r.GeometryFromFileOff()
 r.Update()
 T.check("Spacing" in errs.text() and r.GetOutput().GetNumberOfPoints() == 0,
         "reader Spacing 0: %r" % errs.text())

@@ -34,6 +34,47 @@ extern "C" {
 
 typedef enum gr_exr_pixel_type { GR_EXR_HALF = 1, GR_EXR_FLOAT = 2 } gr_exr_pixel_type;
 
+/*
+ * Geometry and field data in the header (Graupel's own attributes, which
+ * other EXR tools keep and ignore):
+ *   graupel.spacing        v2d     point spacing in x and y, metres, finite and > 0
+ *   graupel.origin         v3d     the south-west point, metres, finite
+ *   graupel.field.NAME     double  a one-value numeric field-data array NAME
+ *   graupel.field.NAME     graupelDoubles (opaque: int32 components, then the
+ *                                  values as float64, little-endian) for more values
+ *   graupel.field.NAME     string or stringvector: a string array NAME
+ * Other attributes are ignored. Attribute names longer than 31 characters
+ * make the writer set OpenEXR's long-name flag.
+ */
+/** Prefix of the attributes that hold field-data arrays. */
+#define GR_EXR_FIELD_PREFIX "graupel.field."
+/** Largest number of field-data arrays kept in or read from a header. */
+#define GR_EXR_MAX_META_FIELDS 1024
+/** Largest number of values (numbers or strings) in one field-data array. */
+#define GR_EXR_MAX_META_VALUES 65536
+/** Type name of the opaque attribute that holds several doubles. */
+#define GR_EXR_DOUBLES_TYPE "graupelDoubles"
+
+/** One field-data array kept in an EXR header: numbers or strings. */
+typedef struct gr_exr_meta_field {
+  char *name;      /**< the array's name (the attribute's name without the prefix) */
+  int is_string;   /**< 1: strings; 0: numbers */
+  int ncomponents; /**< numbers: values per tuple (>= 1, divides count); strings: 1 */
+  int count;       /**< number of values, 1 to GR_EXR_MAX_META_VALUES */
+  double *numbers; /**< count numbers (is_string 0), else NULL */
+  char **strings;  /**< count strings (is_string 1), else NULL */
+} gr_exr_meta_field;
+
+/** Geometry and field data of an EXR header. */
+typedef struct gr_exr_meta {
+  int has_spacing;   /**< 1: spacing holds the file's graupel.spacing */
+  double spacing[2]; /**< x, y in metres */
+  int has_origin;    /**< 1: origin holds the file's graupel.origin */
+  double origin[3];  /**< x, y, z of the south-west point in metres */
+  int nfields;
+  gr_exr_meta_field *fields;
+} gr_exr_meta;
+
 /** An image read from an EXR file: nchannels planes of width*height floats. */
 typedef struct gr_exr_image {
   int width, height;
@@ -41,12 +82,17 @@ typedef struct gr_exr_image {
   char **names;             /**< channel names, as in the file (sorted by EXR) */
   gr_exr_pixel_type *types; /**< the stored type of each channel */
   float **data;             /**< data[c][j*width + i], row 0 = south */
+  gr_exr_meta meta;         /**< the header's graupel.* attributes (all zero without them) */
 } gr_exr_image;
 
 /**
  * Reads every HALF or FLOAT channel of an EXR file. UINT channels are an error.
- * Channels with x/y sampling other than 1 are an error. On failure *out is
- * untouched and err (if given) holds a sentence naming the file and the fault.
+ * Channels with x/y sampling other than 1 are an error. The graupel.*
+ * attributes fill out->meta; one of the wrong type or with a bad value (a
+ * spacing not finite and above 0, an origin not finite, an empty field name,
+ * a value count or size out of range) fails the read with GR_ERR_FORMAT. On
+ * failure *out is untouched and err (if given) holds a sentence naming the
+ * file and the fault.
  */
 GR_API gr_status gr_exr_read(const char *path, gr_exr_image *out, char *err, size_t err_len);
 
@@ -72,6 +118,22 @@ GR_API int gr_exr_find_channel(const gr_exr_image *img, const char *name);
 GR_API gr_status gr_exr_write(const char *path, int width, int height, int nchannels,
                               const char *const *names, const float *const *data,
                               gr_exr_pixel_type type, char *err, size_t err_len);
+
+/**
+ * As gr_exr_write, and keeps meta (NULL: none) in the header as the
+ * graupel.* attributes described above. has_spacing and has_origin choose
+ * whether spacing and origin are written. A spacing not finite and above 0,
+ * an origin not finite, a field without a name, with a name longer than
+ * GR_EXR_MAX_NAME - 14 characters or given twice, or with a value count out
+ * of range gives GR_ERR_INVALID_ARGUMENT and writes nothing.
+ */
+GR_API gr_status gr_exr_write_meta(const char *path, int width, int height, int nchannels,
+                                   const char *const *names, const float *const *data,
+                                   gr_exr_pixel_type type, const gr_exr_meta *meta, char *err,
+                                   size_t err_len);
+
+/** Frees what a reader put in meta (names, numbers, strings); zeroes it. NULL is fine. */
+GR_API void gr_exr_meta_free(gr_exr_meta *meta);
 
 #ifdef __cplusplus
 }
