@@ -1,9 +1,13 @@
 #include "vtkGraupelAlgorithm.h"
 
 #include "vtkDataObject.h"
+#include "vtkDemandDrivenPipeline.h"
 #include "vtkFieldData.h"
+#include "vtkInformation.h"
+#include "vtkInformationVector.h"
 #include "vtkLogger.h"
 #include "vtkNew.h"
+#include "vtkStreamingDemandDrivenPipeline.h"
 #include "vtkStringArray.h"
 
 #include "graupel/runtime.h"
@@ -22,6 +26,8 @@ void LogFromCore(void *, gr_log_level level, const char *message) {
 } // namespace
 
 vtkGraupelAlgorithm::vtkGraupelAlgorithm() {
+  this->SetNumberOfInputPorts(1);
+  this->SetNumberOfOutputPorts(1);
   this->SetDevice("auto");
 }
 
@@ -72,8 +78,10 @@ gr_context *vtkGraupelAlgorithm::GetContext() {
   return this->Context;
 }
 
-int vtkGraupelAlgorithm::ReportFailure(int status, const char *what) {
-  const char *detail = gr_last_error(this->Context);
+int vtkGraupelAlgorithm::ReportFailure(int status, const char *what, const char *detail) {
+  if (!detail || !*detail) {
+    detail = gr_last_error(this->Context);
+  }
   vtkErrorMacro(<< what << ": " << (detail && *detail ? detail : "") << " ["
                 << gr_status_string(static_cast<gr_status>(status)) << "]");
   return 0;
@@ -84,6 +92,71 @@ void vtkGraupelAlgorithm::AddDeviceFieldData(vtkDataObject *output) {
   device->SetName("graupel_device");
   device->InsertNextValue(this->GetDeviceName());
   output->GetFieldData()->AddArray(device);
+}
+
+vtkDataObject *vtkGraupelAlgorithm::GetOutput() {
+  return this->GetOutput(0);
+}
+
+vtkDataObject *vtkGraupelAlgorithm::GetOutput(int port) {
+  return this->GetOutputDataObject(port);
+}
+
+int vtkGraupelAlgorithm::FillInputPortInformation(int, vtkInformation *info) {
+  info->Set(vtkAlgorithm::INPUT_REQUIRED_DATA_TYPE(), "vtkImageData");
+  return 1;
+}
+
+int vtkGraupelAlgorithm::FillOutputPortInformation(int, vtkInformation *info) {
+  info->Set(vtkDataObject::DATA_TYPE_NAME(), "vtkImageData");
+  return 1;
+}
+
+void vtkGraupelAlgorithm::EmptyOutputs(vtkInformationVector *outInfo) {
+  for (int i = 0; i < outInfo->GetNumberOfInformationObjects(); ++i) {
+    vtkInformation *info = outInfo->GetInformationObject(i);
+    vtkDataObject *data = info->Get(vtkDataObject::DATA_OBJECT());
+    if (!data) {
+      continue;
+    }
+    data->Initialize();
+    // Stamped with the requested time, the empty output answers that request:
+    // the executive does not run the filter again (and repeat its error)
+    // until a property, an input or the time changes.
+    if (info->Has(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP())) {
+      data->GetInformation()->Set(vtkDataObject::DATA_TIME_STEP(),
+                                  info->Get(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP()));
+    }
+  }
+}
+
+vtkTypeBool vtkGraupelAlgorithm::ProcessRequest(vtkInformation *request,
+                                                vtkInformationVector **inInfo,
+                                                vtkInformationVector *outInfo) {
+  if (request->Has(vtkDemandDrivenPipeline::REQUEST_INFORMATION())) {
+    this->InformationFailed = !this->RequestInformation(request, inInfo, outInfo);
+    if (this->InformationFailed) {
+      // Said why already; an empty extent lets the data pass go through quietly.
+      static const int empty[6] = {0, -1, 0, -1, 0, -1};
+      for (int i = 0; i < outInfo->GetNumberOfInformationObjects(); ++i) {
+        outInfo->GetInformationObject(i)->Set(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT(),
+                                              empty, 6);
+      }
+    }
+    return 1;
+  }
+  if (request->Has(vtkStreamingDemandDrivenPipeline::REQUEST_UPDATE_EXTENT())) {
+    return this->InformationFailed ? 1 : this->RequestUpdateExtent(request, inInfo, outInfo);
+  }
+  if (request->Has(vtkDemandDrivenPipeline::REQUEST_DATA())) {
+    if (this->InformationFailed || !this->RequestData(request, inInfo, outInfo)) {
+      // The sentence was reported where the failure happened; see the header
+      // for why this is not returned as 0.
+      this->EmptyOutputs(outInfo);
+    }
+    return 1;
+  }
+  return this->Superclass::ProcessRequest(request, inInfo, outInfo);
 }
 
 void vtkGraupelAlgorithm::PrintSelf(ostream &os, vtkIndent indent) {

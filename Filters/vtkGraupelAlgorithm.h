@@ -7,19 +7,41 @@
  * "auto"), the process-wide OpenCL context shared by all filters, the
  * translation of core status codes into one vtkErrorMacro sentence, and the
  * `graupel_device` field-data string that says where an output was computed.
+ *
+ * It derives from vtkAlgorithm, not vtkImageAlgorithm, so that a simulation
+ * whose output is points (vtkPolyData) shares it; it keeps the behaviour of
+ * vtkImageAlgorithm that Graupel's image sources rely on: one input and one
+ * output port, both vtkImageData unless a subclass fills the port
+ * information otherwise, and the requests dispatched to RequestInformation,
+ * RequestUpdateExtent and RequestData.
+ *
+ * Errors are reported once. A RequestData that fails has already said why
+ * in one vtkErrorMacro sentence; ProcessRequest then empties the outputs,
+ * stamps them with the requested time and returns 1 instead of 0. Returning
+ * 0 made vtkExecutive::CallAlgorithm add "Algorithm ... returned failure for
+ * request: vtkInformation ..." with a dump of the request after the
+ * sentence, and an output without DATA_TIME_STEP made
+ * vtkStreamingDemandDrivenPipeline::NeedToExecuteData run the filter again
+ * for each of ParaView's later requests at the same time (the pipeline
+ * update, the representation, the data information), each repeating the
+ * sentence: three errors and two dumps for one mistake. An empty output is
+ * what downstream filters and ParaView's representations expect of a failed
+ * filter anyway. The same holds for a failed RequestInformation: the output
+ * advertises an empty extent and the data pass is skipped without a second
+ * message.
  */
 #ifndef vtkGraupelAlgorithm_h
 #define vtkGraupelAlgorithm_h
 
 #include "GraupelFiltersModule.h"
-#include "vtkImageAlgorithm.h"
+#include "vtkAlgorithm.h"
 
 struct gr_context;
 class vtkDataObject;
 
-class GRAUPELFILTERS_EXPORT vtkGraupelAlgorithm : public vtkImageAlgorithm {
+class GRAUPELFILTERS_EXPORT vtkGraupelAlgorithm : public vtkAlgorithm {
 public:
-  vtkTypeMacro(vtkGraupelAlgorithm, vtkImageAlgorithm);
+  vtkTypeMacro(vtkGraupelAlgorithm, vtkAlgorithm);
   void PrintSelf(ostream &os, vtkIndent indent) override;
 
   ///@{
@@ -42,9 +64,35 @@ public:
    */
   vtkTypeInt64 GetDeviceMaxBufferBytes();
 
+  ///@{
+  /** The output on port 0 (or port), of the type the port declares. */
+  vtkDataObject *GetOutput();
+  vtkDataObject *GetOutput(int port);
+  ///@}
+
+  /** Dispatches the pipeline requests; see the class comment for failures. */
+  vtkTypeBool ProcessRequest(vtkInformation *request, vtkInformationVector **inInfo,
+                             vtkInformationVector *outInfo) override;
+
 protected:
   vtkGraupelAlgorithm();
   ~vtkGraupelAlgorithm() override;
+
+  virtual int RequestInformation(vtkInformation *, vtkInformationVector **,
+                                 vtkInformationVector *) {
+    return 1;
+  }
+  virtual int RequestUpdateExtent(vtkInformation *, vtkInformationVector **,
+                                  vtkInformationVector *) {
+    return 1;
+  }
+  virtual int RequestData(vtkInformation *, vtkInformationVector **, vtkInformationVector *) {
+    return 1;
+  }
+
+  /** vtkImageData on every port unless a subclass says otherwise. */
+  int FillInputPortInformation(int port, vtkInformation *info) override;
+  int FillOutputPortInformation(int port, vtkInformation *info) override;
 
   /**
    * The shared context for the chosen device, acquired on first use.
@@ -54,12 +102,17 @@ protected:
 
   /**
    * Reports a failed core call as one error sentence ("<what>: <detail>")
-   * and returns 0, the value RequestData returns on failure.
+   * and returns 0, the value RequestData returns on failure. detail is the
+   * failing handle's own message when given (gr_<core>_last_error), else
+   * the thread's latest core error.
    */
-  int ReportFailure(int status, const char *what);
+  int ReportFailure(int status, const char *what, const char *detail = nullptr);
 
   /** Adds the `graupel_device` string to the output's field data. */
   void AddDeviceFieldData(vtkDataObject *output);
+
+  /** Empties every output and stamps it with its requested time. */
+  void EmptyOutputs(vtkInformationVector *outInfo);
 
   char *Device = nullptr;
 
@@ -68,6 +121,8 @@ private:
   void operator=(const vtkGraupelAlgorithm &) = delete;
 
   gr_context *Context = nullptr;
+  // RequestInformation failed (and said why): the data pass is skipped.
+  bool InformationFailed = false;
 };
 
 #endif

@@ -1,18 +1,99 @@
 #include "vtkGraupelSimulation.h"
 
+#include "vtkDataArray.h"
 #include "vtkDataObject.h"
+#include "vtkDemandDrivenPipeline.h"
+#include "vtkExecutive.h"
 #include "vtkImageData.h"
 #include "vtkInformation.h"
+#include "vtkInformationExecutivePortKey.h"
 #include "vtkInformationVector.h"
+#include "vtkPointData.h"
 #include "vtkStreamingDemandDrivenPipeline.h"
 
 #include <algorithm>
 #include <cmath>
-#include <vector>
+#include <cstdio>
+#include <string>
+
+#if defined(__unix__) || defined(__APPLE__)
+#include <unistd.h>
+#endif
+
+namespace {
+// The host's physical memory in bytes; 0 when unknown.
+double PhysicalMemoryBytes() {
+#if defined(_SC_PHYS_PAGES) && defined(_SC_PAGESIZE)
+  const long pages = sysconf(_SC_PHYS_PAGES);
+  const long size = sysconf(_SC_PAGESIZE);
+  if (pages > 0 && size > 0) {
+    return static_cast<double>(pages) * static_cast<double>(size);
+  }
+#endif
+  return 0.0;
+}
+
+std::string Seconds(double t) {
+  char text[64];
+  std::snprintf(text, sizeof(text), "%g s", t);
+  return text;
+}
+} // namespace
 
 vtkGraupelSimulation::vtkGraupelSimulation() = default;
 
 vtkGraupelSimulation::~vtkGraupelSimulation() = default;
+
+void vtkGraupelSimulation::SetInputPortPolicy(int port, int policy) {
+  if (port < 0) {
+    return;
+  }
+  if (static_cast<size_t>(port) >= this->Policies.size()) {
+    this->Policies.resize(static_cast<size_t>(port) + 1, STATIC_INPUT);
+  }
+  this->Policies[static_cast<size_t>(port)] = policy;
+  this->Modified();
+}
+
+bool vtkGraupelSimulation::IsInputTemporal(int port) const {
+  return port >= 0 && static_cast<size_t>(port) < this->InputTimes.size() &&
+         this->InputTimes[static_cast<size_t>(port)].size() >= 2;
+}
+
+int vtkGraupelSimulation::SaveState(std::vector<unsigned char> &) {
+  return 0;
+}
+
+int vtkGraupelSimulation::LoadState(const std::vector<unsigned char> &) {
+  return 0;
+}
+
+const char *vtkGraupelSimulation::GetSimulationLabel() {
+  return this->GetClassName();
+}
+
+vtkTypeInt64 vtkGraupelSimulation::GetCheckpointMemoryLimitBytes() const {
+  double limit = this->CheckpointMemoryLimit * 1048576.0;
+  const double physical = PhysicalMemoryBytes();
+  if (physical > 0.0) {
+    limit = std::min(limit, 0.25 * physical);
+  }
+  return static_cast<vtkTypeInt64>(limit);
+}
+
+vtkTypeInt64 vtkGraupelSimulation::GetCheckpointBytes() const {
+  vtkTypeInt64 bytes = 0;
+  for (const Checkpoint &c : this->Checkpoints) {
+    bytes += static_cast<vtkTypeInt64>(c.bytes.size());
+  }
+  return bytes;
+}
+
+int vtkGraupelSimulation::GetCheckpointIndex(int i) const {
+  return i >= 0 && i < this->GetNumberOfCheckpoints()
+             ? this->Checkpoints[static_cast<size_t>(i)].index
+             : -1;
+}
 
 int vtkGraupelSimulation::GetNumberOfOutputTimes() const {
   if (!(this->EndTime >= 0.0) || !(this->OutputInterval > 0.0) || !std::isfinite(this->EndTime)) {
@@ -54,15 +135,50 @@ int vtkGraupelSimulation::CheckTimes() {
 void vtkGraupelSimulation::InvalidateState() {
   this->ReleaseState();
   this->StateIndex = -1;
+  this->Checkpoints.clear();
 }
 
-int vtkGraupelSimulation::RequestInformation(vtkInformation *request,
-                                             vtkInformationVector **inputVector,
+vtkDataObject *vtkGraupelSimulation::GetTemporalInput(int port) {
+  return this->GetInputDataObject(port, 0);
+}
+
+double vtkGraupelSimulation::GetTemporalInputTime(int port) const {
+  return port >= 0 && static_cast<size_t>(port) < this->DeliveredTime.size()
+             ? this->DeliveredTime[static_cast<size_t>(port)]
+             : 0.0;
+}
+
+double vtkGraupelSimulation::InputTimeAt(int port, double t) const {
+  const std::vector<double> &times = this->InputTimes[static_cast<size_t>(port)];
+  // The last time step at or before t; before the first, the first holds.
+  auto it = std::upper_bound(times.begin(), times.end(), t);
+  return it == times.begin() ? times.front() : *(it - 1);
+}
+
+int vtkGraupelSimulation::RequestInformation(vtkInformation *, vtkInformationVector **inputVector,
                                              vtkInformationVector *outputVector) {
-  // Geometry (whole extent, spacing, origin) comes from the terrain input.
-  if (!this->Superclass::RequestInformation(request, inputVector, outputVector)) {
-    return 0;
+  const int nports = this->GetNumberOfInputPorts();
+  this->InputTimes.assign(static_cast<size_t>(nports), std::vector<double>());
+  this->DeliveredTime.resize(static_cast<size_t>(nports), 0.0);
+  this->PendingTime.resize(static_cast<size_t>(nports), 0.0);
+  for (int port = 0; port < nports; ++port) {
+    const bool temporal = static_cast<size_t>(port) < this->Policies.size() &&
+                          this->Policies[static_cast<size_t>(port)] == TEMPORAL_INPUT;
+    vtkInformation *inInfo = inputVector[port]->GetInformationObject(0);
+    if (!temporal || !inInfo || !inInfo->Has(vtkStreamingDemandDrivenPipeline::TIME_STEPS())) {
+      continue;
+    }
+    const double *t = inInfo->Get(vtkStreamingDemandDrivenPipeline::TIME_STEPS());
+    std::vector<double> times(t,
+                              t + inInfo->Length(vtkStreamingDemandDrivenPipeline::TIME_STEPS()));
+    std::sort(times.begin(), times.end());
+    times.erase(std::unique(times.begin(), times.end()), times.end());
+    if (times.size() >= 2) {
+      this->InputTimes[static_cast<size_t>(port)] = times;
+    }
   }
+
+  // The executive copied input 0's times to the output: replace them by ours.
   vtkInformation *outInfo = outputVector->GetInformationObject(0);
   outInfo->Remove(vtkStreamingDemandDrivenPipeline::TIME_STEPS());
   outInfo->Remove(vtkStreamingDemandDrivenPipeline::TIME_RANGE());
@@ -84,56 +200,11 @@ int vtkGraupelSimulation::RequestInformation(vtkInformation *request,
   return 1;
 }
 
-int vtkGraupelSimulation::RequestUpdateExtent(vtkInformation *, vtkInformationVector **inputVector,
-                                              vtkInformationVector *) {
-  for (int port = 0; port < this->GetNumberOfInputPorts(); ++port) {
-    for (int c = 0; c < inputVector[port]->GetNumberOfInformationObjects(); ++c) {
-      vtkInformation *inInfo = inputVector[port]->GetInformationObject(c);
-      // The whole input, at its first time: the simulation needs all of it,
-      // and a time request for the simulation is not one for the terrain.
-      // Asking for piece 0 of 1 as well: a source that can split its output
-      // turns a piece request into its extent, whatever extent was set.
-      inInfo->Set(vtkStreamingDemandDrivenPipeline::UPDATE_PIECE_NUMBER(), 0);
-      inInfo->Set(vtkStreamingDemandDrivenPipeline::UPDATE_NUMBER_OF_PIECES(), 1);
-      inInfo->Set(vtkStreamingDemandDrivenPipeline::UPDATE_NUMBER_OF_GHOST_LEVELS(), 0);
-      if (inInfo->Has(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT())) {
-        inInfo->Set(vtkStreamingDemandDrivenPipeline::UPDATE_EXTENT(),
-                    inInfo->Get(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT()), 6);
-      }
-      inInfo->Remove(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP());
-    }
-  }
-  return 1;
-}
-
-bool vtkGraupelSimulation::StateIsCurrent() {
-  if (this->StateIndex < 0 || this->GetMTime() != this->StateFilterMTime) {
-    return false;
-  }
-  for (int port = 0; port < std::min(2, this->GetNumberOfInputPorts()); ++port) {
-    vtkDataObject *in = this->GetInputDataObject(port, 0);
-    const vtkMTimeType t = in ? in->GetMTime() : 0;
-    if (t != this->StateInputMTime[port]) {
-      return false;
-    }
-  }
-  return true;
-}
-
-int vtkGraupelSimulation::RequestData(vtkInformation *, vtkInformationVector **inputVector,
-                                      vtkInformationVector *outputVector) {
-  vtkInformation *outInfo = outputVector->GetInformationObject(0);
-  vtkImageData *output = vtkImageData::GetData(outInfo);
-  output->Initialize();
-  if (!this->CheckTimes()) {
-    this->InvalidateState();
-    return 0;
-  }
-
+int vtkGraupelSimulation::TargetIndex(vtkInformation *outInfo) const {
   // The requested time, snapped to the last output time at or before it.
   const int n = this->GetNumberOfOutputTimes();
   int target = 0;
-  if (outInfo->Has(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP())) {
+  if (n > 0 && outInfo->Has(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP())) {
     const double t = outInfo->Get(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP());
     if (std::isfinite(t)) {
       target = static_cast<int>(
@@ -143,71 +214,321 @@ int vtkGraupelSimulation::RequestData(vtkInformation *, vtkInformationVector **i
       while (target + 1 < n && this->GetOutputTime(target + 1) <= t + slack) {
         ++target;
       }
+    } else if (t > 0.0) {
+      target = n - 1;
     }
   }
+  return target;
+}
 
-  if (!this->StateIsCurrent()) {
-    this->InvalidateState();
-    if (!this->GetContext()) {
+double vtkGraupelSimulation::PlannedStart(int target) const {
+  const double goal = this->GetOutputTime(target);
+  double start = (this->StateIndex >= 0 && !this->StateLost && this->StateTime <= goal)
+                     ? this->StateTime
+                     : 0.0;
+  for (const Checkpoint &c : this->Checkpoints) {
+    const double tc = this->GetOutputTime(c.index);
+    if (tc <= goal && tc > start) {
+      start = tc;
+    }
+  }
+  return start;
+}
+
+int vtkGraupelSimulation::RequestUpdateExtent(vtkInformation *, vtkInformationVector **inputVector,
+                                              vtkInformationVector *outputVector) {
+  const int nports = this->GetNumberOfInputPorts();
+  if (!this->Continuing) {
+    // First pass of a request: guess the input times the state will need
+    // first; a wrong guess costs one more pass, not a wrong result.
+    const double start =
+        this->PlannedStart(this->TargetIndex(outputVector->GetInformationObject(0)));
+    for (int port = 0; port < nports; ++port) {
+      if (this->IsInputTemporal(port)) {
+        this->PendingTime[static_cast<size_t>(port)] = this->InputTimeAt(port, start);
+      }
+    }
+  }
+  for (int port = 0; port < nports; ++port) {
+    for (int c = 0; c < inputVector[port]->GetNumberOfInformationObjects(); ++c) {
+      vtkInformation *inInfo = inputVector[port]->GetInformationObject(c);
+      // The whole input: the simulation needs all of it. Asking for piece 0
+      // of 1 as well: a source that can split its output turns a piece
+      // request into its extent, whatever extent was set.
+      inInfo->Set(vtkStreamingDemandDrivenPipeline::UPDATE_PIECE_NUMBER(), 0);
+      inInfo->Set(vtkStreamingDemandDrivenPipeline::UPDATE_NUMBER_OF_PIECES(), 1);
+      inInfo->Set(vtkStreamingDemandDrivenPipeline::UPDATE_NUMBER_OF_GHOST_LEVELS(), 0);
+      if (inInfo->Has(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT())) {
+        inInfo->Set(vtkStreamingDemandDrivenPipeline::UPDATE_EXTENT(),
+                    inInfo->Get(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT()), 6);
+      }
+      if (this->IsInputTemporal(port)) {
+        const double t = this->PendingTime[static_cast<size_t>(port)];
+        inInfo->Set(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP(), t);
+        this->DeliveredTime[static_cast<size_t>(port)] = t;
+      } else {
+        // A static input at its first time: a time request for the
+        // simulation is not one for the terrain.
+        inInfo->Remove(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP());
+      }
+    }
+  }
+  return 1;
+}
+
+vtkGraupelSimulation::Key vtkGraupelSimulation::CurrentKey() {
+  Key key;
+  key.filter = this->GetMTime();
+  for (int port = 0; port < this->GetNumberOfInputPorts(); ++port) {
+    vtkMTimeType t = 0;
+    if (this->IsInputTemporal(port)) {
+      // A temporal input's data changes with every time read; what it is
+      // made from changes with its pipeline.
+      vtkInformation *inInfo = this->GetInputInformation(port, 0);
+      vtkExecutive *producer = inInfo ? vtkExecutive::PRODUCER()->GetExecutive(inInfo) : nullptr;
+      if (auto *ddp = vtkDemandDrivenPipeline::SafeDownCast(producer)) {
+        t = ddp->GetPipelineMTime();
+      }
+      key.times.push_back(this->InputTimes[static_cast<size_t>(port)]);
+    } else {
+      vtkDataObject *in =
+          this->GetNumberOfInputConnections(port) ? this->GetInputDataObject(port, 0) : nullptr;
+      t = in ? in->GetMTime() : 0;
+    }
+    key.inputs.push_back(t);
+  }
+  return key;
+}
+
+int vtkGraupelSimulation::Rewind(int target) {
+  const double goal = this->GetOutputTime(target);
+  const bool stateUsable = this->StateIndex >= 0 && !this->StateLost && this->StateTime <= goal;
+  const Checkpoint *best = nullptr;
+  for (const Checkpoint &c : this->Checkpoints) {
+    const double tc = this->GetOutputTime(c.index);
+    if (tc <= goal && (!stateUsable || tc > this->StateTime) && (!best || c.index > best->index)) {
+      best = &c;
+    }
+  }
+  if (best) {
+    if (this->LoadState(best->bytes)) {
+      ++this->RestoreCount;
+      this->StateLost = false;
+      this->StateIndex = best->index;
+      this->StateTime = this->GetOutputTime(best->index);
+      return 1;
+    }
+    // A snapshot that does not load is no use; time 0 still is.
+    this->Checkpoints.clear();
+  }
+  if (stateUsable) {
+    return 1;
+  }
+  ++this->RestartCount;
+  if (!this->ResetState()) {
+    return 0;
+  }
+  this->StateLost = false;
+  this->StateIndex = 0;
+  this->StateTime = 0.0;
+  return 1;
+}
+
+void vtkGraupelSimulation::KeepCheckpoint() {
+  const int k = this->StateIndex;
+  if (this->CheckpointInterval <= 0 || k <= 0 || k % this->CheckpointInterval != 0 ||
+      this->StateTime != this->GetOutputTime(k)) {
+    return;
+  }
+  for (const Checkpoint &c : this->Checkpoints) {
+    if (c.index == k) {
+      return;
+    }
+  }
+  Checkpoint c{k, {}};
+  if (!this->SaveState(c.bytes)) {
+    return;
+  }
+  const vtkTypeInt64 limit = this->GetCheckpointMemoryLimitBytes();
+  const vtkTypeInt64 size = static_cast<vtkTypeInt64>(c.bytes.size());
+  if (size > limit) {
+    return;
+  }
+  while (!this->Checkpoints.empty() && this->GetCheckpointBytes() + size > limit) {
+    this->Checkpoints.pop_front();
+  }
+  c.bytes.shrink_to_fit();
+  this->Checkpoints.push_back(std::move(c));
+}
+
+int vtkGraupelSimulation::ReportProgress(double t) {
+  const double goal = this->GetOutputTime(this->Target);
+  const double span = goal - this->ProgressStart;
+  const double fraction = span > 0.0 ? (t - this->ProgressStart) / span : 1.0;
+  const std::string text =
+      std::string(this->GetSimulationLabel()) + ": t = " + Seconds(t) + " of " + Seconds(goal);
+  this->SetProgressText(text.c_str());
+  this->UpdateProgress(std::max(0.0, std::min(1.0, fraction)));
+  return this->GetAbortExecute() ? 1 : 0;
+}
+
+int vtkGraupelSimulation::CoreProgress(void *user, double time) {
+  return static_cast<vtkGraupelSimulation *>(user)->ReportProgress(time);
+}
+
+vtkDataArray *vtkGraupelSimulation::GetElevation(vtkImageData *terrain, const char *inputName) {
+  vtkDataArray *a = terrain ? terrain->GetPointData()->GetArray("elevation") : nullptr;
+  if (!a || a->GetNumberOfComponents() != 1) {
+    vtkErrorMacro(<< this->GetSimulationLabel() << "'s " << inputName
+                  << " has no one-component point array 'elevation'; name the terrain's "
+                     "heights (m) so, e.g. with a Calculator whose Result Array Name is "
+                     "elevation.");
+    return nullptr;
+  }
+  double spacing[3];
+  terrain->GetSpacing(spacing);
+  double range[2];
+  a->GetRange(range, 0);
+  const double span = range[1] - range[0];
+  if (spacing[0] == 1.0 && spacing[1] == 1.0 && span >= 100.0 &&
+      this->WarnedSpacingFor != terrain->GetMTime()) {
+    this->WarnedSpacingFor = terrain->GetMTime();
+    vtkWarningMacro(<< this->GetSimulationLabel() << "'s " << inputName
+                    << " has a spacing of 1 m while its elevation spans " << span
+                    << " m: if its points lie farther apart, set the terrain's Spacing (on "
+                       "the reader or source) or its slopes are that many times too steep.");
+  }
+  return a;
+}
+
+void vtkGraupelSimulation::Finish(vtkInformation *request) {
+  request->Remove(vtkStreamingDemandDrivenPipeline::CONTINUE_EXECUTING());
+  this->Continuing = false;
+}
+
+int vtkGraupelSimulation::RequestData(vtkInformation *request, vtkInformationVector **inputVector,
+                                      vtkInformationVector *outputVector) {
+  vtkInformation *outInfo = outputVector->GetInformationObject(0);
+  vtkDataObject *output = outInfo->Get(vtkDataObject::DATA_OBJECT());
+  output->Initialize();
+
+  if (!this->Continuing) {
+    const Key key = this->CurrentKey();
+    if (this->HasFailed && key == this->FailedKey) {
+      // Said why already; nothing changed since.
       return 0;
     }
-    ++this->RestartCount;
-    if (!this->SetUpState(inputVector)) {
-      this->ReleaseState();
-      return 0;
-    }
-    this->StateIndex = 0;
-    this->StateFilterMTime = this->GetMTime();
-    for (int port = 0; port < std::min(2, this->GetNumberOfInputPorts()); ++port) {
-      vtkDataObject *in = this->GetInputDataObject(port, 0);
-      this->StateInputMTime[port] = in ? in->GetMTime() : 0;
-    }
-  } else if (target < this->StateIndex) {
-    // Earlier than the state: start again from time 0.
-    ++this->RestartCount;
-    if (!this->ResetState()) {
+    this->HasFailed = false;
+    this->FailedKey = key;
+    if (!this->CheckTimes()) {
       this->InvalidateState();
+      this->HasFailed = true;
       return 0;
     }
-    this->StateIndex = 0;
+    this->Target = this->TargetIndex(outInfo);
+    if (this->StateIndex < 0 || !(key == this->StateKey)) {
+      this->InvalidateState();
+      if (!this->GetContext()) {
+        this->HasFailed = true;
+        return 0;
+      }
+      ++this->RestartCount;
+      if (!this->SetUpState(inputVector)) {
+        this->ReleaseState();
+        this->HasFailed = true;
+        return 0;
+      }
+      this->StateIndex = 0;
+      this->StateTime = 0.0;
+      this->StateLost = false;
+      this->StateKey = key;
+    }
+    if (!this->Rewind(this->Target)) {
+      this->InvalidateState();
+      this->HasFailed = true;
+      return 0;
+    }
+    this->ProgressStart = this->StateTime;
+    this->ReportProgress(this->StateTime);
   }
 
-  const int first = this->StateIndex;
-  this->UpdateProgress(0.0);
-  while (this->StateIndex < target) {
-    const double seconds =
-        this->GetOutputTime(this->StateIndex + 1) - this->GetOutputTime(this->StateIndex);
-    if (!this->AdvanceState(seconds)) {
+  const double goal = this->GetOutputTime(this->Target);
+  const int nports = this->GetNumberOfInputPorts();
+  while (this->StateTime < goal) {
+    // Each temporal input at the time step that holds now, else another pass.
+    bool waiting = false;
+    double next = this->GetOutputTime(this->StateIndex + 1);
+    for (int port = 0; port < nports; ++port) {
+      if (!this->IsInputTemporal(port)) {
+        continue;
+      }
+      const double need = this->InputTimeAt(port, this->StateTime);
+      if (need != this->DeliveredTime[static_cast<size_t>(port)]) {
+        if (this->Continuing && need == this->PendingTime[static_cast<size_t>(port)]) {
+          this->Finish(request);
+          this->InvalidateState();
+          this->HasFailed = true;
+          vtkErrorMacro(<< this->GetSimulationLabel() << ": input " << port
+                        << " did not update to time " << need
+                        << " s; the pipeline above it must honour time requests.");
+          return 0;
+        }
+        this->PendingTime[static_cast<size_t>(port)] = need;
+        waiting = true;
+      }
+      const std::vector<double> &times = this->InputTimes[static_cast<size_t>(port)];
+      auto after = std::upper_bound(times.begin(), times.end(), this->StateTime);
+      if (after != times.end()) {
+        next = std::min(next, *after);
+      }
+    }
+    if (waiting) {
+      request->Set(vtkStreamingDemandDrivenPipeline::CONTINUE_EXECUTING(), 1);
+      this->Continuing = true;
+      ++this->ExtraPassCount;
+      return 1;
+    }
+
+    const int result = this->AdvanceState(this->StateTime, next);
+    if (result == ADVANCE_FAILED) {
+      this->Finish(request);
       this->InvalidateState();
+      this->HasFailed = true;
       return 0;
     }
-    ++this->StateIndex;
-    this->UpdateProgress(static_cast<double>(this->StateIndex - first) / (target - first));
-    if (this->StateIndex < target && this->GetAbortExecute()) {
-      vtkWarningMacro(<< this->GetClassName()
-                      << ": the update was aborted at t = " << this->GetOutputTime(this->StateIndex)
-                      << " s; the output is empty and the next update goes on from there.");
-      // Honour the abort, then make sure the next request runs again; the
-      // state reached so far stays valid for it.
+    if (result == ADVANCE_ABORTED) {
+      // Stopped between the knots: see the class comment. The set-up and the
+      // checkpoints stay; the device state is no longer one to go on from.
+      this->StateLost = true;
+    } else {
+      this->StateTime = next;
+      if (next == this->GetOutputTime(this->StateIndex + 1)) {
+        ++this->StateIndex;
+        this->KeepCheckpoint();
+      }
+      this->ReportProgress(this->StateTime);
+    }
+    if (result == ADVANCE_ABORTED || (this->StateTime < goal && this->GetAbortExecute())) {
+      vtkWarningMacro(<< this->GetSimulationLabel() << ": the update was aborted at t = "
+                      << this->StateTime << " s; the output is empty and the next update "
+                      << (result == ADVANCE_ABORTED ? "starts again from the last checkpoint."
+                                                    : "goes on from there."));
+      this->Finish(request);
+      // Honour the abort, then make sure the next request runs again.
       this->AbortExecute = 0;
       this->Modified();
-      this->StateFilterMTime = this->GetMTime();
+      this->StateKey.filter = this->GetMTime();
       return 1;
     }
   }
 
-  int extent[6];
-  outInfo->Get(vtkStreamingDemandDrivenPipeline::UPDATE_EXTENT(), extent);
-  vtkImageData *input = vtkImageData::GetData(inputVector[0]);
-  output->SetExtent(extent);
-  output->SetSpacing(input->GetSpacing());
-  output->SetOrigin(input->GetOrigin());
-  if (!this->FillOutput(output, extent)) {
+  this->Finish(request);
+  if (!this->FillOutput(output, outInfo)) {
     output->Initialize();
+    this->HasFailed = true;
     return 0;
   }
-  output->GetInformation()->Set(vtkDataObject::DATA_TIME_STEP(),
-                                this->GetOutputTime(this->StateIndex));
+  output->GetInformation()->Set(vtkDataObject::DATA_TIME_STEP(), goal);
   this->AddDeviceFieldData(output);
   return 1;
 }
@@ -216,6 +537,12 @@ void vtkGraupelSimulation::PrintSelf(ostream &os, vtkIndent indent) {
   this->Superclass::PrintSelf(os, indent);
   os << indent << "EndTime: " << this->EndTime << "\n";
   os << indent << "OutputInterval: " << this->OutputInterval << "\n";
+  os << indent << "CheckpointInterval: " << this->CheckpointInterval << "\n";
+  os << indent << "CheckpointMemoryLimit: " << this->CheckpointMemoryLimit << " MiB\n";
   os << indent << "StateIndex: " << this->StateIndex << "\n";
+  os << indent << "StateTime: " << this->StateTime << "\n";
   os << indent << "RestartCount: " << this->RestartCount << "\n";
+  os << indent << "RestoreCount: " << this->RestoreCount << "\n";
+  os << indent << "Checkpoints: " << this->Checkpoints.size() << " (" << this->GetCheckpointBytes()
+     << " bytes)\n";
 }

@@ -5,25 +5,84 @@
  * A simulation filter is a time source: it advertises `TIME_STEPS` (0,
  * OutputInterval, 2 OutputInterval, ..., EndTime) and `TIME_RANGE` [0,
  * EndTime]. A requested time is snapped to the last output time at or
- * before it. The simulation state stays on the device between updates:
+ * before it. The output may be any data type (an image for a grid core,
+ * vtkPolyData for particles): the subclass declares it in
+ * FillOutputPortInformation and fills it in FillOutput; the time logic here
+ * never looks at it.
  *
- * - a request for a later time advances the cached state interval by
- *   interval (progress is reported per interval and an abort is honoured
- *   between intervals: the output is then empty, the state reached is kept,
- *   and the next update continues from it);
- * - a request for an earlier time restarts from the initial state;
- * - a changed property or input sets the simulation up again.
+ * **The state.** It stays on the device between updates, at an absolute
+ * time. A request for a later time advances it; a request for an earlier
+ * time goes back to the nearest kept checkpoint at or before that time (see
+ * below), or to time 0 when there is none; a changed property or a changed
+ * static input sets the simulation up again.
  *
- * Because the state always advances by whole output intervals from time 0,
- * the field at a time never depends on the order in which times were
- * requested (Testing/Python/test_rain_runoff.py checks it bit for bit).
+ * **Inputs in time.** Each input port has a policy (SetInputPortPolicy):
+ * - STATIC: read once, at its first time (a terrain). A change of its data
+ *   sets the simulation up again.
+ * - TEMPORAL: read at the simulated time while stepping (a moving object,
+ *   rain that varies). Its data at input time step tau_i holds from tau_i
+ *   until the next input time step (sample and hold; before the first step
+ *   the first holds). A temporal input that advertises fewer than 2 time
+ *   steps is static. A change upstream of it (its pipeline MTime) or of its
+ *   time steps sets the simulation up again; a new time of it does not.
  *
- * Inputs are read once, at their first time; a terrain that changes in time
- * is not followed. Every rank of an MPI run simulates the whole domain and
- * outputs its piece, so pieces equal the whole.
+ * The simulation gets its temporal inputs through ParaView's own idiom for
+ * filters that consume many input times, CONTINUE_EXECUTING (as
+ * vtkTemporalStatistics does): one input time per pipeline pass.
+ * RequestUpdateExtent asks each temporal input for the time step the state
+ * needs next; RequestData advances the state up to the next input time step
+ * or output time, whichever comes first, then asks the executive for
+ * another pass until the requested output time is reached. Chosen over a
+ * cache of the input's time steps because (a) memory stays one input time
+ * step per port whatever the number of steps (a mesh sequence or rain maps
+ * of hundreds of steps would not fit a cache), (b) the upstream pipeline
+ * runs as ParaView expects (its own caching, progress and MPI pieces
+ * apply), and (c) no filter calls Update() on its input from inside
+ * RequestData, which breaks in client-server pipelines. The cost is one
+ * upstream execution per input time step passed, paid again when going back
+ * in time beyond a checkpoint.
  *
- * Subclasses implement the five hooks below; they translate, they do not
- * compute.
+ * Every AdvanceState(t0, t1) call covers one piece between consecutive
+ * "knots": output times and the temporal inputs' time steps. The knots
+ * depend on properties and inputs only, so the calls made to reach a time
+ * are the same whatever the order in which times were requested, and a
+ * deterministic core gives the same bits (Testing/Cxx and
+ * Testing/Python/test_rain_runoff.py check it).
+ *
+ * **Checkpoints.** Every CheckpointInterval (K, default 10) outputs, the
+ * state is saved on the host through SaveState into a ring bounded by
+ * CheckpointMemoryLimit (MiB, default 1024, never more than a quarter of the
+ * host's physical memory): when a new snapshot would exceed it, the oldest
+ * ones are dropped; a snapshot larger than the limit is not kept. Going
+ * back restores the nearest snapshot at or before the requested time with
+ * LoadState, so it re-steps at most K output intervals; going forward past
+ * a snapshot that is ahead of the state uses it too. K = 10 keeps a
+ * 60-output run (600 s at 10 s) to six snapshots and a replay to at most ten
+ * intervals; a Rain Runoff snapshot is about 36 bytes per grid point, so a
+ * 1024 x 1024 grid keeps 28 of them under 1 GiB. Snapshots are dropped when
+ * the simulation is set up again. RestartCount counts set-ups and returns to
+ * time 0; RestoreCount counts snapshot loads.
+ *
+ * **Progress and abort.** Progress text names what happens ("Rain Runoff:
+ * t = 420 s of 1800 s", the second time being the requested one) and is
+ * updated after every AdvanceState and, through CoreProgress, from inside a
+ * core's long advance. An abort is honoured between AdvanceState calls and,
+ * where the core supports it, inside one (CoreProgress returns nonzero when
+ * GetAbortExecute()). The output of an aborted update is empty and the next
+ * update runs again. After an abort between calls the state is kept and the
+ * next update goes on from it. After an abort inside a call the core stopped
+ * at a step that is not a knot: going on from there would take other steps
+ * than an uninterrupted run, so that state is dropped and the next update
+ * restores the nearest checkpoint (or restarts), and results stay
+ * bit-identical.
+ *
+ * **Errors** are reported once (see vtkGraupelAlgorithm): a failed set-up or
+ * step gives one sentence and an empty output, and the same request is not
+ * tried again (nor its sentence repeated) until a property or input changes.
+ *
+ * Every rank of an MPI run simulates the whole domain and outputs its piece,
+ * so pieces equal the whole. Subclasses implement the hooks below; they
+ * translate, they do not compute.
  */
 #ifndef vtkGraupelSimulation_h
 #define vtkGraupelSimulation_h
@@ -31,6 +90,10 @@
 #include "GraupelFiltersModule.h"
 #include "vtkGraupelAlgorithm.h"
 
+#include <deque>
+#include <vector>
+
+class vtkDataArray;
 class vtkImageData;
 
 class GRAUPELFILTERS_EXPORT vtkGraupelSimulation : public vtkGraupelAlgorithm {
@@ -40,6 +103,9 @@ public:
 
   /** The most output times a simulation advertises. */
   static constexpr int MaximumOutputSteps = 100000;
+
+  /** Input port policies (see the class comment). */
+  enum InputPolicy { STATIC_INPUT = 0, TEMPORAL_INPUT = 1 };
 
   ///@{
   /** Simulated time at the last output, seconds (default 600). */
@@ -53,37 +119,116 @@ public:
   vtkGetMacro(OutputInterval, double);
   ///@}
 
+  ///@{
+  /** A checkpoint every this many outputs (default 10; 0: none). */
+  vtkSetClampMacro(CheckpointInterval, int, 0, MaximumOutputSteps);
+  vtkGetMacro(CheckpointInterval, int);
+  ///@}
+
+  ///@{
+  /**
+   * Most host memory the checkpoints may hold, MiB (default 1024); a quarter
+   * of the host's physical memory applies when that is less.
+   */
+  vtkSetClampMacro(CheckpointMemoryLimit, double, 0.0, 1.0e9);
+  vtkGetMacro(CheckpointMemoryLimit, double);
+  ///@}
+
+  /** The limit in force, bytes: CheckpointMemoryLimit capped by physical memory. */
+  vtkTypeInt64 GetCheckpointMemoryLimitBytes() const;
+
   /** Number of output times: intervals up to EndTime, plus time 0. */
   int GetNumberOfOutputTimes() const;
   /** Output time k (0 <= k < GetNumberOfOutputTimes()), seconds. */
   double GetOutputTime(int k) const;
 
-  /** Output index of the state kept on the device; -1 when there is none. */
+  /** Output index at or before the state kept on the device; -1 when there is none. */
   vtkGetMacro(StateIndex, int);
-  /** How many times the state was set up or restarted (for tests). */
+  /** Absolute time of the state kept on the device, s (meaningful when StateIndex >= 0). */
+  vtkGetMacro(StateTime, double);
+  /** How many times the state was set up or went back to time 0. */
   vtkGetMacro(RestartCount, int);
+  /** How many times a checkpoint was restored. */
+  vtkGetMacro(RestoreCount, int);
+  /** How many pipeline passes were taken for temporal inputs (beyond one per update). */
+  vtkGetMacro(ExtraPassCount, int);
+  /** Checkpoints held now, and their bytes. */
+  int GetNumberOfCheckpoints() const { return static_cast<int>(this->Checkpoints.size()); }
+  vtkTypeInt64 GetCheckpointBytes() const;
+  /** Output index of checkpoint i (0 <= i < GetNumberOfCheckpoints()), oldest first. */
+  int GetCheckpointIndex(int i) const;
+
+  /** Whether input port is read in time now (policy TEMPORAL and >= 2 time steps). */
+  bool IsInputTemporal(int port) const;
 
 protected:
   vtkGraupelSimulation();
   ~vtkGraupelSimulation() override;
 
+  /** Results of AdvanceState. */
+  enum AdvanceResult { ADVANCE_FAILED = 0, ADVANCE_DONE = 1, ADVANCE_ABORTED = 2 };
+
+  /** Sets a port's policy (STATIC_INPUT by default); call in the constructor. */
+  void SetInputPortPolicy(int port, int policy);
+
   /**
    * Validates the inputs and creates the device state at time 0. Reports
    * its own error (one sentence naming the input, array and fix) and
-   * returns 0 on failure; nothing may be left half set up then.
+   * returns 0 on failure; nothing may be left half set up then. Temporal
+   * inputs hold their data at some time step (GetTemporalInputTime).
    */
   virtual int SetUpState(vtkInformationVector **inputVector) = 0;
   /** Back to the time-0 state of the last set-up. 0 on failure. */
   virtual int ResetState() = 0;
-  /** Advances the state by seconds. 0 on failure (error reported). */
-  virtual int AdvanceState(double seconds) = 0;
   /**
-   * Fills output (already given the input's geometry and the requested
-   * extent) with the current fields and ledger. 0 on failure.
+   * Advances the state from absolute time t0 to t1 (seconds, t1 > t0),
+   * reading temporal inputs with GetTemporalInput: their data holds over
+   * the whole of [t0, t1]. ADVANCE_DONE, ADVANCE_FAILED (error reported) or
+   * ADVANCE_ABORTED (the core stopped inside because CoreProgress asked).
    */
-  virtual int FillOutput(vtkImageData *output, const int extent[6]) = 0;
+  virtual int AdvanceState(double t0, double t1) = 0;
+  /**
+   * Fills output (empty, of the port's type) with the current state;
+   * outInfo holds the request (UPDATE_EXTENT, piece). 0 on failure.
+   */
+  virtual int FillOutput(vtkDataObject *output, vtkInformation *outInfo) = 0;
   /** Frees the device state; must accept being called without state. */
   virtual void ReleaseState() = 0;
+
+  ///@{
+  /**
+   * Checkpoint hooks: SaveState replaces bytes with the whole evolving
+   * state; LoadState puts such bytes back, after which every step must be
+   * bit-identical to those that followed the save. Return 1 on success; the
+   * defaults return 0 (no checkpoints: going back restarts from time 0).
+   */
+  virtual int SaveState(std::vector<unsigned char> &bytes);
+  virtual int LoadState(const std::vector<unsigned char> &bytes);
+  ///@}
+
+  /** The name progress and messages use ("Rain Runoff"); the class name by default. */
+  virtual const char *GetSimulationLabel();
+
+  /** A temporal input's data now (its data at GetTemporalInputTime), or a static input's. */
+  vtkDataObject *GetTemporalInput(int port);
+  /** The input time step GetTemporalInput holds, s. */
+  double GetTemporalInputTime(int port) const;
+
+  /**
+   * Progress from inside AdvanceState at absolute time t (s): sets the
+   * progress text and fraction; returns 1 when the user asked to abort.
+   */
+  int ReportProgress(double t);
+  /** ReportProgress as a gr_progress_fn; user is the filter. */
+  static int CoreProgress(void *user, double time);
+
+  /**
+   * The terrain's `elevation` point array: refuses an input without it (one
+   * sentence naming the array and the fix) and warns, once per terrain, when
+   * the spacing is still 1 m while the heights span 100 m or more (a
+   * forgotten Spacing). nullptr after the error.
+   */
+  vtkDataArray *GetElevation(vtkImageData *terrain, const char *inputName);
 
   /** Forgets the state, so the next update sets it up again. */
   void InvalidateState();
@@ -96,20 +241,58 @@ protected:
 
   double EndTime = 600.0;
   double OutputInterval = 10.0;
+  int CheckpointInterval = 10;
+  double CheckpointMemoryLimit = 1024.0;
 
 private:
   vtkGraupelSimulation(const vtkGraupelSimulation &) = delete;
   void operator=(const vtkGraupelSimulation &) = delete;
 
-  /** 0 with an error sentence when EndTime/OutputInterval are unusable. */
-  int CheckTimes();
-  /** Whether the state was built from this filter's and inputs' present values. */
-  bool StateIsCurrent();
+  /** What the state was built from: the filter's and its inputs' present values. */
+  struct Key {
+    vtkMTimeType filter = 0;
+    std::vector<vtkMTimeType> inputs;
+    std::vector<std::vector<double>> times;
+    bool operator==(const Key &o) const {
+      return filter == o.filter && inputs == o.inputs && times == o.times;
+    }
+  };
+  struct Checkpoint {
+    int index;
+    std::vector<unsigned char> bytes;
+  };
 
+  int CheckTimes();
+  Key CurrentKey();
+  int TargetIndex(vtkInformation *outInfo) const;
+  /** The time the next update for target starts stepping from. */
+  double PlannedStart(int target) const;
+  /** Input time step of a temporal port that holds at time t. */
+  double InputTimeAt(int port, double t) const;
+  /** Goes to the best kept state for target: the state, a checkpoint or time 0. */
+  int Rewind(int target);
+  void KeepCheckpoint();
+  /** Ends a request: no further pass. */
+  void Finish(vtkInformation *request);
+
+  std::vector<int> Policies;
+  std::vector<std::vector<double>> InputTimes; // per port; empty when static
+  std::vector<double> DeliveredTime;           // per port: time asked of it this pass
+  std::vector<double> PendingTime;             // per port: time to ask of it next pass
   int StateIndex = -1;
+  double StateTime = 0.0;
+  bool StateLost = false; // an abort inside AdvanceState left it between knots
   int RestartCount = 0;
-  vtkMTimeType StateFilterMTime = 0;
-  vtkMTimeType StateInputMTime[2] = {0, 0};
+  int RestoreCount = 0;
+  int ExtraPassCount = 0;
+  bool Continuing = false;
+  int Target = 0;
+  double ProgressStart = 0.0;
+  Key StateKey;
+  Key FailedKey;
+  bool HasFailed = false;
+  vtkMTimeType WarnedSpacingFor = 0;
+  std::deque<Checkpoint> Checkpoints;
 };
 
 #endif

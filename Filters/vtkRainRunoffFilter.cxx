@@ -11,9 +11,12 @@
 #include "vtkObjectFactory.h"
 #include "vtkPointData.h"
 #include "vtkSmartPointer.h"
+#include "vtkStreamingDemandDrivenPipeline.h"
 
 #include "graupel/rain_runoff.h"
 
+#include <cmath>
+#include <cstring>
 #include <vector>
 
 vtkStandardNewMacro(vtkRainRunoffFilter);
@@ -35,6 +38,18 @@ vtkSmartPointer<vtkFloatArray> AsFloat(vtkDataArray *a) {
   return f;
 }
 
+// The core's parameter table row for a property, or nullptr.
+const gr_param_bound *Bound(const char *property) {
+  int count = 0;
+  const gr_param_bound *table = gr_rain_runoff_param_bounds(&count);
+  for (int k = 0; table && k < count; ++k) {
+    if (table[k].property && std::strcmp(table[k].property, property) == 0) {
+      return &table[k];
+    }
+  }
+  return nullptr;
+}
+
 void AddValue(vtkFieldData *fd, const char *name, double value) {
   vtkNew<vtkDoubleArray> a;
   a->SetName(name);
@@ -45,6 +60,65 @@ void AddValue(vtkFieldData *fd, const char *name, double value) {
 
 vtkRainRunoffFilter::vtkRainRunoffFilter() {
   this->SetNumberOfInputPorts(2);
+}
+
+double vtkRainRunoffFilter::Clamp(const char *property, double value) {
+  const gr_param_bound *b = Bound(property);
+  if (!b || std::isnan(value)) {
+    return value; // the validator names what is wrong at the next update
+  }
+  if (value > b->max) {
+    return b->max;
+  }
+  // An open lower end has no nearest valid value: the validator refuses it.
+  if (value < b->min && !b->min_open) {
+    return b->min;
+  }
+  return value;
+}
+
+#define GRAUPEL_CLAMPED_SETTER(name, type)                                                         \
+  void vtkRainRunoffFilter::Set##name(type value) {                                                \
+    const type v = static_cast<type>(Clamp(#name, static_cast<double>(value)));                    \
+    if (!(this->name == v) ||                                                                      \
+        std::isnan(static_cast<double>(this->name)) != std::isnan(static_cast<double>(v))) {       \
+      this->name = v;                                                                              \
+      this->Modified();                                                                            \
+    }                                                                                              \
+  }
+GRAUPEL_CLAMPED_SETTER(RainRate, double)
+GRAUPEL_CLAMPED_SETTER(Permeability, double)
+GRAUPEL_CLAMPED_SETTER(ManningN, double)
+GRAUPEL_CLAMPED_SETTER(Boundary, int)
+GRAUPEL_CLAMPED_SETTER(MaxTimeStep, double)
+GRAUPEL_CLAMPED_SETTER(CourantNumber, double)
+#undef GRAUPEL_CLAMPED_SETTER
+
+int vtkRainRunoffFilter::CheckParameters() {
+  const struct {
+    const char *property;
+    double value;
+  } values[] = {{"RainRate", this->RainRate},       {"Permeability", this->Permeability},
+                {"ManningN", this->ManningN},       {"Boundary", double(this->Boundary)},
+                {"MaxTimeStep", this->MaxTimeStep}, {"CourantNumber", this->CourantNumber}};
+  for (const auto &p : values) {
+    const gr_param_bound *b = Bound(p.property);
+    if (!b) {
+      continue;
+    }
+    const bool low = b->min_open ? !(p.value > b->min) : !(p.value >= b->min);
+    if (low || !(p.value <= b->max)) {
+      const char *unit = (b->unit && *b->unit) ? b->unit : "";
+      const char *space = *unit ? " " : "";
+      vtkErrorMacro("Rain Runoff: " << p.property << " must be "
+                                    << (b->min_open ? "above " : "from ") << b->min << space << unit
+                                    << (b->min_open ? " and up to " : " to ") << b->max << space
+                                    << unit << "; it is " << p.value << space << unit
+                                    << ". Set it within that range.");
+      return 0;
+    }
+  }
+  return 1;
 }
 
 vtkRainRunoffFilter::~vtkRainRunoffFilter() {
@@ -88,13 +162,8 @@ int vtkRainRunoffFilter::SetUpState(vtkInformationVector **inputVector) {
     return 0;
   }
   vtkPointData *pd = terrain->GetPointData();
-  vtkDataArray *elevationArray = pd->GetArray("elevation");
-  if (!elevationArray) {
-    elevationArray = pd->GetScalars();
-  }
-  if (!elevationArray || elevationArray->GetNumberOfComponents() != 1) {
-    vtkErrorMacro("Rain Runoff's Input has no one-component point array 'elevation' (nor "
-                  "active scalars to use instead); give the terrain heights that name.");
+  vtkDataArray *elevationArray = this->GetElevation(terrain, "Input");
+  if (!elevationArray || !this->CheckParameters()) {
     return 0;
   }
 
@@ -172,9 +241,12 @@ int vtkRainRunoffFilter::SetUpState(vtkInformationVector **inputVector) {
   for (const Upload &u : uploads) {
     st = gr_rain_runoff_set_field(this->Simulation, u.field, u.values->GetPointer(0));
     if (st != GR_OK) {
-      return this->ReportFailure(st, "Rain Runoff could not upload its inputs");
+      return this->ReportFailure(st, "Rain Runoff could not upload its inputs",
+                                 gr_rain_runoff_last_error(this->Simulation));
     }
   }
+  // Progress with the simulated time, and an abort inside a long interval.
+  gr_rain_runoff_set_progress(this->Simulation, &vtkGraupelSimulation::CoreProgress, this);
   this->GridDimensions[0] = dims[0];
   this->GridDimensions[1] = dims[1];
   return 1;
@@ -182,19 +254,49 @@ int vtkRainRunoffFilter::SetUpState(vtkInformationVector **inputVector) {
 
 int vtkRainRunoffFilter::ResetState() {
   const gr_status st = gr_rain_runoff_reset(this->Simulation);
-  return st == GR_OK ? 1 : this->ReportFailure(st, "Rain Runoff could not restart");
+  return st == GR_OK ? 1
+                     : this->ReportFailure(st, "Rain Runoff could not restart",
+                                           gr_rain_runoff_last_error(this->Simulation));
 }
 
-int vtkRainRunoffFilter::AdvanceState(double seconds) {
-  const gr_status st = gr_rain_runoff_advance(this->Simulation, seconds, nullptr);
-  return st == GR_OK ? 1 : this->ReportFailure(st, "Rain Runoff could not advance");
+int vtkRainRunoffFilter::AdvanceState(double t0, double t1) {
+  const gr_status st = gr_rain_runoff_advance(this->Simulation, t1 - t0, nullptr);
+  if (st == GR_ERR_ABORTED) {
+    return ADVANCE_ABORTED;
+  }
+  return st == GR_OK ? ADVANCE_DONE
+                     : this->ReportFailure(st, "Rain Runoff could not advance",
+                                           gr_rain_runoff_last_error(this->Simulation));
 }
 
-int vtkRainRunoffFilter::FillOutput(vtkImageData *output, const int extent[6]) {
+int vtkRainRunoffFilter::SaveState(std::vector<unsigned char> &bytes) {
+  size_t size = 0;
+  if (gr_rain_runoff_state_size(this->Simulation, &size) != GR_OK) {
+    return 0;
+  }
+  bytes.resize(size);
+  return gr_rain_runoff_state_save(this->Simulation, bytes.data(), size) == GR_OK;
+}
+
+int vtkRainRunoffFilter::LoadState(const std::vector<unsigned char> &bytes) {
+  return gr_rain_runoff_state_load(this->Simulation, bytes.data(), bytes.size()) == GR_OK;
+}
+
+int vtkRainRunoffFilter::FillOutput(vtkDataObject *outputObject, vtkInformation *outInfo) {
+  // The image is made here: the terrain's geometry, cropped to the request.
+  vtkImageData *output = vtkImageData::SafeDownCast(outputObject);
+  vtkImageData *input = vtkImageData::GetData(this->GetInputInformation(0, 0));
+  if (!output || !input) {
+    return 0;
+  }
+  int extent[6];
+  outInfo->Get(vtkStreamingDemandDrivenPipeline::UPDATE_EXTENT(), extent);
+  output->SetExtent(extent);
+  output->SetSpacing(input->GetSpacing());
+  output->SetOrigin(input->GetOrigin());
   const vtkIdType n = static_cast<vtkIdType>(this->GridDimensions[0]) * this->GridDimensions[1];
   // The whole grid's fields first (on the input's extent, which need not
   // start at 0), cropped to the requested piece below.
-  vtkImageData *input = vtkImageData::GetData(this->GetInputInformation(0, 0));
   vtkNew<vtkImageData> whole;
   whole->SetExtent(input->GetExtent());
   whole->SetOrigin(output->GetOrigin());
@@ -212,7 +314,8 @@ int vtkRainRunoffFilter::FillOutput(vtkImageData *output, const int extent[6]) {
     a->SetNumberOfTuples(n);
     const gr_status st = gr_rain_runoff_get_field(this->Simulation, f, a->GetPointer(0));
     if (st != GR_OK) {
-      return this->ReportFailure(st, "Rain Runoff could not read its fields back");
+      return this->ReportFailure(st, "Rain Runoff could not read its fields back",
+                                 gr_rain_runoff_last_error(this->Simulation));
     }
     whole->GetPointData()->AddArray(a);
   }
@@ -223,7 +326,8 @@ int vtkRainRunoffFilter::FillOutput(vtkImageData *output, const int extent[6]) {
   gr_rain_runoff_ledger ledger;
   const gr_status st = gr_rain_runoff_ledger_get(this->Simulation, &ledger);
   if (st != GR_OK) {
-    return this->ReportFailure(st, "Rain Runoff could not read its ledger");
+    return this->ReportFailure(st, "Rain Runoff could not read its ledger",
+                               gr_rain_runoff_last_error(this->Simulation));
   }
   vtkFieldData *fd = output->GetFieldData();
   AddValue(fd, "time", ledger.time);

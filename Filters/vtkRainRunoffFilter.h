@@ -4,8 +4,8 @@
  *          (seed 004's water simulation), stepped on OpenCL.
  *
  * Input 0 (`Input`) is the terrain: a 2-D vtkImageData with the point array
- * `elevation` (m; the active scalars are used when there is no array of that
- * name). Optional point arrays on it: `water_depth` (m, the water present at
+ * `elevation` (m; an input without it is refused: active scalars are not
+ * guessed at). Optional point arrays on it: `water_depth` (m, the water present at
  * time 0) and `rain_rate` (m/s, replaces RainRate cell by cell).
  * Input 1 (`PermeabilityMap`, optional) is an image with the same dimensions
  * whose point array `permeability` (m/s) replaces Permeability.
@@ -19,7 +19,15 @@
  * and its conservation are described in kernels/include/graupel/rain_runoff.h.
  *
  * Time is handled by vtkGraupelSimulation: request a time with
- * UpdateTimeStep(t) (ParaView's animation does it).
+ * UpdateTimeStep(t) (ParaView's animation does it). Checkpoints are the
+ * core's gr_rain_runoff_state_save/load; an abort is honoured inside an
+ * output interval through the core's progress callback.
+ *
+ * The setters clamp to the core's parameter table
+ * (gr_rain_runoff_param_bounds, in the user's units): a value beyond a
+ * range becomes its end; a value that is not a number, or at the open end
+ * of a range such as CourantNumber's 0, is refused at the next update with a
+ * sentence in the user's unit.
  */
 #ifndef vtkRainRunoffFilter_h
 #define vtkRainRunoffFilter_h
@@ -38,38 +46,38 @@ public:
   enum Boundaries { OPEN = 0, CLOSED = 1 };
 
   ///@{
-  /** Rain intensity, mm/h (default 10; 0..3600). */
-  vtkSetMacro(RainRate, double);
+  /** Rain intensity, mm/h (default 10). */
+  virtual void SetRainRate(double value);
   vtkGetMacro(RainRate, double);
   ///@}
 
   ///@{
   /** Infiltration capacity of the ground where no map is given, mm/h (default 0). */
-  vtkSetMacro(Permeability, double);
+  virtual void SetPermeability(double value);
   vtkGetMacro(Permeability, double);
   ///@}
 
   ///@{
-  /** Manning roughness of the ground, s/m^(1/3) (default 0.03; 0.005..1). */
-  vtkSetMacro(ManningN, double);
+  /** Manning roughness of the ground, s/m^(1/3) (default 0.03). */
+  virtual void SetManningN(double value);
   vtkGetMacro(ManningN, double);
   ///@}
 
   ///@{
   /** 0: water leaves through the grid's edge (default); 1: the edge is a wall. */
-  vtkSetClampMacro(Boundary, int, 0, 1);
+  virtual void SetBoundary(int value);
   vtkGetMacro(Boundary, int);
   ///@}
 
   ///@{
   /** Longest simulation step, s (default 1); shorter ones are taken when the flow needs them. */
-  vtkSetMacro(MaxTimeStep, double);
+  virtual void SetMaxTimeStep(double value);
   vtkGetMacro(MaxTimeStep, double);
   ///@}
 
   ///@{
-  /** Courant number of the adaptive step, (0, 1] (default 0.7). */
-  vtkSetMacro(CourantNumber, double);
+  /** Courant number of the adaptive step (default 0.7). */
+  virtual void SetCourantNumber(double value);
   vtkGetMacro(CourantNumber, double);
   ///@}
 
@@ -84,9 +92,12 @@ protected:
 
   int SetUpState(vtkInformationVector **inputVector) override;
   int ResetState() override;
-  int AdvanceState(double seconds) override;
-  int FillOutput(vtkImageData *output, const int extent[6]) override;
+  int AdvanceState(double t0, double t1) override;
+  int FillOutput(vtkDataObject *output, vtkInformation *outInfo) override;
   void ReleaseState() override;
+  int SaveState(std::vector<unsigned char> &bytes) override;
+  int LoadState(const std::vector<unsigned char> &bytes) override;
+  const char *GetSimulationLabel() override { return "Rain Runoff"; }
 
   double RainRate = 10.0;
   double Permeability = 0.0;
@@ -98,6 +109,11 @@ protected:
 private:
   vtkRainRunoffFilter(const vtkRainRunoffFilter &) = delete;
   void operator=(const vtkRainRunoffFilter &) = delete;
+
+  /** value clamped to the parameter table's row for property (NaN kept). */
+  static double Clamp(const char *property, double value);
+  /** 0 with one sentence in the user's unit when a property is out of its range. */
+  int CheckParameters();
 
   gr_rain_runoff *Simulation = nullptr;
   int GridDimensions[2] = {0, 0};

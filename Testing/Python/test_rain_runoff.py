@@ -1,8 +1,9 @@
 """vtkRainRunoffFilter in a pipeline (pvpython in the plugin build, plain
 python3 on Debian's VTK): advertised times, results independent of the order
 in which times are requested (a request going backwards restarts), the water
-ledger in field data, the permeability map, pieces, an aborted update, and
-error paths with an empty output."""
+ledger in field data, the permeability map, pieces, an aborted update
+(between intervals and inside one), checkpoints, progress text, clamped
+properties, and error paths with one sentence and an empty output."""
 import os
 import sys
 
@@ -207,6 +208,61 @@ d, out = at(ab, 60.0)
 T.check(d is not None and np.array_equal(d, ref[60.0]), "the next update finishes, equal to a full run")
 T.check(ab.GetRestartCount() == 1, "going on after an abort needs no restart")
 
+# ---- progress names the simulated time ---------------------------------------
+pr = rain(slope + bowl, RainRate=50.0)
+texts = []
+pr.AddObserver("ProgressEvent", lambda o, e: texts.append(o.GetProgressText()))
+at(pr, 60.0)
+T.check("Rain Runoff: t = 30 s of 60 s" in texts,
+        "progress text names the time: %r" % texts[:8])
+
+# ---- checkpoints: going back restores the nearest one, same bits --------------
+ck = rain(slope + bowl, RainRate=50.0, CheckpointInterval=2)
+d60, _ = at(ck, 60.0)
+T.check(ck.GetNumberOfCheckpoints() == 3, "checkpoints at 20, 40, 60 s: %d"
+        % ck.GetNumberOfCheckpoints())
+d30, _ = at(ck, 30.0)
+T.check(np.array_equal(d60, ref[60.0]) and np.array_equal(d30, ref[30.0]),
+        "checkpointed results equal the forward run bit for bit")
+T.check(ck.GetRestoreCount() == 1 and ck.GetRestartCount() == 1,
+        "back to 30 s restored the 20 s checkpoint (restores %d, restarts %d)"
+        % (ck.GetRestoreCount(), ck.GetRestartCount()))
+
+# ---- an abort inside one output interval, then the same bits ---------------------
+# Small steps make one 10 s interval take long enough (> 0.1 s of wall time)
+# for the core to report progress inside it.
+def slow():
+    return rain(slope + bowl, RainRate=50.0, EndTime=20.0, MaxTimeStep=0.002,
+                CheckpointInterval=1)
+
+
+full = slow()
+ref_slow = at(full, 20.0)[0]
+ai = slow()
+at(ai, 10.0)  # kept as a checkpoint
+inside = []
+
+
+def abort_inside(obj, event):
+    if 0.0 < obj.GetProgress() < 1.0 and not inside:
+        inside.append(obj.GetProgressText())
+        obj.SetAbortExecute(1)
+
+
+tag = ai.AddObserver("ProgressEvent", abort_inside)
+warns = T.ErrorCatcher(ai, event="WarningEvent")
+d, _ = at(ai, 20.0)
+ai.RemoveObserver(tag)
+T.check(len(inside) == 1 and d is None, "aborted inside the interval at %r: empty output"
+        % inside)
+T.check("checkpoint" in warns.text(), "abort warning names the checkpoint: %r" % warns.text())
+d, _ = at(ai, 20.0)
+T.check(d is not None and np.array_equal(d, ref_slow),
+        "after an abort inside an interval the next update gives the same bits")
+T.check(ai.GetRestoreCount() == 1 and ai.GetRestartCount() == 1,
+        "it restored the 10 s checkpoint (restores %d, restarts %d)"
+        % (ai.GetRestoreCount(), ai.GetRestartCount()))
+
 # ---- bad input: one sentence, an empty output, the next good update works ------
 bad_elev = bowl.copy()
 bad_elev[3, 7] = np.nan
@@ -214,8 +270,9 @@ cases = [
     ({"elevation": bad_elev}, {}, "elevation"),
     ({"height": bowl}, {}, "elevation"),  # no elevation, and no active scalars
     ({"elevation": bowl, "water_depth": -np.ones((NY, NX))}, {}, "water_depth"),
-    ({"elevation": bowl}, {"RainRate": -1.0}, "RainRate"),
-    ({"elevation": bowl}, {"ManningN": 0.0}, "ManningN"),
+    ({"elevation": bowl}, {"RainRate": float("nan")}, "RainRate"),
+    ({"elevation": bowl}, {"ManningN": float("nan")}, "ManningN"),
+    ({"elevation": bowl}, {"CourantNumber": 0.0}, "CourantNumber"),
     ({"elevation": bowl}, {"OutputInterval": 0.0}, "OutputInterval"),
     ({"elevation": bowl}, {"EndTime": float("nan")}, "EndTime"),
 ]
@@ -244,6 +301,51 @@ errs = T.ErrorCatcher(g)
 g.Update()
 T.check(g.GetOutput().GetNumberOfPoints() == 0 and "2-D" in errs.text(),
         "a 3-D input refused: %r" % errs.text()[:160])
+
+# Setters clamp to the core's parameter table; an error speaks the user's unit.
+g = vtkRainRunoffFilter()
+g.SetRainRate(-1.0)
+T.check(g.GetRainRate() == 0.0, "RainRate -1 clamps to 0 mm/h: %r" % g.GetRainRate())
+g.SetRainRate(1e9)
+T.check(0.0 < g.GetRainRate() < 1e9, "RainRate 1e9 clamps to the table's maximum: %r"
+        % g.GetRainRate())
+g.SetManningN(0.0)
+T.check(g.GetManningN() > 0.0, "ManningN 0 clamps to the table's minimum: %r" % g.GetManningN())
+g = rain(bowl, RainRate=float("nan"))
+errs = T.ErrorCatcher(g)
+at(g, 10.0)
+T.check("mm/h" in errs.text() and "m/s" not in errs.text(),
+        "a RainRate error speaks mm/h: %r" % errs.text()[:200])
+
+# No `elevation` array: refused, active scalars are not guessed at, and one
+# sentence only, however often and for whatever time the output is asked for.
+src = image({"height": bowl})
+src.GetPointData().SetActiveScalars("height")
+g = vtkRainRunoffFilter()
+g.SetInputConnection(producer(src).GetOutputPort())
+errs = T.ErrorCatcher(g)
+for t in (10.0, 10.0, 20.0, 0.0):
+    d, _ = at(g, t)
+T.check(d is None and len(errs.messages) == 1 and "'elevation'" in errs.text(),
+        "missing elevation refused once with a sentence naming it: %d %r"
+        % (len(errs.messages), errs.text()[:200]))
+
+# The forgotten Spacing: 1 m spacing under heights spanning hundreds of metres.
+tall = image({"elevation": 300.0 * i / (NX - 1.0)}, spacing=1.0)
+g = vtkRainRunoffFilter()
+g.SetInputConnection(producer(tall).GetOutputPort())
+g.SetEndTime(20.0)
+warns = T.ErrorCatcher(g, event="WarningEvent")
+at(g, 10.0)
+g.SetRainRate(20.0)  # set up again on the same terrain: no second warning
+d, _ = at(g, 20.0)
+T.check(d is not None and len(warns.messages) == 1 and "Spacing" in warns.text()
+        and "300" in warns.text(), "spacing warning once: %d %r"
+        % (len(warns.messages), warns.text()[:200]))
+quiet = rain(bowl)
+warns = T.ErrorCatcher(quiet, event="WarningEvent")
+at(quiet, 10.0)
+T.check(len(warns.messages) == 0, "no spacing warning for a 2 m grid")
 
 # A kernel that fails to build (bad GRAUPEL_CL_OPTIONS): one sentence with the
 # build log and an empty output; with the options fixed the next update works.
