@@ -10,7 +10,7 @@
 #
 # Under load, pvbatch now and then fails to open a connection to a server that
 # has just started ("bad X server connection", then SIGABRT, before any check
-# ran). That one failure, and only that, is retried once on a new server.
+# ran). That one failure, and only that, is retried on a new server (twice).
 set -u
 dir=$(mktemp -d)
 xpid=
@@ -29,21 +29,26 @@ start_x() {
     tries=$((tries + 1))
     n=$(( $(od -An -N2 -tu2 /dev/urandom) % 800 + 200 ))
     [ -e /tmp/.X$n-lock ] && continue
-    Xvfb :$n -screen 0 1280x1024x24 -nolisten tcp 2>"$dir/xvfb.log" &
+    # An Xvfb that inherits SIGUSR1 as ignored sends it to its parent once it
+    # accepts connections (X's own readiness signal, which xvfb-run uses too):
+    # a socket file alone can appear before the server answers.
+    ready=0
+    trap 'ready=1' USR1
+    (trap '' USR1; exec Xvfb :$n -screen 0 1280x1024x24 -nolisten tcp >/dev/null 2>"$dir/xvfb.log") &
     xpid=$!
     i=0
-    while [ $i -lt 200 ] && kill -0 "$xpid" 2>/dev/null; do
-      if [ -S /tmp/.X11-unix/X$n ]; then
-        sleep 0.1
-        if kill -0 "$xpid" 2>/dev/null; then
-          DISPLAY=:$n
-          export DISPLAY
-          return 0
-        fi
-      fi
+    while [ $ready -eq 0 ] && [ $i -lt 400 ] && kill -0 "$xpid" 2>/dev/null; do
       sleep 0.05
       i=$((i + 1))
     done
+    # The server signals again at every reset (each time its last client
+    # leaves): keep catching it, or the default action would end this script.
+    trap : USR1
+    if [ $ready -eq 1 ] && kill -0 "$xpid" 2>/dev/null; then
+      DISPLAY=:$n
+      export DISPLAY
+      return 0
+    fi
     stop_x
   done
   echo "with_xvfb.sh: no Xvfb could be started:" >&2
@@ -51,14 +56,14 @@ start_x() {
   exit 1
 }
 
-for attempt in 1 2; do
+for attempt in 1 2 3; do
   start_x
   "$@" >"$dir/out" 2>&1
   rc=$?
   cat "$dir/out"
   stop_x
-  if [ $rc -eq 0 ] || [ $attempt -eq 2 ] || ! grep -q "bad X server connection" "$dir/out"; then
+  if [ $rc -eq 0 ] || [ $attempt -eq 3 ] || ! grep -q "bad X server connection" "$dir/out"; then
     exit $rc
   fi
-  echo "with_xvfb.sh: the X connection failed before the test ran; retrying once" >&2
+  echo "with_xvfb.sh: the X connection failed before the test ran; retrying on a new server" >&2
 done

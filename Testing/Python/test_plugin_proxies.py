@@ -36,6 +36,37 @@ for group, name in (("sources", "ProceduralTerrain"), ("sources", "EXRHeightFiel
         T.check(menu is not None and menu.GetAttribute("category") == "Graupel",
                 "%s is in the Graupel menu" % name)
 
+# Device and the Time group are declared once (Plugin/GraupelBase.xml) and
+# inherited: every proxy that runs kernels has Device in its Compute group,
+# every simulation EndTime/OutputInterval/TimestepValues in "Time (s)"; the
+# bases themselves are in no menu and not in paraview.simple.
+def groups_of(proto):
+    out = {}
+    for i in range(proto.GetNumberOfPropertyGroups()):
+        g = proto.GetPropertyGroup(i)
+        names = [proto.GetPropertyName(g.GetProperty(k)) for k in range(g.GetNumberOfProperties())]
+        out.setdefault(g.GetXMLLabel(), []).extend(names)
+    return out
+
+
+for group, name, simulation in (("sources", "ProceduralTerrain", False),
+                                ("filters", "RainRunoff", True)):
+    proto = pxm.GetPrototypeProxy(group, name)
+    groups = groups_of(proto)
+    T.check(proto.GetProperty("Device") is not None and "Device" in groups.get("Compute", []),
+            "%s inherits Device in the Compute group: %r" % (name, groups))
+    if simulation:
+        T.check(all(proto.GetProperty(p) is not None
+                    for p in ("EndTime", "OutputInterval", "TimestepValues")),
+                "%s inherits the time properties" % name)
+        T.check(set(groups.get("Time (s)", [])) >= {"EndTime", "OutputInterval"},
+                "%s has EndTime and OutputInterval in 'Time (s)': %r" % (name, groups))
+T.check(pxm.GetPrototypeProxy("graupel_bases", "GraupelSimulation") is not None,
+        "the base GraupelSimulation is registered")
+T.check(not any(n.startswith("Graupel") for n in dir(servermanager.sources)) and
+        not any(n.startswith("Graupel") for n in dir(servermanager.filters)),
+        "the bases are not sources or filters")
+
 # The terrain with its documented defaults.
 t = ProceduralTerrain()
 T.check(list(t.Dimensions) == [512, 512], "Dimensions default")

@@ -1,0 +1,237 @@
+"""pvpython: one table of parameter bounds per core, and everything a user
+sees agrees with it. For every row that graupel-params prints (the table the
+core's validators follow, gr_<core>_param_bounds):
+
+  * the XML (the plugin's proxy): the default, and the domain. A range domain
+    is the slider: its max is the table's max and its min the table's min (or
+    above it when the table's min is open), unless the property's hint
+    <GraupelRange min max/> declares the slider deliberately narrower: then the
+    hint is the table's range and the slider lies inside it. An enumeration
+    lists every whole number of the range; a boolean is 0-1.
+  * the VTK class: its default, and its clamp: a value just above max reads
+    back as max, just below a closed min as min, and just below an open min is
+    not moved inside the range (the validator refuses it at the next update).
+  * the README: every row once in a property table, in this format (columns
+    property | default | unit, range | meaning):
+
+        | `RainRate` | 10 | mm/h, 0–3600 | rain intensity ... |
+        | `MaxTimeStep` | 1 | s, (0, 3600] | longest step ... |
+        | `Octaves` | 6 | 1–16 | ... |
+        | `NoiseType` | Ridged Multifractal (0) | 0–2 | ... |
+        | `Seed` | 0 | any | ... |
+
+    default: a number, or a name with its number in parentheses; unit, range:
+    the table's unit (none when it has none), a comma, then `min–max` (an en
+    dash; both ends included), `(min, max]` (min excluded) or `any` (every
+    int). Numbers may use an exponent (1e5) and spaces between digit groups.
+"""
+import json
+import math
+import os
+import re
+import subprocess
+import sys
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import gr_check as T  # noqa: E402
+
+
+def extra(p):
+    p.add_argument("--params-tool", required=True)
+    p.add_argument("--readme", required=True)
+
+
+a = T.args(extra)
+
+# The wrapped classes first: importing graupel after a proxy exists is the
+# order issue 7 fixes elsewhere (py.wrapped_classes tests both orders).
+import graupel  # noqa: E402
+from paraview import servermanager  # noqa: E402
+from paraview.simple import LoadPlugin  # noqa: E402
+
+# core -> (proxy group, proxy name, VTK class)
+CORES = {
+    "procedural_terrain": ("sources", "ProceduralTerrain", "vtkProceduralTerrainSource"),
+    "rain_runoff": ("filters", "RainRunoff", "vtkRainRunoffFilter"),
+}
+INT_MIN, INT_MAX = -2 ** 31, 2 ** 31 - 1
+
+if not os.path.exists(a.params_tool):
+    T.check(False, "graupel-params is not built (%s)" % a.params_tool)
+    T.finish()
+run = subprocess.run([a.params_tool], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+T.check(run.returncode == 0, "graupel-params exits 0 (%d: %s)" % (run.returncode, run.stderr))
+tables = json.loads(run.stdout)
+T.check(sorted(tables) == sorted(CORES), "graupel-params lists the cores %s: %s"
+        % (sorted(CORES), sorted(tables)))
+
+
+def same(x, y):
+    return x == y or abs(x - y) <= 1e-12 * max(abs(x), abs(y))
+
+
+def fmt(row):
+    lo = "(%g" % row["min"] if row["min_open"] else "[%g" % row["min"]
+    return "%s, %g] %s" % (lo, row["max"], row["unit"])
+
+
+# ------------------------------------------------------------------ the XML
+LoadPlugin(a.plugin, ns=globals())
+pxm = servermanager.ProxyManager()
+
+
+def check_xml(core, row):
+    group, name, _ = CORES[core]
+    proto = pxm.GetPrototypeProxy(group, name)
+    p = row["property"]
+    prop = proto.GetProperty(p) if proto else None
+    T.check(prop is not None, "%s has the property %s" % (name, p))
+    if prop is None:
+        return
+    where = "%s.%s (table %s)" % (name, p, fmt(row))
+    # A prototype proxy is never modified: its values are the XML defaults.
+    default = prop.GetElement(0)
+    T.check(same(default, row["default"]),
+            "%s: XML default %r, table %r" % (where, default, row["default"]))
+    enum = prop.GetDomain("enum")
+    boolean = prop.GetDomain("bool")
+    rng = prop.GetDomain("range")
+    if enum is not None:
+        values = sorted(enum.GetEntryValue(i) for i in range(enum.GetNumberOfEntries()))
+        want = list(range(int(row["min"]), int(row["max"]) + 1))
+        T.check(row["integer"] and values == want,
+                "%s: enumeration values %r, table %r" % (where, values, want))
+        return
+    if boolean is not None:
+        T.check(row["integer"] and (row["min"], row["max"]) == (0, 1),
+                "%s: a boolean, the table's range is not 0-1" % where)
+        return
+    T.check(rng is not None, "%s has a range domain" % where)
+    if rng is None:
+        return
+    lo = rng.GetMinimum(0) if rng.GetMinimumExists(0) else None
+    hi = rng.GetMaximum(0) if rng.GetMaximumExists(0) else None
+    if lo is None and hi is None:
+        # Unbounded: only a table spanning the whole type says the same.
+        T.check(row["integer"] and row["min"] <= INT_MIN and row["max"] >= INT_MAX,
+                "%s: the domain has no bounds" % where)
+        return
+    T.check(lo is not None and hi is not None, "%s: the domain has both ends (%r, %r)" % (where, lo, hi))
+    if lo is None or hi is None:
+        return
+    hints = prop.GetHints()
+    declared = hints.FindNestedElementByName("GraupelRange") if hints else None
+    if declared is not None:
+        dlo, dhi = float(declared.GetAttribute("min")), float(declared.GetAttribute("max"))
+        T.check(same(dlo, row["min"]) and same(dhi, row["max"]),
+                "%s: GraupelRange hint %g..%g" % (where, dlo, dhi))
+        T.check(hi <= row["max"] and (lo > row["min"] if row["min_open"] else lo >= row["min"])
+                and lo < hi, "%s: slider %g..%g lies inside the range" % (where, lo, hi))
+        T.check(lo <= row["default"] <= hi, "%s: the default lies on the slider %g..%g" % (where, lo, hi))
+    else:
+        T.check(same(hi, row["max"]), "%s: domain max %g" % (where, hi))
+        if row["min_open"]:
+            T.check(lo > row["min"], "%s: domain min %g must exclude the open end" % (where, lo))
+        else:
+            T.check(same(lo, row["min"]), "%s: domain min %g" % (where, lo))
+
+
+# ---------------------------------------------------------- the VTK classes
+def check_class(core, row):
+    cls = getattr(graupel, CORES[core][2])
+    obj = cls()
+    p = row["property"]
+    get, set_ = getattr(obj, "Get" + p), getattr(obj, "Set" + p)
+    where = "%s.Set%s (table %s)" % (CORES[core][2], p, fmt(row))
+    T.check(same(float(get()), row["default"]), "%s: class default %r" % (where, get()))
+    if isinstance(get(), bool) or (row["min"] <= INT_MIN and row["max"] >= INT_MAX):
+        return  # a bool or a whole int: no value lies outside
+    step = 1 if row["integer"] else max(abs(row["max"]), 1.0) * 1e-6
+    set_(row["max"] + step)
+    T.check(same(float(get()), row["max"]), "%s: max + %g reads back %r" % (where, step, get()))
+    step = 1 if row["integer"] else max(abs(row["min"]), 1.0) * 1e-6
+    set_(row["min"] - step)
+    if row["min_open"]:
+        T.check(float(get()) <= row["min"], "%s: below the open min reads back %r, inside the range"
+                % (where, get()))
+    else:
+        T.check(same(float(get()), row["min"]), "%s: min - %g reads back %r" % (where, step, get()))
+
+
+# --------------------------------------------------------------- the README
+NUM = r"-?[0-9][0-9  ]*(?:\.[0-9]+)?(?:e[+-]?[0-9]+)?"
+
+
+def number(text):
+    return float(re.sub(r"[  ]", "", text))
+
+
+def readme_rows(path):
+    """property -> list of (default cell, unit-range cell) of README table rows."""
+    rows = {}
+    with open(path, encoding="utf-8") as f:
+        for line in f:
+            cells = [c.strip() for c in line.strip().strip("|").split("|")]
+            if len(cells) >= 3 and re.fullmatch(r"`[A-Za-z]+`", cells[0]):
+                rows.setdefault(cells[0].strip("`"), []).append((cells[1], cells[2]))
+    return rows
+
+
+def parse_range(cell):
+    """'mm/h, 0–3600' -> ('mm/h', 0, 3600, open); 'any' -> ('', None, None, False)."""
+    m = re.fullmatch(r"(?:(.*?),\s*)?(any|\((%s),\s*(%s)\]|(%s)\s*–\s*(%s))" % (NUM, NUM, NUM, NUM),
+                     cell)
+    if not m:
+        return None
+    unit = m.group(1) or ""
+    if m.group(2) == "any":
+        return unit, None, None, False
+    if m.group(3) is not None:
+        return unit, number(m.group(3)), number(m.group(4)), True
+    return unit, number(m.group(5)), number(m.group(6)), False
+
+
+readme = readme_rows(a.readme)
+
+
+def check_readme(core, row):
+    p = row["property"]
+    found = readme.get(p, [])
+    T.check(len(found) == 1, "README: one table row for `%s` (found %d)" % (p, len(found)))
+    if len(found) != 1:
+        return
+    default_cell, range_cell = found[0]
+    nums = re.findall(NUM, default_cell)
+    T.check(bool(nums) and same(number(nums[-1]), row["default"]),
+            "README `%s`: default '%s', table %r" % (p, default_cell, row["default"]))
+    r = parse_range(range_cell)
+    T.check(r is not None, "README `%s`: '%s' is not 'unit, min–max', 'unit, (min, max]' or 'any'"
+            % (p, range_cell))
+    if r is None:
+        return
+    unit, lo, hi, open_ = r
+    T.check(unit == row["unit"], "README `%s`: unit '%s', table '%s'" % (p, unit, row["unit"]))
+    if lo is None:
+        T.check(row["integer"] and row["min"] <= INT_MIN and row["max"] >= INT_MAX,
+                "README `%s`: 'any', but the table has %s" % (p, fmt(row)))
+    else:
+        T.check(same(lo, row["min"]) and same(hi, row["max"]) and open_ == bool(row["min_open"]),
+                "README `%s`: '%s', table %s" % (p, range_cell, fmt(row)))
+
+
+for core, rows in sorted(tables.items()):
+    if core not in CORES:
+        continue
+    T.check(len(rows) > 0, "%s has a parameter table" % core)
+    for row in rows:
+        T.check(all(isinstance(row.get(k), (int, float)) and math.isfinite(row[k])
+                    for k in ("min", "max", "default", "to_core")),
+                "%s.%s: finite numbers" % (core, row.get("property")))
+        T.check(row["min"] <= row["default"] <= row["max"] and
+                not (row["min_open"] and row["default"] == row["min"]),
+                "%s.%s: the default %g lies in %s" % (core, row["property"], row["default"], fmt(row)))
+        check_xml(core, row)
+        check_class(core, row)
+        check_readme(core, row)
+
+T.finish()
