@@ -1808,12 +1808,314 @@ static void test_pieces_y(void) {
   free_domain(&dm);
 }
 
+/* Pieces that advance on their own: each of two threads advances its piece
+ * with the team's allreduce and a halo exchange through the mailbox, which
+ * the core calls after every step. */
+typedef struct advancer {
+  member m; /* the allreduce's user: team and rank */
+  int side; /* the side toward the other piece */
+  int mode; /* 0: advance by duration; 1: stable_dt, then nsteps steps */
+  double duration;
+  int nsteps, steps, exchanges;
+  progress_log *log; /* this piece's progress callback, or NULL */
+  gr_status st;
+  gr_rain_runoff_ledger l;
+} advancer;
+
+static gr_status team_exchange(void *user) {
+  advancer *a = user;
+  team *t = a->m.t;
+  int r = a->m.rank;
+  gr_status st = gr_rain_runoff_halo_get(a->m.p->s, a->side, t->mail[r], t->mail_bytes[r]);
+  pthread_barrier_wait(&t->barrier);
+  if (st == GR_OK)
+    st = gr_rain_runoff_halo_set(a->m.p->s, a->side, t->mail[1 - r], t->mail_bytes[1 - r]);
+  pthread_barrier_wait(&t->barrier);
+  ++a->exchanges;
+  return st;
+}
+
+static void *advancer_run(void *arg) {
+  advancer *a = arg;
+  gr_rain_runoff *s = a->m.p->s;
+  if (a->mode == 0) {
+    a->st = gr_rain_runoff_advance(s, a->duration, &a->steps);
+  } else {
+    double dt = 0.0;
+    a->st = gr_rain_runoff_stable_dt(s, &dt);
+    if (a->st == GR_OK)
+      a->st = gr_rain_runoff_step(s, dt, a->nsteps);
+    a->steps = a->st == GR_OK ? a->nsteps : 0;
+  }
+  /* The ledger is collective too: both pieces reach it whatever happened. */
+  gr_status s2 = gr_rain_runoff_ledger_get(s, &a->l);
+  if (a->st == GR_OK)
+    a->st = s2;
+  return NULL;
+}
+
+/* Runs both pieces on two threads (mode, duration, nsteps as in advancer)
+ * with the team's callbacks, which are removed again afterwards; logs[k]
+ * becomes piece k's progress callback. Returns the wall time. */
+static double run_team(piece pc[2], int side0, int mode, double duration, int nsteps,
+                       progress_log *logs[2], advancer a[2]) {
+  team t;
+  memset(&t, 0, sizeof(t));
+  pthread_barrier_init(&t.barrier, NULL, 2);
+  pthread_t th[2];
+  for (int k = 0; k < 2; ++k) {
+    int side = k == 0 ? side0 : side0 ^ 1;
+    CHECK(gr_rain_runoff_halo_size(pc[k].s, side, &t.mail_bytes[k]) == GR_OK);
+    t.mail[k] = malloc(t.mail_bytes[k]);
+    memset(&a[k], 0, sizeof(a[k]));
+    a[k].m = (member){&t, k, 0, &pc[k], GR_OK, {0}};
+    a[k].side = side;
+    a[k].mode = mode;
+    a[k].duration = duration;
+    a[k].nsteps = nsteps;
+    a[k].log = logs ? logs[k] : NULL;
+    gr_rain_runoff_set_allreduce(pc[k].s, team_allreduce, &a[k].m);
+    gr_rain_runoff_set_halo_exchange(pc[k].s, team_exchange, &a[k]);
+    if (a[k].log)
+      gr_rain_runoff_set_progress(pc[k].s, on_progress, a[k].log);
+  }
+  double t0 = wall_now();
+  for (int k = 0; k < 2; ++k)
+    pthread_create(&th[k], NULL, advancer_run, &a[k]);
+  for (int k = 0; k < 2; ++k)
+    pthread_join(th[k], NULL);
+  double wall = wall_now() - t0;
+  for (int k = 0; k < 2; ++k) {
+    gr_rain_runoff_set_allreduce(pc[k].s, NULL, NULL);
+    gr_rain_runoff_set_halo_exchange(pc[k].s, NULL, NULL);
+    gr_rain_runoff_set_progress(pc[k].s, NULL, NULL);
+    free(t.mail[k]);
+  }
+  pthread_barrier_destroy(&t.barrier);
+  return wall;
+}
+
+/* The pieces' advance against the whole grid's over the same duration: the
+ * same steps, the same time, every owned cell of every field the same bits;
+ * then 7 steps in one gr_rain_runoff_step call each, the same again. */
+static void check_advance_split(domain *dm, piece pc[2], int side0, const char *what) {
+  gr_rain_runoff_params prm = params_with(0.0, 0.0, GR_BOUNDARY_OPEN);
+  gr_rain_runoff *whole = make_whole(dm, &prm);
+  if (!whole)
+    return;
+  const double duration = 90.0;
+  advancer a[2];
+  run_team(pc, side0, 0, duration, 0, NULL, a);
+  int sw = 0;
+  CHECK(gr_rain_runoff_advance(whole, duration, &sw) == GR_OK);
+  gr_rain_runoff_ledger lw = ledger(whole);
+  double in = lw.initial_volume + lw.rain_volume;
+  for (int k = 0; k < 2; ++k) {
+    CHECK_MSG(a[k].st == GR_OK, "%s: piece %d: %s", what, k, gr_rain_runoff_last_error(pc[k].s));
+    CHECK_MSG(a[k].steps == sw && a[k].exchanges == sw,
+              "%s: piece %d: %d steps, %d exchanges; "
+              "the whole grid %d steps",
+              what, k, a[k].steps, a[k].exchanges, sw);
+    CHECK(a[k].l.time == lw.time && a[k].l.time == duration && a[k].l.steps == lw.steps);
+    CHECK(a[k].l.max_depth == lw.max_depth);
+    CHECK_NEAR(a[k].l.stored_volume, lw.stored_volume, 1e-9 * in);
+    CHECK_NEAR(a[k].l.outflow_volume, lw.outflow_volume, 1e-9 * in);
+    CHECK(fabs(a[k].l.balance_error) <= 1e-7 * in);
+  }
+  CHECK(lw.outflow_volume > 0.0 && sw > 20);
+  printf("%s: advance by %.0f s, %d steps on both pieces and the whole grid\n", what, duration, sw);
+  check_pieces(pc, 2, whole, dm, what);
+  /* Several steps per call on a piece. */
+  double dt = 0.0;
+  run_team(pc, side0, 1, 0.0, 7, NULL, a);
+  CHECK(gr_rain_runoff_stable_dt(whole, &dt) == GR_OK);
+  CHECK(gr_rain_runoff_step(whole, dt, 7) == GR_OK);
+  for (int k = 0; k < 2; ++k)
+    CHECK_MSG(a[k].st == GR_OK && a[k].exchanges == 7, "%s: piece %d: %s, %d exchanges", what, k,
+              gr_rain_runoff_last_error(pc[k].s), a[k].exchanges);
+  check_pieces(pc, 2, whole, dm, "... then 7 steps in one call");
+  gr_rain_runoff_destroy(whole);
+}
+
+static void test_advance_pieces_x(void) {
+  domain dm = make_domain(37, 23);
+  gr_rain_runoff_params prm = params_with(0.0, 0.0, GR_BOUNDARY_OPEN);
+  piece pc[2] = {{0}, {0}};
+  if (make_piece(&pc[0], &dm, &prm, 0, 0, 18, 23) && make_piece(&pc[1], &dm, &prm, 18, 0, 19, 23))
+    check_advance_split(&dm, pc, GR_RAIN_RUNOFF_EAST, "advance split in x on two threads");
+  /* Without both callbacks a piece with a ring still refuses to advance,
+   * and without an exchange it takes one step per call. */
+  if (pc[0].s) {
+    gr_rain_runoff_set_halo_exchange(pc[0].s, team_exchange, NULL);
+    CHECK(gr_rain_runoff_advance(pc[0].s, 1.0, NULL) == GR_ERR_INVALID_ARGUMENT);
+    CHECK_MSG(has(gr_rain_runoff_last_error(pc[0].s), "gr_rain_runoff_set_allreduce"), "'%s'",
+              gr_rain_runoff_last_error(pc[0].s));
+    gr_rain_runoff_set_halo_exchange(pc[0].s, NULL, NULL);
+    CHECK(gr_rain_runoff_step(pc[0].s, 0.01, 2) == GR_ERR_INVALID_ARGUMENT);
+    CHECK(has(gr_rain_runoff_last_error(pc[0].s), "gr_rain_runoff_set_halo_exchange"));
+  }
+  for (int k = 0; k < 2; ++k)
+    gr_rain_runoff_destroy(pc[k].s);
+  free_domain(&dm);
+}
+
+static void test_advance_pieces_y(void) {
+  domain dm = make_domain(29, 41);
+  gr_rain_runoff_params prm = params_with(0.0, 0.0, GR_BOUNDARY_OPEN);
+  piece pc[2] = {{0}, {0}};
+  if (make_piece(&pc[0], &dm, &prm, 0, 0, 29, 20) && make_piece(&pc[1], &dm, &prm, 0, 20, 29, 21))
+    check_advance_split(&dm, pc, GR_RAIN_RUNOFF_NORTH, "advance split in y on two threads");
+  for (int k = 0; k < 2; ++k)
+    gr_rain_runoff_destroy(pc[k].s);
+  free_domain(&dm);
+}
+
+/* A failing exchange stops the step with its status and a sentence. */
+static gr_status failing_exchange(void *user) {
+  (void)user;
+  return GR_ERR_IO;
+}
+
+/* An abort asked for by one piece's progress callback (the other piece has
+ * none) stops both after the same step, within half a second; both go on
+ * from there together. */
+static void test_advance_pieces_abort(void) {
+  domain dm = make_domain(36, 23);
+  gr_rain_runoff_params prm = params_with(0.0, 0.0, GR_BOUNDARY_OPEN);
+  prm.max_dt = 0.002; /* a long advance: 5e6 steps unless stopped */
+  piece pc[2] = {{0}, {0}};
+  if (make_piece(&pc[0], &dm, &prm, 0, 0, 18, 23) && make_piece(&pc[1], &dm, &prm, 18, 0, 18, 23)) {
+    progress_log stop = {0, 1, 2, 0.0, 0.0};
+    progress_log *logs[2] = {&stop, NULL};
+    advancer a[2];
+    const double duration = 1e4;
+    run_team(pc, GR_RAIN_RUNOFF_EAST, 0, duration, 0, logs, a);
+    double honoured = wall_now() - stop.stopped_at_wall;
+    printf("abort on piece 0: both stopped after %d and %d steps at %.4f and %.4f s, honoured in "
+           "%.3f s\n",
+           a[0].steps, a[1].steps, a[0].l.time, a[1].l.time, honoured);
+    for (int k = 0; k < 2; ++k) {
+      CHECK_MSG(a[k].st == GR_ERR_ABORTED, "piece %d: %s", k, gr_status_string(a[k].st));
+      CHECK_MSG(has(gr_rain_runoff_last_error(pc[k].s), "progress callback"), "'%s'",
+                gr_rain_runoff_last_error(pc[k].s));
+    }
+    CHECK(has(gr_rain_runoff_last_error(pc[1].s), "another piece"));
+    CHECK(stop.calls == 2 && honoured < 0.5);
+    CHECK(a[0].steps == a[1].steps && a[0].steps > 0 && a[0].exchanges == a[0].steps);
+    CHECK(a[0].l.time == a[1].l.time && a[0].l.steps == a[1].l.steps);
+    CHECK(a[0].l.time > 0.0 && a[0].l.time < duration);
+    double in = a[0].l.initial_volume + a[0].l.rain_volume;
+    CHECK(fabs(a[0].l.balance_error) <= 1e-7 * in);
+    /* Both go on from the same step. */
+    run_team(pc, GR_RAIN_RUNOFF_EAST, 0, 0.05, 0, NULL, a);
+    CHECK(a[0].st == GR_OK && a[1].st == GR_OK && a[0].steps == a[1].steps);
+    CHECK(a[0].l.time == a[1].l.time && a[0].l.steps == a[1].l.steps);
+    /* A failing exchange. */
+    gr_rain_runoff_set_halo_exchange(pc[0].s, failing_exchange, NULL);
+    CHECK(gr_rain_runoff_step(pc[0].s, 0.001, 3) == GR_ERR_IO);
+    CHECK_MSG(has(gr_rain_runoff_last_error(pc[0].s), "halo exchange"), "'%s'",
+              gr_rain_runoff_last_error(pc[0].s));
+    gr_rain_runoff_set_halo_exchange(pc[0].s, NULL, NULL);
+  }
+  for (int k = 0; k < 2; ++k)
+    gr_rain_runoff_destroy(pc[k].s);
+  free_domain(&dm);
+}
+
+/* A piece's checkpoint holds its ring: pieces advanced to t1 and saved,
+ * then loaded into fresh pieces (no exchange), advance to t2 bit for bit
+ * like the originals and the whole grid; a piece's checkpoint is refused
+ * by the other piece of the same size. */
+static void test_piece_checkpoint(void) {
+  domain dm = make_domain(36, 23);
+  gr_rain_runoff_params prm = params_with(0.0, 0.0, GR_BOUNDARY_OPEN);
+  gr_rain_runoff *whole = make_whole(&dm, &prm);
+  piece pc[2] = {{0}, {0}}, fresh[2] = {{0}, {0}};
+  int ok = whole && make_piece(&pc[0], &dm, &prm, 0, 0, 18, 23) &&
+           make_piece(&pc[1], &dm, &prm, 18, 0, 18, 23) &&
+           make_piece(&fresh[0], &dm, &prm, 0, 0, 18, 23) &&
+           make_piece(&fresh[1], &dm, &prm, 18, 0, 18, 23);
+  void *saved[2] = {NULL, NULL};
+  size_t bytes[2] = {0, 0};
+  if (ok) {
+    advancer a[2];
+    run_team(pc, GR_RAIN_RUNOFF_EAST, 0, 40.0, 0, NULL, a);
+    for (int k = 0; k < 2; ++k) {
+      CHECK(a[k].st == GR_OK);
+      CHECK(gr_rain_runoff_state_size(pc[k].s, &bytes[k]) == GR_OK);
+      saved[k] = malloc(bytes[k]);
+      CHECK(gr_rain_runoff_state_save(pc[k].s, saved[k], bytes[k]) == GR_OK);
+    }
+    /* The ring is in it: 21 x 23 local cells. */
+    size_t cells = 21 * 23, faces = 22 * 23 + 21 * 24;
+    CHECK_MSG(bytes[0] == bytes[1] && bytes[0] > (7 * cells + faces) * sizeof(float) &&
+                  bytes[0] < (7 * cells + faces) * sizeof(float) + 128,
+              "%zu bytes", bytes[0]);
+    run_team(pc, GR_RAIN_RUNOFF_EAST, 0, 30.0, 0, NULL, a);
+    CHECK(gr_rain_runoff_advance(whole, 40.0, NULL) == GR_OK);
+    CHECK(gr_rain_runoff_advance(whole, 30.0, NULL) == GR_OK);
+    check_pieces(pc, 2, whole, &dm, "pieces advanced 40 s + 30 s");
+    for (int k = 0; k < 2; ++k)
+      CHECK(gr_rain_runoff_state_load(fresh[k].s, saved[k], bytes[k]) == GR_OK);
+    advancer b[2];
+    run_team(fresh, GR_RAIN_RUNOFF_EAST, 0, 30.0, 0, NULL, b);
+    for (int k = 0; k < 2; ++k)
+      CHECK(b[k].st == GR_OK && b[k].steps == a[k].steps && b[k].l.time == a[k].l.time &&
+            b[k].l.steps == a[k].l.steps && b[k].l.stored_volume == a[k].l.stored_volume);
+    check_pieces(fresh, 2, whole, &dm, "fresh pieces loaded at 40 s, advanced 30 s");
+    printf("piece checkpoint: %zu bytes per piece; %d steps after the load\n", bytes[0],
+           b[0].steps);
+    /* Piece 0's checkpoint into piece 1: the same size, another place. */
+    CHECK(gr_rain_runoff_state_load(pc[1].s, saved[0], bytes[0]) == GR_ERR_INVALID_ARGUMENT);
+    CHECK_MSG(has(gr_rain_runoff_last_error(pc[1].s), "own checkpoint") &&
+                  has(gr_rain_runoff_last_error(pc[1].s), "(18, 0)"),
+              "'%s'", gr_rain_runoff_last_error(pc[1].s));
+  }
+  for (int k = 0; k < 2; ++k) {
+    free(saved[k]);
+    gr_rain_runoff_destroy(pc[k].s);
+    gr_rain_runoff_destroy(fresh[k].s);
+  }
+  gr_rain_runoff_destroy(whole);
+  free_domain(&dm);
+}
+
+/* For valgrind: the piece entry points on two tiny pieces on two threads. */
+static void test_memcheck_pieces(void) {
+  domain dm = make_domain(8, 5);
+  gr_rain_runoff_params prm = params_with(1e-5, 0.0, GR_BOUNDARY_OPEN);
+  piece pc[2] = {{0}, {0}};
+  if (make_piece(&pc[0], &dm, &prm, 0, 0, 4, 5) && make_piece(&pc[1], &dm, &prm, 4, 0, 4, 5)) {
+    progress_log log = {0, 1, 0, 0.0, 0.0};
+    progress_log *logs[2] = {&log, NULL};
+    advancer a[2];
+    run_team(pc, GR_RAIN_RUNOFF_EAST, 0, 2.0, 0, logs, a);
+    CHECK(a[0].st == GR_OK && a[1].st == GR_OK && a[0].steps >= 2 && a[0].steps == a[1].steps);
+    run_team(pc, GR_RAIN_RUNOFF_EAST, 1, 0.0, 2, NULL, a);
+    CHECK(a[0].st == GR_OK && a[1].st == GR_OK && a[0].exchanges == 2);
+    size_t bytes = 0;
+    CHECK(gr_rain_runoff_state_size(pc[0].s, &bytes) == GR_OK);
+    void *saved = malloc(bytes);
+    CHECK(saved && gr_rain_runoff_state_save(pc[0].s, saved, bytes) == GR_OK);
+    CHECK(saved && gr_rain_runoff_state_load(pc[0].s, saved, bytes) == GR_OK);
+    free(saved);
+    CHECK(gr_rain_runoff_advance(pc[0].s, 1.0, NULL) == GR_ERR_INVALID_ARGUMENT);
+    gr_rain_runoff_set_halo_exchange(pc[0].s, failing_exchange, NULL);
+    CHECK(gr_rain_runoff_step(pc[0].s, 0.01, 2) == GR_ERR_IO);
+  }
+  gr_rain_runoff_set_halo_exchange(NULL, failing_exchange, NULL);
+  for (int k = 0; k < 2; ++k)
+    gr_rain_runoff_destroy(pc[k].s);
+  free_domain(&dm);
+}
+
 /* What valgrind runs: every entry point and error path once, on tiny grids. */
 static void test_memcheck_subset(void) {
   test_memcheck();
   test_errors();
   test_param_table();
   test_shared_context();
+  test_memcheck_pieces();
 }
 
 static const gr_subtest tests[] = {
@@ -1837,6 +2139,10 @@ static const gr_subtest tests[] = {
     {"shared_context", test_shared_context, 0},
     {"pieces_x", test_pieces_x, 0},
     {"pieces_y", test_pieces_y, 0},
+    {"advance_pieces_x", test_advance_pieces_x, 0},
+    {"advance_pieces_y", test_advance_pieces_y, 0},
+    {"advance_pieces_abort", test_advance_pieces_abort, 0},
+    {"piece_checkpoint", test_piece_checkpoint, 0},
     {"memcheck", test_memcheck_subset, 1},
 };
 

@@ -33,7 +33,7 @@
 #define GR_RAIN_RUNOFF_PROGRESS_EVERY 0.1
 /* Checkpoints: "GRR1" and the layout's version. */
 #define GR_RAIN_RUNOFF_STATE_MAGIC 0x31525247u
-#define GR_RAIN_RUNOFF_STATE_VERSION 1u
+#define GR_RAIN_RUNOFF_STATE_VERSION 2u /* 2: the piece's i0, j0 */
 /* Per-cell arrays of a checkpoint: h, h_c, k, inf, inf_c, out, out_c. */
 #define GR_RAIN_RUNOFF_HALO_ARRAYS 4 /* per halo cell: h, k, west and south faces */
 #define GR_RAIN_RUNOFF_STATE_CELL_ARRAYS 7
@@ -102,6 +102,8 @@ struct gr_rain_runoff {
   void *progress_user;
   gr_allreduce_fn allreduce; /* NULL: this simulation is the whole domain's only piece */
   void *allreduce_user;
+  gr_halo_exchange_fn halo_exchange; /* NULL: the caller exchanges between one-step calls */
+  void *halo_user;
   char error[1024]; /* this handle's latest error (gr_error_keep) */
 };
 
@@ -654,6 +656,25 @@ static gr_status gr_rain_runoff_allreduce(gr_rain_runoff *s, double *values, int
   return st;
 }
 
+void gr_rain_runoff_set_halo_exchange(gr_rain_runoff *s, gr_halo_exchange_fn fn, void *user) {
+  if (!s)
+    return;
+  s->halo_exchange = fn;
+  s->halo_user = fn ? user : NULL;
+}
+
+/* After a step of a piece with a ring: the caller's exchange refreshes it. */
+static gr_status gr_rain_runoff_exchange(gr_rain_runoff *s, long long step) {
+  gr_status st = s->halo_exchange(s->halo_user);
+  if (st != GR_OK)
+    return gr_set_error(s->ctx, st,
+                        "The rain runoff piece's halo exchange (the callback given to "
+                        "gr_rain_runoff_set_halo_exchange) failed after step %lld with %s; the "
+                        "piece's ring is not fresh, so restore a checkpoint before stepping on.",
+                        step, gr_status_string(st));
+  return GR_OK;
+}
+
 /* The cells of a halo strip on `side`: GR_RAIN_RUNOFF_GHOST columns by the
  * local array's rows (west, east), or its columns by GR_RAIN_RUNOFF_GHOST
  * rows (south, north); 0 where the side has no neighbour. */
@@ -759,12 +780,45 @@ static double gr_rain_runoff_now(void) {
 typedef struct gr_rain_runoff_watch {
   double last_call, last_wait;
   int batch, since;
+  int global; /* a piece with an allreduce: the stop flag is reduced after every step */
 } gr_rain_runoff_watch;
+
+/* A piece's watch: its own progress callback (if any) only raises a flag,
+ * and the flags of every piece are reduced after every step, so all pieces
+ * stop after the same step whichever asked; every piece makes this call at
+ * every step, callback or not, so the allreduce calls match. One 8-byte
+ * reduction per step costs little next to the step's halo exchange. */
+static gr_status gr_rain_runoff_watch_global(gr_rain_runoff *s, gr_rain_runoff_watch *w,
+                                             double time, int *stop) {
+  double flag = 0.0;
+  gr_status st = GR_OK;
+  if (s->progress) {
+    /* The exchange has usually waited already; this makes the time the
+     * device's for a piece without a ring too. */
+    st = gr_finish(s->ctx);
+    double now = gr_rain_runoff_now();
+    if (st == GR_OK && now - w->last_call >= GR_RAIN_RUNOFF_PROGRESS_EVERY) {
+      w->last_call = now;
+      if (s->progress(s->progress_user, time) != 0)
+        flag = 1.0;
+    }
+  }
+  /* Reached even when the wait failed: a piece that skipped the collective
+   * would leave the others waiting in it. */
+  gr_status sr = gr_rain_runoff_allreduce(s, &flag, 1, GR_REDUCE_MAX);
+  if (st == GR_OK)
+    st = sr;
+  if (st == GR_OK && flag != 0.0)
+    *stop = 1;
+  return st;
+}
 
 /* Called after each enqueued step; `time` is the simulated time it reaches.
  * *stop becomes 1 when the callback asks to stop. */
 static gr_status gr_rain_runoff_watch_step(gr_rain_runoff *s, gr_rain_runoff_watch *w, double time,
                                            int *stop) {
+  if (w->global)
+    return gr_rain_runoff_watch_global(s, w, time, stop);
   if (++w->since < w->batch)
     return GR_OK;
   gr_status st = gr_finish(s->ctx);
@@ -851,7 +905,7 @@ static gr_status gr_rain_runoff_enqueue(gr_rain_runoff *s, double dt, int nsteps
   cl_float dtf = (cl_float)dt;
   const size_t m = sizeof(cl_mem);
   gr_status st = gr_rain_runoff_bind(s, dtf);
-  int done = 0;
+  int done = 0, exchange = s->halo_exchange && gr_rain_runoff_has_ring(s);
   while (st == GR_OK && done < nsteps && !*stop) {
     int old = s->cur, now = 1 - s->cur;
     const gr_rain_runoff_arg flux[] = {
@@ -876,6 +930,8 @@ static gr_status gr_rain_runoff_enqueue(gr_rain_runoff *s, double dt, int nsteps
       st = gr_enqueue_2d(s->ctx, s->update, 0, 0, (size_t)s->nxl, (size_t)s->nyl, NULL);
     if (st == GR_OK)
       ++done;
+    if (st == GR_OK && exchange)
+      st = gr_rain_runoff_exchange(s, s->steps + done);
     if (st == GR_OK && w)
       st = gr_rain_runoff_watch_step(s, w, s->time + dt * (double)done, stop);
   }
@@ -902,10 +958,11 @@ static gr_status gr_rain_runoff_step_impl(gr_rain_runoff *s, double dt, int nste
                         "The number of steps must be 0 or more (got %d).", nsteps);
   if (nsteps == 0)
     return GR_OK;
-  if (nsteps > 1 && gr_rain_runoff_has_ring(s))
+  if (nsteps > 1 && gr_rain_runoff_has_ring(s) && !s->halo_exchange)
     return gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
-                        "A rain runoff piece with neighbours takes one step per call (got %d): "
-                        "exchange its halo between steps.",
+                        "A rain runoff piece with neighbours and no halo exchange takes one step "
+                        "per call (got %d): exchange its halo between steps, or give it an "
+                        "exchange with gr_rain_runoff_set_halo_exchange.",
                         nsteps);
   int done = 0, stop = 0;
   return gr_rain_runoff_enqueue(s, dt, nsteps, NULL, &done, &stop);
@@ -960,11 +1017,13 @@ static gr_status gr_rain_runoff_advance_impl(gr_rain_runoff *s, double duration,
                         "The duration to advance must be a finite number of seconds, 0 or more "
                         "(got %g).",
                         duration);
-  if (gr_rain_runoff_has_ring(s))
+  if (gr_rain_runoff_has_ring(s) && (!s->allreduce || !s->halo_exchange))
     return gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
-                        "A rain runoff piece with neighbours cannot advance on its own: step it "
-                        "with gr_rain_runoff_step and gr_rain_runoff_stable_dt, exchanging its "
-                        "halo between steps.");
+                        "A rain runoff piece with neighbours advances only with a global "
+                        "reduction and a halo exchange (it has %s and %s): set them with "
+                        "gr_rain_runoff_set_allreduce and gr_rain_runoff_set_halo_exchange, or "
+                        "step it with gr_rain_runoff_step, exchanging its halo between steps.",
+                        s->allreduce ? "one" : "none", s->halo_exchange ? "one" : "none");
   /* The stable step is read back again after a few steps, not once: rain
    * filling a dry bowl deepens it, and a step that was stable at the start
    * of a long advance is not by its end. The stretch between reads starts
@@ -975,9 +1034,9 @@ static gr_status gr_rain_runoff_advance_impl(gr_rain_runoff *s, double duration,
    * adds waits. */
   double left = duration, last_dt = 0.0;
   int chunk = GR_RAIN_RUNOFF_CHUNK_MIN, stop = 0;
-  gr_rain_runoff_watch watch = {0.0, 0.0, 1, 0};
+  gr_rain_runoff_watch watch = {0.0, 0.0, 1, 0, s->allreduce != NULL};
   watch.last_call = watch.last_wait = gr_rain_runoff_now();
-  gr_rain_runoff_watch *w = s->progress ? &watch : NULL;
+  gr_rain_runoff_watch *w = s->progress || watch.global ? &watch : NULL;
   gr_status st = GR_OK;
   while (st == GR_OK && left > 0.0 && !stop) {
     double dt = 0.0;
@@ -1012,8 +1071,10 @@ static gr_status gr_rain_runoff_advance_impl(gr_rain_runoff *s, double duration,
   }
   if (st == GR_OK && stop)
     st = gr_set_error(s->ctx, GR_ERR_ABORTED,
-                      "The rain runoff advance was stopped by its progress callback at %g s of "
-                      "simulated time; the state is valid there and may be advanced further.",
+                      "The rain runoff advance was stopped by %s at %g s of simulated time; the "
+                      "state is valid there and may be advanced further.",
+                      watch.global ? "the progress callback of this or another piece of the domain"
+                                   : "its progress callback",
                       s->time);
   return st;
 }
@@ -1191,7 +1252,8 @@ gr_status gr_rain_runoff_reset(gr_rain_runoff *s) {
  * set is rewritten whole by the next step before it is read). */
 typedef struct gr_rain_runoff_state_header {
   uint32_t magic, version;
-  int32_t nx, ny;
+  int32_t nx, ny; /* the local arrays' */
+  int32_t i0, j0; /* the piece's first owned point (0, 0 for a whole grid) */
   int64_t steps;
   double time, rain_volume, initial_volume;
 } gr_rain_runoff_state_header;
@@ -1246,6 +1308,8 @@ static gr_status gr_rain_runoff_state_save_impl(gr_rain_runoff *s, void *host, s
   hd.version = GR_RAIN_RUNOFF_STATE_VERSION;
   hd.nx = s->nxl;
   hd.ny = s->nyl;
+  hd.i0 = s->grid.i0;
+  hd.j0 = s->grid.j0;
   hd.steps = s->steps;
   hd.time = s->time;
   hd.rain_volume = s->rain_volume;
@@ -1296,6 +1360,12 @@ static gr_status gr_rain_runoff_state_load_impl(gr_rain_runoff *s, const void *h
                         "The rain runoff state is of a %d x %d grid but this simulation's grid "
                         "is %d x %d: load it into a simulation of the grid it was saved from.",
                         (int)hd.nx, (int)hd.ny, s->nxl, s->nyl);
+  if (hd.i0 != s->grid.i0 || hd.j0 != s->grid.j0)
+    return gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
+                        "The rain runoff state is of the piece whose first point is (%d, %d) but "
+                        "this simulation's piece starts at (%d, %d): load each piece's own "
+                        "checkpoint.",
+                        (int)hd.i0, (int)hd.j0, s->grid.i0, s->grid.j0);
   if (bytes != need)
     return gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
                         "The rain runoff state has %zu bytes but a %d x %d simulation's state "

@@ -132,6 +132,17 @@ typedef enum gr_reduce_op { GR_REDUCE_SUM = 0, GR_REDUCE_MAX = 1, GR_REDUCE_MIN 
 typedef gr_status (*gr_allreduce_fn)(void *user, double *values, int n, gr_reduce_op op);
 
 /**
+ * Refreshes the ring (halo) of one piece of a split domain from its
+ * neighbours: the core's halo_get on each neighbour, its halo_set on this
+ * piece (across processes, a send and a receive per side). A grid core calls
+ * it after every step it takes on a piece with a ring, so a piece can take
+ * many steps per call; every piece calls it equally often and at the same
+ * steps, so it may be collective. Anything but GR_OK stops the core's call
+ * with that status.
+ */
+typedef gr_status (*gr_halo_exchange_fn)(void *user);
+
+/**
  * One row of a core's parameter table: the single source of a parameter's
  * range that the core's validator, the filter's clamp, the XML domain and the
  * README all follow (a ctest checks that they agree). Values are in the

@@ -155,8 +155,9 @@ GR_API gr_status gr_rain_runoff_set_field(gr_rain_runoff *s, gr_field f, const f
 
 /**
  * Enqueues nsteps (>= 0) steps of length dt (s, 1e-30 to 3600); does not
- * wait. The caller keeps dt stable (see gr_rain_runoff_stable_dt); advance
- * does it for you.
+ * wait (a piece with a ring and a halo exchange waits for each exchange;
+ * one without an exchange takes nsteps = 1 only). The caller keeps dt
+ * stable (see gr_rain_runoff_stable_dt); advance does it for you.
  */
 GR_API gr_status gr_rain_runoff_step(gr_rain_runoff *s, double dt, int nsteps);
 
@@ -177,7 +178,9 @@ GR_API gr_status gr_rain_runoff_stable_dt(gr_rain_runoff *s, double *dt);
  * bowl makes a step that was stable at the start unstable by the end; the
  * last stretch is n = ceil(left / stable_dt) equal steps that end exactly at
  * the duration. The same state and duration always give the same steps.
- * *steps_taken may be NULL. More than INT_MAX steps are refused.
+ * *steps_taken may be NULL. More than INT_MAX steps are refused. A piece
+ * with a ring advances with an allreduce and a halo exchange set (see
+ * "Pieces of a split domain").
  */
 GR_API gr_status gr_rain_runoff_advance(gr_rain_runoff *s, double duration, int *steps_taken);
 
@@ -196,7 +199,8 @@ GR_API gr_status gr_rain_runoff_reset(gr_rain_runoff *s);
 /**
  * Progress and abort for gr_rain_runoff_advance (see gr_progress_fn); NULL
  * removes it. After GR_ERR_ABORTED the state is valid at a step boundary
- * inside the advance (the ledger's time says where).
+ * inside the advance (the ledger's time says where). On a piece with an
+ * allreduce the abort is global: see "Pieces of a split domain".
  */
 GR_API void gr_rain_runoff_set_progress(gr_rain_runoff *s, gr_progress_fn fn, void *user);
 
@@ -235,15 +239,37 @@ GR_API gr_status gr_rain_runoff_state_load(gr_rain_runoff *s, const void *host, 
  *   x sides (west, east) first, then y sides (south, north): an x strip spans
  *   the local array's rows and a y strip its columns, ring included, so
  *   corner cells travel through the x neighbour.
- * A piece with a ring therefore steps one step per gr_rain_runoff_step call
- * and cannot advance on its own (refused with a sentence); the stable step
- * and the ledger are global through the allreduce callback (the deepest cell
- * by GR_REDUCE_MAX; the stored, infiltrated, outflow, rain and initial
- * volumes by GR_REDUCE_SUM), so every piece takes the same dt and the same
- * steps as the whole grid, which makes every owned cell bit-identical to the
- * whole grid's. Input fields (set_field) of a piece cover its local array,
- * ring included: (nx + rings) x (ny + rings) floats, row-major; get_field
- * returns the owned nx x ny cells. A checkpoint holds the local arrays.
+ * The exchange is the caller's (gr_rain_runoff_set_halo_exchange): with
+ * one set, the core calls it after every step it takes on a piece with a
+ * ring, so gr_rain_runoff_step with nsteps > 1 and gr_rain_runoff_advance
+ * work on a piece; without one a piece with a ring takes one step per
+ * gr_rain_runoff_step call (the caller exchanges between calls) and does not
+ * advance (both refused with a sentence). The stable step and the ledger are
+ * global through the allreduce callback (the deepest cell by GR_REDUCE_MAX;
+ * the stored, infiltrated, outflow, rain and initial volumes by
+ * GR_REDUCE_SUM), so every piece takes the same dt and the same steps as the
+ * whole grid, which makes every owned cell bit-identical to the whole
+ * grid's; advance on a piece with a ring needs both callbacks.
+ *
+ * Advance on pieces is collective: every piece calls gr_rain_runoff_advance
+ * with the same duration, and each call makes the same sequence of
+ * allreduce and exchange calls (every piece's advance re-reads the global
+ * stable step at the same steps). Abort: a piece's progress callback (each
+ * piece may have its own, or none) only raises a flag; after every step of
+ * an advance with an allreduce the flags are reduced by GR_REDUCE_MAX, so an
+ * abort asked for on any one piece stops every piece after the same step,
+ * with GR_ERR_ABORTED and the same time and steps in every ledger. An
+ * error on one piece (a failed launch, a failed exchange) returns on that
+ * piece only: the others wait in their next collective call, which the
+ * caller's callbacks must end (MPI_Abort, or a status that is not GR_OK).
+ *
+ * Input fields (set_field) of a piece cover its local array, ring included:
+ * (nx + rings) x (ny + rings) floats, row-major; get_field returns the owned
+ * nx x ny cells. A checkpoint of a piece holds its local arrays, ring
+ * included, and its i0, j0: loading needs no exchange (the ring is as fresh
+ * as when it was saved: save after a step's exchange, as the core's own
+ * steps leave it), and is refused into another piece. Every piece must load
+ * its checkpoint of the same step (their time and steps say which).
  * @{
  */
 
@@ -263,6 +289,13 @@ typedef enum gr_rain_runoff_side {
  * default) for a simulation that is the whole domain or the only piece.
  */
 GR_API void gr_rain_runoff_set_allreduce(gr_rain_runoff *s, gr_allreduce_fn fn, void *user);
+
+/**
+ * The halo exchange (see gr_halo_exchange_fn and above), called with user
+ * after every step the core takes on this piece; NULL (the default) removes
+ * it. Never called for a simulation without a ring (a whole grid).
+ */
+GR_API void gr_rain_runoff_set_halo_exchange(gr_rain_runoff *s, gr_halo_exchange_fn fn, void *user);
 
 /** Bytes of the halo strip on `side` (a gr_rain_runoff_side); 0 where there is no neighbour. */
 GR_API gr_status gr_rain_runoff_halo_size(const gr_rain_runoff *s, int side, size_t *bytes);
