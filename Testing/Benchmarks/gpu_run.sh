@@ -19,7 +19,9 @@ cmake -S kernels -B build-gpu -DCMAKE_BUILD_TYPE=Release >"$OUT/configure.log" 2
 # The core tests on the GPU (test_procedural_terrain also compares the GPU with PoCL).
 (cd build-gpu && GRAUPEL_DEVICE=gpu ctest -L core -LE memcheck --output-on-failure) \
   >"$OUT/ctest_gpu.log" 2>&1; tail -15 "$OUT/ctest_gpu.log"
-for core in ${CORES:-procedural_terrain rain_runoff}; do
+# Every core graupel-bench knows (its registry, from kernels/cores.cmake) unless CORES names some.
+CORES=${CORES:-$(build-gpu/graupel-bench --help | sed -n '/^cores:/,$p' | awk 'NR > 1 {print $1}')}
+for core in $CORES; do
   for n in ${SIZES:-1024 2048 4096 8192}; do
     GRAUPEL_DEVICE=gpu build-gpu/graupel-bench --core "$core" --size "$n" --steps ${STEPS:-50} \
       2>&1 | tee -a "$OUT/bench_gpu.txt" | tail -1

@@ -5,9 +5,10 @@
  *     "max": ..., "default": ..., "to_core": ..., "min_open": 0, "integer": 1},
  *     ...], "rain_runoff": [...]}
  * Numbers are printed with %.17g, so they read back as the same doubles.
- * Needs no OpenCL device. */
-#include "graupel/procedural_terrain.h"
-#include "graupel/rain_runoff.h"
+ * The cores, in order, are those of the registry (graupel_cores.h, written
+ * from kernels/cores.cmake): each core's gr_<core>_param_bounds. Needs no
+ * OpenCL device. */
+#include "graupel_cores.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -63,18 +64,31 @@ static int print_table(const char *core, const gr_param_bound *rows, int n) {
   return bad;
 }
 
+/* Every core of the registry with its table, in the registry's order. */
+typedef struct core_table {
+  const char *name;
+  const gr_param_bound *(*bounds)(int *count);
+} core_table;
+
+#define GR_CORE_TABLE(core) {#core, gr_##core##_param_bounds},
+static const core_table cores[] = {GRAUPEL_CORE_LIST(GR_CORE_TABLE)};
+#undef GR_CORE_TABLE
+static const int ncores = (int)(sizeof(cores) / sizeof(cores[0]));
+
 int main(int argc, char **argv) {
   if (argc > 1 && (strcmp(argv[1], "-h") == 0 || strcmp(argv[1], "--help") == 0)) {
     printf("usage: %s\nPrints every Graupel core's parameter table as JSON.\n", argv[0]);
     return 0;
   }
-  int n = 0, bad = 0;
-  const gr_param_bound *rows = gr_procedural_terrain_param_bounds(&n);
+  int bad = 0;
   printf("{");
-  bad |= print_table("procedural_terrain", rows, n);
-  printf(",\n");
-  rows = gr_rain_runoff_param_bounds(&n);
-  bad |= print_table("rain_runoff", rows, n);
+  for (int i = 0; i < ncores; ++i) {
+    int n = 0;
+    const gr_param_bound *rows = cores[i].bounds(&n);
+    if (i)
+      printf(",\n");
+    bad |= print_table(cores[i].name, rows, n);
+  }
   printf("}\n");
   return bad ? 1 : 0;
 }
