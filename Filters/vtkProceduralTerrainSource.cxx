@@ -12,46 +12,30 @@
 #include "graupel/cl_runtime.h"
 #include "graupel/procedural_terrain.h"
 
+#include "GraupelParameterTable.h"
+
 #include <algorithm>
 #include <cstring>
 #include <string>
 
 vtkStandardNewMacro(vtkProceduralTerrainSource);
 
-namespace {
-// The property's row of the core's parameter table clamps the value, so the
-// class writes no range of its own. NaN passes through (as vtkSetClampMacro
-// lets it) and the core refuses it with a sentence.
-double ClampToTable(const char *property, double value) {
-  int n = 0;
-  const gr_param_bound *rows = gr_procedural_terrain_param_bounds(&n);
-  for (int i = 0; i < n; ++i) {
-    if (std::strcmp(rows[i].property, property) == 0) {
-      return value < rows[i].min ? rows[i].min : (value > rows[i].max ? rows[i].max : value);
-    }
-  }
-  return value;
-}
-} // namespace
-
-#define GR_TABLE_SETTER(name, type)                                                                \
-  void vtkProceduralTerrainSource::Set##name(type value) {                                         \
-    const type clamped = static_cast<type>(ClampToTable(#name, static_cast<double>(value)));       \
-    if (this->name != clamped) {                                                                   \
-      this->name = clamped;                                                                        \
-      this->Modified();                                                                            \
-    }                                                                                              \
-  }
-GR_TABLE_SETTER(NoiseType, int)
-GR_TABLE_SETTER(Octaves, int)
-GR_TABLE_SETTER(Frequency, double)
-GR_TABLE_SETTER(Lacunarity, double)
-GR_TABLE_SETTER(Persistence, double)
-GR_TABLE_SETTER(Offset, double)
-GR_TABLE_SETTER(Gain, double)
-GR_TABLE_SETTER(SpectralExponent, double)
-GR_TABLE_SETTER(HeightScale, double)
-#undef GR_TABLE_SETTER
+// The core's parameter table clamps every ranged property: the class writes
+// no range of its own.
+GRAUPEL_TABLE_SETTER(vtkProceduralTerrainSource, NoiseType, int, gr_procedural_terrain_param_bounds)
+GRAUPEL_TABLE_SETTER(vtkProceduralTerrainSource, Octaves, int, gr_procedural_terrain_param_bounds)
+GRAUPEL_TABLE_SETTER(vtkProceduralTerrainSource, Frequency, double,
+                     gr_procedural_terrain_param_bounds)
+GRAUPEL_TABLE_SETTER(vtkProceduralTerrainSource, Lacunarity, double,
+                     gr_procedural_terrain_param_bounds)
+GRAUPEL_TABLE_SETTER(vtkProceduralTerrainSource, Persistence, double,
+                     gr_procedural_terrain_param_bounds)
+GRAUPEL_TABLE_SETTER(vtkProceduralTerrainSource, Offset, double, gr_procedural_terrain_param_bounds)
+GRAUPEL_TABLE_SETTER(vtkProceduralTerrainSource, Gain, double, gr_procedural_terrain_param_bounds)
+GRAUPEL_TABLE_SETTER(vtkProceduralTerrainSource, SpectralExponent, double,
+                     gr_procedural_terrain_param_bounds)
+GRAUPEL_TABLE_SETTER(vtkProceduralTerrainSource, HeightScale, double,
+                     gr_procedural_terrain_param_bounds)
 
 vtkProceduralTerrainSource::vtkProceduralTerrainSource() {
   this->SetNumberOfInputPorts(0);

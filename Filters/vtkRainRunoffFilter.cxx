@@ -15,6 +15,8 @@
 
 #include "graupel/rain_runoff.h"
 
+#include "GraupelParameterTable.h"
+
 #include <cmath>
 #include <cstring>
 #include <vector>
@@ -42,12 +44,7 @@ vtkSmartPointer<vtkFloatArray> AsFloat(vtkDataArray *a) {
 const gr_param_bound *Bound(const char *property) {
   int count = 0;
   const gr_param_bound *table = gr_rain_runoff_param_bounds(&count);
-  for (int k = 0; table && k < count; ++k) {
-    if (table[k].property && std::strcmp(table[k].property, property) == 0) {
-      return &table[k];
-    }
-  }
-  return nullptr;
+  return gr_param_find(table, count, property);
 }
 
 void AddValue(vtkFieldData *fd, const char *name, double value) {
@@ -62,37 +59,14 @@ vtkRainRunoffFilter::vtkRainRunoffFilter() {
   this->SetNumberOfInputPorts(2);
 }
 
-double vtkRainRunoffFilter::Clamp(const char *property, double value) {
-  const gr_param_bound *b = Bound(property);
-  if (!b || std::isnan(value)) {
-    return value; // the validator names what is wrong at the next update
-  }
-  if (value > b->max) {
-    return b->max;
-  }
-  // An open lower end has no nearest valid value: the validator refuses it.
-  if (value < b->min && !b->min_open) {
-    return b->min;
-  }
-  return value;
-}
-
-#define GRAUPEL_CLAMPED_SETTER(name, type)                                                         \
-  void vtkRainRunoffFilter::Set##name(type value) {                                                \
-    const type v = static_cast<type>(Clamp(#name, static_cast<double>(value)));                    \
-    if (!(this->name == v) ||                                                                      \
-        std::isnan(static_cast<double>(this->name)) != std::isnan(static_cast<double>(v))) {       \
-      this->name = v;                                                                              \
-      this->Modified();                                                                            \
-    }                                                                                              \
-  }
-GRAUPEL_CLAMPED_SETTER(RainRate, double)
-GRAUPEL_CLAMPED_SETTER(Permeability, double)
-GRAUPEL_CLAMPED_SETTER(ManningN, double)
-GRAUPEL_CLAMPED_SETTER(Boundary, int)
-GRAUPEL_CLAMPED_SETTER(MaxTimeStep, double)
-GRAUPEL_CLAMPED_SETTER(CourantNumber, double)
-#undef GRAUPEL_CLAMPED_SETTER
+// The core's parameter table clamps every property: the class writes no
+// range of its own.
+GRAUPEL_TABLE_SETTER(vtkRainRunoffFilter, RainRate, double, gr_rain_runoff_param_bounds)
+GRAUPEL_TABLE_SETTER(vtkRainRunoffFilter, Permeability, double, gr_rain_runoff_param_bounds)
+GRAUPEL_TABLE_SETTER(vtkRainRunoffFilter, ManningN, double, gr_rain_runoff_param_bounds)
+GRAUPEL_TABLE_SETTER(vtkRainRunoffFilter, Boundary, int, gr_rain_runoff_param_bounds)
+GRAUPEL_TABLE_SETTER(vtkRainRunoffFilter, MaxTimeStep, double, gr_rain_runoff_param_bounds)
+GRAUPEL_TABLE_SETTER(vtkRainRunoffFilter, CourantNumber, double, gr_rain_runoff_param_bounds)
 
 int vtkRainRunoffFilter::CheckParameters() {
   const struct {
@@ -106,8 +80,7 @@ int vtkRainRunoffFilter::CheckParameters() {
     if (!b) {
       continue;
     }
-    const bool low = b->min_open ? !(p.value > b->min) : !(p.value >= b->min);
-    if (low || !(p.value <= b->max)) {
+    if (!gr_param_accepts(b, p.value * b->to_core)) {
       const char *unit = (b->unit && *b->unit) ? b->unit : "";
       const char *space = *unit ? " " : "";
       vtkErrorMacro("Rain Runoff: " << p.property << " must be "

@@ -110,8 +110,6 @@ private:
   vtkRainRunoffFilter(const vtkRainRunoffFilter &) = delete;
   void operator=(const vtkRainRunoffFilter &) = delete;
 
-  /** value clamped to the parameter table's row for property (NaN kept). */
-  static double Clamp(const char *property, double value);
   /** 0 with one sentence in the user's unit when a property is out of its range. */
   int CheckParameters();
 

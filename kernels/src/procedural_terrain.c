@@ -139,8 +139,7 @@ gr_status gr_procedural_terrain_params_validate(const gr_procedural_terrain_para
   for (int row = 0; row < GR_PT_ROWS; ++row) {
     const gr_param_bound *b = &gr_pt_bounds[row];
     double v = gr_pt_get(p, row);
-    int above_min = b->min_open ? v > b->min : v >= b->min; /* false for NaN */
-    if (above_min && v <= b->max)
+    if (gr_param_accepts(b, v))
       continue;
     if (msg && msg_len) {
       const char *hint = gr_pt_hints[row] ? gr_pt_hints[row] : "";

@@ -166,10 +166,8 @@ gr_status gr_rain_runoff_params_validate(const gr_rain_runoff_params *p, char *m
   for (int row = 0; row < GR_RAIN_RUNOFF_P_COUNT; ++row) {
     const gr_param_bound *r = &gr_rain_runoff_bounds[row];
     double v = gr_rain_runoff_param_value(p, row);
-    double lo = gr_rain_runoff_core_min(row), hi = gr_rain_runoff_core_max(row);
-    int ok = (r->min_open ? v > lo : v >= lo) && v <= hi && (!r->integer || v == floor(v));
-    if (ok)
-      continue; /* NaN fails every comparison above */
+    if (gr_param_accepts(r, v))
+      continue;
     if (msg && msg_len) {
       const char *sp = r->unit[0] ? " " : "";
       double user = v / r->to_core;

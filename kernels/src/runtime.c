@@ -398,6 +398,29 @@ gr_status gr_points_validate(const gr_points *p, char *msg, size_t msg_len) {
   return GR_OK;
 }
 
+/* ------------------------------------------------------ parameter tables */
+
+const gr_param_bound *gr_param_find(const gr_param_bound *table, int count, const char *property) {
+  for (int k = 0; table && property && k < count; ++k)
+    if (table[k].property && strcmp(table[k].property, property) == 0)
+      return &table[k];
+  return NULL;
+}
+
+int gr_param_accepts(const gr_param_bound *b, double core_value) {
+  if (!b)
+    return 0;
+  double lo = b->min * b->to_core, hi = b->max * b->to_core;
+  int above = b->min_open ? core_value > lo : core_value >= lo; /* false for NaN */
+  return above && core_value <= hi && (!b->integer || core_value == floor(core_value));
+}
+
+double gr_param_clamp(const gr_param_bound *b, double user_value) {
+  if (!b || user_value != user_value)
+    return user_value;
+  return user_value < b->min ? b->min : (user_value > b->max ? b->max : user_value);
+}
+
 /* ------------------------------------------------------------------ errors */
 
 static void gr_log(const gr_context *ctx, gr_log_level level, const char *msg) {

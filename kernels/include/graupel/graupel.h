@@ -158,6 +158,25 @@ typedef struct gr_param_bound {
   int integer;          /**< 1 for whole-number properties */
 } gr_param_bound;
 
+/** The row of table (count rows) for a property name; NULL when there is none. */
+GR_API const gr_param_bound *gr_param_find(const gr_param_bound *table, int count,
+                                           const char *property);
+
+/**
+ * 1 when a core value lies in the row's range: from min * to_core (excluded
+ * when min_open) to max * to_core, a whole number for integer rows; 0 for NaN.
+ * The products are the ones a filter sends for the user's own bounds, so a
+ * user value at a bound is always accepted.
+ */
+GR_API int gr_param_accepts(const gr_param_bound *b, double core_value);
+
+/**
+ * A user value moved into [min, max] (a filter's clamp). An open min is kept
+ * as the excluded end, which gr_param_accepts then refuses with a sentence;
+ * NaN stays NaN for the same reason.
+ */
+GR_API double gr_param_clamp(const gr_param_bound *b, double user_value);
+
 /**
  * A closed triangle mesh (an object: a wheel, a boot, a rock), as views of
  * the caller's arrays. Vertices in the object's own frame, metres;
