@@ -1417,7 +1417,8 @@ static void test_progress(void) {
   printf("progress: %d steps in %.2f s, %d calls, last at %.3f s of %.0f\n", sa, wall, log.calls,
          log.last, duration);
   CHECK(sa == sb && sa > 100);
-  CHECK(log.increasing && log.last > 0.0 && log.last <= duration);
+  /* A fast device (a GPU) may finish before the first call is due. */
+  CHECK(log.increasing && (log.calls == 0 || (log.last > 0.0 && log.last <= duration)));
   /* At least one call per 0.3 s of wall time after the first 0.3 s. */
   CHECK_MSG(log.calls >= (int)(wall / 0.3), "%d calls in %.2f s", log.calls, wall);
   CHECK(same_bits(a, b, &g, "with and without a progress callback"));
@@ -1427,7 +1428,15 @@ static void test_progress(void) {
   gr_rain_runoff_set_progress(a, on_progress, &stop);
   gr_rain_runoff_ledger before = ledger(a);
   int steps = 0;
-  gr_status st = gr_rain_runoff_advance(a, 10.0 * duration, &steps);
+  /* Advance until the third call stops it: on a fast device one advance
+   * may make fewer than three calls (they come at most every 0.1 s). */
+  gr_status st = GR_OK;
+  double started = wall_now();
+  while (st == GR_OK && stop.calls < 3 && wall_now() - started < 60.0) {
+    int more = 0;
+    st = gr_rain_runoff_advance(a, 10.0 * duration, &more);
+    steps += more;
+  }
   double honoured = wall_now() - stop.stopped_at_wall;
   CHECK_MSG(st == GR_ERR_ABORTED, "%s", gr_status_string(st));
   CHECK(stop.calls == 3 && honoured < 0.5);
@@ -1437,8 +1446,9 @@ static void test_progress(void) {
   printf("abort: honoured in %.3f s at %.3f s of simulated time (%d steps), balance %.3g\n",
          honoured, l.time, steps, fabs(l.balance_error) / in);
   CHECK(l.steps == before.steps + steps && steps > 0);
-  CHECK(l.time > before.time && l.time < before.time + 10.0 * duration);
-  CHECK(fabs(l.time - before.time - stop.last) < 1e-9 * l.time || stop.last <= l.time);
+  CHECK(l.time > before.time);
+  /* The callback saw the time the state stopped at (to rounding). */
+  CHECK_MSG(fabs(stop.last - l.time) <= 1e-9 * l.time, "%.17g vs %.17g", stop.last, l.time);
   CHECK(fabs(l.balance_error) <= 1e-7 * in);
   /* The state goes on: without the callback the advance completes. */
   gr_rain_runoff_set_progress(a, NULL, NULL);
@@ -1916,7 +1926,12 @@ static void check_advance_split(domain *dm, piece pc[2], int side0, const char *
               "%s: piece %d: %d steps, %d exchanges; "
               "the whole grid %d steps",
               what, k, a[k].steps, a[k].exchanges, sw);
-    CHECK(a[k].l.time == lw.time && a[k].l.time == duration && a[k].l.steps == lw.steps);
+    /* The same time as the whole grid, to the bit; the duration to rounding
+     * (the last stretch is equal steps of left / n). */
+    CHECK_MSG(a[k].l.time == lw.time && fabs(a[k].l.time - duration) <= 1e-9 * duration &&
+                  a[k].l.steps == lw.steps,
+              "%s: piece %d: time %.17g, whole %.17g, steps %lld vs %lld", what, k, a[k].l.time,
+              lw.time, a[k].l.steps, lw.steps);
     CHECK(a[k].l.max_depth == lw.max_depth);
     CHECK_NEAR(a[k].l.stored_volume, lw.stored_volume, 1e-9 * in);
     CHECK_NEAR(a[k].l.outflow_volume, lw.outflow_volume, 1e-9 * in);
