@@ -3,7 +3,9 @@
  * energy, linear height scale, bounds, tiling by origin, inversion, every
  * device agreeing with the first, parameter errors, the parameter table
  * against the validator, per-generator errors on a shared context, and
- * set_params across kernel variants. */
+ * set_params across kernel variants. `test_procedural_terrain memcheck` (what
+ * valgrind runs) covers every host entry point and error path once on tiny
+ * grids. */
 #include "graupel/cl_runtime.h"
 #include "graupel/procedural_terrain.h"
 #include "gr_test.h"
@@ -637,6 +639,110 @@ static void test_set_params_variants(void) {
   gr_procedural_terrain_destroy(t);
 }
 
+/* Largest difference between a generated grid and the double reference. */
+static double worst_vs_reference(const gr_grid *g, const gr_procedural_terrain_params *p,
+                                 const float *h) {
+  double worst = 0;
+  for (int j = 0; j < g->ny; ++j)
+    for (int i = 0; i < g->nx; ++i) {
+      double d = fabs(ref_elevation(p, g->x0 + (g->i0 + i) * g->dx, g->y0 + (g->j0 + j) * g->dy) -
+                      h[j * g->nx + i]);
+      worst = d > worst ? d : worst;
+    }
+  return worst;
+}
+
+/* For valgrind, where building a kernel variant takes many seconds: every
+ * entry point once on a tiny grid with two variants only (the default and
+ * octaves 1 fBm, both built by the other subtests, so PoCL's cache has
+ * them) and one failing build. */
+static void test_memcheck_tiny(void) {
+  gr_grid g = {9, 7, 3.0, 2.0, 15.0, -4.0, 0, 0};
+  gr_procedural_terrain_params p;
+  gr_procedural_terrain_params_init(&p);
+  float *whole = make(&g, &p);
+  gr_procedural_terrain *t = NULL;
+  CHECK(gr_procedural_terrain_create(ctx, &g, &p, &t) == GR_OK);
+  if (!whole || !t) {
+    free(whole);
+    gr_procedural_terrain_destroy(t);
+    return;
+  }
+  CHECK_MSG(worst_vs_reference(&g, &p, whole) < 1e-4 * p.height_scale, "default %.3g m",
+            worst_vs_reference(&g, &p, whole));
+
+  /* Bands give the whole grid; a band outside is refused. */
+  float got[9 * 7], back[9 * 7];
+  memset(got, 0, sizeof(got));
+  CHECK(gr_procedural_terrain_compute_rows(t, 0, 4) == GR_OK);
+  CHECK(gr_procedural_terrain_compute_rows(t, 4, 3) == GR_OK);
+  CHECK(gr_procedural_terrain_compute_rows(t, 5, 3) == GR_ERR_INVALID_ARGUMENT);
+  CHECK(strstr(gr_procedural_terrain_last_error(t), "Rows 5 to 7") != NULL);
+  CHECK(gr_procedural_terrain_get_field(t, GR_FIELD_ELEVATION, got) == GR_OK);
+  CHECK(memcmp(whole, got, sizeof(got)) == 0);
+
+  /* The kernel switch: a failing build keeps the old variant working... */
+  gr_procedural_terrain_params q = p;
+  q.octaves = 1;
+  q.type = GR_NOISE_FBM;
+  q.seed = 5;
+  setenv("GRAUPEL_CL_OPTIONS", "-DGR_BROKEN_OPTION=( -cl-no-such-option", 1);
+  gr_status st = gr_procedural_terrain_set_params(t, &q);
+  unsetenv("GRAUPEL_CL_OPTIONS");
+  CHECK_MSG(st == GR_ERR_BUILD, "%s", gr_status_string(st));
+  CHECK(strstr(gr_procedural_terrain_last_error(t), "procedural_terrain") != NULL);
+  CHECK(gr_procedural_terrain_compute(t) == GR_OK);
+  CHECK(gr_procedural_terrain_get_field(t, GR_FIELD_ELEVATION, got) == GR_OK);
+  CHECK(memcmp(whole, got, sizeof(got)) == 0);
+  /* ...and once fixed, the other variant computes its own terrain... */
+  CHECK(gr_procedural_terrain_set_params(t, &q) == GR_OK);
+  CHECK(gr_procedural_terrain_compute(t) == GR_OK);
+  CHECK(gr_procedural_terrain_get_field(t, GR_FIELD_ELEVATION, got) == GR_OK);
+  CHECK_MSG(worst_vs_reference(&g, &q, got) < 1e-4 * q.height_scale, "fBm %.3g m",
+            worst_vs_reference(&g, &q, got));
+  CHECK(memcmp(whole, got, sizeof(got)) != 0);
+  /* ...and going back reuses the context's first variant, bit for bit. */
+  CHECK(gr_procedural_terrain_set_params(t, &p) == GR_OK);
+  CHECK(gr_procedural_terrain_compute(t) == GR_OK);
+  CHECK(gr_procedural_terrain_get_field(t, GR_FIELD_ELEVATION, back) == GR_OK);
+  CHECK(memcmp(whole, back, sizeof(back)) == 0);
+
+  /* A piece (i0, j0) of a larger grid is that part of the whole. */
+  gr_grid piece = g;
+  piece.nx = 4;
+  piece.ny = 3;
+  piece.i0 = 5;
+  piece.j0 = 4;
+  float *h = make(&piece, &p);
+  int mismatched = h ? 0 : 1;
+  for (int j = 0; h && j < piece.ny; ++j)
+    for (int i = 0; i < piece.nx; ++i)
+      mismatched += h[j * piece.nx + i] != whole[(j + 4) * g.nx + i + 5];
+  CHECK_MSG(mismatched == 0, "%d piece values differ", mismatched);
+  free(h);
+
+  /* NULL handles are refused with a sentence, not a crash. */
+  CHECK(gr_procedural_terrain_compute(NULL) == GR_ERR_INVALID_ARGUMENT);
+  CHECK(gr_procedural_terrain_compute_rows(NULL, 0, 1) == GR_ERR_INVALID_ARGUMENT);
+  CHECK(gr_procedural_terrain_set_params(NULL, &p) == GR_ERR_INVALID_ARGUMENT);
+  CHECK(gr_procedural_terrain_get_field(t, GR_FIELD_ELEVATION, NULL) == GR_ERR_INVALID_ARGUMENT);
+  gr_procedural_terrain *none = NULL;
+  CHECK(gr_procedural_terrain_create(NULL, &g, &p, &none) == GR_ERR_INVALID_ARGUMENT);
+  CHECK(none == NULL && strlen(gr_procedural_terrain_last_error(NULL)) > 10);
+  gr_procedural_terrain_destroy(t);
+  free(whole);
+}
+
+/* What valgrind runs (memcheck.procedural_terrain): every host entry point
+ * and error path once, on tiny grids, with as few kernel builds as possible;
+ * the larger subtests run natively and under ASan. */
+static void test_memcheck(void) {
+  test_errors();
+  test_param_table();
+  test_shared_context_errors();
+  test_memcheck_tiny();
+}
+
 static int setup(void) {
   if (gr_context_create(NULL, &ctx) != GR_OK)
     return 0;
@@ -661,6 +767,7 @@ static const gr_subtest tests[] = {
     {"set_params_variants", test_set_params_variants, 0},
     {"bands", test_bands, 0},
     {"build_failure", test_build_failure, 0},
+    {"memcheck", test_memcheck, 1},
 };
 
 int main(int argc, char **argv) {

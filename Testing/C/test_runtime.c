@@ -2,6 +2,8 @@
  * count, a trivial kernel, kernel arguments by name, a failing build's log,
  * buffer limits, per-thread errors, the embedded sources, the field table,
  * mesh and point validation, and that every error is a sentence.
+ * `test_runtime memcheck` (what valgrind runs) covers the same host paths with
+ * one program build.
  * `test_runtime --expect-no-platform` (the same as `test_runtime
  * no_platform`; run with OCL_ICD_VENDORS pointing at an empty folder) checks
  * the no-driver path. */
@@ -526,6 +528,163 @@ static void test_points(void) {
   CHECK(gr_points_validate(NULL, NULL, 0) == GR_ERR_INVALID_ARGUMENT);
 }
 
+/* For valgrind, where every program build takes seconds: the paths of
+ * kernels and kernel_arg with one program build (kernel_arg's source) and one
+ * refused build, plus the argument cache's eviction: more kernels alive at
+ * once than the cache holds (64 entries). */
+static void test_memcheck_kernels(void) {
+  gr_context *ctx = NULL;
+  CHECK(gr_context_create(NULL, &ctx) == GR_OK);
+  if (!ctx)
+    return;
+  cl_program p2 = NULL;
+  CHECK(gr_program_get(ctx, "unknown_core", NULL, &p2) == GR_ERR_INVALID_ARGUMENT);
+  CHECK(p2 == NULL && is_sentence(gr_last_error(ctx)));
+  CHECK(gr_program_get(NULL, "rain_runoff", NULL, &p2) == GR_ERR_INVALID_ARGUMENT);
+  CHECK(gr_program_build_source(ctx, NULL, NULL, &p2) == GR_ERR_INVALID_ARGUMENT);
+
+  const char *src = "__kernel void axpb(__global float *x, float a, float b, int n) {"
+                    " int i = get_global_id(0); if (i < n) x[i] = a * x[i] + b; }\n"
+                    "__kernel void bxpa(int n, float b, float a, __global float *x) {"
+                    " int i = get_global_id(0); if (i < n) x[i] = b * x[i] + a; }";
+  cl_program prog = NULL;
+  CHECK(gr_program_build_source(ctx, src, NULL, &prog) == GR_OK);
+  enum { N = 19, KEPT = 80 };
+  float host[N], out[N];
+  for (int i = 0; i < N; ++i)
+    host[i] = (float)i;
+  cl_mem x = NULL;
+  CHECK(gr_buffer_create(ctx, CL_MEM_READ_WRITE, sizeof(host), host, &x) == GR_OK);
+  cl_kernel *kept = calloc(KEPT, sizeof(cl_kernel));
+  if (!prog || !x || !kept) {
+    free(kept);
+    clReleaseProgram(prog);
+    gr_buffer_release(&x);
+    gr_context_release(ctx);
+    return;
+  }
+  cl_float a = 2.0f, b = -3.0f;
+  cl_int n = N;
+
+  /* Positional arguments, and a wrong index named with the kernel. */
+  cl_kernel k = NULL;
+  CHECK(gr_kernel_create(ctx, prog, "axpb", &k) == GR_OK);
+  CHECK(gr_kernel_args(ctx, k, sizeof(cl_mem), &x, sizeof(cl_float), &a, sizeof(cl_float), &b,
+                       sizeof(cl_int), &n, (size_t)0) == GR_OK);
+  CHECK(gr_enqueue_2d(ctx, k, 0, 0, N, 1, NULL) == GR_OK);
+  CHECK(gr_buffer_read(ctx, x, 0, sizeof(out), out) == GR_OK);
+  int wrong = 0;
+  for (int i = 0; i < N; ++i)
+    wrong += out[i] != a * (float)i + b;
+  CHECK_MSG(wrong == 0, "positional: %d of %d values wrong", wrong, N);
+  CHECK(gr_kernel_args(ctx, k, sizeof(cl_mem), &x, sizeof(cl_float), &a, sizeof(cl_float), &b,
+                       sizeof(cl_int), &n, sizeof(cl_int), &n, (size_t)0) == GR_ERR_OPENCL);
+  CHECK(strstr(gr_last_error(ctx), "axpb") && strstr(gr_last_error(ctx), "argument 4"));
+  cl_kernel none = NULL;
+  CHECK(gr_kernel_create(ctx, prog, "no_such_kernel", &none) == GR_ERR_OPENCL);
+  CHECK(strstr(gr_last_error(ctx), "no_such_kernel") != NULL);
+
+  /* By name: unknown names, wrong sizes and missing handles are sentences. */
+  cl_int nope = 1;
+  CHECK(GR_KERNEL_ARG(ctx, k, nope) == GR_ERR_INVALID_ARGUMENT);
+  CHECK_MSG(strstr(gr_last_error(ctx), "'nope'") && is_sentence(gr_last_error(ctx)), "'%s'",
+            gr_last_error(ctx));
+  double wide = 1.0;
+  CHECK(gr_kernel_arg(ctx, k, "n", sizeof(wide), &wide) == GR_ERR_OPENCL);
+  CHECK(strstr(gr_last_error(ctx), "CL_INVALID_ARG_SIZE") != NULL);
+  CHECK(gr_kernel_arg(ctx, NULL, "n", sizeof(n), &n) == GR_ERR_INVALID_ARGUMENT);
+  CHECK(gr_kernel_arg(ctx, k, NULL, sizeof(n), &n) == GR_ERR_INVALID_ARGUMENT);
+  CHECK(gr_kernel_arg(NULL, k, "n", sizeof(n), &n) == GR_ERR_INVALID_ARGUMENT);
+  clReleaseKernel(k);
+
+  /* KEPT kernels alive at once, alternating argument orders: setting x on
+   * each after n on all of them finds every early entry evicted; the first
+   * kernel, re-read, still computes with its own argument order. */
+  int failures = 0;
+  for (int i = 0; i < KEPT; ++i) {
+    failures += gr_kernel_create(ctx, prog, i % 2 ? "bxpa" : "axpb", &kept[i]) != GR_OK;
+    failures += kept[i] && GR_KERNEL_ARG(ctx, kept[i], n) != GR_OK;
+  }
+  for (int i = 0; i < KEPT; ++i)
+    failures += kept[i] && GR_KERNEL_ARG(ctx, kept[i], x) != GR_OK;
+  CHECK_MSG(failures == 0, "%d failures", failures);
+  for (int r = 0; r < 2 && kept[r]; ++r) {
+    CHECK(GR_KERNEL_ARG(ctx, kept[r], a) == GR_OK);
+    CHECK(GR_KERNEL_ARG(ctx, kept[r], b) == GR_OK);
+    CHECK(gr_buffer_write(ctx, x, 0, sizeof(host), host) == GR_OK);
+    CHECK(gr_enqueue_2d(ctx, kept[r], 0, 0, N, 1, NULL) == GR_OK);
+    CHECK(gr_buffer_read(ctx, x, 0, sizeof(out), out) == GR_OK);
+    wrong = 0;
+    for (int i = 0; i < N; ++i)
+      wrong += out[i] != (r ? b * (float)i + a : a * (float)i + b);
+    CHECK_MSG(wrong == 0, "kernel %d after eviction: %d of %d values wrong", r, wrong, N);
+  }
+  /* A released kernel's handle may come back for the other kernel: its
+   * cached names must not be used. */
+  for (int i = 0; i < KEPT; ++i)
+    if (kept[i])
+      clReleaseKernel(kept[i]);
+  for (int round = 0; round < 2; ++round) {
+    k = NULL;
+    CHECK(gr_kernel_create(ctx, prog, round ? "bxpa" : "axpb", &k) == GR_OK);
+    if (!k)
+      break;
+    CHECK(GR_KERNEL_ARG(ctx, k, n) == GR_OK && GR_KERNEL_ARG(ctx, k, x) == GR_OK);
+    CHECK(GR_KERNEL_ARG(ctx, k, a) == GR_OK && GR_KERNEL_ARG(ctx, k, b) == GR_OK);
+    CHECK(gr_buffer_write(ctx, x, 0, sizeof(host), host) == GR_OK);
+    CHECK(gr_enqueue_2d(ctx, k, 0, 0, N, 1, NULL) == GR_OK);
+    CHECK(gr_buffer_read(ctx, x, 0, sizeof(out), out) == GR_OK);
+    wrong = 0;
+    for (int i = 0; i < N; ++i)
+      wrong += out[i] != (round ? b * (float)i + a : a * (float)i + b);
+    CHECK_MSG(wrong == 0, "round %d: %d of %d values wrong", round, wrong, N);
+    clReleaseKernel(k);
+  }
+  free(kept);
+  clReleaseProgram(prog);
+  gr_buffer_release(&x);
+  CHECK(x == NULL);
+  gr_buffer_release(&x);
+
+  /* A failing build reports the driver's log. Refused options take the same
+   * path as a compile error (the kernels subtest has one) without running
+   * the compiler, which under valgrind takes seconds. */
+  CHECK(gr_program_build_source(ctx, src, "-cl-no-such-option-xyz", &prog) == GR_ERR_BUILD);
+  CHECK(prog == NULL);
+  CHECK_MSG(strstr(gr_last_error(ctx), "Build log") &&
+                strstr(gr_last_error(ctx), "-cl-no-such-option-xyz") &&
+                strstr(gr_last_error(ctx), "failed to build"),
+            "'%s'", gr_last_error(ctx));
+
+  /* Buffer limits, and the error helpers. */
+  gr_device_info info;
+  CHECK(gr_context_device_info(ctx, &info) == GR_OK);
+  cl_mem big = NULL;
+  CHECK(gr_buffer_create(ctx, CL_MEM_READ_WRITE, (size_t)info.max_alloc_bytes + 4096, NULL, &big) ==
+        GR_ERR_TOO_LARGE);
+  CHECK(big == NULL && strstr(gr_last_error(ctx), "MiB") != NULL);
+  CHECK(gr_buffer_create(ctx, CL_MEM_READ_WRITE, 0, NULL, &big) == GR_ERR_INVALID_ARGUMENT);
+  CHECK(gr_context_device_info(ctx, NULL) == GR_ERR_INVALID_ARGUMENT);
+  CHECK(gr_cl_check(ctx, CL_SUCCESS, "nothing") == GR_OK);
+  CHECK(gr_cl_check(ctx, CL_OUT_OF_HOST_MEMORY, "Something") == GR_ERR_OUT_OF_MEMORY);
+  CHECK(strstr(gr_last_error(ctx), "CL_OUT_OF_HOST_MEMORY") != NULL);
+  gr_context_release(ctx);
+}
+
+/* What valgrind runs (memcheck.runtime): every host entry point and error
+ * path once, with one program build; the full subtests run natively and
+ * under ASan. */
+static void test_memcheck(void) {
+  test_names();
+  test_devices();
+  test_shared();
+  test_embed();
+  test_memcheck_kernels();
+  test_errors_per_thread();
+  test_mesh();
+  test_points();
+}
+
 /* Without an OpenCL device the tests that need one are skipped (77). */
 static int have_device(void) {
   gr_context *ctx = NULL;
@@ -546,6 +705,7 @@ static const gr_subtest tests[] = {
     {"errors_per_thread", test_errors_per_thread, 0},
     {"mesh", test_mesh, 0},
     {"points", test_points, 0},
+    {"memcheck", test_memcheck, 1}, /* what valgrind runs */
 };
 
 int main(int argc, char **argv) {
