@@ -146,6 +146,9 @@ static void test_shared(void) {
   gr_context *a = NULL, *b = NULL;
   CHECK(gr_context_acquire(&opt, &a) == GR_OK);
   CHECK(log_lines == 1); /* the chosen device is reported once */
+  /* An error goes to the caller, not also to the log: reported once. */
+  CHECK(gr_set_error(a, GR_ERR_INVALID_ARGUMENT, "A test error.") == GR_ERR_INVALID_ARGUMENT);
+  CHECK(strcmp(gr_last_error(a), "A test error.") == 0 && log_lines == 1);
   CHECK(gr_context_acquire(NULL, &b) == GR_OK);
   CHECK(a == b);
   CHECK(gr_context_refcount(a) == 2);

@@ -437,7 +437,9 @@ gr_status gr_set_error(const gr_context *ctx, gr_status st, const char *fmt, ...
   vsnprintf(scratch, sizeof(scratch), fmt, ap);
   va_end(ap);
   memcpy(gr_thread_error, scratch, sizeof(gr_thread_error));
-  gr_log(ctx, GR_LOG_WARNING, gr_thread_error);
+  /* Not logged as well: the caller gets the status and reports the sentence
+   * once (a filter as its one error); the log is for what is not an error. */
+  (void)ctx;
   return st;
 }
 
