@@ -33,10 +33,29 @@ double PhysicalMemoryBytes() {
   return 0.0;
 }
 
-std::string Seconds(double t) {
-  char text[64];
-  std::snprintf(text, sizeof(text), "%g s", t);
-  return text;
+// The progress text's times: the requested time as set (%g), the running
+// time to about a thousandth of it without trailing zeros, so that it reads
+// "92 s of 1800 s", "3.2 s of 60 s" and "30 s of 60 s" rather than
+// "91.5385 s of 1800 s".
+std::string ProgressTimes(double t, double goal) {
+  const double scale = std::fabs(goal) > 0.0 ? std::fabs(goal) : 1.0;
+  const int decimals =
+      std::max(0, std::min(6, 2 - static_cast<int>(std::floor(std::log10(scale)))));
+  char now[64];
+  std::snprintf(now, sizeof(now), "%.*f", decimals, t);
+  std::string text = now;
+  if (text.find('.') != std::string::npos) {
+    text.erase(text.find_last_not_of('0') + 1);
+    if (text.back() == '.') {
+      text.pop_back();
+    }
+  }
+  if (text == "-0") {
+    text = "0";
+  }
+  char end[64];
+  std::snprintf(end, sizeof(end), "%g", goal);
+  return "t = " + text + " s of " + end + " s";
 }
 } // namespace
 
@@ -365,8 +384,7 @@ int vtkGraupelSimulation::ReportProgress(double t) {
   const double goal = this->GetOutputTime(this->Target);
   const double span = goal - this->ProgressStart;
   const double fraction = span > 0.0 ? (t - this->ProgressStart) / span : 1.0;
-  const std::string text =
-      std::string(this->GetSimulationLabel()) + ": t = " + Seconds(t) + " of " + Seconds(goal);
+  const std::string text = std::string(this->GetSimulationLabel()) + ": " + ProgressTimes(t, goal);
   this->SetProgressText(text.c_str());
   this->UpdateProgress(std::max(0.0, std::min(1.0, fraction)));
   return this->GetAbortExecute() ? 1 : 0;
@@ -412,6 +430,15 @@ int vtkGraupelSimulation::RequestData(vtkInformation *request, vtkInformationVec
   vtkDataObject *output = outInfo->Get(vtkDataObject::DATA_OBJECT());
   output->Initialize();
 
+#if GRAUPEL_VTK_ABORT_OUTPUT
+  if (!this->Continuing && (this->GetAbortExecute() || this->GetAbortOutput())) {
+    // Aborted before it began (see the class comment): an empty output, no
+    // warning, nothing touched.
+    this->AbortExecute = 0;
+    this->SetAbortOutput(true);
+    return 1;
+  }
+#endif
   if (!this->Continuing) {
     const Key key = this->CurrentKey();
     if (this->HasFailed && key == this->FailedKey) {
@@ -514,10 +541,15 @@ int vtkGraupelSimulation::RequestData(vtkInformation *request, vtkInformationVec
                       << (result == ADVANCE_ABORTED ? "starts again from the last checkpoint."
                                                     : "goes on from there."));
       this->Finish(request);
-      // Honour the abort, then make sure the next request runs again.
+      // Consume the abort; the executive empties the output and marks it
+      // ABORTED, so the next request runs again (see the class comment).
       this->AbortExecute = 0;
+#if GRAUPEL_VTK_ABORT_OUTPUT
+      this->SetAbortOutput(true);
+#else
       this->Modified();
       this->StateKey.filter = this->GetMTime();
+#endif
       return 1;
     }
   }
@@ -532,6 +564,26 @@ int vtkGraupelSimulation::RequestData(vtkInformation *request, vtkInformationVec
   this->AddDeviceFieldData(output);
   return 1;
 }
+
+#if GRAUPEL_VTK_ABORT_OUTPUT
+void vtkGraupelSimulation::SetAbortExecute(vtkTypeBool abort) {
+  this->AbortExecute = abort;
+}
+
+void vtkGraupelSimulation::SetAbortOutput(bool abort) {
+  // vtkAlgorithm's setter calls Modified() (and the member is private): an
+  // abort is execution state, so the keys that were current stay current.
+  const vtkMTimeType before = this->GetMTime();
+  this->Superclass::SetAbortOutput(abort);
+  const vtkMTimeType after = this->GetMTime();
+  if (this->StateKey.filter == before) {
+    this->StateKey.filter = after;
+  }
+  if (this->FailedKey.filter == before) {
+    this->FailedKey.filter = after;
+  }
+}
+#endif
 
 void vtkGraupelSimulation::PrintSelf(ostream &os, vtkIndent indent) {
   this->Superclass::PrintSelf(os, indent);

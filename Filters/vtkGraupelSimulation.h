@@ -68,8 +68,21 @@
  * updated after every AdvanceState and, through CoreProgress, from inside a
  * core's long advance. An abort is honoured between AdvanceState calls and,
  * where the core supports it, inside one (CoreProgress returns nonzero when
- * GetAbortExecute()). The output of an aborted update is empty and the next
- * update runs again. After an abort between calls the state is kept and the
+ * GetAbortExecute()). An aborted update uses VTK's aborted-output protocol
+ * rather than Modified(): RequestData consumes AbortExecute and sets
+ * AbortOutput, so the executive empties the output, stamps it with the
+ * requested time and marks the port ABORTED, and the next request executes
+ * again although no parameter changed. An update that starts with
+ * AbortExecute (or AbortOutput, from an aborted input) already set returns
+ * that empty output at once. ParaView's Render asks for the data more than
+ * once; in ParaView 5.11's GUI the plugin's pqGraupelAbortStarter sets
+ * AbortExecute again whenever the aborted filter starts executing until
+ * that Render ends, so the Render returns at once and the next one (a new
+ * time, Apply) runs the simulation. An abort is execution state, not a
+ * parameter: setting AbortExecute does not modify the filter, and setting
+ * AbortOutput (whose vtkAlgorithm setter does) keeps the state. On VTK
+ * without that protocol (9.1) the filter calls Modified() instead. After an
+ * abort between calls the state is kept and the
  * next update goes on from it. After an abort inside a call the core stopped
  * at a step that is not a knot: going on from there would take other steps
  * than an uninterrupted run, so that state is dropped and the next update
@@ -89,6 +102,15 @@
 
 #include "GraupelFiltersModule.h"
 #include "vtkGraupelAlgorithm.h"
+#include "vtkVersionMacros.h"
+
+// VTK's aborted-output protocol (AbortOutput, vtkAlgorithm::ABORTED) came
+// after 9.2.x: ParaView 5.11's VTK has it, Debian's VTK 9.1 does not.
+#if VTK_VERSION_NUMBER >= VTK_VERSION_CHECK(9, 2, 20220614)
+#define GRAUPEL_VTK_ABORT_OUTPUT 1
+#else
+#define GRAUPEL_VTK_ABORT_OUTPUT 0
+#endif
 
 #include <deque>
 #include <vector>
@@ -239,6 +261,15 @@ protected:
                           vtkInformationVector *) override;
   int RequestData(vtkInformation *, vtkInformationVector **, vtkInformationVector *) override;
 
+#if GRAUPEL_VTK_ABORT_OUTPUT
+public:
+  /** Without Modified(): see "Progress and abort" in the class comment. */
+  void SetAbortExecute(vtkTypeBool abort) override;
+  /** Keeps the state: the executive resets it before every execution. */
+  void SetAbortOutput(bool abort) override;
+#endif
+
+protected:
   double EndTime = 600.0;
   double OutputInterval = 10.0;
   int CheckpointInterval = 10;

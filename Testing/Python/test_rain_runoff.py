@@ -5,7 +5,9 @@ ledger in field data, the permeability map, pieces, an aborted update
 (between intervals and inside one), checkpoints, progress text, clamped
 properties, and error paths with one sentence and an empty output."""
 import os
+import re
 import sys
+import time
 
 import numpy as np
 
@@ -237,24 +239,40 @@ def slow():
 
 
 full = slow()
+at(full, 10.0)
+t0 = time.perf_counter()
 ref_slow = at(full, 20.0)[0]
+interval_s = time.perf_counter() - t0  # wall time of the 10 -> 20 s interval
 ai = slow()
 at(ai, 10.0)  # kept as a checkpoint
 inside = []
 
 
+# The abort ParaView's GUI sends (ParaView 6.1, and the plugin's
+# pqGraupelAbortStarter on 5.11) is SetAbortExecuteAndUpdateTime on the
+# running algorithm, from a progress event: the same here, on the first
+# progress inside the interval.
 def abort_inside(obj, event):
     if 0.0 < obj.GetProgress() < 1.0 and not inside:
-        inside.append(obj.GetProgressText())
-        obj.SetAbortExecute(1)
+        inside.append((obj.GetProgressText(), obj.GetProgress(), time.perf_counter()))
+        if hasattr(obj, "SetAbortExecuteAndUpdateTime"):  # VTK >= 9.2
+            obj.SetAbortExecuteAndUpdateTime()
+        else:
+            obj.SetAbortExecute(1)
 
 
 tag = ai.AddObserver("ProgressEvent", abort_inside)
 warns = T.ErrorCatcher(ai, event="WarningEvent")
 d, _ = at(ai, 20.0)
+stop_s = time.perf_counter() - inside[0][2] if inside else float("inf")
 ai.RemoveObserver(tag)
 T.check(len(inside) == 1 and d is None, "aborted inside the interval at %r: empty output"
-        % inside)
+        % (inside[:1],))
+remaining_s = interval_s * (1.0 - inside[0][1]) if inside else 0.0
+T.check(stop_s < 0.5, "the abort stopped the update within 0.5 s: %.3f s (the rest of the "
+        "interval would have taken %.2f s)" % (stop_s, remaining_s))
+T.check(bool(inside) and re.fullmatch(r"Rain Runoff: t = \d+(\.\d)? s of 20 s", inside[0][0]),
+        "progress text rounded to a thousandth of the requested time: %r" % (inside[:1],))
 T.check("checkpoint" in warns.text(), "abort warning names the checkpoint: %r" % warns.text())
 d, _ = at(ai, 20.0)
 T.check(d is not None and np.array_equal(d, ref_slow),

@@ -1,0 +1,239 @@
+#include "pqGraupelAbortStarter.h"
+
+#include "pqApplicationCore.h"
+#include "pqPipelineSource.h"
+#include "pqProgressManager.h"
+#include "pqServer.h"
+#include "pqServerManagerModel.h"
+#include "vtkAlgorithm.h"
+#include "vtkCallbackCommand.h"
+#include "vtkCommand.h"
+#include "vtkNew.h"
+#include "vtkSMProxy.h"
+#include "vtkWeakPointer.h"
+
+#include <QAbstractButton>
+#include <QApplication>
+#include <QDateTime>
+#include <QFile>
+#include <QEvent>
+#include <QMouseEvent>
+#include <QPointer>
+#include <QTimer>
+
+namespace {
+// The algorithm that reported progress last: the one running. A free
+// function and a weak pointer, so that an observer left on an algorithm
+// after this object is gone touches nothing freed.
+vtkWeakPointer<vtkAlgorithm> LastProgressing;
+// The algorithm aborted in the progress now shown; null when none.
+vtkWeakPointer<vtkAlgorithm> Aborted;
+
+void RememberProgressing(vtkObject *caller, unsigned long, void *, void *) {
+  LastProgressing = vtkAlgorithm::SafeDownCast(caller);
+}
+
+void AbortAgain(vtkObject *caller, unsigned long, void *, void *) {
+  if (caller && caller == Aborted.GetPointer()) {
+    Aborted->SetAbortExecuteAndUpdateTime();
+  }
+}
+
+bool IsBuiltin() {
+  pqServer *server = pqApplicationCore::instance()->getActiveServer();
+  return server && !server->isRemote();
+}
+
+// For the GUI test (Testing/Python/check_gui_plugin.py): with
+// GRAUPEL_GUI_TEST_ABORT_MS=N, clicks the abort button N ms after the first
+// progress of a Graupel simulation, once per process, and writes the time of
+// the click (seconds since the epoch) to GRAUPEL_GUI_TEST_ABORT_LOG. The
+// timer fires only if Qt processes events during the update, as the real
+// click needs.
+void ArmTestClick() {
+  const int ms = qEnvironmentVariableIntValue("GRAUPEL_GUI_TEST_ABORT_MS");
+  if (ms <= 0) {
+    return;
+  }
+  QTimer::singleShot(ms, QCoreApplication::instance(), []() {
+    for (QWidget *w : QApplication::allWidgets()) {
+      auto *button = qobject_cast<QAbstractButton *>(w);
+      if (button && button->objectName() == QLatin1String("AbortButton")) {
+        const QString log = qEnvironmentVariable("GRAUPEL_GUI_TEST_ABORT_LOG");
+        QFile file(log);
+        if (!log.isEmpty() && file.open(QIODevice::WriteOnly)) {
+          file.write(QByteArray::number(QDateTime::currentMSecsSinceEpoch() / 1000.0, 'f', 3) +
+                     (button->isEnabled() ? " enabled\n" : " disabled\n"));
+        }
+        button->click();
+        return;
+      }
+    }
+  });
+}
+
+bool IsAbortButton(QObject *obj) {
+  for (QObject *o = obj; o; o = o->parent()) {
+    if (o->objectName() == QLatin1String("AbortButton")) {
+      return true;
+    }
+  }
+  return false;
+}
+} // namespace
+
+void graupel_gui_start() {
+  static QPointer<pqGraupelAbortStarter> started;
+  static int tries = 0;
+  auto *app = qobject_cast<QApplication *>(QCoreApplication::instance());
+  if (started || !app) {
+    return;
+  }
+  pqApplicationCore *core = pqApplicationCore::instance();
+  if (!core) {
+    // An autoloaded plugin loads while the application core is being made:
+    // try again once the event loop runs (for at most 10 s).
+    if (++tries <= 100) {
+      QTimer::singleShot(100, app, []() { graupel_gui_start(); });
+    }
+    return;
+  }
+  started = new pqGraupelAbortStarter(core);
+  started->onStartup();
+}
+
+pqGraupelAbortStarter::pqGraupelAbortStarter(QObject *p) : Superclass(p) {}
+
+pqGraupelAbortStarter::~pqGraupelAbortStarter() {
+  if (this->Active) {
+    QApplication::instance()->removeEventFilter(this);
+  }
+}
+
+void pqGraupelAbortStarter::onStartup() {
+  pqApplicationCore *core = pqApplicationCore::instance();
+  pqProgressManager *pm = core->getProgressManager();
+  pqServerManagerModel *smm = core->getServerManagerModel();
+  if (!pm || !smm) {
+    return;
+  }
+  QObject::connect(pm, &pqProgressManager::progressStartEvent, this,
+                   [this]() { this->onProgressStart(); });
+  QObject::connect(pm, &pqProgressManager::progressEndEvent, this,
+                   [this]() { this->onProgressEnd(); });
+  QObject::connect(pm, &pqProgressManager::progress, this,
+                   [this](const QString &text, int percent) { this->onProgress(text, percent); });
+  QObject::connect(pm, &pqProgressManager::abort, this, [this]() { this->onAbort(); });
+  QObject::connect(smm, &pqServerManagerModel::sourceAdded, this,
+                   [this](pqPipelineSource *source) { this->onSourceAdded(source); });
+  for (pqPipelineSource *source : smm->findItems<pqPipelineSource *>()) {
+    this->onSourceAdded(source);
+  }
+}
+
+void pqGraupelAbortStarter::onSourceAdded(pqPipelineSource *source) {
+  vtkSMProxy *proxy = source ? source->getProxy() : nullptr;
+  // Only a builtin session has the running algorithm in this process.
+  if (!proxy || !source->getServer() || source->getServer()->isRemote()) {
+    return;
+  }
+  if (auto *algorithm = vtkAlgorithm::SafeDownCast(proxy->GetClientSideObject())) {
+    vtkNew<vtkCallbackCommand> remember;
+    remember->SetCallback(RememberProgressing);
+    algorithm->AddObserver(vtkCommand::ProgressEvent, remember);
+    vtkNew<vtkCallbackCommand> again;
+    again->SetCallback(AbortAgain);
+    algorithm->AddObserver(vtkCommand::StartEvent, again);
+  }
+}
+
+void pqGraupelAbortStarter::onProgressStart() {
+  if (this->Active || !IsBuiltin()) {
+    return;
+  }
+  this->Active = true;
+  // Only an algorithm that reports progress in this update is aborted.
+  LastProgressing = nullptr;
+  QApplication::instance()->installEventFilter(this);
+  pqApplicationCore::instance()->getProgressManager()->setEnableAbort(true);
+}
+
+void pqGraupelAbortStarter::onProgressEnd() {
+  if (!this->Active) {
+    return;
+  }
+  this->Active = false;
+  if (Aborted) {
+    Aborted->SetAbortExecute(0);
+    Aborted = nullptr;
+  }
+  QApplication::instance()->removeEventFilter(this);
+  pqApplicationCore::instance()->getProgressManager()->setEnableAbort(false);
+}
+
+void pqGraupelAbortStarter::onProgress(const QString &text, int percent) {
+  // Not at 0 %: ParaView avoids processing events there because some of its
+  // timers expect a fixed order (see pqProgressManager::setProgress).
+  if (!this->Active || this->Processing || percent <= 0) {
+    return;
+  }
+  if (!this->TestArmed && text.contains(QLatin1String(" s of "))) {
+    this->TestArmed = true;
+    ArmTestClick();
+  }
+  // pqProgressManager's own filter would drop the press on the top-level
+  // window before it reaches the button: ours filters instead meanwhile.
+  pqProgressManager *pm = pqApplicationCore::instance()->getProgressManager();
+  const bool wasUnblocked = pm->unblockEvents(true);
+  this->Processing = true;
+  QApplication::processEvents();
+  this->Processing = false;
+  pm->unblockEvents(wasUnblocked);
+}
+
+void pqGraupelAbortStarter::onAbort() {
+  if (this->Active && LastProgressing) {
+    Aborted = LastProgressing;
+    Aborted->SetAbortExecuteAndUpdateTime();
+  }
+}
+
+bool pqGraupelAbortStarter::eventFilter(QObject *obj, QEvent *event) {
+  if (this->Processing) {
+    switch (event->type()) {
+    case QEvent::MouseButtonPress:
+    case QEvent::MouseButtonRelease:
+    case QEvent::MouseButtonDblClick:
+    case QEvent::MouseMove: {
+      // The abort button alone takes clicks during an update. A click
+      // reaches the top-level QWindow first: look at what lies under it.
+      auto *mouse = static_cast<QMouseEvent *>(event);
+      QObject *target = obj->isWidgetType() ? obj : QApplication::widgetAt(mouse->globalPos());
+      if (IsAbortButton(target)) {
+        break;
+      }
+      return true;
+    }
+    case QEvent::Wheel:
+    case QEvent::KeyPress:
+    case QEvent::KeyRelease:
+    case QEvent::Shortcut:
+    case QEvent::ShortcutOverride:
+    case QEvent::ContextMenu:
+    case QEvent::DragEnter:
+    case QEvent::DragMove:
+    case QEvent::Drop:
+    case QEvent::TouchBegin:
+    case QEvent::TouchUpdate:
+    case QEvent::TouchEnd:
+      return true;
+    case QEvent::Close:
+      // Closing the window inside an update would free what is running.
+      event->ignore();
+      return true;
+    default:
+      break;
+    }
+  }
+  return this->Superclass::eventFilter(obj, event);
+}
