@@ -10,4 +10,5 @@
 set(GRAUPEL_CORES
   procedural_terrain
   rain_runoff
+  snow_deformation
 )

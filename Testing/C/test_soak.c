@@ -11,6 +11,12 @@
  *                            water balance within 1e-4 of the water that came
  *                            in; a second simulation is created, stepped and
  *                            freed every 10^4 steps
+ *   test_soak snow_deformation N    a box moving in circles over a small snow
+ *                            field, stepped N times; every 1000 steps the
+ *                            depth and density must be finite and in range
+ *                            and the ledger closed (mass and volume within
+ *                            1e-5 relative); a checkpoint goes into a second
+ *                            simulation, freed again, every 10^4 steps
  *
  * Memory is "flat" when the resident set after the last cycle exceeds the one
  * after the first tenth of the cycles by less than a small allowance (the
@@ -20,6 +26,7 @@
 #include "graupel/exr_io.h"
 #include "graupel/rain_runoff.h"
 #include "graupel/procedural_terrain.h"
+#include "graupel/snow_deformation.h"
 #include "gr_test.h"
 
 #include <math.h>
@@ -312,9 +319,111 @@ static void soak_rain_runoff(long n) {
   gr_context_release(ctx);
 }
 
+static void soak_snow_deformation(long n) {
+  gr_context *ctx = NULL;
+  if (gr_context_acquire(NULL, &ctx) != GR_OK) {
+    CHECK_MSG(0, "%s", gr_last_error(NULL));
+    return;
+  }
+  const gr_grid g = {24, 20, 0.1, 0.1, 0.0, 0.0, 0, 0};
+  const size_t cells = (size_t)g.nx * (size_t)g.ny;
+  float *d = malloc(cells * sizeof(float)), *r = malloc(cells * sizeof(float));
+  static const float bv[] = {-0.3f, -0.2f, -0.2f, 0.3f,  -0.2f, -0.2f, 0.3f, 0.2f,
+                             -0.2f, -0.3f, 0.2f,  -0.2f, -0.3f, -0.2f, 0.2f, 0.3f,
+                             -0.2f, 0.2f,  0.3f,  0.2f,  0.2f,  -0.3f, 0.2f, 0.2f};
+  static const int bt[] = {0, 2, 1, 0, 3, 2, 4, 5, 6, 4, 6, 7, 0, 1, 5, 0, 5, 4,
+                           1, 2, 6, 1, 6, 5, 2, 3, 7, 2, 7, 6, 3, 0, 4, 3, 4, 7};
+  gr_mesh box = {bv, 8, bt, 12, {0}};
+  gr_snow_deformation_params p;
+  gr_snow_deformation_params_init(&p);
+  gr_snow_deformation *sim = NULL;
+  gr_status st = gr_snow_deformation_create(ctx, &g, &p, &sim);
+  CHECK_MSG(st == GR_OK, "set-up: %s", gr_last_error(ctx));
+  long first = 0, done = 0;
+  double worst = 0.0, t0 = (double)clock(), dt = 1.0 / 60.0;
+  while (st == GR_OK && done < n) {
+    /* A circle of 0.6 m radius every 600 steps, the box 0.1 m deep in the
+     * snow, facing its motion. */
+    double a = 2.0 * 3.14159265358979 * (double)(done % 600) / 600.0,
+           w = 2.0 * 3.14159265358979 / 10.0;
+    for (int k = 0; k < 16; ++k)
+      box.transform[k] = 0.0;
+    box.transform[0] = -sin(a), box.transform[1] = cos(a);
+    box.transform[4] = -cos(a), box.transform[5] = -sin(a);
+    box.transform[10] = box.transform[15] = 1.0;
+    box.transform[12] = 1.2 + 0.6 * cos(a);
+    box.transform[13] = 1.0 + 0.6 * sin(a);
+    box.transform[14] = 0.4 + 0.2;
+    double v[3] = {-0.6 * w * sin(a), 0.6 * w * cos(a), 0.0};
+    st = gr_snow_deformation_set_objects(sim, &box, 1, v);
+    if (st == GR_OK)
+      st = gr_snow_deformation_step(sim, dt);
+    ++done;
+    if (st == GR_OK && (done % 1000 == 0 || done == n)) {
+      gr_snow_deformation_ledger led;
+      st = gr_snow_deformation_get_field(sim, GR_FIELD_SNOW_DEPTH, d);
+      if (st == GR_OK)
+        st = gr_snow_deformation_get_field(sim, GR_FIELD_SNOW_DENSITY, r);
+      if (st == GR_OK)
+        st = gr_snow_deformation_ledger_get(sim, &led);
+      if (st != GR_OK)
+        break;
+      int bad = 0;
+      for (size_t i = 0; i < cells; ++i)
+        bad += !(d[i] >= 0.0f && d[i] < 1e4f) || !(r[i] >= 99.99f && r[i] <= 400.01f);
+      CHECK_MSG(bad == 0, "step %ld: %d depths or densities not finite or out of range", done, bad);
+      double mrel = fabs(led.balance_error) / led.initial_mass;
+      double vrel = fabs(led.volume_error) / led.initial_volume;
+      worst = fmax(worst, fmax(mrel, vrel));
+      CHECK_MSG(mrel <= 1e-5 && vrel <= 1e-5, "step %ld: mass error %g, volume error %g", done,
+                mrel, vrel);
+      CHECK_MSG(led.steps == done, "ledger counts %lld steps, %ld were taken", led.steps, done);
+      if (done % 10000 == 0) {
+        gr_snow_deformation *other = NULL;
+        size_t bytes = 0;
+        gr_status so = gr_snow_deformation_create(ctx, &g, &p, &other);
+        if (so == GR_OK)
+          so = gr_snow_deformation_state_size(sim, &bytes);
+        void *state = so == GR_OK ? malloc(bytes) : NULL;
+        if (state) {
+          so = gr_snow_deformation_state_save(sim, state, bytes);
+          if (so == GR_OK)
+            so = gr_snow_deformation_state_load(other, state, bytes);
+          CHECK(gr_snow_deformation_state_load(other, state, bytes / 2) == GR_ERR_INVALID_ARGUMENT);
+        }
+        gr_snow_deformation_ledger lo;
+        if (so == GR_OK)
+          so = gr_snow_deformation_ledger_get(other, &lo);
+        CHECK_MSG(so == GR_OK && lo.steps == done, "checkpoint: %s",
+                  other ? gr_snow_deformation_last_error(other) : gr_last_error(ctx));
+        free(state);
+        gr_snow_deformation_destroy(other);
+      }
+    }
+    if (done == n / 10)
+      first = rss_kib();
+    if (gr_test_failures > 10)
+      break;
+  }
+  CHECK_MSG(st == GR_OK, "step %ld: %s", done, sim ? gr_snow_deformation_last_error(sim) : "");
+  long last = rss_kib();
+  gr_snow_deformation_ledger led;
+  if (sim && gr_snow_deformation_ledger_get(sim, &led) == GR_OK)
+    printf("snow soak: %ld steps in %.1f s CPU; worst ledger error %.3g; displaced %.4g m^3, "
+           "compressed %.4g of %.4g; resident %ld KiB after %ld steps, %ld KiB at the end\n",
+           done, ((double)clock() - t0) / CLOCKS_PER_SEC, worst, led.displaced_volume,
+           led.compressed_volume, led.initial_volume, first, n / 10, last);
+  CHECK_MSG(last - first < GR_SOAK_SLACK_KIB, "resident memory grew by %ld KiB", last - first);
+  gr_snow_deformation_destroy(sim);
+  free(d);
+  free(r);
+  gr_context_release(ctx);
+}
+
 int main(int argc, char **argv) {
   if (argc < 3) {
-    fprintf(stderr, "usage: test_soak runtime N | procedural_terrain N DIR | rain_runoff N\n");
+    fprintf(stderr, "usage: test_soak runtime N | procedural_terrain N DIR | rain_runoff N | "
+                    "snow_deformation N\n");
     return 2;
   }
   long n = atol(argv[2]);
@@ -328,8 +437,11 @@ int main(int argc, char **argv) {
     soak_procedural_terrain(n, argv[3]);
   else if (strcmp(argv[1], "rain_runoff") == 0)
     soak_rain_runoff(n);
+  else if (strcmp(argv[1], "snow_deformation") == 0)
+    soak_snow_deformation(n);
   else {
-    fprintf(stderr, "usage: test_soak runtime N | procedural_terrain N DIR | rain_runoff N\n");
+    fprintf(stderr, "usage: test_soak runtime N | procedural_terrain N DIR | rain_runoff N | "
+                    "snow_deformation N\n");
     return 2;
   }
   return GR_TEST_RESULT();

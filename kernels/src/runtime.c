@@ -117,6 +117,7 @@ static const struct gr_field_row {
     {GR_FIELD_INFILTRATED, "infiltrated", 1, "m"},
     {GR_FIELD_PERMEABILITY, "permeability", 1, "m/s"},
     {GR_FIELD_RAIN_RATE, "rain_rate", 1, "m/s"},
+    {GR_FIELD_CONTACT, "contact", 1, "1"},
 };
 
 static const struct gr_field_row *gr_field_row_of(gr_field f) {

@@ -101,6 +101,7 @@ typedef enum gr_field {
   GR_FIELD_INFILTRATED,
   GR_FIELD_PERMEABILITY,
   GR_FIELD_RAIN_RATE,
+  GR_FIELD_CONTACT, /**< 1 where an object touches the snow, else 0 */
   GR_FIELD_COUNT
 } gr_field;
 

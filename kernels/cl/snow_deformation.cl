@@ -1,0 +1,329 @@
+/* Snow deformation by objects (seed 000, notes/000.md section 2 with the errata
+ * of section 9 fixed). The model is documented in graupel/snow_deformation.h.
+ *
+ * State: snow depth S and density rho per point (two sets, alternating
+ * between talus iterations), the ground B; per object and step the underside
+ * U (+inf where the object is not), the overlap D and the contour weight cw
+ * (-1 off the contour); per step the lowest underside of all objects Umin,
+ * the summed overlap and the contact flag.
+ *
+ * Every kernel is a gather that writes only its own point. What a point
+ * gives (press, talus) is computed by the same inline function from the same
+ * floats in the kernel of the giver and of the receiver, so what leaves one
+ * point arrives in the other, and no atomics are needed. FP_CONTRACT is off
+ * (common.h). */
+#include "common.h"
+#include "reduce.h"
+#include "snow_deformation_shared.h"
+
+/* The underside at grid point (i, j): the lowest crossing of the vertical
+ * line by a triangle of tri[9 (first + t)] (world coordinates relative to the
+ * grid's point (0, 0)). Outside the object's box [bi0, bi1] x [bj0, bj1]
+ * nothing can cover the point. */
+__kernel void snow_raster(__global const float *restrict tri, int first, int ntri, int nx, int ny,
+                          float dx, float dy, int bi0, int bi1, int bj0, int bj1,
+                          __global float *restrict under) {
+  int i = get_global_id(0), j = get_global_id(1);
+  if (!gr_inside(i, j, nx, ny))
+    return;
+  float u = INFINITY;
+  if (i >= bi0 && i <= bi1 && j >= bj0 && j <= bj1) {
+    float px = i * dx, py = j * dy;
+    for (int t = 0; t < ntri; ++t) {
+      __global const float *v = tri + 9 * (first + t);
+      float ax = v[0], ay = v[1], bx = v[3], by = v[4], cx = v[6], cy = v[7];
+      if (px < fmin(ax, fmin(bx, cx)) - dx || px > fmax(ax, fmax(bx, cx)) + dx ||
+          py < fmin(ay, fmin(by, cy)) - dy || py > fmax(ay, fmax(by, cy)) + dy)
+        continue;
+      float area = (bx - ax) * (cy - ay) - (by - ay) * (cx - ax);
+      if (area == 0.0f)
+        continue; /* vertical: its neighbours give the crossing */
+      float w0 = (bx - px) * (cy - py) - (by - py) * (cx - px);
+      float w1 = (cx - px) * (ay - py) - (cy - py) * (ax - px);
+      float w2 = (ax - px) * (by - py) - (ay - py) * (bx - px);
+      float s = area > 0.0f ? 1.0f : -1.0f, tol = -GR_SNOW_EDGE_EPS * fabs(area);
+      if (s * w0 < tol || s * w1 < tol || s * w2 < tol)
+        continue;
+      float z = (w0 * v[2] + w1 * v[5] + w2 * v[8]) / area;
+      u = fmin(u, z);
+    }
+  }
+  under[gr_idx(i, j, nx)] = u;
+}
+
+/* D = min(S, max(0, H - U)): the ground is rigid. */
+GR_INLINE float snow_overlap_of(float b, float s, float u) {
+  return fmin(s, fmax(0.0f, (b + s) - u));
+}
+
+__kernel void snow_overlap(__global const float *restrict ground,
+                           __global const float *restrict depth,
+                           __global const float *restrict under, int nx, int ny,
+                           __global float *restrict overlap) {
+  int i = get_global_id(0), j = get_global_id(1);
+  if (!gr_inside(i, j, nx, ny))
+    return;
+  int c = gr_idx(i, j, nx);
+  overlap[c] = snow_overlap_of(ground[c], depth[c], under[c]);
+}
+
+/* Contour weight: -1 off the contour (overlapped, or no overlapped
+ * 8-neighbour); on it s_w = max(0, v^ . w^) + r / K with w^ the outward
+ * direction, minus the sum of the overlapped neighbours' offsets. */
+__kernel void snow_contour(__global const float *restrict overlap, int nx, int ny, float vx,
+                           float vy, float rest, __global float *restrict weight) {
+  int i = get_global_id(0), j = get_global_id(1);
+  if (!gr_inside(i, j, nx, ny))
+    return;
+  int c = gr_idx(i, j, nx);
+  float cw = -1.0f;
+  if (overlap[c] <= 0.0f) {
+    int any = 0, ox = 0, oy = 0;
+    for (int dj = -1; dj <= 1; ++dj)
+      for (int di = -1; di <= 1; ++di) {
+        int a = i + di, b = j + dj;
+        if ((di | dj) == 0 || a < 0 || b < 0 || a >= nx || b >= ny)
+          continue;
+        if (overlap[gr_idx(a, b, nx)] > 0.0f) {
+          any = 1;
+          ox += di;
+          oy += dj;
+        }
+      }
+    if (any) {
+      float len = sqrt((float)(ox * ox + oy * oy));
+      float d = len > 0.0f ? (-(float)ox * vx - (float)oy * vy) / len : 0.0f;
+      cw = fmax(0.0f, d) + rest;
+    }
+  }
+  weight[c] = cw;
+}
+
+/* The press of one point: the displaced height e and the new density
+ * (mass-consistent Eqs. 3.9-3.11; see the header). w_const < 0 selects the
+ * density-driven model. */
+GR_INLINE float snow_displaced(float s, float rho, float d, float rho_min, float rho_max,
+                               float w_const) {
+  if (d <= 0.0f)
+    return 0.0f;
+  float w;
+  if (w_const >= 0.0f)
+    w = w_const;
+  else if (rho_max > rho_min)
+    w = clamp((rho - rho_min) / (rho_max - rho_min), 0.0f, 1.0f);
+  else
+    w = 1.0f;
+  float e = fmax(w * d, s - (s - d) * (rho_max / rho));
+  return clamp(e, 0.0f, d);
+}
+
+__kernel void
+snow_object_reduce(__global const float *restrict ground, __global const float *restrict depth,
+                   __global const float *restrict density, __global const float *restrict under,
+                   __global const float *restrict overlap, __global const float *restrict weight,
+                   float rho_min, float rho_max, float w_const, float gap, int n,
+                   __global float *restrict partial, __local float *restrict scratch) {
+  int lid = get_local_id(0), wg = get_local_size(0), start, end;
+  gr_reduce_block(n, &start, &end);
+  float hi[GR_SNOW_OBJ_SUMS], lo[GR_SNOW_OBJ_SUMS];
+  for (int q = 0; q < GR_SNOW_OBJ_SUMS; ++q)
+    hi[q] = lo[q] = 0.0f;
+  for (int c = start + lid; c < end; c += wg) {
+    float s = depth[c], rho = density[c], d = overlap[c], cw = weight[c];
+    float e = snow_displaced(s, rho, d, rho_min, rho_max, w_const);
+    gr_df_add(&hi[0], &lo[0], e);
+    gr_df_add(&hi[1], &lo[1], e * rho);
+    if (cw >= 0.0f) {
+      gr_df_add(&hi[2], &lo[2], cw);
+      gr_df_add(&hi[3], &lo[3], 1.0f);
+    }
+    gr_df_add(&hi[4], &lo[4], d * rho);
+    gr_df_add(&hi[5], &lo[5], d - e);
+    if (ground[c] + s >= under[c] - gap)
+      gr_df_add(&hi[6], &lo[6], 1.0f);
+  }
+  __local float *mine = gr_reduce_slots(scratch, GR_SNOW_OBJ_SUMS, 0);
+  for (int q = 0; q < GR_SNOW_OBJ_SUMS; ++q) {
+    mine[2 * q] = hi[q];
+    mine[2 * q + 1] = lo[q];
+  }
+  gr_reduce_group(scratch, GR_SNOW_OBJ_SUMS, 0, partial);
+}
+
+/* Press and deposit: an overlapped point drops to the underside keeping the
+ * mass (S - e) rho; a contour point gains cw * add_depth of depth and
+ * cw * add_mass of mass per unit area (add_* = 0 when the object deforms
+ * nothing this step) of density add_rho, the mean density of the displaced
+ * snow. Also the step's overlap sum, contact flag and lowest
+ * underside. */
+__kernel void snow_apply(__global const float *restrict ground, __global float *restrict depth,
+                         __global float *restrict density, __global const float *restrict under,
+                         __global const float *restrict overlap,
+                         __global const float *restrict weight, float rho_min, float rho_max,
+                         float w_const, float gap, float add_depth, float add_rho, int press,
+                         int nx, int ny, __global float *restrict overlap_sum,
+                         __global float *restrict contact, __global float *restrict under_min) {
+  int i = get_global_id(0), j = get_global_id(1);
+  if (!gr_inside(i, j, nx, ny))
+    return;
+  int c = gr_idx(i, j, nx);
+  float s = depth[c], rho = density[c], d = overlap[c], cw = weight[c], u = under[c];
+  if (ground[c] + s >= u - gap)
+    contact[c] = 1.0f;
+  under_min[c] = fmin(under_min[c], u);
+  if (!press)
+    return;
+  if (d > 0.0f) {
+    float e = snow_displaced(s, rho, d, rho_min, rho_max, w_const);
+    float s1 = s - d;
+    depth[c] = s1;
+    /* rho (S - e) / (S - D) written as rho + rho (D - e) / (S - D): when
+     * nothing is compressed (e = D) the density stays bit for bit. */
+    if (s1 > 0.0f)
+      density[c] = fmin(rho_max, rho + rho * ((d - e) / s1));
+    overlap_sum[c] += d;
+  } else if (cw > 0.0f) {
+    /* The mass-weighted mean written as a change, so that snow of the same
+     * density leaves the density bit for bit as it was. */
+    float add = cw * add_depth, s1 = s + add;
+    depth[c] = s1;
+    density[c] = rho + add * ((add_rho - rho) / s1);
+  }
+}
+
+/* Talus: the excess of point a (height ha) over its neighbour b (height hb,
+ * lowest underside ub) at the distance whose threshold is thr. Zero when b
+ * is under an object below ha: snow must not flow into the imprint. */
+GR_INLINE float snow_excess(float ha, float hb, float ub, float thr) {
+  if (ub <= ha)
+    return 0.0f;
+  return fmax(0.0f, ha - hb - thr);
+}
+
+/* The threshold of the offset (di, dj). */
+GR_INLINE float snow_threshold(int di, int dj, float tx, float ty, float td) {
+  return (di != 0 && dj != 0) ? td : (di != 0 ? tx : ty);
+}
+
+/* Per point a: the factor k_a of every excess it gives (1/10, less when it
+ * holds less snow than that), and what it could still move,
+ * min(S, largest excess), for the convergence test. */
+__kernel void snow_relax_rate(__global const float *restrict ground,
+                              __global const float *restrict depth,
+                              __global const float *restrict under_min, int nx, int ny, float tx,
+                              float ty, float td, __global float *restrict rate,
+                              __global float *restrict movable) {
+  int i = get_global_id(0), j = get_global_id(1);
+  if (!gr_inside(i, j, nx, ny))
+    return;
+  int c = gr_idx(i, j, nx);
+  float s = depth[c], ha = ground[c] + s, sum = 0.0f, big = 0.0f;
+  for (int dj = -1; dj <= 1; ++dj)
+    for (int di = -1; di <= 1; ++di) {
+      int a = i + di, b = j + dj;
+      if ((di | dj) == 0 || a < 0 || b < 0 || a >= nx || b >= ny)
+        continue;
+      int n = gr_idx(a, b, nx);
+      float x =
+          snow_excess(ha, ground[n] + depth[n], under_min[n], snow_threshold(di, dj, tx, ty, td));
+      sum += x;
+      big = fmax(big, x);
+    }
+  float k = 0.0f;
+  if (sum > 0.0f)
+    k = fmin(GR_SNOW_TALUS_RATE, GR_SNOW_KEEP * s / sum);
+  rate[c] = k;
+  movable[c] = s > 0.0f ? fmin(s, big) : 0.0f;
+}
+
+/* Per point b: gives k_b x_bn to each neighbour n and receives k_a x_ab
+ * (with a's density) from each neighbour a; the same floats both ways. */
+__kernel void
+snow_relax_move(__global const float *restrict ground, __global const float *restrict depth,
+                __global const float *restrict density, __global const float *restrict under_min,
+                __global const float *restrict rate, int nx, int ny, float tx, float ty, float td,
+                __global float *restrict depth_out, __global float *restrict density_out) {
+  int i = get_global_id(0), j = get_global_id(1);
+  if (!gr_inside(i, j, nx, ny))
+    return;
+  int c = gr_idx(i, j, nx);
+  float s = depth[c], rho = density[c], hb = ground[c] + s, ub = under_min[c], kb = rate[c];
+  float out = 0.0f, in = 0.0f, mass_in = 0.0f; /* mass_in: relative to rho */
+  for (int dj = -1; dj <= 1; ++dj)
+    for (int di = -1; di <= 1; ++di) {
+      int a = i + di, b = j + dj;
+      if ((di | dj) == 0 || a < 0 || b < 0 || a >= nx || b >= ny)
+        continue;
+      int n = gr_idx(a, b, nx);
+      float thr = snow_threshold(di, dj, tx, ty, td);
+      float hn = ground[n] + depth[n];
+      if (kb > 0.0f)
+        out += kb * snow_excess(hb, hn, under_min[n], thr);
+      float ka = rate[n];
+      if (ka > 0.0f) {
+        float f = ka * snow_excess(hn, hb, ub, thr);
+        in += f;
+        mass_in += f * (density[n] - rho);
+      }
+    }
+  float kept = fmax(0.0f, s - out), s1 = kept + in;
+  depth_out[c] = s1;
+  /* (kept rho + sum f rho_a) / s1 as a change: equal densities stay put. */
+  density_out[c] = (in > 0.0f && s1 > 0.0f) ? rho + mass_in / s1 : rho;
+}
+
+/* The largest movable amount (one maximum). */
+__kernel void snow_check_reduce(__global const float *restrict movable, int n,
+                                __global float *restrict partial, __local float *restrict scratch) {
+  int lid = get_local_id(0), wg = get_local_size(0), start, end;
+  gr_reduce_block(n, &start, &end);
+  float m = 0.0f;
+  for (int c = start + lid; c < end; c += wg)
+    m = fmax(m, movable[c]);
+  __local float *mine = gr_reduce_slots(scratch, 0, GR_SNOW_CHECK_MAXES);
+  mine[0] = m;
+  gr_reduce_group(scratch, 0, GR_SNOW_CHECK_MAXES, partial);
+}
+
+/* The ledger: sum S and sum S rho. */
+__kernel void snow_ledger_reduce(__global const float *restrict depth,
+                                 __global const float *restrict density, int n,
+                                 __global float *restrict partial,
+                                 __local float *restrict scratch) {
+  int lid = get_local_id(0), wg = get_local_size(0), start, end;
+  gr_reduce_block(n, &start, &end);
+  float v_hi = 0.0f, v_lo = 0.0f, m_hi = 0.0f, m_lo = 0.0f;
+  for (int c = start + lid; c < end; c += wg) {
+    float s = depth[c];
+    gr_df_add(&v_hi, &v_lo, s);
+    gr_df_add(&m_hi, &m_lo, s * density[c]);
+  }
+  __local float *mine = gr_reduce_slots(scratch, GR_SNOW_LEDGER_SUMS, 0);
+  mine[0] = v_hi;
+  mine[1] = v_lo;
+  mine[2] = m_hi;
+  mine[3] = m_lo;
+  gr_reduce_group(scratch, GR_SNOW_LEDGER_SUMS, 0, partial);
+}
+
+/* Snow surface B + S. */
+__kernel void snow_surface(__global const float *restrict ground,
+                           __global const float *restrict depth, int n,
+                           __global float *restrict out) {
+  int c = get_global_id(0);
+  if (c < n)
+    out[c] = ground[c] + depth[c];
+}
+
+/* graupel-bench's yardstick (issue 8: a step against plain 5-point stencil
+ * passes): one Jacobi pass of the 5-point Laplacian, edges clamped. */
+__kernel void snow_bench_stencil5(__global const float *restrict in, int nx, int ny,
+                                  __global float *restrict out) {
+  int i = get_global_id(0), j = get_global_id(1);
+  if (!gr_inside(i, j, nx, ny))
+    return;
+  int c = gr_idx(i, j, nx);
+  float w = in[gr_idx(max(i - 1, 0), j, nx)], e = in[gr_idx(min(i + 1, nx - 1), j, nx)];
+  float sn = in[gr_idx(i, max(j - 1, 0), nx)], n = in[gr_idx(i, min(j + 1, ny - 1), nx)];
+  out[c] = 0.2f * (in[c] + w + e + sn + n);
+}

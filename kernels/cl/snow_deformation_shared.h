@@ -1,0 +1,33 @@
+/* Constants of the snow deformation core that the host (snow_deformation.c)
+ * and the device (snow_deformation.cl) must agree on. Plain preprocessor
+ * definitions only, valid C11 and OpenCL C. */
+#ifndef GRAUPEL_CL_SNOW_DEFORMATION_SHARED_H
+#define GRAUPEL_CL_SNOW_DEFORMATION_SHARED_H
+
+/* The talus flux per unit excess: the explicit 8-neighbour Jacobi step is
+ * stable up to 1/8 (a pit whose 8 higher neighbours all give at once must
+ * not rise above them); 1/10 leaves a margin for float rounding. */
+#define GR_SNOW_TALUS_RATE 0.1f
+
+/* A cell gives at most this fraction of its snow in one talus iteration, so
+ * that rounding never takes it below zero. */
+#define GR_SNOW_KEEP 0.999999f
+
+/* A point lies inside a triangle's xy projection when each edge function
+ * is at least -GR_SNOW_EDGE_EPS times twice the area: points on a shared edge
+ * then belong to both triangles whatever the rounding (the minimum does not
+ * mind), so a closed mesh has no pin-holes. */
+#define GR_SNOW_EDGE_EPS 1.0e-6f
+
+/* Reductions: per object, seven double-float sums (displaced volume e,
+ * displaced mass e rho, the contour weights, contour points, the moved mass
+ * D rho, the compressed height D - e, contact points), per unit cell area;
+ * the ledger two (depth, depth times density); the talus check one maximum. */
+#define GR_SNOW_OBJ_SUMS 7
+#define GR_SNOW_LEDGER_SUMS 2
+#define GR_SNOW_CHECK_MAXES 1
+
+/* The talus check runs every this many iterations. */
+#define GR_SNOW_CHECK_EVERY 8
+
+#endif

@@ -1,0 +1,291 @@
+/**
+ * @file snow_deformation.h
+ * @brief Objects pressing into and ploughing through snow (seed 000's
+ * thesis, notes/000.md section 2), as a mass-conserving, deterministic height-field
+ * model on the device.
+ *
+ * State per grid point: snow depth S (m) over a rigid ground B (m) and the
+ * snow's density rho (kg/m^3); the snow surface is H = B + S.
+ *
+ * One step (gr_snow_deformation_step) takes the objects at the poses last
+ * given to gr_snow_deformation_set_objects (the core never moves them: the
+ * caller, e.g. the filter, sets each step's poses) and, object by object in
+ * the order given:
+ *  1. raster: the underside U(i, j) = the lowest height at which the
+ *     object's surface crosses the vertical line through grid point (i, j):
+ *     the exact minimum over every triangle whose xy projection contains the
+ *     point (edges included), of the triangle's plane at the point; +inf
+ *     where no triangle covers it (not a bounding box).
+ *  2. overlap: D = min(S, max(0, H - U)) (the ground is rigid: snow never
+ *     goes below it, so an object below the ground presses at most S).
+ *  3. compression vs displacement (Eqs. 3.9-3.11 made mass-consistent):
+ *     the displaced height is e = max(W D, S - (S - D) rho_max / rho), at
+ *     most D, with W = (rho - rho_min) / (rho_max - rho_min) clamped to
+ *     [0, 1] (CompressionModel 0, density-driven; W = 1 when rho_min =
+ *     rho_max) or W = 1 - 0.15 (CompressionModel 1, the thesis code's
+ *     constant compressed fraction). The column keeps the mass (S - e) rho
+ *     in the height S - D: rho' = (S - e) rho / (S - D), never above
+ *     rho_max (the second term of e: snow that cannot be compressed further
+ *     is displaced; a column pressed to the ground is displaced whole). The
+ *     compressed volume is D - e. Thesis errata fixed: Eq. 3.11 lowers the
+ *     column by D Q only, the code by D without changing rho (mass lost).
+ *  4. imprint: S' = S - D, so the surface meets the underside (or the ground).
+ *  5. contour: the points with D = 0 that have an 8-neighbour with D > 0;
+ *     outward direction w = -sum over overlapped 8-neighbours of their offset
+ *     (the unit-weight filter of Alg. 4.8 on the overlap mask), normalised (0
+ *     when the offsets cancel).
+ *  6. distribution: the displaced volume V = sum e dx dy and its mass M = sum
+ *     e rho dx dy go to the contour, each contour point c receiving the
+ *     fraction s_w(c) / sum s_w, s_w = max(0, v^ . (w_x, w_y, 0)) + r / K,
+ *     v^ the object's unit velocity (3-D), r = v^_z^2 (the code form of Eq.
+ *     3.19, notes section 2.8; zero velocity counts as straight down: a uniform
+ *     ring), K = DirectionFalloff. The point's volume grows by its share of
+ *     V and its mass by its share of M (rho mixes), so both are conserved.
+ *     The totals are device reductions (reduce.h): no atomics, no append
+ *     buffers. An object whose overlap leaves no contour point on the grid
+ *     (it covers the whole grid) or whose weights sum to 0 (none ahead, the
+ *     rest off the grid) deforms nothing that step.
+ * Then, after all objects, talus relaxation (Eqs. 3.29-3.33, with Alg.
+ * 4.11's loss fixed): Jacobi iterations with gather (each point computes
+ * what it gives and what it receives from the same floats, so volume and
+ * mass are conserved and reruns are bit-identical). Point a gives to each
+ * 8-neighbour b the excess x_ab = max(0, H_a - H_b - MaxSlope d_ab), d_ab
+ * the pair's distance (dx, dy or the diagonal: the slope is a true slope,
+ * unlike the thesis' per-cell constant), times 1/10 (the explicit 8-neighbour
+ * step is stable up to 1/8), scaled down to S_a when a holds less; never to
+ * a point under an object whose underside is below H_a (U_b <= H_a), which
+ * holds the imprint. Moved snow carries its density (mass mixes). It stops
+ * when no point can move more than RelaxTolerance (the largest
+ * min(S_a, x_ab) over the grid, read every 8 iterations) or after
+ * MaxRelaxIterations.
+ *
+ * Resistance per object (Eqs. 3.6-3.8 made dimensionally sensible): the
+ * snow the object moved this step has the mass m = sum D rho dx dy (Eq. 3.6
+ * with the cell area the thesis left out); the object brings it to its own
+ * velocity within the step, so the force on the object is the momentum flux
+ *   F = -m v / dt   (N),
+ * opposite to the motion. For steady ploughing D per step is the frontal
+ * area A times v dt, so F = rho A |v| v: the familiar drag form, growing with
+ * speed and density, and zero without contact or motion. contact_area =
+ * dx dy times the number of points whose snow surface reaches to within
+ * GR_SNOW_DEFORMATION_CONTACT_GAP of the underside (or above it) before the
+ * imprint.
+ *
+ * Fields (gr_field): set ELEVATION (required, m), optionally SNOW_DEPTH (m;
+ * default params.initial_snow_depth) and SNOW_DENSITY (kg/m^3, within
+ * [min_density, max_density]; default params.initial_density). Read
+ * SNOW_DEPTH, SNOW_SURFACE (= elevation + depth), SNOW_DENSITY, OVERLAP (sum
+ * over the objects of D in the last step, m), CONTACT (1 where some object
+ * touched the snow in the last step, else 0) and ELEVATION.
+ *
+ * Pieces: whole grids only, for now. A gr_grid with i0, j0, ghost or a
+ * global size other than its own is refused with a sentence (the contour,
+ * the distribution and the talus relaxation reach any distance in one step,
+ * so a piece needs a global exchange the core does not do yet).
+ */
+#ifndef GRAUPEL_SNOW_DEFORMATION_H
+#define GRAUPEL_SNOW_DEFORMATION_H
+
+#include "graupel/runtime.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/** The thesis code's constant compressed fraction (CompressionModel 1). */
+#define GR_SNOW_DEFORMATION_CONSTANT_COMPRESSION 0.15
+
+/** An underside within this of the snow surface counts as contact, m. */
+#define GR_SNOW_DEFORMATION_CONTACT_GAP 1e-3
+
+/** Most objects one simulation takes at once. */
+#define GR_SNOW_DEFORMATION_MAX_OBJECTS 64
+
+/** CompressionModel values. */
+typedef enum gr_snow_compression {
+  GR_SNOW_COMPRESSION_DENSITY = 0, /**< Eqs. 3.9-3.11, mass-consistent (default) */
+  GR_SNOW_COMPRESSION_CONSTANT = 1 /**< a constant compressed fraction, 0.15 */
+} gr_snow_compression;
+
+/**
+ * The parameters, in the core's units (SI). Ranges and defaults are the rows
+ * of gr_snow_deformation_param_bounds, written nowhere else.
+ */
+typedef struct gr_snow_deformation_params {
+  double initial_snow_depth; /**< m, when no SNOW_DEPTH is set (row InitialSnowDepth) */
+  double initial_density;    /**< kg/m^3, when no SNOW_DENSITY is set (row InitialDensity) */
+  double min_density;        /**< rho_min, kg/m^3 (row MinDensity; DensityRange[0]) */
+  double max_density;        /**< rho_max, kg/m^3 (row MaxDensity; DensityRange[1]) */
+  int compression_model;     /**< gr_snow_compression (row CompressionModel) */
+  double max_slope;          /**< talus slope, m/m (row MaxSlope) */
+  double direction_falloff;  /**< K of s_w (row DirectionFalloff) */
+  int max_relax_iterations;  /**< talus iteration cap per step (row MaxRelaxIterations) */
+  double relax_tolerance;    /**< m (row RelaxTolerance) */
+} gr_snow_deformation_params;
+
+/** The table's defaults. */
+GR_API void gr_snow_deformation_params_init(gr_snow_deformation_params *p);
+
+/**
+ * Checks every parameter against its row of the table, and that
+ * min_density <= initial_density <= max_density; the sentence in msg names
+ * the property, its value and the range.
+ */
+GR_API gr_status gr_snow_deformation_params_validate(const gr_snow_deformation_params *p, char *msg,
+                                                     size_t msg_len);
+
+/**
+ * The parameter table (InitialSnowDepth m, InitialDensity kg/m^3,
+ * MinDensity kg/m^3, MaxDensity kg/m^3, CompressionModel, MaxSlope m/m,
+ * DirectionFalloff, MaxRelaxIterations, RelaxTolerance m); *count gets the
+ * number of rows.
+ */
+GR_API const gr_param_bound *gr_snow_deformation_param_bounds(int *count);
+
+/**
+ * The check set_field applies to an input field, on the host (no device):
+ * f must be ELEVATION, SNOW_DEPTH or SNOW_DENSITY; n values, rows of nx
+ * points (nx 0: one row, for naming the point); every value finite,
+ * elevations within +-1e6 m, depths 0 to 1e4 m, densities within
+ * [p->min_density, p->max_density] (as floats). The sentence names the field,
+ * the point (i, j) and the value. values may be NULL only when n is 0.
+ */
+GR_API gr_status gr_snow_deformation_field_validate(const gr_snow_deformation_params *p, gr_field f,
+                                                    const float *values, size_t n, size_t nx,
+                                                    char *msg, size_t msg_len);
+
+/** Book-keeping; volumes m^3, masses kg, cumulative since create or reset. */
+typedef struct gr_snow_deformation_ledger {
+  double time;              /**< simulated time, s (the sum of the steps' dt) */
+  long long steps;          /**< steps taken */
+  double initial_volume;    /**< snow volume at the start (grows with set_field) */
+  double initial_mass;      /**< snow mass at the start (grows with set_field) */
+  double snow_volume;       /**< snow volume now, sum S dx dy */
+  double snow_mass;         /**< snow mass now, sum S rho dx dy */
+  double compressed_volume; /**< volume lost to compression, cumulative */
+  double displaced_volume;  /**< volume moved to contours, cumulative */
+  /** snow_mass - initial_mass (kg): float rounding only */
+  double balance_error;
+  /** initial_volume - compressed_volume - snow_volume (m^3): float rounding only */
+  double volume_error;
+  int relax_iterations; /**< talus iterations of the last step */
+} gr_snow_deformation_ledger;
+
+typedef struct gr_snow_deformation gr_snow_deformation;
+
+/**
+ * A simulation on one whole grid (see "Pieces" above): validates grid and
+ * parameters, builds the kernels, allocates the state: flat ground at 0,
+ * snow of initial_snow_depth and initial_density, no objects.
+ */
+GR_API gr_status gr_snow_deformation_create(gr_context *ctx, const gr_grid *grid,
+                                            const gr_snow_deformation_params *p,
+                                            gr_snow_deformation **out);
+
+/**
+ * New parameters from the next step on (validated; the state is kept;
+ * initial_snow_depth and initial_density only matter to create).
+ */
+GR_API gr_status gr_snow_deformation_set_params(gr_snow_deformation *s,
+                                                const gr_snow_deformation_params *p);
+
+/**
+ * Uploads ELEVATION, SNOW_DEPTH or SNOW_DENSITY (nx*ny floats, row-major):
+ * every value finite, elevations within +-1e6 m, depths 0 to 1e4 m,
+ * densities within [min_density, max_density]; a refused field (a sentence
+ * naming the field, the point (i, j) and the value) leaves the state as it
+ * was. SNOW_DEPTH and SNOW_DENSITY replace the snow now and become the state
+ * reset returns to; the ledger's initial volume and mass move by the change.
+ */
+GR_API gr_status gr_snow_deformation_set_field(gr_snow_deformation *s, gr_field f,
+                                               const float *host);
+
+/**
+ * The objects for the next steps (copied; n from 0 to
+ * GR_SNOW_DEFORMATION_MAX_OBJECTS): each mesh must pass
+ * gr_mesh_validate(mesh, 1, ...) (closed), its pose is its transform (world,
+ * z up). velocities: 3 per object, m/s, world (for the direction weights and
+ * the resistance); NULL means all at rest. An object wholly outside the grid
+ * is accepted and touches nothing. A refusal names the object and keeps the
+ * objects set before.
+ */
+GR_API gr_status gr_snow_deformation_set_objects(gr_snow_deformation *s, const gr_mesh *meshes,
+                                                 int n, const double *velocities);
+
+/** One step of dt seconds (finite, 1e-9 to 3600); waits. */
+GR_API gr_status gr_snow_deformation_step(gr_snow_deformation *s, double dt);
+
+/**
+ * Reads a field back (waits): SNOW_DEPTH, SNOW_SURFACE, SNOW_DENSITY,
+ * OVERLAP, CONTACT or ELEVATION, nx*ny floats.
+ */
+GR_API gr_status gr_snow_deformation_get_field(gr_snow_deformation *s, gr_field f, float *host);
+
+/** The ledger now (waits; reduces volume and mass on the device). */
+GR_API gr_status gr_snow_deformation_ledger_get(gr_snow_deformation *s,
+                                                gr_snow_deformation_ledger *out);
+
+/**
+ * The resistance of the last step per object (see above): force3 gets 3
+ * doubles per object (N, world), area one per object (m^2); either may be
+ * NULL. n must equal the number of objects set. Zeros before the first step.
+ */
+GR_API gr_status gr_snow_deformation_object_forces(gr_snow_deformation *s, double *force3,
+                                                   double *area, int n);
+
+/**
+ * Progress (see gr_progress_fn): called after each step with the time
+ * reached; a non-zero return makes the next gr_snow_deformation_step
+ * refuse with GR_ERR_ABORTED until set_progress or reset is called. NULL
+ * removes it.
+ */
+GR_API void gr_snow_deformation_set_progress(gr_snow_deformation *s, gr_progress_fn fn, void *user);
+
+/**
+ * Checkpoints: depth, density, overlap, contact, the last forces, time,
+ * steps and ledger as bytes. Loading into a simulation of the same grid,
+ * inputs and objects makes every later step bit-identical. Inputs
+ * (elevation), parameters and objects are not part of it.
+ */
+GR_API gr_status gr_snow_deformation_state_size(const gr_snow_deformation *s, size_t *bytes);
+GR_API gr_status gr_snow_deformation_state_save(gr_snow_deformation *s, void *host, size_t bytes);
+GR_API gr_status gr_snow_deformation_state_load(gr_snow_deformation *s, const void *host,
+                                                size_t bytes);
+
+/** Back to the initial snow (the last SNOW_DEPTH/SNOW_DENSITY set, or the params'), ledger zeroed;
+ * elevation and objects kept. */
+GR_API gr_status gr_snow_deformation_reset(gr_snow_deformation *s);
+
+/** The latest error of a call on this simulation ("" when none). Never NULL. */
+GR_API const char *gr_snow_deformation_last_error(const gr_snow_deformation *s);
+
+/**
+ * Per-stage wall times, for graupel-bench: cumulative since timing was last
+ * switched on (ms). While on, each step waits for the device after every
+ * stage (slower: for profiling only).
+ */
+typedef struct gr_snow_deformation_timing {
+  long long steps;            /**< steps timed */
+  double raster_ms;           /**< underside raster, all objects */
+  double press_ms;            /**< overlap, compression totals (reduction) */
+  double contour_ms;          /**< contour cells and weights */
+  double distribution_ms;     /**< imprint and deposit on the contour */
+  double relax_ms;            /**< talus relaxation */
+  long long relax_iterations; /**< talus iterations, summed over the steps */
+} gr_snow_deformation_timing;
+
+/** Switches per-stage timing on (non-zero; the sums restart) or off. */
+GR_API void gr_snow_deformation_set_timing(gr_snow_deformation *s, int on);
+
+/** The sums since timing was switched on (zeros when it never was). */
+GR_API gr_status gr_snow_deformation_timing_get(const gr_snow_deformation *s,
+                                                gr_snow_deformation_timing *out);
+
+/** Frees the simulation; NULL is fine. */
+GR_API void gr_snow_deformation_destroy(gr_snow_deformation *s);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif

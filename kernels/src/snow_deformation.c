@@ -1,0 +1,1159 @@
+/* Snow deformation core (seed 000's thesis): host side of
+ * snow_deformation.cl. The model, its step order and its book-keeping are
+ * documented in graupel/snow_deformation.h; the constants both sides share
+ * in snow_deformation_shared.h. */
+#include "graupel/snow_deformation.h"
+#include "graupel/cl_runtime.h"
+#include "graupel/reduce.h"
+#include "snow_deformation_shared.h"
+
+#include <limits.h>
+#include <math.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#define GR_SNOW_MAX_ELEVATION 1.0e6
+#define GR_SNOW_MAX_DEPTH 1.0e4
+#define GR_SNOW_MIN_DT 1.0e-9
+#define GR_SNOW_MAX_DT 3600.0
+/* Checkpoints: "GSD1". */
+#define GR_SNOW_STATE_MAGIC 0x31445347u
+#define GR_SNOW_STATE_VERSION 1u
+/* Per-point arrays of a checkpoint: depth, density, overlap sum, contact. */
+#define GR_SNOW_STATE_ARRAYS 4
+
+enum {
+  GR_SNOW_P_INITIAL_DEPTH,
+  GR_SNOW_P_INITIAL_DENSITY,
+  GR_SNOW_P_MIN_DENSITY,
+  GR_SNOW_P_MAX_DENSITY,
+  GR_SNOW_P_COMPRESSION,
+  GR_SNOW_P_MAX_SLOPE,
+  GR_SNOW_P_FALLOFF,
+  GR_SNOW_P_ITERATIONS,
+  GR_SNOW_P_TOLERANCE,
+  GR_SNOW_P_COUNT
+};
+
+/* The one place each range is written. Densities: Table 3.1 of the thesis
+ * spans 30 (new snow) to 900 (ice) kg/m^3; sand reaches about 2000. */
+static const gr_param_bound gr_snow_bounds[GR_SNOW_P_COUNT] = {
+    {"InitialSnowDepth", "m", 0.0, 100.0, 0.5, 1.0, 0, 0},
+    {"InitialDensity", "kg/m^3", 1.0, 3000.0, 150.0, 1.0, 0, 0},
+    {"MinDensity", "kg/m^3", 1.0, 3000.0, 100.0, 1.0, 0, 0},
+    {"MaxDensity", "kg/m^3", 1.0, 3000.0, 400.0, 1.0, 0, 0},
+    {"CompressionModel", "", 0.0, 1.0, 0.0, 1.0, 0, 1},
+    {"MaxSlope", "m/m", 0.0, 100.0, 0.6, 1.0, 1, 0},
+    {"DirectionFalloff", "", 1.0, 1000.0, 8.0, 1.0, 0, 0},
+    {"MaxRelaxIterations", "", 0.0, 100000.0, 200.0, 1.0, 0, 1},
+    {"RelaxTolerance", "m", 0.0, 1.0, 1e-4, 1.0, 1, 0},
+};
+
+typedef struct gr_snow_object {
+  int first, count;       /* triangles in the world-triangle array */
+  int bi0, bi1, bj0, bj1; /* the box of points it may cover; bi0 > bi1: none */
+  double v[3];
+} gr_snow_object;
+
+struct gr_snow_deformation {
+  gr_context *ctx;
+  gr_grid grid;
+  gr_snow_deformation_params params;
+  cl_kernel raster, overlap_k, contour, obj_reduce, apply, relax_rate, relax_move, check_reduce,
+      ledger_reduce, surface;
+  cl_mem depth[2], density[2]; /* [cur] is the state */
+  int cur;
+  cl_mem ground, depth0, density0, under, overlap, weight, overlap_sum, contact, under_min, rate,
+      movable, scratch;
+  cl_mem tri; /* world triangles, 9 floats each */
+  size_t tri_cap;
+  gr_reduction red_obj, red_check, red_ledger;
+  gr_snow_object objects[GR_SNOW_DEFORMATION_MAX_OBJECTS];
+  int nobjects;
+  double force[GR_SNOW_DEFORMATION_MAX_OBJECTS][3], area[GR_SNOW_DEFORMATION_MAX_OBJECTS];
+  double time, initial_volume, initial_mass, compressed, displaced;
+  long long steps;
+  int relax_iterations;
+  int relax_full; /* the next relaxation covers the whole grid */
+  gr_progress_fn progress;
+  void *progress_user;
+  int aborted;
+  int timing; /* per-stage timing on: wait after each stage */
+  double t_mark;
+  gr_snow_deformation_timing tm;
+  char error[1024];
+};
+
+#define GR_SNOW_KEEP_ERROR(s, st) gr_error_keep((s)->error, sizeof((s)->error), (st))
+#define GR_SNOW_ARG(s, k, name, var) gr_kernel_arg((s)->ctx, (k), (name), sizeof(var), &(var))
+
+const gr_param_bound *gr_snow_deformation_param_bounds(int *count) {
+  if (count)
+    *count = GR_SNOW_P_COUNT;
+  return gr_snow_bounds;
+}
+
+const char *gr_snow_deformation_last_error(const gr_snow_deformation *s) {
+  return s ? s->error : "";
+}
+
+void gr_snow_deformation_params_init(gr_snow_deformation_params *p) {
+  if (!p)
+    return;
+  memset(p, 0, sizeof(*p));
+  const gr_param_bound *t = gr_snow_bounds;
+  p->initial_snow_depth = t[GR_SNOW_P_INITIAL_DEPTH].default_value;
+  p->initial_density = t[GR_SNOW_P_INITIAL_DENSITY].default_value;
+  p->min_density = t[GR_SNOW_P_MIN_DENSITY].default_value;
+  p->max_density = t[GR_SNOW_P_MAX_DENSITY].default_value;
+  p->compression_model = (int)t[GR_SNOW_P_COMPRESSION].default_value;
+  p->max_slope = t[GR_SNOW_P_MAX_SLOPE].default_value;
+  p->direction_falloff = t[GR_SNOW_P_FALLOFF].default_value;
+  p->max_relax_iterations = (int)t[GR_SNOW_P_ITERATIONS].default_value;
+  p->relax_tolerance = t[GR_SNOW_P_TOLERANCE].default_value;
+}
+
+static double gr_snow_param_value(const gr_snow_deformation_params *p, int row) {
+  switch (row) {
+  case GR_SNOW_P_INITIAL_DEPTH:
+    return p->initial_snow_depth;
+  case GR_SNOW_P_INITIAL_DENSITY:
+    return p->initial_density;
+  case GR_SNOW_P_MIN_DENSITY:
+    return p->min_density;
+  case GR_SNOW_P_MAX_DENSITY:
+    return p->max_density;
+  case GR_SNOW_P_COMPRESSION:
+    return (double)p->compression_model;
+  case GR_SNOW_P_MAX_SLOPE:
+    return p->max_slope;
+  case GR_SNOW_P_FALLOFF:
+    return p->direction_falloff;
+  case GR_SNOW_P_ITERATIONS:
+    return (double)p->max_relax_iterations;
+  default:
+    return p->relax_tolerance;
+  }
+}
+
+gr_status gr_snow_deformation_params_validate(const gr_snow_deformation_params *p, char *msg,
+                                              size_t msg_len) {
+  if (!p) {
+    if (msg && msg_len)
+      snprintf(msg, msg_len, "Invalid snow deformation parameters: no parameters were given.");
+    return GR_ERR_INVALID_ARGUMENT;
+  }
+  for (int row = 0; row < GR_SNOW_P_COUNT; ++row) {
+    const gr_param_bound *r = &gr_snow_bounds[row];
+    double v = gr_snow_param_value(p, row);
+    if (gr_param_accepts(r, v))
+      continue;
+    if (msg && msg_len) {
+      const char *sp = r->unit[0] ? " " : "";
+      double user = v / r->to_core;
+      if (r->integer)
+        snprintf(msg, msg_len,
+                 "Invalid snow deformation parameters: %s must be a whole number from %g to %g "
+                 "(got %g).",
+                 r->property, r->min, r->max, user);
+      else if (r->min_open)
+        snprintf(msg, msg_len,
+                 "Invalid snow deformation parameters: %s must be above %g and at most %g%s%s "
+                 "(got %g%s%s).",
+                 r->property, r->min, r->max, sp, r->unit, user, sp, r->unit);
+      else
+        snprintf(msg, msg_len,
+                 "Invalid snow deformation parameters: %s must lie between %g and %g%s%s (got "
+                 "%g%s%s).",
+                 r->property, r->min, r->max, sp, r->unit, user, sp, r->unit);
+    }
+    return GR_ERR_INVALID_ARGUMENT;
+  }
+  if (p->min_density > p->max_density) {
+    if (msg && msg_len)
+      snprintf(msg, msg_len,
+               "Invalid snow deformation parameters: MinDensity (%g kg/m^3) must not exceed "
+               "MaxDensity (%g kg/m^3); swap the two ends of DensityRange.",
+               p->min_density, p->max_density);
+    return GR_ERR_INVALID_ARGUMENT;
+  }
+  if (p->initial_density < p->min_density || p->initial_density > p->max_density) {
+    if (msg && msg_len)
+      snprintf(msg, msg_len,
+               "Invalid snow deformation parameters: InitialDensity must lie within DensityRange "
+               "%g to %g kg/m^3 (got %g kg/m^3).",
+               p->min_density, p->max_density, p->initial_density);
+    return GR_ERR_INVALID_ARGUMENT;
+  }
+  return GR_OK;
+}
+
+static double gr_snow_now_ms(void) {
+  struct timespec ts;
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return 1e3 * (double)ts.tv_sec + 1e-6 * (double)ts.tv_nsec;
+}
+
+/* With timing on: waits for the stage just enqueued and charges its time. */
+static gr_status gr_snow_mark(gr_snow_deformation *s, double *acc) {
+  if (!s->timing)
+    return GR_OK;
+  gr_status st = gr_finish(s->ctx);
+  double t = gr_snow_now_ms();
+  *acc += t - s->t_mark;
+  s->t_mark = t;
+  return st;
+}
+
+void gr_snow_deformation_set_timing(gr_snow_deformation *s, int on) {
+  if (!s)
+    return;
+  s->timing = on != 0;
+  memset(&s->tm, 0, sizeof(s->tm));
+}
+
+gr_status gr_snow_deformation_timing_get(const gr_snow_deformation *s,
+                                         gr_snow_deformation_timing *out) {
+  if (!s || !out)
+    return gr_set_error(NULL, GR_ERR_INVALID_ARGUMENT,
+                        "gr_snow_deformation_timing_get needs a simulation and a place for the "
+                        "times.");
+  *out = s->tm;
+  return GR_OK;
+}
+
+static size_t gr_snow_cells(const gr_snow_deformation *s) {
+  return (size_t)s->grid.nx * (size_t)s->grid.ny;
+}
+
+static gr_status gr_snow_fill(gr_snow_deformation *s, cl_mem buf, float value) {
+  return gr_cl_check(s->ctx,
+                     clEnqueueFillBuffer(gr_context_queue(s->ctx), buf, &value, sizeof(value), 0,
+                                         gr_snow_cells(s) * sizeof(float), 0, NULL, NULL),
+                     "Filling a device buffer");
+}
+
+static gr_status gr_snow_copy(gr_snow_deformation *s, cl_mem from, cl_mem to) {
+  return gr_cl_check(s->ctx,
+                     clEnqueueCopyBuffer(gr_context_queue(s->ctx), from, to, 0, 0,
+                                         gr_snow_cells(s) * sizeof(float), 0, NULL, NULL),
+                     "Copying a device buffer");
+}
+
+/* sum S and sum S rho, per unit area. */
+static gr_status gr_snow_ledger_sums(gr_snow_deformation *s, double *vol, double *mass) {
+  int n = (int)gr_snow_cells(s);
+  gr_status st = GR_SNOW_ARG(s, s->ledger_reduce, "depth", s->depth[s->cur]);
+  if (st == GR_OK)
+    st = GR_SNOW_ARG(s, s->ledger_reduce, "density", s->density[s->cur]);
+  if (st == GR_OK)
+    st = GR_SNOW_ARG(s, s->ledger_reduce, "n", n);
+  double sums[GR_SNOW_LEDGER_SUMS];
+  if (st == GR_OK)
+    st = gr_reduction_run(s->ctx, &s->red_ledger, s->ledger_reduce, sums, NULL);
+  if (st == GR_OK) {
+    double a = s->grid.dx * s->grid.dy;
+    *vol = sums[0] * a;
+    *mass = sums[1] * a;
+  }
+  return st;
+}
+
+static gr_status gr_snow_initial_state(gr_snow_deformation *s) {
+  s->cur = 0;
+  gr_status st = gr_snow_copy(s, s->depth0, s->depth[0]);
+  if (st == GR_OK)
+    st = gr_snow_copy(s, s->density0, s->density[0]);
+  if (st == GR_OK)
+    st = gr_snow_fill(s, s->overlap_sum, 0.0f);
+  if (st == GR_OK)
+    st = gr_snow_fill(s, s->contact, 0.0f);
+  s->time = s->compressed = s->displaced = 0.0;
+  s->steps = 0;
+  s->relax_iterations = 0;
+  s->relax_full = 1;
+  s->aborted = 0;
+  memset(s->force, 0, sizeof(s->force));
+  memset(s->area, 0, sizeof(s->area));
+  if (st == GR_OK)
+    st = gr_snow_ledger_sums(s, &s->initial_volume, &s->initial_mass);
+  return st;
+}
+
+gr_status gr_snow_deformation_create(gr_context *ctx, const gr_grid *grid,
+                                     const gr_snow_deformation_params *p,
+                                     gr_snow_deformation **out) {
+  char msg[320];
+  if (!ctx || !out)
+    return gr_set_error(ctx, GR_ERR_INVALID_ARGUMENT,
+                        "gr_snow_deformation_create needs a context and a place for the "
+                        "simulation.");
+  *out = NULL;
+  if (gr_grid_validate(grid, msg, sizeof(msg)) != GR_OK)
+    return gr_set_error(ctx, GR_ERR_INVALID_ARGUMENT, "%s", msg);
+  if (gr_snow_deformation_params_validate(p, msg, sizeof(msg)) != GR_OK)
+    return gr_set_error(ctx, GR_ERR_INVALID_ARGUMENT, "%s", msg);
+  if (grid->i0 != 0 || grid->j0 != 0 || grid->ghost != 0 ||
+      (grid->global_nx != 0 && grid->global_nx != grid->nx) ||
+      (grid->global_ny != 0 && grid->global_ny != grid->ny))
+    return gr_set_error(ctx, GR_ERR_INVALID_ARGUMENT,
+                        "Snow deformation runs on whole grids only for now: this grid is a "
+                        "piece (i0 %d, j0 %d, ghost %d, global %d x %d); run it on the whole "
+                        "domain.",
+                        grid->i0, grid->j0, grid->ghost, grid->global_nx, grid->global_ny);
+  if ((double)grid->nx * (double)grid->ny > (double)INT_MAX / 2)
+    return gr_set_error(ctx, GR_ERR_TOO_LARGE,
+                        "The snow deformation grid of %d x %d points is too large: the kernels "
+                        "address at most about 1e9 points; coarsen it.",
+                        grid->nx, grid->ny);
+  gr_snow_deformation *s = calloc(1, sizeof(*s));
+  if (!s)
+    return gr_set_error(ctx, GR_ERR_OUT_OF_MEMORY, "Out of host memory.");
+  s->ctx = gr_context_retain(ctx);
+  s->grid = *grid;
+  s->params = *p;
+  size_t cells = gr_snow_cells(s), bytes = cells * sizeof(float);
+  cl_program prog = NULL;
+  gr_status st = gr_program_get(ctx, "snow_deformation", NULL, &prog);
+  struct {
+    const char *name;
+    cl_kernel *k;
+  } ks[] = {{"snow_raster", &s->raster},
+            {"snow_overlap", &s->overlap_k},
+            {"snow_contour", &s->contour},
+            {"snow_object_reduce", &s->obj_reduce},
+            {"snow_apply", &s->apply},
+            {"snow_relax_rate", &s->relax_rate},
+            {"snow_relax_move", &s->relax_move},
+            {"snow_check_reduce", &s->check_reduce},
+            {"snow_ledger_reduce", &s->ledger_reduce},
+            {"snow_surface", &s->surface}};
+  for (size_t i = 0; st == GR_OK && i < sizeof(ks) / sizeof(ks[0]); ++i)
+    st = gr_kernel_create(ctx, prog, ks[i].name, ks[i].k);
+  cl_mem *bufs[] = {&s->depth[0],  &s->depth[1], &s->density[0],  &s->density[1],
+                    &s->ground,    &s->depth0,   &s->density0,    &s->under,
+                    &s->overlap,   &s->weight,   &s->overlap_sum, &s->contact,
+                    &s->under_min, &s->rate,     &s->movable,     &s->scratch};
+  for (size_t i = 0; st == GR_OK && i < sizeof(bufs) / sizeof(bufs[0]); ++i)
+    st = gr_buffer_create(ctx, CL_MEM_READ_WRITE, bytes, NULL, bufs[i]);
+  if (st == GR_OK)
+    st = gr_reduction_init(ctx, s->obj_reduce, cells, GR_SNOW_OBJ_SUMS, 0, &s->red_obj);
+  if (st == GR_OK)
+    st = gr_reduction_init(ctx, s->check_reduce, cells, 0, GR_SNOW_CHECK_MAXES, &s->red_check);
+  if (st == GR_OK)
+    st = gr_reduction_init(ctx, s->ledger_reduce, cells, GR_SNOW_LEDGER_SUMS, 0, &s->red_ledger);
+  if (st == GR_OK)
+    st = gr_snow_fill(s, s->ground, 0.0f);
+  if (st == GR_OK)
+    st = gr_snow_fill(s, s->depth0, (float)p->initial_snow_depth);
+  if (st == GR_OK)
+    st = gr_snow_fill(s, s->density0, (float)p->initial_density);
+  if (st == GR_OK)
+    st = gr_snow_fill(s, s->overlap, 0.0f);
+  if (st == GR_OK)
+    st = gr_snow_initial_state(s);
+  if (st != GR_OK) {
+    gr_snow_deformation_destroy(s);
+    return st;
+  }
+  *out = s;
+  return GR_OK;
+}
+
+void gr_snow_deformation_destroy(gr_snow_deformation *s) {
+  if (!s)
+    return;
+  cl_kernel ks[] = {s->raster,     s->overlap_k,  s->contour,      s->obj_reduce,    s->apply,
+                    s->relax_rate, s->relax_move, s->check_reduce, s->ledger_reduce, s->surface};
+  for (size_t i = 0; i < sizeof(ks) / sizeof(ks[0]); ++i)
+    if (ks[i])
+      clReleaseKernel(ks[i]);
+  cl_mem *bufs[] = {&s->depth[0],    &s->depth[1], &s->density[0], &s->density[1], &s->ground,
+                    &s->depth0,      &s->density0, &s->under,      &s->overlap,    &s->weight,
+                    &s->overlap_sum, &s->contact,  &s->under_min,  &s->rate,       &s->movable,
+                    &s->scratch,     &s->tri};
+  for (size_t i = 0; i < sizeof(bufs) / sizeof(bufs[0]); ++i)
+    gr_buffer_release(bufs[i]);
+  gr_reduction_release(&s->red_obj);
+  gr_reduction_release(&s->red_check);
+  gr_reduction_release(&s->red_ledger);
+  gr_context_release(s->ctx);
+  free(s);
+}
+
+gr_status gr_snow_deformation_set_params(gr_snow_deformation *s,
+                                         const gr_snow_deformation_params *p) {
+  char msg[320];
+  if (!s)
+    return gr_set_error(NULL, GR_ERR_INVALID_ARGUMENT,
+                        "gr_snow_deformation_set_params needs a simulation.");
+  if (gr_snow_deformation_params_validate(p, msg, sizeof(msg)) != GR_OK)
+    return GR_SNOW_KEEP_ERROR(s, gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT, "%s", msg));
+  s->params = *p;
+  s->relax_full = 1; /* a new MaxSlope may make any slope too steep */
+  return GR_OK;
+}
+
+gr_status gr_snow_deformation_field_validate(const gr_snow_deformation_params *p, gr_field f,
+                                             const float *values, size_t n, size_t nx, char *msg,
+                                             size_t msg_len) {
+  double lo, hi;
+  const char *rule;
+  char rule_text[200];
+  const char *name = gr_field_name(f);
+  if (!name)
+    name = "(unknown field)";
+  switch (f) {
+  case GR_FIELD_ELEVATION:
+    lo = -GR_SNOW_MAX_ELEVATION;
+    hi = GR_SNOW_MAX_ELEVATION;
+    rule = "elevations must be finite and within +-1e6 m";
+    break;
+  case GR_FIELD_SNOW_DEPTH:
+    lo = 0.0;
+    hi = GR_SNOW_MAX_DEPTH;
+    rule = "snow depths must be finite, at least 0 and at most 1e4 m";
+    break;
+  case GR_FIELD_SNOW_DENSITY:
+    if (!p) {
+      if (msg && msg_len)
+        snprintf(msg, msg_len,
+                 "Checking the field 'snow_density' needs the parameters (its DensityRange); "
+                 "pass them.");
+      return GR_ERR_INVALID_ARGUMENT;
+    }
+    lo = (double)(float)p->min_density;
+    hi = (double)(float)p->max_density;
+    snprintf(rule_text, sizeof(rule_text),
+             "snow densities must lie within DensityRange, %g to %g kg/m^3", lo, hi);
+    rule = rule_text;
+    break;
+  default:
+    if (msg && msg_len)
+      snprintf(msg, msg_len,
+               "The field '%s' is not an input of the snow deformation simulation; its inputs "
+               "are elevation, snow_depth and snow_density.",
+               name);
+    return GR_ERR_INVALID_ARGUMENT;
+  }
+  if (!values && n > 0) {
+    if (msg && msg_len)
+      snprintf(msg, msg_len, "The field '%s' has no values (got NULL for %zu points); pass them.",
+               name, n);
+    return GR_ERR_INVALID_ARGUMENT;
+  }
+  size_t row = nx > 0 ? nx : (n > 0 ? n : 1);
+  for (size_t c = 0; c < n; ++c) {
+    double v = values[c];
+    if (isfinite(v) && v >= lo && v <= hi)
+      continue;
+    if (msg && msg_len)
+      snprintf(msg, msg_len, "The field '%s' has the value %g at point (%zu, %zu): %s.", name, v,
+               c % row, c / row, rule);
+    return GR_ERR_INVALID_ARGUMENT;
+  }
+  return GR_OK;
+}
+
+static gr_status gr_snow_set_field_impl(gr_snow_deformation *s, gr_field f, const float *host) {
+  size_t cells = gr_snow_cells(s), nx = (size_t)s->grid.nx;
+  char msg[512];
+  if (gr_snow_deformation_field_validate(&s->params, f, host, cells, nx, msg, sizeof(msg)) != GR_OK)
+    return gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT, "%s", msg);
+  size_t bytes = cells * sizeof(float);
+  s->relax_full = 1; /* new snow or ground may be too steep anywhere */
+  if (f == GR_FIELD_ELEVATION)
+    return gr_buffer_write(s->ctx, s->ground, 0, bytes, host);
+  /* The new snow replaces what is there: the ledger's initial volume and
+   * mass move by the change, so the balance still closes. */
+  double v0, m0, v1, m1;
+  gr_status st = gr_snow_ledger_sums(s, &v0, &m0);
+  cl_mem init = f == GR_FIELD_SNOW_DEPTH ? s->depth0 : s->density0;
+  cl_mem now = f == GR_FIELD_SNOW_DEPTH ? s->depth[s->cur] : s->density[s->cur];
+  if (st == GR_OK)
+    st = gr_buffer_write(s->ctx, init, 0, bytes, host);
+  if (st == GR_OK)
+    st = gr_buffer_write(s->ctx, now, 0, bytes, host);
+  if (st == GR_OK)
+    st = gr_snow_ledger_sums(s, &v1, &m1);
+  if (st == GR_OK) {
+    s->initial_volume += v1 - v0;
+    s->initial_mass += m1 - m0;
+  }
+  return st;
+}
+
+gr_status gr_snow_deformation_set_field(gr_snow_deformation *s, gr_field f, const float *host) {
+  if (!s)
+    return gr_set_error(NULL, GR_ERR_INVALID_ARGUMENT,
+                        "gr_snow_deformation_set_field needs a simulation.");
+  if (!host)
+    return GR_SNOW_KEEP_ERROR(
+        s, gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
+                        "gr_snow_deformation_set_field needs the field's values (got NULL)."));
+  return GR_SNOW_KEEP_ERROR(s, gr_snow_set_field_impl(s, f, host));
+}
+
+static gr_status gr_snow_set_objects_impl(gr_snow_deformation *s, const gr_mesh *meshes, int n,
+                                          const double *velocities) {
+  char msg[320];
+  if (n < 0 || n > GR_SNOW_DEFORMATION_MAX_OBJECTS || (n > 0 && !meshes))
+    return gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
+                        "gr_snow_deformation_set_objects takes 0 to %d objects with their meshes "
+                        "(got %d%s).",
+                        GR_SNOW_DEFORMATION_MAX_OBJECTS, n,
+                        n > 0 && !meshes ? " and no meshes" : "");
+  size_t total = 0;
+  for (int o = 0; o < n; ++o) {
+    if (gr_mesh_validate(&meshes[o], 1, msg, sizeof(msg)) != GR_OK)
+      return gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT, "Object %d: %s", o, msg);
+    if (velocities)
+      for (int a = 0; a < 3; ++a)
+        if (!isfinite(velocities[3 * o + a]))
+          return gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
+                              "Object %d has a velocity that is not finite (component %d is %g); "
+                              "give finite velocities in m/s.",
+                              o, a, velocities[3 * o + a]);
+    total += (size_t)meshes[o].ntriangles;
+  }
+  if (total > (size_t)INT_MAX / 9)
+    return gr_set_error(s->ctx, GR_ERR_TOO_LARGE,
+                        "The objects have %zu triangles, more than the core addresses; simplify "
+                        "the meshes.",
+                        total);
+  float *tri = total ? malloc(total * 9 * sizeof(float)) : NULL;
+  if (total && !tri)
+    return gr_set_error(s->ctx, GR_ERR_OUT_OF_MEMORY, "Out of host memory.");
+  gr_snow_object objs[GR_SNOW_DEFORMATION_MAX_OBJECTS];
+  const gr_grid *g = &s->grid;
+  size_t at = 0;
+  for (int o = 0; o < n; ++o) {
+    const gr_mesh *m = &meshes[o];
+    const double *T = m->transform;
+    double lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
+    objs[o].first = (int)at;
+    objs[o].count = m->ntriangles;
+    for (int t = 0; t < m->ntriangles; ++t, ++at)
+      for (int k = 0; k < 3; ++k) {
+        const float *v = m->vertices + 3 * m->triangles[3 * t + k];
+        double w[3];
+        for (int a = 0; a < 3; ++a)
+          w[a] = T[a] * v[0] + T[4 + a] * v[1] + T[8 + a] * v[2] + T[12 + a];
+        /* Relative to grid point (0, 0), where float keeps its precision. */
+        w[0] -= g->x0;
+        w[1] -= g->y0;
+        for (int a = 0; a < 3; ++a) {
+          tri[9 * at + 3 * k + a] = (float)w[a];
+          lo[a] = fmin(lo[a], w[a]);
+          hi[a] = fmax(hi[a], w[a]);
+        }
+      }
+    double fi0 = ceil(lo[0] / g->dx - 1.0), fi1 = floor(hi[0] / g->dx + 1.0);
+    double fj0 = ceil(lo[1] / g->dy - 1.0), fj1 = floor(hi[1] / g->dy + 1.0);
+    if (fi1 < 0 || fj1 < 0 || fi0 > g->nx - 1 || fj0 > g->ny - 1) {
+      objs[o].bi0 = objs[o].bj0 = 1;
+      objs[o].bi1 = objs[o].bj1 = 0; /* wholly outside: touches nothing */
+    } else {
+      objs[o].bi0 = (int)fmax(0.0, fi0);
+      objs[o].bi1 = (int)fmin(g->nx - 1.0, fi1);
+      objs[o].bj0 = (int)fmax(0.0, fj0);
+      objs[o].bj1 = (int)fmin(g->ny - 1.0, fj1);
+    }
+    for (int a = 0; a < 3; ++a)
+      objs[o].v[a] = velocities ? velocities[3 * o + a] : 0.0;
+  }
+  gr_status st = GR_OK;
+  if (total > s->tri_cap) {
+    gr_buffer_release(&s->tri);
+    s->tri_cap = 0;
+    st = gr_buffer_create(s->ctx, CL_MEM_READ_ONLY, total * 9 * sizeof(float), NULL, &s->tri);
+    if (st == GR_OK)
+      s->tri_cap = total;
+  }
+  if (st == GR_OK && total)
+    st = gr_buffer_write(s->ctx, s->tri, 0, total * 9 * sizeof(float), tri);
+  free(tri);
+  if (st != GR_OK)
+    return st;
+  memcpy(s->objects, objs, (size_t)n * sizeof(objs[0]));
+  if (n != s->nobjects) {
+    memset(s->force, 0, sizeof(s->force));
+    memset(s->area, 0, sizeof(s->area));
+  }
+  s->nobjects = n;
+  return GR_OK;
+}
+
+gr_status gr_snow_deformation_set_objects(gr_snow_deformation *s, const gr_mesh *meshes, int n,
+                                          const double *velocities) {
+  if (!s)
+    return gr_set_error(NULL, GR_ERR_INVALID_ARGUMENT,
+                        "gr_snow_deformation_set_objects needs a simulation.");
+  return GR_SNOW_KEEP_ERROR(s, gr_snow_set_objects_impl(s, meshes, n, velocities));
+}
+
+/* The press parameters both press kernels take. */
+static gr_status gr_snow_press_args(gr_snow_deformation *s, cl_kernel k) {
+  float rho_min = (float)s->params.min_density, rho_max = (float)s->params.max_density;
+  float w_const = s->params.compression_model == GR_SNOW_COMPRESSION_CONSTANT
+                      ? (float)(1.0 - GR_SNOW_DEFORMATION_CONSTANT_COMPRESSION)
+                      : -1.0f;
+  float gap = (float)GR_SNOW_DEFORMATION_CONTACT_GAP;
+  gr_status st = GR_SNOW_ARG(s, k, "ground", s->ground);
+  if (st == GR_OK)
+    st = GR_SNOW_ARG(s, k, "depth", s->depth[s->cur]);
+  if (st == GR_OK)
+    st = GR_SNOW_ARG(s, k, "density", s->density[s->cur]);
+  if (st == GR_OK)
+    st = GR_SNOW_ARG(s, k, "under", s->under);
+  if (st == GR_OK)
+    st = GR_SNOW_ARG(s, k, "overlap", s->overlap);
+  if (st == GR_OK)
+    st = GR_SNOW_ARG(s, k, "weight", s->weight);
+  if (st == GR_OK)
+    st = GR_SNOW_ARG(s, k, "rho_min", rho_min);
+  if (st == GR_OK)
+    st = GR_SNOW_ARG(s, k, "rho_max", rho_max);
+  if (st == GR_OK)
+    st = GR_SNOW_ARG(s, k, "w_const", w_const);
+  if (st == GR_OK)
+    st = GR_SNOW_ARG(s, k, "gap", gap);
+  return st;
+}
+
+static gr_status gr_snow_object_step(gr_snow_deformation *s, int o, double dt) {
+  const gr_snow_object *ob = &s->objects[o];
+  gr_context *ctx = s->ctx;
+  int nx = s->grid.nx, ny = s->grid.ny, n = nx * ny;
+  float dx = (float)s->grid.dx, dy = (float)s->grid.dy;
+  size_t NX = (size_t)nx, NY = (size_t)ny;
+  gr_status st = GR_SNOW_ARG(s, s->raster, "tri", s->tri);
+  int first = ob->first, ntri = ob->count, bi0 = ob->bi0, bi1 = ob->bi1, bj0 = ob->bj0,
+      bj1 = ob->bj1;
+  if (st == GR_OK)
+    st = GR_SNOW_ARG(s, s->raster, "ntri", ntri);
+  if (st == GR_OK)
+    st = GR_SNOW_ARG(s, s->raster, "first", first);
+  if (st == GR_OK)
+    st = GR_SNOW_ARG(s, s->raster, "nx", nx);
+  if (st == GR_OK)
+    st = GR_SNOW_ARG(s, s->raster, "ny", ny);
+  if (st == GR_OK)
+    st = GR_SNOW_ARG(s, s->raster, "dx", dx);
+  if (st == GR_OK)
+    st = GR_SNOW_ARG(s, s->raster, "dy", dy);
+  if (st == GR_OK)
+    st = GR_SNOW_ARG(s, s->raster, "bi0", bi0);
+  if (st == GR_OK)
+    st = GR_SNOW_ARG(s, s->raster, "bi1", bi1);
+  if (st == GR_OK)
+    st = GR_SNOW_ARG(s, s->raster, "bj0", bj0);
+  if (st == GR_OK)
+    st = GR_SNOW_ARG(s, s->raster, "bj1", bj1);
+  if (st == GR_OK)
+    st = GR_SNOW_ARG(s, s->raster, "under", s->under);
+  if (st == GR_OK)
+    st = gr_enqueue_2d(ctx, s->raster, 0, 0, NX, NY, NULL);
+  if (st == GR_OK)
+    st = gr_snow_mark(s, &s->tm.raster_ms);
+  /* overlap */
+  if (st == GR_OK)
+    st = GR_SNOW_ARG(s, s->overlap_k, "ground", s->ground);
+  if (st == GR_OK)
+    st = GR_SNOW_ARG(s, s->overlap_k, "depth", s->depth[s->cur]);
+  if (st == GR_OK)
+    st = GR_SNOW_ARG(s, s->overlap_k, "under", s->under);
+  if (st == GR_OK)
+    st = GR_SNOW_ARG(s, s->overlap_k, "nx", nx);
+  if (st == GR_OK)
+    st = GR_SNOW_ARG(s, s->overlap_k, "ny", ny);
+  if (st == GR_OK)
+    st = GR_SNOW_ARG(s, s->overlap_k, "overlap", s->overlap);
+  if (st == GR_OK)
+    st = gr_enqueue_2d(ctx, s->overlap_k, 0, 0, NX, NY, NULL);
+  if (st == GR_OK)
+    st = gr_snow_mark(s, &s->tm.press_ms);
+  /* contour and weights */
+  double vn = sqrt(ob->v[0] * ob->v[0] + ob->v[1] * ob->v[1] + ob->v[2] * ob->v[2]);
+  double ux = 0.0, uy = 0.0, uz = -1.0; /* at rest: straight down, a uniform ring */
+  if (vn > 0.0) {
+    ux = ob->v[0] / vn;
+    uy = ob->v[1] / vn;
+    uz = ob->v[2] / vn;
+  }
+  float vx = (float)ux, vy = (float)uy, rest = (float)(uz * uz / s->params.direction_falloff);
+  if (st == GR_OK)
+    st = GR_SNOW_ARG(s, s->contour, "overlap", s->overlap);
+  if (st == GR_OK)
+    st = GR_SNOW_ARG(s, s->contour, "nx", nx);
+  if (st == GR_OK)
+    st = GR_SNOW_ARG(s, s->contour, "ny", ny);
+  if (st == GR_OK)
+    st = GR_SNOW_ARG(s, s->contour, "vx", vx);
+  if (st == GR_OK)
+    st = GR_SNOW_ARG(s, s->contour, "vy", vy);
+  if (st == GR_OK)
+    st = GR_SNOW_ARG(s, s->contour, "rest", rest);
+  if (st == GR_OK)
+    st = GR_SNOW_ARG(s, s->contour, "weight", s->weight);
+  if (st == GR_OK)
+    st = gr_enqueue_2d(ctx, s->contour, 0, 0, NX, NY, NULL);
+  if (st == GR_OK)
+    st = gr_snow_mark(s, &s->tm.contour_ms);
+  /* totals */
+  double sums[GR_SNOW_OBJ_SUMS];
+  if (st == GR_OK)
+    st = gr_snow_press_args(s, s->obj_reduce);
+  if (st == GR_OK)
+    st = GR_SNOW_ARG(s, s->obj_reduce, "n", n);
+  if (st == GR_OK)
+    st = gr_reduction_run(ctx, &s->red_obj, s->obj_reduce, sums, NULL);
+  if (st == GR_OK)
+    st = gr_snow_mark(s, &s->tm.press_ms);
+  if (st != GR_OK)
+    return st;
+  double area = s->grid.dx * s->grid.dy;
+  /* sums: 0 e, 1 e rho, 2 weights, 3 contour points, 4 D rho, 5 D - e, 6 contact */
+  int press = sums[3] > 0.0 && sums[2] > 0.0 && sums[0] > 0.0;
+  if (sums[0] <= 0.0 && sums[5] > 0.0)
+    press = 1; /* all compressed, nothing to distribute */
+  float add_depth = 0.0f, add_rho = (float)s->params.max_density;
+  if (press && sums[2] > 0.0 && sums[0] > 0.0) {
+    add_depth = (float)(sums[0] / sums[2]);
+    add_rho = (float)fmin(s->params.max_density, sums[1] / sums[0]);
+  }
+  if (press) {
+    s->compressed += sums[5] * area;
+    s->displaced += sums[0] * area;
+    double m = sums[4] * area;
+    for (int a = 0; a < 3; ++a)
+      s->force[o][a] += -m * ob->v[a] / dt;
+  }
+  s->area[o] = sums[6] * area;
+  if (st == GR_OK)
+    st = gr_snow_press_args(s, s->apply);
+  if (st == GR_OK)
+    st = GR_SNOW_ARG(s, s->apply, "add_depth", add_depth);
+  if (st == GR_OK)
+    st = GR_SNOW_ARG(s, s->apply, "add_rho", add_rho);
+  if (st == GR_OK)
+    st = GR_SNOW_ARG(s, s->apply, "press", press);
+  if (st == GR_OK)
+    st = GR_SNOW_ARG(s, s->apply, "nx", nx);
+  if (st == GR_OK)
+    st = GR_SNOW_ARG(s, s->apply, "ny", ny);
+  if (st == GR_OK)
+    st = GR_SNOW_ARG(s, s->apply, "overlap_sum", s->overlap_sum);
+  if (st == GR_OK)
+    st = GR_SNOW_ARG(s, s->apply, "contact", s->contact);
+  if (st == GR_OK)
+    st = GR_SNOW_ARG(s, s->apply, "under_min", s->under_min);
+  if (st == GR_OK)
+    st = gr_enqueue_2d(ctx, s->apply, 0, 0, NX, NY, NULL);
+  if (st == GR_OK)
+    st = gr_snow_mark(s, &s->tm.distribution_ms);
+  return st;
+}
+
+/* Talus relaxation on a window that grows by one point per iteration: a
+ * height that changes in one iteration can only change what its
+ * 8-neighbours give in the next, so outside the window nothing moves. The
+ * window starts at the objects' boxes (grown by the contour ring), or at the
+ * whole grid after the snow or the ground was set (relax_full). The rates
+ * run on the window R, the moves on R grown by one (the points that only
+ * receive); both buffers of the pair hold the same values outside the move
+ * window (copied first, and the windows only grow), so the ping-pong stays
+ * exact. */
+static gr_status gr_snow_relax(gr_snow_deformation *s) {
+  gr_context *ctx = s->ctx;
+  int nx = s->grid.nx, ny = s->grid.ny, n = nx * ny;
+  double dx = s->grid.dx, dy = s->grid.dy, slope = s->params.max_slope;
+  float tx = (float)(slope * dx), ty = (float)(slope * dy),
+        td = (float)(slope * sqrt(dx * dx + dy * dy));
+  gr_status st = GR_OK;
+  int it = 0, x0 = nx, x1 = -1, y0 = ny, y1 = -1;
+  s->relax_iterations = 0;
+  if (s->relax_full) {
+    x0 = y0 = 0;
+    x1 = nx - 1;
+    y1 = ny - 1;
+  } else {
+    for (int o = 0; o < s->nobjects; ++o) {
+      const gr_snow_object *ob = &s->objects[o];
+      if (ob->bi0 > ob->bi1 || ob->bj0 > ob->bj1)
+        continue;
+      x0 = x0 < ob->bi0 - 2 ? x0 : ob->bi0 - 2;
+      x1 = x1 > ob->bi1 + 2 ? x1 : ob->bi1 + 2;
+      y0 = y0 < ob->bj0 - 2 ? y0 : ob->bj0 - 2;
+      y1 = y1 > ob->bj1 + 2 ? y1 : ob->bj1 + 2;
+    }
+  }
+  if (x0 > x1 || y0 > y1 || s->params.max_relax_iterations == 0)
+    return GR_OK; /* nothing touched the snow: it stays as relaxed as it was */
+  s->relax_full = 0;
+  st = gr_snow_copy(s, s->depth[s->cur], s->depth[1 - s->cur]);
+  if (st == GR_OK)
+    st = gr_snow_copy(s, s->density[s->cur], s->density[1 - s->cur]);
+  if (st == GR_OK)
+    st = gr_snow_fill(s, s->rate, 0.0f);
+  if (st == GR_OK)
+    st = gr_snow_fill(s, s->movable, 0.0f);
+  while (st == GR_OK && it < s->params.max_relax_iterations) {
+    x0 = x0 > 0 ? x0 : 0;
+    y0 = y0 > 0 ? y0 : 0;
+    x1 = x1 < nx - 1 ? x1 : nx - 1;
+    y1 = y1 < ny - 1 ? y1 : ny - 1;
+    int mx0 = x0 > 0 ? x0 - 1 : 0, my0 = y0 > 0 ? y0 - 1 : 0;
+    int mx1 = x1 < nx - 1 ? x1 + 1 : nx - 1, my1 = y1 < ny - 1 ? y1 + 1 : ny - 1;
+    cl_kernel k = s->relax_rate;
+    st = GR_SNOW_ARG(s, k, "ground", s->ground);
+    if (st == GR_OK)
+      st = GR_SNOW_ARG(s, k, "depth", s->depth[s->cur]);
+    if (st == GR_OK)
+      st = GR_SNOW_ARG(s, k, "under_min", s->under_min);
+    if (st == GR_OK)
+      st = GR_SNOW_ARG(s, k, "nx", nx);
+    if (st == GR_OK)
+      st = GR_SNOW_ARG(s, k, "ny", ny);
+    if (st == GR_OK)
+      st = GR_SNOW_ARG(s, k, "tx", tx);
+    if (st == GR_OK)
+      st = GR_SNOW_ARG(s, k, "ty", ty);
+    if (st == GR_OK)
+      st = GR_SNOW_ARG(s, k, "td", td);
+    if (st == GR_OK)
+      st = GR_SNOW_ARG(s, k, "rate", s->rate);
+    if (st == GR_OK)
+      st = GR_SNOW_ARG(s, k, "movable", s->movable);
+    if (st == GR_OK)
+      st = gr_enqueue_2d(ctx, k, (size_t)x0, (size_t)y0, (size_t)(x1 - x0 + 1),
+                         (size_t)(y1 - y0 + 1), NULL);
+    if (st == GR_OK && it % GR_SNOW_CHECK_EVERY == 0) {
+      double mx = 0.0;
+      st = GR_SNOW_ARG(s, s->check_reduce, "movable", s->movable);
+      if (st == GR_OK)
+        st = GR_SNOW_ARG(s, s->check_reduce, "n", n);
+      if (st == GR_OK)
+        st = gr_reduction_run(ctx, &s->red_check, s->check_reduce, NULL, &mx);
+      if (st == GR_OK && mx <= s->params.relax_tolerance)
+        break;
+    }
+    k = s->relax_move;
+    int nxt = 1 - s->cur;
+    if (st == GR_OK)
+      st = GR_SNOW_ARG(s, k, "ground", s->ground);
+    if (st == GR_OK)
+      st = GR_SNOW_ARG(s, k, "depth", s->depth[s->cur]);
+    if (st == GR_OK)
+      st = GR_SNOW_ARG(s, k, "density", s->density[s->cur]);
+    if (st == GR_OK)
+      st = GR_SNOW_ARG(s, k, "under_min", s->under_min);
+    if (st == GR_OK)
+      st = GR_SNOW_ARG(s, k, "rate", s->rate);
+    if (st == GR_OK)
+      st = GR_SNOW_ARG(s, k, "nx", nx);
+    if (st == GR_OK)
+      st = GR_SNOW_ARG(s, k, "ny", ny);
+    if (st == GR_OK)
+      st = GR_SNOW_ARG(s, k, "tx", tx);
+    if (st == GR_OK)
+      st = GR_SNOW_ARG(s, k, "ty", ty);
+    if (st == GR_OK)
+      st = GR_SNOW_ARG(s, k, "td", td);
+    if (st == GR_OK)
+      st = GR_SNOW_ARG(s, k, "depth_out", s->depth[nxt]);
+    if (st == GR_OK)
+      st = GR_SNOW_ARG(s, k, "density_out", s->density[nxt]);
+    if (st == GR_OK)
+      st = gr_enqueue_2d(ctx, k, (size_t)mx0, (size_t)my0, (size_t)(mx1 - mx0 + 1),
+                         (size_t)(my1 - my0 + 1), NULL);
+    if (st == GR_OK)
+      s->cur = nxt;
+    ++it;
+    --x0, --y0, ++x1, ++y1;
+  }
+  s->relax_iterations = it;
+  return st;
+}
+
+gr_status gr_snow_deformation_step(gr_snow_deformation *s, double dt) {
+  if (!s)
+    return gr_set_error(NULL, GR_ERR_INVALID_ARGUMENT,
+                        "gr_snow_deformation_step needs a simulation.");
+  if (!(dt >= GR_SNOW_MIN_DT && dt <= GR_SNOW_MAX_DT))
+    return GR_SNOW_KEEP_ERROR(
+        s, gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
+                        "The snow deformation time step must lie between 1e-9 and 3600 s (got "
+                        "%g s).",
+                        dt));
+  if (s->aborted)
+    return GR_SNOW_KEEP_ERROR(
+        s, gr_set_error(s->ctx, GR_ERR_ABORTED,
+                        "The snow deformation was stopped by its progress callback; set the "
+                        "callback again or reset to go on."));
+  gr_status st = gr_snow_fill(s, s->overlap_sum, 0.0f);
+  if (st == GR_OK)
+    st = gr_snow_fill(s, s->contact, 0.0f);
+  if (st == GR_OK)
+    st = gr_snow_fill(s, s->under_min, INFINITY);
+  memset(s->force, 0, sizeof(s->force));
+  if (st == GR_OK && s->timing) {
+    st = gr_finish(s->ctx);
+    s->t_mark = gr_snow_now_ms();
+  }
+  for (int o = 0; st == GR_OK && o < s->nobjects; ++o)
+    st = gr_snow_object_step(s, o, dt);
+  if (st == GR_OK)
+    st = gr_snow_relax(s);
+  if (st == GR_OK)
+    st = gr_snow_mark(s, &s->tm.relax_ms);
+  if (st == GR_OK && s->timing) {
+    s->tm.steps++;
+    s->tm.relax_iterations += s->relax_iterations;
+  }
+  if (st == GR_OK)
+    st = gr_finish(s->ctx);
+  if (st != GR_OK)
+    return GR_SNOW_KEEP_ERROR(s, st);
+  s->time += dt;
+  s->steps++;
+  if (s->progress && s->progress(s->progress_user, s->time) != 0)
+    s->aborted = 1;
+  return GR_OK;
+}
+
+gr_status gr_snow_deformation_get_field(gr_snow_deformation *s, gr_field f, float *host) {
+  if (!s)
+    return gr_set_error(NULL, GR_ERR_INVALID_ARGUMENT,
+                        "gr_snow_deformation_get_field needs a simulation.");
+  if (!host)
+    return GR_SNOW_KEEP_ERROR(s, gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
+                                              "gr_snow_deformation_get_field needs a place for "
+                                              "the values (got NULL)."));
+  size_t bytes = gr_snow_cells(s) * sizeof(float);
+  cl_mem src = NULL;
+  gr_status st = GR_OK;
+  switch (f) {
+  case GR_FIELD_SNOW_DEPTH:
+    src = s->depth[s->cur];
+    break;
+  case GR_FIELD_SNOW_DENSITY:
+    src = s->density[s->cur];
+    break;
+  case GR_FIELD_OVERLAP:
+    src = s->overlap_sum;
+    break;
+  case GR_FIELD_CONTACT:
+    src = s->contact;
+    break;
+  case GR_FIELD_ELEVATION:
+    src = s->ground;
+    break;
+  case GR_FIELD_SNOW_SURFACE: {
+    int n = (int)gr_snow_cells(s);
+    st = GR_SNOW_ARG(s, s->surface, "ground", s->ground);
+    if (st == GR_OK)
+      st = GR_SNOW_ARG(s, s->surface, "depth", s->depth[s->cur]);
+    if (st == GR_OK)
+      st = GR_SNOW_ARG(s, s->surface, "n", n);
+    if (st == GR_OK)
+      st = GR_SNOW_ARG(s, s->surface, "out", s->scratch);
+    if (st == GR_OK)
+      st = gr_enqueue_2d(s->ctx, s->surface, 0, 0, (size_t)n, 1, NULL);
+    src = s->scratch;
+    break;
+  }
+  default: {
+    const char *name = gr_field_name(f);
+    return GR_SNOW_KEEP_ERROR(
+        s, gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
+                        "The snow deformation simulation has no output field '%s'; it gives "
+                        "snow_depth, snow_surface, snow_density, overlap, contact and elevation.",
+                        name ? name : "(unknown field)"));
+  }
+  }
+  if (st == GR_OK)
+    st = gr_buffer_read(s->ctx, src, 0, bytes, host);
+  return st == GR_OK ? GR_OK : GR_SNOW_KEEP_ERROR(s, st);
+}
+
+gr_status gr_snow_deformation_ledger_get(gr_snow_deformation *s, gr_snow_deformation_ledger *out) {
+  if (!s || !out)
+    return s ? GR_SNOW_KEEP_ERROR(s, gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
+                                                  "gr_snow_deformation_ledger_get needs a place "
+                                                  "for the ledger."))
+             : gr_set_error(NULL, GR_ERR_INVALID_ARGUMENT,
+                            "gr_snow_deformation_ledger_get needs a simulation.");
+  double v, m;
+  gr_status st = gr_snow_ledger_sums(s, &v, &m);
+  if (st != GR_OK)
+    return GR_SNOW_KEEP_ERROR(s, st);
+  memset(out, 0, sizeof(*out));
+  out->time = s->time;
+  out->steps = s->steps;
+  out->initial_volume = s->initial_volume;
+  out->initial_mass = s->initial_mass;
+  out->snow_volume = v;
+  out->snow_mass = m;
+  out->compressed_volume = s->compressed;
+  out->displaced_volume = s->displaced;
+  out->balance_error = m - s->initial_mass;
+  out->volume_error = s->initial_volume - s->compressed - v;
+  out->relax_iterations = s->relax_iterations;
+  return GR_OK;
+}
+
+gr_status gr_snow_deformation_object_forces(gr_snow_deformation *s, double *force3, double *area,
+                                            int n) {
+  if (!s)
+    return gr_set_error(NULL, GR_ERR_INVALID_ARGUMENT,
+                        "gr_snow_deformation_object_forces needs a simulation.");
+  if (n != s->nobjects)
+    return GR_SNOW_KEEP_ERROR(
+        s, gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
+                        "gr_snow_deformation_object_forces was asked for %d objects but %d are "
+                        "set; pass the number given to set_objects.",
+                        n, s->nobjects));
+  for (int o = 0; o < n; ++o) {
+    if (force3)
+      for (int a = 0; a < 3; ++a)
+        force3[3 * o + a] = s->force[o][a];
+    if (area)
+      area[o] = s->area[o];
+  }
+  return GR_OK;
+}
+
+void gr_snow_deformation_set_progress(gr_snow_deformation *s, gr_progress_fn fn, void *user) {
+  if (!s)
+    return;
+  s->progress = fn;
+  s->progress_user = user;
+  s->aborted = 0;
+}
+
+/* ---------------------------------------------------------- checkpoints */
+
+typedef struct gr_snow_state_header {
+  uint32_t magic, version;
+  int32_t nx, ny, relax_full, relax_iterations;
+  int64_t steps;
+  double time, initial_volume, initial_mass, compressed, displaced;
+  double force[GR_SNOW_DEFORMATION_MAX_OBJECTS][3], area[GR_SNOW_DEFORMATION_MAX_OBJECTS];
+} gr_snow_state_header;
+
+static size_t gr_snow_state_bytes(const gr_snow_deformation *s) {
+  return sizeof(gr_snow_state_header) + GR_SNOW_STATE_ARRAYS * gr_snow_cells(s) * sizeof(float);
+}
+
+gr_status gr_snow_deformation_state_size(const gr_snow_deformation *s, size_t *bytes) {
+  if (!s || !bytes)
+    return gr_set_error(NULL, GR_ERR_INVALID_ARGUMENT,
+                        "gr_snow_deformation_state_size needs a simulation and a place for the "
+                        "size.");
+  *bytes = gr_snow_state_bytes(s);
+  return GR_OK;
+}
+
+static cl_mem gr_snow_state_array(gr_snow_deformation *s, int a) {
+  cl_mem arrays[GR_SNOW_STATE_ARRAYS] = {s->depth[s->cur], s->density[s->cur], s->overlap_sum,
+                                         s->contact};
+  return arrays[a];
+}
+
+gr_status gr_snow_deformation_state_save(gr_snow_deformation *s, void *host, size_t bytes) {
+  if (!s)
+    return gr_set_error(NULL, GR_ERR_INVALID_ARGUMENT,
+                        "gr_snow_deformation_state_save needs a simulation.");
+  size_t need = gr_snow_state_bytes(s);
+  if (!host || bytes != need)
+    return GR_SNOW_KEEP_ERROR(
+        s, gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
+                        "The buffer for the snow deformation state has %zu bytes but this %d x %d "
+                        "simulation's state has %zu: size it with gr_snow_deformation_state_size.",
+                        host ? bytes : 0, s->grid.nx, s->grid.ny, need));
+  gr_snow_state_header hd;
+  memset(&hd, 0, sizeof(hd));
+  hd.magic = GR_SNOW_STATE_MAGIC;
+  hd.version = GR_SNOW_STATE_VERSION;
+  hd.nx = s->grid.nx;
+  hd.ny = s->grid.ny;
+  hd.relax_iterations = s->relax_iterations;
+  hd.relax_full = s->relax_full;
+  hd.steps = s->steps;
+  hd.time = s->time;
+  hd.initial_volume = s->initial_volume;
+  hd.initial_mass = s->initial_mass;
+  hd.compressed = s->compressed;
+  hd.displaced = s->displaced;
+  memcpy(hd.force, s->force, sizeof(hd.force));
+  memcpy(hd.area, s->area, sizeof(hd.area));
+  memcpy(host, &hd, sizeof(hd));
+  size_t ab = gr_snow_cells(s) * sizeof(float);
+  gr_status st = GR_OK;
+  for (int a = 0; st == GR_OK && a < GR_SNOW_STATE_ARRAYS; ++a)
+    st = gr_buffer_read(s->ctx, gr_snow_state_array(s, a), 0, ab,
+                        (char *)host + sizeof(hd) + (size_t)a * ab);
+  return st == GR_OK ? GR_OK : GR_SNOW_KEEP_ERROR(s, st);
+}
+
+gr_status gr_snow_deformation_state_load(gr_snow_deformation *s, const void *host, size_t bytes) {
+  if (!s)
+    return gr_set_error(NULL, GR_ERR_INVALID_ARGUMENT,
+                        "gr_snow_deformation_state_load needs a simulation.");
+  size_t need = gr_snow_state_bytes(s);
+  gr_snow_state_header hd;
+  if (!host || bytes != need)
+    return GR_SNOW_KEEP_ERROR(
+        s, gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
+                        "The snow deformation state has %zu bytes but this %d x %d simulation "
+                        "needs %zu: load a state saved from a grid of the same size.",
+                        host ? bytes : 0, s->grid.nx, s->grid.ny, need));
+  memcpy(&hd, host, sizeof(hd));
+  if (hd.magic != GR_SNOW_STATE_MAGIC || hd.version != GR_SNOW_STATE_VERSION ||
+      hd.nx != s->grid.nx || hd.ny != s->grid.ny)
+    return GR_SNOW_KEEP_ERROR(
+        s, gr_set_error(s->ctx, GR_ERR_FORMAT,
+                        "The bytes are not a snow deformation state of a %d x %d grid (version "
+                        "%u); load one saved by gr_snow_deformation_state_save.",
+                        s->grid.nx, s->grid.ny, GR_SNOW_STATE_VERSION));
+  size_t ab = gr_snow_cells(s) * sizeof(float);
+  const char *base = (const char *)host + sizeof(hd);
+  for (size_t c = 0; c < 2 * gr_snow_cells(s); ++c) {
+    float v;
+    memcpy(&v, base + c * sizeof(float), sizeof(v));
+    if (!isfinite(v) || v < 0.0f)
+      return GR_SNOW_KEEP_ERROR(
+          s, gr_set_error(s->ctx, GR_ERR_FORMAT,
+                          "The snow deformation state holds a depth or density of %g: it is "
+                          "damaged; load an intact one.",
+                          (double)v));
+  }
+  gr_status st = GR_OK;
+  for (int a = 0; st == GR_OK && a < GR_SNOW_STATE_ARRAYS; ++a)
+    st = gr_buffer_write(s->ctx, gr_snow_state_array(s, a), 0, ab, base + (size_t)a * ab);
+  if (st != GR_OK)
+    return GR_SNOW_KEEP_ERROR(s, st);
+  s->relax_iterations = hd.relax_iterations;
+  s->relax_full = hd.relax_full != 0;
+  s->steps = hd.steps;
+  s->time = hd.time;
+  s->initial_volume = hd.initial_volume;
+  s->initial_mass = hd.initial_mass;
+  s->compressed = hd.compressed;
+  s->displaced = hd.displaced;
+  memcpy(s->force, hd.force, sizeof(hd.force));
+  memcpy(s->area, hd.area, sizeof(hd.area));
+  return GR_OK;
+}
+
+gr_status gr_snow_deformation_reset(gr_snow_deformation *s) {
+  if (!s)
+    return gr_set_error(NULL, GR_ERR_INVALID_ARGUMENT,
+                        "gr_snow_deformation_reset needs a simulation.");
+  gr_status st = gr_snow_initial_state(s);
+  return st == GR_OK ? GR_OK : GR_SNOW_KEEP_ERROR(s, st);
+}
