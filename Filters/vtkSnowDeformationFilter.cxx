@@ -1,0 +1,898 @@
+#include "vtkSnowDeformationFilter.h"
+
+#include "vtkAlgorithmOutput.h"
+#include "vtkCellArray.h"
+#include "vtkCompositeDataIterator.h"
+#include "vtkCompositeDataSet.h"
+#include "vtkCellData.h"
+#include "vtkDemandDrivenPipeline.h"
+#include "vtkDoubleArray.h"
+#include "vtkExecutive.h"
+#include "vtkFieldData.h"
+#include "vtkFloatArray.h"
+#include "vtkGraupelMotion.h"
+#include "vtkIdList.h"
+#include "vtkImageData.h"
+#include "vtkInformation.h"
+#include "vtkInformationVector.h"
+#include "vtkMultiBlockDataSet.h"
+#include "vtkNew.h"
+#include "vtkObjectFactory.h"
+#include "vtkPointData.h"
+#include "vtkPoints.h"
+#include "vtkPolyData.h"
+#include "vtkSmartPointer.h"
+#include "vtkStreamingDemandDrivenPipeline.h"
+
+#include "graupel/snow_deformation.h"
+
+#include "GraupelParameterTable.h"
+
+#include <array>
+#include <chrono>
+#include <map>
+#include <cmath>
+#include <string>
+#include <vector>
+
+vtkStandardNewMacro(vtkSnowDeformationFilter);
+
+namespace {
+// The array as float32 (a copy when it is stored otherwise), or nullptr.
+vtkSmartPointer<vtkFloatArray> AsFloat(vtkDataArray *a) {
+  if (!a) {
+    return nullptr;
+  }
+  if (auto *f = vtkFloatArray::SafeDownCast(a)) {
+    return f;
+  }
+  auto f = vtkSmartPointer<vtkFloatArray>::New();
+  f->DeepCopy(a);
+  return f;
+}
+
+const gr_param_bound *Bound(const char *property) {
+  int count = 0;
+  const gr_param_bound *table = gr_snow_deformation_param_bounds(&count);
+  return gr_param_find(table, count, property);
+}
+
+double TableDefault(const char *property, double fallback) {
+  const gr_param_bound *b = Bound(property);
+  return b ? b->default_value : fallback;
+}
+
+void AddValue(vtkFieldData *fd, const char *name, double value) {
+  vtkNew<vtkDoubleArray> a;
+  a->SetName(name);
+  a->InsertNextValue(value);
+  fd->AddArray(a);
+}
+
+void AddForce(vtkFieldData *fd, const double force[3], double area) {
+  vtkNew<vtkDoubleArray> f;
+  f->SetName("force");
+  f->SetNumberOfComponents(3);
+  f->InsertNextTuple(force);
+  fd->AddArray(f);
+  AddValue(fd, "contact_area", area);
+}
+
+// The leaves of an Objects input in order: the polydata itself, or every
+// non-empty leaf of a composite.
+std::vector<vtkPolyData *> Leaves(vtkDataObject *objects, bool *other) {
+  std::vector<vtkPolyData *> leaves;
+  *other = false;
+  if (auto *cd = vtkCompositeDataSet::SafeDownCast(objects)) {
+    vtkSmartPointer<vtkCompositeDataIterator> it;
+    it.TakeReference(cd->NewIterator());
+    for (it->InitTraversal(); !it->IsDoneWithTraversal(); it->GoToNextItem()) {
+      auto *pd = vtkPolyData::SafeDownCast(it->GetCurrentDataObject());
+      if (pd && pd->GetNumberOfPoints() > 0) {
+        leaves.push_back(pd);
+      } else if (!pd && it->GetCurrentDataObject()) {
+        *other = true;
+      }
+    }
+  } else if (auto *pd = vtkPolyData::SafeDownCast(objects)) {
+    if (pd->GetNumberOfPoints() > 0) {
+      leaves.push_back(pd); // an empty polydata is no object
+    }
+  } else if (objects) {
+    *other = true;
+  }
+  return leaves;
+}
+
+// Vectors (normals) turned by the pose's rotation.
+vtkSmartPointer<vtkDataArray> Turned(vtkDataArray *v, const double m[16]) {
+  if (!v || v->GetNumberOfComponents() != 3) {
+    return v;
+  }
+  auto out = vtkSmartPointer<vtkFloatArray>::New();
+  out->SetName(v->GetName());
+  out->SetNumberOfComponents(3);
+  out->SetNumberOfTuples(v->GetNumberOfTuples());
+  for (vtkIdType i = 0; i < v->GetNumberOfTuples(); ++i) {
+    double a[3];
+    v->GetTuple(i, a);
+    out->SetTuple3(i, m[0] * a[0] + m[4] * a[1] + m[8] * a[2],
+                   m[1] * a[0] + m[5] * a[1] + m[9] * a[2],
+                   m[2] * a[0] + m[6] * a[1] + m[10] * a[2]);
+  }
+  return out;
+}
+
+// A copy of pd's geometry moved by the pose: world = M (p - centre).
+vtkSmartPointer<vtkPolyData> Posed(vtkPolyData *pd, const double centre[3], const double m[16]) {
+  auto out = vtkSmartPointer<vtkPolyData>::New();
+  out->ShallowCopy(pd);
+  vtkNew<vtkPoints> points;
+  points->SetDataTypeToDouble();
+  const vtkIdType n = pd->GetNumberOfPoints();
+  points->SetNumberOfPoints(n);
+  for (vtkIdType i = 0; i < n; ++i) {
+    double p[3];
+    pd->GetPoint(i, p);
+    const double x = p[0] - centre[0], y = p[1] - centre[1], z = p[2] - centre[2];
+    points->SetPoint(i, m[0] * x + m[4] * y + m[8] * z + m[12],
+                     m[1] * x + m[5] * y + m[9] * z + m[13],
+                     m[2] * x + m[6] * y + m[10] * z + m[14]);
+  }
+  out->SetPoints(points);
+  if (vtkDataArray *normals = pd->GetPointData()->GetNormals()) {
+    out->GetPointData()->SetNormals(Turned(normals, m));
+  }
+  if (vtkDataArray *normals = pd->GetCellData()->GetNormals()) {
+    out->GetCellData()->SetNormals(Turned(normals, m));
+  }
+  vtkNew<vtkFieldData> fd;
+  fd->ShallowCopy(pd->GetFieldData());
+  out->SetFieldData(fd);
+  return out;
+}
+} // namespace
+
+vtkSnowDeformationFilter::vtkSnowDeformationFilter() {
+  this->SetNumberOfInputPorts(3);
+  this->SetNumberOfOutputPorts(2);
+  // Objects with time steps are read in time; others are posed by the properties.
+  this->SetInputPortPolicy(1, TEMPORAL_INPUT);
+  this->MaxRelaxIterations = static_cast<int>(TableDefault("MaxRelaxIterations", 64));
+  this->RelaxTolerance = TableDefault("RelaxTolerance", 1e-4);
+}
+
+vtkSnowDeformationFilter::~vtkSnowDeformationFilter() {
+  this->ReleaseState();
+}
+
+GRAUPEL_TABLE_SETTER(vtkSnowDeformationFilter, InitialSnowDepth, double,
+                     gr_snow_deformation_param_bounds)
+GRAUPEL_TABLE_SETTER(vtkSnowDeformationFilter, InitialDensity, double,
+                     gr_snow_deformation_param_bounds)
+GRAUPEL_TABLE_SETTER(vtkSnowDeformationFilter, MinDensity, double, gr_snow_deformation_param_bounds)
+GRAUPEL_TABLE_SETTER(vtkSnowDeformationFilter, MaxDensity, double, gr_snow_deformation_param_bounds)
+GRAUPEL_TABLE_SETTER(vtkSnowDeformationFilter, CompressionModel, int,
+                     gr_snow_deformation_param_bounds)
+GRAUPEL_TABLE_SETTER(vtkSnowDeformationFilter, MaxSlope, double, gr_snow_deformation_param_bounds)
+GRAUPEL_TABLE_SETTER(vtkSnowDeformationFilter, DirectionFalloff, double,
+                     gr_snow_deformation_param_bounds)
+GRAUPEL_TABLE_SETTER(vtkSnowDeformationFilter, MaxRelaxIterations, int,
+                     gr_snow_deformation_param_bounds)
+GRAUPEL_TABLE_SETTER(vtkSnowDeformationFilter, RelaxTolerance, double,
+                     gr_snow_deformation_param_bounds)
+
+void vtkSnowDeformationFilter::SetDensityRange(double minimum, double maximum) {
+  this->SetMinDensity(minimum);
+  this->SetMaxDensity(maximum);
+}
+
+void vtkSnowDeformationFilter::SetObjectsConnection(vtkAlgorithmOutput *output) {
+  this->SetInputConnection(1, output);
+}
+
+void vtkSnowDeformationFilter::SetPathConnection(vtkAlgorithmOutput *output) {
+  this->SetInputConnection(2, output);
+}
+
+int vtkSnowDeformationFilter::FillInputPortInformation(int port, vtkInformation *info) {
+  if (port == 0) {
+    info->Set(vtkAlgorithm::INPUT_REQUIRED_DATA_TYPE(), "vtkImageData");
+    return 1;
+  }
+  // A multiblock is taken whole (one object per leaf): a composite pipeline
+  // would otherwise run the filter once per block.
+  info->Set(vtkAlgorithm::INPUT_REQUIRED_DATA_TYPE(), "vtkPolyData");
+  if (port == 1) {
+    info->Append(vtkAlgorithm::INPUT_REQUIRED_DATA_TYPE(), "vtkMultiBlockDataSet");
+  }
+  info->Set(vtkAlgorithm::INPUT_IS_OPTIONAL(), 1);
+  return 1;
+}
+
+int vtkSnowDeformationFilter::FillOutputPortInformation(int port, vtkInformation *info) {
+  // Port 1 follows the Objects input's type (REQUEST_DATA_OBJECT below).
+  info->Set(vtkDataObject::DATA_TYPE_NAME(), port == 0 ? "vtkImageData" : "vtkDataObject");
+  return 1;
+}
+
+vtkTypeBool vtkSnowDeformationFilter::ProcessRequest(vtkInformation *request,
+                                                     vtkInformationVector **inInfo,
+                                                     vtkInformationVector *outInfo) {
+  if (request->Has(vtkDemandDrivenPipeline::REQUEST_DATA_OBJECT())) {
+    vtkInformation *objInfo = inInfo[1]->GetInformationObject(0);
+    vtkDataObject *objects = objInfo ? objInfo->Get(vtkDataObject::DATA_OBJECT()) : nullptr;
+    const bool composite = vtkCompositeDataSet::SafeDownCast(objects) != nullptr;
+    vtkInformation *info = outInfo->GetInformationObject(1);
+    vtkDataObject *current = info->Get(vtkDataObject::DATA_OBJECT());
+    const bool fits =
+        current && (composite ? current->IsA("vtkMultiBlockDataSet") : current->IsA("vtkPolyData"));
+    if (!fits) {
+      vtkSmartPointer<vtkDataObject> made;
+      if (composite) {
+        made = vtkSmartPointer<vtkMultiBlockDataSet>::New();
+      } else {
+        made = vtkSmartPointer<vtkPolyData>::New();
+      }
+      info->Set(vtkDataObject::DATA_OBJECT(), made);
+    }
+    return this->Superclass::ProcessRequest(request, inInfo, outInfo);
+  }
+  // A request from the objects' port asks for the same time of the
+  // simulation, which the base reads from port 0.
+  if ((request->Has(vtkStreamingDemandDrivenPipeline::REQUEST_UPDATE_EXTENT()) ||
+       request->Has(vtkDemandDrivenPipeline::REQUEST_DATA())) &&
+      request->Has(vtkExecutive::FROM_OUTPUT_PORT()) &&
+      request->Get(vtkExecutive::FROM_OUTPUT_PORT()) == 1) {
+    vtkInformation *from = outInfo->GetInformationObject(1);
+    vtkInformation *to = outInfo->GetInformationObject(0);
+    if (from->Has(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP())) {
+      to->Set(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP(),
+              from->Get(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP()));
+    }
+  }
+  return this->Superclass::ProcessRequest(request, inInfo, outInfo);
+}
+
+int vtkSnowDeformationFilter::RequestInformation(vtkInformation *request,
+                                                 vtkInformationVector **inputVector,
+                                                 vtkInformationVector *outputVector) {
+  const int ok = this->Superclass::RequestInformation(request, inputVector, outputVector);
+  // The objects' output has the simulation's times, not the input's.
+  vtkInformation *image = outputVector->GetInformationObject(0);
+  vtkInformation *objects = outputVector->GetInformationObject(1);
+  objects->Remove(vtkStreamingDemandDrivenPipeline::TIME_STEPS());
+  objects->Remove(vtkStreamingDemandDrivenPipeline::TIME_RANGE());
+  if (image->Has(vtkStreamingDemandDrivenPipeline::TIME_STEPS())) {
+    objects->CopyEntry(image, vtkStreamingDemandDrivenPipeline::TIME_STEPS());
+    objects->CopyEntry(image, vtkStreamingDemandDrivenPipeline::TIME_RANGE());
+  }
+  return ok;
+}
+
+int vtkSnowDeformationFilter::RequestData(vtkInformation *request,
+                                          vtkInformationVector **inputVector,
+                                          vtkInformationVector *outputVector) {
+  vtkInformation *objInfo = outputVector->GetInformationObject(1);
+  if (vtkDataObject *objects = objInfo->Get(vtkDataObject::DATA_OBJECT())) {
+    objects->Initialize();
+  }
+  this->OutputVector = outputVector;
+  this->ObjectsFilled = false;
+  const int ok = this->Superclass::RequestData(request, inputVector, outputVector);
+  this->OutputVector = nullptr;
+  if (ok && this->ObjectsFilled) {
+    vtkDataObject *image = outputVector->GetInformationObject(0)->Get(vtkDataObject::DATA_OBJECT());
+    vtkDataObject *objects = objInfo->Get(vtkDataObject::DATA_OBJECT());
+    if (image->GetInformation()->Has(vtkDataObject::DATA_TIME_STEP())) {
+      objects->GetInformation()->Set(vtkDataObject::DATA_TIME_STEP(),
+                                     image->GetInformation()->Get(vtkDataObject::DATA_TIME_STEP()));
+    }
+  }
+  return ok;
+}
+
+int vtkSnowDeformationFilter::CheckParameters() {
+  const struct {
+    const char *property;
+    double value;
+  } values[] = {{"InitialSnowDepth", this->InitialSnowDepth},
+                {"InitialDensity", this->InitialDensity},
+                {"MinDensity", this->MinDensity},
+                {"MaxDensity", this->MaxDensity},
+                {"CompressionModel", double(this->CompressionModel)},
+                {"MaxSlope", this->MaxSlope},
+                {"DirectionFalloff", this->DirectionFalloff},
+                {"MaxRelaxIterations", double(this->MaxRelaxIterations)},
+                {"RelaxTolerance", this->RelaxTolerance}};
+  for (const auto &p : values) {
+    const gr_param_bound *b = Bound(p.property);
+    if (!b || gr_param_accepts(b, p.value * b->to_core)) {
+      continue;
+    }
+    const char *unit = (b->unit && *b->unit) ? b->unit : "";
+    const char *space = *unit ? " " : "";
+    vtkErrorMacro("Snow Deformation: " << p.property << " must be "
+                                       << (b->min_open ? "above " : "from ") << b->min << space
+                                       << unit << (b->min_open ? " and up to " : " to ") << b->max
+                                       << space << unit << "; it is " << p.value << space << unit
+                                       << ". Set it within that range.");
+    return 0;
+  }
+  if (!(this->TimeStep >= 1.0e-6 && this->TimeStep <= 60.0)) {
+    vtkErrorMacro("Snow Deformation: TimeStep must be from 1e-6 s to 60 s; it is "
+                  << this->TimeStep << " s. Set it within that range.");
+    return 0;
+  }
+  if (!(this->MinDensity <= this->MaxDensity)) {
+    vtkErrorMacro("Snow Deformation: MinDensity ("
+                  << this->MinDensity << " kg/m^3) is above MaxDensity (" << this->MaxDensity
+                  << " kg/m^3); swap the DensityRange's ends.");
+    return 0;
+  }
+  const double *v = this->ObjectVelocity;
+  if (!std::isfinite(v[0]) || !std::isfinite(v[1]) || !std::isfinite(v[2]) ||
+      !std::isfinite(this->ObjectAngularVelocity) || !std::isfinite(this->RotationAxis[0]) ||
+      !std::isfinite(this->RotationAxis[1]) || !std::isfinite(this->RotationAxis[2])) {
+    vtkErrorMacro("Snow Deformation: ObjectVelocity ("
+                  << v[0] << " " << v[1] << " " << v[2] << " m/s), ObjectAngularVelocity ("
+                  << this->ObjectAngularVelocity
+                  << " deg/s) and RotationAxis must be finite numbers; set them so.");
+    return 0;
+  }
+  return 1;
+}
+
+int vtkSnowDeformationFilter::ReadPath(vtkPolyData *path) {
+  this->Path.clear();
+  if (!path) {
+    return 1;
+  }
+  // The first polyline in its order; without lines, the points in theirs.
+  vtkNew<vtkIdList> ids;
+  vtkCellArray *lines = path->GetLines();
+  if (lines && lines->GetNumberOfCells() > 0) {
+    lines->InitTraversal();
+    lines->GetNextCell(ids);
+  } else {
+    for (vtkIdType i = 0; i < path->GetNumberOfPoints(); ++i) {
+      ids->InsertNextId(i);
+    }
+  }
+  double length = 0.0;
+  for (vtkIdType k = 0; k < ids->GetNumberOfIds(); ++k) {
+    double p[3];
+    path->GetPoint(ids->GetId(k), p);
+    if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2])) {
+      vtkErrorMacro("Snow Deformation's Path has a point that is not finite (point "
+                    << ids->GetId(k) << "); fix or remove it.");
+      return 0;
+    }
+    if (k > 0) {
+      const double *q = &this->Path[this->Path.size() - 3];
+      length += std::sqrt((p[0] - q[0]) * (p[0] - q[0]) + (p[1] - q[1]) * (p[1] - q[1]) +
+                          (p[2] - q[2]) * (p[2] - q[2]));
+    }
+    this->Path.insert(this->Path.end(), {p[0], p[1], p[2]});
+  }
+  if (this->Path.size() < 6 || !(length > 0.0)) {
+    vtkErrorMacro("Snow Deformation's Path must be a polyline of at least two distinct points; "
+                  "it has "
+                  << this->Path.size() / 3 << " point(s) and a length of " << length
+                  << " m. Give it a polyline (e.g. a Poly Line Source) or disconnect it.");
+    this->Path.clear();
+    return 0;
+  }
+  return 1;
+}
+
+int vtkSnowDeformationFilter::ReadObjects(vtkDataObject *objects) {
+  this->Objects.clear();
+  bool other = false;
+  const std::vector<vtkPolyData *> leaves = Leaves(objects, &other);
+  if (other) {
+    vtkErrorMacro("Snow Deformation's Objects must be vtkPolyData or a multiblock of them; "
+                  "convert the other blocks with Extract Surface.");
+    return 0;
+  }
+  if (leaves.size() > GR_SNOW_DEFORMATION_MAX_OBJECTS) {
+    vtkErrorMacro("Snow Deformation's Objects has " << leaves.size() << " blocks; at most "
+                                                    << GR_SNOW_DEFORMATION_MAX_OBJECTS
+                                                    << " objects are simulated. Merge some.");
+    return 0;
+  }
+  for (size_t k = 0; k < leaves.size(); ++k) {
+    vtkPolyData *pd = leaves[k];
+    Object o;
+    double b[6];
+    pd->GetBounds(b);
+    for (int c = 0; c < 3; ++c) {
+      o.centre[c] = 0.5 * (b[2 * c] + b[2 * c + 1]);
+      o.velocity[c] = this->ObjectVelocity[c];
+    }
+    vtkDataArray *v = pd->GetFieldData()->GetArray("velocity");
+    if (v) {
+      if (v->GetNumberOfComponents() != 3 || v->GetNumberOfTuples() < 1) {
+        vtkErrorMacro("Snow Deformation's Objects block "
+                      << k << " has a field array 'velocity' that is not one 3-component "
+                      << "value (m/s); give it 3 components or remove it.");
+        return 0;
+      }
+      v->GetTuple(0, o.velocity);
+    }
+    // Points at the same place are one vertex: sources such as a box or a
+    // capped cylinder repeat corners per face (for their normals), which
+    // would leave every edge open.
+    const vtkIdType n = pd->GetNumberOfPoints();
+    std::vector<int> vertexOf(static_cast<size_t>(n));
+    std::map<std::array<double, 3>, int> merged;
+    for (vtkIdType i = 0; i < n; ++i) {
+      std::array<double, 3> p;
+      pd->GetPoint(i, p.data());
+      auto found = merged.emplace(p, static_cast<int>(merged.size()));
+      vertexOf[static_cast<size_t>(i)] = found.first->second;
+      if (found.second) {
+        for (int c = 0; c < 3; ++c) {
+          o.vertices.push_back(static_cast<float>(p[static_cast<size_t>(c)] - o.centre[c]));
+        }
+      }
+    }
+    // An id out of range becomes -1, which gr_mesh_validate names.
+    auto vertex = [&](vtkIdType id) {
+      return id >= 0 && id < n ? vertexOf[static_cast<size_t>(id)] : -1;
+    };
+    // Polygons as fans, strips with alternating winding: the triangles the
+    // core takes, without a dependency on VTK's filters.
+    vtkNew<vtkIdList> ids;
+    vtkCellArray *polys = pd->GetPolys();
+    for (polys->InitTraversal(); polys->GetNextCell(ids);) {
+      for (vtkIdType j = 2; j < ids->GetNumberOfIds(); ++j) {
+        o.triangles.insert(o.triangles.end(), {vertex(ids->GetId(0)), vertex(ids->GetId(j - 1)),
+                                               vertex(ids->GetId(j))});
+      }
+    }
+    vtkCellArray *strips = pd->GetStrips();
+    for (strips->InitTraversal(); strips->GetNextCell(ids);) {
+      for (vtkIdType j = 2; j < ids->GetNumberOfIds(); ++j) {
+        const int a = vertex(ids->GetId(j - 2));
+        const int b1 = vertex(ids->GetId(j - 1));
+        const int c = vertex(ids->GetId(j));
+        if (j % 2 == 0) {
+          o.triangles.insert(o.triangles.end(), {a, b1, c});
+        } else {
+          o.triangles.insert(o.triangles.end(), {b1, a, c});
+        }
+      }
+    }
+    gr_mesh mesh = {};
+    mesh.vertices = o.vertices.data();
+    mesh.nvertices = static_cast<int>(o.vertices.size() / 3);
+    mesh.triangles = o.triangles.data();
+    mesh.ntriangles = static_cast<int>(o.triangles.size() / 3);
+    for (int i = 0; i < 16; ++i) {
+      mesh.transform[i] = (i % 5 == 0) ? 1.0 : 0.0;
+    }
+    char msg[512];
+    if (gr_mesh_validate(&mesh, 1, msg, sizeof(msg)) != GR_OK) {
+      vtkErrorMacro("Snow Deformation's Objects"
+                    << (leaves.size() > 1 ? " block " + std::to_string(k) : std::string()) << ": "
+                    << msg);
+      return 0;
+    }
+    this->Objects.push_back(std::move(o));
+  }
+  this->ObjectsTemporal = this->IsInputTemporal(1);
+  if (!this->Path.empty() && !this->ObjectsTemporal) {
+    for (size_t k = 0; k < this->Objects.size(); ++k) {
+      const double *v = this->Objects[k].velocity;
+      if (!(std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]) > 0.0)) {
+        vtkErrorMacro("Snow Deformation: along the Path the objects move at the speed of "
+                      "ObjectVelocity (or of a block's 'velocity'), and object "
+                      << k << "'s is 0 m/s; set ObjectVelocity to the speed wanted.");
+        return 0;
+      }
+    }
+  }
+  return 1;
+}
+
+void vtkSnowDeformationFilter::Pose(size_t k, double t, double m[16]) const {
+  const Object &o = this->Objects[k];
+  if (this->ObjectsTemporal) {
+    // The geometry is the pose: back to where it was read.
+    for (int i = 0; i < 16; ++i) {
+      m[i] = (i % 5 == 0) ? 1.0 : 0.0;
+    }
+    m[12] = o.centre[0];
+    m[13] = o.centre[1];
+    m[14] = o.centre[2];
+    return;
+  }
+  vtkNew<vtkGraupelMotion> motion;
+  motion->SetAngularVelocity(this->ObjectAngularVelocity);
+  motion->SetRotationAxis(this->RotationAxis[0], this->RotationAxis[1], this->RotationAxis[2]);
+  if (!this->Path.empty()) {
+    for (size_t p = 0; p + 2 < this->Path.size(); p += 3) {
+      motion->AddPathPoint(this->Path[p], this->Path[p + 1], this->Path[p + 2]);
+    }
+    motion->SetPathSpeed(std::sqrt(o.velocity[0] * o.velocity[0] + o.velocity[1] * o.velocity[1] +
+                                   o.velocity[2] * o.velocity[2]));
+    motion->EvaluatePose(t, m);
+    return;
+  }
+  motion->SetVelocity(o.velocity[0], o.velocity[1], o.velocity[2]);
+  motion->EvaluatePose(t, m);
+  // The motion starts from the object's own place.
+  m[12] += o.centre[0];
+  m[13] += o.centre[1];
+  m[14] += o.centre[2];
+}
+
+int vtkSnowDeformationFilter::SetObjects(double t, double h) {
+  const size_t n = this->Objects.size();
+  std::vector<gr_mesh> meshes(n);
+  std::vector<double> velocities(3 * n, 0.0);
+  for (size_t k = 0; k < n; ++k) {
+    const Object &o = this->Objects[k];
+    gr_mesh &m = meshes[k];
+    m.vertices = o.vertices.data();
+    m.nvertices = static_cast<int>(o.vertices.size() / 3);
+    m.triangles = o.triangles.data();
+    m.ntriangles = static_cast<int>(o.triangles.size() / 3);
+    this->Pose(k, t, m.transform);
+    if (!this->ObjectsTemporal && !this->Path.empty()) {
+      // The centre's velocity over the step: along a path it turns with the
+      // path and stops at its end.
+      double before[16];
+      this->Pose(k, t - h, before);
+      for (int c = 0; c < 3; ++c) {
+        velocities[3 * k + c] = h > 0.0 ? (m.transform[12 + c] - before[12 + c]) / h : 0.0;
+      }
+    } else {
+      for (int c = 0; c < 3; ++c) {
+        velocities[3 * k + c] = o.velocity[c];
+      }
+    }
+  }
+  const gr_status st = gr_snow_deformation_set_objects(
+      this->Simulation, meshes.data(), static_cast<int>(n), n ? velocities.data() : nullptr);
+  if (st != GR_OK) {
+    return this->ReportFailure(st, "Snow Deformation's Objects",
+                               gr_snow_deformation_last_error(this->Simulation));
+  }
+  return 1;
+}
+
+int vtkSnowDeformationFilter::StepProgress(void *user, double time) {
+  auto *self = static_cast<vtkSnowDeformationFilter *>(user);
+  if (self->GetAbortExecute()) {
+    return 1;
+  }
+  // Every step reports; the text and the event only a few times a second.
+  const double now =
+      std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+  if (now - self->LastProgressWall < 0.1) {
+    return 0;
+  }
+  self->LastProgressWall = now;
+  return vtkGraupelSimulation::CoreProgress(user, time);
+}
+
+int vtkSnowDeformationFilter::SetUpState(vtkInformationVector **inputVector) {
+  vtkImageData *terrain = vtkImageData::GetData(inputVector[0]);
+  if (!terrain) {
+    vtkErrorMacro("Snow Deformation needs a terrain image on its Input.");
+    return 0;
+  }
+  int dims[3];
+  terrain->GetDimensions(dims);
+  double spacing[3];
+  terrain->GetSpacing(spacing);
+  if (dims[0] < 2 || dims[1] < 2 || dims[2] != 1) {
+    vtkErrorMacro("Snow Deformation needs a 2-D terrain of at least 2 x 2 points on its Input; "
+                  "it got "
+                  << dims[0] << " x " << dims[1] << " x " << dims[2]
+                  << ". Slice a volume or resample the terrain first.");
+    return 0;
+  }
+  if (!(spacing[0] > 0.0) || !(spacing[1] > 0.0)) {
+    vtkErrorMacro("Snow Deformation needs a terrain spacing above 0 m in x and y; the Input has "
+                  << spacing[0] << " x " << spacing[1] << " m. Set the spacing on the source.");
+    return 0;
+  }
+  vtkDataArray *elevationArray = this->GetElevation(terrain, "Input");
+  if (!elevationArray || !this->CheckParameters()) {
+    return 0;
+  }
+  const size_t npoints = static_cast<size_t>(dims[0]) * static_cast<size_t>(dims[1]);
+  struct Upload {
+    gr_field field;
+    vtkSmartPointer<vtkFloatArray> values;
+  };
+  std::vector<Upload> uploads;
+  uploads.push_back({GR_FIELD_ELEVATION, AsFloat(elevationArray)});
+  vtkPointData *pd = terrain->GetPointData();
+  if (vtkDataArray *depth = pd->GetArray("snow_depth")) {
+    uploads.push_back({GR_FIELD_SNOW_DEPTH, AsFloat(depth)});
+  }
+  if (vtkDataArray *density = pd->GetArray("snow_density")) {
+    uploads.push_back({GR_FIELD_SNOW_DENSITY, AsFloat(density)});
+  }
+  for (const Upload &u : uploads) {
+    if (u.values->GetNumberOfComponents() != 1 ||
+        static_cast<size_t>(u.values->GetNumberOfTuples()) != npoints) {
+      vtkErrorMacro("Snow Deformation's Input array '"
+                    << gr_field_name(u.field) << "' has " << u.values->GetNumberOfTuples()
+                    << " tuples of " << u.values->GetNumberOfComponents()
+                    << " component(s); it must have one value per point (" << npoints
+                    << "): resample it onto the terrain's grid or remove it.");
+      return 0;
+    }
+  }
+
+  const int nobjects = this->GetNumberOfInputConnections(1);
+  vtkPolyData *path =
+      this->GetNumberOfInputConnections(2) ? vtkPolyData::GetData(inputVector[2]) : nullptr;
+  if (!this->ReadPath(path) ||
+      !this->ReadObjects(nobjects ? vtkDataObject::GetData(inputVector[1]) : nullptr)) {
+    return 0;
+  }
+  this->ObjectsReadAt = this->GetTemporalInputTime(1);
+
+  gr_snow_deformation_params p;
+  gr_snow_deformation_params_init(&p);
+  p.initial_snow_depth = this->InitialSnowDepth;
+  p.initial_density = this->InitialDensity;
+  p.min_density = this->MinDensity;
+  p.max_density = this->MaxDensity;
+  p.compression_model = this->CompressionModel;
+  p.max_slope = this->MaxSlope;
+  p.direction_falloff = this->DirectionFalloff;
+  p.max_relax_iterations = this->MaxRelaxIterations;
+  p.relax_tolerance = this->RelaxTolerance;
+  char msg[512];
+  if (gr_snow_deformation_params_validate(&p, msg, sizeof(msg)) != GR_OK) {
+    vtkErrorMacro("Snow Deformation: " << msg);
+    return 0;
+  }
+  gr_grid grid = {};
+  grid.nx = dims[0];
+  grid.ny = dims[1];
+  grid.dx = spacing[0];
+  grid.dy = spacing[1];
+  grid.x0 = terrain->GetOrigin()[0];
+  grid.y0 = terrain->GetOrigin()[1];
+  gr_status st = gr_snow_deformation_create(this->GetContext(), &grid, &p, &this->Simulation);
+  if (st != GR_OK) {
+    return this->ReportFailure(st, "Snow Deformation could not set up the simulation");
+  }
+  for (const Upload &u : uploads) {
+    st = gr_snow_deformation_set_field(this->Simulation, u.field, u.values->GetPointer(0));
+    if (st != GR_OK) {
+      vtkErrorMacro(
+          "Snow Deformation's Input: " << gr_snow_deformation_last_error(this->Simulation));
+      return 0;
+    }
+  }
+  this->GridDimensions[0] = dims[0];
+  this->GridDimensions[1] = dims[1];
+  gr_snow_deformation_set_progress(this->Simulation, &vtkSnowDeformationFilter::StepProgress, this);
+  // The objects at time 0: the forces (zero) have their count before a step.
+  return this->SetObjects(0.0, 0.0);
+}
+
+int vtkSnowDeformationFilter::ResetState() {
+  const gr_status st = gr_snow_deformation_reset(this->Simulation);
+  gr_snow_deformation_set_progress(this->Simulation, &vtkSnowDeformationFilter::StepProgress, this);
+  return st == GR_OK ? 1
+                     : this->ReportFailure(st, "Snow Deformation could not restart",
+                                           gr_snow_deformation_last_error(this->Simulation));
+}
+
+int vtkSnowDeformationFilter::AdvanceState(double t0, double t1) {
+  if (this->ObjectsTemporal && this->GetTemporalInputTime(1) != this->ObjectsReadAt) {
+    // The objects' next time step holds from t0 on.
+    if (!this->ReadObjects(this->GetTemporalInput(1))) {
+      return ADVANCE_FAILED;
+    }
+    this->ObjectsReadAt = this->GetTemporalInputTime(1);
+  }
+  // A progress callback that asked to stop leaves the core refusing steps
+  // until it is set again; an abort consumed since must not stop this call.
+  gr_snow_deformation_set_progress(this->Simulation, &vtkSnowDeformationFilter::StepProgress, this);
+  // Steps of TimeStep from t0, the last one ending on t1; the step ends are
+  // t0 + k dt (not a running sum), so they depend on t0, t1 and dt only.
+  const double dt = this->TimeStep;
+  const double count = std::ceil((t1 - t0) / dt - 1e-9);
+  const long long n = count < 1.0 ? 1 : static_cast<long long>(count);
+  double t = t0;
+  for (long long k = 1; k <= n; ++k) {
+    const double next = k == n ? t1 : t0 + static_cast<double>(k) * dt;
+    if (!this->SetObjects(next, next - t)) {
+      return ADVANCE_FAILED;
+    }
+    const gr_status st = gr_snow_deformation_step(this->Simulation, next - t);
+    if (st == GR_ERR_ABORTED) {
+      return ADVANCE_ABORTED;
+    }
+    if (st != GR_OK) {
+      return this->ReportFailure(st, "Snow Deformation could not advance",
+                                 gr_snow_deformation_last_error(this->Simulation));
+    }
+    t = next;
+  }
+  return ADVANCE_DONE;
+}
+
+int vtkSnowDeformationFilter::SaveState(std::vector<unsigned char> &bytes) {
+  size_t size = 0;
+  if (gr_snow_deformation_state_size(this->Simulation, &size) != GR_OK) {
+    return 0;
+  }
+  bytes.resize(size);
+  return gr_snow_deformation_state_save(this->Simulation, bytes.data(), size) == GR_OK;
+}
+
+int vtkSnowDeformationFilter::LoadState(const std::vector<unsigned char> &bytes) {
+  // An abort inside a step leaves the core refusing until set_progress.
+  gr_snow_deformation_set_progress(this->Simulation, &vtkSnowDeformationFilter::StepProgress, this);
+  return gr_snow_deformation_state_load(this->Simulation, bytes.data(), bytes.size()) == GR_OK;
+}
+
+int vtkSnowDeformationFilter::FillObjects(vtkDataObject *output, double t) {
+  vtkDataObject *input = this->GetNumberOfInputConnections(1) ? this->GetTemporalInput(1) : nullptr;
+  if (!input || !output) {
+    return 1;
+  }
+  const size_t n = this->Objects.size();
+  std::vector<double> force(3 * n + 3, 0.0), area(n + 1, 0.0);
+  if (n > 0) {
+    const gr_status st = gr_snow_deformation_object_forces(this->Simulation, force.data(),
+                                                           area.data(), static_cast<int>(n));
+    if (st != GR_OK) {
+      return this->ReportFailure(st, "Snow Deformation could not read the objects' forces",
+                                 gr_snow_deformation_last_error(this->Simulation));
+    }
+  }
+  bool other = false;
+  const std::vector<vtkPolyData *> leaves = Leaves(input, &other);
+  if (leaves.size() != n) {
+    return 1; // the objects changed since the state was made; nothing to pose
+  }
+  double matrix[16];
+  if (auto *pd = vtkPolyData::SafeDownCast(output)) {
+    if (n == 1) {
+      this->Pose(0, t, matrix);
+      pd->ShallowCopy(Posed(leaves[0], this->Objects[0].centre, matrix));
+      AddForce(pd->GetFieldData(), &force[0], area[0]);
+    }
+    return 1;
+  }
+  auto *mb = vtkMultiBlockDataSet::SafeDownCast(output);
+  auto *in = vtkCompositeDataSet::SafeDownCast(input);
+  if (!mb || !in) {
+    return 1;
+  }
+  mb->CopyStructure(in);
+  vtkSmartPointer<vtkCompositeDataIterator> it;
+  it.TakeReference(in->NewIterator());
+  size_t k = 0;
+  double total[3] = {0.0, 0.0, 0.0}, totalArea = 0.0;
+  for (it->InitTraversal(); !it->IsDoneWithTraversal() && k < n; it->GoToNextItem()) {
+    auto *leaf = vtkPolyData::SafeDownCast(it->GetCurrentDataObject());
+    if (!leaf || leaf->GetNumberOfPoints() == 0) {
+      continue;
+    }
+    this->Pose(k, t, matrix);
+    vtkSmartPointer<vtkPolyData> posed = Posed(leaf, this->Objects[k].centre, matrix);
+    AddForce(posed->GetFieldData(), &force[3 * k], area[k]);
+    mb->SetDataSet(it, posed);
+    for (int c = 0; c < 3; ++c) {
+      total[c] += force[3 * k + c];
+    }
+    totalArea += area[k];
+    ++k;
+  }
+  AddForce(mb->GetFieldData(), total, totalArea);
+  return 1;
+}
+
+int vtkSnowDeformationFilter::FillOutput(vtkDataObject *outputObject, vtkInformation *outInfo) {
+  vtkImageData *output = vtkImageData::SafeDownCast(outputObject);
+  vtkImageData *input = vtkImageData::GetData(this->GetInputInformation(0, 0));
+  if (!output || !input) {
+    return 0;
+  }
+  int extent[6];
+  if (outInfo->Has(vtkStreamingDemandDrivenPipeline::UPDATE_EXTENT())) {
+    outInfo->Get(vtkStreamingDemandDrivenPipeline::UPDATE_EXTENT(), extent);
+  } else {
+    input->GetExtent(extent);
+  }
+  output->SetExtent(extent);
+  output->SetSpacing(input->GetSpacing());
+  output->SetOrigin(input->GetOrigin());
+  const vtkIdType n = static_cast<vtkIdType>(this->GridDimensions[0]) * this->GridDimensions[1];
+  vtkNew<vtkImageData> whole;
+  whole->SetExtent(input->GetExtent());
+  whole->SetOrigin(output->GetOrigin());
+  whole->SetSpacing(output->GetSpacing());
+  const gr_field fields[] = {GR_FIELD_SNOW_DEPTH, GR_FIELD_SNOW_SURFACE, GR_FIELD_SNOW_DENSITY,
+                             GR_FIELD_OVERLAP,    GR_FIELD_CONTACT,      GR_FIELD_ELEVATION};
+  for (gr_field f : fields) {
+    vtkNew<vtkFloatArray> a;
+    a->SetName(gr_field_name(f));
+    if (!a->Allocate(n)) {
+      vtkErrorMacro("Snow Deformation: out of host memory for the output fields.");
+      return 0;
+    }
+    a->SetNumberOfTuples(n);
+    const gr_status st = gr_snow_deformation_get_field(this->Simulation, f, a->GetPointer(0));
+    if (st != GR_OK) {
+      return this->ReportFailure(st, "Snow Deformation could not read its fields back",
+                                 gr_snow_deformation_last_error(this->Simulation));
+    }
+    whole->GetPointData()->AddArray(a);
+  }
+  whole->GetPointData()->SetActiveScalars("snow_depth");
+  output->ShallowCopy(whole);
+  output->Crop(extent);
+
+  gr_snow_deformation_ledger ledger;
+  const gr_status st = gr_snow_deformation_ledger_get(this->Simulation, &ledger);
+  if (st != GR_OK) {
+    return this->ReportFailure(st, "Snow Deformation could not read its ledger",
+                               gr_snow_deformation_last_error(this->Simulation));
+  }
+  vtkFieldData *fd = output->GetFieldData();
+  // The state's absolute time: the ledger's sum of steps drifts by rounding.
+  AddValue(fd, "time", this->GetStateTime());
+  AddValue(fd, "steps", static_cast<double>(ledger.steps));
+  AddValue(fd, "initial_volume", ledger.initial_volume);
+  AddValue(fd, "initial_mass", ledger.initial_mass);
+  AddValue(fd, "snow_volume", ledger.snow_volume);
+  AddValue(fd, "snow_mass", ledger.snow_mass);
+  AddValue(fd, "compressed_volume", ledger.compressed_volume);
+  AddValue(fd, "displaced_volume", ledger.displaced_volume);
+  AddValue(fd, "balance_error", ledger.balance_error);
+  AddValue(fd, "volume_error", ledger.volume_error);
+  AddValue(fd, "relax_iterations", ledger.relax_iterations);
+
+  // The objects' output, at the same time; only piece 0 carries them, so
+  // an MPI run shows each object once.
+  if (this->OutputVector) {
+    vtkInformation *objInfo = this->OutputVector->GetInformationObject(1);
+    vtkDataObject *objects = objInfo->Get(vtkDataObject::DATA_OBJECT());
+    const int piece = objInfo->Has(vtkStreamingDemandDrivenPipeline::UPDATE_PIECE_NUMBER())
+                          ? objInfo->Get(vtkStreamingDemandDrivenPipeline::UPDATE_PIECE_NUMBER())
+                          : 0;
+    if (piece == 0 && !this->FillObjects(objects, this->GetStateTime())) {
+      return 0;
+    }
+    this->ObjectsFilled = true;
+  }
+  return 1;
+}
+
+void vtkSnowDeformationFilter::ReleaseState() {
+  gr_snow_deformation_destroy(this->Simulation);
+  this->Simulation = nullptr;
+}
+
+void vtkSnowDeformationFilter::PrintSelf(ostream &os, vtkIndent indent) {
+  this->Superclass::PrintSelf(os, indent);
+  os << indent << "TimeStep: " << this->TimeStep << " s\n";
+  os << indent << "InitialSnowDepth: " << this->InitialSnowDepth << " m\n";
+  os << indent << "InitialDensity: " << this->InitialDensity << " kg/m^3\n";
+  os << indent << "DensityRange: " << this->MinDensity << " " << this->MaxDensity << " kg/m^3\n";
+  os << indent << "CompressionModel: " << this->CompressionModel << "\n";
+  os << indent << "MaxSlope: " << this->MaxSlope << " m/m\n";
+  os << indent << "DirectionFalloff: " << this->DirectionFalloff << "\n";
+  os << indent << "MaxRelaxIterations: " << this->MaxRelaxIterations << "\n";
+  os << indent << "RelaxTolerance: " << this->RelaxTolerance << " m\n";
+  os << indent << "ObjectVelocity: " << this->ObjectVelocity[0] << " " << this->ObjectVelocity[1]
+     << " " << this->ObjectVelocity[2] << " m/s\n";
+  os << indent << "ObjectAngularVelocity: " << this->ObjectAngularVelocity << " deg/s\n";
+  os << indent << "RotationAxis: " << this->RotationAxis[0] << " " << this->RotationAxis[1] << " "
+     << this->RotationAxis[2] << "\n";
+}

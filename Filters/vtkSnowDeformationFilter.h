@@ -1,0 +1,231 @@
+/**
+ * @class   vtkSnowDeformationFilter
+ * @brief   Objects pressing into and ploughing through snow (seed 000's
+ *          thesis), stepped on OpenCL.
+ *
+ * Input 0 (`Input`) is the terrain: a 2-D vtkImageData with the point array
+ * `elevation` (m). Optional point arrays on it give the snow at time 0:
+ * `snow_depth` (m) and `snow_density` (kg/m^3), so Snow Accumulation's output
+ * chains in; without them InitialSnowDepth and InitialDensity apply.
+ *
+ * Input 1 (`Objects`, optional) is a closed triangle mesh (vtkPolyData; its
+ * polygons and strips are split into triangles here) or a multiblock of them,
+ * one object per leaf. Each object is handed to the core in its own frame:
+ * its vertices about the centre of its bounds, with a pose that puts it in
+ * the world (float vertices stay exact far from the origin).
+ * - Objects that do not advertise time steps move by the properties
+ *   (vtkGraupelMotion): the centre moves at ObjectVelocity (m/s) and the
+ *   object turns at ObjectAngularVelocity (deg/s) about RotationAxis
+ *   through its centre; with a Path (input 2, a polyline) the centre follows
+ *   the path at the speed |ObjectVelocity|, the object's +x turned along the
+ *   path's tangent. A leaf's field data `velocity` (3 values, m/s) replaces
+ *   ObjectVelocity for that object.
+ * - Objects that advertise time steps are read at each (sample and hold,
+ *   see vtkGraupelSimulation): their geometry is the pose, and their
+ *   velocity (for the direction of the displaced snow and the resistance) is
+ *   the leaf's field data `velocity`, else ObjectVelocity.
+ *
+ * Time: every interval between the simulation's knots (output times, the
+ * objects' time steps) is stepped in TimeStep-sized steps, the last one
+ * shortened to end on the knot; each step takes the objects at their pose at
+ * the step's end. The knots depend on properties and inputs only, so a
+ * result does not depend on the order in which times are requested.
+ *
+ * Output 0 has the terrain's geometry and the point arrays `snow_depth` (m,
+ * active scalars), `snow_surface` (m), `snow_density` (kg/m^3), `overlap`
+ * (m, last step), `contact` (1 under an object in the last step) and
+ * `elevation`; field data `time` (s), `steps`, `snow_volume` (m^3),
+ * `snow_mass` (kg), `compressed_volume` and `displaced_volume` (m^3,
+ * cumulative), `balance_error` (kg: mass now minus mass at the start),
+ * `volume_error` (m^3) and `relax_iterations`. Output 1 is the objects at
+ * their pose at the output time (vtkPolyData, or a multiblock of the same
+ * structure as the input), each with field data `force` (3 components, N:
+ * the snow's resistance in the last step) and `contact_area` (m^2); a
+ * multiblock's own field data holds their sums.
+ *
+ * The model is described in kernels/include/graupel/snow_deformation.h; the
+ * setters clamp to its parameter table (gr_snow_deformation_param_bounds).
+ */
+#ifndef vtkSnowDeformationFilter_h
+#define vtkSnowDeformationFilter_h
+
+#include "GraupelFiltersModule.h"
+#include "vtkGraupelSimulation.h"
+
+#include <vector>
+
+struct gr_snow_deformation;
+class vtkDataObject;
+class vtkPolyData;
+
+class GRAUPELFILTERS_EXPORT vtkSnowDeformationFilter : public vtkGraupelSimulation {
+public:
+  static vtkSnowDeformationFilter *New();
+  vtkTypeMacro(vtkSnowDeformationFilter, vtkGraupelSimulation);
+  void PrintSelf(ostream &os, vtkIndent indent) override;
+
+  enum CompressionModels { DENSITY_DRIVEN = 0, CONSTANT_FRACTION = 1 };
+
+  ///@{
+  /** Length of one simulation step, s (default 1/60; from 1e-6 to 60). */
+  vtkSetClampMacro(TimeStep, double, 1.0e-6, 60.0);
+  vtkGetMacro(TimeStep, double);
+  ///@}
+
+  ///@{
+  /** Snow depth where the Input has no `snow_depth`, m (default 0.5). */
+  virtual void SetInitialSnowDepth(double value);
+  vtkGetMacro(InitialSnowDepth, double);
+  ///@}
+
+  ///@{
+  /** Snow density where the Input has no `snow_density`, kg/m^3 (default 150). */
+  virtual void SetInitialDensity(double value);
+  vtkGetMacro(InitialDensity, double);
+  ///@}
+
+  ///@{
+  /** Density of the loosest snow (rho_min), kg/m^3 (default 100). */
+  virtual void SetMinDensity(double value);
+  vtkGetMacro(MinDensity, double);
+  ///@}
+
+  ///@{
+  /** Density of fully compressed snow (rho_max), kg/m^3 (default 400). */
+  virtual void SetMaxDensity(double value);
+  vtkGetMacro(MaxDensity, double);
+  ///@}
+
+  ///@{
+  /** Both densities at once, kg/m^3 (ParaView's DensityRange). */
+  void SetDensityRange(double minimum, double maximum);
+  void SetDensityRange(const double range[2]) { this->SetDensityRange(range[0], range[1]); }
+  ///@}
+
+  ///@{
+  /** 0: density-driven compression (default); 1: a constant 15 % compressed. */
+  virtual void SetCompressionModel(int value);
+  vtkGetMacro(CompressionModel, int);
+  ///@}
+
+  ///@{
+  /** Steepest slope the snow keeps (talus), m/m (default 0.6). */
+  virtual void SetMaxSlope(double value);
+  vtkGetMacro(MaxSlope, double);
+  ///@}
+
+  ///@{
+  /** K of the direction weights: higher sends more snow ahead (default 8). */
+  virtual void SetDirectionFalloff(double value);
+  vtkGetMacro(DirectionFalloff, double);
+  ///@}
+
+  ///@{
+  /** Most talus relaxation iterations per step. */
+  virtual void SetMaxRelaxIterations(int value);
+  vtkGetMacro(MaxRelaxIterations, int);
+  ///@}
+
+  ///@{
+  /** Talus relaxation stops when no point can move more snow than this, m. */
+  virtual void SetRelaxTolerance(double value);
+  vtkGetMacro(RelaxTolerance, double);
+  ///@}
+
+  ///@{
+  /** Velocity of the objects' centres, m/s (default 0 0 0); along a Path its length is the speed.
+   */
+  vtkSetVector3Macro(ObjectVelocity, double);
+  vtkGetVector3Macro(ObjectVelocity, double);
+  ///@}
+
+  ///@{
+  /** Rotation speed of the objects about RotationAxis through their centres, deg/s (default 0). */
+  vtkSetMacro(ObjectAngularVelocity, double);
+  vtkGetMacro(ObjectAngularVelocity, double);
+  ///@}
+
+  ///@{
+  /** Axis of that rotation, object frame (default 0 1 0: a wheel rolling along x). */
+  vtkSetVector3Macro(RotationAxis, double);
+  vtkGetVector3Macro(RotationAxis, double);
+  ///@}
+
+  /** Connects the objects (input port 1). */
+  void SetObjectsConnection(vtkAlgorithmOutput *output);
+  /** Connects the optional path (input port 2). */
+  void SetPathConnection(vtkAlgorithmOutput *output);
+
+  /** Dispatches requests; see the .cxx for what the second output needs. */
+  vtkTypeBool ProcessRequest(vtkInformation *request, vtkInformationVector **inInfo,
+                             vtkInformationVector *outInfo) override;
+
+protected:
+  vtkSnowDeformationFilter();
+  ~vtkSnowDeformationFilter() override;
+
+  int FillInputPortInformation(int port, vtkInformation *info) override;
+  int FillOutputPortInformation(int port, vtkInformation *info) override;
+
+  int RequestInformation(vtkInformation *, vtkInformationVector **,
+                         vtkInformationVector *) override;
+  int RequestData(vtkInformation *, vtkInformationVector **, vtkInformationVector *) override;
+
+  int SetUpState(vtkInformationVector **inputVector) override;
+  int ResetState() override;
+  int AdvanceState(double t0, double t1) override;
+  int FillOutput(vtkDataObject *output, vtkInformation *outInfo) override;
+  void ReleaseState() override;
+  int SaveState(std::vector<unsigned char> &bytes) override;
+  int LoadState(const std::vector<unsigned char> &bytes) override;
+  const char *GetSimulationLabel() override { return "Snow Deformation"; }
+
+  double TimeStep = 1.0 / 60.0;
+  double InitialSnowDepth = 0.5;
+  double InitialDensity = 150.0;
+  double MinDensity = 100.0;
+  double MaxDensity = 400.0;
+  int CompressionModel = DENSITY_DRIVEN;
+  double MaxSlope = 0.6;
+  double DirectionFalloff = 8.0;
+  int MaxRelaxIterations = 0; // the table's default, set in the constructor
+  double RelaxTolerance = 0.0;
+  double ObjectVelocity[3] = {0.0, 0.0, 0.0};
+  double ObjectAngularVelocity = 0.0;
+  double RotationAxis[3] = {0.0, 1.0, 0.0};
+
+private:
+  vtkSnowDeformationFilter(const vtkSnowDeformationFilter &) = delete;
+  void operator=(const vtkSnowDeformationFilter &) = delete;
+
+  /** One object as the core sees it: vertices about its centre. */
+  struct Object {
+    std::vector<float> vertices;
+    std::vector<int> triangles;
+    double centre[3];
+    double velocity[3]; // m/s: the leaf's `velocity`, else ObjectVelocity
+  };
+
+  int CheckParameters();
+  /** Reads the objects (and, once, the path) into Objects; 0 after one sentence. */
+  int ReadObjects(vtkDataObject *objects);
+  int ReadPath(vtkPolyData *path);
+  /** The pose (column-major) of object k at time t. */
+  void Pose(size_t k, double t, double matrix[16]) const;
+  /** Hands the objects at their poses at time t to the core (velocities over [t - h, t]). */
+  int SetObjects(double t, double h);
+  int FillObjects(vtkDataObject *output, double t);
+
+  gr_snow_deformation *Simulation = nullptr;
+  int GridDimensions[2] = {0, 0};
+  std::vector<Object> Objects;
+  std::vector<double> Path; // xyz per point; empty when none
+  bool ObjectsTemporal = false;
+  double ObjectsReadAt = 0.0;
+  vtkInformationVector *OutputVector = nullptr; // during RequestData only
+  bool ObjectsFilled = false;
+  double LastProgressWall = 0.0;
+  static int StepProgress(void *user, double time);
+};
+
+#endif
