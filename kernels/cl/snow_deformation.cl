@@ -211,10 +211,13 @@ GR_INLINE float snow_threshold(int di, int dj, float tx, float ty, float td) {
 __kernel void snow_relax_rate(__global const float *restrict ground,
                               __global const float *restrict depth,
                               __global const float *restrict under_min, int nx, int ny, float tx,
-                              float ty, float td, __global float *restrict rate,
-                              __global float *restrict movable) {
+                              float ty, float td, int x_end, int y_end,
+                              __global float *restrict rate, __global float *restrict movable) {
+  /* Launched on a window from its offset: the launch is rounded up to the
+   * work-group shape (16 x 16 on a GPU), and a point beyond the window's end
+   * must not run (its neighbours' rates there are stale). */
   int i = get_global_id(0), j = get_global_id(1);
-  if (!gr_inside(i, j, nx, ny))
+  if (!gr_inside(i, j, nx, ny) || i >= x_end || j >= y_end)
     return;
   int c = gr_idx(i, j, nx);
   float s = depth[c], ha = ground[c] + s, sum = 0.0f, big = 0.0f;
@@ -242,10 +245,11 @@ __kernel void
 snow_relax_move(__global const float *restrict ground, __global const float *restrict depth,
                 __global const float *restrict density, __global const float *restrict under_min,
                 __global const float *restrict rate, int nx, int ny, float tx, float ty, float td,
-                __global float *restrict depth_out, __global float *restrict density_out) {
+                int x_end, int y_end, __global float *restrict depth_out,
+                __global float *restrict density_out) {
   int i = get_global_id(0), j = get_global_id(1);
-  if (!gr_inside(i, j, nx, ny))
-    return;
+  if (!gr_inside(i, j, nx, ny) || i >= x_end || j >= y_end)
+    return; /* beyond the window (see snow_relax_rate) */
   int c = gr_idx(i, j, nx);
   float s = depth[c], rho = density[c], hb = ground[c] + s, ub = under_min[c], kb = rate[c];
   float out = 0.0f, in = 0.0f, mass_in = 0.0f; /* mass_in: relative to rho */

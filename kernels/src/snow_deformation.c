@@ -828,6 +828,11 @@ static gr_status gr_snow_relax(gr_snow_deformation *s) {
       st = GR_SNOW_ARG(s, k, "rate", s->rate);
     if (st == GR_OK)
       st = GR_SNOW_ARG(s, k, "movable", s->movable);
+    cl_int x_end = x1 + 1, y_end = y1 + 1;
+    if (st == GR_OK)
+      st = GR_SNOW_ARG(s, k, "x_end", x_end);
+    if (st == GR_OK)
+      st = GR_SNOW_ARG(s, k, "y_end", y_end);
     if (st == GR_OK)
       st = gr_enqueue_2d(ctx, k, (size_t)x0, (size_t)y0, (size_t)(x1 - x0 + 1),
                          (size_t)(y1 - y0 + 1), NULL);
@@ -867,6 +872,11 @@ static gr_status gr_snow_relax(gr_snow_deformation *s) {
       st = GR_SNOW_ARG(s, k, "depth_out", s->depth[nxt]);
     if (st == GR_OK)
       st = GR_SNOW_ARG(s, k, "density_out", s->density[nxt]);
+    cl_int mx_end = mx1 + 1, my_end = my1 + 1;
+    if (st == GR_OK)
+      st = GR_SNOW_ARG(s, k, "x_end", mx_end);
+    if (st == GR_OK)
+      st = GR_SNOW_ARG(s, k, "y_end", my_end);
     if (st == GR_OK)
       st = gr_enqueue_2d(ctx, k, (size_t)mx0, (size_t)my0, (size_t)(mx1 - mx0 + 1),
                          (size_t)(my1 - my0 + 1), NULL);
