@@ -4,12 +4,16 @@
 #include "vtkDataObject.h"
 #include "vtkDemandDrivenPipeline.h"
 #include "vtkExecutive.h"
+#include "vtkFloatArray.h"
 #include "vtkImageData.h"
 #include "vtkInformation.h"
 #include "vtkInformationExecutivePortKey.h"
 #include "vtkInformationVector.h"
+#include "vtkNew.h"
 #include "vtkPointData.h"
 #include "vtkStreamingDemandDrivenPipeline.h"
+
+#include "graupel/graupel.h"
 
 #include <algorithm>
 #include <cmath>
@@ -597,4 +601,52 @@ void vtkGraupelSimulation::PrintSelf(ostream &os, vtkIndent indent) {
   os << indent << "RestoreCount: " << this->RestoreCount << "\n";
   os << indent << "Checkpoints: " << this->Checkpoints.size() << " (" << this->GetCheckpointBytes()
      << " bytes)\n";
+}
+
+int vtkGraupelSimulation::FillImage(vtkDataObject *outputObject, vtkInformation *outInfo,
+                                    const int *fields, int count,
+                                    const std::function<int(int, float *)> &read,
+                                    const std::function<const char *()> &detail) {
+  vtkImageData *output = vtkImageData::SafeDownCast(outputObject);
+  vtkImageData *input = vtkImageData::GetData(this->GetInputInformation(0, 0));
+  if (!output || !input || count < 1) {
+    return 0;
+  }
+  int extent[6];
+  if (outInfo && outInfo->Has(vtkStreamingDemandDrivenPipeline::UPDATE_EXTENT())) {
+    outInfo->Get(vtkStreamingDemandDrivenPipeline::UPDATE_EXTENT(), extent);
+  } else {
+    input->GetExtent(extent);
+  }
+  int dims[3];
+  input->GetDimensions(dims);
+  const vtkIdType n = static_cast<vtkIdType>(dims[0]) * dims[1];
+  // The whole grid's fields first (on the input's extent, which need not
+  // start at 0), cropped to the requested piece below.
+  vtkNew<vtkImageData> whole;
+  whole->SetExtent(input->GetExtent());
+  whole->SetOrigin(input->GetOrigin());
+  whole->SetSpacing(input->GetSpacing());
+  const std::string label = this->GetSimulationLabel();
+  for (int k = 0; k < count; ++k) {
+    const gr_field f = static_cast<gr_field>(fields[k]);
+    const int components = gr_field_components(f);
+    vtkNew<vtkFloatArray> a;
+    a->SetName(gr_field_name(f));
+    a->SetNumberOfComponents(components);
+    if (components < 1 || !a->Allocate(n * components)) {
+      vtkErrorMacro(<< label << ": out of host memory for the output fields.");
+      return 0;
+    }
+    a->SetNumberOfTuples(n);
+    const int st = read(fields[k], a->GetPointer(0));
+    if (st != GR_OK) {
+      return this->ReportFailure(st, (label + " could not read its fields back").c_str(), detail());
+    }
+    whole->GetPointData()->AddArray(a);
+  }
+  whole->GetPointData()->SetActiveScalars(gr_field_name(static_cast<gr_field>(fields[0])));
+  output->ShallowCopy(whole);
+  output->Crop(extent);
+  return 1;
 }

@@ -113,6 +113,7 @@
 #endif
 
 #include <deque>
+#include <functional>
 #include <vector>
 
 class vtkDataArray;
@@ -214,6 +215,18 @@ protected:
    * outInfo holds the request (UPDATE_EXTENT, piece). 0 on failure.
    */
   virtual int FillOutput(vtkDataObject *output, vtkInformation *outInfo) = 0;
+
+  /**
+   * For a grid simulation's FillOutput: gives output (an image) the terrain
+   * input's geometry, cropped to the extent outInfo requests, and one float
+   * point array per field (gr_field values), each read from the core by
+   * read(field, values) into the whole grid (a gr_status). The first field
+   * becomes the active scalars. A failed read is reported with detail() (the
+   * core's own sentence); returns 0 then.
+   */
+  int FillImage(vtkDataObject *output, vtkInformation *outInfo, const int *fields, int count,
+                const std::function<int(int, float *)> &read,
+                const std::function<const char *()> &detail);
   /** Frees the device state; must accept being called without state. */
   virtual void ReleaseState() = 0;
 

@@ -220,8 +220,6 @@ int vtkRainRunoffFilter::SetUpState(vtkInformationVector **inputVector) {
   }
   // Progress with the simulated time, and an abort inside a long interval.
   gr_rain_runoff_set_progress(this->Simulation, &vtkGraupelSimulation::CoreProgress, this);
-  this->GridDimensions[0] = dims[0];
-  this->GridDimensions[1] = dims[1];
   return 1;
 }
 
@@ -256,45 +254,18 @@ int vtkRainRunoffFilter::LoadState(const std::vector<unsigned char> &bytes) {
 }
 
 int vtkRainRunoffFilter::FillOutput(vtkDataObject *outputObject, vtkInformation *outInfo) {
-  // The image is made here: the terrain's geometry, cropped to the request.
-  vtkImageData *output = vtkImageData::SafeDownCast(outputObject);
-  vtkImageData *input = vtkImageData::GetData(this->GetInputInformation(0, 0));
-  if (!output || !input) {
+  const int fields[] = {GR_FIELD_WATER_DEPTH, GR_FIELD_WATER_SURFACE, GR_FIELD_VELOCITY,
+                        GR_FIELD_DISCHARGE,   GR_FIELD_INFILTRATED,   GR_FIELD_ELEVATION};
+  if (!this->FillImage(
+          outputObject, outInfo, fields, static_cast<int>(sizeof(fields) / sizeof(fields[0])),
+          [this](int f, float *values) {
+            return static_cast<int>(
+                gr_rain_runoff_get_field(this->Simulation, static_cast<gr_field>(f), values));
+          },
+          [this]() { return gr_rain_runoff_last_error(this->Simulation); })) {
     return 0;
   }
-  int extent[6];
-  outInfo->Get(vtkStreamingDemandDrivenPipeline::UPDATE_EXTENT(), extent);
-  output->SetExtent(extent);
-  output->SetSpacing(input->GetSpacing());
-  output->SetOrigin(input->GetOrigin());
-  const vtkIdType n = static_cast<vtkIdType>(this->GridDimensions[0]) * this->GridDimensions[1];
-  // The whole grid's fields first (on the input's extent, which need not
-  // start at 0), cropped to the requested piece below.
-  vtkNew<vtkImageData> whole;
-  whole->SetExtent(input->GetExtent());
-  whole->SetOrigin(output->GetOrigin());
-  whole->SetSpacing(output->GetSpacing());
-  const gr_field fields[] = {GR_FIELD_WATER_DEPTH, GR_FIELD_WATER_SURFACE, GR_FIELD_VELOCITY,
-                             GR_FIELD_DISCHARGE,   GR_FIELD_INFILTRATED,   GR_FIELD_ELEVATION};
-  for (gr_field f : fields) {
-    vtkNew<vtkFloatArray> a;
-    a->SetName(gr_field_name(f));
-    a->SetNumberOfComponents(gr_field_components(f));
-    if (!a->Allocate(n * gr_field_components(f))) {
-      vtkErrorMacro("Rain Runoff: out of host memory for the output fields.");
-      return 0;
-    }
-    a->SetNumberOfTuples(n);
-    const gr_status st = gr_rain_runoff_get_field(this->Simulation, f, a->GetPointer(0));
-    if (st != GR_OK) {
-      return this->ReportFailure(st, "Rain Runoff could not read its fields back",
-                                 gr_rain_runoff_last_error(this->Simulation));
-    }
-    whole->GetPointData()->AddArray(a);
-  }
-  whole->GetPointData()->SetActiveScalars("water_depth");
-  output->ShallowCopy(whole);
-  output->Crop(extent);
+  vtkImageData *output = vtkImageData::SafeDownCast(outputObject);
 
   gr_rain_runoff_ledger ledger;
   const gr_status st = gr_rain_runoff_ledger_get(this->Simulation, &ledger);

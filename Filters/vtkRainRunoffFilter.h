@@ -114,7 +114,6 @@ private:
   int CheckParameters();
 
   gr_rain_runoff *Simulation = nullptr;
-  int GridDimensions[2] = {0, 0};
 };
 
 #endif

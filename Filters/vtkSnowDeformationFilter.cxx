@@ -674,8 +674,6 @@ int vtkSnowDeformationFilter::SetUpState(vtkInformationVector **inputVector) {
       return 0;
     }
   }
-  this->GridDimensions[0] = dims[0];
-  this->GridDimensions[1] = dims[1];
   gr_snow_deformation_set_progress(this->Simulation, &vtkSnowDeformationFilter::StepProgress, this);
   // The objects at time 0: the forces (zero) have their count before a step.
   return this->SetObjects(0.0, 0.0);
@@ -798,45 +796,18 @@ int vtkSnowDeformationFilter::FillObjects(vtkDataObject *output, double t) {
 }
 
 int vtkSnowDeformationFilter::FillOutput(vtkDataObject *outputObject, vtkInformation *outInfo) {
-  vtkImageData *output = vtkImageData::SafeDownCast(outputObject);
-  vtkImageData *input = vtkImageData::GetData(this->GetInputInformation(0, 0));
-  if (!output || !input) {
+  const int fields[] = {GR_FIELD_SNOW_DEPTH, GR_FIELD_SNOW_SURFACE, GR_FIELD_SNOW_DENSITY,
+                        GR_FIELD_OVERLAP,    GR_FIELD_CONTACT,      GR_FIELD_ELEVATION};
+  if (!this->FillImage(
+          outputObject, outInfo, fields, static_cast<int>(sizeof(fields) / sizeof(fields[0])),
+          [this](int f, float *values) {
+            return static_cast<int>(
+                gr_snow_deformation_get_field(this->Simulation, static_cast<gr_field>(f), values));
+          },
+          [this]() { return gr_snow_deformation_last_error(this->Simulation); })) {
     return 0;
   }
-  int extent[6];
-  if (outInfo->Has(vtkStreamingDemandDrivenPipeline::UPDATE_EXTENT())) {
-    outInfo->Get(vtkStreamingDemandDrivenPipeline::UPDATE_EXTENT(), extent);
-  } else {
-    input->GetExtent(extent);
-  }
-  output->SetExtent(extent);
-  output->SetSpacing(input->GetSpacing());
-  output->SetOrigin(input->GetOrigin());
-  const vtkIdType n = static_cast<vtkIdType>(this->GridDimensions[0]) * this->GridDimensions[1];
-  vtkNew<vtkImageData> whole;
-  whole->SetExtent(input->GetExtent());
-  whole->SetOrigin(output->GetOrigin());
-  whole->SetSpacing(output->GetSpacing());
-  const gr_field fields[] = {GR_FIELD_SNOW_DEPTH, GR_FIELD_SNOW_SURFACE, GR_FIELD_SNOW_DENSITY,
-                             GR_FIELD_OVERLAP,    GR_FIELD_CONTACT,      GR_FIELD_ELEVATION};
-  for (gr_field f : fields) {
-    vtkNew<vtkFloatArray> a;
-    a->SetName(gr_field_name(f));
-    if (!a->Allocate(n)) {
-      vtkErrorMacro("Snow Deformation: out of host memory for the output fields.");
-      return 0;
-    }
-    a->SetNumberOfTuples(n);
-    const gr_status st = gr_snow_deformation_get_field(this->Simulation, f, a->GetPointer(0));
-    if (st != GR_OK) {
-      return this->ReportFailure(st, "Snow Deformation could not read its fields back",
-                                 gr_snow_deformation_last_error(this->Simulation));
-    }
-    whole->GetPointData()->AddArray(a);
-  }
-  whole->GetPointData()->SetActiveScalars("snow_depth");
-  output->ShallowCopy(whole);
-  output->Crop(extent);
+  vtkImageData *output = vtkImageData::SafeDownCast(outputObject);
 
   gr_snow_deformation_ledger ledger;
   const gr_status st = gr_snow_deformation_ledger_get(this->Simulation, &ledger);

@@ -217,7 +217,6 @@ private:
   int FillObjects(vtkDataObject *output, double t);
 
   gr_snow_deformation *Simulation = nullptr;
-  int GridDimensions[2] = {0, 0};
   std::vector<Object> Objects;
   std::vector<double> Path; // xyz per point; empty when none
   bool ObjectsTemporal = false;
