@@ -4,6 +4,8 @@
 
 #include "graupel/graupel.h"
 
+#include <float.h>
+#include <math.h>
 #include <stddef.h>
 #include <stdint.h>
 #include <string.h>
@@ -47,6 +49,71 @@ static inline void check_message(gr_status st, const char *msg) {
     return;
   n = strlen(msg);
   REQUIRE(n > 0 && msg[n - 1] == '.');
+}
+
+/* The row of a core's parameter table (n rows) for a property; every
+ * property a harness names must be there. */
+static inline const gr_param_bound *fuzz_row(const gr_param_bound *t, int n, const char *property) {
+  for (int r = 0; r < n; ++r)
+    if (strcmp(t[r].property, property) == 0)
+      return &t[r];
+  REQUIRE(!"a parameter is missing from the table");
+  return NULL;
+}
+
+/* Accepted by a row: within [min, max] times to_core (min excluded when
+ * open), a whole number when the row says so. The harnesses' own statement
+ * of the rule, independent of the core's gr_param_accepts. */
+static inline int fuzz_in_row(const gr_param_bound *row, double v) {
+  const double lo = row->min * row->to_core, hi = row->max * row->to_core;
+  return (row->min_open ? v > lo : v >= lo) && v <= hi && (!row->integer || v == floor(v));
+}
+
+/* An edge value for a fuzzed parameter picked by b: NaN, the infinities and
+ * extremes, one of the harness's fixed values, or for a row of the table
+ * (core units) its min, max, default, or one ulp either side of min and max. */
+static inline double fuzz_table_edge(const gr_param_bound *t, int n, const double *fixed,
+                                     size_t nfixed, uint8_t b) {
+  const size_t nrow = 7 * (size_t)n, special = 6;
+  size_t k = b % (special + nfixed + nrow);
+  switch (k) {
+  case 0:
+    return NAN;
+  case 1:
+    return INFINITY;
+  case 2:
+    return -INFINITY;
+  case 3:
+    return DBL_MAX;
+  case 4:
+    return nextafter(0.0, 1.0);
+  case 5:
+    return DBL_MIN;
+  default:
+    break;
+  }
+  k -= special;
+  if (k < nfixed)
+    return fixed[k];
+  k -= nfixed;
+  const gr_param_bound *row = &t[k / 7];
+  const double lo = row->min * row->to_core, hi = row->max * row->to_core;
+  switch (k % 7) {
+  case 0:
+    return lo;
+  case 1:
+    return hi;
+  case 2:
+    return row->default_value * row->to_core;
+  case 3:
+    return nextafter(lo, -HUGE_VAL);
+  case 4:
+    return nextafter(lo, HUGE_VAL);
+  case 5:
+    return nextafter(hi, -HUGE_VAL);
+  default:
+    return nextafter(hi, HUGE_VAL);
+  }
 }
 
 #endif

@@ -26,71 +26,21 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* The table's row for a property (every row exists: the harness checks). */
 static const gr_param_bound *row_of(const char *property) {
   int n = 0;
   const gr_param_bound *t = gr_rain_runoff_param_bounds(&n);
-  for (int r = 0; r < n; ++r)
-    if (strcmp(t[r].property, property) == 0)
-      return &t[r];
-  REQUIRE(!"a parameter is missing from the table");
-  return NULL;
+  return fuzz_row(t, n, property);
 }
 
 static double edge_double(uint8_t b) {
   static const double fixed[] = {0.0, -0.0, -1e-12, 1e30, -1.0, 0.5, 2.0, 7200.0};
-  const size_t nfixed = sizeof fixed / sizeof fixed[0];
   int n = 0;
   const gr_param_bound *t = gr_rain_runoff_param_bounds(&n);
-  /* Per row: min, max, the default, and one ulp either side of min and max. */
-  const size_t nrow = 7 * (size_t)n, special = 6;
-  size_t k = b % (special + nfixed + nrow);
-  switch (k) {
-  case 0:
-    return NAN;
-  case 1:
-    return INFINITY;
-  case 2:
-    return -INFINITY;
-  case 3:
-    return DBL_MAX;
-  case 4:
-    return nextafter(0.0, 1.0);
-  case 5:
-    return DBL_MIN;
-  default:
-    break;
-  }
-  k -= special;
-  if (k < nfixed)
-    return fixed[k];
-  k -= nfixed;
-  const gr_param_bound *row = &t[k / 7];
-  const double lo = row->min * row->to_core, hi = row->max * row->to_core;
-  switch (k % 7) {
-  case 0:
-    return lo;
-  case 1:
-    return hi;
-  case 2:
-    return row->default_value * row->to_core;
-  case 3:
-    return nextafter(lo, -HUGE_VAL);
-  case 4:
-    return nextafter(lo, HUGE_VAL);
-  case 5:
-    return nextafter(hi, -HUGE_VAL);
-  default:
-    return nextafter(hi, HUGE_VAL);
-  }
+  return fuzz_table_edge(t, n, fixed, sizeof fixed / sizeof fixed[0], b);
 }
 
-/* Accepted by a row of the table: within [min, max] times to_core (min
- * excluded when open), a whole number when the row says so. */
 static int in_row(const char *property, double v) {
-  const gr_param_bound *row = row_of(property);
-  const double lo = row->min * row->to_core, hi = row->max * row->to_core;
-  return (row->min_open ? v > lo : v >= lo) && v <= hi && (!row->integer || v == floor(v));
+  return fuzz_in_row(row_of(property), v);
 }
 
 static int params_documented(const gr_rain_runoff_params *p) {
