@@ -17,11 +17,16 @@
 #include "snow_deformation_shared.h"
 
 /* The underside at grid point (i, j): the lowest crossing of the vertical
- * line by a triangle of tri[9 (first + t)] (world coordinates relative to the
- * grid's point (0, 0)). Outside the object's box [bi0, bi1] x [bj0, bj1]
- * nothing can cover the point. */
-__kernel void snow_raster(__global const float *restrict tri, int first, int ntri, int nx, int ny,
-                          float dx, float dy, int bi0, int bi1, int bj0, int bj1,
+ * line by a triangle (world coordinates relative to the grid's point (0, 0))
+ * of the point's tile, tile_list[tile_start[k] .. tile_start[k + 1]) with k
+ * = tile0 + tj * ntx + ti, (ti, tj) the point's tile of tile x tile points
+ * from the box's corner; the host lists in a tile every triangle that may
+ * pass the test below there. Outside the object's box [bi0, bi1] x
+ * [bj0, bj1] nothing can cover the point. */
+__kernel void snow_raster(__global const float *restrict tri,
+                          __global const int *restrict tile_start,
+                          __global const int *restrict tile_list, int tile0, int ntx, int tile,
+                          int nx, int ny, float dx, float dy, int bi0, int bi1, int bj0, int bj1,
                           __global float *restrict under) {
   int i = get_global_id(0), j = get_global_id(1);
   if (!gr_inside(i, j, nx, ny))
@@ -29,8 +34,10 @@ __kernel void snow_raster(__global const float *restrict tri, int first, int ntr
   float u = INFINITY;
   if (i >= bi0 && i <= bi1 && j >= bj0 && j <= bj1) {
     float px = i * dx, py = j * dy;
-    for (int t = 0; t < ntri; ++t) {
-      __global const float *v = tri + 9 * (first + t);
+    int k = tile0 + ((j - bj0) / tile) * ntx + (i - bi0) / tile;
+    int end = tile_start[k + 1];
+    for (int e = tile_start[k]; e < end; ++e) {
+      __global const float *v = tri + 9 * tile_list[e];
       float ax = v[0], ay = v[1], bx = v[3], by = v[4], cx = v[6], cy = v[7];
       if (px < fmin(ax, fmin(bx, cx)) - dx || px > fmax(ax, fmax(bx, cx)) + dx ||
           py < fmin(ay, fmin(by, cy)) - dy || py > fmax(ay, fmax(by, cy)) + dy)
@@ -205,14 +212,22 @@ GR_INLINE float snow_threshold(int di, int dj, float tx, float ty, float td) {
   return (di != 0 && dj != 0) ? td : (di != 0 ? tx : ty);
 }
 
-/* Per point a: the factor k_a of every excess it gives (1/10, less when it
- * holds less snow than that), and what it could still move,
- * min(S, largest excess), for the convergence test. */
+/* Per point: k_out, the factor of every excess it gives, and k_in, the
+ * factor of every excess it may receive; the pair (a, b) moves
+ * x_ab min(k_out_a, k_in_b). Thermal erosion's bound: a gives at most
+ * GR_SNOW_TALUS_SHARE of its largest excess in all (and never more than it
+ * holds) and b takes at most that share of its largest incoming excess, so a
+ * lone pair levels to the threshold in one iteration and a pit filled from
+ * eight sides at once still does not rise above them. Also what a point could
+ * still move, min(S, largest excess), for the convergence test. Givers are
+ * the window [gx0, gx_end) x [gy0, gy_end); k_in is written on the whole
+ * launch (the window grown by one). */
 __kernel void snow_relax_rate(__global const float *restrict ground,
                               __global const float *restrict depth,
                               __global const float *restrict under_min, int nx, int ny, float tx,
-                              float ty, float td, int x_end, int y_end,
-                              __global float *restrict rate, __global float *restrict movable) {
+                              float ty, float td, int gx0, int gy0, int gx_end, int gy_end,
+                              int x_end, int y_end, __global float *restrict rate,
+                              __global float *restrict rate_in, __global float *restrict movable) {
   /* Launched on a window from its offset: the launch is rounded up to the
    * work-group shape (16 x 16 on a GPU), and a point beyond the window's end
    * must not run (its neighbours' rates there are stale). */
@@ -220,38 +235,48 @@ __kernel void snow_relax_rate(__global const float *restrict ground,
   if (!gr_inside(i, j, nx, ny) || i >= x_end || j >= y_end)
     return;
   int c = gr_idx(i, j, nx);
-  float s = depth[c], ha = ground[c] + s, sum = 0.0f, big = 0.0f;
+  float s = depth[c], ha = ground[c] + s, ua = under_min[c];
+  float sum = 0.0f, big = 0.0f, sum_in = 0.0f, big_in = 0.0f;
   for (int dj = -1; dj <= 1; ++dj)
     for (int di = -1; di <= 1; ++di) {
       int a = i + di, b = j + dj;
       if ((di | dj) == 0 || a < 0 || b < 0 || a >= nx || b >= ny)
         continue;
       int n = gr_idx(a, b, nx);
-      float x =
-          snow_excess(ha, ground[n] + depth[n], under_min[n], snow_threshold(di, dj, tx, ty, td));
+      float sn = depth[n], hn = ground[n] + sn, thr = snow_threshold(di, dj, tx, ty, td);
+      float x = snow_excess(ha, hn, under_min[n], thr);
       sum += x;
       big = fmax(big, x);
+      if (sn > 0.0f) { /* a neighbour without snow gives nothing */
+        float y = snow_excess(hn, ha, ua, thr);
+        sum_in += y;
+        big_in = fmax(big_in, y);
+      }
     }
+  int giver = i >= gx0 && j >= gy0 && i < gx_end && j < gy_end;
   float k = 0.0f;
-  if (sum > 0.0f)
-    k = fmin(GR_SNOW_TALUS_RATE, GR_SNOW_KEEP * s / sum);
+  if (giver && sum > 0.0f)
+    k = fmin(GR_SNOW_TALUS_SHARE * (big / sum), GR_SNOW_KEEP * s / sum);
   rate[c] = k;
-  movable[c] = s > 0.0f ? fmin(s, big) : 0.0f;
+  rate_in[c] = sum_in > 0.0f ? GR_SNOW_TALUS_SHARE * (big_in / sum_in) : 0.0f;
+  movable[c] = giver && s > 0.0f ? fmin(s, big) : 0.0f;
 }
 
-/* Per point b: gives k_b x_bn to each neighbour n and receives k_a x_ab
- * (with a's density) from each neighbour a; the same floats both ways. */
+/* Per point b: gives x_bn min(k_b, k_in_n) to each neighbour n and receives
+ * x_ab min(k_a, k_in_b) (with a's density) from each neighbour a; the same
+ * floats both ways. */
 __kernel void
 snow_relax_move(__global const float *restrict ground, __global const float *restrict depth,
                 __global const float *restrict density, __global const float *restrict under_min,
-                __global const float *restrict rate, int nx, int ny, float tx, float ty, float td,
-                int x_end, int y_end, __global float *restrict depth_out,
-                __global float *restrict density_out) {
+                __global const float *restrict rate, __global const float *restrict rate_in, int nx,
+                int ny, float tx, float ty, float td, int x_end, int y_end,
+                __global float *restrict depth_out, __global float *restrict density_out) {
   int i = get_global_id(0), j = get_global_id(1);
   if (!gr_inside(i, j, nx, ny) || i >= x_end || j >= y_end)
     return; /* beyond the window (see snow_relax_rate) */
   int c = gr_idx(i, j, nx);
-  float s = depth[c], rho = density[c], hb = ground[c] + s, ub = under_min[c], kb = rate[c];
+  float s = depth[c], rho = density[c], hb = ground[c] + s, ub = under_min[c], kb = rate[c],
+        kin = rate_in[c];
   float out = 0.0f, in = 0.0f, mass_in = 0.0f; /* mass_in: relative to rho */
   for (int dj = -1; dj <= 1; ++dj)
     for (int di = -1; di <= 1; ++di) {
@@ -262,10 +287,10 @@ snow_relax_move(__global const float *restrict ground, __global const float *res
       float thr = snow_threshold(di, dj, tx, ty, td);
       float hn = ground[n] + depth[n];
       if (kb > 0.0f)
-        out += kb * snow_excess(hb, hn, under_min[n], thr);
+        out += snow_excess(hb, hn, under_min[n], thr) * fmin(kb, rate_in[n]);
       float ka = rate[n];
-      if (ka > 0.0f) {
-        float f = ka * snow_excess(hn, hb, ub, thr);
+      if (ka > 0.0f && kin > 0.0f) {
+        float f = snow_excess(hn, hb, ub, thr) * fmin(ka, kin);
         in += f;
         mass_in += f * (density[n] - rho);
       }

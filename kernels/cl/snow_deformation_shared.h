@@ -4,10 +4,11 @@
 #ifndef GRAUPEL_CL_SNOW_DEFORMATION_SHARED_H
 #define GRAUPEL_CL_SNOW_DEFORMATION_SHARED_H
 
-/* The talus flux per unit excess: the explicit 8-neighbour Jacobi step is
- * stable up to 1/8 (a pit whose 8 higher neighbours all give at once must
- * not rise above them); 1/10 leaves a margin for float rounding. */
-#define GR_SNOW_TALUS_RATE 0.1f
+/* The talus share (thermal erosion): a point gives at most this fraction of
+ * its largest excess per iteration, and a point takes at most this fraction
+ * of its largest incoming excess; 1/2 levels a lone pair to the threshold in
+ * one iteration. */
+#define GR_SNOW_TALUS_SHARE 0.5f
 
 /* A cell gives at most this fraction of its snow in one talus iteration, so
  * that rounding never takes it below zero. */

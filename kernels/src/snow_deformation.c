@@ -55,6 +55,7 @@ static const gr_param_bound gr_snow_bounds[GR_SNOW_P_COUNT] = {
 typedef struct gr_snow_object {
   int first, count;       /* triangles in the world-triangle array */
   int bi0, bi1, bj0, bj1; /* the box of points it may cover; bi0 > bi1: none */
+  int tile0, ntx, tile;   /* its tiles: the first, per row, tile x tile points each */
   double v[3];
 } gr_snow_object;
 
@@ -67,9 +68,13 @@ struct gr_snow_deformation {
   cl_mem depth[2], density[2]; /* [cur] is the state */
   int cur;
   cl_mem ground, depth0, density0, under, overlap, weight, overlap_sum, contact, under_min, rate,
-      movable, scratch;
+      rate_in, movable, scratch;
   cl_mem tri; /* world triangles, 9 floats each */
   size_t tri_cap;
+  /* The raster's bins: tile t of all objects lists the triangles
+   * tri_list[tile_start[t] .. tile_start[t + 1]) that may cover its points. */
+  cl_mem tile_start, tile_list;
+  size_t tile_start_cap, tile_list_cap;
   gr_reduction red_obj, red_check, red_ledger;
   gr_snow_object objects[GR_SNOW_DEFORMATION_MAX_OBJECTS];
   int nobjects;
@@ -333,10 +338,10 @@ gr_status gr_snow_deformation_create(gr_context *ctx, const gr_grid *grid,
             {"snow_surface", &s->surface}};
   for (size_t i = 0; st == GR_OK && i < sizeof(ks) / sizeof(ks[0]); ++i)
     st = gr_kernel_create(ctx, prog, ks[i].name, ks[i].k);
-  cl_mem *bufs[] = {&s->depth[0],  &s->depth[1], &s->density[0],  &s->density[1],
-                    &s->ground,    &s->depth0,   &s->density0,    &s->under,
-                    &s->overlap,   &s->weight,   &s->overlap_sum, &s->contact,
-                    &s->under_min, &s->rate,     &s->movable,     &s->scratch};
+  cl_mem *bufs[] = {&s->depth[0],    &s->depth[1], &s->density[0], &s->density[1], &s->ground,
+                    &s->depth0,      &s->density0, &s->under,      &s->overlap,    &s->weight,
+                    &s->overlap_sum, &s->contact,  &s->under_min,  &s->rate,       &s->rate_in,
+                    &s->movable,     &s->scratch};
   for (size_t i = 0; st == GR_OK && i < sizeof(bufs) / sizeof(bufs[0]); ++i)
     st = gr_buffer_create(ctx, CL_MEM_READ_WRITE, bytes, NULL, bufs[i]);
   if (st == GR_OK)
@@ -373,8 +378,8 @@ void gr_snow_deformation_destroy(gr_snow_deformation *s) {
       clReleaseKernel(ks[i]);
   cl_mem *bufs[] = {&s->depth[0],    &s->depth[1], &s->density[0], &s->density[1], &s->ground,
                     &s->depth0,      &s->density0, &s->under,      &s->overlap,    &s->weight,
-                    &s->overlap_sum, &s->contact,  &s->under_min,  &s->rate,       &s->movable,
-                    &s->scratch,     &s->tri};
+                    &s->overlap_sum, &s->contact,  &s->under_min,  &s->rate,       &s->rate_in,
+                    &s->movable,     &s->scratch,  &s->tri,        &s->tile_start, &s->tile_list};
   for (size_t i = 0; i < sizeof(bufs) / sizeof(bufs[0]); ++i)
     gr_buffer_release(bufs[i]);
   gr_reduction_release(&s->red_obj);
@@ -497,6 +502,142 @@ gr_status gr_snow_deformation_set_field(gr_snow_deformation *s, gr_field f, cons
   return GR_SNOW_KEEP_ERROR(s, gr_snow_set_field_impl(s, f, host));
 }
 
+/* The points [*lo, *hi] of a box [b0, b1] whose raster test may pass for
+ * coordinates in [a, b] at spacing d (the kernel widens each triangle by one
+ * spacing; one more here covers the rounding). Empty: *lo > *hi. */
+static void gr_snow_span(double a, double b, double d, int b0, int b1, int *lo, int *hi) {
+  double l = floor(a / d) - 2.0, h = ceil(b / d) + 2.0;
+  l = l > b0 ? l : b0;
+  h = h < b1 ? h : b1;
+  *lo = l > h ? 1 : (int)l;
+  *hi = l > h ? 0 : (int)h;
+}
+
+/* Sorts each object's triangles into square tiles of its box, so that the
+ * raster tests at a point only the triangles that may cover its tile. The
+ * minimum is exact and every triangle that can pass the test is listed, so
+ * the underside is bit for bit what testing all of them gives. The tile
+ * side doubles while the lists would hold more than 16 entries a triangle
+ * (large triangles over a large box), which bounds the memory. */
+static gr_status gr_snow_bin(gr_snow_deformation *s, gr_snow_object *objs, int n,
+                             const float *tri) {
+  const gr_grid *g = &s->grid;
+  size_t ntiles = 0, entries = 0;
+  for (int pass = 0; pass < 2; ++pass) {
+    int *start = NULL, *list = NULL, *fill = NULL;
+    if (pass == 1) {
+      start = malloc((ntiles + 1) * sizeof(int));
+      list = malloc((entries ? entries : 1) * sizeof(int));
+      fill = malloc((ntiles + 1) * sizeof(int));
+      if (!start || !list || !fill) {
+        free(start), free(list), free(fill);
+        return gr_set_error(s->ctx, GR_ERR_OUT_OF_MEMORY, "Out of host memory.");
+      }
+      memset(start, 0, (ntiles + 1) * sizeof(int));
+    }
+    for (int o = 0; o < n; ++o) {
+      gr_snow_object *ob = &objs[o];
+      if (pass == 0) {
+        ob->tile0 = (int)ntiles;
+        ob->ntx = 0;
+        ob->tile = 8;
+        if (ob->bi0 > ob->bi1 || ob->bj0 > ob->bj1)
+          continue;
+        for (;;) {
+          size_t e = 0;
+          for (int t = ob->first; t < ob->first + ob->count; ++t) {
+            const float *v = tri + 9 * (size_t)t;
+            int i0, i1, j0, j1;
+            gr_snow_span(fmin(v[0], fmin(v[3], v[6])), fmax(v[0], fmax(v[3], v[6])), g->dx, ob->bi0,
+                         ob->bi1, &i0, &i1);
+            gr_snow_span(fmin(v[1], fmin(v[4], v[7])), fmax(v[1], fmax(v[4], v[7])), g->dy, ob->bj0,
+                         ob->bj1, &j0, &j1);
+            if (i0 <= i1 && j0 <= j1)
+              e += (size_t)((i1 - ob->bi0) / ob->tile - (i0 - ob->bi0) / ob->tile + 1) *
+                   (size_t)((j1 - ob->bj0) / ob->tile - (j0 - ob->bj0) / ob->tile + 1);
+          }
+          int w = ob->bi1 - ob->bi0 + 1, h = ob->bj1 - ob->bj0 + 1;
+          if (e <= 16 * (size_t)ob->count + 1024 || (ob->tile >= w && ob->tile >= h)) {
+            ob->ntx = (w + ob->tile - 1) / ob->tile;
+            ntiles += (size_t)ob->ntx * (size_t)((h + ob->tile - 1) / ob->tile);
+            entries += e;
+            break;
+          }
+          ob->tile *= 2;
+        }
+        if (ntiles > (size_t)INT_MAX / 2 || entries > (size_t)INT_MAX / 2)
+          return gr_set_error(s->ctx, GR_ERR_TOO_LARGE,
+                              "The objects cover %zu raster tiles with %zu triangle entries, more "
+                              "than the core addresses; simplify the meshes.",
+                              ntiles, entries);
+        continue;
+      }
+      if (ob->ntx == 0)
+        continue;
+      /* count per tile; the lists are filled in triangle order below */
+      for (int t = ob->first; t < ob->first + ob->count; ++t) {
+        const float *v = tri + 9 * (size_t)t;
+        int i0, i1, j0, j1;
+        gr_snow_span(fmin(v[0], fmin(v[3], v[6])), fmax(v[0], fmax(v[3], v[6])), g->dx, ob->bi0,
+                     ob->bi1, &i0, &i1);
+        gr_snow_span(fmin(v[1], fmin(v[4], v[7])), fmax(v[1], fmax(v[4], v[7])), g->dy, ob->bj0,
+                     ob->bj1, &j0, &j1);
+        if (i0 > i1 || j0 > j1)
+          continue;
+        for (int tj = (j0 - ob->bj0) / ob->tile; tj <= (j1 - ob->bj0) / ob->tile; ++tj)
+          for (int ti = (i0 - ob->bi0) / ob->tile; ti <= (i1 - ob->bi0) / ob->tile; ++ti)
+            start[ob->tile0 + tj * ob->ntx + ti + 1]++;
+      }
+    }
+    if (pass == 1) {
+      for (size_t k = 0; k < ntiles; ++k)
+        start[k + 1] += start[k];
+      memcpy(fill, start, (ntiles + 1) * sizeof(int));
+      for (int o = 0; o < n; ++o) {
+        gr_snow_object *ob = &objs[o];
+        if (ob->ntx == 0)
+          continue;
+        for (int t = ob->first; t < ob->first + ob->count; ++t) {
+          const float *v = tri + 9 * (size_t)t;
+          int i0, i1, j0, j1;
+          gr_snow_span(fmin(v[0], fmin(v[3], v[6])), fmax(v[0], fmax(v[3], v[6])), g->dx, ob->bi0,
+                       ob->bi1, &i0, &i1);
+          gr_snow_span(fmin(v[1], fmin(v[4], v[7])), fmax(v[1], fmax(v[4], v[7])), g->dy, ob->bj0,
+                       ob->bj1, &j0, &j1);
+          if (i0 > i1 || j0 > j1)
+            continue;
+          for (int tj = (j0 - ob->bj0) / ob->tile; tj <= (j1 - ob->bj0) / ob->tile; ++tj)
+            for (int ti = (i0 - ob->bi0) / ob->tile; ti <= (i1 - ob->bi0) / ob->tile; ++ti)
+              list[fill[ob->tile0 + tj * ob->ntx + ti]++] = t;
+        }
+      }
+      gr_status st = GR_OK;
+      size_t sb = (ntiles + 1) * sizeof(int), lb = (entries ? entries : 1) * sizeof(int);
+      if (sb > s->tile_start_cap) {
+        gr_buffer_release(&s->tile_start);
+        s->tile_start_cap = 0;
+        st = gr_buffer_create(s->ctx, CL_MEM_READ_ONLY, sb, NULL, &s->tile_start);
+        if (st == GR_OK)
+          s->tile_start_cap = sb;
+      }
+      if (st == GR_OK && lb > s->tile_list_cap) {
+        gr_buffer_release(&s->tile_list);
+        s->tile_list_cap = 0;
+        st = gr_buffer_create(s->ctx, CL_MEM_READ_ONLY, lb, NULL, &s->tile_list);
+        if (st == GR_OK)
+          s->tile_list_cap = lb;
+      }
+      if (st == GR_OK)
+        st = gr_buffer_write(s->ctx, s->tile_start, 0, sb, start);
+      if (st == GR_OK)
+        st = gr_buffer_write(s->ctx, s->tile_list, 0, lb, list);
+      free(start), free(list), free(fill);
+      return st;
+    }
+  }
+  return GR_OK;
+}
+
 static gr_status gr_snow_set_objects_impl(gr_snow_deformation *s, const gr_mesh *meshes, int n,
                                           const double *velocities) {
   char msg[320];
@@ -565,7 +706,11 @@ static gr_status gr_snow_set_objects_impl(gr_snow_deformation *s, const gr_mesh 
     for (int a = 0; a < 3; ++a)
       objs[o].v[a] = velocities ? velocities[3 * o + a] : 0.0;
   }
-  gr_status st = GR_OK;
+  gr_status st = gr_snow_bin(s, objs, n, tri);
+  if (st != GR_OK) {
+    free(tri);
+    return st;
+  }
   if (total > s->tri_cap) {
     gr_buffer_release(&s->tri);
     s->tri_cap = 0;
@@ -631,12 +776,18 @@ static gr_status gr_snow_object_step(gr_snow_deformation *s, int o, double dt) {
   float dx = (float)s->grid.dx, dy = (float)s->grid.dy;
   size_t NX = (size_t)nx, NY = (size_t)ny;
   gr_status st = GR_SNOW_ARG(s, s->raster, "tri", s->tri);
-  int first = ob->first, ntri = ob->count, bi0 = ob->bi0, bi1 = ob->bi1, bj0 = ob->bj0,
-      bj1 = ob->bj1;
+  int tile0 = ob->tile0, ntx = ob->ntx, tile = ob->tile, bi0 = ob->bi0, bi1 = ob->bi1,
+      bj0 = ob->bj0, bj1 = ob->bj1;
   if (st == GR_OK)
-    st = GR_SNOW_ARG(s, s->raster, "ntri", ntri);
+    st = GR_SNOW_ARG(s, s->raster, "tile_start", s->tile_start);
   if (st == GR_OK)
-    st = GR_SNOW_ARG(s, s->raster, "first", first);
+    st = GR_SNOW_ARG(s, s->raster, "tile_list", s->tile_list);
+  if (st == GR_OK)
+    st = GR_SNOW_ARG(s, s->raster, "tile0", tile0);
+  if (st == GR_OK)
+    st = GR_SNOW_ARG(s, s->raster, "ntx", ntx);
+  if (st == GR_OK)
+    st = GR_SNOW_ARG(s, s->raster, "tile", tile);
   if (st == GR_OK)
     st = GR_SNOW_ARG(s, s->raster, "nx", nx);
   if (st == GR_OK)
@@ -800,6 +951,8 @@ static gr_status gr_snow_relax(gr_snow_deformation *s) {
   if (st == GR_OK)
     st = gr_snow_fill(s, s->rate, 0.0f);
   if (st == GR_OK)
+    st = gr_snow_fill(s, s->rate_in, 0.0f);
+  if (st == GR_OK)
     st = gr_snow_fill(s, s->movable, 0.0f);
   while (st == GR_OK && it < s->params.max_relax_iterations) {
     x0 = x0 > 0 ? x0 : 0;
@@ -828,14 +981,26 @@ static gr_status gr_snow_relax(gr_snow_deformation *s) {
       st = GR_SNOW_ARG(s, k, "rate", s->rate);
     if (st == GR_OK)
       st = GR_SNOW_ARG(s, k, "movable", s->movable);
-    cl_int x_end = x1 + 1, y_end = y1 + 1;
     if (st == GR_OK)
-      st = GR_SNOW_ARG(s, k, "x_end", x_end);
+      st = GR_SNOW_ARG(s, k, "rate_in", s->rate_in);
+    /* The givers are R; the receivers' intake limits are needed on R grown
+     * by one, where the moves run. */
+    cl_int gx0 = x0, gy0 = y0, gx_end = x1 + 1, gy_end = y1 + 1, rx_end = mx1 + 1, ry_end = my1 + 1;
     if (st == GR_OK)
-      st = GR_SNOW_ARG(s, k, "y_end", y_end);
+      st = GR_SNOW_ARG(s, k, "gx0", gx0);
     if (st == GR_OK)
-      st = gr_enqueue_2d(ctx, k, (size_t)x0, (size_t)y0, (size_t)(x1 - x0 + 1),
-                         (size_t)(y1 - y0 + 1), NULL);
+      st = GR_SNOW_ARG(s, k, "gy0", gy0);
+    if (st == GR_OK)
+      st = GR_SNOW_ARG(s, k, "gx_end", gx_end);
+    if (st == GR_OK)
+      st = GR_SNOW_ARG(s, k, "gy_end", gy_end);
+    if (st == GR_OK)
+      st = GR_SNOW_ARG(s, k, "x_end", rx_end);
+    if (st == GR_OK)
+      st = GR_SNOW_ARG(s, k, "y_end", ry_end);
+    if (st == GR_OK)
+      st = gr_enqueue_2d(ctx, k, (size_t)mx0, (size_t)my0, (size_t)(mx1 - mx0 + 1),
+                         (size_t)(my1 - my0 + 1), NULL);
     if (st == GR_OK && it % GR_SNOW_CHECK_EVERY == 0) {
       double mx = 0.0;
       st = GR_SNOW_ARG(s, s->check_reduce, "movable", s->movable);
@@ -858,6 +1023,8 @@ static gr_status gr_snow_relax(gr_snow_deformation *s) {
       st = GR_SNOW_ARG(s, k, "under_min", s->under_min);
     if (st == GR_OK)
       st = GR_SNOW_ARG(s, k, "rate", s->rate);
+    if (st == GR_OK)
+      st = GR_SNOW_ARG(s, k, "rate_in", s->rate_in);
     if (st == GR_OK)
       st = GR_SNOW_ARG(s, k, "nx", nx);
     if (st == GR_OK)

@@ -51,10 +51,12 @@
  * mass are conserved and reruns are bit-identical). Point a gives to each
  * 8-neighbour b the excess x_ab = max(0, H_a - H_b - MaxSlope d_ab), d_ab
  * the pair's distance (dx, dy or the diagonal: the slope is a true slope,
- * unlike the thesis' per-cell constant), times 1/10 (the explicit 8-neighbour
- * step is stable up to 1/8), scaled down to S_a when a holds less; never to
- * a point under an object whose underside is below H_a (U_b <= H_a), which
- * holds the imprint. Moved snow carries its density (mass mixes). It stops
+ * unlike the thesis' per-cell constant), times min(k_a, k_in_b), the
+ * thermal-erosion limits on both sides of the pair: a gives at most half its
+ * largest excess in all (and no more than S_a), b takes at most half its
+ * largest incoming excess (so heights never cross and a lone pair levels in
+ * one iteration); never to a point under an object whose underside is below
+ * H_a (U_b <= H_a), which holds the imprint. Moved snow carries its density (mass mixes). It stops
  * when no point can move more than RelaxTolerance (the largest
  * min(S_a, x_ab) over the grid, read every 8 iterations) or after
  * MaxRelaxIterations.
