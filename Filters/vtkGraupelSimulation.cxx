@@ -650,3 +650,15 @@ int vtkGraupelSimulation::FillImage(vtkDataObject *outputObject, vtkInformation 
   output->Crop(extent);
   return 1;
 }
+
+void vtkGraupelSimulation::TerrainGrid(vtkImageData *terrain, gr_grid *grid) {
+  *grid = gr_grid{};
+  int dims[3];
+  terrain->GetDimensions(dims);
+  grid->nx = dims[0];
+  grid->ny = dims[1];
+  grid->dx = terrain->GetSpacing()[0];
+  grid->dy = terrain->GetSpacing()[1];
+  grid->x0 = terrain->GetOrigin()[0];
+  grid->y0 = terrain->GetOrigin()[1];
+}

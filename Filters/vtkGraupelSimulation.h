@@ -119,6 +119,7 @@
 class vtkDataArray;
 class vtkImageData;
 
+struct gr_grid;
 class GRAUPELFILTERS_EXPORT vtkGraupelSimulation : public vtkGraupelAlgorithm {
 public:
   vtkTypeMacro(vtkGraupelSimulation, vtkGraupelAlgorithm);
@@ -224,6 +225,9 @@ protected:
    * becomes the active scalars. A failed read is reported with detail() (the
    * core's own sentence); returns 0 then.
    */
+  /** The core's grid of a 2-D terrain image: its points, spacing and origin (a whole grid). */
+  static void TerrainGrid(vtkImageData *terrain, gr_grid *grid);
+
   int FillImage(vtkDataObject *output, vtkInformation *outInfo, const int *fields, int count,
                 const std::function<int(int, float *)> &read,
                 const std::function<const char *()> &detail);

@@ -200,13 +200,8 @@ int vtkRainRunoffFilter::SetUpState(vtkInformationVector **inputVector) {
     return 0;
   }
 
-  gr_grid grid = {};
-  grid.nx = dims[0];
-  grid.ny = dims[1];
-  grid.dx = spacing[0];
-  grid.dy = spacing[1];
-  grid.x0 = terrain->GetOrigin()[0];
-  grid.y0 = terrain->GetOrigin()[1];
+  gr_grid grid;
+  TerrainGrid(terrain, &grid);
   gr_status st = gr_rain_runoff_create(this->GetContext(), &grid, &p, &this->Simulation);
   if (st != GR_OK) {
     return this->ReportFailure(st, "Rain Runoff could not set up the simulation");

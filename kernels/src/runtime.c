@@ -422,6 +422,24 @@ double gr_param_clamp(const gr_param_bound *b, double user_value) {
   return user_value < b->min ? b->min : (user_value > b->max ? b->max : user_value);
 }
 
+void gr_param_explain(const gr_param_bound *b, double core_value, const char *what, char *msg,
+                      size_t msg_len) {
+  if (!b || !msg || !msg_len)
+    return;
+  const char *w = what ? what : "Invalid parameters";
+  const char *sp = b->unit[0] ? " " : "";
+  double user = core_value / b->to_core;
+  if (b->integer)
+    snprintf(msg, msg_len, "%s: %s must be a whole number from %g to %g (got %g).", w, b->property,
+             b->min, b->max, user);
+  else if (b->min_open)
+    snprintf(msg, msg_len, "%s: %s must be above %g and at most %g%s%s (got %g%s%s).", w,
+             b->property, b->min, b->max, sp, b->unit, user, sp, b->unit);
+  else
+    snprintf(msg, msg_len, "%s: %s must lie between %g and %g%s%s (got %g%s%s).", w, b->property,
+             b->min, b->max, sp, b->unit, user, sp, b->unit);
+}
+
 /* ------------------------------------------------------------------ errors */
 
 static void gr_log(const gr_context *ctx, gr_log_level level, const char *msg) {

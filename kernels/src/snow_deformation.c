@@ -156,25 +156,7 @@ gr_status gr_snow_deformation_params_validate(const gr_snow_deformation_params *
     double v = gr_snow_param_value(p, row);
     if (gr_param_accepts(r, v))
       continue;
-    if (msg && msg_len) {
-      const char *sp = r->unit[0] ? " " : "";
-      double user = v / r->to_core;
-      if (r->integer)
-        snprintf(msg, msg_len,
-                 "Invalid snow deformation parameters: %s must be a whole number from %g to %g "
-                 "(got %g).",
-                 r->property, r->min, r->max, user);
-      else if (r->min_open)
-        snprintf(msg, msg_len,
-                 "Invalid snow deformation parameters: %s must be above %g and at most %g%s%s "
-                 "(got %g%s%s).",
-                 r->property, r->min, r->max, sp, r->unit, user, sp, r->unit);
-      else
-        snprintf(msg, msg_len,
-                 "Invalid snow deformation parameters: %s must lie between %g and %g%s%s (got "
-                 "%g%s%s).",
-                 r->property, r->min, r->max, sp, r->unit, user, sp, r->unit);
-    }
+    gr_param_explain(r, v, "Invalid snow deformation parameters", msg, msg_len);
     return GR_ERR_INVALID_ARGUMENT;
   }
   if (p->min_density > p->max_density) {

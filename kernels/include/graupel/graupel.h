@@ -179,6 +179,15 @@ GR_API int gr_param_accepts(const gr_param_bound *b, double core_value);
 GR_API double gr_param_clamp(const gr_param_bound *b, double user_value);
 
 /**
+ * The sentence for a core value that row b refuses, in the user's unit:
+ * "<what>: RainRate must lie between 0 and 3600 mm/h (got 7200 mm/h)." (or
+ * "must be above .. and at most ..", or "must be a whole number from .. to
+ * .."), written to msg.
+ */
+GR_API void gr_param_explain(const gr_param_bound *b, double core_value, const char *what,
+                             char *msg, size_t msg_len);
+
+/**
  * A closed triangle mesh (an object: a wheel, a boot, a rock), as views of
  * the caller's arrays. Vertices in the object's own frame, metres;
  * triangles wound counter-clockwise seen from outside; transform maps the
