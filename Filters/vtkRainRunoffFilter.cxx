@@ -15,6 +15,7 @@
 
 #include "graupel/rain_runoff.h"
 
+#include "GraupelArrays.h"
 #include "GraupelParameterTable.h"
 
 #include <cmath>
@@ -24,21 +25,10 @@
 vtkStandardNewMacro(vtkRainRunoffFilter);
 
 namespace {
+using graupel::AddValue;
+using graupel::AsFloat;
 // User-facing intensities are in mm/h; the core speaks m/s.
 constexpr double MillimetresPerHour = 1.0 / 3.6e6;
-
-// The array as float32 (a copy when it is stored otherwise), or nullptr.
-vtkSmartPointer<vtkFloatArray> AsFloat(vtkDataArray *a) {
-  if (!a) {
-    return nullptr;
-  }
-  if (auto *f = vtkFloatArray::SafeDownCast(a)) {
-    return f;
-  }
-  auto f = vtkSmartPointer<vtkFloatArray>::New();
-  f->DeepCopy(a);
-  return f;
-}
 
 // The core's parameter table row for a property, or nullptr.
 const gr_param_bound *Bound(const char *property) {
@@ -47,12 +37,6 @@ const gr_param_bound *Bound(const char *property) {
   return gr_param_find(table, count, property);
 }
 
-void AddValue(vtkFieldData *fd, const char *name, double value) {
-  vtkNew<vtkDoubleArray> a;
-  a->SetName(name);
-  a->InsertNextValue(value);
-  fd->AddArray(a);
-}
 } // namespace
 
 vtkRainRunoffFilter::vtkRainRunoffFilter() {

@@ -26,6 +26,7 @@
 
 #include "graupel/snow_deformation.h"
 
+#include "GraupelArrays.h"
 #include "GraupelParameterTable.h"
 
 #include <array>
@@ -38,19 +39,8 @@
 vtkStandardNewMacro(vtkSnowDeformationFilter);
 
 namespace {
-// The array as float32 (a copy when it is stored otherwise), or nullptr.
-vtkSmartPointer<vtkFloatArray> AsFloat(vtkDataArray *a) {
-  if (!a) {
-    return nullptr;
-  }
-  if (auto *f = vtkFloatArray::SafeDownCast(a)) {
-    return f;
-  }
-  auto f = vtkSmartPointer<vtkFloatArray>::New();
-  f->DeepCopy(a);
-  return f;
-}
-
+using graupel::AddValue;
+using graupel::AsFloat;
 const gr_param_bound *Bound(const char *property) {
   int count = 0;
   const gr_param_bound *table = gr_snow_deformation_param_bounds(&count);
@@ -60,13 +50,6 @@ const gr_param_bound *Bound(const char *property) {
 double TableDefault(const char *property, double fallback) {
   const gr_param_bound *b = Bound(property);
   return b ? b->default_value : fallback;
-}
-
-void AddValue(vtkFieldData *fd, const char *name, double value) {
-  vtkNew<vtkDoubleArray> a;
-  a->SetName(name);
-  a->InsertNextValue(value);
-  fd->AddArray(a);
 }
 
 void AddForce(vtkFieldData *fd, const double force[3], double area) {
