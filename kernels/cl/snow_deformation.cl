@@ -27,10 +27,10 @@ __kernel void snow_raster(__global const float *restrict tri,
                           __global const int *restrict tile_start,
                           __global const int *restrict tile_list, int tile0, int ntx, int tile,
                           int nx, int ny, float dx, float dy, int bi0, int bi1, int bj0, int bj1,
-                          __global float *restrict under) {
+                          int x_end, int y_end, __global float *restrict under) {
   int i = get_global_id(0), j = get_global_id(1);
-  if (!gr_inside(i, j, nx, ny))
-    return;
+  if (!gr_inside(i, j, nx, ny) || i >= x_end || j >= y_end)
+    return; /* beyond the window (see snow_relax_rate) */
   float u = INFINITY;
   if (i >= bi0 && i <= bi1 && j >= bj0 && j <= bj1) {
     float px = i * dx, py = j * dy;
@@ -65,10 +65,10 @@ GR_INLINE float snow_overlap_of(float b, float s, float u) {
 
 __kernel void snow_overlap(__global const float *restrict ground,
                            __global const float *restrict depth,
-                           __global const float *restrict under, int nx, int ny,
-                           __global float *restrict overlap) {
+                           __global const float *restrict under, int nx, int ny, int x_end,
+                           int y_end, __global float *restrict overlap) {
   int i = get_global_id(0), j = get_global_id(1);
-  if (!gr_inside(i, j, nx, ny))
+  if (!gr_inside(i, j, nx, ny) || i >= x_end || j >= y_end)
     return;
   int c = gr_idx(i, j, nx);
   overlap[c] = snow_overlap_of(ground[c], depth[c], under[c]);
@@ -78,9 +78,10 @@ __kernel void snow_overlap(__global const float *restrict ground,
  * 8-neighbour); on it s_w = max(0, v^ . w^) + r / K with w^ the outward
  * direction, minus the sum of the overlapped neighbours' offsets. */
 __kernel void snow_contour(__global const float *restrict overlap, int nx, int ny, float vx,
-                           float vy, float rest, __global float *restrict weight) {
+                           float vy, float rest, int x_end, int y_end,
+                           __global float *restrict weight) {
   int i = get_global_id(0), j = get_global_id(1);
-  if (!gr_inside(i, j, nx, ny))
+  if (!gr_inside(i, j, nx, ny) || i >= x_end || j >= y_end)
     return;
   int c = gr_idx(i, j, nx);
   float cw = -1.0f;
@@ -128,14 +129,17 @@ __kernel void
 snow_object_reduce(__global const float *restrict ground, __global const float *restrict depth,
                    __global const float *restrict density, __global const float *restrict under,
                    __global const float *restrict overlap, __global const float *restrict weight,
-                   float rho_min, float rho_max, float w_const, float gap, int n,
-                   __global float *restrict partial, __local float *restrict scratch) {
+                   float rho_min, float rho_max, float w_const, float gap, int nx, int x0, int y0,
+                   int w, int n, __global float *restrict partial,
+                   __local float *restrict scratch) {
+  /* Over the window [x0, x0 + w) x [y0, y0 + n / w). */
   int lid = get_local_id(0), wg = get_local_size(0), start, end;
   gr_reduce_block(n, &start, &end);
   float hi[GR_SNOW_OBJ_SUMS], lo[GR_SNOW_OBJ_SUMS];
   for (int q = 0; q < GR_SNOW_OBJ_SUMS; ++q)
     hi[q] = lo[q] = 0.0f;
-  for (int c = start + lid; c < end; c += wg) {
+  for (int q = start + lid; q < end; q += wg) {
+    int c = gr_idx(x0 + q % w, y0 + q / w, nx);
     float s = depth[c], rho = density[c], d = overlap[c], cw = weight[c];
     float e = snow_displaced(s, rho, d, rho_min, rho_max, w_const);
     gr_df_add(&hi[0], &lo[0], e);
@@ -168,10 +172,10 @@ __kernel void snow_apply(__global const float *restrict ground, __global float *
                          __global const float *restrict overlap,
                          __global const float *restrict weight, float rho_min, float rho_max,
                          float w_const, float gap, float add_depth, float add_rho, int press,
-                         int nx, int ny, __global float *restrict overlap_sum,
+                         int nx, int ny, int x_end, int y_end, __global float *restrict overlap_sum,
                          __global float *restrict contact, __global float *restrict under_min) {
   int i = get_global_id(0), j = get_global_id(1);
-  if (!gr_inside(i, j, nx, ny))
+  if (!gr_inside(i, j, nx, ny) || i >= x_end || j >= y_end)
     return;
   int c = gr_idx(i, j, nx);
   float s = depth[c], rho = density[c], d = overlap[c], cw = weight[c], u = under[c];
@@ -198,6 +202,18 @@ __kernel void snow_apply(__global const float *restrict ground, __global float *
   }
 }
 
+/* The start of a step, on where the last step's objects wrote. */
+__kernel void snow_reset(int nx, int ny, int x_end, int y_end, __global float *restrict overlap_sum,
+                         __global float *restrict contact, __global float *restrict under_min) {
+  int i = get_global_id(0), j = get_global_id(1);
+  if (!gr_inside(i, j, nx, ny) || i >= x_end || j >= y_end)
+    return;
+  int c = gr_idx(i, j, nx);
+  overlap_sum[c] = 0.0f;
+  contact[c] = 0.0f;
+  under_min[c] = INFINITY;
+}
+
 /* Talus: the excess of point a (height ha) over its neighbour b (height hb,
  * lowest underside ub) at the distance whose threshold is thr. Zero when b
  * is under an object below ha: snow must not flow into the imprint. */
@@ -212,6 +228,15 @@ GR_INLINE float snow_threshold(int di, int dj, float tx, float ty, float td) {
   return (di != 0 && dj != 0) ? td : (di != 0 ? tx : ty);
 }
 
+/* The neighbour of point (i, j) at offset (di, dj): its index, or the
+ * point's own index off the grid. A point has no excess over itself (the
+ * thresholds are positive), so an edge drops the pair at both of its ends
+ * alike, with no branch. */
+GR_INLINE int snow_neighbour(int i, int j, int di, int dj, int nx, int ny) {
+  int a = i + di, b = j + dj;
+  return (a < 0 || b < 0 || a >= nx || b >= ny) ? gr_idx(i, j, nx) : gr_idx(a, b, nx);
+}
+
 /* Per point: k_out, the factor of every excess it gives, and k_in, the
  * factor of every excess it may receive; the pair (a, b) moves
  * x_ab min(k_out_a, k_in_b). Thermal erosion's bound: a gives at most
@@ -221,12 +246,12 @@ GR_INLINE float snow_threshold(int di, int dj, float tx, float ty, float td) {
  * eight sides at once still does not rise above them. Also what a point could
  * still move, min(S, largest excess), for the convergence test. Givers are
  * the window [gx0, gx_end) x [gy0, gy_end); k_in is written on the whole
- * launch (the window grown by one). */
+ * launch. */
 __kernel void snow_relax_rate(__global const float *restrict ground,
                               __global const float *restrict depth,
                               __global const float *restrict under_min, int nx, int ny, float tx,
-                              float ty, float td, int gx0, int gy0, int gx_end, int gy_end,
-                              int x_end, int y_end, __global float *restrict rate,
+                              float ty, float td, float tol, int gx0, int gy0, int gx_end,
+                              int gy_end, int x_end, int y_end, __global float *restrict rate,
                               __global float *restrict rate_in, __global float *restrict movable) {
   /* Launched on a window from its offset: the launch is rounded up to the
    * work-group shape (16 x 16 on a GPU), and a point beyond the window's end
@@ -239,10 +264,9 @@ __kernel void snow_relax_rate(__global const float *restrict ground,
   float sum = 0.0f, big = 0.0f, sum_in = 0.0f, big_in = 0.0f;
   for (int dj = -1; dj <= 1; ++dj)
     for (int di = -1; di <= 1; ++di) {
-      int a = i + di, b = j + dj;
-      if ((di | dj) == 0 || a < 0 || b < 0 || a >= nx || b >= ny)
+      if ((di | dj) == 0)
         continue;
-      int n = gr_idx(a, b, nx);
+      int n = snow_neighbour(i, j, di, dj, nx, ny);
       float sn = depth[n], hn = ground[n] + sn, thr = snow_threshold(di, dj, tx, ty, td);
       float x = snow_excess(ha, hn, under_min[n], thr);
       sum += x;
@@ -254,12 +278,14 @@ __kernel void snow_relax_rate(__global const float *restrict ground,
       }
     }
   int giver = i >= gx0 && j >= gy0 && i < gx_end && j < gy_end;
-  float k = 0.0f;
-  if (giver && sum > 0.0f)
+  float mv = giver && s > 0.0f ? fmin(s, big) : 0.0f, k = 0.0f;
+  /* Only a point that can move more than tol gives: the relaxation ends
+   * when none can, and the points still moving bound the next window. */
+  if (mv > tol && sum > 0.0f)
     k = fmin(GR_SNOW_TALUS_SHARE * (big / sum), GR_SNOW_KEEP * s / sum);
   rate[c] = k;
   rate_in[c] = sum_in > 0.0f ? GR_SNOW_TALUS_SHARE * (big_in / sum_in) : 0.0f;
-  movable[c] = giver && s > 0.0f ? fmin(s, big) : 0.0f;
+  movable[c] = mv;
 }
 
 /* Per point b: gives x_bn min(k_b, k_in_n) to each neighbour n and receives
@@ -280,10 +306,9 @@ snow_relax_move(__global const float *restrict ground, __global const float *res
   float out = 0.0f, in = 0.0f, mass_in = 0.0f; /* mass_in: relative to rho */
   for (int dj = -1; dj <= 1; ++dj)
     for (int di = -1; di <= 1; ++di) {
-      int a = i + di, b = j + dj;
-      if ((di | dj) == 0 || a < 0 || b < 0 || a >= nx || b >= ny)
+      if ((di | dj) == 0)
         continue;
-      int n = gr_idx(a, b, nx);
+      int n = snow_neighbour(i, j, di, dj, nx, ny);
       float thr = snow_threshold(di, dj, tx, ty, td);
       float hn = ground[n] + depth[n];
       if (kb > 0.0f)
@@ -301,16 +326,32 @@ snow_relax_move(__global const float *restrict ground, __global const float *res
   density_out[c] = (in > 0.0f && s1 > 0.0f) ? rho + mass_in / s1 : rho;
 }
 
-/* The largest movable amount (one maximum). */
-__kernel void snow_check_reduce(__global const float *restrict movable, int n,
-                                __global float *restrict partial, __local float *restrict scratch) {
+/* The largest movable amount on the window [x0, x0 + w) x [y0, y0 + h)
+ * (n = w h points), and the box of the points that can still move more
+ * than tol, as four maxima (-i, i, -j, j; -1e9 when there is none). */
+__kernel void snow_check_reduce(__global const float *restrict movable, int nx, int x0, int y0,
+                                int w, int n, float tol, __global float *restrict partial,
+                                __local float *restrict scratch) {
   int lid = get_local_id(0), wg = get_local_size(0), start, end;
   gr_reduce_block(n, &start, &end);
-  float m = 0.0f;
-  for (int c = start + lid; c < end; c += wg)
-    m = fmax(m, movable[c]);
+  float m = 0.0f, bx0 = -1.0e9f, bx1 = -1.0e9f, by0 = -1.0e9f, by1 = -1.0e9f;
+  for (int q = start + lid; q < end; q += wg) {
+    int i = x0 + q % w, j = y0 + q / w;
+    float v = movable[gr_idx(i, j, nx)];
+    m = fmax(m, v);
+    if (v > tol) {
+      bx0 = fmax(bx0, (float)-i);
+      bx1 = fmax(bx1, (float)i);
+      by0 = fmax(by0, (float)-j);
+      by1 = fmax(by1, (float)j);
+    }
+  }
   __local float *mine = gr_reduce_slots(scratch, 0, GR_SNOW_CHECK_MAXES);
   mine[0] = m;
+  mine[1] = bx0;
+  mine[2] = bx1;
+  mine[3] = by0;
+  mine[4] = by1;
   gr_reduce_group(scratch, 0, GR_SNOW_CHECK_MAXES, partial);
 }
 

@@ -23,12 +23,15 @@
 /* Reductions: per object, seven double-float sums (displaced volume e,
  * displaced mass e rho, the contour weights, contour points, the moved mass
  * D rho, the compressed height D - e, contact points), per unit cell area;
- * the ledger two (depth, depth times density); the talus check one maximum. */
+ * the ledger two (depth, depth times density); the talus check five maxima
+ * (the largest movable amount and the box of the points still moving). */
 #define GR_SNOW_OBJ_SUMS 7
 #define GR_SNOW_LEDGER_SUMS 2
-#define GR_SNOW_CHECK_MAXES 1
+#define GR_SNOW_CHECK_MAXES 5
 
-/* The talus check runs every this many iterations. */
-#define GR_SNOW_CHECK_EVERY 8
+/* The talus check (the largest movable amount, and the box of the points
+ * still moving, which becomes the window) runs every this many
+ * iterations. */
+#define GR_SNOW_CHECK_EVERY 4
 
 #endif

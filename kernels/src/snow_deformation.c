@@ -64,7 +64,7 @@ struct gr_snow_deformation {
   gr_grid grid;
   gr_snow_deformation_params params;
   cl_kernel raster, overlap_k, contour, obj_reduce, apply, relax_rate, relax_move, check_reduce,
-      ledger_reduce, surface;
+      ledger_reduce, surface, reset;
   cl_mem depth[2], density[2]; /* [cur] is the state */
   int cur;
   cl_mem ground, depth0, density0, under, overlap, weight, overlap_sum, contact, under_min, rate,
@@ -83,6 +83,9 @@ struct gr_snow_deformation {
   long long steps;
   int relax_iterations;
   int relax_full; /* the next relaxation covers the whole grid */
+  int sync_full;  /* the state's other buffer may differ anywhere */
+  int dirty[4];   /* x0 y0 x1 y1: where the last step's objects wrote */
+  int reset_full; /* the next step clears the per-step arrays everywhere */
   gr_progress_fn progress;
   void *progress_user;
   int aborted;
@@ -230,6 +233,23 @@ static gr_status gr_snow_copy(gr_snow_deformation *s, cl_mem from, cl_mem to) {
                      "Copying a device buffer");
 }
 
+/* The state (depth and density) of points [x0, x1] x [y0, y1] from the
+ * current buffer of the pair to the other one. */
+static gr_status gr_snow_sync_rect(gr_snow_deformation *s, int x0, int y0, int x1, int y1) {
+  if (x0 > x1 || y0 > y1)
+    return GR_OK;
+  size_t origin[3] = {(size_t)x0 * sizeof(float), (size_t)y0, 0};
+  size_t region[3] = {(size_t)(x1 - x0 + 1) * sizeof(float), (size_t)(y1 - y0 + 1), 1};
+  size_t pitch = (size_t)s->grid.nx * sizeof(float);
+  cl_int err = CL_SUCCESS;
+  for (int q = 0; q < 2 && err == CL_SUCCESS; ++q) {
+    cl_mem *pair = q ? s->density : s->depth;
+    err = clEnqueueCopyBufferRect(gr_context_queue(s->ctx), pair[s->cur], pair[1 - s->cur], origin,
+                                  origin, region, pitch, 0, pitch, 0, 0, NULL, NULL);
+  }
+  return gr_cl_check(s->ctx, err, "Copying a window of the snow state");
+}
+
 /* sum S and sum S rho, per unit area. */
 static gr_status gr_snow_ledger_sums(gr_snow_deformation *s, double *vol, double *mass) {
   int n = (int)gr_snow_cells(s);
@@ -262,6 +282,8 @@ static gr_status gr_snow_initial_state(gr_snow_deformation *s) {
   s->steps = 0;
   s->relax_iterations = 0;
   s->relax_full = 1;
+  s->sync_full = 1;
+  s->reset_full = 1;
   s->aborted = 0;
   memset(s->force, 0, sizeof(s->force));
   memset(s->area, 0, sizeof(s->area));
@@ -317,7 +339,8 @@ gr_status gr_snow_deformation_create(gr_context *ctx, const gr_grid *grid,
             {"snow_relax_move", &s->relax_move},
             {"snow_check_reduce", &s->check_reduce},
             {"snow_ledger_reduce", &s->ledger_reduce},
-            {"snow_surface", &s->surface}};
+            {"snow_surface", &s->surface},
+            {"snow_reset", &s->reset}};
   for (size_t i = 0; st == GR_OK && i < sizeof(ks) / sizeof(ks[0]); ++i)
     st = gr_kernel_create(ctx, prog, ks[i].name, ks[i].k);
   cl_mem *bufs[] = {&s->depth[0],    &s->depth[1], &s->density[0], &s->density[1], &s->ground,
@@ -353,8 +376,9 @@ gr_status gr_snow_deformation_create(gr_context *ctx, const gr_grid *grid,
 void gr_snow_deformation_destroy(gr_snow_deformation *s) {
   if (!s)
     return;
-  cl_kernel ks[] = {s->raster,     s->overlap_k,  s->contour,      s->obj_reduce,    s->apply,
-                    s->relax_rate, s->relax_move, s->check_reduce, s->ledger_reduce, s->surface};
+  cl_kernel ks[] = {s->raster,        s->overlap_k,  s->contour,    s->obj_reduce,
+                    s->apply,         s->relax_rate, s->relax_move, s->check_reduce,
+                    s->ledger_reduce, s->surface,    s->reset};
   for (size_t i = 0; i < sizeof(ks) / sizeof(ks[0]); ++i)
     if (ks[i])
       clReleaseKernel(ks[i]);
@@ -452,6 +476,7 @@ static gr_status gr_snow_set_field_impl(gr_snow_deformation *s, gr_field f, cons
     return gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT, "%s", msg);
   size_t bytes = cells * sizeof(float);
   s->relax_full = 1; /* new snow or ground may be too steep anywhere */
+  s->sync_full = 1;
   if (f == GR_FIELD_ELEVATION)
     return gr_buffer_write(s->ctx, s->ground, 0, bytes, host);
   /* The new snow replaces what is there: the ledger's initial volume and
@@ -751,12 +776,81 @@ static gr_status gr_snow_press_args(gr_snow_deformation *s, cl_kernel k) {
   return st;
 }
 
+/* Grows the box of the points this step's objects wrote (their overlap
+ * sum, contact and lowest underside), which the next step clears. */
+static void gr_snow_dirty(gr_snow_deformation *s, int x0, int y0, int x1, int y1) {
+  int *d = s->dirty;
+  if (d[0] > d[2]) {
+    d[0] = x0, d[1] = y0, d[2] = x1, d[3] = y1;
+    return;
+  }
+  d[0] = d[0] < x0 ? d[0] : x0;
+  d[1] = d[1] < y0 ? d[1] : y0;
+  d[2] = d[2] > x1 ? d[2] : x1;
+  d[3] = d[3] > y1 ? d[3] : y1;
+}
+
+/* The start of a step: the overlap sum and contact 0 and the lowest
+ * underside +inf where the last step's objects wrote them (everywhere
+ * after the state was set). */
+static gr_status gr_snow_reset(gr_snow_deformation *s) {
+  int nx = s->grid.nx, ny = s->grid.ny, *d = s->dirty;
+  if (s->reset_full) {
+    d[0] = d[1] = 0;
+    d[2] = nx - 1;
+    d[3] = ny - 1;
+    s->reset_full = 0;
+  }
+  if (d[0] > d[2] || d[1] > d[3])
+    return GR_OK;
+  cl_kernel k = s->reset;
+  cl_int x_end = d[2] + 1, y_end = d[3] + 1;
+  gr_status st = GR_SNOW_ARG(s, k, "nx", nx);
+  if (st == GR_OK)
+    st = GR_SNOW_ARG(s, k, "ny", ny);
+  if (st == GR_OK)
+    st = GR_SNOW_ARG(s, k, "x_end", x_end);
+  if (st == GR_OK)
+    st = GR_SNOW_ARG(s, k, "y_end", y_end);
+  if (st == GR_OK)
+    st = GR_SNOW_ARG(s, k, "overlap_sum", s->overlap_sum);
+  if (st == GR_OK)
+    st = GR_SNOW_ARG(s, k, "contact", s->contact);
+  if (st == GR_OK)
+    st = GR_SNOW_ARG(s, k, "under_min", s->under_min);
+  if (st == GR_OK)
+    st = gr_enqueue_2d(s->ctx, k, (size_t)d[0], (size_t)d[1], (size_t)(d[2] - d[0] + 1),
+                       (size_t)(d[3] - d[1] + 1), NULL);
+  d[0] = d[1] = 0;
+  d[2] = d[3] = -1; /* clean */
+  return st;
+}
+
 static gr_status gr_snow_object_step(gr_snow_deformation *s, int o, double dt) {
   const gr_snow_object *ob = &s->objects[o];
   gr_context *ctx = s->ctx;
-  int nx = s->grid.nx, ny = s->grid.ny, n = nx * ny;
+  int nx = s->grid.nx, ny = s->grid.ny;
   float dx = (float)s->grid.dx, dy = (float)s->grid.dy;
-  size_t NX = (size_t)nx, NY = (size_t)ny;
+  s->area[o] = 0.0;
+  if (ob->bi0 > ob->bi1 || ob->bj0 > ob->bj1)
+    return GR_OK; /* wholly off the grid: it touches nothing */
+  /* The kernels run on the object's box grown by two (W: the underside,
+   * +inf beyond the box, and the overlap, 0 there) and by one (the contour
+   * ring and everything that reads the contour). Outside W nothing changes,
+   * and the step's reset clears W again. */
+  int wx0 = ob->bi0 - 2 > 0 ? ob->bi0 - 2 : 0, wy0 = ob->bj0 - 2 > 0 ? ob->bj0 - 2 : 0;
+  int wx1 = ob->bi1 + 2 < nx - 1 ? ob->bi1 + 2 : nx - 1,
+      wy1 = ob->bj1 + 2 < ny - 1 ? ob->bj1 + 2 : ny - 1;
+  int cx0 = ob->bi0 - 1 > 0 ? ob->bi0 - 1 : 0, cy0 = ob->bj0 - 1 > 0 ? ob->bj0 - 1 : 0;
+  int cx1 = ob->bi1 + 1 < nx - 1 ? ob->bi1 + 1 : nx - 1,
+      cy1 = ob->bj1 + 1 < ny - 1 ? ob->bj1 + 1 : ny - 1;
+  size_t WX0 = (size_t)wx0, WY0 = (size_t)wy0, WW = (size_t)(wx1 - wx0 + 1),
+         WH = (size_t)(wy1 - wy0 + 1), CX0 = (size_t)cx0, CY0 = (size_t)cy0,
+         CW = (size_t)(cx1 - cx0 + 1), CH = (size_t)(cy1 - cy0 + 1);
+  /* A launch is rounded up to whole work-groups: the kernels stop at the
+   * window's end, as what lies beyond is another object's or step's. */
+  cl_int wx_end = wx1 + 1, wy_end = wy1 + 1, cx_end = cx1 + 1, cy_end = cy1 + 1;
+  gr_snow_dirty(s, wx0, wy0, wx1, wy1);
   gr_status st = GR_SNOW_ARG(s, s->raster, "tri", s->tri);
   int tile0 = ob->tile0, ntx = ob->ntx, tile = ob->tile, bi0 = ob->bi0, bi1 = ob->bi1,
       bj0 = ob->bj0, bj1 = ob->bj1;
@@ -789,7 +883,11 @@ static gr_status gr_snow_object_step(gr_snow_deformation *s, int o, double dt) {
   if (st == GR_OK)
     st = GR_SNOW_ARG(s, s->raster, "under", s->under);
   if (st == GR_OK)
-    st = gr_enqueue_2d(ctx, s->raster, 0, 0, NX, NY, NULL);
+    st = GR_SNOW_ARG(s, s->raster, "x_end", wx_end);
+  if (st == GR_OK)
+    st = GR_SNOW_ARG(s, s->raster, "y_end", wy_end);
+  if (st == GR_OK)
+    st = gr_enqueue_2d(ctx, s->raster, WX0, WY0, WW, WH, NULL);
   if (st == GR_OK)
     st = gr_snow_mark(s, &s->tm.raster_ms);
   /* overlap */
@@ -806,7 +904,11 @@ static gr_status gr_snow_object_step(gr_snow_deformation *s, int o, double dt) {
   if (st == GR_OK)
     st = GR_SNOW_ARG(s, s->overlap_k, "overlap", s->overlap);
   if (st == GR_OK)
-    st = gr_enqueue_2d(ctx, s->overlap_k, 0, 0, NX, NY, NULL);
+    st = GR_SNOW_ARG(s, s->overlap_k, "x_end", wx_end);
+  if (st == GR_OK)
+    st = GR_SNOW_ARG(s, s->overlap_k, "y_end", wy_end);
+  if (st == GR_OK)
+    st = gr_enqueue_2d(ctx, s->overlap_k, WX0, WY0, WW, WH, NULL);
   if (st == GR_OK)
     st = gr_snow_mark(s, &s->tm.press_ms);
   /* contour and weights */
@@ -833,15 +935,28 @@ static gr_status gr_snow_object_step(gr_snow_deformation *s, int o, double dt) {
   if (st == GR_OK)
     st = GR_SNOW_ARG(s, s->contour, "weight", s->weight);
   if (st == GR_OK)
-    st = gr_enqueue_2d(ctx, s->contour, 0, 0, NX, NY, NULL);
+    st = GR_SNOW_ARG(s, s->contour, "x_end", cx_end);
+  if (st == GR_OK)
+    st = GR_SNOW_ARG(s, s->contour, "y_end", cy_end);
+  if (st == GR_OK)
+    st = gr_enqueue_2d(ctx, s->contour, CX0, CY0, CW, CH, NULL);
   if (st == GR_OK)
     st = gr_snow_mark(s, &s->tm.contour_ms);
   /* totals */
   double sums[GR_SNOW_OBJ_SUMS];
   if (st == GR_OK)
     st = gr_snow_press_args(s, s->obj_reduce);
+  cl_int cw = cx1 - cx0 + 1, cn = cw * (cy1 - cy0 + 1);
   if (st == GR_OK)
-    st = GR_SNOW_ARG(s, s->obj_reduce, "n", n);
+    st = GR_SNOW_ARG(s, s->obj_reduce, "nx", nx);
+  if (st == GR_OK)
+    st = GR_SNOW_ARG(s, s->obj_reduce, "x0", cx0);
+  if (st == GR_OK)
+    st = GR_SNOW_ARG(s, s->obj_reduce, "y0", cy0);
+  if (st == GR_OK)
+    st = GR_SNOW_ARG(s, s->obj_reduce, "w", cw);
+  if (st == GR_OK)
+    st = GR_SNOW_ARG(s, s->obj_reduce, "n", cn);
   if (st == GR_OK)
     st = gr_reduction_run(ctx, &s->red_obj, s->obj_reduce, sums, NULL);
   if (st == GR_OK)
@@ -885,27 +1000,96 @@ static gr_status gr_snow_object_step(gr_snow_deformation *s, int o, double dt) {
   if (st == GR_OK)
     st = GR_SNOW_ARG(s, s->apply, "under_min", s->under_min);
   if (st == GR_OK)
-    st = gr_enqueue_2d(ctx, s->apply, 0, 0, NX, NY, NULL);
+    st = GR_SNOW_ARG(s, s->apply, "x_end", cx_end);
+  if (st == GR_OK)
+    st = GR_SNOW_ARG(s, s->apply, "y_end", cy_end);
+  if (st == GR_OK)
+    st = gr_enqueue_2d(ctx, s->apply, CX0, CY0, CW, CH, NULL);
   if (st == GR_OK)
     st = gr_snow_mark(s, &s->tm.distribution_ms);
   return st;
 }
 
-/* Talus relaxation on a window that grows by one point per iteration: a
- * height that changes in one iteration can only change what its
- * 8-neighbours give in the next, so outside the window nothing moves. The
- * window starts at the objects' boxes (grown by the contour ring), or at the
- * whole grid after the snow or the ground was set (relax_full). The rates
- * run on the window R, the moves on R grown by one (the points that only
- * receive); both buffers of the pair hold the same values outside the move
- * window (copied first, and the windows only grow), so the ping-pong stays
- * exact. */
-static gr_status gr_snow_relax(gr_snow_deformation *s) {
-  gr_context *ctx = s->ctx;
-  int nx = s->grid.nx, ny = s->grid.ny, n = nx * ny;
+/* The arguments both talus kernels take. */
+static gr_status gr_snow_relax_args(gr_snow_deformation *s, cl_kernel k) {
+  int nx = s->grid.nx, ny = s->grid.ny;
   double dx = s->grid.dx, dy = s->grid.dy, slope = s->params.max_slope;
   float tx = (float)(slope * dx), ty = (float)(slope * dy),
         td = (float)(slope * sqrt(dx * dx + dy * dy));
+  gr_status st = GR_SNOW_ARG(s, k, "ground", s->ground);
+  if (st == GR_OK)
+    st = GR_SNOW_ARG(s, k, "depth", s->depth[s->cur]);
+  if (st == GR_OK)
+    st = GR_SNOW_ARG(s, k, "under_min", s->under_min);
+  if (st == GR_OK)
+    st = GR_SNOW_ARG(s, k, "nx", nx);
+  if (st == GR_OK)
+    st = GR_SNOW_ARG(s, k, "ny", ny);
+  if (st == GR_OK)
+    st = GR_SNOW_ARG(s, k, "tx", tx);
+  if (st == GR_OK)
+    st = GR_SNOW_ARG(s, k, "ty", ty);
+  if (st == GR_OK)
+    st = GR_SNOW_ARG(s, k, "td", td);
+  if (st == GR_OK)
+    st = GR_SNOW_ARG(s, k, "rate", s->rate);
+  if (st == GR_OK)
+    st = GR_SNOW_ARG(s, k, "rate_in", s->rate_in);
+  return st;
+}
+
+/* The check: the largest amount a point of the givers' window R can still
+ * move, and the box of the points that can move more than the tolerance
+ * (out[1..4]: -x0, x1, -y0, y1). */
+static gr_status gr_snow_relax_check(gr_snow_deformation *s, int x0, int y0, int x1, int y1,
+                                     double out[GR_SNOW_CHECK_MAXES]) {
+  cl_kernel k = s->check_reduce;
+  cl_int nx = s->grid.nx, w = x1 - x0 + 1, cnt = w * (y1 - y0 + 1);
+  float tol = (float)s->params.relax_tolerance;
+  gr_status st = GR_SNOW_ARG(s, k, "movable", s->movable);
+  if (st == GR_OK)
+    st = GR_SNOW_ARG(s, k, "nx", nx);
+  if (st == GR_OK)
+    st = GR_SNOW_ARG(s, k, "x0", x0);
+  if (st == GR_OK)
+    st = GR_SNOW_ARG(s, k, "y0", y0);
+  if (st == GR_OK)
+    st = GR_SNOW_ARG(s, k, "w", w);
+  if (st == GR_OK)
+    st = GR_SNOW_ARG(s, k, "n", cnt);
+  if (st == GR_OK)
+    st = GR_SNOW_ARG(s, k, "tol", tol);
+  if (st == GR_OK)
+    st = gr_reduction_run(s->ctx, &s->red_check, k, NULL, out);
+  return st;
+}
+
+/* Talus relaxation on a window that follows the snow that can move.
+ *
+ * The window: the givers R (at first the objects' boxes grown by the
+ * contour ring, or the whole grid after the snow or the ground was set:
+ * relax_full); the moves run on R grown by one (the points that only
+ * receive), the rates on R grown by two (every neighbour of a move has a
+ * rate of this iteration). Snow leaves only points of R, so after an
+ * iteration only points within one of R changed, and only those and their
+ * neighbours can have gained an excess: R grows by one per iteration.
+ * Every GR_SNOW_CHECK_EVERY iterations the check reads the largest amount
+ * a point can still move (the end when it is at most RelaxTolerance) and
+ * the box of the points that can move more; only those give (a point gives
+ * only while it can move more than RelaxTolerance), so R shrinks to that
+ * box. The window decides what is computed, never the result: a run from
+ * the whole grid ends bit for bit where a run from the objects' boxes does
+ * when the rest was relaxed.
+ *
+ * The pair of buffers: the moves write the other buffer on their window
+ * only, so outside it the other buffer must equal the state. That holds at
+ * the start of a step but where the objects pressed (synchronised first),
+ * and is restored after a window shrinks and at the end (the last move
+ * window copied across). */
+static gr_status gr_snow_relax(gr_snow_deformation *s) {
+  gr_context *ctx = s->ctx;
+  int nx = s->grid.nx, ny = s->grid.ny;
+  float tol = (float)s->params.relax_tolerance;
   gr_status st = GR_OK;
   int it = 0, x0 = nx, x1 = -1, y0 = ny, y1 = -1;
   s->relax_iterations = 0;
@@ -924,50 +1108,36 @@ static gr_status gr_snow_relax(gr_snow_deformation *s) {
       y1 = y1 > ob->bj1 + 2 ? y1 : ob->bj1 + 2;
     }
   }
-  if (x0 > x1 || y0 > y1 || s->params.max_relax_iterations == 0)
+  if (s->params.max_relax_iterations == 0) {
+    s->sync_full |= x0 <= x1; /* the objects changed the state alone */
+    return GR_OK;
+  }
+  if (x0 > x1 || y0 > y1)
     return GR_OK; /* nothing touched the snow: it stays as relaxed as it was */
-  s->relax_full = 0;
-  st = gr_snow_copy(s, s->depth[s->cur], s->depth[1 - s->cur]);
-  if (st == GR_OK)
-    st = gr_snow_copy(s, s->density[s->cur], s->density[1 - s->cur]);
-  if (st == GR_OK)
-    st = gr_snow_fill(s, s->rate, 0.0f);
-  if (st == GR_OK)
-    st = gr_snow_fill(s, s->rate_in, 0.0f);
-  if (st == GR_OK)
-    st = gr_snow_fill(s, s->movable, 0.0f);
+  x0 = x0 > 0 ? x0 : 0;
+  y0 = y0 > 0 ? y0 : 0;
+  x1 = x1 < nx - 1 ? x1 : nx - 1;
+  y1 = y1 < ny - 1 ? y1 : ny - 1;
+  if (s->sync_full || s->relax_full)
+    st = gr_snow_sync_rect(s, 0, 0, nx - 1, ny - 1);
+  else
+    st = gr_snow_sync_rect(s, x0, y0, x1, y1);
+  s->relax_full = s->sync_full = 0;
+  int lx0 = 0, ly0 = 0, lx1 = -1, ly1 = -1; /* the last move window */
   while (st == GR_OK && it < s->params.max_relax_iterations) {
     x0 = x0 > 0 ? x0 : 0;
     y0 = y0 > 0 ? y0 : 0;
     x1 = x1 < nx - 1 ? x1 : nx - 1;
     y1 = y1 < ny - 1 ? y1 : ny - 1;
-    int mx0 = x0 > 0 ? x0 - 1 : 0, my0 = y0 > 0 ? y0 - 1 : 0;
-    int mx1 = x1 < nx - 1 ? x1 + 1 : nx - 1, my1 = y1 < ny - 1 ? y1 + 1 : ny - 1;
+    cl_int gx0 = x0, gy0 = y0, gx_end = x1 + 1, gy_end = y1 + 1;
+    cl_int rx0 = x0 > 1 ? x0 - 2 : 0, ry0 = y0 > 1 ? y0 - 2 : 0;
+    cl_int rx_end = x1 + 3 < nx ? x1 + 3 : nx, ry_end = y1 + 3 < ny ? y1 + 3 : ny;
     cl_kernel k = s->relax_rate;
-    st = GR_SNOW_ARG(s, k, "ground", s->ground);
-    if (st == GR_OK)
-      st = GR_SNOW_ARG(s, k, "depth", s->depth[s->cur]);
-    if (st == GR_OK)
-      st = GR_SNOW_ARG(s, k, "under_min", s->under_min);
-    if (st == GR_OK)
-      st = GR_SNOW_ARG(s, k, "nx", nx);
-    if (st == GR_OK)
-      st = GR_SNOW_ARG(s, k, "ny", ny);
-    if (st == GR_OK)
-      st = GR_SNOW_ARG(s, k, "tx", tx);
-    if (st == GR_OK)
-      st = GR_SNOW_ARG(s, k, "ty", ty);
-    if (st == GR_OK)
-      st = GR_SNOW_ARG(s, k, "td", td);
-    if (st == GR_OK)
-      st = GR_SNOW_ARG(s, k, "rate", s->rate);
+    st = gr_snow_relax_args(s, k);
     if (st == GR_OK)
       st = GR_SNOW_ARG(s, k, "movable", s->movable);
     if (st == GR_OK)
-      st = GR_SNOW_ARG(s, k, "rate_in", s->rate_in);
-    /* The givers are R; the receivers' intake limits are needed on R grown
-     * by one, where the moves run. */
-    cl_int gx0 = x0, gy0 = y0, gx_end = x1 + 1, gy_end = y1 + 1, rx_end = mx1 + 1, ry_end = my1 + 1;
+      st = GR_SNOW_ARG(s, k, "tol", tol);
     if (st == GR_OK)
       st = GR_SNOW_ARG(s, k, "gx0", gx0);
     if (st == GR_OK)
@@ -981,59 +1151,50 @@ static gr_status gr_snow_relax(gr_snow_deformation *s) {
     if (st == GR_OK)
       st = GR_SNOW_ARG(s, k, "y_end", ry_end);
     if (st == GR_OK)
-      st = gr_enqueue_2d(ctx, k, (size_t)mx0, (size_t)my0, (size_t)(mx1 - mx0 + 1),
-                         (size_t)(my1 - my0 + 1), NULL);
+      st = gr_enqueue_2d(ctx, k, (size_t)rx0, (size_t)ry0, (size_t)(rx_end - rx0),
+                         (size_t)(ry_end - ry0), NULL);
     if (st == GR_OK && it % GR_SNOW_CHECK_EVERY == 0) {
-      double mx = 0.0;
-      st = GR_SNOW_ARG(s, s->check_reduce, "movable", s->movable);
-      if (st == GR_OK)
-        st = GR_SNOW_ARG(s, s->check_reduce, "n", n);
-      if (st == GR_OK)
-        st = gr_reduction_run(ctx, &s->red_check, s->check_reduce, NULL, &mx);
-      if (st == GR_OK && mx <= s->params.relax_tolerance)
+      double m[GR_SNOW_CHECK_MAXES];
+      st = gr_snow_relax_check(s, x0, y0, x1, y1, m);
+      if (st == GR_OK && m[0] <= s->params.relax_tolerance)
         break;
+      /* Only the points of the box give in this iteration. The move window
+       * may now lie inside the last one, which the buffer the move writes
+       * does not hold yet. */
+      if (st == GR_OK) {
+        x0 = (int)-m[1], x1 = (int)m[2], y0 = (int)-m[3], y1 = (int)m[4];
+        st = gr_snow_sync_rect(s, lx0, ly0, lx1, ly1);
+      }
     }
+    cl_int mx0 = x0 > 0 ? x0 - 1 : 0, my0 = y0 > 0 ? y0 - 1 : 0;
+    cl_int mx_end = x1 + 2 < nx ? x1 + 2 : nx, my_end = y1 + 2 < ny ? y1 + 2 : ny;
     k = s->relax_move;
     int nxt = 1 - s->cur;
     if (st == GR_OK)
-      st = GR_SNOW_ARG(s, k, "ground", s->ground);
-    if (st == GR_OK)
-      st = GR_SNOW_ARG(s, k, "depth", s->depth[s->cur]);
+      st = gr_snow_relax_args(s, k);
     if (st == GR_OK)
       st = GR_SNOW_ARG(s, k, "density", s->density[s->cur]);
-    if (st == GR_OK)
-      st = GR_SNOW_ARG(s, k, "under_min", s->under_min);
-    if (st == GR_OK)
-      st = GR_SNOW_ARG(s, k, "rate", s->rate);
-    if (st == GR_OK)
-      st = GR_SNOW_ARG(s, k, "rate_in", s->rate_in);
-    if (st == GR_OK)
-      st = GR_SNOW_ARG(s, k, "nx", nx);
-    if (st == GR_OK)
-      st = GR_SNOW_ARG(s, k, "ny", ny);
-    if (st == GR_OK)
-      st = GR_SNOW_ARG(s, k, "tx", tx);
-    if (st == GR_OK)
-      st = GR_SNOW_ARG(s, k, "ty", ty);
-    if (st == GR_OK)
-      st = GR_SNOW_ARG(s, k, "td", td);
     if (st == GR_OK)
       st = GR_SNOW_ARG(s, k, "depth_out", s->depth[nxt]);
     if (st == GR_OK)
       st = GR_SNOW_ARG(s, k, "density_out", s->density[nxt]);
-    cl_int mx_end = mx1 + 1, my_end = my1 + 1;
     if (st == GR_OK)
       st = GR_SNOW_ARG(s, k, "x_end", mx_end);
     if (st == GR_OK)
       st = GR_SNOW_ARG(s, k, "y_end", my_end);
     if (st == GR_OK)
-      st = gr_enqueue_2d(ctx, k, (size_t)mx0, (size_t)my0, (size_t)(mx1 - mx0 + 1),
-                         (size_t)(my1 - my0 + 1), NULL);
-    if (st == GR_OK)
+      st = gr_enqueue_2d(ctx, k, (size_t)mx0, (size_t)my0, (size_t)(mx_end - mx0),
+                         (size_t)(my_end - my0), NULL);
+    if (st == GR_OK) {
       s->cur = nxt;
+      lx0 = mx0, ly0 = my0, lx1 = mx_end - 1, ly1 = my_end - 1;
+    }
     ++it;
     --x0, --y0, ++x1, ++y1;
   }
+  /* Both buffers equal again: the last move window from the state. */
+  if (st == GR_OK)
+    st = gr_snow_sync_rect(s, lx0, ly0, lx1, ly1);
   s->relax_iterations = it;
   return st;
 }
@@ -1053,11 +1214,7 @@ gr_status gr_snow_deformation_step(gr_snow_deformation *s, double dt) {
         s, gr_set_error(s->ctx, GR_ERR_ABORTED,
                         "The snow deformation was stopped by its progress callback; set the "
                         "callback again or reset to go on."));
-  gr_status st = gr_snow_fill(s, s->overlap_sum, 0.0f);
-  if (st == GR_OK)
-    st = gr_snow_fill(s, s->contact, 0.0f);
-  if (st == GR_OK)
-    st = gr_snow_fill(s, s->under_min, INFINITY);
+  gr_status st = gr_snow_reset(s);
   memset(s->force, 0, sizeof(s->force));
   if (st == GR_OK && s->timing) {
     st = gr_finish(s->ctx);
@@ -1298,6 +1455,8 @@ gr_status gr_snow_deformation_state_load(gr_snow_deformation *s, const void *hos
     return GR_SNOW_KEEP_ERROR(s, st);
   s->relax_iterations = hd.relax_iterations;
   s->relax_full = hd.relax_full != 0;
+  s->sync_full = 1;
+  s->reset_full = 1;
   s->steps = hd.steps;
   s->time = hd.time;
   s->initial_volume = hd.initial_volume;
