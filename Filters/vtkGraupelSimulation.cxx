@@ -67,6 +67,12 @@ vtkGraupelSimulation::vtkGraupelSimulation() = default;
 
 vtkGraupelSimulation::~vtkGraupelSimulation() = default;
 
+void vtkGraupelSimulation::SetTimeDefaults(double endTime, double outputInterval) {
+  this->EndTime = this->DefaultEndTime = endTime;
+  this->OutputInterval = this->DefaultOutputInterval = outputInterval;
+  this->Modified();
+}
+
 void vtkGraupelSimulation::SetInputPortPolicy(int port, int policy) {
   if (port < 0) {
     return;

@@ -144,6 +144,18 @@ public:
   ///@}
 
   ///@{
+  /**
+   * The EndTime and OutputInterval a new object of this class starts with,
+   * seconds: a simulation whose time scale differs sets its own in its
+   * constructor (SetTimeDefaults). ParaView's EndTime and OutputInterval
+   * (Plugin/GraupelBase.xml, shared by every simulation) take their defaults
+   * from these, so each class's defaults are stated once, here in C++.
+   */
+  vtkGetMacro(DefaultEndTime, double);
+  vtkGetMacro(DefaultOutputInterval, double);
+  ///@}
+
+  ///@{
   /** A checkpoint every this many outputs (default 10; 0: none). */
   vtkSetClampMacro(CheckpointInterval, int, 0, MaximumOutputSteps);
   vtkGetMacro(CheckpointInterval, int);
@@ -194,6 +206,9 @@ protected:
 
   /** Sets a port's policy (STATIC_INPUT by default); call in the constructor. */
   void SetInputPortPolicy(int port, int policy);
+
+  /** Sets EndTime and OutputInterval, the class's defaults; call in the constructor. */
+  void SetTimeDefaults(double endTime, double outputInterval);
 
   /**
    * Validates the inputs and creates the device state at time 0. Reports
@@ -295,6 +310,9 @@ protected:
 private:
   vtkGraupelSimulation(const vtkGraupelSimulation &) = delete;
   void operator=(const vtkGraupelSimulation &) = delete;
+
+  double DefaultEndTime = EndTime; // the base's, until SetTimeDefaults
+  double DefaultOutputInterval = OutputInterval;
 
   /** What the state was built from: the filter's and its inputs' present values. */
   struct Key {

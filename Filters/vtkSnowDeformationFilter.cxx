@@ -29,6 +29,7 @@
 #include "GraupelArrays.h"
 #include "GraupelParameterTable.h"
 
+#include <algorithm>
 #include <array>
 #include <chrono>
 #include <map>
@@ -46,6 +47,24 @@ const gr_param_bound *Bound(const char *property) {
   const gr_param_bound *table = gr_snow_deformation_param_bounds(&count);
   return gr_param_find(table, count, property);
 }
+
+// rho min and rho max (kg/m^3) per DensityPresets value from 1 on. The snow
+// types are the thesis' Table 3.1 (seed 000, L887-L898, "Dichtevergleich
+// unterschiedlicher Schneearten"). Sand is not in the thesis, which asks
+// only for close ends (little compression) and a lower MaxSlope (L2993-L3002):
+// 1500-1700 is dry sand's bulk density from loose to packed as soil-mechanics
+// handbooks tabulate it (about 1.5-1.7 g/cm^3).
+const double DensityPresetTable[][2] = {
+    {30.0, 50.0},    // DRY_NEW_SNOW: trockener, lockerer Neuschnee
+    {50.0, 100.0},   // BONDED_NEW_SNOW: gebundener Neuschnee
+    {100.0, 200.0},  // STRONGLY_BONDED_NEW_SNOW: stark gebundener Neuschnee
+    {200.0, 400.0},  // DRY_OLD_SNOW: trockener Altschnee
+    {300.0, 500.0},  // WET_OLD_SNOW: feuchtnasser Altschnee
+    {150.0, 300.0},  // DEPTH_HOAR: Schwimmschnee
+    {500.0, 800.0},  // FIRN: mehrjaehriger Firn
+    {800.0, 900.0},  // ICE: Eis
+    {1500.0, 1700.0} // SAND
+};
 
 double TableDefault(const char *property, double fallback) {
   const gr_param_bound *b = Bound(property);
@@ -141,6 +160,10 @@ vtkSnowDeformationFilter::vtkSnowDeformationFilter() {
   this->SetNumberOfOutputPorts(2);
   // Objects with time steps are read in time; others are posed by the properties.
   this->SetInputPortPolicy(1, TEMPORAL_INPUT);
+  // Steps of 1/60 s: 600 outputs of 10 s would be 36000 steps, and a wheel
+  // at 2 m/s would move 20 m between outputs. 10 s of 0.25 s outputs show a
+  // crossing of a few metres, 15 steps per output.
+  this->SetTimeDefaults(10.0, 0.25);
   this->MaxRelaxIterations = static_cast<int>(TableDefault("MaxRelaxIterations", 64));
   this->RelaxTolerance = TableDefault("RelaxTolerance", 1e-4);
 }
@@ -168,6 +191,32 @@ GRAUPEL_TABLE_SETTER(vtkSnowDeformationFilter, RelaxTolerance, double,
 void vtkSnowDeformationFilter::SetDensityRange(double minimum, double maximum) {
   this->SetMinDensity(minimum);
   this->SetMaxDensity(maximum);
+}
+
+void vtkSnowDeformationFilter::GetDensityRange(double range[2]) const {
+  range[0] = this->MinDensity;
+  range[1] = this->MaxDensity;
+}
+
+bool vtkSnowDeformationFilter::GetDensityPresetRange(int preset, double range[2]) {
+  if (preset <= CUSTOM || preset > SAND) {
+    return false;
+  }
+  range[0] = DensityPresetTable[preset - 1][0];
+  range[1] = DensityPresetTable[preset - 1][1];
+  return true;
+}
+
+void vtkSnowDeformationFilter::GetDensityRangeInUse(double range[2]) const {
+  if (!GetDensityPresetRange(this->DensityPreset, range)) {
+    this->GetDensityRange(range);
+  }
+}
+
+double vtkSnowDeformationFilter::GetInitialDensityInUse() const {
+  double range[2];
+  // A preset's snow starts loose: it compresses towards the type's rho max.
+  return GetDensityPresetRange(this->DensityPreset, range) ? range[0] : this->InitialDensity;
 }
 
 void vtkSnowDeformationFilter::SetObjectsConnection(vtkAlgorithmOutput *output) {
@@ -276,18 +325,23 @@ int vtkSnowDeformationFilter::RequestData(vtkInformation *request,
 }
 
 int vtkSnowDeformationFilter::CheckParameters() {
+  // The table's rows MinDensity and MaxDensity are DensityRange's two values.
+  const bool custom = this->DensityPreset == CUSTOM;
+  double range[2];
+  this->GetDensityRangeInUse(range);
   const struct {
     const char *property;
+    const char *name; // as the user sets it
     double value;
-  } values[] = {{"InitialSnowDepth", this->InitialSnowDepth},
-                {"InitialDensity", this->InitialDensity},
-                {"MinDensity", this->MinDensity},
-                {"MaxDensity", this->MaxDensity},
-                {"CompressionModel", double(this->CompressionModel)},
-                {"MaxSlope", this->MaxSlope},
-                {"DirectionFalloff", this->DirectionFalloff},
-                {"MaxRelaxIterations", double(this->MaxRelaxIterations)},
-                {"RelaxTolerance", this->RelaxTolerance}};
+  } values[] = {{"InitialSnowDepth", "InitialSnowDepth", this->InitialSnowDepth},
+                {"InitialDensity", "InitialDensity", this->GetInitialDensityInUse()},
+                {"MinDensity", "DensityRange's first value (rho min)", range[0]},
+                {"MaxDensity", "DensityRange's second value (rho max)", range[1]},
+                {"CompressionModel", "CompressionModel", double(this->CompressionModel)},
+                {"MaxSlope", "MaxSlope", this->MaxSlope},
+                {"DirectionFalloff", "DirectionFalloff", this->DirectionFalloff},
+                {"MaxRelaxIterations", "MaxRelaxIterations", double(this->MaxRelaxIterations)},
+                {"RelaxTolerance", "RelaxTolerance", this->RelaxTolerance}};
   for (const auto &p : values) {
     const gr_param_bound *b = Bound(p.property);
     if (!b || gr_param_accepts(b, p.value * b->to_core)) {
@@ -295,11 +349,10 @@ int vtkSnowDeformationFilter::CheckParameters() {
     }
     const char *unit = (b->unit && *b->unit) ? b->unit : "";
     const char *space = *unit ? " " : "";
-    vtkErrorMacro("Snow Deformation: " << p.property << " must be "
-                                       << (b->min_open ? "above " : "from ") << b->min << space
-                                       << unit << (b->min_open ? " and up to " : " to ") << b->max
-                                       << space << unit << "; it is " << p.value << space << unit
-                                       << ". Set it within that range.");
+    vtkErrorMacro("Snow Deformation: "
+                  << p.name << " must be " << (b->min_open ? "above " : "from ") << b->min << space
+                  << unit << (b->min_open ? " and up to " : " to ") << b->max << space << unit
+                  << "; it is " << p.value << space << unit << ". Set it within that range.");
     return 0;
   }
   if (!(this->TimeStep >= 1.0e-6 && this->TimeStep <= 60.0)) {
@@ -307,10 +360,18 @@ int vtkSnowDeformationFilter::CheckParameters() {
                   << this->TimeStep << " s. Set it within that range.");
     return 0;
   }
-  if (!(this->MinDensity <= this->MaxDensity)) {
-    vtkErrorMacro("Snow Deformation: MinDensity ("
-                  << this->MinDensity << " kg/m^3) is above MaxDensity (" << this->MaxDensity
-                  << " kg/m^3); swap the DensityRange's ends.");
+  if (custom && !(this->MinDensity <= this->MaxDensity)) {
+    vtkErrorMacro("Snow Deformation: DensityRange runs backwards, from "
+                  << this->MinDensity << " to " << this->MaxDensity
+                  << " kg/m^3; give rho min first (swap the two values).");
+    return 0;
+  }
+  if (custom &&
+      !(this->InitialDensity >= this->MinDensity && this->InitialDensity <= this->MaxDensity)) {
+    vtkErrorMacro("Snow Deformation: InitialDensity ("
+                  << this->InitialDensity << " kg/m^3) lies outside DensityRange ("
+                  << this->MinDensity << " to " << this->MaxDensity
+                  << " kg/m^3); set it within the range or pick a DensityPreset.");
     return 0;
   }
   const double *v = this->ObjectVelocity;
@@ -479,6 +540,88 @@ int vtkSnowDeformationFilter::ReadObjects(vtkDataObject *objects) {
   return 1;
 }
 
+int vtkSnowDeformationFilter::CheckObjectsReachGrid(const double grid[4], double margin) {
+  if (this->ObjectsTemporal || this->Objects.empty()) {
+    return 1;
+  }
+  // The step ends AdvanceState takes (t0 + j dt within each output interval,
+  // the last on the output time), so the test is exact; past 1e5 steps,
+  // 1e5 even samples, each box widened by what the object can move between
+  // two (the speed times the gap, plus its radius for any turn), so that an
+  // object is never refused that a step could bring over the grid.
+  std::vector<double> times;
+  const int outputs = this->GetNumberOfOutputTimes();
+  const double dt = this->TimeStep;
+  const double end = outputs > 0 ? this->GetOutputTime(outputs - 1) : 0.0;
+  const double limit = 1.0e5;
+  const bool exact = end / dt < limit;
+  times.push_back(0.0);
+  if (exact) {
+    for (int k = 1; k < outputs; ++k) {
+      const double t0 = this->GetOutputTime(k - 1), t1 = this->GetOutputTime(k);
+      const double count = std::ceil((t1 - t0) / dt - 1e-9);
+      const long long n = count < 1.0 ? 1 : static_cast<long long>(count);
+      for (long long j = 1; j <= n; ++j) {
+        times.push_back(j == n ? t1 : t0 + static_cast<double>(j) * dt);
+      }
+    }
+  } else {
+    for (int j = 1; j <= static_cast<int>(limit); ++j) {
+      times.push_back(end * j / limit);
+    }
+  }
+  for (size_t k = 0; k < this->Objects.size(); ++k) {
+    const Object &o = this->Objects[k];
+    double lo[3] = {1e300, 1e300, 1e300}, hi[3] = {-1e300, -1e300, -1e300};
+    for (size_t v = 0; v + 2 < o.vertices.size(); v += 3) {
+      for (int c = 0; c < 3; ++c) {
+        lo[c] = std::min(lo[c], static_cast<double>(o.vertices[v + c]));
+        hi[c] = std::max(hi[c], static_cast<double>(o.vertices[v + c]));
+      }
+    }
+    double pad = margin;
+    if (!exact) {
+      const double *u = o.velocity;
+      const double radius = std::sqrt(std::max(lo[0] * lo[0], hi[0] * hi[0]) +
+                                      std::max(lo[1] * lo[1], hi[1] * hi[1]) +
+                                      std::max(lo[2] * lo[2], hi[2] * hi[2]));
+      pad += std::sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]) * end / limit + radius;
+    }
+    double first[4] = {0.0, 0.0, 0.0, 0.0};
+    bool over = false;
+    for (size_t n = 0; n < times.size() && !over; ++n) {
+      double m[16];
+      this->Pose(k, times[n], m);
+      double box[4] = {1e300, -1e300, 1e300, -1e300};
+      for (int corner = 0; corner < 8; ++corner) {
+        const double p[3] = {(corner & 1) ? hi[0] : lo[0], (corner & 2) ? hi[1] : lo[1],
+                             (corner & 4) ? hi[2] : lo[2]};
+        for (int c = 0; c < 2; ++c) {
+          const double w = m[c] * p[0] + m[4 + c] * p[1] + m[8 + c] * p[2] + m[12 + c];
+          box[2 * c] = std::min(box[2 * c], w);
+          box[2 * c + 1] = std::max(box[2 * c + 1], w);
+        }
+      }
+      if (n == 0) {
+        std::copy(box, box + 4, first);
+      }
+      over = box[1] >= grid[0] - pad && box[0] <= grid[1] + pad && box[3] >= grid[2] - pad &&
+             box[2] <= grid[3] + pad;
+    }
+    if (!over) {
+      vtkErrorMacro("Snow Deformation's Objects"
+                    << (this->Objects.size() > 1 ? " block " + std::to_string(k) : std::string())
+                    << " lies outside the terrain's grid at every step up to " << end
+                    << " s: at 0 s it spans x " << first[0] << " to " << first[1] << " m, y "
+                    << first[2] << " to " << first[3] << " m, and the grid x " << grid[0] << " to "
+                    << grid[1] << " m, y " << grid[2] << " to " << grid[3]
+                    << " m; move the object onto the grid or give it a motion that reaches it.");
+      return 0;
+    }
+  }
+  return 1;
+}
+
 void vtkSnowDeformationFilter::Pose(size_t k, double t, double m[16]) const {
   const Object &o = this->Objects[k];
   if (this->ObjectsTemporal) {
@@ -625,9 +768,11 @@ int vtkSnowDeformationFilter::SetUpState(vtkInformationVector **inputVector) {
   gr_snow_deformation_params p;
   gr_snow_deformation_params_init(&p);
   p.initial_snow_depth = this->InitialSnowDepth;
-  p.initial_density = this->InitialDensity;
-  p.min_density = this->MinDensity;
-  p.max_density = this->MaxDensity;
+  double range[2];
+  this->GetDensityRangeInUse(range);
+  p.initial_density = this->GetInitialDensityInUse();
+  p.min_density = range[0];
+  p.max_density = range[1];
   p.compression_model = this->CompressionModel;
   p.max_slope = this->MaxSlope;
   p.direction_falloff = this->DirectionFalloff;
@@ -640,6 +785,13 @@ int vtkSnowDeformationFilter::SetUpState(vtkInformationVector **inputVector) {
   }
   gr_grid grid;
   TerrainGrid(terrain, &grid);
+  const double gridBounds[4] = {grid.x0, grid.x0 + (grid.nx - 1) * grid.dx, grid.y0,
+                                grid.y0 + (grid.ny - 1) * grid.dy};
+  // The core gives an object whose box reaches within a spacing of the grid
+  // its rows and columns; farther out it touches nothing.
+  if (!this->CheckObjectsReachGrid(gridBounds, std::max(grid.dx, grid.dy))) {
+    return 0;
+  }
   gr_status st = gr_snow_deformation_create(this->GetContext(), &grid, &p, &this->Simulation);
   if (st != GR_OK) {
     return this->ReportFailure(st, "Snow Deformation could not set up the simulation");
@@ -834,6 +986,7 @@ void vtkSnowDeformationFilter::PrintSelf(ostream &os, vtkIndent indent) {
   os << indent << "InitialSnowDepth: " << this->InitialSnowDepth << " m\n";
   os << indent << "InitialDensity: " << this->InitialDensity << " kg/m^3\n";
   os << indent << "DensityRange: " << this->MinDensity << " " << this->MaxDensity << " kg/m^3\n";
+  os << indent << "DensityPreset: " << this->DensityPreset << "\n";
   os << indent << "CompressionModel: " << this->CompressionModel << "\n";
   os << indent << "MaxSlope: " << this->MaxSlope << " m/m\n";
   os << indent << "DirectionFalloff: " << this->DirectionFalloff << "\n";

@@ -43,6 +43,18 @@
  * the snow's resistance in the last step) and `contact_area` (m^2); a
  * multiblock's own field data holds their sums.
  *
+ * The snow type: DensityRange (rho min, rho max) and InitialDensity, or a
+ * DensityPreset (the thesis' Table 3.1 snow types, and sand), which then
+ * sets both: the range it names and an initial density at its loose end.
+ *
+ * An object that never comes over the grid (its bounds more than a grid
+ * spacing beyond the terrain's at every step up to EndTime) is refused: it
+ * is a misplaced object, not an idle one. Objects with time steps are taken
+ * as they come.
+ *
+ * Time defaults (SetTimeDefaults): EndTime 10 s, OutputInterval 0.25 s,
+ * the scale of a wheel crossing a few metres of snow in steps of 1/60 s.
+ *
  * The model is described in kernels/include/graupel/snow_deformation.h; the
  * setters clamp to its parameter table (gr_snow_deformation_param_bounds).
  */
@@ -65,6 +77,20 @@ public:
   void PrintSelf(ostream &os, vtkIndent indent) override;
 
   enum CompressionModels { DENSITY_DRIVEN = 0, CONSTANT_FRACTION = 1 };
+
+  /** Snow types of the thesis' Table 3.1, and sand (see GetDensityPresetRange). */
+  enum DensityPresets {
+    CUSTOM = 0, // DensityRange and InitialDensity as set
+    DRY_NEW_SNOW = 1,
+    BONDED_NEW_SNOW = 2,
+    STRONGLY_BONDED_NEW_SNOW = 3,
+    DRY_OLD_SNOW = 4,
+    WET_OLD_SNOW = 5,
+    DEPTH_HOAR = 6,
+    FIRN = 7,
+    ICE = 8,
+    SAND = 9
+  };
 
   ///@{
   /** Length of one simulation step, s (default 1/60; from 1e-6 to 60). */
@@ -97,10 +123,32 @@ public:
   ///@}
 
   ///@{
-  /** Both densities at once, kg/m^3 (ParaView's DensityRange). */
+  /**
+   * Both densities at once, kg/m^3 (ParaView's DensityRange, default 100
+   * 400): the custom range, in force while DensityPreset is CUSTOM.
+   */
   void SetDensityRange(double minimum, double maximum);
   void SetDensityRange(const double range[2]) { this->SetDensityRange(range[0], range[1]); }
+  void GetDensityRange(double range[2]) const;
   ///@}
+
+  ///@{
+  /**
+   * A snow type (DensityPresets; default CUSTOM). Any but CUSTOM sets the
+   * density range to the type's and the initial density to its loose end,
+   * in place of DensityRange and InitialDensity, which are kept for CUSTOM.
+   */
+  vtkSetClampMacro(DensityPreset, int, CUSTOM, SAND);
+  vtkGetMacro(DensityPreset, int);
+  ///@}
+
+  /** A preset's density range, kg/m^3; false (range untouched) for CUSTOM or no preset. */
+  static bool GetDensityPresetRange(int preset, double range[2]);
+
+  /** The density range in force: the preset's, or DensityRange for CUSTOM, kg/m^3. */
+  void GetDensityRangeInUse(double range[2]) const;
+  /** The initial density in force: the preset's loose end, or InitialDensity, kg/m^3. */
+  double GetInitialDensityInUse() const;
 
   ///@{
   /** 0: density-driven compression (default); 1: a constant 15 % compressed. */
@@ -185,6 +233,7 @@ protected:
   double InitialDensity = 150.0;
   double MinDensity = 100.0;
   double MaxDensity = 400.0;
+  int DensityPreset = CUSTOM;
   int CompressionModel = DENSITY_DRIVEN;
   double MaxSlope = 0.6;
   double DirectionFalloff = 8.0;
@@ -207,6 +256,8 @@ private:
   };
 
   int CheckParameters();
+  /** Refuses an object that is over the terrain's grid at no step up to EndTime. */
+  int CheckObjectsReachGrid(const double gridBounds[4], double margin);
   /** Reads the objects (and, once, the path) into Objects; 0 after one sentence. */
   int ReadObjects(vtkDataObject *objects);
   int ReadPath(vtkPolyData *path);

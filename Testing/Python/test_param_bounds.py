@@ -87,17 +87,35 @@ for core in tables:
     T.check(core in CORES, "the core %s has a proxy named %s in the plugin" % (core, name))
 
 
+# A property of several values (DensityRange) stands for several rows: its
+# hint <GraupelTableRows rows="MinDensity MaxDensity"/> names the row of each
+# value. ELEMENT maps (core, row) -> (property, value index); the README row
+# is the property's, its default cell the values in order.
+ELEMENT = {}
+for core, (group, name, _) in CORES.items():
+    proto = pxm.GetPrototypeProxy(group, name)
+    it = proto.NewPropertyIterator()
+    it.Begin()
+    while not it.IsAtEnd():
+        hints = it.GetProperty().GetHints()
+        rows = hints.FindNestedElementByName("GraupelTableRows") if hints else None
+        if rows is not None:
+            for k, r in enumerate(rows.GetAttribute("rows").split()):
+                ELEMENT[(core, r)] = (it.GetKey(), k)
+        it.Next()
+
+
 def check_xml(core, row):
     group, name, _ = CORES[core]
     proto = pxm.GetPrototypeProxy(group, name)
-    p = row["property"]
+    p, index = ELEMENT.get((core, row["property"]), (row["property"], 0))
     prop = proto.GetProperty(p) if proto else None
     T.check(prop is not None, "%s has the property %s" % (name, p))
     if prop is None:
         return
-    where = "%s.%s (table %s)" % (name, p, fmt(row))
+    where = "%s.%s[%d] (table %s %s)" % (name, p, index, row["property"], fmt(row))
     # A prototype proxy is never modified: its values are the XML defaults.
-    default = prop.GetElement(0)
+    default = prop.GetElement(index)
     T.check(same(default, row["default"]),
             "%s: XML default %r, table %r" % (where, default, row["default"]))
     enum = prop.GetDomain("enum")
@@ -202,14 +220,14 @@ readme = readme_rows(a.readme)
 
 
 def check_readme(core, row):
-    p = row["property"]
+    p, index = ELEMENT.get((core, row["property"]), (row["property"], -1))
     found = readme.get(p, [])
     T.check(len(found) == 1, "README: one table row for `%s` (found %d)" % (p, len(found)))
     if len(found) != 1:
         return
     default_cell, range_cell = found[0]
     nums = re.findall(NUM, default_cell)
-    T.check(bool(nums) and same(number(nums[-1]), row["default"]),
+    T.check(len(nums) > max(index, 0) and same(number(nums[index]), row["default"]),
             "README `%s`: default '%s', table %r" % (p, default_cell, row["default"]))
     r = parse_range(range_cell)
     T.check(r is not None, "README `%s`: '%s' is not 'unit, min–max', 'unit, (min, max]' or 'any'"

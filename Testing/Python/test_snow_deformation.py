@@ -4,9 +4,12 @@ python3 on Debian's VTK): a sphere pressed into and dragged across a flat
 imprint leaves, the rim and the front bulge, results bit-identical whatever
 the order of requested times (and with checkpoints), the field data, the
 objects' output posed at the output time with its force and contact area,
-multiblock objects with a per-block velocity, a Path, and bad input (an open
-mesh, a missing or NaN elevation, a mismatched array, a path without speed):
-one sentence, an empty output, and the next good update works."""
+multiblock objects with a per-block velocity, a Path, a wheel rolling along a
+curved Path, the resistance against speed and density, the density presets,
+the time defaults (and, under pvpython, the proxies' own), and bad input (an
+open mesh, an object outside the grid, a missing or NaN elevation, a
+mismatched array, a path without speed, a backwards DensityRange): one
+sentence, an empty output, and the next good update works."""
 import math
 import os
 import sys
@@ -32,6 +35,7 @@ from vtkmodules.vtkCommonExecutionModel import (  # noqa: E402
 )
 from vtkmodules.vtkFiltersSources import (  # noqa: E402
     vtkCubeSource,
+    vtkCylinderSource,
     vtkPlaneSource,
     vtkSphereSource,
 )
@@ -120,6 +124,84 @@ T.check((f.GetMinDensity(), f.GetMaxDensity(), f.GetCompressionModel()) == (100.
 T.check(f.GetMaxSlope() == 0.6 and f.GetDirectionFalloff() == 8.0, "defaults MaxSlope, K")
 f.SetMaxSlope(1e9)
 T.check(f.GetMaxSlope() == 100.0, "MaxSlope clamps to the table's 100: %r" % f.GetMaxSlope())
+# Steps of 1/60 s want seconds, not Rain Runoff's minutes: the class's own
+# time defaults, which ParaView's proxy takes (checked below under pvpython).
+T.check((f.GetEndTime(), f.GetOutputInterval()) == (10.0, 0.25)
+        and (f.GetDefaultEndTime(), f.GetDefaultOutputInterval()) == (10.0, 0.25),
+        "time defaults EndTime 10 s, OutputInterval 0.25 s: %r"
+        % ((f.GetEndTime(), f.GetOutputInterval()),))
+
+# ---- density presets: the thesis' Table 3.1 (kg/m^3), and sand -------------------
+TABLE_3_1 = {1: (30, 50), 2: (50, 100), 3: (100, 200), 4: (200, 400), 5: (300, 500),
+             6: (150, 300), 7: (500, 800), 8: (800, 900)}
+for k, want in TABLE_3_1.items():
+    r = [0.0, 0.0]
+    ok = vtkSnowDeformationFilter.GetDensityPresetRange(k, r)
+    T.check(ok and tuple(r) == want, "preset %d is Table 3.1's %r: %r" % (k, want, r))
+r = [0.0, 0.0]
+T.check(vtkSnowDeformationFilter.GetDensityPresetRange(vtkSnowDeformationFilter.SAND, r)
+        and r[0] > 900.0 and r[1] / r[0] < 1.2,
+        "sand: denser than ice, close ends (little compression): %r" % r)
+T.check(not vtkSnowDeformationFilter.GetDensityPresetRange(0, [0.0, 0.0]),
+        "Custom has no preset range")
+f.SetDensityRange(120.0, 350.0)
+f.SetInitialDensity(140.0)
+f.SetDensityPreset(vtkSnowDeformationFilter.FIRN)
+r = [0.0, 0.0]
+f.GetDensityRangeInUse(r)
+T.check(tuple(r) == (500.0, 800.0) and f.GetInitialDensityInUse() == 500.0,
+        "Firn sets the range 500-800 and the initial density 500: %r %r"
+        % (r, f.GetInitialDensityInUse()))
+f.SetDensityPreset(vtkSnowDeformationFilter.CUSTOM)
+f.GetDensityRangeInUse(r)
+T.check(tuple(r) == (120.0, 350.0) and f.GetInitialDensityInUse() == 140.0
+        and (f.GetMinDensity(), f.GetMaxDensity()) == (120.0, 350.0),
+        "back to Custom, the custom range and density are kept: %r" % r)
+f.SetDensityPreset(42)
+T.check(f.GetDensityPreset() == vtkSnowDeformationFilter.SAND, "DensityPreset clamps to Sand")
+
+# ---- the proxies (pvpython with the plugin) ------------------------------------
+# The plugin lies beside the module in the build tree (or comes as --plugin);
+# plain python3 on Debian's VTK has no ParaView and skips this.
+plugin = a.plugin
+if plugin is None:
+    import glob  # noqa: E402
+    import graupel  # noqa: E402
+    lib = os.path.dirname(os.path.dirname(os.path.dirname(os.path.dirname(graupel.__file__))))
+    found = glob.glob(os.path.join(lib, "paraview-*", "plugins", "Graupel", "Graupel.so"))
+    plugin = found[0] if found else None
+if plugin is not None:
+    from paraview import simple as pv  # noqa: E402
+    from graupel import vtkRainRunoffFilter  # noqa: E402
+
+    px = globals()  # where LoadPlugin puts the plugin's proxies
+    pv.LoadPlugin(plugin, ns=px)
+    ground = px["ProceduralTerrain"](Dimensions=[8, 8])
+    sd, rr = px["SnowDeformation"](Input=ground), px["RainRunoff"](Input=ground)
+    vs, vr = vtkSnowDeformationFilter(), vtkRainRunoffFilter()
+    T.check((sd.EndTime, sd.OutputInterval) == (vs.GetEndTime(), vs.GetOutputInterval())
+            and (rr.EndTime, rr.OutputInterval) == (vr.GetEndTime(), vr.GetOutputInterval())
+            and sd.EndTime != rr.EndTime and sd.OutputInterval != rr.OutputInterval,
+            "proxy time defaults are each class's: Snow Deformation %r, Rain Runoff %r"
+            % ((sd.EndTime, sd.OutputInterval), (rr.EndTime, rr.OutputInterval)))
+    sd2 = px["SnowDeformation"](Input=ground, EndTime=3.0)
+    T.check((sd2.EndTime, sd2.OutputInterval) == (3.0, 0.25), "a given EndTime is kept")
+    T.check(list(sd.DensityRange) == [100.0, 400.0] and sd.DensityPreset == "Custom",
+            "proxy DensityRange 100 400, DensityPreset Custom")
+    sd.DensityRange = [120.0, 350.0]
+    sd.DensityPreset = "Dry old snow"
+    sd.UpdateVTKObjects()
+    obj = sd.GetClientSideObject()
+    obj.GetDensityRangeInUse(r)
+    T.check(tuple(r) == (200.0, 400.0), "proxy preset Dry old snow: range in use %r" % r)
+    sd.DensityPreset = "Custom"
+    sd.UpdateVTKObjects()
+    obj.GetDensityRangeInUse(r)
+    T.check(tuple(r) == (120.0, 350.0), "proxy back to Custom keeps 120 350: %r" % r)
+    for p in (sd, sd2, rr, ground):
+        pv.Delete(p)
+else:
+    print("no ParaView plugin beside the module: proxy checks skipped (plain VTK)")
 
 # ---- a sphere pressed straight down ------------------------------------------------
 # Radius 0.4 m, its bottom starting at 0.4 m (0.1 m into the 0.5 m snow) and
@@ -319,6 +401,114 @@ T.check(s is not None and np.allclose(centre_of(obj), (1.6, 2.0, 0.5), atol=1e-3
 T.check(s is not None and s[int(0.8 / DX), int(1.2 / DX)] < DEPTH - 0.1
         and s[int(1.4 / DX), int(1.6 / DX)] < DEPTH - 0.1, "a trench along both legs")
 
+# ---- a preset in a pipeline: the snow starts at its loose end, stays in its range --
+ps = press(DensityPreset=vtkSnowDeformationFilter.DRY_OLD_SNOW, DensityRange=(120.0, 350.0),
+           OutputInterval=1.0)
+s, out = at(ps, 0.0)
+d0 = vtk_to_numpy(out.GetPointData().GetArray("snow_density")) if s is not None else None
+T.check(d0 is not None and float(d0.min()) == 200.0 and float(d0.max()) == 200.0,
+        "Dry old snow starts at 200 kg/m^3 everywhere")
+s, out = at(ps, 1.0)
+d1 = vtk_to_numpy(out.GetPointData().GetArray("snow_density")) if s is not None else None
+T.check(d1 is not None and 200.0 < float(d1.max()) <= 400.0 + 1e-3,
+        "pressed Dry old snow compresses within 200-400: max %r"
+        % (None if d1 is None else float(d1.max())))
+T.check(s is not None and abs(field(out, "balance_error")) <= 1e-5 * DEPTH * 200.0 * AREA,
+        "the preset run keeps the mass")
+cu = press(DensityRange=(120.0, 350.0), OutputInterval=1.0)
+s, out = at(cu, 1.0)
+d1 = vtk_to_numpy(out.GetPointData().GetArray("snow_density")) if s is not None else None
+T.check(d1 is not None and float(d1.min()) == RHO and RHO < float(d1.max()) <= 350.0 + 1e-3,
+        "a custom 120-350 is the range in force: density from-to %r"
+        % ((None if d1 is None else (float(d1.min()), float(d1.max()))),))
+
+
+# ---- resistance: grows with speed and density, zero without contact --------------
+# A sphere 0.3 m into the snow, dragged from x = 0.8 m; the force is the last
+# step's at 0.25 s (15 steps), when it ploughs: F = -m v / dt with m the snow
+# moved in the step, about rho A v^2 for a frontal area A.
+def resistance(speed, rho=RHO, z=0.5):
+    g = snow(sphere((0.8, 1.6, z), 0.3, 16), ObjectVelocity=(speed, 0.0, 0.0),
+             InitialDensity=rho, EndTime=0.25, OutputInterval=0.25)
+    s, _ = at(g, 0.25)
+    o = g.GetOutputDataObject(1)
+    fd = o.GetFieldData()
+    fa = fd.GetArray("force")
+    return (s, fa.GetTuple3(0) if fa else None, field(o, "contact_area"))
+
+
+_, f_slow, _ = resistance(0.5)
+_, f_fast, _ = resistance(1.0)
+_, f_dense, _ = resistance(1.0, rho=300.0)
+print("resistance Fx: 0.5 m/s %.4g N, 1 m/s %.4g N, 1 m/s at 300 kg/m^3 %.4g N"
+      % (f_slow[0], f_fast[0], f_dense[0]))
+T.check(f_slow[0] < 0.0 and f_fast[0] < 0.0 and f_dense[0] < 0.0, "the resistance opposes x")
+T.check(3.0 < f_fast[0] / f_slow[0] < 5.0,
+        "twice the speed, about four times the resistance (v^2): %.4g vs %.4g N"
+        % (f_fast[0], f_slow[0]))
+T.check(f_dense[0] / f_fast[0] > 1.8,
+        "twice the density, at least 1.8 times the resistance: %.4g vs %.4g N"
+        % (f_dense[0], f_fast[0]))
+s, f_air, area_air = resistance(1.0, z=0.85)  # its bottom 5 cm above the snow
+T.check(f_air == (0.0, 0.0, 0.0) and area_air == 0.0 and s is not None
+        and float(np.abs(s - DEPTH).max()) == 0.0,
+        "no contact: no force (%r), no contact_area (%r), snow untouched" % (f_air, area_air))
+
+# ---- a wheel rolling along a curved path leaves a curved trench ------------------
+# A cylinder (radius 0.25 m, 0.2 m wide, its axle along y: rolling along its
+# +x, which the path turns along the tangent) rolls at 2 m/s, 458 deg/s, on
+# an arc of radius 1.1 m about (1.6, 0.4) from 160 degrees on; in 1 s it goes
+# 2 m, to 55.8 degrees. Its bottom is 0.1 m into the snow.
+AC, AR, WR = np.array([1.6, 0.4]), 1.1, 0.25
+arc = vtkPoints()
+angles = np.radians(np.arange(160.0, 19.0, -5.0))
+for th in angles:
+    arc.InsertNextPoint(AC[0] + AR * math.cos(th), AC[1] + AR * math.sin(th), 0.5 - 0.1 + WR)
+arc_line = vtkCellArray()
+arc_line.InsertNextCell(len(angles))
+for k in range(len(angles)):
+    arc_line.InsertCellPoint(k)
+arc_path = vtkPolyData()
+arc_path.SetPoints(arc)
+arc_path.SetLines(arc_line)
+cyl = vtkCylinderSource()
+cyl.SetRadius(WR)
+cyl.SetHeight(0.2)
+cyl.SetResolution(24)
+cyl.Update()
+wheel = snow(cyl.GetOutput(), ObjectVelocity=(2.0, 0.0, 0.0),
+             ObjectAngularVelocity=2.0 / WR * 180.0 / math.pi, RotationAxis=(0.0, 1.0, 0.0),
+             OutputInterval=1.0)
+wheel.SetPathConnection(producer(arc_path))
+s, out = at(wheel, 1.0)
+T.check(s is not None, "the wheel on the arc gives an output")
+if s is not None:
+    worst = 0.0
+    for deg in (150.0, 135.0, 120.0, 105.0, 90.0, 75.0):
+        th = math.radians(deg)
+        rs = np.arange(0.6, 1.6, 0.005)
+        ii = np.rint((AC[0] + rs * math.cos(th)) / DX).astype(int)
+        jj = np.rint((AC[1] + rs * math.sin(th)) / DX).astype(int)
+        h = s[jj, ii]
+        bottom = rs[h <= h.min() + 1e-3].mean()
+        worst = max(worst, abs(bottom - AR))
+        T.check(h.min() < DEPTH - 0.05, "a trench at %g degrees: %.3f m" % (deg, h.min()))
+    print("wheel trench: deepest points within %.3f m of the arc" % worst)
+    T.check(worst <= 2 * DX, "across the path, the trench's deepest point lies within two "
+            "cells of the arc: %.3f m" % worst)
+    T.check(abs(field(out, "balance_error")) <= 1e-5 * mass0, "the wheel keeps the mass")
+    obj = wheel.GetOutputDataObject(1)
+    th = math.radians(160.0) - 2.0 / AR
+    T.check(np.allclose(centre_of(obj)[:2], AC + AR * np.array([math.cos(th), math.sin(th)]),
+                        atol=0.02), "the wheel ends 2 m along the arc: %r" % (centre_of(obj),))
+
+# An object that starts off the grid and drives onto it is no error.
+enter = snow(sphere((-0.5, 1.6, 0.5), 0.3, 16), ObjectVelocity=(2.0, 0.0, 0.0),
+             EndTime=0.5, OutputInterval=0.5)
+s, _ = at(enter, 0.5)
+T.check(s is not None and float(s.min()) < DEPTH - 0.1,
+        "a sphere driving onto the grid from outside is simulated")
+
 # ---- objects with time steps: each step's geometry is the pose -------------------
 from vtkmodules.util.vtkAlgorithm import VTKPythonAlgorithmBase  # noqa: E402
 
@@ -388,7 +578,12 @@ cases = [
                                           "snow_depth": np.zeros((N, N - 1))}}, ["snow_depth"]),
     ("zero-speed path", {"path": True}, ["Path", "ObjectVelocity"]),
     ("NaN TimeStep", {"props": {"TimeStep": float("nan")}}, ["TimeStep", " s"]),
-    ("MinDensity above MaxDensity", {"props": {"MinDensity": 500.0}}, ["MinDensity", "kg/m^3"]),
+    ("backwards DensityRange", {"props": {"DensityRange": (500.0, 400.0)}},
+     ["DensityRange", "kg/m^3"]),
+    ("InitialDensity outside DensityRange", {"props": {"InitialDensity": 50.0}},
+     ["InitialDensity", "DensityRange"]),
+    ("object outside the grid", {"objects": sphere((10.0, 10.0, 0.8), 0.3, 16)},
+     ["Objects", "outside", "10", "grid x 0 to 3.15 m"]),
 ]
 for what, case, words in cases:
     g = snow(case.get("objects", sphere((1.6, 1.6, 0.8), 0.3, 16)), case.get("ground"))
@@ -409,7 +604,8 @@ for what, case, words in cases:
     g.SetInputConnection(2, None)
     g.SetObjectVelocity(0.0, 0.0, VZ)
     g.SetTimeStep(1.0 / 60.0)
-    g.SetMinDensity(100.0)
+    g.SetDensityRange(100.0, 400.0)
+    g.SetInitialDensity(RHO)
     s, _ = at(g, 1.0)
     T.check(s is not None and np.array_equal(s, ref[1.0]), "%s: fixed, it works again" % what)
 
