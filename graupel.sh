@@ -2,7 +2,7 @@
 # Graupel's one entry point for set-up, demo and tests.
 #
 #   ./graupel.sh demo   install what the demo needs, build the plugin, run
-#                       Examples/demo_terrain.py -> out/
+#                       Examples/demo_terrain.py and demo_snow_deformation.py -> out/
 #   ./graupel.sh test   install what is missing, build all four configurations, run ctest
 #   ./graupel.sh build  install what the plugin needs and build the plugin only
 #   ./graupel.sh soak   the long soak runs (ctest label "soak", kept out of "test")
@@ -112,6 +112,11 @@ case "$cmd" in
     PYTHONPATH="$ROOT/build/lib/python3/site-packages${PYTHONPATH:+:$PYTHONPATH}" \
     PV_PLUGIN_PATH="$ROOT/build/lib/paraview-5.11/plugins/Graupel" \
       xvfb-run -a -s "-screen 0 1280x1024x24" pvbatch Examples/demo_terrain.py --out out
+    # A wheel rolling through snow: out/snow_deformation_t1..t3.png (a third, two
+    # thirds and the end of its crossing), snow_deformation_close.png and .vti.
+    PYTHONPATH="$ROOT/build/lib/python3/site-packages${PYTHONPATH:+:$PYTHONPATH}" \
+    PV_PLUGIN_PATH="$ROOT/build/lib/paraview-5.11/plugins/Graupel" \
+      xvfb-run -a -s "-screen 0 1280x1024x24" pvbatch Examples/demo_snow_deformation.py --out out
     ;;
   test)
     ensure_packages "${PACKAGES[@]}" "${TEST_PACKAGES[@]}"
