@@ -29,6 +29,10 @@ for core in $CORES; do
   GRAUPEL_DEVICE=cpu build-gpu/graupel-bench --core "$core" --size 1024 --steps 10 \
     2>&1 | tee -a "$OUT/bench_pocl_host.txt" | tail -1
 done
+# SOAK=N: N steps of each simulation's soak on the GPU (SOAK_CORES picks them).
 if [ -n "${SOAK:-}" ]; then
-  GRAUPEL_DEVICE=gpu build-gpu/Testing/C/test_soak rain_runoff "$SOAK" 2>&1 | tee "$OUT/soak_rain_gpu.txt" | tail -3
+  for core in ${SOAK_CORES:-rain_runoff snow_deformation}; do
+    GRAUPEL_DEVICE=gpu build-gpu/Testing/C/test_soak "$core" "$SOAK" 2>&1 |
+      tee "$OUT/soak_${core}_gpu.txt" | tail -3
+  done
 fi

@@ -186,24 +186,29 @@ static void plough(gr_snow_deformation *s, int steps, double speed, double dt) {
   mesh_free(&box);
 }
 
+/* Issue 8: 10^4 steps. The talus gets 8 iterations a step (the snow need
+ * not settle for the books to close, and the test stays quick); every
+ * amount that moves is whole quanta (snow_deformation_shared.h), so the
+ * volume closes to the rounding of the ledger's own double sums. */
+#define MASS_STEPS 10000
+
 static void test_mass_no_compression(void) {
   gr_snow_deformation_params p;
   gr_snow_deformation_params_init(&p);
   p.initial_density = p.max_density; /* nothing can be compressed */
+  p.max_relax_iterations = 8;
   gr_snow_deformation *s = make_sim(64, 48, 0.05, &p);
   if (!s)
     return;
   gr_snow_deformation_ledger l;
-  /* 300 steps: the float state drifts by about 2e-9 of the volume per step
-   * (1.7e-6 after 1000); see mass_compression. */
-  plough(s, 300, 1.5, 1.0 / 60.0);
+  plough(s, MASS_STEPS, 1.5, 1.0 / 60.0);
   CHECK(gr_snow_deformation_ledger_get(s, &l) == GR_OK);
   double rel = fabs(l.snow_volume - l.initial_volume) / l.initial_volume;
-  printf("no compression: %lld steps, volume %.9g of %.9g (rel %.3g), displaced %.4g m^3, "
+  printf("no compression: %lld steps, volume %.12g of %.12g (rel %.3g), displaced %.4g m^3, "
          "compressed %.3g\n",
          l.steps, l.snow_volume, l.initial_volume, rel, l.displaced_volume, l.compressed_volume);
-  CHECK(l.steps == 300);
-  CHECK(rel < 1e-6);
+  CHECK(l.steps == MASS_STEPS);
+  CHECK(rel < 1e-12); /* issue 8 asks for 1e-6 */
   CHECK(l.compressed_volume == 0.0);
   CHECK(l.displaced_volume > 1.0); /* the box did move snow */
   CHECK(fabs(l.balance_error) / l.initial_mass < 1e-6);
@@ -215,6 +220,7 @@ static void test_mass_compression(void) {
     gr_snow_deformation_params p;
     gr_snow_deformation_params_init(&p);
     p.compression_model = model;
+    p.max_relax_iterations = 8;
     gr_snow_deformation *s = make_sim(64, 48, 0.05, &p);
     if (!s)
       return;
@@ -223,13 +229,14 @@ static void test_mass_compression(void) {
     CHECK(gr_snow_deformation_ledger_get(s, &l) == GR_OK);
     /* First step: the density is 150 in [100, 400], W = 1/6 (model 0) or
      * the constant 0.85 (model 1) of the overlap is displaced. */
+    /* Every point under the box is pressed alike (0.2 m), and its share
+     * rounds to the same whole quantum: within half a quantum of 0.2 m. */
     double frac = l.compressed_volume / (l.compressed_volume + l.displaced_volume);
     printf("model %d: compressed fraction of the first press %.9f\n", model, frac);
-    CHECK_NEAR(frac, model == 0 ? 5.0 / 6.0 : 0.15, 1e-6);
-    /* 300 steps: the float state drifts by about 1e-9 of the mass per step
-     * (1.2e-6 after 1000 steps in the density model, 4e-6 in the constant
-     * one); per-point compensated sums would remove it (see the report). */
-    plough(s, 300, 1.5, 1.0 / 60.0);
+    CHECK_NEAR(frac, model == 0 ? 5.0 / 6.0 : 0.15, 0.5 / 1048576.0 / 0.2 + 1e-9);
+    /* The volume closes exactly; the mass, depth times a float density,
+     * to the densities' rounding. */
+    plough(s, MASS_STEPS, 1.5, 1.0 / 60.0);
     CHECK(gr_snow_deformation_ledger_get(s, &l) == GR_OK);
     double mrel = fabs(l.balance_error) / l.initial_mass;
     double vrel = fabs(l.volume_error) / l.initial_volume;
@@ -237,7 +244,7 @@ static void test_mass_compression(void) {
            "%.5g)\n",
            model, l.steps, mrel, vrel, l.compressed_volume, l.initial_volume);
     CHECK(mrel < 1e-6);
-    CHECK(vrel < 1e-6);
+    CHECK(vrel < 1e-12);
     CHECK(l.compressed_volume > 1e-3);
     CHECK(l.snow_volume < l.initial_volume - 1e-3);
     /* Densities stay in the range: compression never goes beyond rho_max. */
@@ -777,17 +784,19 @@ static float *drag(int steps, double dt, double speed, int *iterations) {
 
 /* A trail in dense snow (all of the overlap displaced): every column the
  * box crossed from x = 0.5 m to where its back stopped (1.8 m) keeps a
- * trench below the initial surface along the path and a rim above it
- * beside the path after the object has gone, and the front bulge lies
- * ahead. With horizontal motion the direction weights give the side
- * contour nothing (s_w = max(0, v . w), r = 0), so the rims are the talus
- * of the bulge; under the last imprint the bulge slumps back in. */
+ * trench below the initial surface along the path after the object has
+ * gone, and the front bulge lies ahead. With horizontal motion the
+ * direction weights give the side contour nothing (s_w = max(0, v . w),
+ * r = 0), so the rims are the talus of the bulge as it is pushed along:
+ * beside the path from where the box first stood (its front at 0.925 m:
+ * the snow of that first press all went ahead) on; under the last imprint
+ * the bulge slumps back in. */
 static void test_trail(void) {
   int its = 0;
   float *h = drag(60, 1.0 / 60.0, 1.5, &its); /* 0.025 m a step, to x = 2.1 m */
   if (!h)
     return;
-  int nx = 64, trench = 0, rim = 0, cols = 0;
+  int nx = 64, trench = 0, rim = 0, cols = 0, rim_cols = 0;
   double shallowest = 1.0, bulge = 0.0;
   for (int i = (int)ceil(0.5 / 0.05); i <= (int)floor(1.75 / 0.05); ++i) {
     ++cols;
@@ -797,16 +806,19 @@ static void test_trail(void) {
     trench += centre < 0.5 - 0.05;
     if (centre >= 0.5 - 0.05)
       printf("trail: column %d (x %.2f m) centre %.4f m\n", i, i * 0.05, centre);
-    rim += top > 0.5 + 0.005;
+    if (i * 0.05 >= 0.95) {
+      ++rim_cols;
+      rim += top > 0.5 + 0.005;
+    }
     shallowest = fmin(shallowest, 0.5 - centre);
   }
   for (int i = (int)ceil(2.4 / 0.05); i < nx; ++i)
     for (int j = 0; j < 48; ++j)
       bulge = fmax(bulge, h[j * nx + i] - 0.5);
-  printf("trail: %d columns, %d with a trench (shallowest %.4g m), %d with a rim; front bulge "
-         "%.4g m; up to %d talus iterations a step\n",
-         cols, trench, shallowest, rim, bulge, its);
-  CHECK(cols == 26 && trench == cols && rim == cols);
+  printf("trail: %d columns, %d with a trench (shallowest %.4g m), %d of %d with a rim; front "
+         "bulge %.4g m; up to %d talus iterations a step\n",
+         cols, trench, shallowest, rim, rim_cols, bulge, its);
+  CHECK(cols == 26 && trench == cols && rim_cols == 17 && rim == rim_cols);
   CHECK(bulge > 0.05);
   free(h);
 }

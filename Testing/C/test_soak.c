@@ -375,7 +375,9 @@ static void soak_snow_deformation(long n) {
       double mrel = fabs(led.balance_error) / led.initial_mass;
       double vrel = fabs(led.volume_error) / led.initial_volume;
       worst = fmax(worst, fmax(mrel, vrel));
-      CHECK_MSG(mrel <= 1e-5 && vrel <= 1e-5, "step %ld: mass error %g, volume error %g", done,
+      /* The volume moves in whole quanta: it closes to the ledger's own
+       * rounding; the mass to that of the float densities. */
+      CHECK_MSG(mrel <= 1e-5 && vrel <= 1e-12, "step %ld: mass error %g, volume error %g", done,
                 mrel, vrel);
       CHECK_MSG(led.steps == done, "ledger counts %lld steps, %ld were taken", led.steps, done);
       if (done % 10000 == 0) {

@@ -58,9 +58,15 @@ __kernel void snow_raster(__global const float *restrict tri,
   under[gr_idx(i, j, nx)] = u;
 }
 
-/* D = min(S, max(0, H - U)): the ground is rigid. */
+/* An amount of snow rounded down to whole quanta (see
+ * snow_deformation_shared.h); exact, as the quantum is a power of two. */
+GR_INLINE float snow_q(float x) {
+  return floor(x * GR_SNOW_QUANTUM_INV) * GR_SNOW_QUANTUM;
+}
+
+/* D = min(S, max(0, H - U)) in whole quanta: the ground is rigid. */
 GR_INLINE float snow_overlap_of(float b, float s, float u) {
-  return fmin(s, fmax(0.0f, (b + s) - u));
+  return fmin(s, snow_q(fmax(0.0f, (b + s) - u)));
 }
 
 __kernel void snow_overlap(__global const float *restrict ground,
@@ -74,18 +80,24 @@ __kernel void snow_overlap(__global const float *restrict ground,
   overlap[c] = snow_overlap_of(ground[c], depth[c], under[c]);
 }
 
-/* Contour weight: -1 off the contour (overlapped, or no overlapped
- * 8-neighbour); on it s_w = max(0, v^ . w^) + r / K with w^ the outward
+/* Contour weight: -1 off the contour (overlapped or touched, or no
+ * overlapped 8-neighbour); on it s_w = max(0, v^ . w^) + r / K with w^ the outward
  * direction, minus the sum of the overlapped neighbours' offsets. */
-__kernel void snow_contour(__global const float *restrict overlap, int nx, int ny, float vx,
-                           float vy, float rest, int x_end, int y_end,
+__kernel void snow_contour(__global const float *restrict ground,
+                           __global const float *restrict depth,
+                           __global const float *restrict under,
+                           __global const float *restrict overlap, int nx, int ny, float vx,
+                           float vy, float rest, float gap, int x_end, int y_end,
                            __global float *restrict weight) {
   int i = get_global_id(0), j = get_global_id(1);
   if (!gr_inside(i, j, nx, ny) || i >= x_end || j >= y_end)
     return;
   int c = gr_idx(i, j, nx);
   float cw = -1.0f;
-  if (overlap[c] <= 0.0f) {
+  /* A point the object touches without pressing it (pressed before: its
+   * surface at the underside) lies under the object, not on its contour:
+   * snow is never put under an object. */
+  if (overlap[c] <= 0.0f && ground[c] + depth[c] < under[c] - gap) {
     int any = 0, ox = 0, oy = 0;
     for (int dj = -1; dj <= 1; ++dj)
       for (int di = -1; di <= 1; ++di) {
@@ -121,8 +133,10 @@ GR_INLINE float snow_displaced(float s, float rho, float d, float rho_min, float
     w = clamp((rho - rho_min) / (rho_max - rho_min), 0.0f, 1.0f);
   else
     w = 1.0f;
+  /* To the nearest quantum (d is whole quanta, so e stays within [0, d]):
+   * the compressed fraction keeps no bias. */
   float e = fmax(w * d, s - (s - d) * (rho_max / rho));
-  return clamp(e, 0.0f, d);
+  return rint(clamp(e, 0.0f, d) * GR_SNOW_QUANTUM_INV) * GR_SNOW_QUANTUM;
 }
 
 __kernel void
@@ -196,10 +210,38 @@ __kernel void snow_apply(__global const float *restrict ground, __global float *
   } else if (cw > 0.0f) {
     /* The mass-weighted mean written as a change, so that snow of the same
      * density leaves the density bit for bit as it was. */
-    float add = cw * add_depth, s1 = s + add;
+    float add = snow_q(cw * add_depth), s1 = s + add;
     depth[c] = s1;
     density[c] = rho + add * ((add_rho - rho) / s1);
   }
+}
+
+/* What the contour of the window [x0, x0 + w) x [y0, y0 + n / w) received
+ * in snow_apply (the same floats): one double-float sum. */
+__kernel void snow_added_reduce(__global const float *restrict overlap,
+                                __global const float *restrict weight, float add_depth, int nx,
+                                int x0, int y0, int w, int n, __global float *restrict partial,
+                                __local float *restrict scratch) {
+  int lid = get_local_id(0), wg = get_local_size(0), start, end;
+  gr_reduce_block(n, &start, &end);
+  float hi = 0.0f, lo = 0.0f;
+  for (int q = start + lid; q < end; q += wg) {
+    int c = gr_idx(x0 + q % w, y0 + q / w, nx);
+    float cw = weight[c];
+    if (overlap[c] <= 0.0f && cw > 0.0f)
+      gr_df_add(&hi, &lo, snow_q(cw * add_depth));
+  }
+  __local float *mine = gr_reduce_slots(scratch, 1, 0);
+  mine[0] = hi;
+  mine[1] = lo;
+  gr_reduce_group(scratch, 1, 0, partial);
+}
+
+/* Depths to the nearest whole quantum. */
+__kernel void snow_quantize(int n, __global float *restrict depth) {
+  int c = get_global_id(0);
+  if (c < n)
+    depth[c] = rint(depth[c] * GR_SNOW_QUANTUM_INV) * GR_SNOW_QUANTUM;
 }
 
 /* The start of a step, on where the last step's objects wrote. */
@@ -312,14 +354,15 @@ snow_relax_move(__global const float *restrict ground, __global const float *res
       float thr = snow_threshold(di, dj, tx, ty, td);
       float hn = ground[n] + depth[n];
       if (kb > 0.0f)
-        out += snow_excess(hb, hn, under_min[n], thr) * fmin(kb, rate_in[n]);
+        out += snow_q(snow_excess(hb, hn, under_min[n], thr) * fmin(kb, rate_in[n]));
       float ka = rate[n];
       if (ka > 0.0f && kin > 0.0f) {
-        float f = snow_excess(hn, hb, ub, thr) * fmin(ka, kin);
+        float f = snow_q(snow_excess(hn, hb, ub, thr) * fmin(ka, kin));
         in += f;
         mass_in += f * (density[n] - rho);
       }
     }
+  /* Whole quanta below 16 m: exact, and out <= S (the rate's bound). */
   float kept = fmax(0.0f, s - out), s1 = kept + in;
   depth_out[c] = s1;
   /* (kept rho + sum f rho_a) / s1 as a change: equal densities stay put. */

@@ -34,4 +34,18 @@
  * iterations. */
 #define GR_SNOW_CHECK_EVERY 4
 
+/* The quantum of snow depth, 2^-20 m (about 1 micrometre). Depths and
+ * every amount of snow that moves (pressed, displaced, deposited, slid) are
+ * whole multiples of it: below 16 m of snow (2^24 quanta, a float's
+ * significand) every sum and difference of them is exact, so what leaves a
+ * point arrives at another to the bit and the volume ledger closes exactly
+ * over any number of steps. */
+#define GR_SNOW_QUANTUM_INV 1048576.0f
+#define GR_SNOW_QUANTUM (1.0f / GR_SNOW_QUANTUM_INV)
+
+/* A point slides only while it can move more than this (and more than
+ * RelaxTolerance): 16 quanta, so that its largest pair moves at least a
+ * quantum and every iteration that runs makes progress. */
+#define GR_SNOW_MIN_MOVE (16.0f * GR_SNOW_QUANTUM)
+
 #endif

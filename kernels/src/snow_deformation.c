@@ -21,7 +21,7 @@
 #define GR_SNOW_MAX_DT 3600.0
 /* Checkpoints: "GSD1". */
 #define GR_SNOW_STATE_MAGIC 0x31445347u
-#define GR_SNOW_STATE_VERSION 1u
+#define GR_SNOW_STATE_VERSION 2u
 /* Per-point arrays of a checkpoint: depth, density, overlap sum, contact. */
 #define GR_SNOW_STATE_ARRAYS 4
 
@@ -64,7 +64,7 @@ struct gr_snow_deformation {
   gr_grid grid;
   gr_snow_deformation_params params;
   cl_kernel raster, overlap_k, contour, obj_reduce, apply, relax_rate, relax_move, check_reduce,
-      ledger_reduce, surface, reset;
+      ledger_reduce, surface, reset, added_reduce, quantize;
   cl_mem depth[2], density[2]; /* [cur] is the state */
   int cur;
   cl_mem ground, depth0, density0, under, overlap, weight, overlap_sum, contact, under_min, rate,
@@ -75,11 +75,14 @@ struct gr_snow_deformation {
    * tri_list[tile_start[t] .. tile_start[t + 1]) that may cover its points. */
   cl_mem tile_start, tile_list;
   size_t tile_start_cap, tile_list_cap;
-  gr_reduction red_obj, red_check, red_ledger;
+  gr_reduction red_obj, red_check, red_ledger, red_added;
   gr_snow_object objects[GR_SNOW_DEFORMATION_MAX_OBJECTS];
   int nobjects;
   double force[GR_SNOW_DEFORMATION_MAX_OBJECTS][3], area[GR_SNOW_DEFORMATION_MAX_OBJECTS];
   double time, initial_volume, initial_mass, compressed, displaced;
+  /* Displaced snow not yet deposited (the rounding to whole quanta), per
+   * unit cell area, and its mass. */
+  double pending, pending_mass;
   long long steps;
   int relax_iterations;
   int relax_full; /* the next relaxation covers the whole grid */
@@ -233,6 +236,17 @@ static gr_status gr_snow_copy(gr_snow_deformation *s, cl_mem from, cl_mem to) {
                      "Copying a device buffer");
 }
 
+/* Depths to whole quanta (snow_deformation_shared.h). */
+static gr_status gr_snow_quantize(gr_snow_deformation *s, cl_mem depth) {
+  cl_int n = (cl_int)gr_snow_cells(s);
+  gr_status st = GR_SNOW_ARG(s, s->quantize, "n", n);
+  if (st == GR_OK)
+    st = GR_SNOW_ARG(s, s->quantize, "depth", depth);
+  if (st == GR_OK)
+    st = gr_enqueue_2d(s->ctx, s->quantize, 0, 0, (size_t)n, 1, NULL);
+  return st;
+}
+
 /* The state (depth and density) of points [x0, x1] x [y0, y1] from the
  * current buffer of the pair to the other one. */
 static gr_status gr_snow_sync_rect(gr_snow_deformation *s, int x0, int y0, int x1, int y1) {
@@ -278,7 +292,7 @@ static gr_status gr_snow_initial_state(gr_snow_deformation *s) {
     st = gr_snow_fill(s, s->overlap_sum, 0.0f);
   if (st == GR_OK)
     st = gr_snow_fill(s, s->contact, 0.0f);
-  s->time = s->compressed = s->displaced = 0.0;
+  s->time = s->compressed = s->displaced = s->pending = s->pending_mass = 0.0;
   s->steps = 0;
   s->relax_iterations = 0;
   s->relax_full = 1;
@@ -340,7 +354,9 @@ gr_status gr_snow_deformation_create(gr_context *ctx, const gr_grid *grid,
             {"snow_check_reduce", &s->check_reduce},
             {"snow_ledger_reduce", &s->ledger_reduce},
             {"snow_surface", &s->surface},
-            {"snow_reset", &s->reset}};
+            {"snow_reset", &s->reset},
+            {"snow_added_reduce", &s->added_reduce},
+            {"snow_quantize", &s->quantize}};
   for (size_t i = 0; st == GR_OK && i < sizeof(ks) / sizeof(ks[0]); ++i)
     st = gr_kernel_create(ctx, prog, ks[i].name, ks[i].k);
   cl_mem *bufs[] = {&s->depth[0],    &s->depth[1], &s->density[0], &s->density[1], &s->ground,
@@ -356,9 +372,13 @@ gr_status gr_snow_deformation_create(gr_context *ctx, const gr_grid *grid,
   if (st == GR_OK)
     st = gr_reduction_init(ctx, s->ledger_reduce, cells, GR_SNOW_LEDGER_SUMS, 0, &s->red_ledger);
   if (st == GR_OK)
+    st = gr_reduction_init(ctx, s->added_reduce, cells, 1, 0, &s->red_added);
+  if (st == GR_OK)
     st = gr_snow_fill(s, s->ground, 0.0f);
   if (st == GR_OK)
     st = gr_snow_fill(s, s->depth0, (float)p->initial_snow_depth);
+  if (st == GR_OK)
+    st = gr_snow_quantize(s, s->depth0);
   if (st == GR_OK)
     st = gr_snow_fill(s, s->density0, (float)p->initial_density);
   if (st == GR_OK)
@@ -376,9 +396,9 @@ gr_status gr_snow_deformation_create(gr_context *ctx, const gr_grid *grid,
 void gr_snow_deformation_destroy(gr_snow_deformation *s) {
   if (!s)
     return;
-  cl_kernel ks[] = {s->raster,        s->overlap_k,  s->contour,    s->obj_reduce,
-                    s->apply,         s->relax_rate, s->relax_move, s->check_reduce,
-                    s->ledger_reduce, s->surface,    s->reset};
+  cl_kernel ks[] = {s->raster,     s->overlap_k,    s->contour,      s->obj_reduce,    s->apply,
+                    s->relax_rate, s->relax_move,   s->check_reduce, s->ledger_reduce, s->surface,
+                    s->reset,      s->added_reduce, s->quantize};
   for (size_t i = 0; i < sizeof(ks) / sizeof(ks[0]); ++i)
     if (ks[i])
       clReleaseKernel(ks[i]);
@@ -391,6 +411,7 @@ void gr_snow_deformation_destroy(gr_snow_deformation *s) {
   gr_reduction_release(&s->red_obj);
   gr_reduction_release(&s->red_check);
   gr_reduction_release(&s->red_ledger);
+  gr_reduction_release(&s->red_added);
   gr_context_release(s->ctx);
   free(s);
 }
@@ -489,6 +510,10 @@ static gr_status gr_snow_set_field_impl(gr_snow_deformation *s, gr_field f, cons
     st = gr_buffer_write(s->ctx, init, 0, bytes, host);
   if (st == GR_OK)
     st = gr_buffer_write(s->ctx, now, 0, bytes, host);
+  if (st == GR_OK && f == GR_FIELD_SNOW_DEPTH)
+    st = gr_snow_quantize(s, init);
+  if (st == GR_OK && f == GR_FIELD_SNOW_DEPTH)
+    st = gr_snow_quantize(s, now);
   if (st == GR_OK)
     st = gr_snow_ledger_sums(s, &v1, &m1);
   if (st == GR_OK) {
@@ -920,6 +945,15 @@ static gr_status gr_snow_object_step(gr_snow_deformation *s, int o, double dt) {
     uz = ob->v[2] / vn;
   }
   float vx = (float)ux, vy = (float)uy, rest = (float)(uz * uz / s->params.direction_falloff);
+  float gap = (float)GR_SNOW_DEFORMATION_CONTACT_GAP;
+  if (st == GR_OK)
+    st = GR_SNOW_ARG(s, s->contour, "ground", s->ground);
+  if (st == GR_OK)
+    st = GR_SNOW_ARG(s, s->contour, "depth", s->depth[s->cur]);
+  if (st == GR_OK)
+    st = GR_SNOW_ARG(s, s->contour, "under", s->under);
+  if (st == GR_OK)
+    st = GR_SNOW_ARG(s, s->contour, "gap", gap);
   if (st == GR_OK)
     st = GR_SNOW_ARG(s, s->contour, "overlap", s->overlap);
   if (st == GR_OK)
@@ -969,8 +1003,15 @@ static gr_status gr_snow_object_step(gr_snow_deformation *s, int o, double dt) {
   if (sums[0] <= 0.0 && sums[5] > 0.0)
     press = 1; /* all compressed, nothing to distribute */
   float add_depth = 0.0f, add_rho = (float)s->params.max_density;
+  /* What the contour receives: this object's displaced snow and what the
+   * rounding to whole quanta kept back before (pending), per unit weight,
+   * rounded down so that the contour never receives more. */
+  double give = sums[0] + s->pending;
   if (press && sums[2] > 0.0 && sums[0] > 0.0) {
-    add_depth = (float)(sums[0] / sums[2]);
+    double per = give / sums[2];
+    add_depth = (float)per;
+    if ((double)add_depth > per)
+      add_depth = nextafterf(add_depth, 0.0f);
     add_rho = (float)fmin(s->params.max_density, sums[1] / sums[0]);
   }
   if (press) {
@@ -1005,9 +1046,44 @@ static gr_status gr_snow_object_step(gr_snow_deformation *s, int o, double dt) {
     st = GR_SNOW_ARG(s, s->apply, "y_end", cy_end);
   if (st == GR_OK)
     st = gr_enqueue_2d(ctx, s->apply, CX0, CY0, CW, CH, NULL);
+  /* The contour received whole quanta, a little less than given: the rest
+   * waits for the next press (and counts in the ledger meanwhile). */
+  if (st == GR_OK && add_depth > 0.0f) {
+    cl_kernel k = s->added_reduce;
+    double got = 0.0;
+    st = GR_SNOW_ARG(s, k, "overlap", s->overlap);
+    if (st == GR_OK)
+      st = GR_SNOW_ARG(s, k, "weight", s->weight);
+    if (st == GR_OK)
+      st = GR_SNOW_ARG(s, k, "add_depth", add_depth);
+    if (st == GR_OK)
+      st = GR_SNOW_ARG(s, k, "nx", nx);
+    if (st == GR_OK)
+      st = GR_SNOW_ARG(s, k, "x0", cx0);
+    if (st == GR_OK)
+      st = GR_SNOW_ARG(s, k, "y0", cy0);
+    if (st == GR_OK)
+      st = GR_SNOW_ARG(s, k, "w", cw);
+    if (st == GR_OK)
+      st = GR_SNOW_ARG(s, k, "n", cn);
+    if (st == GR_OK)
+      st = gr_reduction_run(ctx, &s->red_added, k, &got, NULL);
+    if (st == GR_OK) {
+      double rest = give - got;
+      s->pending_mass = rest > 0.0 ? rest * add_rho : 0.0;
+      s->pending = rest > 0.0 ? rest : 0.0;
+    }
+  }
   if (st == GR_OK)
     st = gr_snow_mark(s, &s->tm.distribution_ms);
   return st;
+}
+
+/* RelaxTolerance, but at least GR_SNOW_MIN_MOVE (below it an iteration
+ * could move nothing). */
+static float gr_snow_tolerance(const gr_snow_deformation *s) {
+  float tol = (float)s->params.relax_tolerance;
+  return tol > GR_SNOW_MIN_MOVE ? tol : GR_SNOW_MIN_MOVE;
 }
 
 /* The arguments both talus kernels take. */
@@ -1045,7 +1121,7 @@ static gr_status gr_snow_relax_check(gr_snow_deformation *s, int x0, int y0, int
                                      double out[GR_SNOW_CHECK_MAXES]) {
   cl_kernel k = s->check_reduce;
   cl_int nx = s->grid.nx, w = x1 - x0 + 1, cnt = w * (y1 - y0 + 1);
-  float tol = (float)s->params.relax_tolerance;
+  float tol = gr_snow_tolerance(s);
   gr_status st = GR_SNOW_ARG(s, k, "movable", s->movable);
   if (st == GR_OK)
     st = GR_SNOW_ARG(s, k, "nx", nx);
@@ -1089,7 +1165,7 @@ static gr_status gr_snow_relax_check(gr_snow_deformation *s, int x0, int y0, int
 static gr_status gr_snow_relax(gr_snow_deformation *s) {
   gr_context *ctx = s->ctx;
   int nx = s->grid.nx, ny = s->grid.ny;
-  float tol = (float)s->params.relax_tolerance;
+  float tol = gr_snow_tolerance(s);
   gr_status st = GR_OK;
   int it = 0, x0 = nx, x1 = -1, y0 = ny, y1 = -1;
   s->relax_iterations = 0;
@@ -1156,7 +1232,7 @@ static gr_status gr_snow_relax(gr_snow_deformation *s) {
     if (st == GR_OK && it % GR_SNOW_CHECK_EVERY == 0) {
       double m[GR_SNOW_CHECK_MAXES];
       st = gr_snow_relax_check(s, x0, y0, x1, y1, m);
-      if (st == GR_OK && m[0] <= s->params.relax_tolerance)
+      if (st == GR_OK && m[0] <= tol)
         break;
       /* Only the points of the box give in this iteration. The move window
        * may now lie inside the last one, which the buffer the move writes
@@ -1312,6 +1388,9 @@ gr_status gr_snow_deformation_ledger_get(gr_snow_deformation *s, gr_snow_deforma
   out->steps = s->steps;
   out->initial_volume = s->initial_volume;
   out->initial_mass = s->initial_mass;
+  /* Displaced snow waiting for a contour is still snow. */
+  v += s->pending * s->grid.dx * s->grid.dy;
+  m += s->pending_mass * s->grid.dx * s->grid.dy;
   out->snow_volume = v;
   out->snow_mass = m;
   out->compressed_volume = s->compressed;
@@ -1357,7 +1436,7 @@ typedef struct gr_snow_state_header {
   uint32_t magic, version;
   int32_t nx, ny, relax_full, relax_iterations;
   int64_t steps;
-  double time, initial_volume, initial_mass, compressed, displaced;
+  double time, initial_volume, initial_mass, compressed, displaced, pending, pending_mass;
   double force[GR_SNOW_DEFORMATION_MAX_OBJECTS][3], area[GR_SNOW_DEFORMATION_MAX_OBJECTS];
 } gr_snow_state_header;
 
@@ -1405,6 +1484,8 @@ gr_status gr_snow_deformation_state_save(gr_snow_deformation *s, void *host, siz
   hd.initial_mass = s->initial_mass;
   hd.compressed = s->compressed;
   hd.displaced = s->displaced;
+  hd.pending = s->pending;
+  hd.pending_mass = s->pending_mass;
   memcpy(hd.force, s->force, sizeof(hd.force));
   memcpy(hd.area, s->area, sizeof(hd.area));
   memcpy(host, &hd, sizeof(hd));
@@ -1463,6 +1544,8 @@ gr_status gr_snow_deformation_state_load(gr_snow_deformation *s, const void *hos
   s->initial_mass = hd.initial_mass;
   s->compressed = hd.compressed;
   s->displaced = hd.displaced;
+  s->pending = hd.pending;
+  s->pending_mass = hd.pending_mass;
   memcpy(s->force, hd.force, sizeof(hd.force));
   memcpy(s->area, hd.area, sizeof(hd.area));
   return GR_OK;
