@@ -753,13 +753,18 @@ static void test_two_objects(void) {
 /* The trench of a box dragged along y = 1.2 m from x = 0.6 to x0_end at
  * speed * dt per step (a fraction of its 0.6 m length), then lifted off
  * for one more step: surfaces per column. Returns the surface. */
-static float *drag(int steps, double dt, double speed, int *iterations) {
+static float *drag_with(int steps, double dt, double speed, int *iterations, int blocked,
+                        int max_iterations) {
   gr_snow_deformation_params p;
   gr_snow_deformation_params_init(&p);
   p.initial_density = p.max_density; /* dense snow: all of it is displaced */
+  if (max_iterations >= 0)
+    p.max_relax_iterations = max_iterations;
   gr_snow_deformation *s = make_sim(64, 48, 0.05, &p);
   if (!s)
     return NULL;
+  if (blocked >= 0)
+    gr_snow_deformation_set_blocked(s, blocked);
   test_mesh box;
   mesh_box(&box, 0.3, 0.2, 0.25);
   double v[3] = {speed, 0.0, 0.0};
@@ -777,9 +782,40 @@ static float *drag(int steps, double dt, double speed, int *iterations) {
   if (iterations)
     *iterations = most;
   float *h = get(s, GR_FIELD_SNOW_SURFACE, 64 * 48);
+  float *r = get(s, GR_FIELD_SNOW_DENSITY, 64 * 48);
+  h = realloc(h, 2 * 64 * 48 * sizeof(float));
+  if (h && r)
+    memcpy(h + 64 * 48, r, 64 * 48 * sizeof(float)); /* the densities after the surface */
+  free(r);
   mesh_free(&box);
   gr_snow_deformation_destroy(s);
   return h;
+}
+
+static float *drag(int steps, double dt, double speed, int *iterations) {
+  return drag_with(steps, dt, speed, iterations, -1, -1);
+}
+
+/* The talus in blocks of iterations per launch (the GPU's way) and in two
+ * launches per iteration (the CPU's way) give the same bits, converged
+ * (the default cap) or cut short every step (8 iterations). */
+static void test_blocked(void) {
+  for (int cap = 0; cap < 2; ++cap) {
+    int its[2] = {0, 0}, max = cap ? 8 : -1;
+    float *a = drag_with(30, 1.0 / 60.0, 1.5, &its[0], 0, max);
+    float *b = drag_with(30, 1.0 / 60.0, 1.5, &its[1], 1, max);
+    if (!a || !b) {
+      free(a), free(b);
+      return;
+    }
+    int differ = 0;
+    for (int c = 0; c < 2 * 64 * 48; ++c)
+      differ += memcmp(&a[c], &b[c], sizeof(float)) != 0;
+    printf("blocked talus (cap %d): %d of %d values differ; up to %d and %d iterations a step\n",
+           max, differ, 2 * 64 * 48, its[0], its[1]);
+    CHECK(differ == 0 && its[0] == its[1] && its[0] > 4);
+    free(a), free(b);
+  }
 }
 
 /* A trail in dense snow (all of the overlap displaced): every column the
@@ -938,6 +974,7 @@ static const gr_subtest tests[] = {
     {"two_objects", test_two_objects, 0},
     {"trail", test_trail, 0},
     {"time_step", test_time_step, 0},
+    {"blocked", test_blocked, 0},
     {"memcheck", test_memcheck, 1},
 };
 

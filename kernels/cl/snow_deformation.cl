@@ -270,31 +270,98 @@ GR_INLINE float snow_threshold(int di, int dj, float tx, float ty, float td) {
   return (di != 0 && dj != 0) ? td : (di != 0 ? tx : ty);
 }
 
-/* The neighbour of point (i, j) at offset (di, dj): its index, or the
- * point's own index off the grid. A point has no excess over itself (the
- * thresholds are positive), so an edge drops the pair at both of its ends
- * alike, with no branch. */
-GR_INLINE int snow_neighbour(int i, int j, int di, int dj, int nx, int ny) {
-  int a = i + di, b = j + dj;
+/* One talus iteration, per point (the same functions for the one-launch
+ * iteration, snow_relax_rate and snow_relax_move, and for the blocked one,
+ * snow_relax_block, so that both give the same bits). The 8 neighbours come
+ * in the order of GR_SNOW_NEIGHBOUR_DI/DJ; a neighbour off the grid is the
+ * point itself: a point has no excess over itself (the thresholds are
+ * positive), so an edge drops the pair at both of its ends alike.
+ *
+ * The rate: k_out, the factor of every excess the point gives, and k_in,
+ * the factor of every excess it may receive; the pair (a, b) moves
+ * x_ab min(k_out_a, k_in_b). Thermal erosion's bound: a gives at most
+ * GR_SNOW_TALUS_SHARE of its largest excess in all (and never more than it
+ * holds) and b takes at most that share of its largest incoming excess, so
+ * a lone pair levels to the threshold in one iteration and a pit filled
+ * from eight sides at once still does not rise above them. A point gives
+ * only if it is a giver (in the iteration's window) and can move more than
+ * tol, min(S, its largest excess) (mv, for the check): the relaxation ends
+ * when none can, and the points still moving bound the next window. */
+GR_INLINE void snow_rate_at(float s, float g, float u, const float *sn, const float *gn,
+                            const float *un, float tx, float ty, float td, int giver, float tol,
+                            float *k_out, float *k_in, float *mv) {
+  float ha = g + s, sum = 0.0f, big = 0.0f, sum_in = 0.0f, big_in = 0.0f;
+  for (int q = 0; q < 8; ++q) {
+    float hn = gn[q] + sn[q];
+    float thr = snow_threshold(GR_SNOW_NEIGHBOUR_DI(q), GR_SNOW_NEIGHBOUR_DJ(q), tx, ty, td);
+    float x = snow_excess(ha, hn, un[q], thr);
+    sum += x;
+    big = fmax(big, x);
+    if (sn[q] > 0.0f) { /* a neighbour without snow gives nothing */
+      float y = snow_excess(hn, ha, u, thr);
+      sum_in += y;
+      big_in = fmax(big_in, y);
+    }
+  }
+  float m = giver && s > 0.0f ? fmin(s, big) : 0.0f, k = 0.0f;
+  if (m > tol && sum > 0.0f)
+    k = fmin(GR_SNOW_TALUS_SHARE * (big / sum), GR_SNOW_KEEP * s / sum);
+  *k_out = k;
+  *k_in = sum_in > 0.0f ? GR_SNOW_TALUS_SHARE * (big_in / sum_in) : 0.0f;
+  *mv = m;
+}
+
+/* The move: the point gives x_bn min(k_b, k_in_n) to each neighbour n and
+ * receives x_ab min(k_a, k_in_b) (with a's density) from each neighbour a:
+ * the same floats both ways, in whole quanta. */
+GR_INLINE void snow_move_at(float s, float rho, float g, float u, float kb, float kin,
+                            const float *sn, const float *gn, const float *un, const float *rn,
+                            const float *kon, const float *kinn, float tx, float ty, float td,
+                            float *s_out, float *rho_out) {
+  float hb = g + s, out = 0.0f, in = 0.0f, mass_in = 0.0f; /* mass_in: relative to rho */
+  for (int q = 0; q < 8; ++q) {
+    float thr = snow_threshold(GR_SNOW_NEIGHBOUR_DI(q), GR_SNOW_NEIGHBOUR_DJ(q), tx, ty, td);
+    float hn = gn[q] + sn[q];
+    if (kb > 0.0f)
+      out += snow_q(snow_excess(hb, hn, un[q], thr) * fmin(kb, kinn[q]));
+    if (kon[q] > 0.0f && kin > 0.0f) {
+      float f = snow_q(snow_excess(hn, hb, u, thr) * fmin(kon[q], kin));
+      in += f;
+      mass_in += f * (rn[q] - rho);
+    }
+  }
+  /* Whole quanta below 16 m: exact, and out <= S (the rate's bound). */
+  float kept = fmax(0.0f, s - out), s1 = kept + in;
+  *s_out = s1;
+  /* (kept rho + sum f rho_a) / s1 as a change: equal densities stay put. */
+  *rho_out = (in > 0.0f && s1 > 0.0f) ? rho + mass_in / s1 : rho;
+}
+
+/* The index of neighbour q of point (i, j), or the point's own off the
+ * grid. */
+GR_INLINE int snow_neighbour(int i, int j, int q, int nx, int ny) {
+  int a = i + GR_SNOW_NEIGHBOUR_DI(q), b = j + GR_SNOW_NEIGHBOUR_DJ(q);
   return (a < 0 || b < 0 || a >= nx || b >= ny) ? gr_idx(i, j, nx) : gr_idx(a, b, nx);
 }
 
-/* Per point: k_out, the factor of every excess it gives, and k_in, the
- * factor of every excess it may receive; the pair (a, b) moves
- * x_ab min(k_out_a, k_in_b). Thermal erosion's bound: a gives at most
- * GR_SNOW_TALUS_SHARE of its largest excess in all (and never more than it
- * holds) and b takes at most that share of its largest incoming excess, so a
- * lone pair levels to the threshold in one iteration and a pit filled from
- * eight sides at once still does not rise above them. Also what a point could
- * still move, min(S, largest excess), for the convergence test. Givers are
- * the window [gx0, gx_end) x [gy0, gy_end); k_in is written on the whole
- * launch. */
+/* Whether point (i, j) gives in iteration t of a launch whose givers'
+ * window is [gx0, gx_end) x [gy0, gy_end) at its first iteration: the
+ * window grows by one per iteration (snow leaves only its points, so only
+ * points within one of it can have gained an excess). */
+GR_INLINE int snow_giver(int i, int j, int t, int gx0, int gy0, int gx_end, int gy_end) {
+  return i >= gx0 - t && j >= gy0 - t && i < gx_end + t && j < gy_end + t;
+}
+
+/* One-launch iteration t, first half: the rates on the launch (the move
+ * window grown by one, so that every neighbour of a move has one), and
+ * at t = 0 the movable amounts for the check. */
 __kernel void snow_relax_rate(__global const float *restrict ground,
                               __global const float *restrict depth,
                               __global const float *restrict under_min, int nx, int ny, float tx,
                               float ty, float td, float tol, int gx0, int gy0, int gx_end,
-                              int gy_end, int x_end, int y_end, __global float *restrict rate,
-                              __global float *restrict rate_in, __global float *restrict movable) {
+                              int gy_end, int t, int x_end, int y_end,
+                              __global float *restrict rate, __global float *restrict rate_in,
+                              __global float *restrict movable) {
   /* Launched on a window from its offset: the launch is rounded up to the
    * work-group shape (16 x 16 on a GPU), and a point beyond the window's end
    * must not run (its neighbours' rates there are stale). */
@@ -302,37 +369,22 @@ __kernel void snow_relax_rate(__global const float *restrict ground,
   if (!gr_inside(i, j, nx, ny) || i >= x_end || j >= y_end)
     return;
   int c = gr_idx(i, j, nx);
-  float s = depth[c], ha = ground[c] + s, ua = under_min[c];
-  float sum = 0.0f, big = 0.0f, sum_in = 0.0f, big_in = 0.0f;
-  for (int dj = -1; dj <= 1; ++dj)
-    for (int di = -1; di <= 1; ++di) {
-      if ((di | dj) == 0)
-        continue;
-      int n = snow_neighbour(i, j, di, dj, nx, ny);
-      float sn = depth[n], hn = ground[n] + sn, thr = snow_threshold(di, dj, tx, ty, td);
-      float x = snow_excess(ha, hn, under_min[n], thr);
-      sum += x;
-      big = fmax(big, x);
-      if (sn > 0.0f) { /* a neighbour without snow gives nothing */
-        float y = snow_excess(hn, ha, ua, thr);
-        sum_in += y;
-        big_in = fmax(big_in, y);
-      }
-    }
-  int giver = i >= gx0 && j >= gy0 && i < gx_end && j < gy_end;
-  float mv = giver && s > 0.0f ? fmin(s, big) : 0.0f, k = 0.0f;
-  /* Only a point that can move more than tol gives: the relaxation ends
-   * when none can, and the points still moving bound the next window. */
-  if (mv > tol && sum > 0.0f)
-    k = fmin(GR_SNOW_TALUS_SHARE * (big / sum), GR_SNOW_KEEP * s / sum);
+  float sn[8], gn[8], un[8], k, kin, mv;
+  for (int q = 0; q < 8; ++q) {
+    int m = snow_neighbour(i, j, q, nx, ny);
+    sn[q] = depth[m];
+    gn[q] = ground[m];
+    un[q] = under_min[m];
+  }
+  snow_rate_at(depth[c], ground[c], under_min[c], sn, gn, un, tx, ty, td,
+               snow_giver(i, j, t, gx0, gy0, gx_end, gy_end), tol, &k, &kin, &mv);
   rate[c] = k;
-  rate_in[c] = sum_in > 0.0f ? GR_SNOW_TALUS_SHARE * (big_in / sum_in) : 0.0f;
-  movable[c] = mv;
+  rate_in[c] = kin;
+  if (t == 0)
+    movable[c] = mv;
 }
 
-/* Per point b: gives x_bn min(k_b, k_in_n) to each neighbour n and receives
- * x_ab min(k_a, k_in_b) (with a's density) from each neighbour a; the same
- * floats both ways. */
+/* One-launch iteration, second half: the moves, on the move window. */
 __kernel void
 snow_relax_move(__global const float *restrict ground, __global const float *restrict depth,
                 __global const float *restrict density, __global const float *restrict under_min,
@@ -343,30 +395,121 @@ snow_relax_move(__global const float *restrict ground, __global const float *res
   if (!gr_inside(i, j, nx, ny) || i >= x_end || j >= y_end)
     return; /* beyond the window (see snow_relax_rate) */
   int c = gr_idx(i, j, nx);
-  float s = depth[c], rho = density[c], hb = ground[c] + s, ub = under_min[c], kb = rate[c],
-        kin = rate_in[c];
-  float out = 0.0f, in = 0.0f, mass_in = 0.0f; /* mass_in: relative to rho */
-  for (int dj = -1; dj <= 1; ++dj)
-    for (int di = -1; di <= 1; ++di) {
-      if ((di | dj) == 0)
-        continue;
-      int n = snow_neighbour(i, j, di, dj, nx, ny);
-      float thr = snow_threshold(di, dj, tx, ty, td);
-      float hn = ground[n] + depth[n];
-      if (kb > 0.0f)
-        out += snow_q(snow_excess(hb, hn, under_min[n], thr) * fmin(kb, rate_in[n]));
-      float ka = rate[n];
-      if (ka > 0.0f && kin > 0.0f) {
-        float f = snow_q(snow_excess(hn, hb, ub, thr) * fmin(ka, kin));
-        in += f;
-        mass_in += f * (density[n] - rho);
-      }
-    }
-  /* Whole quanta below 16 m: exact, and out <= S (the rate's bound). */
-  float kept = fmax(0.0f, s - out), s1 = kept + in;
+  float sn[8], gn[8], un[8], rn[8], kon[8], kinn[8], s1, r1;
+  for (int q = 0; q < 8; ++q) {
+    int m = snow_neighbour(i, j, q, nx, ny);
+    sn[q] = depth[m];
+    gn[q] = ground[m];
+    un[q] = under_min[m];
+    rn[q] = density[m];
+    kon[q] = rate[m];
+    kinn[q] = rate_in[m];
+  }
+  snow_move_at(depth[c], density[c], ground[c], under_min[c], rate[c], rate_in[c], sn, gn, un, rn,
+               kon, kinn, tx, ty, td, &s1, &r1);
   depth_out[c] = s1;
-  /* (kept rho + sum f rho_a) / s1 as a change: equal densities stay put. */
-  density_out[c] = (in > 0.0f && s1 > 0.0f) ? rho + mass_in / s1 : rho;
+  density_out[c] = r1;
+}
+
+/* The talus, GR_SNOW_BLOCK_ITERATIONS iterations per launch (temporal
+ * blocking, for GPUs, where a launch costs more than its work): a
+ * work-group loads its tile of lx x ly points and a halo of 2 per iteration
+ * into local memory, iterates there, and writes the tile back. A point's
+ * move depends on points two away (its rate on its neighbours' heights,
+ * its move on its neighbours' rates), so after k iterations the tile is
+ * still exact while the halo goes stale from its edge inwards, two a step.
+ * The same functions as the one-launch iteration: the same bits.
+ *
+ * Local memory: 8 planes of (lx + 4 K) x (ly + 4 K) floats (K =
+ * GR_SNOW_BLOCK_ITERATIONS): ground, lowest underside, depth and density
+ * (two of each, ping-pong), k_out, k_in. The launch covers the move window
+ * [its offset, x_end) x [.., y_end): only points there are written. */
+__kernel void
+snow_relax_block(__global const float *restrict ground, __global const float *restrict depth,
+                 __global const float *restrict density, __global const float *restrict under_min,
+                 int nx, int ny, float tx, float ty, float td, float tol, int gx0, int gy0,
+                 int gx_end, int gy_end, int x_end, int y_end, int iters,
+                 __global float *restrict depth_out, __global float *restrict density_out,
+                 __global float *restrict movable, __local float *restrict lmem) {
+  const int lx = get_local_size(0), ly = get_local_size(1), halo = 2 * GR_SNOW_BLOCK_ITERATIONS;
+  const int w = lx + 2 * halo, h = ly + 2 * halo, n = w * h;
+  /* The grid point of local (0, 0). */
+  const int ox = (int)get_global_offset(0) + (int)get_group_id(0) * lx - halo;
+  const int oy = (int)get_global_offset(1) + (int)get_group_id(1) * ly - halo;
+  const int lid = (int)get_local_id(1) * lx + (int)get_local_id(0), wg = lx * ly;
+  __local float *G = lmem, *U = G + n, *S = U + n, *R = S + n, *S2 = R + n, *R2 = S2 + n,
+                *KO = R2 + n, *KI = KO + n;
+  for (int q = lid; q < n; q += wg) {
+    int i = ox + q % w, j = oy + q / w;
+    int on = i >= 0 && j >= 0 && i < nx && j < ny;
+    int c = on ? gr_idx(i, j, nx) : 0;
+    G[q] = on ? ground[c] : 0.0f;
+    U[q] = on ? under_min[c] : INFINITY;
+    S[q] = on ? depth[c] : 0.0f;
+    R[q] = on ? density[c] : 0.0f;
+    KO[q] = KI[q] = 0.0f;
+  }
+  barrier(CLK_LOCAL_MEM_FENCE);
+  for (int t = 0; t < iters; ++t) {
+    for (int q = lid; q < n; q += wg) {
+      int a = q % w, b = q / w, i = ox + a, j = oy + b;
+      if (a < 1 || b < 1 || a >= w - 1 || b >= h - 1 || i < 0 || j < 0 || i >= nx || j >= ny)
+        continue;
+      float sn[8], gn[8], un[8], k, kin, mv;
+      for (int e = 0; e < 8; ++e) {
+        int di = GR_SNOW_NEIGHBOUR_DI(e), dj = GR_SNOW_NEIGHBOUR_DJ(e);
+        int off = i + di < 0 || j + dj < 0 || i + di >= nx || j + dj >= ny;
+        int m = off ? q : q + dj * w + di;
+        sn[e] = S[m];
+        gn[e] = G[m];
+        un[e] = U[m];
+      }
+      snow_rate_at(S[q], G[q], U[q], sn, gn, un, tx, ty, td,
+                   snow_giver(i, j, t, gx0, gy0, gx_end, gy_end), tol, &k, &kin, &mv);
+      KO[q] = k;
+      KI[q] = kin;
+      if (t == 0 && a >= halo && b >= halo && a < halo + lx && b < halo + ly && i < x_end &&
+          j < y_end)
+        movable[gr_idx(i, j, nx)] = mv;
+    }
+    barrier(CLK_LOCAL_MEM_FENCE);
+    for (int q = lid; q < n; q += wg) {
+      int a = q % w, b = q / w, i = ox + a, j = oy + b;
+      if (a < 1 || b < 1 || a >= w - 1 || b >= h - 1 || i < 0 || j < 0 || i >= nx || j >= ny)
+        continue;
+      float sn[8], gn[8], un[8], rn[8], kon[8], kinn[8], s1, r1;
+      for (int e = 0; e < 8; ++e) {
+        int di = GR_SNOW_NEIGHBOUR_DI(e), dj = GR_SNOW_NEIGHBOUR_DJ(e);
+        int off = i + di < 0 || j + dj < 0 || i + di >= nx || j + dj >= ny;
+        int m = off ? q : q + dj * w + di;
+        sn[e] = S[m];
+        gn[e] = G[m];
+        un[e] = U[m];
+        rn[e] = R[m];
+        kon[e] = KO[m];
+        kinn[e] = KI[m];
+      }
+      snow_move_at(S[q], R[q], G[q], U[q], KO[q], KI[q], sn, gn, un, rn, kon, kinn, tx, ty, td, &s1,
+                   &r1);
+      S2[q] = s1;
+      R2[q] = r1;
+    }
+    barrier(CLK_LOCAL_MEM_FENCE);
+    __local float *swap = S;
+    S = S2;
+    S2 = swap;
+    swap = R;
+    R = R2;
+    R2 = swap;
+  }
+  for (int q = lid; q < lx * ly; q += wg) {
+    int a = halo + q % lx, b = halo + q / lx, i = ox + a, j = oy + b;
+    if (i >= nx || j >= ny || i >= x_end || j >= y_end)
+      continue;
+    int c = gr_idx(i, j, nx), m = b * w + a;
+    depth_out[c] = S[m];
+    density_out[c] = R[m];
+  }
 }
 
 /* The largest movable amount on the window [x0, x0 + w) x [y0, y0 + h)

@@ -29,10 +29,15 @@
 #define GR_SNOW_LEDGER_SUMS 2
 #define GR_SNOW_CHECK_MAXES 5
 
-/* The talus check (the largest movable amount, and the box of the points
- * still moving, which becomes the window) runs every this many
- * iterations. */
-#define GR_SNOW_CHECK_EVERY 4
+/* Talus iterations per launch of snow_relax_block (temporal blocking);
+ * the check (the largest movable amount, and the box of the points still
+ * moving, which becomes the window) runs after every launch. */
+#define GR_SNOW_BLOCK_ITERATIONS 4
+
+/* The 8 neighbours' offsets, in the order the talus adds them up:
+ * row by row from (-1, -1), the point itself left out. */
+#define GR_SNOW_NEIGHBOUR_DI(q) ((q) < 3 ? (q)-1 : (q) < 5 ? 2 * ((q)-3) - 1 : (q)-6)
+#define GR_SNOW_NEIGHBOUR_DJ(q) ((q) < 3 ? -1 : (q) < 5 ? 0 : 1)
 
 /* The quantum of snow depth, 2^-20 m (about 1 micrometre). Depths and
  * every amount of snow that moves (pressed, displaced, deposited, slid) are

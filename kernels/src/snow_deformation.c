@@ -63,13 +63,15 @@ struct gr_snow_deformation {
   gr_context *ctx;
   gr_grid grid;
   gr_snow_deformation_params params;
-  cl_kernel raster, overlap_k, contour, obj_reduce, apply, relax_rate, relax_move, check_reduce,
-      ledger_reduce, surface, reset, added_reduce, quantize;
+  cl_kernel raster, overlap_k, contour, obj_reduce, apply, relax_rate, relax_move, relax_block,
+      check_reduce, ledger_reduce, surface, reset, added_reduce, quantize;
   cl_mem depth[2], density[2]; /* [cur] is the state */
   int cur;
   cl_mem ground, depth0, density0, under, overlap, weight, overlap_sum, contact, under_min, rate,
       rate_in, movable, scratch;
-  cl_mem tri; /* world triangles, 9 floats each */
+  size_t block[2]; /* the blocked talus launch's work-group: its tile of points */
+  int blocked;     /* the talus in blocked launches (GPUs) or one launch per iteration */
+  cl_mem tri;      /* world triangles, 9 floats each */
   size_t tri_cap;
   /* The raster's bins: tile t of all objects lists the triangles
    * tri_list[tile_start[t] .. tile_start[t + 1]) that may cover its points. */
@@ -201,6 +203,11 @@ static gr_status gr_snow_mark(gr_snow_deformation *s, double *acc) {
   return st;
 }
 
+void gr_snow_deformation_set_blocked(gr_snow_deformation *s, int on) {
+  if (s)
+    s->blocked = on != 0;
+}
+
 void gr_snow_deformation_set_timing(gr_snow_deformation *s, int on) {
   if (!s)
     return;
@@ -306,6 +313,39 @@ static gr_status gr_snow_initial_state(gr_snow_deformation *s) {
   return st;
 }
 
+/* The talus launch's tile: 32 x 32 points on a CPU (its halo, 2 per
+ * iteration on each side, then costs about as much again), 16 x 16 on a
+ * GPU, smaller where the kernel's work-group or the local memory (8
+ * planes of the tile and halo) does not allow it. */
+static gr_status gr_snow_block_shape(gr_snow_deformation *s) {
+  cl_device_id dev = gr_context_device(s->ctx);
+  cl_device_type type = 0;
+  cl_ulong local_mem = 0;
+  size_t wg = 0;
+  cl_int err = clGetDeviceInfo(dev, CL_DEVICE_TYPE, sizeof(type), &type, NULL);
+  if (err == CL_SUCCESS)
+    err = clGetDeviceInfo(dev, CL_DEVICE_LOCAL_MEM_SIZE, sizeof(local_mem), &local_mem, NULL);
+  if (err == CL_SUCCESS)
+    err = clGetKernelWorkGroupInfo(s->relax_block, dev, CL_KERNEL_WORK_GROUP_SIZE, sizeof(wg), &wg,
+                                   NULL);
+  if (err != CL_SUCCESS)
+    return gr_cl_check(s->ctx, err, "Querying the device for the talus kernel's work-group");
+  size_t t = (type & CL_DEVICE_TYPE_GPU) ? 16 : 64;
+  for (; t > 1; t /= 2) {
+    size_t side = t + 4 * GR_SNOW_BLOCK_ITERATIONS;
+    if (t * t <= wg && 8 * side * side * sizeof(cl_float) <= local_mem)
+      break;
+  }
+  if (t < 4)
+    return gr_set_error(s->ctx, GR_ERR_TOO_LARGE,
+                        "The OpenCL device offers too little local memory (%llu bytes) or too "
+                        "small work-groups (%zu) for the snow talus kernel; pick another device.",
+                        (unsigned long long)local_mem, wg);
+  s->block[0] = s->block[1] = t;
+  s->blocked = (type & CL_DEVICE_TYPE_GPU) != 0;
+  return GR_OK;
+}
+
 gr_status gr_snow_deformation_create(gr_context *ctx, const gr_grid *grid,
                                      const gr_snow_deformation_params *p,
                                      gr_snow_deformation **out) {
@@ -351,6 +391,7 @@ gr_status gr_snow_deformation_create(gr_context *ctx, const gr_grid *grid,
             {"snow_apply", &s->apply},
             {"snow_relax_rate", &s->relax_rate},
             {"snow_relax_move", &s->relax_move},
+            {"snow_relax_block", &s->relax_block},
             {"snow_check_reduce", &s->check_reduce},
             {"snow_ledger_reduce", &s->ledger_reduce},
             {"snow_surface", &s->surface},
@@ -365,6 +406,8 @@ gr_status gr_snow_deformation_create(gr_context *ctx, const gr_grid *grid,
                     &s->movable,     &s->scratch};
   for (size_t i = 0; st == GR_OK && i < sizeof(bufs) / sizeof(bufs[0]); ++i)
     st = gr_buffer_create(ctx, CL_MEM_READ_WRITE, bytes, NULL, bufs[i]);
+  if (st == GR_OK)
+    st = gr_snow_block_shape(s);
   if (st == GR_OK)
     st = gr_reduction_init(ctx, s->obj_reduce, cells, GR_SNOW_OBJ_SUMS, 0, &s->red_obj);
   if (st == GR_OK)
@@ -396,9 +439,10 @@ gr_status gr_snow_deformation_create(gr_context *ctx, const gr_grid *grid,
 void gr_snow_deformation_destroy(gr_snow_deformation *s) {
   if (!s)
     return;
-  cl_kernel ks[] = {s->raster,     s->overlap_k,    s->contour,      s->obj_reduce,    s->apply,
-                    s->relax_rate, s->relax_move,   s->check_reduce, s->ledger_reduce, s->surface,
-                    s->reset,      s->added_reduce, s->quantize};
+  cl_kernel ks[] = {s->raster,       s->overlap_k,     s->contour,    s->obj_reduce,
+                    s->apply,        s->relax_rate,    s->relax_move, s->relax_block,
+                    s->check_reduce, s->ledger_reduce, s->surface,    s->reset,
+                    s->added_reduce, s->quantize};
   for (size_t i = 0; i < sizeof(ks) / sizeof(ks[0]); ++i)
     if (ks[i])
       clReleaseKernel(ks[i]);
@@ -1086,34 +1130,6 @@ static float gr_snow_tolerance(const gr_snow_deformation *s) {
   return tol > GR_SNOW_MIN_MOVE ? tol : GR_SNOW_MIN_MOVE;
 }
 
-/* The arguments both talus kernels take. */
-static gr_status gr_snow_relax_args(gr_snow_deformation *s, cl_kernel k) {
-  int nx = s->grid.nx, ny = s->grid.ny;
-  double dx = s->grid.dx, dy = s->grid.dy, slope = s->params.max_slope;
-  float tx = (float)(slope * dx), ty = (float)(slope * dy),
-        td = (float)(slope * sqrt(dx * dx + dy * dy));
-  gr_status st = GR_SNOW_ARG(s, k, "ground", s->ground);
-  if (st == GR_OK)
-    st = GR_SNOW_ARG(s, k, "depth", s->depth[s->cur]);
-  if (st == GR_OK)
-    st = GR_SNOW_ARG(s, k, "under_min", s->under_min);
-  if (st == GR_OK)
-    st = GR_SNOW_ARG(s, k, "nx", nx);
-  if (st == GR_OK)
-    st = GR_SNOW_ARG(s, k, "ny", ny);
-  if (st == GR_OK)
-    st = GR_SNOW_ARG(s, k, "tx", tx);
-  if (st == GR_OK)
-    st = GR_SNOW_ARG(s, k, "ty", ty);
-  if (st == GR_OK)
-    st = GR_SNOW_ARG(s, k, "td", td);
-  if (st == GR_OK)
-    st = GR_SNOW_ARG(s, k, "rate", s->rate);
-  if (st == GR_OK)
-    st = GR_SNOW_ARG(s, k, "rate_in", s->rate_in);
-  return st;
-}
-
 /* The check: the largest amount a point of the givers' window R can still
  * move, and the box of the points that can move more than the tolerance
  * (out[1..4]: -x0, x1, -y0, y1). */
@@ -1140,30 +1156,157 @@ static gr_status gr_snow_relax_check(gr_snow_deformation *s, int x0, int y0, int
   return st;
 }
 
+/* The talus thresholds: MaxSlope times the distance along x, y and the
+ * diagonal. */
+static void gr_snow_thresholds(const gr_snow_deformation *s, float thr[3]) {
+  double slope = s->params.max_slope, dx = s->grid.dx, dy = s->grid.dy;
+  thr[0] = (float)(slope * dx);
+  thr[1] = (float)(slope * dy);
+  thr[2] = (float)(slope * sqrt(dx * dx + dy * dy));
+}
+
+/* A named kernel argument. */
+typedef struct gr_snow_arg {
+  const char *name;
+  size_t size;
+  const void *value;
+} gr_snow_arg;
+
+static gr_status gr_snow_args(gr_snow_deformation *s, cl_kernel k, const gr_snow_arg *args,
+                              size_t n) {
+  gr_status st = GR_OK;
+  for (size_t q = 0; st == GR_OK && q < n; ++q)
+    st = gr_kernel_arg(s->ctx, k, args[q].name, args[q].size, args[q].value);
+  return st;
+}
+
+/* Iteration t of a launch whose givers' window at t = 0 is [gx0, gx_end) x
+ * [gy0, gy_end), in two launches: the rates on the window grown by t + 2,
+ * the moves on it grown by t + 1; the state flips buffers. */
+static gr_status gr_snow_relax_once(gr_snow_deformation *s, cl_int gx0, cl_int gy0, cl_int gx_end,
+                                    cl_int gy_end, cl_int t, float tol) {
+  cl_int nx = s->grid.nx, ny = s->grid.ny, nxt = 1 - s->cur;
+  float thr[3];
+  gr_snow_thresholds(s, thr);
+  cl_int rx0 = gx0 - t - 2 > 0 ? gx0 - t - 2 : 0, ry0 = gy0 - t - 2 > 0 ? gy0 - t - 2 : 0;
+  cl_int rx_end = gx_end + t + 2 < nx ? gx_end + t + 2 : nx,
+         ry_end = gy_end + t + 2 < ny ? gy_end + t + 2 : ny;
+  cl_int mx0 = gx0 - t - 1 > 0 ? gx0 - t - 1 : 0, my0 = gy0 - t - 1 > 0 ? gy0 - t - 1 : 0;
+  cl_int mx_end = gx_end + t + 1 < nx ? gx_end + t + 1 : nx,
+         my_end = gy_end + t + 1 < ny ? gy_end + t + 1 : ny;
+  const gr_snow_arg rate[] = {{"ground", sizeof(cl_mem), &s->ground},
+                              {"depth", sizeof(cl_mem), &s->depth[s->cur]},
+                              {"under_min", sizeof(cl_mem), &s->under_min},
+                              {"nx", sizeof(nx), &nx},
+                              {"ny", sizeof(ny), &ny},
+                              {"tx", sizeof(float), &thr[0]},
+                              {"ty", sizeof(float), &thr[1]},
+                              {"td", sizeof(float), &thr[2]},
+                              {"tol", sizeof(tol), &tol},
+                              {"gx0", sizeof(gx0), &gx0},
+                              {"gy0", sizeof(gy0), &gy0},
+                              {"gx_end", sizeof(gx_end), &gx_end},
+                              {"gy_end", sizeof(gy_end), &gy_end},
+                              {"t", sizeof(t), &t},
+                              {"x_end", sizeof(rx_end), &rx_end},
+                              {"y_end", sizeof(ry_end), &ry_end},
+                              {"rate", sizeof(cl_mem), &s->rate},
+                              {"rate_in", sizeof(cl_mem), &s->rate_in},
+                              {"movable", sizeof(cl_mem), &s->movable}};
+  gr_status st = gr_snow_args(s, s->relax_rate, rate, sizeof(rate) / sizeof(rate[0]));
+  if (st == GR_OK)
+    st = gr_enqueue_2d(s->ctx, s->relax_rate, (size_t)rx0, (size_t)ry0, (size_t)(rx_end - rx0),
+                       (size_t)(ry_end - ry0), NULL);
+  const gr_snow_arg move[] = {{"ground", sizeof(cl_mem), &s->ground},
+                              {"depth", sizeof(cl_mem), &s->depth[s->cur]},
+                              {"density", sizeof(cl_mem), &s->density[s->cur]},
+                              {"under_min", sizeof(cl_mem), &s->under_min},
+                              {"rate", sizeof(cl_mem), &s->rate},
+                              {"rate_in", sizeof(cl_mem), &s->rate_in},
+                              {"nx", sizeof(nx), &nx},
+                              {"ny", sizeof(ny), &ny},
+                              {"tx", sizeof(float), &thr[0]},
+                              {"ty", sizeof(float), &thr[1]},
+                              {"td", sizeof(float), &thr[2]},
+                              {"x_end", sizeof(mx_end), &mx_end},
+                              {"y_end", sizeof(my_end), &my_end},
+                              {"depth_out", sizeof(cl_mem), &s->depth[nxt]},
+                              {"density_out", sizeof(cl_mem), &s->density[nxt]}};
+  if (st == GR_OK)
+    st = gr_snow_args(s, s->relax_move, move, sizeof(move) / sizeof(move[0]));
+  if (st == GR_OK)
+    st = gr_enqueue_2d(s->ctx, s->relax_move, (size_t)mx0, (size_t)my0, (size_t)(mx_end - mx0),
+                       (size_t)(my_end - my0), NULL);
+  if (st == GR_OK)
+    s->cur = nxt;
+  return st;
+}
+
+/* iters iterations in one launch of snow_relax_block over the move window
+ * [mx0, mx_end) x [my0, my_end); the state flips buffers. */
+static gr_status gr_snow_relax_blocked(gr_snow_deformation *s, cl_int gx0, cl_int gy0,
+                                       cl_int gx_end, cl_int gy_end, cl_int mx0, cl_int my0,
+                                       cl_int mx_end, cl_int my_end, cl_int iters, float tol) {
+  cl_int nx = s->grid.nx, ny = s->grid.ny, nxt = 1 - s->cur;
+  float thr[3];
+  gr_snow_thresholds(s, thr);
+  size_t bw = s->block[0], bh = s->block[1];
+  size_t lbytes = 8 * (bw + 4 * GR_SNOW_BLOCK_ITERATIONS) * (bh + 4 * GR_SNOW_BLOCK_ITERATIONS) *
+                  sizeof(cl_float);
+  const gr_snow_arg args[] = {{"ground", sizeof(cl_mem), &s->ground},
+                              {"depth", sizeof(cl_mem), &s->depth[s->cur]},
+                              {"density", sizeof(cl_mem), &s->density[s->cur]},
+                              {"under_min", sizeof(cl_mem), &s->under_min},
+                              {"nx", sizeof(nx), &nx},
+                              {"ny", sizeof(ny), &ny},
+                              {"tx", sizeof(float), &thr[0]},
+                              {"ty", sizeof(float), &thr[1]},
+                              {"td", sizeof(float), &thr[2]},
+                              {"tol", sizeof(tol), &tol},
+                              {"gx0", sizeof(gx0), &gx0},
+                              {"gy0", sizeof(gy0), &gy0},
+                              {"gx_end", sizeof(gx_end), &gx_end},
+                              {"gy_end", sizeof(gy_end), &gy_end},
+                              {"x_end", sizeof(mx_end), &mx_end},
+                              {"y_end", sizeof(my_end), &my_end},
+                              {"iters", sizeof(iters), &iters},
+                              {"depth_out", sizeof(cl_mem), &s->depth[nxt]},
+                              {"density_out", sizeof(cl_mem), &s->density[nxt]},
+                              {"movable", sizeof(cl_mem), &s->movable},
+                              {"lmem", lbytes, NULL}};
+  const size_t local[2] = {bw, bh};
+  gr_status st = gr_snow_args(s, s->relax_block, args, sizeof(args) / sizeof(args[0]));
+  if (st == GR_OK)
+    st = gr_enqueue_2d(s->ctx, s->relax_block, (size_t)mx0, (size_t)my0, (size_t)(mx_end - mx0),
+                       (size_t)(my_end - my0), local);
+  if (st == GR_OK)
+    s->cur = nxt;
+  return st;
+}
+
 /* Talus relaxation on a window that follows the snow that can move.
  *
  * The window: the givers R (at first the objects' boxes grown by the
  * contour ring, or the whole grid after the snow or the ground was set:
- * relax_full); the moves run on R grown by one (the points that only
- * receive), the rates on R grown by two (every neighbour of a move has a
- * rate of this iteration). Snow leaves only points of R, so after an
- * iteration only points within one of R changed, and only those and their
- * neighbours can have gained an excess: R grows by one per iteration.
- * Every GR_SNOW_CHECK_EVERY iterations the check reads the largest amount
- * a point can still move (the end when it is at most RelaxTolerance) and
- * the box of the points that can move more; only those give (a point gives
- * only while it can move more than RelaxTolerance), so R shrinks to that
- * box. The window decides what is computed, never the result: a run from
- * the whole grid ends bit for bit where a run from the objects' boxes does
- * when the rest was relaxed.
+ * relax_full). Snow leaves only points of R, so after an iteration only
+ * points within one of R changed, and only those and their neighbours can
+ * have gained an excess: R grows by one per iteration. A launch of
+ * snow_relax_block runs GR_SNOW_BLOCK_ITERATIONS iterations and writes the
+ * moves' window, R grown by that many. Then the check reads the first
+ * iteration's largest movable amount (the end when it is at most
+ * RelaxTolerance: then nothing moved in the launch) and the box of the
+ * points that could move more; only those gave (a point gives only while
+ * it can move more than RelaxTolerance), so R shrinks to that box grown by
+ * the iterations run. The window decides what is computed, never the
+ * result: a run from the whole grid ends bit for bit where a run from the
+ * objects' boxes does when the rest was relaxed.
  *
- * The pair of buffers: the moves write the other buffer on their window
- * only, so outside it the other buffer must equal the state. That holds at
- * the start of a step but where the objects pressed (synchronised first),
- * and is restored after a window shrinks and at the end (the last move
- * window copied across). */
+ * The pair of buffers: a launch writes the other buffer on its window only,
+ * so outside it the other buffer must equal the state. That holds at the
+ * start of a step but where the objects pressed (synchronised first), and
+ * is restored when a window does not cover the last one and at the end (the
+ * last window copied across). */
 static gr_status gr_snow_relax(gr_snow_deformation *s) {
-  gr_context *ctx = s->ctx;
   int nx = s->grid.nx, ny = s->grid.ny;
   float tol = gr_snow_tolerance(s);
   gr_status st = GR_OK;
@@ -1199,76 +1342,47 @@ static gr_status gr_snow_relax(gr_snow_deformation *s) {
   else
     st = gr_snow_sync_rect(s, x0, y0, x1, y1);
   s->relax_full = s->sync_full = 0;
-  int lx0 = 0, ly0 = 0, lx1 = -1, ly1 = -1; /* the last move window */
+  int lx0 = 0, ly0 = 0, lx1 = -1, ly1 = -1; /* the last launch's window */
   while (st == GR_OK && it < s->params.max_relax_iterations) {
+    int left = s->params.max_relax_iterations - it;
+    cl_int iters = left < GR_SNOW_BLOCK_ITERATIONS ? left : GR_SNOW_BLOCK_ITERATIONS;
     x0 = x0 > 0 ? x0 : 0;
     y0 = y0 > 0 ? y0 : 0;
     x1 = x1 < nx - 1 ? x1 : nx - 1;
     y1 = y1 < ny - 1 ? y1 : ny - 1;
     cl_int gx0 = x0, gy0 = y0, gx_end = x1 + 1, gy_end = y1 + 1;
-    cl_int rx0 = x0 > 1 ? x0 - 2 : 0, ry0 = y0 > 1 ? y0 - 2 : 0;
-    cl_int rx_end = x1 + 3 < nx ? x1 + 3 : nx, ry_end = y1 + 3 < ny ? y1 + 3 : ny;
-    cl_kernel k = s->relax_rate;
-    st = gr_snow_relax_args(s, k);
+    /* The launch's window: R grown by the iterations. */
+    int mx0 = x0 - iters > 0 ? x0 - iters : 0, my0 = y0 - iters > 0 ? y0 - iters : 0;
+    cl_int mx_end = x1 + iters + 1 < nx ? x1 + iters + 1 : nx,
+           my_end = y1 + iters + 1 < ny ? y1 + iters + 1 : ny;
+    /* The buffer the first write goes to lags the state on the last
+     * window; it must not where that write does not reach: all of the
+     * launch's window in one blocked launch, R grown by one in the first of
+     * the one-launch iterations (each later one covers its predecessor's). */
+    int grow = s->blocked ? iters : 1;
+    int fx0 = x0 - grow > 0 ? x0 - grow : 0, fy0 = y0 - grow > 0 ? y0 - grow : 0;
+    int fx1 = x1 + grow < nx - 1 ? x1 + grow : nx - 1,
+        fy1 = y1 + grow < ny - 1 ? y1 + grow : ny - 1;
+    if (lx0 < fx0 || ly0 < fy0 || lx1 > fx1 || ly1 > fy1)
+      st = gr_snow_sync_rect(s, lx0, ly0, lx1, ly1);
+    if (st == GR_OK && s->blocked)
+      st = gr_snow_relax_blocked(s, gx0, gy0, gx_end, gy_end, mx0, my0, mx_end, my_end, iters, tol);
+    for (cl_int t = 0; st == GR_OK && !s->blocked && t < iters; ++t)
+      st = gr_snow_relax_once(s, gx0, gy0, gx_end, gy_end, t, tol);
     if (st == GR_OK)
-      st = GR_SNOW_ARG(s, k, "movable", s->movable);
-    if (st == GR_OK)
-      st = GR_SNOW_ARG(s, k, "tol", tol);
-    if (st == GR_OK)
-      st = GR_SNOW_ARG(s, k, "gx0", gx0);
-    if (st == GR_OK)
-      st = GR_SNOW_ARG(s, k, "gy0", gy0);
-    if (st == GR_OK)
-      st = GR_SNOW_ARG(s, k, "gx_end", gx_end);
-    if (st == GR_OK)
-      st = GR_SNOW_ARG(s, k, "gy_end", gy_end);
-    if (st == GR_OK)
-      st = GR_SNOW_ARG(s, k, "x_end", rx_end);
-    if (st == GR_OK)
-      st = GR_SNOW_ARG(s, k, "y_end", ry_end);
-    if (st == GR_OK)
-      st = gr_enqueue_2d(ctx, k, (size_t)rx0, (size_t)ry0, (size_t)(rx_end - rx0),
-                         (size_t)(ry_end - ry0), NULL);
-    if (st == GR_OK && it % GR_SNOW_CHECK_EVERY == 0) {
-      double m[GR_SNOW_CHECK_MAXES];
-      st = gr_snow_relax_check(s, x0, y0, x1, y1, m);
-      if (st == GR_OK && m[0] <= tol)
-        break;
-      /* Only the points of the box give in this iteration. The move window
-       * may now lie inside the last one, which the buffer the move writes
-       * does not hold yet. */
-      if (st == GR_OK) {
-        x0 = (int)-m[1], x1 = (int)m[2], y0 = (int)-m[3], y1 = (int)m[4];
-        st = gr_snow_sync_rect(s, lx0, ly0, lx1, ly1);
-      }
-    }
-    cl_int mx0 = x0 > 0 ? x0 - 1 : 0, my0 = y0 > 0 ? y0 - 1 : 0;
-    cl_int mx_end = x1 + 2 < nx ? x1 + 2 : nx, my_end = y1 + 2 < ny ? y1 + 2 : ny;
-    k = s->relax_move;
-    int nxt = 1 - s->cur;
-    if (st == GR_OK)
-      st = gr_snow_relax_args(s, k);
-    if (st == GR_OK)
-      st = GR_SNOW_ARG(s, k, "density", s->density[s->cur]);
-    if (st == GR_OK)
-      st = GR_SNOW_ARG(s, k, "depth_out", s->depth[nxt]);
-    if (st == GR_OK)
-      st = GR_SNOW_ARG(s, k, "density_out", s->density[nxt]);
-    if (st == GR_OK)
-      st = GR_SNOW_ARG(s, k, "x_end", mx_end);
-    if (st == GR_OK)
-      st = GR_SNOW_ARG(s, k, "y_end", my_end);
-    if (st == GR_OK)
-      st = gr_enqueue_2d(ctx, k, (size_t)mx0, (size_t)my0, (size_t)(mx_end - mx0),
-                         (size_t)(my_end - my0), NULL);
-    if (st == GR_OK) {
-      s->cur = nxt;
       lx0 = mx0, ly0 = my0, lx1 = mx_end - 1, ly1 = my_end - 1;
+    double m[GR_SNOW_CHECK_MAXES];
+    if (st == GR_OK)
+      st = gr_snow_relax_check(s, x0, y0, x1, y1, m);
+    if (st == GR_OK && m[0] <= tol)
+      break; /* nothing could move: the launch changed nothing */
+    if (st == GR_OK) {
+      it += iters;
+      x0 = (int)-m[1] - iters, x1 = (int)m[2] + iters;
+      y0 = (int)-m[3] - iters, y1 = (int)m[4] + iters;
     }
-    ++it;
-    --x0, --y0, ++x1, ++y1;
   }
-  /* Both buffers equal again: the last move window from the state. */
+  /* Both buffers equal again: the last window from the state. */
   if (st == GR_OK)
     st = gr_snow_sync_rect(s, lx0, ly0, lx1, ly1);
   s->relax_iterations = it;

@@ -297,6 +297,16 @@ typedef struct gr_snow_deformation_timing {
 /** Switches per-stage timing on (non-zero; the sums restart) or off. */
 GR_API void gr_snow_deformation_set_timing(gr_snow_deformation *s, int on);
 
+/**
+ * How the talus iterations are launched: in blocks of 4 iterations per
+ * launch, a work-group iterating its tile in local memory (non-zero; the
+ * default on a GPU, where a launch costs more than its work), or two
+ * launches per iteration (0; the default on a CPU, where the blocks' halos
+ * cost more than the launches). Both give the same bits; only the speed
+ * differs.
+ */
+GR_API void gr_snow_deformation_set_blocked(gr_snow_deformation *s, int on);
+
 /** The sums since timing was switched on (zeros when it never was). */
 GR_API gr_status gr_snow_deformation_timing_get(const gr_snow_deformation *s,
                                                 gr_snow_deformation_timing *out);
