@@ -305,24 +305,54 @@ gr_status gr_mesh_validate(const gr_mesh *m, int closed, char *msg, size_t msg_l
   if (!closed)
     return GR_OK;
 
+  /* The edges in gr_edge_cmp's order: counted into buckets by their lower
+   * vertex in triangle order (a stable counting sort, linear: a simulation
+   * checks its objects every step), then each bucket, a vertex's few edges,
+   * sorted by the upper vertex, stably. */
   size_t ne = 3 * (size_t)m->ntriangles;
   gr_edge *edges = malloc(ne * sizeof(*edges));
-  if (!edges) {
+  size_t *start = calloc((size_t)m->nvertices + 1, sizeof(*start));
+  if (!edges || !start) {
+    free(edges);
+    free(start);
     if (msg && msg_len)
       snprintf(msg, msg_len, "Out of host memory while checking a mesh of %d triangles.",
                m->ntriangles);
     return GR_ERR_OUT_OF_MEMORY;
   }
+  for (size_t q = 0; q < ne; ++q) {
+    int a = m->triangles[q], b = m->triangles[q % 3 == 2 ? q - 2 : q + 1];
+    ++start[(a < b ? a : b) + 1];
+  }
+  for (int v = 0; v < m->nvertices; ++v)
+    start[v + 1] += start[v];
   for (int t = 0; t < m->ntriangles; ++t)
     for (int k = 0; k < 3; ++k) {
       int a = m->triangles[3 * t + k], b = m->triangles[3 * t + (k + 1) % 3];
-      gr_edge *e = &edges[3 * (size_t)t + k];
+      gr_edge *e = &edges[start[a < b ? a : b]++];
       e->lo = a < b ? a : b;
       e->hi = a < b ? b : a;
       e->forward = a < b;
       e->triangle = t;
     }
-  qsort(edges, ne, sizeof(*edges), gr_edge_cmp);
+  for (size_t i = 0; i < ne;) {
+    size_t n = 1;
+    while (i + n < ne && edges[i + n].lo == edges[i].lo)
+      ++n;
+    if (n > 32) {
+      qsort(edges + i, n, sizeof(*edges), gr_edge_cmp);
+    } else {
+      for (size_t a = i + 1; a < i + n; ++a) {
+        gr_edge e = edges[a];
+        size_t b = a;
+        for (; b > i && gr_edge_cmp(&edges[b - 1], &e) > 0; --b)
+          edges[b] = edges[b - 1];
+        edges[b] = e;
+      }
+    }
+    i += n;
+  }
+  free(start);
   gr_status st = GR_OK;
   for (size_t i = 0; i < ne && st == GR_OK;) {
     size_t n = 1;

@@ -598,7 +598,27 @@ static void gr_snow_span(double a, double b, double d, int b0, int b1, int *lo, 
 static gr_status gr_snow_bin(gr_snow_deformation *s, gr_snow_object *objs, int n,
                              const float *tri) {
   const gr_grid *g = &s->grid;
-  size_t ntiles = 0, entries = 0;
+  size_t ntiles = 0, entries = 0, total = 0;
+  for (int o = 0; o < n; ++o)
+    total += (size_t)objs[o].count;
+  /* Each triangle's span of points (i0, i1, j0, j1) in its object's box,
+   * once: the passes below read it. */
+  int *span = malloc((total ? total : 1) * 4 * sizeof(int));
+  if (!span)
+    return gr_set_error(s->ctx, GR_ERR_OUT_OF_MEMORY, "Out of host memory.");
+  for (int o = 0; o < n; ++o) {
+    const gr_snow_object *ob = &objs[o];
+    for (int t = ob->first; t < ob->first + ob->count; ++t) {
+      const float *v = tri + 9 * (size_t)t;
+      float xa = v[0] < v[3] ? v[0] : v[3], xb = v[0] > v[3] ? v[0] : v[3];
+      float ya = v[1] < v[4] ? v[1] : v[4], yb = v[1] > v[4] ? v[1] : v[4];
+      xa = xa < v[6] ? xa : v[6], xb = xb > v[6] ? xb : v[6];
+      ya = ya < v[7] ? ya : v[7], yb = yb > v[7] ? yb : v[7];
+      int *sp = span + 4 * (size_t)t;
+      gr_snow_span(xa, xb, g->dx, ob->bi0, ob->bi1, &sp[0], &sp[1]);
+      gr_snow_span(ya, yb, g->dy, ob->bj0, ob->bj1, &sp[2], &sp[3]);
+    }
+  }
   for (int pass = 0; pass < 2; ++pass) {
     int *start = NULL, *list = NULL, *fill = NULL;
     if (pass == 1) {
@@ -606,7 +626,7 @@ static gr_status gr_snow_bin(gr_snow_deformation *s, gr_snow_object *objs, int n
       list = malloc((entries ? entries : 1) * sizeof(int));
       fill = malloc((ntiles + 1) * sizeof(int));
       if (!start || !list || !fill) {
-        free(start), free(list), free(fill);
+        free(start), free(list), free(fill), free(span);
         return gr_set_error(s->ctx, GR_ERR_OUT_OF_MEMORY, "Out of host memory.");
       }
       memset(start, 0, (ntiles + 1) * sizeof(int));
@@ -622,15 +642,10 @@ static gr_status gr_snow_bin(gr_snow_deformation *s, gr_snow_object *objs, int n
         for (;;) {
           size_t e = 0;
           for (int t = ob->first; t < ob->first + ob->count; ++t) {
-            const float *v = tri + 9 * (size_t)t;
-            int i0, i1, j0, j1;
-            gr_snow_span(fmin(v[0], fmin(v[3], v[6])), fmax(v[0], fmax(v[3], v[6])), g->dx, ob->bi0,
-                         ob->bi1, &i0, &i1);
-            gr_snow_span(fmin(v[1], fmin(v[4], v[7])), fmax(v[1], fmax(v[4], v[7])), g->dy, ob->bj0,
-                         ob->bj1, &j0, &j1);
-            if (i0 <= i1 && j0 <= j1)
-              e += (size_t)((i1 - ob->bi0) / ob->tile - (i0 - ob->bi0) / ob->tile + 1) *
-                   (size_t)((j1 - ob->bj0) / ob->tile - (j0 - ob->bj0) / ob->tile + 1);
+            const int *sp = span + 4 * (size_t)t;
+            if (sp[0] <= sp[1] && sp[2] <= sp[3])
+              e += (size_t)((sp[1] - ob->bi0) / ob->tile - (sp[0] - ob->bi0) / ob->tile + 1) *
+                   (size_t)((sp[3] - ob->bj0) / ob->tile - (sp[2] - ob->bj0) / ob->tile + 1);
           }
           int w = ob->bi1 - ob->bi0 + 1, h = ob->bj1 - ob->bj0 + 1;
           if (e <= 16 * (size_t)ob->count + 1024 || (ob->tile >= w && ob->tile >= h)) {
@@ -641,27 +656,24 @@ static gr_status gr_snow_bin(gr_snow_deformation *s, gr_snow_object *objs, int n
           }
           ob->tile *= 2;
         }
-        if (ntiles > (size_t)INT_MAX / 2 || entries > (size_t)INT_MAX / 2)
+        if (ntiles > (size_t)INT_MAX / 2 || entries > (size_t)INT_MAX / 2) {
+          free(span);
           return gr_set_error(s->ctx, GR_ERR_TOO_LARGE,
                               "The objects cover %zu raster tiles with %zu triangle entries, more "
                               "than the core addresses; simplify the meshes.",
                               ntiles, entries);
+        }
         continue;
       }
       if (ob->ntx == 0)
         continue;
       /* count per tile; the lists are filled in triangle order below */
       for (int t = ob->first; t < ob->first + ob->count; ++t) {
-        const float *v = tri + 9 * (size_t)t;
-        int i0, i1, j0, j1;
-        gr_snow_span(fmin(v[0], fmin(v[3], v[6])), fmax(v[0], fmax(v[3], v[6])), g->dx, ob->bi0,
-                     ob->bi1, &i0, &i1);
-        gr_snow_span(fmin(v[1], fmin(v[4], v[7])), fmax(v[1], fmax(v[4], v[7])), g->dy, ob->bj0,
-                     ob->bj1, &j0, &j1);
-        if (i0 > i1 || j0 > j1)
+        const int *sp = span + 4 * (size_t)t;
+        if (sp[0] > sp[1] || sp[2] > sp[3])
           continue;
-        for (int tj = (j0 - ob->bj0) / ob->tile; tj <= (j1 - ob->bj0) / ob->tile; ++tj)
-          for (int ti = (i0 - ob->bi0) / ob->tile; ti <= (i1 - ob->bi0) / ob->tile; ++ti)
+        for (int tj = (sp[2] - ob->bj0) / ob->tile; tj <= (sp[3] - ob->bj0) / ob->tile; ++tj)
+          for (int ti = (sp[0] - ob->bi0) / ob->tile; ti <= (sp[1] - ob->bi0) / ob->tile; ++ti)
             start[ob->tile0 + tj * ob->ntx + ti + 1]++;
       }
     }
@@ -674,19 +686,16 @@ static gr_status gr_snow_bin(gr_snow_deformation *s, gr_snow_object *objs, int n
         if (ob->ntx == 0)
           continue;
         for (int t = ob->first; t < ob->first + ob->count; ++t) {
-          const float *v = tri + 9 * (size_t)t;
-          int i0, i1, j0, j1;
-          gr_snow_span(fmin(v[0], fmin(v[3], v[6])), fmax(v[0], fmax(v[3], v[6])), g->dx, ob->bi0,
-                       ob->bi1, &i0, &i1);
-          gr_snow_span(fmin(v[1], fmin(v[4], v[7])), fmax(v[1], fmax(v[4], v[7])), g->dy, ob->bj0,
-                       ob->bj1, &j0, &j1);
-          if (i0 > i1 || j0 > j1)
+          const int *sp = span + 4 * (size_t)t;
+          if (sp[0] > sp[1] || sp[2] > sp[3])
             continue;
-          for (int tj = (j0 - ob->bj0) / ob->tile; tj <= (j1 - ob->bj0) / ob->tile; ++tj)
-            for (int ti = (i0 - ob->bi0) / ob->tile; ti <= (i1 - ob->bi0) / ob->tile; ++ti)
+          for (int tj = (sp[2] - ob->bj0) / ob->tile; tj <= (sp[3] - ob->bj0) / ob->tile; ++tj)
+            for (int ti = (sp[0] - ob->bi0) / ob->tile; ti <= (sp[1] - ob->bi0) / ob->tile; ++ti)
               list[fill[ob->tile0 + tj * ob->ntx + ti]++] = t;
         }
       }
+      free(span);
+      span = NULL;
       gr_status st = GR_OK;
       size_t sb = (ntiles + 1) * sizeof(int), lb = (entries ? entries : 1) * sizeof(int);
       if (sb > s->tile_start_cap) {
@@ -711,6 +720,7 @@ static gr_status gr_snow_bin(gr_snow_deformation *s, gr_snow_object *objs, int n
       return st;
     }
   }
+  free(span); /* not reached: pass 1 returns */
   return GR_OK;
 }
 
@@ -741,9 +751,16 @@ static gr_status gr_snow_set_objects_impl(gr_snow_deformation *s, const gr_mesh 
                         "The objects have %zu triangles, more than the core addresses; simplify "
                         "the meshes.",
                         total);
+  int most_vertices = 0;
+  for (int o = 0; o < n; ++o)
+    most_vertices = meshes[o].nvertices > most_vertices ? meshes[o].nvertices : most_vertices;
   float *tri = total ? malloc(total * 9 * sizeof(float)) : NULL;
-  if (total && !tri)
+  double *world = most_vertices ? malloc((size_t)most_vertices * 3 * sizeof(double)) : NULL;
+  if ((total && !tri) || (most_vertices && !world)) {
+    free(tri);
+    free(world);
     return gr_set_error(s->ctx, GR_ERR_OUT_OF_MEMORY, "Out of host memory.");
+  }
   gr_snow_object objs[GR_SNOW_DEFORMATION_MAX_OBJECTS];
   const gr_grid *g = &s->grid;
   size_t at = 0;
@@ -753,19 +770,23 @@ static gr_status gr_snow_set_objects_impl(gr_snow_deformation *s, const gr_mesh 
     double lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
     objs[o].first = (int)at;
     objs[o].count = m->ntriangles;
+    /* Each vertex once, relative to grid point (0, 0), where float keeps
+     * its precision. */
+    for (int q = 0; q < m->nvertices; ++q) {
+      const float *v = m->vertices + 3 * q;
+      double *w = world + 3 * q;
+      for (int a = 0; a < 3; ++a)
+        w[a] = T[a] * v[0] + T[4 + a] * v[1] + T[8 + a] * v[2] + T[12 + a];
+      w[0] -= g->x0;
+      w[1] -= g->y0;
+    }
     for (int t = 0; t < m->ntriangles; ++t, ++at)
       for (int k = 0; k < 3; ++k) {
-        const float *v = m->vertices + 3 * m->triangles[3 * t + k];
-        double w[3];
-        for (int a = 0; a < 3; ++a)
-          w[a] = T[a] * v[0] + T[4 + a] * v[1] + T[8 + a] * v[2] + T[12 + a];
-        /* Relative to grid point (0, 0), where float keeps its precision. */
-        w[0] -= g->x0;
-        w[1] -= g->y0;
+        const double *w = world + 3 * m->triangles[3 * t + k];
         for (int a = 0; a < 3; ++a) {
           tri[9 * at + 3 * k + a] = (float)w[a];
-          lo[a] = fmin(lo[a], w[a]);
-          hi[a] = fmax(hi[a], w[a]);
+          lo[a] = w[a] < lo[a] ? w[a] : lo[a];
+          hi[a] = w[a] > hi[a] ? w[a] : hi[a];
         }
       }
     double fi0 = ceil(lo[0] / g->dx - 1.0), fi1 = floor(hi[0] / g->dx + 1.0);
@@ -782,6 +803,7 @@ static gr_status gr_snow_set_objects_impl(gr_snow_deformation *s, const gr_mesh 
     for (int a = 0; a < 3; ++a)
       objs[o].v[a] = velocities ? velocities[3 * o + a] : 0.0;
   }
+  free(world);
   gr_status st = gr_snow_bin(s, objs, n, tri);
   if (st != GR_OK) {
     free(tri);
