@@ -1,0 +1,279 @@
+/**
+ * @file snow_accumulation.h
+ * @brief Snowfall from a direction onto terrain and objects (seed 002: the
+ * occlusion-based accumulation of Reynolds, Laycock & Day as a CTU thesis
+ * implements it; notes/002.md), as a deterministic, volume-keeping model on
+ * the device.
+ *
+ * State: snow depth S per grid point over a ground B (the snow surface is
+ * H = B + S), and snow depth per mesh point of every object (it lives in the
+ * object's own frame, so it moves with the object).
+ *
+ * One step of dt seconds (gr_snow_accumulation_step), with d the unit snow
+ * direction (SnowDirection, turned by up to Flutter at random each step,
+ * seeded by Seed and the step's number):
+ *  1. exposure view: an orthographic depth view along d of the snow surface
+ *     H (two triangles per grid cell) and of every object triangle at its
+ *     pose, at ExposureResolution texels across. Rays along d are named by
+ *     where they cross z = 0 (an oblique projection, which orders and
+ *     separates points exactly as an orthographic view along d does); a
+ *     texel keeps the highest crossing of its centre's ray, by an integer
+ *     atomic_max on the float's ordered bits: order-independent, so reruns
+ *     are bit-identical (no float atomics).
+ *  2. exposure: a grid point, or a mesh point moved half a texel along its
+ *     normal, is exposed (1) when nothing in the view lies above it on its
+ *     ray by more than a depth bias (a quarter texel plus the surface's
+ *     slope in the view times 0.75 texel: a surface does not shadow
+ *     itself), else 0. Binary, like the thesis' occlusion render.
+ *  3. growth: g = SnowfallRate x exposure x max(0, n . -d) x (1 + A N) x dt,
+ *     n the ground's normal (grid) or the mesh point's normal (objects), N a
+ *     seeded value noise in [-1, 1] of the position (world xy on the
+ *     terrain, the object's own frame on objects) with a lattice of
+ *     NoiseScale metres, A = NoiseAmplitude. SnowfallRate is the fall per
+ *     area across the snow direction: what an exposed surface facing the
+ *     snow receives (a horizontal one, for vertical snow).
+ *  4. on the grid only: the growth is blurred (a separable binomial kernel
+ *     of radius r = BlurRadius points, weights C(2r + 4, r + 2 + k); r = 4
+ *     is the thesis' 9-tap kernel, notes/002.md 2.4; near the grid's edge
+ *     the weights are renormalised) and, with Dilation, replaced by its
+ *     maximum over the 3 x 3 neighbourhood (the thesis' dilation).
+ *  5. increment and stability: S += g, then with the capacity
+ *     c = MaxDepth x max(0, n . up) the excess over it is shed:
+ *     S -= (1 - (1 - f)^dt) (S - c) where S > c, f = StabilityFactor (the
+ *     fraction of the excess shed per second; f = 1 keeps S at c whatever
+ *     dt). Shed snow leaves the simulation and is counted (shed_volume).
+ *
+ * Deviations from the thesis, on purpose (notes/002.md 2.2, 2.5, 7): its
+ * stability branch sets every point below capacity to 0 (flat surfaces
+ * could never hold snow): here snow below capacity stays. Its growth is a
+ * noise value per frame: here it is a rate times dt, and the noise is a
+ * fixed pattern in space (not re-drawn per step), so the same simulated
+ * time gives the same snow whether it is taken in 10 steps or 100 (exactly
+ * with f = 1 while the exposure does not change). Its "5x5" blur is the 9-tap
+ * kernel above. Its per-object UV textures become per-mesh-point depths
+ * (no UV unwrap needed).
+ *
+ * Book-keeping: every grid point and mesh point keeps its depth, the snow
+ * that fell on it and the snow it shed as double-float pairs, so
+ *   stored = initial + snowfall - shed - dropped
+ * holds to about 1e-12 over any number of steps (dropped: the snow of
+ * objects that set_objects removed). Volumes: grid points count dx dy each;
+ * a mesh point counts a third of the area of its triangles (in the object's
+ * own frame: poses are rigid).
+ *
+ * Fields (gr_field): set ELEVATION (required, m; within +-1e6 m, finite)
+ * and optionally SNOW_DEPTH (m, 0 to 1e4, the initial snow). Read
+ * SNOW_DEPTH, SNOW_SURFACE, SNOW_DENSITY (SnowDensity everywhere, for Snow
+ * Deformation), EXPOSURE (0 or 1, the last step's) and ELEVATION.
+ *
+ * Objects: triangle meshes (gr_mesh; open surfaces such as a roof plane
+ * are fine, triangles wound counter-clockwise seen from the side that
+ * receives snow), at the pose of their transform; set them before each
+ * step that moves them. Pieces: whole grids only, for now.
+ */
+#ifndef GRAUPEL_SNOW_ACCUMULATION_H
+#define GRAUPEL_SNOW_ACCUMULATION_H
+
+#include "graupel/runtime.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/** Most objects one simulation takes. */
+#define GR_SNOW_ACCUMULATION_MAX_OBJECTS 256
+
+/** The largest angle of SnowDirection from straight down, degrees. */
+#define GR_SNOW_ACCUMULATION_MAX_TILT 75.0
+
+/**
+ * The parameters, in the core's units (SI; Flutter in radians). Ranges and
+ * defaults are the rows of gr_snow_accumulation_param_bounds, written
+ * nowhere else, but for direction (a vector: finite, not zero, at most
+ * GR_SNOW_ACCUMULATION_MAX_TILT degrees from straight down; default 0 0 -1).
+ */
+typedef struct gr_snow_accumulation_params {
+  double direction[3];    /**< SnowDirection, any length (normalised) */
+  double flutter;         /**< rad, the largest random turn per step (row Flutter) */
+  double snowfall_rate;   /**< m/s (row SnowfallRate, cm/h) */
+  double noise_amplitude; /**< A (row NoiseAmplitude) */
+  double noise_scale;     /**< m, the noise lattice (row NoiseScale) */
+  int seed;               /**< row Seed */
+  int exposure_resolution; /**< texels across the view (row ExposureResolution) */
+  int blur_radius;        /**< grid points (row BlurRadius) */
+  int dilation;           /**< 0 or 1 (row Dilation) */
+  double max_depth;       /**< m, the capacity of a horizontal surface (row MaxDepth) */
+  double stability_factor; /**< f, per second (row StabilityFactor) */
+  double snow_density;    /**< kg/m^3 of the fresh snow (row SnowDensity) */
+} gr_snow_accumulation_params;
+
+/** The table's defaults, direction 0 0 -1. */
+GR_API void gr_snow_accumulation_params_init(gr_snow_accumulation_params *p);
+
+/**
+ * Checks every parameter against its row of the table and the direction;
+ * the sentence in msg names the property, its value and the fix.
+ */
+GR_API gr_status gr_snow_accumulation_params_validate(const gr_snow_accumulation_params *p,
+                                                      char *msg, size_t msg_len);
+
+/**
+ * The parameter table (Flutter deg, SnowfallRate cm/h, NoiseAmplitude,
+ * NoiseScale m, Seed, ExposureResolution, BlurRadius, Dilation, MaxDepth m,
+ * StabilityFactor 1/s, SnowDensity kg/m^3); *count gets the number of rows.
+ */
+GR_API const gr_param_bound *gr_snow_accumulation_param_bounds(int *count);
+
+/**
+ * The check set_field applies, on the host: f must be ELEVATION (finite,
+ * within +-1e6 m) or SNOW_DEPTH (finite, 0 to 1e4 m); n values in rows of
+ * nx (0: one row). The sentence names the field, the point (i, j) and the
+ * value. values may be NULL only when n is 0.
+ */
+GR_API gr_status gr_snow_accumulation_field_validate(gr_field f, const float *values, size_t n,
+                                                     size_t nx, char *msg, size_t msg_len);
+
+/** Book-keeping; volumes m^3, cumulative since create or reset. */
+typedef struct gr_snow_accumulation_ledger {
+  double time;                  /**< simulated time, s */
+  long long steps;              /**< steps taken */
+  double initial_volume;        /**< snow set with SNOW_DEPTH and set_object_snow */
+  double snowfall_volume;       /**< all that fell (the growth after blur and dilation) */
+  double stored_volume;         /**< terrain + objects now */
+  double stored_volume_terrain; /**< sum S dx dy */
+  double stored_volume_objects; /**< sum over mesh points of depth x area */
+  double shed_volume;           /**< removed by the stability cap */
+  double dropped_volume;        /**< on objects that set_objects removed */
+  /** initial + snowfall - shed - dropped - stored: rounding only */
+  double balance_error;
+} gr_snow_accumulation_ledger;
+
+typedef struct gr_snow_accumulation gr_snow_accumulation;
+
+/**
+ * A simulation on one whole grid: validates grid and parameters, checks
+ * that the exposure view fits the device (no wider than its largest 2-D
+ * image where it has images, and within its largest buffer:
+ * GR_ERR_TOO_LARGE with a sentence otherwise), builds the kernels, and
+ * starts with flat ground at 0, no snow and no objects.
+ */
+GR_API gr_status gr_snow_accumulation_create(gr_context *ctx, const gr_grid *grid,
+                                             const gr_snow_accumulation_params *p,
+                                             gr_snow_accumulation **out);
+
+/** New parameters from the next step on (validated like create; the state is kept). */
+GR_API gr_status gr_snow_accumulation_set_params(gr_snow_accumulation *s,
+                                                 const gr_snow_accumulation_params *p);
+
+/**
+ * Uploads ELEVATION or SNOW_DEPTH (nx*ny floats; see field_validate); a
+ * refused field leaves the state as it was. SNOW_DEPTH replaces the snow
+ * on the grid and becomes what reset returns to; the ledger's initial
+ * volume moves by the change.
+ */
+GR_API gr_status gr_snow_accumulation_set_field(gr_snow_accumulation *s, gr_field f,
+                                                const float *host);
+
+/**
+ * The objects for the next steps (copied; 0 to
+ * GR_SNOW_ACCUMULATION_MAX_OBJECTS), each passing gr_mesh_validate(mesh, 0)
+ * (open surfaces allowed), at the pose of its transform. Object o keeps its
+ * snow when the previous call had an object o with as many vertices (the
+ * same mesh at a new pose: its snow moves with it); otherwise its snow
+ * starts at 0 and the snow of an object that is gone counts as dropped. A
+ * refusal names the object and keeps the objects set before.
+ */
+GR_API gr_status gr_snow_accumulation_set_objects(gr_snow_accumulation *s, const gr_mesh *meshes,
+                                                  int n);
+
+/**
+ * Object o's snow per mesh point (n must be its vertex count): SNOW_DEPTH
+ * (m, along the point's normal) or EXPOSURE (0 or 1, the last step's).
+ */
+GR_API gr_status gr_snow_accumulation_get_object_field(gr_snow_accumulation *s, int o, gr_field f,
+                                                       float *host, int n);
+
+/** Object o's snow cap as offsets: 3 floats per mesh point, world normal x depth (m). */
+GR_API gr_status gr_snow_accumulation_get_object_offsets(gr_snow_accumulation *s, int o,
+                                                         float *xyz, int n);
+
+/** Sets object o's snow per mesh point (m, 0 to 1e4); the initial volume moves by the change. */
+GR_API gr_status gr_snow_accumulation_set_object_snow(gr_snow_accumulation *s, int o,
+                                                      const float *depth, int n);
+
+/** One step of dt seconds (finite, 1e-6 to 86400); enqueues and does not wait. */
+GR_API gr_status gr_snow_accumulation_step(gr_snow_accumulation *s, double dt);
+
+/** Reads a grid field back (waits): SNOW_DEPTH, SNOW_SURFACE, SNOW_DENSITY, EXPOSURE, ELEVATION. */
+GR_API gr_status gr_snow_accumulation_get_field(gr_snow_accumulation *s, gr_field f, float *host);
+
+/** The ledger now (waits; reduces on the device). */
+GR_API gr_status gr_snow_accumulation_ledger_get(gr_snow_accumulation *s,
+                                                 gr_snow_accumulation_ledger *out);
+
+/**
+ * Progress (gr_progress_fn): called after each step with the time reached;
+ * a non-zero return makes the next step refuse with GR_ERR_ABORTED until
+ * set_progress or reset is called. NULL removes it.
+ */
+GR_API void gr_snow_accumulation_set_progress(gr_snow_accumulation *s, gr_progress_fn fn,
+                                              void *user);
+
+/**
+ * Checkpoints: the grid's and the objects' snow, fallen and shed snow,
+ * exposures, time, steps and ledger as bytes. Loading into a simulation of
+ * the same grid with the same objects set (as many, with as many mesh
+ * points) makes every later step bit-identical. Elevation, parameters and
+ * object poses are not part of it.
+ */
+GR_API gr_status gr_snow_accumulation_state_size(const gr_snow_accumulation *s, size_t *bytes);
+GR_API gr_status gr_snow_accumulation_state_save(gr_snow_accumulation *s, void *host,
+                                                 size_t bytes);
+GR_API gr_status gr_snow_accumulation_state_load(gr_snow_accumulation *s, const void *host,
+                                                 size_t bytes);
+
+/**
+ * Back to the initial snow (the last SNOW_DEPTH set, none on objects),
+ * ledger zeroed; elevation and objects kept.
+ */
+GR_API gr_status gr_snow_accumulation_reset(gr_snow_accumulation *s);
+
+/** The latest error of a call on this simulation ("" when none). Never NULL. */
+GR_API const char *gr_snow_accumulation_last_error(const gr_snow_accumulation *s);
+
+/**
+ * Per-stage wall times for graupel-bench, cumulative since timing was
+ * switched on (ms); while on, each step waits after every stage.
+ */
+typedef struct gr_snow_accumulation_timing {
+  long long steps;    /**< steps timed */
+  double view_ms;     /**< clearing the view and rasterising terrain and objects */
+  double exposure_ms; /**< exposure and growth of the grid points */
+  double blur_ms;     /**< blur and dilation */
+  double apply_ms;    /**< increment and stability on the grid */
+  double objects_ms;  /**< exposure, growth and stability of the mesh points */
+  double host_ms;     /**< the view's extent and the direction, on the host */
+} gr_snow_accumulation_timing;
+
+/** Switches per-stage timing on (non-zero; the sums restart) or off. */
+GR_API void gr_snow_accumulation_set_timing(gr_snow_accumulation *s, int on);
+
+/** The sums since timing was switched on. */
+GR_API gr_status gr_snow_accumulation_timing_get(const gr_snow_accumulation *s,
+                                                 gr_snow_accumulation_timing *out);
+
+/**
+ * The largest ExposureResolution this simulation's device takes (its 2-D
+ * image width where it has images, and the view within its largest
+ * buffer), for error messages and the filter's domain.
+ */
+GR_API gr_status gr_snow_accumulation_max_resolution(gr_context *ctx, int *out);
+
+/** Frees the simulation; NULL is fine. */
+GR_API void gr_snow_accumulation_destroy(gr_snow_accumulation *s);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif
