@@ -16,46 +16,59 @@
 #include "reduce.h"
 #include "snow_deformation_shared.h"
 
-/* The underside at grid point (i, j): the lowest crossing of the vertical
- * line by a triangle (world coordinates relative to the grid's point (0, 0))
- * of the point's tile, tile_list[tile_start[k] .. tile_start[k + 1]) with k
- * = tile0 + tj * ntx + ti, (ti, tj) the point's tile of tile x tile points
- * from the box's corner; the host lists in a tile every triangle that may
- * pass the test below there. Outside the object's box [bi0, bi1] x
- * [bj0, bj1] nothing can cover the point. */
-__kernel void snow_raster(__global const float *restrict tri,
-                          __global const int *restrict tile_start,
-                          __global const int *restrict tile_list, int tile0, int ntx, int tile,
-                          int nx, int ny, float dx, float dy, int bi0, int bi1, int bj0, int bj1,
-                          int x_end, int y_end, __global float *restrict under) {
+/* The underside U(i, j): the lowest crossing of the vertical line through
+ * grid point (i, j) by the object's triangles (world coordinates relative
+ * to the grid's point (0, 0)), +inf where none crosses it. A scatter, one
+ * work-item per triangle over the points of its box (within the object's
+ * box [bi0, bi1] x [bj0, bj1]), into an integer minimum: a float's bits
+ * made order-preserving as a signed int (snow_order), so atomic_min gives
+ * the exact minimum whatever the order (deterministic, no float atomics).
+ * snow_raster_clear fills the window with +inf first; snow_overlap turns
+ * the ints back into floats. */
+GR_INLINE int snow_order_bits(int b) {
+  return b >= 0 ? b : b ^ 0x7fffffff; /* an involution: it also decodes */
+}
+
+GR_INLINE int snow_order(float z) {
+  return snow_order_bits(as_int(z));
+}
+
+__kernel void snow_raster_clear(int nx, int ny, int x_end, int y_end,
+                                __global int *restrict under) {
   int i = get_global_id(0), j = get_global_id(1);
   if (!gr_inside(i, j, nx, ny) || i >= x_end || j >= y_end)
-    return; /* beyond the window (see snow_relax_rate) */
-  float u = INFINITY;
-  if (i >= bi0 && i <= bi1 && j >= bj0 && j <= bj1) {
-    float px = i * dx, py = j * dy;
-    int k = tile0 + ((j - bj0) / tile) * ntx + (i - bi0) / tile;
-    int end = tile_start[k + 1];
-    for (int e = tile_start[k]; e < end; ++e) {
-      __global const float *v = tri + 9 * tile_list[e];
-      float ax = v[0], ay = v[1], bx = v[3], by = v[4], cx = v[6], cy = v[7];
-      if (px < fmin(ax, fmin(bx, cx)) - dx || px > fmax(ax, fmax(bx, cx)) + dx ||
-          py < fmin(ay, fmin(by, cy)) - dy || py > fmax(ay, fmax(by, cy)) + dy)
-        continue;
-      float area = (bx - ax) * (cy - ay) - (by - ay) * (cx - ax);
-      if (area == 0.0f)
-        continue; /* vertical: its neighbours give the crossing */
+    return;
+  under[gr_idx(i, j, nx)] = snow_order(INFINITY);
+}
+
+__kernel void snow_raster(__global const float *restrict tri, int first, int count, int nx,
+                          float dx, float dy, int bi0, int bi1, int bj0, int bj1,
+                          __global int *restrict under) {
+  int t = get_global_id(0);
+  if (t >= count)
+    return;
+  __global const float *v = tri + 9 * (first + t);
+  float ax = v[0], ay = v[1], bx = v[3], by = v[4], cx = v[6], cy = v[7];
+  float area = (bx - ax) * (cy - ay) - (by - ay) * (cx - ax);
+  if (area == 0.0f)
+    return; /* vertical: its neighbours give the crossing */
+  float xlo = fmin(ax, fmin(bx, cx)), xhi = fmax(ax, fmax(bx, cx));
+  float ylo = fmin(ay, fmin(by, cy)), yhi = fmax(ay, fmax(by, cy));
+  /* The points within a point of the triangle's box, in the object's box. */
+  int i0 = max(bi0, (int)floor(xlo / dx) - 1), i1 = min(bi1, (int)ceil(xhi / dx) + 1);
+  int j0 = max(bj0, (int)floor(ylo / dy) - 1), j1 = min(bj1, (int)ceil(yhi / dy) + 1);
+  float s = area > 0.0f ? 1.0f : -1.0f, tol = -GR_SNOW_EDGE_EPS * fabs(area);
+  for (int j = j0; j <= j1; ++j)
+    for (int i = i0; i <= i1; ++i) {
+      float px = i * dx, py = j * dy;
       float w0 = (bx - px) * (cy - py) - (by - py) * (cx - px);
       float w1 = (cx - px) * (ay - py) - (cy - py) * (ax - px);
       float w2 = (ax - px) * (by - py) - (ay - py) * (bx - px);
-      float s = area > 0.0f ? 1.0f : -1.0f, tol = -GR_SNOW_EDGE_EPS * fabs(area);
       if (s * w0 < tol || s * w1 < tol || s * w2 < tol)
         continue;
       float z = (w0 * v[2] + w1 * v[5] + w2 * v[8]) / area;
-      u = fmin(u, z);
+      atomic_min(under + gr_idx(i, j, nx), snow_order(z));
     }
-  }
-  under[gr_idx(i, j, nx)] = u;
 }
 
 /* An amount of snow rounded down to whole quanta (see
@@ -69,15 +82,17 @@ GR_INLINE float snow_overlap_of(float b, float s, float u) {
   return fmin(s, snow_q(fmax(0.0f, (b + s) - u)));
 }
 
+/* Also turns the raster's ordered ints back into the underside's floats. */
 __kernel void snow_overlap(__global const float *restrict ground,
-                           __global const float *restrict depth,
-                           __global const float *restrict under, int nx, int ny, int x_end,
-                           int y_end, __global float *restrict overlap) {
+                           __global const float *restrict depth, __global float *restrict under,
+                           int nx, int ny, int x_end, int y_end, __global float *restrict overlap) {
   int i = get_global_id(0), j = get_global_id(1);
   if (!gr_inside(i, j, nx, ny) || i >= x_end || j >= y_end)
     return;
   int c = gr_idx(i, j, nx);
-  overlap[c] = snow_overlap_of(ground[c], depth[c], under[c]);
+  float u = as_float(snow_order_bits(as_int(under[c])));
+  under[c] = u;
+  overlap[c] = snow_overlap_of(ground[c], depth[c], u);
 }
 
 /* Contour weight: -1 off the contour (overlapped or touched, or no

@@ -55,7 +55,6 @@ static const gr_param_bound gr_snow_bounds[GR_SNOW_P_COUNT] = {
 typedef struct gr_snow_object {
   int first, count;       /* triangles in the world-triangle array */
   int bi0, bi1, bj0, bj1; /* the box of points it may cover; bi0 > bi1: none */
-  int tile0, ntx, tile;   /* its tiles: the first, per row, tile x tile points each */
   double v[3];
 } gr_snow_object;
 
@@ -63,8 +62,8 @@ struct gr_snow_deformation {
   gr_context *ctx;
   gr_grid grid;
   gr_snow_deformation_params params;
-  cl_kernel raster, overlap_k, contour, obj_reduce, apply, relax_rate, relax_move, relax_block,
-      check_reduce, ledger_reduce, surface, reset, added_reduce, quantize;
+  cl_kernel raster, raster_clear, overlap_k, contour, obj_reduce, apply, relax_rate, relax_move,
+      relax_block, check_reduce, ledger_reduce, surface, reset, added_reduce, quantize;
   cl_mem depth[2], density[2]; /* [cur] is the state */
   int cur;
   cl_mem ground, depth0, density0, under, overlap, weight, overlap_sum, contact, under_min, rate,
@@ -73,10 +72,6 @@ struct gr_snow_deformation {
   int blocked;     /* the talus in blocked launches (GPUs) or one launch per iteration */
   cl_mem tri;      /* world triangles, 9 floats each */
   size_t tri_cap;
-  /* The raster's bins: tile t of all objects lists the triangles
-   * tri_list[tile_start[t] .. tile_start[t + 1]) that may cover its points. */
-  cl_mem tile_start, tile_list;
-  size_t tile_start_cap, tile_list_cap;
   gr_reduction red_obj, red_check, red_ledger, red_added;
   gr_snow_object objects[GR_SNOW_DEFORMATION_MAX_OBJECTS];
   int nobjects;
@@ -399,6 +394,7 @@ gr_status gr_snow_deformation_create(gr_context *ctx, const gr_grid *grid,
     const char *name;
     cl_kernel *k;
   } ks[] = {{"snow_raster", &s->raster},
+            {"snow_raster_clear", &s->raster_clear},
             {"snow_overlap", &s->overlap_k},
             {"snow_contour", &s->contour},
             {"snow_object_reduce", &s->obj_reduce},
@@ -453,17 +449,17 @@ gr_status gr_snow_deformation_create(gr_context *ctx, const gr_grid *grid,
 void gr_snow_deformation_destroy(gr_snow_deformation *s) {
   if (!s)
     return;
-  cl_kernel ks[] = {s->raster,       s->overlap_k,     s->contour,    s->obj_reduce,
-                    s->apply,        s->relax_rate,    s->relax_move, s->relax_block,
-                    s->check_reduce, s->ledger_reduce, s->surface,    s->reset,
-                    s->added_reduce, s->quantize};
+  cl_kernel ks[] = {s->raster,      s->raster_clear, s->overlap_k,     s->contour,
+                    s->obj_reduce,  s->apply,        s->relax_rate,    s->relax_move,
+                    s->relax_block, s->check_reduce, s->ledger_reduce, s->surface,
+                    s->reset,       s->added_reduce, s->quantize};
   for (size_t i = 0; i < sizeof(ks) / sizeof(ks[0]); ++i)
     if (ks[i])
       clReleaseKernel(ks[i]);
   cl_mem *bufs[] = {&s->depth[0],    &s->depth[1], &s->density[0], &s->density[1], &s->ground,
                     &s->depth0,      &s->density0, &s->under,      &s->overlap,    &s->weight,
                     &s->overlap_sum, &s->contact,  &s->under_min,  &s->rate,       &s->rate_in,
-                    &s->movable,     &s->scratch,  &s->tri,        &s->tile_start, &s->tile_list};
+                    &s->movable,     &s->scratch,  &s->tri};
   for (size_t i = 0; i < sizeof(bufs) / sizeof(bufs[0]); ++i)
     gr_buffer_release(bufs[i]);
   gr_reduction_release(&s->red_obj);
@@ -595,149 +591,6 @@ gr_status gr_snow_deformation_set_field(gr_snow_deformation *s, gr_field f, cons
 /* The points [*lo, *hi] of a box [b0, b1] whose raster test may pass for
  * coordinates in [a, b] at spacing d (the kernel widens each triangle by one
  * spacing; one more here covers the rounding). Empty: *lo > *hi. */
-static void gr_snow_span(double a, double b, double d, int b0, int b1, int *lo, int *hi) {
-  double l = floor(a / d) - 2.0, h = ceil(b / d) + 2.0;
-  l = l > b0 ? l : b0;
-  h = h < b1 ? h : b1;
-  *lo = l > h ? 1 : (int)l;
-  *hi = l > h ? 0 : (int)h;
-}
-
-/* Sorts each object's triangles into square tiles of its box, so that the
- * raster tests at a point only the triangles that may cover its tile. The
- * minimum is exact and every triangle that can pass the test is listed, so
- * the underside is bit for bit what testing all of them gives. The tile
- * side doubles while the lists would hold more than 16 entries a triangle
- * (large triangles over a large box), which bounds the memory. */
-static gr_status gr_snow_bin(gr_snow_deformation *s, gr_snow_object *objs, int n,
-                             const float *tri) {
-  const gr_grid *g = &s->grid;
-  size_t ntiles = 0, entries = 0, total = 0;
-  for (int o = 0; o < n; ++o)
-    total += (size_t)objs[o].count;
-  /* Each triangle's span of points (i0, i1, j0, j1) in its object's box,
-   * once: the passes below read it. */
-  int *span = malloc((total ? total : 1) * 4 * sizeof(int));
-  if (!span)
-    return gr_set_error(s->ctx, GR_ERR_OUT_OF_MEMORY, "Out of host memory.");
-  for (int o = 0; o < n; ++o) {
-    const gr_snow_object *ob = &objs[o];
-    for (int t = ob->first; t < ob->first + ob->count; ++t) {
-      const float *v = tri + 9 * (size_t)t;
-      float xa = v[0] < v[3] ? v[0] : v[3], xb = v[0] > v[3] ? v[0] : v[3];
-      float ya = v[1] < v[4] ? v[1] : v[4], yb = v[1] > v[4] ? v[1] : v[4];
-      xa = xa < v[6] ? xa : v[6], xb = xb > v[6] ? xb : v[6];
-      ya = ya < v[7] ? ya : v[7], yb = yb > v[7] ? yb : v[7];
-      int *sp = span + 4 * (size_t)t;
-      gr_snow_span(xa, xb, g->dx, ob->bi0, ob->bi1, &sp[0], &sp[1]);
-      gr_snow_span(ya, yb, g->dy, ob->bj0, ob->bj1, &sp[2], &sp[3]);
-    }
-  }
-  for (int pass = 0; pass < 2; ++pass) {
-    int *start = NULL, *list = NULL, *fill = NULL;
-    if (pass == 1) {
-      start = malloc((ntiles + 1) * sizeof(int));
-      list = malloc((entries ? entries : 1) * sizeof(int));
-      fill = malloc((ntiles + 1) * sizeof(int));
-      if (!start || !list || !fill) {
-        free(start), free(list), free(fill), free(span);
-        return gr_set_error(s->ctx, GR_ERR_OUT_OF_MEMORY, "Out of host memory.");
-      }
-      memset(start, 0, (ntiles + 1) * sizeof(int));
-    }
-    for (int o = 0; o < n; ++o) {
-      gr_snow_object *ob = &objs[o];
-      if (pass == 0) {
-        ob->tile0 = (int)ntiles;
-        ob->ntx = 0;
-        ob->tile = 8;
-        if (ob->bi0 > ob->bi1 || ob->bj0 > ob->bj1)
-          continue;
-        for (;;) {
-          size_t e = 0;
-          for (int t = ob->first; t < ob->first + ob->count; ++t) {
-            const int *sp = span + 4 * (size_t)t;
-            if (sp[0] <= sp[1] && sp[2] <= sp[3])
-              e += (size_t)((sp[1] - ob->bi0) / ob->tile - (sp[0] - ob->bi0) / ob->tile + 1) *
-                   (size_t)((sp[3] - ob->bj0) / ob->tile - (sp[2] - ob->bj0) / ob->tile + 1);
-          }
-          int w = ob->bi1 - ob->bi0 + 1, h = ob->bj1 - ob->bj0 + 1;
-          if (e <= 16 * (size_t)ob->count + 1024 || (ob->tile >= w && ob->tile >= h)) {
-            ob->ntx = (w + ob->tile - 1) / ob->tile;
-            ntiles += (size_t)ob->ntx * (size_t)((h + ob->tile - 1) / ob->tile);
-            entries += e;
-            break;
-          }
-          ob->tile *= 2;
-        }
-        if (ntiles > (size_t)INT_MAX / 2 || entries > (size_t)INT_MAX / 2) {
-          free(span);
-          return gr_set_error(s->ctx, GR_ERR_TOO_LARGE,
-                              "The objects cover %zu raster tiles with %zu triangle entries, more "
-                              "than the core addresses; simplify the meshes.",
-                              ntiles, entries);
-        }
-        continue;
-      }
-      if (ob->ntx == 0)
-        continue;
-      /* count per tile; the lists are filled in triangle order below */
-      for (int t = ob->first; t < ob->first + ob->count; ++t) {
-        const int *sp = span + 4 * (size_t)t;
-        if (sp[0] > sp[1] || sp[2] > sp[3])
-          continue;
-        for (int tj = (sp[2] - ob->bj0) / ob->tile; tj <= (sp[3] - ob->bj0) / ob->tile; ++tj)
-          for (int ti = (sp[0] - ob->bi0) / ob->tile; ti <= (sp[1] - ob->bi0) / ob->tile; ++ti)
-            start[ob->tile0 + tj * ob->ntx + ti + 1]++;
-      }
-    }
-    if (pass == 1) {
-      for (size_t k = 0; k < ntiles; ++k)
-        start[k + 1] += start[k];
-      memcpy(fill, start, (ntiles + 1) * sizeof(int));
-      for (int o = 0; o < n; ++o) {
-        gr_snow_object *ob = &objs[o];
-        if (ob->ntx == 0)
-          continue;
-        for (int t = ob->first; t < ob->first + ob->count; ++t) {
-          const int *sp = span + 4 * (size_t)t;
-          if (sp[0] > sp[1] || sp[2] > sp[3])
-            continue;
-          for (int tj = (sp[2] - ob->bj0) / ob->tile; tj <= (sp[3] - ob->bj0) / ob->tile; ++tj)
-            for (int ti = (sp[0] - ob->bi0) / ob->tile; ti <= (sp[1] - ob->bi0) / ob->tile; ++ti)
-              list[fill[ob->tile0 + tj * ob->ntx + ti]++] = t;
-        }
-      }
-      free(span);
-      span = NULL;
-      gr_status st = GR_OK;
-      size_t sb = (ntiles + 1) * sizeof(int), lb = (entries ? entries : 1) * sizeof(int);
-      if (sb > s->tile_start_cap) {
-        gr_buffer_release(&s->tile_start);
-        s->tile_start_cap = 0;
-        st = gr_buffer_create(s->ctx, CL_MEM_READ_ONLY, sb, NULL, &s->tile_start);
-        if (st == GR_OK)
-          s->tile_start_cap = sb;
-      }
-      if (st == GR_OK && lb > s->tile_list_cap) {
-        gr_buffer_release(&s->tile_list);
-        s->tile_list_cap = 0;
-        st = gr_buffer_create(s->ctx, CL_MEM_READ_ONLY, lb, NULL, &s->tile_list);
-        if (st == GR_OK)
-          s->tile_list_cap = lb;
-      }
-      if (st == GR_OK)
-        st = gr_buffer_write(s->ctx, s->tile_start, 0, sb, start);
-      if (st == GR_OK)
-        st = gr_buffer_write(s->ctx, s->tile_list, 0, lb, list);
-      free(start), free(list), free(fill);
-      return st;
-    }
-  }
-  free(span); /* not reached: pass 1 returns */
-  return GR_OK;
-}
-
 static gr_status gr_snow_set_objects_impl(gr_snow_deformation *s, const gr_mesh *meshes, int n,
                                           const double *velocities) {
   char msg[320];
@@ -818,11 +671,7 @@ static gr_status gr_snow_set_objects_impl(gr_snow_deformation *s, const gr_mesh 
       objs[o].v[a] = velocities ? velocities[3 * o + a] : 0.0;
   }
   free(world);
-  gr_status st = gr_snow_bin(s, objs, n, tri);
-  if (st != GR_OK) {
-    free(tri);
-    return st;
-  }
+  gr_status st = GR_OK;
   if (total > s->tri_cap) {
     gr_buffer_release(&s->tri);
     s->tri_cap = 0;
@@ -850,6 +699,21 @@ gr_status gr_snow_deformation_set_objects(gr_snow_deformation *s, const gr_mesh 
     return gr_set_error(NULL, GR_ERR_INVALID_ARGUMENT,
                         "gr_snow_deformation_set_objects needs a simulation.");
   return GR_SNOW_KEEP_ERROR(s, gr_snow_set_objects_impl(s, meshes, n, velocities));
+}
+
+/* A named kernel argument. */
+typedef struct gr_snow_arg {
+  const char *name;
+  size_t size;
+  const void *value;
+} gr_snow_arg;
+
+static gr_status gr_snow_args(gr_snow_deformation *s, cl_kernel k, const gr_snow_arg *args,
+                              size_t n) {
+  gr_status st = GR_OK;
+  for (size_t q = 0; st == GR_OK && q < n; ++q)
+    st = gr_kernel_arg(s->ctx, k, args[q].name, args[q].size, args[q].value);
+  return st;
 }
 
 /* The press parameters both press kernels take. */
@@ -956,43 +820,35 @@ static gr_status gr_snow_object_step(gr_snow_deformation *s, int o, double dt) {
    * window's end, as what lies beyond is another object's or step's. */
   cl_int wx_end = wx1 + 1, wy_end = wy1 + 1, cx_end = cx1 + 1, cy_end = cy1 + 1;
   gr_snow_dirty(s, wx0, wy0, wx1, wy1);
-  gr_status st = GR_SNOW_ARG(s, s->raster, "tri", s->tri);
-  int tile0 = ob->tile0, ntx = ob->ntx, tile = ob->tile, bi0 = ob->bi0, bi1 = ob->bi1,
-      bj0 = ob->bj0, bj1 = ob->bj1;
+  cl_int first = ob->first, count = ob->count, bi0 = ob->bi0, bi1 = ob->bi1, bj0 = ob->bj0,
+         bj1 = ob->bj1;
+  gr_status st = GR_SNOW_ARG(s, s->raster_clear, "nx", nx);
   if (st == GR_OK)
-    st = GR_SNOW_ARG(s, s->raster, "tile_start", s->tile_start);
+    st = GR_SNOW_ARG(s, s->raster_clear, "ny", ny);
   if (st == GR_OK)
-    st = GR_SNOW_ARG(s, s->raster, "tile_list", s->tile_list);
+    st = GR_SNOW_ARG(s, s->raster_clear, "x_end", wx_end);
   if (st == GR_OK)
-    st = GR_SNOW_ARG(s, s->raster, "tile0", tile0);
+    st = GR_SNOW_ARG(s, s->raster_clear, "y_end", wy_end);
   if (st == GR_OK)
-    st = GR_SNOW_ARG(s, s->raster, "ntx", ntx);
+    st = GR_SNOW_ARG(s, s->raster_clear, "under", s->under);
   if (st == GR_OK)
-    st = GR_SNOW_ARG(s, s->raster, "tile", tile);
+    st = gr_enqueue_2d(ctx, s->raster_clear, WX0, WY0, WW, WH, NULL);
+  const gr_snow_arg raster[] = {{"tri", sizeof(cl_mem), &s->tri},
+                                {"first", sizeof(first), &first},
+                                {"count", sizeof(count), &count},
+                                {"nx", sizeof(nx), &nx},
+                                {"dx", sizeof(dx), &dx},
+                                {"dy", sizeof(dy), &dy},
+                                {"bi0", sizeof(bi0), &bi0},
+                                {"bi1", sizeof(bi1), &bi1},
+                                {"bj0", sizeof(bj0), &bj0},
+                                {"bj1", sizeof(bj1), &bj1},
+                                {"under", sizeof(cl_mem), &s->under}};
   if (st == GR_OK)
-    st = GR_SNOW_ARG(s, s->raster, "nx", nx);
-  if (st == GR_OK)
-    st = GR_SNOW_ARG(s, s->raster, "ny", ny);
-  if (st == GR_OK)
-    st = GR_SNOW_ARG(s, s->raster, "dx", dx);
-  if (st == GR_OK)
-    st = GR_SNOW_ARG(s, s->raster, "dy", dy);
-  if (st == GR_OK)
-    st = GR_SNOW_ARG(s, s->raster, "bi0", bi0);
-  if (st == GR_OK)
-    st = GR_SNOW_ARG(s, s->raster, "bi1", bi1);
-  if (st == GR_OK)
-    st = GR_SNOW_ARG(s, s->raster, "bj0", bj0);
-  if (st == GR_OK)
-    st = GR_SNOW_ARG(s, s->raster, "bj1", bj1);
-  if (st == GR_OK)
-    st = GR_SNOW_ARG(s, s->raster, "under", s->under);
-  if (st == GR_OK)
-    st = GR_SNOW_ARG(s, s->raster, "x_end", wx_end);
-  if (st == GR_OK)
-    st = GR_SNOW_ARG(s, s->raster, "y_end", wy_end);
-  if (st == GR_OK)
-    st = gr_enqueue_2d(ctx, s->raster, WX0, WY0, WW, WH, NULL);
+    st = gr_snow_args(s, s->raster, raster, sizeof(raster) / sizeof(raster[0]));
+  const size_t line[2] = {64, 1}; /* one work-item per triangle */
+  if (st == GR_OK && count > 0)
+    st = gr_enqueue_2d(ctx, s->raster, 0, 0, (size_t)count, 1, line);
   if (st == GR_OK)
     st = gr_snow_mark(s, &s->tm.raster_ms);
   /* overlap */
@@ -1199,21 +1055,6 @@ static void gr_snow_thresholds(const gr_snow_deformation *s, float thr[3]) {
   thr[0] = (float)(slope * dx);
   thr[1] = (float)(slope * dy);
   thr[2] = (float)(slope * sqrt(dx * dx + dy * dy));
-}
-
-/* A named kernel argument. */
-typedef struct gr_snow_arg {
-  const char *name;
-  size_t size;
-  const void *value;
-} gr_snow_arg;
-
-static gr_status gr_snow_args(gr_snow_deformation *s, cl_kernel k, const gr_snow_arg *args,
-                              size_t n) {
-  gr_status st = GR_OK;
-  for (size_t q = 0; st == GR_OK && q < n; ++q)
-    st = gr_kernel_arg(s->ctx, k, args[q].name, args[q].size, args[q].value);
-  return st;
 }
 
 /* Iteration t of a launch whose givers' window at t = 0 is [gx0, gx_end) x

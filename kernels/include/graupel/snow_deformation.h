@@ -15,7 +15,9 @@
  *     object's surface crosses the vertical line through grid point (i, j):
  *     the exact minimum over every triangle whose xy projection contains the
  *     point (edges included), of the triangle's plane at the point; +inf
- *     where no triangle covers it (not a bounding box).
+ *     where no triangle covers it (not a bounding box). A scatter, one
+ *     work-item per triangle, into an integer atomic minimum of the heights'
+ *     order-preserving bits: the exact minimum whatever the order.
  *  2. overlap: D = min(S, max(0, H - U)) (the ground is rigid: snow never
  *     goes below it, so an object below the ground presses at most S).
  *  3. compression vs displacement (Eqs. 3.9-3.11 made mass-consistent):
