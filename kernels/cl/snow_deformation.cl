@@ -297,8 +297,8 @@ GR_INLINE float snow_threshold(int di, int dj, float tx, float ty, float td) {
  * x_ab min(k_out_a, k_in_b). Thermal erosion's bound: a gives at most
  * GR_SNOW_TALUS_SHARE of its largest excess in all (and never more than it
  * holds) and b takes at most that share of its largest incoming excess, so
- * a lone pair levels to the threshold in one iteration and a pit filled
- * from eight sides at once still does not rise above them. A point gives
+ * a lone pair ends a little below the threshold in one iteration and a pit
+ * filled from eight sides at once still does not rise above them. A point gives
  * only if it is a giver (in the iteration's window) and can move more than
  * tol, min(S, its largest excess) (mv, for the check): the relaxation ends
  * when none can, and the points still moving bound the next window. */

@@ -4,11 +4,16 @@
 #ifndef GRAUPEL_CL_SNOW_DEFORMATION_SHARED_H
 #define GRAUPEL_CL_SNOW_DEFORMATION_SHARED_H
 
-/* The talus share (thermal erosion): a point gives at most this fraction of
- * its largest excess per iteration, and a point takes at most this fraction
- * of its largest incoming excess; 1/2 levels a lone pair to the threshold in
- * one iteration. */
-#define GR_SNOW_TALUS_SHARE 0.5f
+/* The talus share (thermal erosion): a point gives at most this fraction
+ * of its largest excess per iteration, and a point takes at most this
+ * fraction of its largest incoming excess. 1/2 would level a lone pair to
+ * the threshold in one iteration; 3/4 takes it a quarter of the excess
+ * below (over-relaxation), which carries a small excess down a long slope
+ * at the talus angle in far fewer iterations (measured: the talus column in
+ * 8 iterations instead of 24, the trail's worst step in 68 instead of 192)
+ * and leaves the cone within 1 % of its analytic top; from 0.8 on the cone
+ * comes out visibly flatter than MaxSlope (3.5 % at 0.8, 22 % at 0.9). */
+#define GR_SNOW_TALUS_SHARE 0.75f
 
 /* A cell gives at most this fraction of its snow in one talus iteration, so
  * that rounding never takes it below zero. */

@@ -57,11 +57,15 @@
  * 8-neighbour b the excess x_ab = max(0, H_a - H_b - MaxSlope d_ab), d_ab
  * the pair's distance (dx, dy or the diagonal: the slope is a true slope,
  * unlike the thesis' per-cell constant), times min(k_a, k_in_b), the
- * thermal-erosion limits on both sides of the pair: a gives at most half its
- * largest excess in all (and no more than S_a), b takes at most half its
- * largest incoming excess (so heights never cross and a lone pair levels in
- * one iteration); never to a point under an object whose underside is below
- * H_a (U_b <= H_a), which holds the imprint. Moved snow carries its density
+ * thermal-erosion limits on both sides of the pair: a gives at most 3/4 of
+ * its largest excess in all (and no more than S_a), b takes at most 3/4 of
+ * its largest incoming excess: a lone pair with excess x ends at the
+ * threshold minus x/2, an over-relaxation that settles long slopes in a
+ * third of the iterations of exact levelling (see GR_SNOW_TALUS_SHARE; a
+ * pair overshoots past level only where x exceeds twice the threshold, and
+ * the next iteration sends the overshoot back); never to a point under an
+ * object whose underside is below H_a (U_b <= H_a), which holds the
+ * imprint. Moved snow carries its density
  * (mass mixes). Only a point that can move more than RelaxTolerance gives
  * (min(S_a, largest x_ab)), and the relaxation stops when none can (read
  * every 4 iterations, with the box of those points, which bounds the next
