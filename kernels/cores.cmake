@@ -10,5 +10,6 @@
 set(GRAUPEL_CORES
   procedural_terrain
   rain_runoff
+  snow_accumulation
   snow_deformation
 )

@@ -11,6 +11,13 @@
  *                            water balance within 1e-4 of the water that came
  *                            in; a second simulation is created, stepped and
  *                            freed every 10^4 steps
+ *   test_soak snow_accumulation N   tilted, fluttering snow on a small rough
+ *                            field with a box circling over it, stepped N
+ *                            times; every 1000 steps the depths must be
+ *                            finite, 0 to MaxDepth, and the ledger closed
+ *                            (1e-9 of the snowfall); a checkpoint goes into
+ *                            a second simulation, freed again, every 10^4
+ *                            steps
  *   test_soak snow_deformation N    a box moving in circles over a small snow
  *                            field, stepped N times; every 1000 steps the
  *                            depth and density must be finite and in range
@@ -26,6 +33,7 @@
 #include "graupel/exr_io.h"
 #include "graupel/rain_runoff.h"
 #include "graupel/procedural_terrain.h"
+#include "graupel/snow_accumulation.h"
 #include "graupel/snow_deformation.h"
 #include "gr_test.h"
 
@@ -319,6 +327,116 @@ static void soak_rain_runoff(long n) {
   gr_context_release(ctx);
 }
 
+static void soak_snow_accumulation(long n) {
+  gr_context *ctx = NULL;
+  if (gr_context_acquire(NULL, &ctx) != GR_OK) {
+    CHECK_MSG(0, "%s", gr_last_error(NULL));
+    return;
+  }
+  const gr_grid g = {24, 20, 0.1, 0.1, 0.0, 0.0, 0, 0};
+  const size_t cells = (size_t)g.nx * (size_t)g.ny;
+  float *d = malloc(cells * sizeof(float)), *b = malloc(cells * sizeof(float));
+  for (size_t c = 0; c < cells; ++c)
+    b[c] = (float)(0.2 * sin(0.5 * (double)(c % 24)) * cos(0.4 * (double)(c / 24)));
+  static const float bv[] = {-0.3f, -0.2f, -0.2f, 0.3f,  -0.2f, -0.2f, 0.3f, 0.2f,
+                             -0.2f, -0.3f, 0.2f,  -0.2f, -0.3f, -0.2f, 0.2f, 0.3f,
+                             -0.2f, 0.2f,  0.3f,  0.2f,  0.2f,  -0.3f, 0.2f, 0.2f};
+  static const int bt[] = {0, 2, 1, 0, 3, 2, 4, 5, 6, 4, 6, 7, 0, 1, 5, 0, 5, 4,
+                           1, 2, 6, 1, 6, 5, 2, 3, 7, 2, 7, 6, 3, 0, 4, 3, 4, 7};
+  gr_mesh box = {bv, 8, bt, 12, {0}};
+  gr_snow_accumulation_params p;
+  gr_snow_accumulation_params_init(&p);
+  p.exposure_resolution = 128;
+  p.snowfall_rate = 1e-4;
+  p.max_depth = 0.3;
+  p.stability_factor = 0.5;
+  p.flutter = 0.05;
+  p.blur_radius = 2;
+  p.dilation = 1;
+  p.direction[0] = 0.3;
+  gr_snow_accumulation *sim = NULL;
+  gr_status st = gr_snow_accumulation_create(ctx, &g, &p, &sim);
+  if (st == GR_OK)
+    st = gr_snow_accumulation_set_field(sim, GR_FIELD_ELEVATION, b);
+  CHECK_MSG(st == GR_OK, "set-up: %s", gr_last_error(ctx));
+  long first = 0, done = 0;
+  double worst = 0.0, t0 = (double)clock(), dt = 30.0;
+  while (st == GR_OK && done < n) {
+    /* A circle of 0.6 m radius every 600 steps, 0.8 m above the ground. */
+    double a = 2.0 * 3.14159265358979 * (double)(done % 600) / 600.0;
+    for (int k = 0; k < 16; ++k)
+      box.transform[k] = (k % 5 == 0) ? 1.0 : 0.0;
+    box.transform[12] = 1.2 + 0.6 * cos(a);
+    box.transform[13] = 1.0 + 0.6 * sin(a);
+    box.transform[14] = 0.8;
+    st = gr_snow_accumulation_set_objects(sim, &box, 1);
+    if (st == GR_OK)
+      st = gr_snow_accumulation_step(sim, dt);
+    ++done;
+    if (st == GR_OK && (done % 1000 == 0 || done == n)) {
+      gr_snow_accumulation_ledger led;
+      st = gr_snow_accumulation_get_field(sim, GR_FIELD_SNOW_DEPTH, d);
+      if (st == GR_OK)
+        st = gr_snow_accumulation_ledger_get(sim, &led);
+      if (st != GR_OK)
+        break;
+      int bad = 0;
+      /* The soft cap lets the depth stand a little above MaxDepth: at
+       * most a step's fall, shed at half per second. */
+      for (size_t i = 0; i < cells; ++i)
+        bad += !(d[i] >= 0.0f && d[i] <= 0.31f);
+      CHECK_MSG(bad == 0, "step %ld: %d depths not finite or out of range", done, bad);
+      double rel = fabs(led.balance_error) / led.snowfall_volume;
+      worst = fmax(worst, rel);
+      CHECK_MSG(rel <= 1e-9, "step %ld: balance error %g of the snowfall", done, rel);
+      CHECK_MSG(led.steps == done, "ledger counts %lld steps, %ld were taken", led.steps, done);
+      if (done % 10000 == 0) {
+        gr_snow_accumulation *other = NULL;
+        size_t bytes = 0;
+        gr_status so = gr_snow_accumulation_create(ctx, &g, &p, &other);
+        if (so == GR_OK)
+          so = gr_snow_accumulation_set_objects(other, &box, 1);
+        if (so == GR_OK)
+          so = gr_snow_accumulation_state_size(sim, &bytes);
+        void *state = so == GR_OK ? malloc(bytes) : NULL;
+        if (state) {
+          so = gr_snow_accumulation_state_save(sim, state, bytes);
+          if (so == GR_OK)
+            so = gr_snow_accumulation_state_load(other, state, bytes);
+          CHECK(gr_snow_accumulation_state_load(other, state, bytes / 2) ==
+                GR_ERR_INVALID_ARGUMENT);
+        }
+        gr_snow_accumulation_ledger lo;
+        if (so == GR_OK)
+          so = gr_snow_accumulation_ledger_get(other, &lo);
+        CHECK_MSG(so == GR_OK && lo.steps == done && lo.stored_volume == led.stored_volume,
+                  "checkpoint: %s",
+                  other ? gr_snow_accumulation_last_error(other) : gr_last_error(ctx));
+        free(state);
+        gr_snow_accumulation_destroy(other);
+      }
+    }
+    if (done == n / 10)
+      first = rss_kib();
+    if (gr_test_failures > 10)
+      break;
+  }
+  CHECK_MSG(st == GR_OK, "step %ld: %s", done, sim ? gr_snow_accumulation_last_error(sim) : "");
+  long last = rss_kib();
+  gr_snow_accumulation_ledger led;
+  if (sim && gr_snow_accumulation_ledger_get(sim, &led) == GR_OK)
+    printf("snow accumulation soak: %ld steps in %.1f s CPU; worst balance error %.3g of the "
+           "snowfall; snowfall %.4g m^3, stored %.4g (objects %.4g), shed %.4g; resident %ld KiB "
+           "after %ld steps, %ld KiB at the end\n",
+           done, ((double)clock() - t0) / CLOCKS_PER_SEC, worst, led.snowfall_volume,
+           led.stored_volume, led.stored_volume_objects, led.shed_volume, first, n / 10, last);
+  CHECK_MSG(last - first < GR_SOAK_SLACK_KIB, "resident memory grew by %ld KiB", last - first);
+  gr_snow_accumulation_destroy(sim);
+  free(d);
+  free(b);
+  gr_context_release(ctx);
+}
+
 static void soak_snow_deformation(long n) {
   gr_context *ctx = NULL;
   if (gr_context_acquire(NULL, &ctx) != GR_OK) {
@@ -425,7 +543,7 @@ static void soak_snow_deformation(long n) {
 int main(int argc, char **argv) {
   if (argc < 3) {
     fprintf(stderr, "usage: test_soak runtime N | procedural_terrain N DIR | rain_runoff N | "
-                    "snow_deformation N\n");
+                    "snow_accumulation N | snow_deformation N\n");
     return 2;
   }
   long n = atol(argv[2]);
@@ -439,11 +557,13 @@ int main(int argc, char **argv) {
     soak_procedural_terrain(n, argv[3]);
   else if (strcmp(argv[1], "rain_runoff") == 0)
     soak_rain_runoff(n);
+  else if (strcmp(argv[1], "snow_accumulation") == 0)
+    soak_snow_accumulation(n);
   else if (strcmp(argv[1], "snow_deformation") == 0)
     soak_snow_deformation(n);
   else {
     fprintf(stderr, "usage: test_soak runtime N | procedural_terrain N DIR | rain_runoff N | "
-                    "snow_deformation N\n");
+                    "snow_accumulation N | snow_deformation N\n");
     return 2;
   }
   return GR_TEST_RESULT();

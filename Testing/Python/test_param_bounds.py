@@ -75,6 +75,11 @@ def fmt(row):
 
 
 # ------------------------------------------------------------------ the XML
+# A core lands before its filter (the VTK-free layer first); until the
+# filter comes it is named here, so that a core without a proxy is a
+# decision, not an oversight. Its table is checked against the README
+# when the filter brings the README's table.
+CORE_ONLY = {"snow_accumulation"}
 LoadPlugin(a.plugin, ns=globals())
 pxm = servermanager.ProxyManager()
 for core in tables:
@@ -84,6 +89,10 @@ for core in tables:
         if proto is not None:
             CORES[core] = (group, name, proto.GetVTKClassName())
             break
+    if core in CORE_ONLY:
+        T.check(core not in CORES, "the core %s has its proxy %s now: take it off CORE_ONLY"
+                % (core, name))
+        continue
     T.check(core in CORES, "the core %s has a proxy named %s in the plugin" % (core, name))
 
 

@@ -93,18 +93,18 @@ extern "C" {
  * GR_SNOW_ACCUMULATION_MAX_TILT degrees from straight down; default 0 0 -1).
  */
 typedef struct gr_snow_accumulation_params {
-  double direction[3];    /**< SnowDirection, any length (normalised) */
-  double flutter;         /**< rad, the largest random turn per step (row Flutter) */
-  double snowfall_rate;   /**< m/s (row SnowfallRate, cm/h) */
-  double noise_amplitude; /**< A (row NoiseAmplitude) */
-  double noise_scale;     /**< m, the noise lattice (row NoiseScale) */
-  int seed;               /**< row Seed */
+  double direction[3];     /**< SnowDirection, any length (normalised) */
+  double flutter;          /**< rad, the largest random turn per step (row Flutter) */
+  double snowfall_rate;    /**< m/s (row SnowfallRate, cm/h) */
+  double noise_amplitude;  /**< A (row NoiseAmplitude) */
+  double noise_scale;      /**< m, the noise lattice (row NoiseScale) */
+  int seed;                /**< row Seed */
   int exposure_resolution; /**< texels across the view (row ExposureResolution) */
-  int blur_radius;        /**< grid points (row BlurRadius) */
-  int dilation;           /**< 0 or 1 (row Dilation) */
-  double max_depth;       /**< m, the capacity of a horizontal surface (row MaxDepth) */
+  int blur_radius;         /**< grid points (row BlurRadius) */
+  int dilation;            /**< 0 or 1 (row Dilation) */
+  double max_depth;        /**< m, the capacity of a horizontal surface (row MaxDepth) */
   double stability_factor; /**< f, per second (row StabilityFactor) */
-  double snow_density;    /**< kg/m^3 of the fresh snow (row SnowDensity) */
+  double snow_density;     /**< kg/m^3 of the fresh snow (row SnowDensity) */
 } gr_snow_accumulation_params;
 
 /** The table's defaults, direction 0 0 -1. */
@@ -194,8 +194,8 @@ GR_API gr_status gr_snow_accumulation_get_object_field(gr_snow_accumulation *s, 
                                                        float *host, int n);
 
 /** Object o's snow cap as offsets: 3 floats per mesh point, world normal x depth (m). */
-GR_API gr_status gr_snow_accumulation_get_object_offsets(gr_snow_accumulation *s, int o,
-                                                         float *xyz, int n);
+GR_API gr_status gr_snow_accumulation_get_object_offsets(gr_snow_accumulation *s, int o, float *xyz,
+                                                         int n);
 
 /** Sets object o's snow per mesh point (m, 0 to 1e4); the initial volume moves by the change. */
 GR_API gr_status gr_snow_accumulation_set_object_snow(gr_snow_accumulation *s, int o,
@@ -227,8 +227,7 @@ GR_API void gr_snow_accumulation_set_progress(gr_snow_accumulation *s, gr_progre
  * object poses are not part of it.
  */
 GR_API gr_status gr_snow_accumulation_state_size(const gr_snow_accumulation *s, size_t *bytes);
-GR_API gr_status gr_snow_accumulation_state_save(gr_snow_accumulation *s, void *host,
-                                                 size_t bytes);
+GR_API gr_status gr_snow_accumulation_state_save(gr_snow_accumulation *s, void *host, size_t bytes);
 GR_API gr_status gr_snow_accumulation_state_load(gr_snow_accumulation *s, const void *host,
                                                  size_t bytes);
 

@@ -1,0 +1,830 @@
+/* Tests of the snow accumulation core (graupel/snow_accumulation.h): the
+ * ledger, exposure (occluded ground, vertical faces, the lee of a wall in
+ * tilted snow), growth (rate x t within the noise, the cap MaxDepth x cos
+ * of the slope, the thesis' zeroing branch not copied), independence of
+ * the number of steps, snow on objects that moves with them, determinism,
+ * checkpoints, the parameter table and the error paths. */
+#include "gr_test.h"
+
+#include "graupel/snow_accumulation.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#ifndef M_PI
+#define M_PI 3.14159265358979323846
+#endif
+
+static gr_context *ctx;
+
+/* A mesh owned by the test: vertices, triangles and the pose. */
+typedef struct test_mesh {
+  float *v;
+  int *t;
+  gr_mesh m;
+} test_mesh;
+
+static void mesh_pose(test_mesh *tm, double x, double y, double z) {
+  for (int k = 0; k < 16; ++k)
+    tm->m.transform[k] = (k % 5 == 0) ? 1.0 : 0.0;
+  tm->m.transform[12] = x;
+  tm->m.transform[13] = y;
+  tm->m.transform[14] = z;
+}
+
+/* A closed box of half sizes (hx, hy, hz) about its centre: 8 corners. */
+static void mesh_box(test_mesh *tm, double hx, double hy, double hz) {
+  static const int tri[] = {0, 2, 1, 0, 3, 2, 4, 5, 6, 4, 6, 7, 0, 1, 5, 0, 5, 4,
+                            1, 2, 6, 1, 6, 5, 2, 3, 7, 2, 7, 6, 3, 0, 4, 3, 4, 7};
+  tm->v = malloc(24 * sizeof(float));
+  tm->t = malloc(sizeof(tri));
+  for (int k = 0; k < 8; ++k) {
+    tm->v[3 * k + 0] = (float)((k == 1 || k == 2 || k == 5 || k == 6) ? hx : -hx);
+    tm->v[3 * k + 1] = (float)((k == 2 || k == 3 || k == 6 || k == 7) ? hy : -hy);
+    tm->v[3 * k + 2] = (float)(k >= 4 ? hz : -hz);
+  }
+  memcpy(tm->t, tri, sizeof(tri));
+  tm->m.vertices = tm->v;
+  tm->m.nvertices = 8;
+  tm->m.triangles = tm->t;
+  tm->m.ntriangles = 12;
+  mesh_pose(tm, 0, 0, 0);
+}
+
+/* A box whose six faces are m x m grids of their own points, so that every
+ * point has its face's normal: face 0 is the top ((m + 1)^2 points first),
+ * then the bottom, +x, -x, +y, -y; wound counter-clockwise from outside. */
+static void mesh_faces(test_mesh *tm, double hx, double hy, double hz, int m) {
+  const double o[6][3] = {{-hx, -hy, hz},  {-hx, -hy, -hz}, {hx, -hy, -hz},
+                          {-hx, -hy, -hz}, {-hx, hy, -hz},  {-hx, -hy, -hz}};
+  const double u[6][3] = {{2 * hx, 0, 0}, {0, 2 * hy, 0}, {0, 2 * hy, 0},
+                          {0, 0, 2 * hz}, {0, 0, 2 * hz}, {2 * hx, 0, 0}};
+  const double w[6][3] = {{0, 2 * hy, 0}, {2 * hx, 0, 0}, {0, 0, 2 * hz},
+                          {0, 2 * hy, 0}, {2 * hx, 0, 0}, {0, 0, 2 * hz}};
+  int per = (m + 1) * (m + 1);
+  tm->v = malloc((size_t)6 * per * 3 * sizeof(float));
+  tm->t = malloc((size_t)6 * m * m * 6 * sizeof(int));
+  int k = 0;
+  for (int f = 0; f < 6; ++f) {
+    for (int b = 0; b <= m; ++b)
+      for (int a = 0; a <= m; ++a)
+        for (int e = 0; e < 3; ++e)
+          tm->v[3 * (f * per + b * (m + 1) + a) + e] =
+              (float)(o[f][e] + u[f][e] * a / m + w[f][e] * b / m);
+    for (int b = 0; b < m; ++b)
+      for (int a = 0; a < m; ++a) {
+        int p00 = f * per + b * (m + 1) + a, p10 = p00 + 1, p01 = p00 + m + 1, p11 = p01 + 1;
+        tm->t[k++] = p00, tm->t[k++] = p10, tm->t[k++] = p11;
+        tm->t[k++] = p00, tm->t[k++] = p11, tm->t[k++] = p01;
+      }
+  }
+  tm->m.vertices = tm->v;
+  tm->m.nvertices = 6 * per;
+  tm->m.triangles = tm->t;
+  tm->m.ntriangles = k / 3;
+  mesh_pose(tm, 0, 0, 0);
+}
+
+static void mesh_free(test_mesh *tm) {
+  free(tm->v);
+  free(tm->t);
+}
+
+static gr_snow_accumulation *make_sim(int nx, int ny, double dx,
+                                      const gr_snow_accumulation_params *p) {
+  gr_grid g = {.nx = nx, .ny = ny, .dx = dx, .dy = dx};
+  gr_snow_accumulation *s = NULL;
+  gr_status st = gr_snow_accumulation_create(ctx, &g, p, &s);
+  CHECK_MSG(st == GR_OK, "create: %s", gr_last_error(ctx));
+  return s;
+}
+
+static float *get(gr_snow_accumulation *s, gr_field f, int n) {
+  float *a = malloc((size_t)n * sizeof(float));
+  gr_status st = gr_snow_accumulation_get_field(s, f, a);
+  CHECK_MSG(st == GR_OK, "get_field: %s", gr_snow_accumulation_last_error(s));
+  return a;
+}
+
+static float *get_object(gr_snow_accumulation *s, int o, gr_field f, int n) {
+  float *a = malloc((size_t)n * sizeof(float));
+  gr_status st = gr_snow_accumulation_get_object_field(s, o, f, a, n);
+  CHECK_MSG(st == GR_OK, "get_object_field: %s", gr_snow_accumulation_last_error(s));
+  return a;
+}
+
+static void run(gr_snow_accumulation *s, int steps, double dt) {
+  for (int k = 0; k < steps; ++k) {
+    gr_status st = gr_snow_accumulation_step(s, dt);
+    if (st != GR_OK) {
+      CHECK_MSG(0, "step %d: %s", k, gr_snow_accumulation_last_error(s));
+      return;
+    }
+  }
+}
+
+/* A plain parameter set: vertical snow, no noise, blur or flutter, rate
+ * in m/s, MaxDepth in m. */
+static void plain(gr_snow_accumulation_params *p, double rate, double max_depth) {
+  gr_snow_accumulation_params_init(p);
+  p->snowfall_rate = rate;
+  p->noise_amplitude = 0.0;
+  p->blur_radius = 0;
+  p->max_depth = max_depth;
+  p->exposure_resolution = 256;
+}
+
+static void test_param_table(void) {
+  int n = 0;
+  const gr_param_bound *t = gr_snow_accumulation_param_bounds(&n);
+  CHECK(n == 11);
+  const char *names[] = {"Flutter",  "SnowfallRate",       "NoiseAmplitude", "NoiseScale",
+                         "Seed",     "ExposureResolution", "BlurRadius",     "Dilation",
+                         "MaxDepth", "StabilityFactor",    "SnowDensity"};
+  for (int r = 0; r < n && r < 11; ++r)
+    CHECK(strcmp(t[r].property, names[r]) == 0);
+  gr_snow_accumulation_params p, q;
+  gr_snow_accumulation_params_init(&p);
+  char msg[400];
+  CHECK(gr_snow_accumulation_params_validate(&p, msg, sizeof(msg)) == GR_OK);
+  CHECK(p.direction[0] == 0.0 && p.direction[1] == 0.0 && p.direction[2] == -1.0);
+  CHECK(p.exposure_resolution == 1024 && p.snow_density == 100.0 && p.dilation == 0);
+  CHECK_NEAR(p.snowfall_rate, 0.02 / 3600.0, 1e-15);
+  /* Each row: its bounds accepted, beyond them refused with a sentence
+   * naming the property. */
+  for (int r = 0; r < n; ++r) {
+    double lo = t[r].min * t[r].to_core, hi = t[r].max * t[r].to_core;
+    double vals[4] = {lo, hi, lo - fabs(lo) - 1.0, hi * 2.0 + 1.0};
+    if (t[r].min_open)
+      vals[0] = 0.5 * hi, vals[2] = lo;
+    for (int k = 0; k < 4; ++k) {
+      gr_snow_accumulation_params_init(&q);
+      double v = vals[k];
+      switch (r) {
+      case 0:
+        q.flutter = v;
+        break;
+      case 1:
+        q.snowfall_rate = v;
+        break;
+      case 2:
+        q.noise_amplitude = v;
+        break;
+      case 3:
+        q.noise_scale = v;
+        break;
+      case 4:
+        q.seed = v > 2147483647.0 ? -1 : (int)v;
+        break;
+      case 5:
+        q.exposure_resolution = (int)v;
+        break;
+      case 6:
+        q.blur_radius = (int)v;
+        break;
+      case 7:
+        q.dilation = (int)v;
+        break;
+      case 8:
+        q.max_depth = v;
+        break;
+      case 9:
+        q.stability_factor = v;
+        break;
+      default:
+        q.snow_density = v;
+      }
+      msg[0] = 0;
+      gr_status st = gr_snow_accumulation_params_validate(&q, msg, sizeof(msg));
+      if (k < 2)
+        CHECK_MSG(st == GR_OK, "row %s value %g: %s", t[r].property, v, msg);
+      else
+        CHECK_MSG(st == GR_ERR_INVALID_ARGUMENT && strstr(msg, t[r].property),
+                  "row %s value %g: %s", t[r].property, v, msg);
+    }
+  }
+  /* The direction: degenerate, not finite, sideways, upward or tilted
+   * beyond 75 degrees is refused; any length is fine. */
+  const double bad[][3] = {{0, 0, 0},        {NAN, 0, -1},
+                           {1, 0, 0},        {0, 0, 1},
+                           {0, 1e-30, 0},    {sin(80 * M_PI / 180), 0, -cos(80 * M_PI / 180)},
+                           {INFINITY, 0, -1}};
+  for (size_t k = 0; k < sizeof(bad) / sizeof(bad[0]); ++k) {
+    gr_snow_accumulation_params_init(&q);
+    memcpy(q.direction, bad[k], sizeof(q.direction));
+    msg[0] = 0;
+    CHECK_MSG(gr_snow_accumulation_params_validate(&q, msg, sizeof(msg)) ==
+                      GR_ERR_INVALID_ARGUMENT &&
+                  strstr(msg, "SnowDirection"),
+              "direction %zu: %s", k, msg);
+  }
+  gr_snow_accumulation_params_init(&q);
+  q.direction[0] = 5.0 * sin(70 * M_PI / 180), q.direction[2] = -5.0 * cos(70 * M_PI / 180);
+  CHECK(gr_snow_accumulation_params_validate(&q, msg, sizeof(msg)) == GR_OK);
+  CHECK(gr_snow_accumulation_params_validate(NULL, msg, sizeof(msg)) == GR_ERR_INVALID_ARGUMENT);
+}
+
+/* Flat ground, no occluder: every point grows at rate x t times its noise
+ * factor (within [1 - A, 1 + A]), exactly rate x t without noise, never
+ * faster, and stops at MaxDepth (the thesis' branch that zeroes snow below
+ * capacity would leave nothing). */
+static void test_flat_growth(void) {
+  const int nx = 24, ny = 20, n = nx * ny;
+  const double rate = 1e-4, A = 0.3, md = 0.5;
+  gr_snow_accumulation_params p;
+  plain(&p, rate, md);
+  p.noise_amplitude = A;
+  p.noise_scale = 0.3;
+  gr_snow_accumulation *s = make_sim(nx, ny, 0.1, &p);
+  if (!s)
+    return;
+  run(s, 20, 50.0); /* 1000 s: 0.1 m */
+  float *d = get(s, GR_FIELD_SNOW_DEPTH, n);
+  double lo = 1e9, hi = -1e9, sum = 0.0;
+  for (int c = 0; c < n; ++c)
+    lo = fmin(lo, d[c]), hi = fmax(hi, d[c]), sum += d[c];
+  printf("flat: depth after 1000 s from %.5f to %.5f m, mean %.5f (rate x t = 0.1)\n", lo, hi,
+         sum / n);
+  CHECK(lo >= (1.0 - A) * 0.1 - 1e-7 && hi <= (1.0 + A) * 0.1 + 1e-7);
+  CHECK(hi - lo > 0.2 * A * 0.1); /* the noise is there */
+  CHECK(fabs(sum / n - 0.1) < 0.25 * A * 0.1);
+  free(d);
+  /* Without noise: exactly rate x t, then the cap. */
+  p.noise_amplitude = 0.0;
+  CHECK(gr_snow_accumulation_set_params(s, &p) == GR_OK);
+  CHECK(gr_snow_accumulation_reset(s) == GR_OK);
+  run(s, 20, 50.0);
+  d = get(s, GR_FIELD_SNOW_DEPTH, n);
+  double worst = 0.0;
+  for (int c = 0; c < n; ++c)
+    worst = fmax(worst, fabs(d[c] - 0.1));
+  printf("flat: without noise |depth - rate t| <= %.3g m\n", worst);
+  CHECK(worst <= 1e-6);
+  free(d);
+  run(s, 200, 50.0); /* 11000 s in all: 1.1 m would fall, the cap is 0.5 */
+  d = get(s, GR_FIELD_SNOW_DEPTH, n);
+  float *e = get(s, GR_FIELD_EXPOSURE, n);
+  worst = 0.0;
+  int exposed = 0;
+  for (int c = 0; c < n; ++c)
+    worst = fmax(worst, fabs(d[c] - md)), exposed += e[c] == 1.0f;
+  CHECK(exposed == n);
+  CHECK_MSG(worst <= 1e-6, "capped depth off MaxDepth by %g", worst);
+  gr_snow_accumulation_ledger l;
+  CHECK(gr_snow_accumulation_ledger_get(s, &l) == GR_OK);
+  double area = 0.1 * 0.1 * n;
+  CHECK_NEAR(l.snowfall_volume, rate * 11000.0 * area, 1e-6 * rate * 11000.0 * area);
+  CHECK_NEAR(l.shed_volume, (rate * 11000.0 - md) * area, 1e-6 * rate * 11000.0 * area);
+  free(d), free(e);
+  gr_snow_accumulation_destroy(s);
+}
+
+/* A planar slope of angle theta under vertical snow settles at
+ * MaxDepth cos(theta) with StabilityFactor 1. */
+static void test_slope(void) {
+  const int nx = 20, ny = 12, n = nx * ny;
+  const double md = 0.5;
+  for (int k = 0; k < 2; ++k) {
+    double theta = (k ? 60.0 : 30.0) * M_PI / 180.0;
+    gr_snow_accumulation_params p;
+    plain(&p, 1e-3, md);
+    gr_snow_accumulation *s = make_sim(nx, ny, 0.1, &p);
+    if (!s)
+      return;
+    float *b = malloc(n * sizeof(float));
+    for (int c = 0; c < n; ++c)
+      b[c] = (float)((c % nx) * 0.1 * tan(theta));
+    CHECK(gr_snow_accumulation_set_field(s, GR_FIELD_ELEVATION, b) == GR_OK);
+    run(s, 40, 50.0); /* 2 m would fall on a level surface */
+    float *d = get(s, GR_FIELD_SNOW_DEPTH, n), *e = get(s, GR_FIELD_EXPOSURE, n);
+    double worst = 0.0, want = md * cos(theta);
+    int exposed = 0;
+    for (int c = 0; c < n; ++c)
+      worst = fmax(worst, fabs(d[c] - want)), exposed += e[c] == 1.0f;
+    printf("slope %.0f deg: depth %.6f m (MaxDepth cos = %.6f), worst %.3g; %d of %d exposed\n",
+           theta * 180 / M_PI, d[nx + 5], want, worst, exposed, n);
+    CHECK(exposed == n);
+    CHECK(worst <= 1e-5);
+    free(b), free(d), free(e);
+    gr_snow_accumulation_destroy(s);
+  }
+}
+
+/* A box lid over the ground: the ground under it gets exactly nothing
+ * (beyond the blur radius and the dilation), the ground around and the
+ * lid's top get snow, the lid's underside none. */
+static void test_occluded(void) {
+  const int nx = 40, ny = 40, n = nx * ny;
+  gr_snow_accumulation_params p;
+  plain(&p, 1e-4, 1.0);
+  p.noise_amplitude = 0.2;
+  p.blur_radius = 2;
+  p.dilation = 1;
+  p.direction[0] = 0.05; /* a little tilt: the lid still covers its middle */
+  gr_snow_accumulation *s = make_sim(nx, ny, 0.1, &p);
+  if (!s)
+    return;
+  test_mesh lid;
+  mesh_faces(&lid, 1.0, 1.0, 0.1, 4);
+  mesh_pose(&lid, 2.0, 2.0, 1.0); /* x, y 1 to 3 m, z 0.9 to 1.1 m */
+  CHECK(gr_snow_accumulation_set_objects(s, &lid.m, 1) == GR_OK);
+  run(s, 30, 60.0);
+  float *d = get(s, GR_FIELD_SNOW_DEPTH, n), *e = get(s, GR_FIELD_EXPOSURE, n);
+  int under = 0, under_snow = 0, open = 0, open_bare = 0;
+  for (int j = 0; j < ny; ++j)
+    for (int i = 0; i < nx; ++i) {
+      int c = j * nx + i;
+      double x = i * 0.1, y = j * 0.1;
+      /* 3 points inside the lid's edge, more than blur + dilation */
+      if (x > 1.35 && x < 2.65 && y > 1.35 && y < 2.65)
+        under++, under_snow += d[c] != 0.0f || e[c] != 0.0f;
+      if (x < 0.6 || x > 3.4 || y < 0.6 || y > 3.4)
+        open++, open_bare += !(d[c] > 0.0f) || e[c] != 1.0f;
+    }
+  printf("occluded: %d points under the lid, %d with snow; %d in the open, %d bare\n", under,
+         under_snow, open, open_bare);
+  CHECK(under > 100 && under_snow == 0);
+  CHECK(open > 400 && open_bare == 0);
+  int nv = lid.m.nvertices, per = 25;
+  float *od = get_object(s, 0, GR_FIELD_SNOW_DEPTH, nv),
+        *oe = get_object(s, 0, GR_FIELD_EXPOSURE, nv);
+  int top_ok = 0, bottom_bare = 0;
+  /* The underside gets nothing; its points off the edge are hidden (those
+   * on the edge see the sky past it, but face away from the snow). */
+  for (int v = 0; v < per; ++v) {
+    int inner = v % 5 > 0 && v % 5 < 4 && v / 5 > 0 && v / 5 < 4;
+    top_ok += oe[v] == 1.0f && od[v] > 0.8f * 1e-4 * 1800.0 && od[v] < 1.2f * 1e-4 * 1800.0;
+    bottom_bare += od[per + v] == 0.0f && (!inner || oe[per + v] == 0.0f);
+  }
+  CHECK_MSG(top_ok == per, "%d of %d top points exposed with rate t snow", top_ok, per);
+  CHECK_MSG(bottom_bare == per, "%d of %d bottom points bare", bottom_bare, per);
+  free(d), free(e), free(od), free(oe);
+  mesh_free(&lid);
+  gr_snow_accumulation_destroy(s);
+}
+
+/* Vertical snow on a box: its vertical faces get nothing (n . -d = 0 and
+ * capacity 0), its top rate x t, its top's edge points too. */
+static void test_vertical_faces(void) {
+  gr_snow_accumulation_params p;
+  plain(&p, 1e-4, 1.0);
+  gr_snow_accumulation *s = make_sim(30, 30, 0.1, &p);
+  if (!s)
+    return;
+  test_mesh box;
+  mesh_faces(&box, 0.5, 0.5, 0.5, 6);
+  mesh_pose(&box, 1.5, 1.5, 0.45);
+  CHECK(gr_snow_accumulation_set_objects(s, &box.m, 1) == GR_OK);
+  run(s, 10, 100.0);
+  int nv = box.m.nvertices, per = 49;
+  float *od = get_object(s, 0, GR_FIELD_SNOW_DEPTH, nv);
+  double top_lo = 1e9, top_hi = -1e9, side_max = 0.0;
+  for (int v = 0; v < per; ++v)
+    top_lo = fmin(top_lo, od[v]), top_hi = fmax(top_hi, od[v]);
+  for (int v = 2 * per; v < 6 * per; ++v)
+    side_max = fmax(side_max, od[v]);
+  printf("vertical faces: top %.6f to %.6f m (rate t = 0.1), sides at most %.3g m\n", top_lo,
+         top_hi, side_max);
+  CHECK(fabs(top_lo - 0.1) < 1e-6 && fabs(top_hi - 0.1) < 1e-6);
+  CHECK(side_max <= 1e-9);
+  /* The offsets: normal x depth, straight up on the top. */
+  float *off = malloc((size_t)nv * 3 * sizeof(float));
+  CHECK(gr_snow_accumulation_get_object_offsets(s, 0, off, nv) == GR_OK);
+  CHECK(off[0] == 0.0f && off[1] == 0.0f && fabs(off[2] - od[0]) < 1e-7);
+  free(off), free(od);
+  mesh_free(&box);
+  gr_snow_accumulation_destroy(s);
+}
+
+/* Wind: a wall across x, snow tilted by alpha towards +x. The bare patch
+ * behind the wall is h tan(alpha) long, within one cell; with vertical
+ * snow there is none. */
+static void test_wind_lee(void) {
+  const int nx = 100, ny = 20, n = nx * ny;
+  const double dx = 0.05, h = 1.0, face = 1.2;
+  test_mesh wall;
+  mesh_box(&wall, 0.1, 2.0, 0.55);
+  mesh_pose(&wall, 1.1, 0.5, 0.45); /* x 1.0 to 1.2 m, z -0.1 to 1.0 m */
+  for (int k = 0; k < 3; ++k) {
+    double alpha = (k == 0 ? 0.0 : k == 1 ? 30.0 : 50.0) * M_PI / 180.0;
+    gr_snow_accumulation_params p;
+    plain(&p, 1e-4, 1.0);
+    p.exposure_resolution = 1024;
+    p.direction[0] = sin(alpha), p.direction[2] = -cos(alpha);
+    gr_snow_accumulation *s = make_sim(nx, ny, dx, &p);
+    if (!s)
+      break;
+    CHECK(gr_snow_accumulation_set_objects(s, &wall.m, 1) == GR_OK);
+    run(s, 5, 60.0);
+    float *d = get(s, GR_FIELD_SNOW_DEPTH, n), *e = get(s, GR_FIELD_EXPOSURE, n);
+    double worst = 0.0;
+    for (int j = 2; j < ny - 2; ++j) {
+      /* The first exposed point behind the wall's lee face. */
+      int i = (int)ceil(face / dx + 1e-9);
+      while (i < nx && e[j * nx + i] == 0.0f)
+        ++i;
+      /* The patch ends between the last hidden point (or the face) and
+       * the first exposed one. */
+      double last = fmax(face, (i - 1) * dx);
+      double patch = 0.5 * (last + i * dx) - face, want = h * tan(alpha);
+      worst = fmax(worst, fabs(patch - want));
+      /* The patch is bare, the rest of the row has snow. */
+      for (int q = (int)ceil(face / dx + 1e-9); q < nx; ++q) {
+        int c = j * nx + q;
+        CHECK(q < i ? d[c] == 0.0f : d[c] > 0.0f);
+      }
+      /* Windward of the wall the ground is exposed. */
+      CHECK(e[j * nx + 10] == 1.0f && e[j * nx + 18] == 1.0f);
+    }
+    printf("wind %.0f deg: lee patch %.3f m expected (h tan), worst error %.3f m (cell %.2f)\n",
+           alpha * 180 / M_PI, h * tan(alpha), worst, dx);
+    CHECK(worst <= dx);
+    free(d), free(e);
+    gr_snow_accumulation_destroy(s);
+  }
+  mesh_free(&wall);
+}
+
+/* A scene with everything on: rough ground, a lid, a box, tilt, noise,
+ * blur, dilation, a soft cap. */
+static gr_snow_accumulation *scene(gr_snow_accumulation_params *p, test_mesh *m, int flutter) {
+  const int nx = 32, ny = 28, n = nx * ny;
+  gr_snow_accumulation_params_init(p);
+  p->snowfall_rate = 2e-4;
+  p->max_depth = 0.3;
+  p->stability_factor = 0.05;
+  p->noise_amplitude = 0.4;
+  p->noise_scale = 0.5;
+  p->seed = 7;
+  p->blur_radius = 2;
+  p->dilation = 1;
+  p->direction[0] = 0.2, p->direction[1] = -0.1;
+  p->flutter = flutter ? 3.0 * M_PI / 180.0 : 0.0;
+  p->exposure_resolution = 256;
+  gr_snow_accumulation *s = make_sim(nx, ny, 0.1, p);
+  if (!s)
+    return NULL;
+  float *b = malloc(n * sizeof(float));
+  for (int c = 0; c < n; ++c)
+    b[c] = (float)(0.3 * sin(0.4 * (c % nx)) * cos(0.3 * (c / nx)) + 0.02 * (c % 7));
+  CHECK(gr_snow_accumulation_set_field(s, GR_FIELD_ELEVATION, b) == GR_OK);
+  free(b);
+  mesh_box(&m[0], 0.6, 0.5, 0.05);
+  mesh_pose(&m[0], 1.2, 1.2, 1.0);
+  mesh_faces(&m[1], 0.3, 0.3, 0.3, 3);
+  mesh_pose(&m[1], 2.2, 1.8, 0.4);
+  gr_mesh ms[2] = {m[0].m, m[1].m};
+  CHECK(gr_snow_accumulation_set_objects(s, ms, 2) == GR_OK);
+  return s;
+}
+
+/* Issue 9: snowfall = stored + shed to 1e-6 relative over 10^4 steps. */
+static void test_ledger(void) {
+  gr_snow_accumulation_params p;
+  test_mesh m[2];
+  gr_snow_accumulation *s = scene(&p, m, 1);
+  if (!s)
+    return;
+  run(s, 10000, 20.0);
+  gr_snow_accumulation_ledger l;
+  CHECK(gr_snow_accumulation_ledger_get(s, &l) == GR_OK);
+  double rel = fabs(l.balance_error) / l.snowfall_volume;
+  printf("ledger: %lld steps; snowfall %.6g m^3 = stored %.6g (terrain %.6g, objects %.6g) + "
+         "shed %.6g; balance error %.3g (%.3g relative)\n",
+         l.steps, l.snowfall_volume, l.stored_volume, l.stored_volume_terrain,
+         l.stored_volume_objects, l.shed_volume, l.balance_error, rel);
+  CHECK(l.steps == 10000 && l.time == 200000.0);
+  CHECK(rel <= 1e-6);
+  CHECK(l.shed_volume > 0.1 * l.snowfall_volume && l.stored_volume_objects > 0.0);
+  CHECK(l.initial_volume == 0.0 && l.dropped_volume == 0.0);
+  /* Replace the box by nothing: its snow is dropped, and counted. */
+  CHECK(gr_snow_accumulation_set_objects(s, &m[0].m, 1) == GR_OK);
+  gr_snow_accumulation_ledger l2;
+  CHECK(gr_snow_accumulation_ledger_get(s, &l2) == GR_OK);
+  CHECK(l2.dropped_volume > 0.0);
+  CHECK(fabs(l2.balance_error) <= 1e-6 * l2.snowfall_volume);
+  gr_snow_accumulation_destroy(s);
+  mesh_free(&m[0]), mesh_free(&m[1]);
+}
+
+/* The same simulated time in 10 steps or 100: the same stored volume
+ * within 1%. */
+static void test_step_count(void) {
+  double stored[2];
+  for (int k = 0; k < 2; ++k) {
+    gr_snow_accumulation_params p;
+    test_mesh m[2];
+    gr_snow_accumulation *s = scene(&p, m, 0);
+    if (!s)
+      return;
+    p.stability_factor = 1.0;
+    CHECK(gr_snow_accumulation_set_params(s, &p) == GR_OK);
+    int steps = k ? 100 : 10;
+    run(s, steps, 2400.0 / steps);
+    gr_snow_accumulation_ledger l;
+    CHECK(gr_snow_accumulation_ledger_get(s, &l) == GR_OK);
+    stored[k] = l.stored_volume;
+    gr_snow_accumulation_destroy(s);
+    mesh_free(&m[0]), mesh_free(&m[1]);
+  }
+  double rel = fabs(stored[1] - stored[0]) / stored[0];
+  printf("step count: stored %.6g m^3 in 10 steps, %.6g in 100 (%.3g apart)\n", stored[0],
+         stored[1], rel);
+  CHECK(stored[0] > 0.0 && rel <= 0.01);
+}
+
+/* Two runs with the same inputs give the same bits (flutter included). */
+static void test_determinism(void) {
+  float *d[2] = {NULL, NULL}, *o[2] = {NULL, NULL};
+  int nv = 0;
+  for (int k = 0; k < 2; ++k) {
+    gr_snow_accumulation_params p;
+    test_mesh m[2];
+    gr_snow_accumulation *s = scene(&p, m, 1);
+    if (!s)
+      return;
+    run(s, 50, 30.0);
+    nv = m[1].m.nvertices;
+    d[k] = get(s, GR_FIELD_SNOW_DEPTH, 32 * 28);
+    o[k] = get_object(s, 1, GR_FIELD_SNOW_DEPTH, nv);
+    gr_snow_accumulation_destroy(s);
+    mesh_free(&m[0]), mesh_free(&m[1]);
+  }
+  CHECK(memcmp(d[0], d[1], 32 * 28 * sizeof(float)) == 0);
+  CHECK(memcmp(o[0], o[1], (size_t)nv * sizeof(float)) == 0);
+  free(d[0]), free(d[1]), free(o[0]), free(o[1]);
+}
+
+/* Save after 20 steps, go on 20; load into a fresh simulation and go on
+ * 20: the same bits. Wrong sizes and damaged bytes are refused. */
+static void test_checkpoint(void) {
+  gr_snow_accumulation_params p;
+  test_mesh m[2], m2[2];
+  gr_snow_accumulation *a = scene(&p, m, 1), *b = scene(&p, m2, 1);
+  if (!a || !b)
+    return;
+  run(a, 20, 30.0);
+  size_t bytes = 0;
+  CHECK(gr_snow_accumulation_state_size(a, &bytes) == GR_OK && bytes > 0);
+  char *buf = malloc(bytes);
+  CHECK(gr_snow_accumulation_state_save(a, buf, bytes) == GR_OK);
+  run(a, 20, 30.0);
+  CHECK(gr_snow_accumulation_state_load(b, buf, bytes - 1) == GR_ERR_INVALID_ARGUMENT);
+  buf[0] ^= 1;
+  CHECK(gr_snow_accumulation_state_load(b, buf, bytes) == GR_ERR_FORMAT);
+  buf[0] ^= 1;
+  CHECK(gr_snow_accumulation_state_load(b, buf, bytes) == GR_OK);
+  run(b, 20, 30.0);
+  int n = 32 * 28, nv = m[1].m.nvertices;
+  float *da = get(a, GR_FIELD_SNOW_DEPTH, n), *db = get(b, GR_FIELD_SNOW_DEPTH, n);
+  float *oa = get_object(a, 1, GR_FIELD_SNOW_DEPTH, nv),
+        *ob = get_object(b, 1, GR_FIELD_SNOW_DEPTH, nv);
+  CHECK(memcmp(da, db, (size_t)n * sizeof(float)) == 0);
+  CHECK(memcmp(oa, ob, (size_t)nv * sizeof(float)) == 0);
+  gr_snow_accumulation_ledger la, lb;
+  CHECK(gr_snow_accumulation_ledger_get(a, &la) == GR_OK);
+  CHECK(gr_snow_accumulation_ledger_get(b, &lb) == GR_OK);
+  CHECK(la.steps == 40 && lb.steps == 40 && la.stored_volume == lb.stored_volume &&
+        la.snowfall_volume == lb.snowfall_volume);
+  /* Other objects: refused. */
+  CHECK(gr_snow_accumulation_set_objects(b, &m2[0].m, 1) == GR_OK);
+  CHECK(gr_snow_accumulation_state_load(b, buf, bytes) == GR_ERR_INVALID_ARGUMENT);
+  free(buf), free(da), free(db), free(oa), free(ob);
+  gr_snow_accumulation_destroy(a);
+  gr_snow_accumulation_destroy(b);
+  mesh_free(&m[0]), mesh_free(&m[1]), mesh_free(&m2[0]), mesh_free(&m2[1]);
+}
+
+/* An object keeps its snow when it moves under a roof, and carries it. */
+static void test_persistence(void) {
+  gr_snow_accumulation_params p;
+  plain(&p, 1e-4, 1.0);
+  gr_snow_accumulation *s = make_sim(40, 20, 0.1, &p);
+  if (!s)
+    return;
+  test_mesh roof, cube;
+  mesh_box(&roof, 0.6, 0.6, 0.05);
+  mesh_pose(&roof, 3.0, 1.0, 1.5);
+  mesh_faces(&cube, 0.2, 0.2, 0.2, 2);
+  mesh_pose(&cube, 1.0, 1.0, 0.3);
+  gr_mesh ms[2] = {roof.m, cube.m};
+  CHECK(gr_snow_accumulation_set_objects(s, ms, 2) == GR_OK);
+  run(s, 10, 60.0); /* 0.06 m on the cube's top */
+  int nv = cube.m.nvertices;
+  float *before = get_object(s, 1, GR_FIELD_SNOW_DEPTH, nv);
+  CHECK(fabs(before[4] - 0.06f) < 1e-6f);
+  for (int k = 1; k <= 10; ++k) { /* slide under the roof, 0.2 m a step */
+    mesh_pose(&cube, 1.0 + 0.2 * k, 1.0, 0.3);
+    ms[1] = cube.m;
+    CHECK(gr_snow_accumulation_set_objects(s, ms, 2) == GR_OK);
+    CHECK(gr_snow_accumulation_step(s, 60.0) == GR_OK);
+  }
+  run(s, 10, 60.0);
+  float *after = get_object(s, 1, GR_FIELD_SNOW_DEPTH, nv),
+        *e = get_object(s, 1, GR_FIELD_EXPOSURE, nv);
+  /* On the way it gained at most what 10 steps bring; under the roof nothing. */
+  printf("persistence: cube top %.4f m in the open, %.4f m after the ride and 10 steps under the "
+         "roof\n",
+         before[4], after[4]);
+  CHECK(after[4] >= before[4] && after[4] <= before[4] + 0.06f + 1e-6f);
+  CHECK(e[4] == 0.0f);
+  float *later = NULL;
+  run(s, 10, 60.0);
+  later = get_object(s, 1, GR_FIELD_SNOW_DEPTH, nv);
+  CHECK(memcmp(later, after, (size_t)nv * sizeof(float)) == 0);
+  free(before), free(after), free(e), free(later);
+  mesh_free(&roof), mesh_free(&cube);
+  gr_snow_accumulation_destroy(s);
+}
+
+static void test_errors(void) {
+  gr_snow_accumulation_params p;
+  gr_snow_accumulation_params_init(&p);
+  p.exposure_resolution = 128;
+  gr_grid g = {.nx = 16, .ny = 16, .dx = 0.1, .dy = 0.1};
+  gr_snow_accumulation *s = NULL;
+  p.max_depth = 0.0;
+  CHECK(gr_snow_accumulation_create(ctx, &g, &p, &s) == GR_ERR_INVALID_ARGUMENT && !s);
+  CHECK(strstr(gr_last_error(ctx), "MaxDepth") != NULL);
+  p.max_depth = 1.0;
+  gr_grid piece = g;
+  piece.global_nx = 32;
+  CHECK(gr_snow_accumulation_create(ctx, &piece, &p, &s) == GR_ERR_INVALID_ARGUMENT && !s);
+  /* ExposureResolution beyond the device: one sentence, no simulation. */
+  int limit = 0;
+  CHECK(gr_snow_accumulation_max_resolution(ctx, &limit) == GR_OK && limit >= 1024);
+  printf("errors: this device takes ExposureResolution up to %d\n", limit);
+  if (limit < 65536) {
+    gr_snow_accumulation_params big = p;
+    big.exposure_resolution = limit + 1;
+    CHECK(gr_snow_accumulation_create(ctx, &g, &big, &s) == GR_ERR_TOO_LARGE && !s);
+    CHECK(strstr(gr_last_error(ctx), "ExposureResolution") != NULL);
+  }
+  CHECK(gr_snow_accumulation_create(ctx, &g, &p, &s) == GR_OK);
+  if (!s)
+    return;
+  if (limit < 65536) {
+    gr_snow_accumulation_params big = p;
+    big.exposure_resolution = limit + 1;
+    CHECK(gr_snow_accumulation_set_params(s, &big) == GR_ERR_TOO_LARGE);
+    CHECK(strstr(gr_snow_accumulation_last_error(s), "ExposureResolution") != NULL);
+  }
+  /* NaN elevation: refused, the point named; the state is kept. */
+  float *e = calloc(256, sizeof(float));
+  e[3 * 16 + 5] = NAN;
+  CHECK(gr_snow_accumulation_set_field(s, GR_FIELD_ELEVATION, e) == GR_ERR_INVALID_ARGUMENT);
+  CHECK(strstr(gr_snow_accumulation_last_error(s), "elevation") &&
+        strstr(gr_snow_accumulation_last_error(s), "(5, 3)"));
+  e[3 * 16 + 5] = -1.0f;
+  CHECK(gr_snow_accumulation_set_field(s, GR_FIELD_SNOW_DEPTH, e) == GR_ERR_INVALID_ARGUMENT);
+  CHECK(gr_snow_accumulation_set_field(s, GR_FIELD_VELOCITY, e) == GR_ERR_INVALID_ARGUMENT);
+  CHECK(gr_snow_accumulation_get_field(s, GR_FIELD_VELOCITY, e) == GR_ERR_INVALID_ARGUMENT);
+  /* A degenerate direction and a bad parameter: refused, the old ones kept. */
+  gr_snow_accumulation_params q = p;
+  q.direction[2] = 0.0;
+  CHECK(gr_snow_accumulation_set_params(s, &q) == GR_ERR_INVALID_ARGUMENT);
+  CHECK(strstr(gr_snow_accumulation_last_error(s), "SnowDirection") != NULL);
+  q = p;
+  q.stability_factor = 2.0;
+  CHECK(gr_snow_accumulation_set_params(s, &q) == GR_ERR_INVALID_ARGUMENT);
+  CHECK(strstr(gr_snow_accumulation_last_error(s), "StabilityFactor") != NULL);
+  /* Bad objects. */
+  test_mesh box;
+  mesh_box(&box, 0.2, 0.2, 0.2);
+  mesh_pose(&box, 0.8, 0.8, 0.5);
+  CHECK(gr_snow_accumulation_set_objects(s, NULL, 1) == GR_ERR_INVALID_ARGUMENT);
+  box.t[4] = 99;
+  CHECK(gr_snow_accumulation_set_objects(s, &box.m, 1) == GR_ERR_INVALID_ARGUMENT);
+  CHECK(strstr(gr_snow_accumulation_last_error(s), "Object 0") != NULL);
+  box.t[4] = 3;
+  CHECK(gr_snow_accumulation_set_objects(s, &box.m, 1) == GR_OK);
+  float od[8];
+  CHECK(gr_snow_accumulation_get_object_field(s, 0, GR_FIELD_SNOW_DEPTH, od, 7) ==
+        GR_ERR_INVALID_ARGUMENT);
+  CHECK(gr_snow_accumulation_get_object_field(s, 1, GR_FIELD_SNOW_DEPTH, od, 8) ==
+        GR_ERR_INVALID_ARGUMENT);
+  CHECK(gr_snow_accumulation_step(s, 0.0) == GR_ERR_INVALID_ARGUMENT);
+  CHECK(gr_snow_accumulation_step(s, NAN) == GR_ERR_INVALID_ARGUMENT);
+  /* Usable after all that: snow falls with the old parameters. */
+  CHECK(gr_snow_accumulation_step(s, 100.0) == GR_OK);
+  float *d = calloc(256, sizeof(float));
+  CHECK(gr_snow_accumulation_get_field(s, GR_FIELD_SNOW_DEPTH, d) == GR_OK);
+  CHECK(d[0] > 0.0f && d[0] < 2.0f * (float)(p.snowfall_rate * 100.0));
+  CHECK(strcmp(gr_snow_accumulation_last_error(s), "") != 0);
+  free(e), free(d);
+  mesh_free(&box);
+  gr_snow_accumulation_destroy(s);
+}
+
+static int stop_now(void *user, double time) {
+  int *calls = user;
+  (void)time;
+  return ++*calls >= 2;
+}
+
+/* Every entry point once, on a tiny grid (valgrind runs this one). */
+static void test_memcheck(void) {
+  gr_snow_accumulation_params p;
+  gr_snow_accumulation_params_init(&p);
+  p.exposure_resolution = 64;
+  p.blur_radius = 1;
+  p.dilation = 1;
+  p.flutter = 0.02;
+  gr_snow_accumulation *s = make_sim(12, 10, 0.1, &p);
+  if (!s)
+    return;
+  float f[120];
+  for (int k = 0; k < 120; ++k)
+    f[k] = 0.01f * (float)(k % 7);
+  CHECK(gr_snow_accumulation_set_field(s, GR_FIELD_ELEVATION, f) == GR_OK);
+  CHECK(gr_snow_accumulation_set_field(s, GR_FIELD_SNOW_DEPTH, f) == GR_OK);
+  test_mesh box;
+  mesh_box(&box, 0.2, 0.2, 0.2);
+  mesh_pose(&box, 0.5, 0.5, 0.6);
+  CHECK(gr_snow_accumulation_set_objects(s, &box.m, 1) == GR_OK);
+  float snow[8] = {0.01f, 0.02f, 0, 0, 0, 0, 0, 0}, off[24];
+  CHECK(gr_snow_accumulation_set_object_snow(s, 0, snow, 8) == GR_OK);
+  int calls = 0;
+  gr_snow_accumulation_set_progress(s, stop_now, &calls);
+  CHECK(gr_snow_accumulation_step(s, 10.0) == GR_OK);
+  CHECK(gr_snow_accumulation_step(s, 10.0) == GR_OK);
+  CHECK(gr_snow_accumulation_step(s, 10.0) == GR_ERR_ABORTED);
+  gr_snow_accumulation_set_progress(s, NULL, NULL);
+  CHECK(gr_snow_accumulation_step(s, 10.0) == GR_OK);
+  gr_field outs[] = {GR_FIELD_SNOW_DEPTH, GR_FIELD_SNOW_SURFACE, GR_FIELD_SNOW_DENSITY,
+                     GR_FIELD_EXPOSURE, GR_FIELD_ELEVATION};
+  for (int k = 0; k < 5; ++k)
+    CHECK(gr_snow_accumulation_get_field(s, outs[k], f) == GR_OK);
+  CHECK(gr_snow_accumulation_get_object_field(s, 0, GR_FIELD_SNOW_DEPTH, snow, 8) == GR_OK);
+  CHECK(gr_snow_accumulation_get_object_field(s, 0, GR_FIELD_EXPOSURE, snow, 8) == GR_OK);
+  CHECK(gr_snow_accumulation_get_object_offsets(s, 0, off, 8) == GR_OK);
+  gr_snow_accumulation_ledger l;
+  CHECK(gr_snow_accumulation_ledger_get(s, &l) == GR_OK && l.steps == 3);
+  CHECK(fabs(l.balance_error) <= 1e-9);
+  size_t bytes;
+  CHECK(gr_snow_accumulation_state_size(s, &bytes) == GR_OK);
+  void *buf = malloc(bytes);
+  CHECK(gr_snow_accumulation_state_save(s, buf, bytes) == GR_OK);
+  CHECK(gr_snow_accumulation_state_load(s, buf, bytes) == GR_OK);
+  CHECK(gr_snow_accumulation_set_params(s, &p) == GR_OK);
+  CHECK(gr_snow_accumulation_reset(s) == GR_OK);
+  CHECK(gr_snow_accumulation_ledger_get(s, &l) == GR_OK && l.steps == 0);
+  CHECK(gr_snow_accumulation_step(s, 0.0) == GR_ERR_INVALID_ARGUMENT);
+  CHECK(gr_snow_accumulation_set_objects(s, NULL, 0) == GR_OK);
+  CHECK(gr_snow_accumulation_step(s, 10.0) == GR_OK);
+  char m[256];
+  CHECK(gr_snow_accumulation_field_validate(GR_FIELD_SNOW_DEPTH, f, 120, 12, m, sizeof(m)) ==
+        GR_OK);
+  f[13] = -1.0f;
+  CHECK(gr_snow_accumulation_field_validate(GR_FIELD_SNOW_DEPTH, f, 120, 12, m, sizeof(m)) ==
+            GR_ERR_INVALID_ARGUMENT &&
+        strstr(m, "(1, 1)"));
+  int limit = 0;
+  CHECK(gr_snow_accumulation_max_resolution(ctx, &limit) == GR_OK);
+  gr_snow_accumulation_timing tm;
+  gr_snow_accumulation_set_timing(s, 1);
+  CHECK(gr_snow_accumulation_set_objects(s, &box.m, 1) == GR_OK);
+  CHECK(gr_snow_accumulation_step(s, 10.0) == GR_OK);
+  CHECK(gr_snow_accumulation_timing_get(s, &tm) == GR_OK && tm.steps == 1 && tm.view_ms >= 0.0);
+  gr_snow_accumulation_set_timing(s, 0);
+  CHECK(gr_snow_accumulation_timing_get(s, &tm) == GR_OK && tm.steps == 0);
+  CHECK(gr_snow_accumulation_timing_get(NULL, &tm) == GR_ERR_INVALID_ARGUMENT);
+  free(buf);
+  mesh_free(&box);
+  gr_snow_accumulation_destroy(s);
+  gr_snow_accumulation_destroy(NULL);
+  CHECK(strcmp(gr_snow_accumulation_last_error(NULL), "") == 0);
+}
+
+static const gr_subtest tests[] = {
+    {"param_table", test_param_table, 0},
+    {"flat_growth", test_flat_growth, 0},
+    {"slope", test_slope, 0},
+    {"occluded", test_occluded, 0},
+    {"vertical_faces", test_vertical_faces, 0},
+    {"wind_lee", test_wind_lee, 0},
+    {"ledger", test_ledger, 0},
+    {"step_count", test_step_count, 0},
+    {"determinism", test_determinism, 0},
+    {"checkpoint", test_checkpoint, 0},
+    {"persistence", test_persistence, 0},
+    {"errors", test_errors, 0},
+    {"memcheck", test_memcheck, 1},
+};
+
+static int setup(void) {
+  if (gr_context_create(NULL, &ctx) != GR_OK)
+    return 0;
+  printf("device: %s\n", gr_context_device_name(ctx));
+  return 1;
+}
+
+static void teardown(void) {
+  gr_context_release(ctx);
+}
+
+int main(int argc, char **argv) {
+  return gr_test_main(argc, argv, tests, (int)(sizeof(tests) / sizeof(tests[0])), setup, teardown);
+}

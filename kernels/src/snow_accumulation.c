@@ -1,0 +1,1406 @@
+/* Snow accumulation core (seed 002's thesis): host side of
+ * snow_accumulation.cl. The model, its step order and its book-keeping are
+ * documented in graupel/snow_accumulation.h; the constants both sides share
+ * in snow_accumulation_shared.h. */
+#include "graupel/snow_accumulation.h"
+#include "graupel/cl_runtime.h"
+#include "graupel/reduce.h"
+#include "snow_accumulation_shared.h"
+
+#include <limits.h>
+#include <math.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#define GR_SNAC_MAX_ELEVATION 1.0e6
+#define GR_SNAC_MAX_DEPTH 1.0e4
+#define GR_SNAC_MIN_DT 1.0e-6
+#define GR_SNAC_MAX_DT 86400.0
+#define GR_SNAC_PI 3.14159265358979323846
+/* Checkpoints: "GSA1". */
+#define GR_SNAC_STATE_MAGIC 0x31415347u
+#define GR_SNAC_STATE_VERSION 1u
+/* Per-point arrays of the state: depth, its low part, fallen and shed
+ * snow (pairs) and the exposure. */
+#define GR_SNAC_ARRAYS 7
+/* The step waits for the device every this many steps, so that a long
+ * loop of steps does not queue without bound. */
+#define GR_SNAC_SYNC_EVERY 8
+
+enum {
+  GR_SNAC_P_FLUTTER,
+  GR_SNAC_P_RATE,
+  GR_SNAC_P_AMPLITUDE,
+  GR_SNAC_P_SCALE,
+  GR_SNAC_P_SEED,
+  GR_SNAC_P_RESOLUTION,
+  GR_SNAC_P_BLUR,
+  GR_SNAC_P_DILATION,
+  GR_SNAC_P_MAX_DEPTH,
+  GR_SNAC_P_STABILITY,
+  GR_SNAC_P_DENSITY,
+  GR_SNAC_P_COUNT
+};
+
+/* The one place each range is written. SnowfallRate: heavy snowfall is a
+ * few cm/h, record falls about 20 cm/h. SnowDensity: fresh snow is 30 to
+ * 200 kg/m^3, ice 900. */
+static const gr_param_bound gr_snac_bounds[GR_SNAC_P_COUNT] = {
+    {"Flutter", "deg", 0.0, 10.0, 0.0, GR_SNAC_PI / 180.0, 0, 0},
+    {"SnowfallRate", "cm/h", 0.0, 1000.0, 2.0, 0.01 / 3600.0, 0, 0},
+    {"NoiseAmplitude", "", 0.0, 1.0, 0.2, 1.0, 0, 0},
+    {"NoiseScale", "m", 0.0, 1.0e4, 1.0, 1.0, 1, 0},
+    {"Seed", "", 0.0, 2147483647.0, 0.0, 1.0, 0, 1},
+    {"ExposureResolution", "", 16.0, 65536.0, 1024.0, 1.0, 0, 1},
+    {"BlurRadius", "", 0.0, (double)GR_SNAC_MAX_BLUR, 1.0, 1.0, 0, 1},
+    {"Dilation", "", 0.0, 1.0, 0.0, 1.0, 0, 1},
+    {"MaxDepth", "m", 0.0, 100.0, 1.0, 1.0, 1, 0},
+    {"StabilityFactor", "1/s", 0.0, 1.0, 1.0, 1.0, 0, 0},
+    {"SnowDensity", "kg/m^3", 1.0, 1000.0, 100.0, 1.0, 0, 0},
+};
+
+struct gr_snow_accumulation {
+  gr_context *ctx;
+  gr_grid grid;
+  gr_snow_accumulation_params params;
+  cl_kernel raster_terrain, raster_objects, exposure_k, blur, dilate, apply, objects_k, reduce,
+      surface;
+  /* The grid: ground, initial snow, the state pairs, exposure, growth and
+   * a scratch array, the blur weights and the view. */
+  cl_mem ground, depth0, arr[GR_SNAC_ARRAYS], growth, scratch, weights, view;
+  size_t view_cap; /* ints */
+  /* The objects: world triangles, per mesh point the world position and
+   * normal, the noise coordinates, the area and the state arrays. */
+  int nobjects, nv, ntri;
+  int first[GR_SNOW_ACCUMULATION_MAX_OBJECTS + 1], nverts[GR_SNOW_ACCUMULATION_MAX_OBJECTS];
+  cl_mem o_tri, o_pos, o_nrm, o_local, o_area, o_arr[GR_SNAC_ARRAYS];
+  double *hv;                /* world vertices, 3 per mesh point, absolute */
+  int *ht;                   /* triangles, indices into hv */
+  float *hnrm;               /* world normals, 3 per mesh point */
+  double ob_lo[3], ob_hi[3]; /* the objects' world box */
+  gr_reduction red;
+  double zref, bmin, bmax, init_max, snow_bound;
+  double time, initial_volume, retired_fall, retired_shed, dropped;
+  long long steps;
+  gr_progress_fn progress;
+  void *progress_user;
+  int aborted;
+  int timing;
+  double t_mark;
+  gr_snow_accumulation_timing tm;
+  char error[1024];
+};
+
+#define GR_SNAC_KEEP_ERROR(s, st) gr_error_keep((s)->error, sizeof((s)->error), (st))
+
+/* A named kernel argument. */
+typedef struct gr_snac_arg {
+  const char *name;
+  size_t size;
+  const void *value;
+} gr_snac_arg;
+
+#define GR_SNAC_MEM(name, m)                                                                       \
+  { (name), sizeof(cl_mem), &(m) }
+#define GR_SNAC_VAL(name, v)                                                                       \
+  { (name), sizeof(v), &(v) }
+
+static gr_status gr_snac_args(gr_snow_accumulation *s, cl_kernel k, const gr_snac_arg *args,
+                              size_t n) {
+  gr_status st = GR_OK;
+  for (size_t q = 0; st == GR_OK && q < n; ++q)
+    st = gr_kernel_arg(s->ctx, k, args[q].name, args[q].size, args[q].value);
+  return st;
+}
+
+const gr_param_bound *gr_snow_accumulation_param_bounds(int *count) {
+  if (count)
+    *count = GR_SNAC_P_COUNT;
+  return gr_snac_bounds;
+}
+
+const char *gr_snow_accumulation_last_error(const gr_snow_accumulation *s) {
+  return s ? s->error : "";
+}
+
+void gr_snow_accumulation_params_init(gr_snow_accumulation_params *p) {
+  if (!p)
+    return;
+  memset(p, 0, sizeof(*p));
+  const gr_param_bound *t = gr_snac_bounds;
+  p->direction[2] = -1.0;
+  p->flutter = t[GR_SNAC_P_FLUTTER].default_value * t[GR_SNAC_P_FLUTTER].to_core;
+  p->snowfall_rate = t[GR_SNAC_P_RATE].default_value * t[GR_SNAC_P_RATE].to_core;
+  p->noise_amplitude = t[GR_SNAC_P_AMPLITUDE].default_value;
+  p->noise_scale = t[GR_SNAC_P_SCALE].default_value;
+  p->seed = (int)t[GR_SNAC_P_SEED].default_value;
+  p->exposure_resolution = (int)t[GR_SNAC_P_RESOLUTION].default_value;
+  p->blur_radius = (int)t[GR_SNAC_P_BLUR].default_value;
+  p->dilation = (int)t[GR_SNAC_P_DILATION].default_value;
+  p->max_depth = t[GR_SNAC_P_MAX_DEPTH].default_value;
+  p->stability_factor = t[GR_SNAC_P_STABILITY].default_value;
+  p->snow_density = t[GR_SNAC_P_DENSITY].default_value;
+}
+
+static double gr_snac_param_value(const gr_snow_accumulation_params *p, int row) {
+  switch (row) {
+  case GR_SNAC_P_FLUTTER:
+    return p->flutter;
+  case GR_SNAC_P_RATE:
+    return p->snowfall_rate;
+  case GR_SNAC_P_AMPLITUDE:
+    return p->noise_amplitude;
+  case GR_SNAC_P_SCALE:
+    return p->noise_scale;
+  case GR_SNAC_P_SEED:
+    return (double)p->seed;
+  case GR_SNAC_P_RESOLUTION:
+    return (double)p->exposure_resolution;
+  case GR_SNAC_P_BLUR:
+    return (double)p->blur_radius;
+  case GR_SNAC_P_DILATION:
+    return (double)p->dilation;
+  case GR_SNAC_P_MAX_DEPTH:
+    return p->max_depth;
+  case GR_SNAC_P_STABILITY:
+    return p->stability_factor;
+  default:
+    return p->snow_density;
+  }
+}
+
+gr_status gr_snow_accumulation_params_validate(const gr_snow_accumulation_params *p, char *msg,
+                                               size_t msg_len) {
+  if (!p) {
+    if (msg && msg_len)
+      snprintf(msg, msg_len, "Invalid snow accumulation parameters: no parameters were given.");
+    return GR_ERR_INVALID_ARGUMENT;
+  }
+  for (int row = 0; row < GR_SNAC_P_COUNT; ++row) {
+    const gr_param_bound *r = &gr_snac_bounds[row];
+    double v = gr_snac_param_value(p, row);
+    if (gr_param_accepts(r, v))
+      continue;
+    gr_param_explain(r, v, "Invalid snow accumulation parameters", msg, msg_len);
+    return GR_ERR_INVALID_ARGUMENT;
+  }
+  const double *d = p->direction;
+  double len = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+  if (!isfinite(d[0]) || !isfinite(d[1]) || !isfinite(d[2]) || !isfinite(len) || len < 1e-9 ||
+      -d[2] / len < cos(GR_SNOW_ACCUMULATION_MAX_TILT * GR_SNAC_PI / 180.0)) {
+    if (msg && msg_len)
+      snprintf(msg, msg_len,
+               "Invalid snow accumulation parameters: SnowDirection (%g, %g, %g) must point "
+               "down, at most %g degrees from straight down (0 0 -1); give a direction with a "
+               "negative z component.",
+               d[0], d[1], d[2], GR_SNOW_ACCUMULATION_MAX_TILT);
+    return GR_ERR_INVALID_ARGUMENT;
+  }
+  return GR_OK;
+}
+
+gr_status gr_snow_accumulation_field_validate(gr_field f, const float *values, size_t n, size_t nx,
+                                              char *msg, size_t msg_len) {
+  double lo, hi;
+  const char *rule;
+  const char *name = gr_field_name(f);
+  if (!name)
+    name = "(unknown field)";
+  if (f == GR_FIELD_ELEVATION) {
+    lo = -GR_SNAC_MAX_ELEVATION, hi = GR_SNAC_MAX_ELEVATION;
+    rule = "elevations must be finite and within +-1e6 m";
+  } else if (f == GR_FIELD_SNOW_DEPTH) {
+    lo = 0.0, hi = GR_SNAC_MAX_DEPTH;
+    rule = "snow depths must be finite, at least 0 and at most 1e4 m";
+  } else {
+    if (msg && msg_len)
+      snprintf(msg, msg_len,
+               "The field '%s' is not an input of the snow accumulation simulation; its inputs "
+               "are elevation and snow_depth.",
+               name);
+    return GR_ERR_INVALID_ARGUMENT;
+  }
+  if (!values && n > 0) {
+    if (msg && msg_len)
+      snprintf(msg, msg_len, "The field '%s' has no values (got NULL for %zu points); pass them.",
+               name, n);
+    return GR_ERR_INVALID_ARGUMENT;
+  }
+  size_t row = nx > 0 ? nx : (n > 0 ? n : 1);
+  for (size_t c = 0; c < n; ++c) {
+    double v = values[c];
+    if (isfinite(v) && v >= lo && v <= hi)
+      continue;
+    if (msg && msg_len)
+      snprintf(msg, msg_len, "The field '%s' has the value %g at point (%zu, %zu): %s.", name, v,
+               c % row, c / row, rule);
+    return GR_ERR_INVALID_ARGUMENT;
+  }
+  return GR_OK;
+}
+
+static double gr_snac_now_ms(void) {
+  struct timespec ts;
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return 1e3 * (double)ts.tv_sec + 1e-6 * (double)ts.tv_nsec;
+}
+
+/* With timing on: waits for the stage just enqueued and charges its time. */
+static gr_status gr_snac_mark(gr_snow_accumulation *s, double *acc) {
+  if (!s->timing)
+    return GR_OK;
+  gr_status st = gr_finish(s->ctx);
+  double t = gr_snac_now_ms();
+  *acc += t - s->t_mark;
+  s->t_mark = t;
+  return st;
+}
+
+void gr_snow_accumulation_set_timing(gr_snow_accumulation *s, int on) {
+  if (!s)
+    return;
+  s->timing = on != 0;
+  memset(&s->tm, 0, sizeof(s->tm));
+}
+
+gr_status gr_snow_accumulation_timing_get(const gr_snow_accumulation *s,
+                                          gr_snow_accumulation_timing *out) {
+  if (!s || !out)
+    return gr_set_error(NULL, GR_ERR_INVALID_ARGUMENT,
+                        "gr_snow_accumulation_timing_get needs a simulation and a place for the "
+                        "times.");
+  *out = s->tm;
+  return GR_OK;
+}
+
+static size_t gr_snac_cells(const gr_snow_accumulation *s) {
+  return (size_t)s->grid.nx * (size_t)s->grid.ny;
+}
+
+static gr_status gr_snac_fill(gr_snow_accumulation *s, cl_mem buf, size_t n, float value) {
+  if (n == 0)
+    return GR_OK;
+  return gr_cl_check(s->ctx,
+                     clEnqueueFillBuffer(gr_context_queue(s->ctx), buf, &value, sizeof(value), 0,
+                                         n * sizeof(float), 0, NULL, NULL),
+                     "Filling a device buffer");
+}
+
+gr_status gr_snow_accumulation_max_resolution(gr_context *ctx, int *out) {
+  if (!ctx || !out)
+    return gr_set_error(ctx, GR_ERR_INVALID_ARGUMENT,
+                        "gr_snow_accumulation_max_resolution needs a context and a place for the "
+                        "answer.");
+  cl_device_id dev = gr_context_device(ctx);
+  cl_bool images = CL_FALSE;
+  size_t width = 0;
+  cl_ulong max_alloc = 0;
+  cl_int err = clGetDeviceInfo(dev, CL_DEVICE_IMAGE_SUPPORT, sizeof(images), &images, NULL);
+  if (err == CL_SUCCESS && images)
+    err = clGetDeviceInfo(dev, CL_DEVICE_IMAGE2D_MAX_WIDTH, sizeof(width), &width, NULL);
+  if (err == CL_SUCCESS)
+    err = clGetDeviceInfo(dev, CL_DEVICE_MAX_MEM_ALLOC_SIZE, sizeof(max_alloc), &max_alloc, NULL);
+  if (err != CL_SUCCESS)
+    return gr_cl_check(ctx, err, "Querying the device's image and buffer limits");
+  /* The view holds (res + 2 margin + 1)^2 ints. */
+  double side = floor(sqrt((double)max_alloc / 4.0)) - 2.0 * GR_SNAC_VIEW_MARGIN - 1.0;
+  double limit = side;
+  if (images && width > 0 && (double)width < limit)
+    limit = (double)width;
+  if (limit > 65536.0)
+    limit = 65536.0;
+  *out = limit < 0.0 ? 0 : (int)limit;
+  return GR_OK;
+}
+
+/* The view buffer for the parameters' resolution, and the blur weights. */
+static gr_status gr_snac_prepare(gr_snow_accumulation *s, const gr_snow_accumulation_params *p) {
+  int limit = 0;
+  gr_status st = gr_snow_accumulation_max_resolution(s->ctx, &limit);
+  if (st != GR_OK)
+    return st;
+  if (p->exposure_resolution > limit)
+    return gr_set_error(s->ctx, GR_ERR_TOO_LARGE,
+                        "ExposureResolution %d is beyond the device '%s': its exposure view can "
+                        "be at most %d texels across (its widest 2-D image and largest buffer); "
+                        "lower ExposureResolution or pick another device.",
+                        p->exposure_resolution, gr_context_device_name(s->ctx), limit);
+  size_t side = (size_t)p->exposure_resolution + 2 * GR_SNAC_VIEW_MARGIN + 1;
+  size_t need = side * side;
+  if (need > s->view_cap) {
+    cl_mem view = NULL;
+    st = gr_buffer_create(s->ctx, CL_MEM_READ_WRITE, need * sizeof(cl_int), NULL, &view);
+    if (st != GR_OK)
+      return st;
+    gr_buffer_release(&s->view);
+    s->view = view;
+    s->view_cap = need;
+  }
+  /* Binomial weights C(2r + 4, r + 2 + k), k = 0 .. r (r = 4: the
+   * thesis' 9 taps); normalised on the device over the taps on the grid. */
+  float w[GR_SNAC_MAX_BLUR + 1];
+  int r = p->blur_radius, m = 2 * r + 4;
+  for (int k = 0; k <= r; ++k) {
+    double c = 1.0;
+    for (int q = 1; q <= r + 2 + k; ++q)
+      c = c * (double)(m - (r + 2 + k) + q) / (double)q;
+    w[k] = (float)c;
+  }
+  return gr_buffer_write(s->ctx, s->weights, 0, (size_t)(r + 1) * sizeof(float), w);
+}
+
+/* sums[0..2]: stored, fallen, shed over points first .. first + n - 1 of
+ * the grid (area 1: the caller multiplies by dx dy) or of the objects. */
+static gr_status gr_snac_sums(gr_snow_accumulation *s, int objects, int first, int n,
+                              double sums[GR_SNAC_SUMS]) {
+  for (int q = 0; q < GR_SNAC_SUMS; ++q)
+    sums[q] = 0.0;
+  if (n <= 0)
+    return GR_OK;
+  cl_mem *a = objects ? s->o_arr : s->arr;
+  cl_mem area = objects ? s->o_area : s->ground;
+  cl_int weighted = objects != 0;
+  const gr_snac_arg args[] = {GR_SNAC_MEM("depth", a[0]),  GR_SNAC_MEM("depth_lo", a[1]),
+                              GR_SNAC_MEM("fall", a[2]),   GR_SNAC_MEM("fall_lo", a[3]),
+                              GR_SNAC_MEM("shed", a[4]),   GR_SNAC_MEM("shed_lo", a[5]),
+                              GR_SNAC_MEM("area", area),   GR_SNAC_VAL("weighted", weighted),
+                              GR_SNAC_VAL("first", first), GR_SNAC_VAL("n", n)};
+  gr_status st = gr_snac_args(s, s->reduce, args, sizeof(args) / sizeof(args[0]));
+  if (st == GR_OK)
+    st = gr_reduction_run(s->ctx, &s->red, s->reduce, sums, NULL);
+  return st;
+}
+
+static gr_status gr_snac_initial_state(gr_snow_accumulation *s) {
+  size_t cells = gr_snac_cells(s);
+  gr_status st = gr_cl_check(s->ctx,
+                             clEnqueueCopyBuffer(gr_context_queue(s->ctx), s->depth0, s->arr[0], 0,
+                                                 0, cells * sizeof(float), 0, NULL, NULL),
+                             "Copying the initial snow");
+  for (int a = 1; st == GR_OK && a < GR_SNAC_ARRAYS; ++a)
+    st = gr_snac_fill(s, s->arr[a], cells, 0.0f);
+  for (int a = 0; st == GR_OK && a < GR_SNAC_ARRAYS && s->nv > 0; ++a)
+    st = gr_snac_fill(s, s->o_arr[a], (size_t)s->nv, 0.0f);
+  s->time = s->retired_fall = s->retired_shed = s->dropped = 0.0;
+  s->steps = 0;
+  s->aborted = 0;
+  s->snow_bound = s->init_max;
+  double sums[GR_SNAC_SUMS];
+  if (st == GR_OK)
+    st = gr_snac_sums(s, 0, 0, (int)cells, sums);
+  if (st == GR_OK)
+    s->initial_volume = sums[0] * s->grid.dx * s->grid.dy;
+  return st;
+}
+
+gr_status gr_snow_accumulation_create(gr_context *ctx, const gr_grid *grid,
+                                      const gr_snow_accumulation_params *p,
+                                      gr_snow_accumulation **out) {
+  char msg[400];
+  if (!ctx || !out)
+    return gr_set_error(ctx, GR_ERR_INVALID_ARGUMENT,
+                        "gr_snow_accumulation_create needs a context and a place for the "
+                        "simulation.");
+  *out = NULL;
+  if (gr_grid_validate(grid, msg, sizeof(msg)) != GR_OK)
+    return gr_set_error(ctx, GR_ERR_INVALID_ARGUMENT, "%s", msg);
+  if (gr_snow_accumulation_params_validate(p, msg, sizeof(msg)) != GR_OK)
+    return gr_set_error(ctx, GR_ERR_INVALID_ARGUMENT, "%s", msg);
+  if (grid->i0 != 0 || grid->j0 != 0 || grid->ghost != 0 ||
+      (grid->global_nx != 0 && grid->global_nx != grid->nx) ||
+      (grid->global_ny != 0 && grid->global_ny != grid->ny))
+    return gr_set_error(ctx, GR_ERR_INVALID_ARGUMENT,
+                        "Snow accumulation runs on whole grids only for now: this grid is a "
+                        "piece (i0 %d, j0 %d, ghost %d, global %d x %d); run it on the whole "
+                        "domain.",
+                        grid->i0, grid->j0, grid->ghost, grid->global_nx, grid->global_ny);
+  if ((double)grid->nx * (double)grid->ny > (double)INT_MAX / 2)
+    return gr_set_error(ctx, GR_ERR_TOO_LARGE,
+                        "The snow accumulation grid of %d x %d points is too large: the kernels "
+                        "address at most about 1e9 points; coarsen it.",
+                        grid->nx, grid->ny);
+  gr_snow_accumulation *s = calloc(1, sizeof(*s));
+  if (!s)
+    return gr_set_error(ctx, GR_ERR_OUT_OF_MEMORY, "Out of host memory.");
+  s->ctx = gr_context_retain(ctx);
+  s->grid = *grid;
+  s->params = *p;
+  size_t cells = gr_snac_cells(s), bytes = cells * sizeof(float);
+  cl_program prog = NULL;
+  gr_status st = gr_program_get(ctx, "snow_accumulation", NULL, &prog);
+  struct {
+    const char *name;
+    cl_kernel *k;
+  } ks[] = {{"snow_accumulation_raster_terrain", &s->raster_terrain},
+            {"snow_accumulation_raster_objects", &s->raster_objects},
+            {"snow_accumulation_exposure", &s->exposure_k},
+            {"snow_accumulation_blur", &s->blur},
+            {"snow_accumulation_dilate", &s->dilate},
+            {"snow_accumulation_apply", &s->apply},
+            {"snow_accumulation_objects", &s->objects_k},
+            {"snow_accumulation_reduce", &s->reduce},
+            {"snow_accumulation_surface", &s->surface}};
+  for (size_t i = 0; st == GR_OK && i < sizeof(ks) / sizeof(ks[0]); ++i)
+    st = gr_kernel_create(ctx, prog, ks[i].name, ks[i].k);
+  cl_mem *bufs[] = {&s->ground, &s->depth0, &s->growth, &s->scratch};
+  for (size_t i = 0; st == GR_OK && i < sizeof(bufs) / sizeof(bufs[0]); ++i)
+    st = gr_buffer_create(ctx, CL_MEM_READ_WRITE, bytes, NULL, bufs[i]);
+  for (int a = 0; st == GR_OK && a < GR_SNAC_ARRAYS; ++a)
+    st = gr_buffer_create(ctx, CL_MEM_READ_WRITE, bytes, NULL, &s->arr[a]);
+  if (st == GR_OK)
+    st = gr_buffer_create(ctx, CL_MEM_READ_ONLY, (GR_SNAC_MAX_BLUR + 1) * sizeof(float), NULL,
+                          &s->weights);
+  if (st == GR_OK)
+    st = gr_snac_prepare(s, p);
+  if (st == GR_OK)
+    st = gr_reduction_init(ctx, s->reduce, cells, GR_SNAC_SUMS, 0, &s->red);
+  if (st == GR_OK)
+    st = gr_snac_fill(s, s->ground, cells, 0.0f);
+  if (st == GR_OK)
+    st = gr_snac_fill(s, s->depth0, cells, 0.0f);
+  if (st == GR_OK)
+    st = gr_snac_initial_state(s);
+  if (st != GR_OK) {
+    gr_snow_accumulation_destroy(s);
+    return st;
+  }
+  *out = s;
+  return GR_OK;
+}
+
+static void gr_snac_release_objects(gr_snow_accumulation *s) {
+  cl_mem *bufs[] = {&s->o_tri, &s->o_pos, &s->o_nrm, &s->o_local, &s->o_area};
+  for (size_t i = 0; i < sizeof(bufs) / sizeof(bufs[0]); ++i)
+    gr_buffer_release(bufs[i]);
+  for (int a = 0; a < GR_SNAC_ARRAYS; ++a)
+    gr_buffer_release(&s->o_arr[a]);
+}
+
+void gr_snow_accumulation_destroy(gr_snow_accumulation *s) {
+  if (!s)
+    return;
+  cl_kernel ks[] = {s->raster_terrain, s->raster_objects, s->exposure_k, s->blur,   s->dilate,
+                    s->apply,          s->objects_k,      s->reduce,     s->surface};
+  for (size_t i = 0; i < sizeof(ks) / sizeof(ks[0]); ++i)
+    if (ks[i])
+      clReleaseKernel(ks[i]);
+  cl_mem *bufs[] = {&s->ground, &s->depth0, &s->growth, &s->scratch, &s->weights, &s->view};
+  for (size_t i = 0; i < sizeof(bufs) / sizeof(bufs[0]); ++i)
+    gr_buffer_release(bufs[i]);
+  for (int a = 0; a < GR_SNAC_ARRAYS; ++a)
+    gr_buffer_release(&s->arr[a]);
+  gr_snac_release_objects(s);
+  gr_reduction_release(&s->red);
+  free(s->hv);
+  free(s->ht);
+  free(s->hnrm);
+  gr_context_release(s->ctx);
+  free(s);
+}
+
+gr_status gr_snow_accumulation_set_params(gr_snow_accumulation *s,
+                                          const gr_snow_accumulation_params *p) {
+  char msg[400];
+  if (!s)
+    return gr_set_error(NULL, GR_ERR_INVALID_ARGUMENT,
+                        "gr_snow_accumulation_set_params needs a simulation.");
+  if (gr_snow_accumulation_params_validate(p, msg, sizeof(msg)) != GR_OK)
+    return GR_SNAC_KEEP_ERROR(s, gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT, "%s", msg));
+  gr_status st = gr_snac_prepare(s, p);
+  if (st != GR_OK)
+    return GR_SNAC_KEEP_ERROR(s, st);
+  s->params = *p;
+  return GR_OK;
+}
+
+/* Uploads the objects' world geometry relative to grid point (0, 0) and
+ * zref (again whenever zref moves). */
+static gr_status gr_snac_upload_geometry(gr_snow_accumulation *s) {
+  if (s->nv == 0)
+    return GR_OK;
+  size_t nv = (size_t)s->nv, nt = (size_t)s->ntri;
+  float *pos = malloc(nv * 3 * sizeof(float)), *tri = malloc((nt ? nt : 1) * 9 * sizeof(float));
+  if (!pos || !tri) {
+    free(pos), free(tri);
+    return gr_set_error(s->ctx, GR_ERR_OUT_OF_MEMORY, "Out of host memory.");
+  }
+  double off[3] = {s->grid.x0, s->grid.y0, s->zref};
+  for (size_t v = 0; v < nv; ++v)
+    for (int a = 0; a < 3; ++a)
+      pos[3 * v + a] = (float)(s->hv[3 * v + a] - off[a]);
+  for (size_t t = 0; t < nt; ++t)
+    for (int k = 0; k < 3; ++k)
+      memcpy(tri + 9 * t + 3 * k, pos + 3 * (size_t)s->ht[3 * t + k], 3 * sizeof(float));
+  gr_status st = gr_buffer_write(s->ctx, s->o_pos, 0, nv * 3 * sizeof(float), pos);
+  if (st == GR_OK && nt)
+    st = gr_buffer_write(s->ctx, s->o_tri, 0, nt * 9 * sizeof(float), tri);
+  free(pos), free(tri);
+  return st;
+}
+
+static gr_status gr_snac_set_field_impl(gr_snow_accumulation *s, gr_field f, const float *host) {
+  size_t cells = gr_snac_cells(s), nx = (size_t)s->grid.nx;
+  char msg[512];
+  if (gr_snow_accumulation_field_validate(f, host, cells, nx, msg, sizeof(msg)) != GR_OK)
+    return gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT, "%s", msg);
+  size_t bytes = cells * sizeof(float);
+  double lo = HUGE_VAL, hi = -HUGE_VAL;
+  for (size_t c = 0; c < cells; ++c) {
+    lo = fmin(lo, (double)host[c]);
+    hi = fmax(hi, (double)host[c]);
+  }
+  if (f == GR_FIELD_ELEVATION) {
+    gr_status st = gr_buffer_write(s->ctx, s->ground, 0, bytes, host);
+    if (st != GR_OK)
+      return st;
+    s->bmin = lo, s->bmax = hi;
+    if (s->zref != lo) {
+      s->zref = lo;
+      st = gr_snac_upload_geometry(s);
+    }
+    return st;
+  }
+  /* The new snow replaces what lies on the grid: the ledger's initial
+   * volume moves by the change, so the balance still closes. */
+  double before[GR_SNAC_SUMS], after[GR_SNAC_SUMS];
+  gr_status st = gr_snac_sums(s, 0, 0, (int)cells, before);
+  if (st == GR_OK)
+    st = gr_buffer_write(s->ctx, s->depth0, 0, bytes, host);
+  if (st == GR_OK)
+    st = gr_buffer_write(s->ctx, s->arr[0], 0, bytes, host);
+  if (st == GR_OK)
+    st = gr_snac_fill(s, s->arr[1], cells, 0.0f);
+  if (st == GR_OK)
+    st = gr_snac_sums(s, 0, 0, (int)cells, after);
+  if (st == GR_OK) {
+    s->initial_volume += (after[0] - before[0]) * s->grid.dx * s->grid.dy;
+    s->init_max = hi;
+    s->snow_bound = fmax(s->snow_bound, hi);
+  }
+  return st;
+}
+
+gr_status gr_snow_accumulation_set_field(gr_snow_accumulation *s, gr_field f, const float *host) {
+  if (!s)
+    return gr_set_error(NULL, GR_ERR_INVALID_ARGUMENT,
+                        "gr_snow_accumulation_set_field needs a simulation.");
+  if (!host)
+    return GR_SNAC_KEEP_ERROR(
+        s, gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
+                        "gr_snow_accumulation_set_field needs the field's values (got NULL)."));
+  return GR_SNAC_KEEP_ERROR(s, gr_snac_set_field_impl(s, f, host));
+}
+
+/* The new objects' geometry on the host: world vertices, triangles with
+ * global indices, world normals (area-weighted), noise coordinates and
+ * areas (in the object's own frame). */
+typedef struct gr_snac_geometry {
+  double *hv;
+  int *ht;
+  float *nrm, *local, *area;
+  double lo[3], hi[3];
+} gr_snac_geometry;
+
+static void gr_snac_geometry_free(gr_snac_geometry *g) {
+  free(g->hv), free(g->ht), free(g->nrm), free(g->local), free(g->area);
+}
+
+static gr_status gr_snac_build_geometry(gr_snow_accumulation *s, const gr_mesh *meshes, int n,
+                                        const int *first, int nv, int nt, gr_snac_geometry *g) {
+  size_t V = nv ? (size_t)nv : 1, T = nt ? (size_t)nt : 1;
+  g->hv = malloc(V * 3 * sizeof(double));
+  g->ht = malloc(T * 3 * sizeof(int));
+  g->nrm = calloc(V * 3, sizeof(float));
+  g->local = malloc(V * 3 * sizeof(float));
+  g->area = calloc(V, sizeof(float));
+  double *acc = calloc(V * 3, sizeof(double)), *area = calloc(V, sizeof(double));
+  if (!g->hv || !g->ht || !g->nrm || !g->local || !g->area || !acc || !area) {
+    free(acc), free(area);
+    return gr_set_error(s->ctx, GR_ERR_OUT_OF_MEMORY, "Out of host memory.");
+  }
+  for (int a = 0; a < 3; ++a)
+    g->lo[a] = HUGE_VAL, g->hi[a] = -HUGE_VAL;
+  double inv_scale = 1.0 / s->params.noise_scale;
+  size_t at = 0;
+  for (int o = 0; o < n; ++o) {
+    const gr_mesh *m = &meshes[o];
+    const double *T4 = m->transform;
+    for (int v = 0; v < m->nvertices; ++v) {
+      const float *p = m->vertices + 3 * v;
+      size_t k = (size_t)(first[o] + v);
+      for (int a = 0; a < 3; ++a) {
+        double w = T4[a] * p[0] + T4[4 + a] * p[1] + T4[8 + a] * p[2] + T4[12 + a];
+        g->hv[3 * k + a] = w;
+        g->lo[a] = fmin(g->lo[a], w);
+        g->hi[a] = fmax(g->hi[a], w);
+        /* Per object a different stretch of the noise lattice. */
+        g->local[3 * k + a] =
+            (float)fmod(p[a] * inv_scale + 97.0 * (double)o, GR_SNAC_NOISE_PERIOD);
+      }
+    }
+    for (int t = 0; t < m->ntriangles; ++t, ++at) {
+      int idx[3];
+      for (int q = 0; q < 3; ++q) {
+        idx[q] = first[o] + m->triangles[3 * t + q];
+        g->ht[3 * at + q] = idx[q];
+      }
+      const double *A = g->hv + 3 * (size_t)idx[0], *B = g->hv + 3 * (size_t)idx[1],
+                   *C = g->hv + 3 * (size_t)idx[2];
+      double u[3] = {B[0] - A[0], B[1] - A[1], B[2] - A[2]};
+      double w[3] = {C[0] - A[0], C[1] - A[1], C[2] - A[2]};
+      double cr[3] = {u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2],
+                      u[0] * w[1] - u[1] * w[0]};
+      const float *a = m->vertices + 3 * m->triangles[3 * t],
+                  *b = m->vertices + 3 * m->triangles[3 * t + 1],
+                  *c = m->vertices + 3 * m->triangles[3 * t + 2];
+      double lu[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+      double lw[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+      double lc[3] = {lu[1] * lw[2] - lu[2] * lw[1], lu[2] * lw[0] - lu[0] * lw[2],
+                      lu[0] * lw[1] - lu[1] * lw[0]};
+      double la = 0.5 * sqrt(lc[0] * lc[0] + lc[1] * lc[1] + lc[2] * lc[2]);
+      for (int q = 0; q < 3; ++q) {
+        for (int e = 0; e < 3; ++e)
+          acc[3 * (size_t)idx[q] + e] += cr[e];
+        area[idx[q]] += la / 3.0;
+      }
+    }
+  }
+  for (size_t v = 0; v < (size_t)nv; ++v) {
+    double *c = acc + 3 * v;
+    double len = sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
+    for (int e = 0; e < 3 && len > 0.0; ++e)
+      g->nrm[3 * v + e] = (float)(c[e] / len);
+    g->area[v] = (float)area[v];
+  }
+  free(acc), free(area);
+  return GR_OK;
+}
+
+static gr_status gr_snac_set_objects_impl(gr_snow_accumulation *s, const gr_mesh *meshes, int n) {
+  char msg[320];
+  if (n < 0 || n > GR_SNOW_ACCUMULATION_MAX_OBJECTS || (n > 0 && !meshes))
+    return gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
+                        "gr_snow_accumulation_set_objects takes 0 to %d objects with their meshes "
+                        "(got %d%s).",
+                        GR_SNOW_ACCUMULATION_MAX_OBJECTS, n,
+                        n > 0 && !meshes ? " and no meshes" : "");
+  int first[GR_SNOW_ACCUMULATION_MAX_OBJECTS + 1];
+  long long nv = 0, nt = 0;
+  for (int o = 0; o < n; ++o) {
+    if (gr_mesh_validate(&meshes[o], 0, msg, sizeof(msg)) != GR_OK)
+      return gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT, "Object %d: %s", o, msg);
+    first[o] = (int)nv;
+    nv += meshes[o].nvertices;
+    nt += meshes[o].ntriangles;
+    if (nv > INT_MAX / 4 || nt > INT_MAX / 16)
+      return gr_set_error(s->ctx, GR_ERR_TOO_LARGE,
+                          "The objects have more than %d mesh points or %d triangles, more than "
+                          "the core addresses; simplify the meshes.",
+                          INT_MAX / 4, INT_MAX / 16);
+  }
+  first[n] = (int)nv;
+  /* Which objects keep their snow: the same index with as many points. */
+  int same = n == s->nobjects;
+  for (int o = 0; same && o < n; ++o)
+    same = meshes[o].nvertices == s->nverts[o];
+  gr_snac_geometry g;
+  memset(&g, 0, sizeof(g));
+  gr_status st = gr_snac_build_geometry(s, meshes, n, first, (int)nv, (int)nt, &g);
+  cl_mem nb[5] = {NULL, NULL, NULL, NULL, NULL}, na[GR_SNAC_ARRAYS];
+  memset(na, 0, sizeof(na));
+  size_t V = nv ? (size_t)nv : 1, T = nt ? (size_t)nt : 1;
+  if (!same) {
+    size_t sizes[5] = {T * 9, V * 3, V * 3, V * 3, V};
+    for (int b = 0; st == GR_OK && b < 5; ++b)
+      st = gr_buffer_create(s->ctx, CL_MEM_READ_WRITE, sizes[b] * sizeof(float), NULL, &nb[b]);
+    for (int a = 0; st == GR_OK && a < GR_SNAC_ARRAYS; ++a)
+      st = gr_buffer_create(s->ctx, CL_MEM_READ_WRITE, V * sizeof(float), NULL, &na[a]);
+    /* Kept objects' state to their new place, the rest zero; the snow of
+     * objects that go is dropped (counted). */
+    for (int a = 0; st == GR_OK && a < GR_SNAC_ARRAYS; ++a) {
+      float zero = 0.0f;
+      st = gr_cl_check(s->ctx,
+                       clEnqueueFillBuffer(gr_context_queue(s->ctx), na[a], &zero, sizeof(zero), 0,
+                                           V * sizeof(float), 0, NULL, NULL),
+                       "Clearing the objects' snow");
+    }
+    double fall = 0.0, shed = 0.0, stored = 0.0;
+    for (int o = 0; st == GR_OK && o < s->nobjects; ++o) {
+      int keep = o < n && meshes[o].nvertices == s->nverts[o];
+      if (keep && s->nverts[o] > 0) {
+        for (int a = 0; st == GR_OK && a < GR_SNAC_ARRAYS; ++a)
+          st = gr_cl_check(s->ctx,
+                           clEnqueueCopyBuffer(gr_context_queue(s->ctx), s->o_arr[a], na[a],
+                                               (size_t)s->first[o] * sizeof(float),
+                                               (size_t)first[o] * sizeof(float),
+                                               (size_t)s->nverts[o] * sizeof(float), 0, NULL, NULL),
+                           "Copying an object's snow");
+      } else if (!keep) {
+        double sums[GR_SNAC_SUMS];
+        st = gr_snac_sums(s, 1, s->first[o], s->nverts[o], sums);
+        stored += sums[0], fall += sums[1], shed += sums[2];
+      }
+    }
+    if (st == GR_OK) {
+      s->retired_fall += fall;
+      s->retired_shed += shed;
+      s->dropped += stored;
+    }
+  }
+  if (st != GR_OK) {
+    for (int b = 0; b < 5; ++b)
+      gr_buffer_release(&nb[b]);
+    for (int a = 0; a < GR_SNAC_ARRAYS; ++a)
+      gr_buffer_release(&na[a]);
+    gr_snac_geometry_free(&g);
+    return st;
+  }
+  if (!same) {
+    gr_snac_release_objects(s);
+    s->o_tri = nb[0], s->o_pos = nb[1], s->o_nrm = nb[2], s->o_local = nb[3], s->o_area = nb[4];
+    memcpy(s->o_arr, na, sizeof(na));
+  }
+  free(s->hv), free(s->ht), free(s->hnrm);
+  s->hv = g.hv, s->ht = g.ht, s->hnrm = g.nrm;
+  s->nobjects = n;
+  s->nv = (int)nv;
+  s->ntri = (int)nt;
+  for (int o = 0; o < n; ++o)
+    s->nverts[o] = meshes[o].nvertices;
+  memcpy(s->first, first, (size_t)(n + 1) * sizeof(int));
+  memcpy(s->ob_lo, g.lo, sizeof(g.lo));
+  memcpy(s->ob_hi, g.hi, sizeof(g.hi));
+  if (nv > 0) {
+    st = gr_buffer_write(s->ctx, s->o_nrm, 0, (size_t)nv * 3 * sizeof(float), g.nrm);
+    if (st == GR_OK)
+      st = gr_buffer_write(s->ctx, s->o_local, 0, (size_t)nv * 3 * sizeof(float), g.local);
+    if (st == GR_OK)
+      st = gr_buffer_write(s->ctx, s->o_area, 0, (size_t)nv * sizeof(float), g.area);
+    if (st == GR_OK)
+      st = gr_snac_upload_geometry(s);
+  }
+  free(g.local), free(g.area);
+  return st;
+}
+
+gr_status gr_snow_accumulation_set_objects(gr_snow_accumulation *s, const gr_mesh *meshes, int n) {
+  if (!s)
+    return gr_set_error(NULL, GR_ERR_INVALID_ARGUMENT,
+                        "gr_snow_accumulation_set_objects needs a simulation.");
+  return GR_SNAC_KEEP_ERROR(s, gr_snac_set_objects_impl(s, meshes, n));
+}
+
+static gr_status gr_snac_check_object(gr_snow_accumulation *s, const char *what, int o, int n,
+                                      const void *host) {
+  if (o < 0 || o >= s->nobjects)
+    return gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
+                        "%s: there is no object %d (%d are set); pass an index from 0 to %d.", what,
+                        o, s->nobjects, s->nobjects - 1);
+  if (!host || n != s->nverts[o])
+    return gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
+                        "%s: object %d has %d mesh points but %d were given%s; pass one value per "
+                        "mesh point.",
+                        what, o, s->nverts[o], n, host ? "" : " (and no array)");
+  return GR_OK;
+}
+
+gr_status gr_snow_accumulation_get_object_field(gr_snow_accumulation *s, int o, gr_field f,
+                                                float *host, int n) {
+  if (!s)
+    return gr_set_error(NULL, GR_ERR_INVALID_ARGUMENT,
+                        "gr_snow_accumulation_get_object_field needs a simulation.");
+  gr_status st = gr_snac_check_object(s, "gr_snow_accumulation_get_object_field", o, n, host);
+  if (st == GR_OK && f != GR_FIELD_SNOW_DEPTH && f != GR_FIELD_EXPOSURE) {
+    const char *name = gr_field_name(f);
+    st = gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
+                      "The objects of the snow accumulation have no field '%s'; they give "
+                      "snow_depth and exposure.",
+                      name ? name : "(unknown field)");
+  }
+  if (st == GR_OK && n > 0)
+    st = gr_buffer_read(s->ctx, s->o_arr[f == GR_FIELD_SNOW_DEPTH ? 0 : 6],
+                        (size_t)s->first[o] * sizeof(float), (size_t)n * sizeof(float), host);
+  return st == GR_OK ? GR_OK : GR_SNAC_KEEP_ERROR(s, st);
+}
+
+gr_status gr_snow_accumulation_get_object_offsets(gr_snow_accumulation *s, int o, float *xyz,
+                                                  int n) {
+  if (!s)
+    return gr_set_error(NULL, GR_ERR_INVALID_ARGUMENT,
+                        "gr_snow_accumulation_get_object_offsets needs a simulation.");
+  gr_status st = gr_snac_check_object(s, "gr_snow_accumulation_get_object_offsets", o, n, xyz);
+  if (st == GR_OK && n > 0)
+    st = gr_buffer_read(s->ctx, s->o_arr[0], (size_t)s->first[o] * sizeof(float),
+                        (size_t)n * sizeof(float), xyz);
+  if (st != GR_OK)
+    return GR_SNAC_KEEP_ERROR(s, st);
+  /* In place, from the back: depth k sits at xyz[k]. */
+  for (int k = n - 1; k >= 0; --k) {
+    float d = xyz[k];
+    const float *nr = s->hnrm + 3 * (size_t)(s->first[o] + k);
+    for (int a = 2; a >= 0; --a)
+      xyz[3 * k + a] = nr[a] * d;
+  }
+  return GR_OK;
+}
+
+gr_status gr_snow_accumulation_set_object_snow(gr_snow_accumulation *s, int o, const float *depth,
+                                               int n) {
+  if (!s)
+    return gr_set_error(NULL, GR_ERR_INVALID_ARGUMENT,
+                        "gr_snow_accumulation_set_object_snow needs a simulation.");
+  gr_status st = gr_snac_check_object(s, "gr_snow_accumulation_set_object_snow", o, n, depth);
+  char msg[400];
+  if (st == GR_OK && gr_snow_accumulation_field_validate(GR_FIELD_SNOW_DEPTH, depth, (size_t)n, 0,
+                                                         msg, sizeof(msg)) != GR_OK)
+    st = gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT, "Object %d: %s", o, msg);
+  if (st != GR_OK || n == 0)
+    return st == GR_OK ? GR_OK : GR_SNAC_KEEP_ERROR(s, st);
+  double before[GR_SNAC_SUMS], after[GR_SNAC_SUMS];
+  size_t off = (size_t)s->first[o] * sizeof(float), bytes = (size_t)n * sizeof(float);
+  float zero = 0.0f;
+  st = gr_snac_sums(s, 1, s->first[o], n, before);
+  if (st == GR_OK)
+    st = gr_buffer_write(s->ctx, s->o_arr[0], off, bytes, depth);
+  if (st == GR_OK)
+    st = gr_cl_check(s->ctx,
+                     clEnqueueFillBuffer(gr_context_queue(s->ctx), s->o_arr[1], &zero, sizeof(zero),
+                                         off, bytes, 0, NULL, NULL),
+                     "Clearing an object's snow");
+  if (st == GR_OK)
+    st = gr_snac_sums(s, 1, s->first[o], n, after);
+  if (st == GR_OK)
+    s->initial_volume += after[0] - before[0];
+  return st == GR_OK ? GR_OK : GR_SNAC_KEEP_ERROR(s, st);
+}
+
+/* A 64-bit mix (splitmix64): the flutter's random numbers per step. */
+static uint64_t gr_snac_mix(uint64_t x) {
+  x += 0x9e3779b97f4a7c15ULL;
+  x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ULL;
+  x = (x ^ (x >> 27)) * 0x94d049bb133111ebULL;
+  return x ^ (x >> 31);
+}
+
+/* This step's unit snow direction: SnowDirection turned by up to Flutter,
+ * uniformly over the cone's disc, seeded by Seed and the step's number. */
+static void gr_snac_direction(const gr_snow_accumulation *s, double d[3]) {
+  const double *p = s->params.direction;
+  double len = sqrt(p[0] * p[0] + p[1] * p[1] + p[2] * p[2]);
+  for (int a = 0; a < 3; ++a)
+    d[a] = p[a] / len;
+  if (!(s->params.flutter > 0.0))
+    return;
+  uint64_t h = gr_snac_mix(((uint64_t)(uint32_t)s->params.seed << 32) ^ (uint64_t)s->steps);
+  double u1 = (double)(h >> 11) / 9007199254740992.0;
+  double u2 = (double)(gr_snac_mix(h) >> 11) / 9007199254740992.0;
+  double alpha = s->params.flutter * sqrt(u1), beta = 2.0 * GR_SNAC_PI * u2;
+  /* e1, e2: unit vectors across d. */
+  double e1[3] = {1.0, 0.0, 0.0};
+  if (fabs(d[0]) > 0.9)
+    e1[0] = 0.0, e1[1] = 1.0;
+  double dot = e1[0] * d[0] + e1[1] * d[1] + e1[2] * d[2];
+  for (int a = 0; a < 3; ++a)
+    e1[a] -= dot * d[a];
+  double l1 = sqrt(e1[0] * e1[0] + e1[1] * e1[1] + e1[2] * e1[2]);
+  for (int a = 0; a < 3; ++a)
+    e1[a] /= l1;
+  double e2[3] = {d[1] * e1[2] - d[2] * e1[1], d[2] * e1[0] - d[0] * e1[2],
+                  d[0] * e1[1] - d[1] * e1[0]};
+  for (int a = 0; a < 3; ++a)
+    d[a] = cos(alpha) * d[a] + sin(alpha) * (cos(beta) * e1[a] + sin(beta) * e2[a]);
+}
+
+/* The view of one step: where rays along d cross z = 0 (tau), the extent
+ * of the terrain's and the objects' crossings, and the texel. */
+typedef struct gr_snac_view {
+  float tau_x, tau_y, qx0, qy0, inv_texel, texel;
+  int vw, vh;
+} gr_snac_view;
+
+static void gr_snac_view_of(const gr_snow_accumulation *s, const double d[3], gr_snac_view *v) {
+  const gr_grid *g = &s->grid;
+  double tx = -d[0] / d[2], ty = -d[1] / d[2];
+  double W = (g->nx - 1) * g->dx, H = (g->ny - 1) * g->dy;
+  double box[2][3][2] = {
+      {{0.0, W}, {0.0, H}, {s->bmin - s->zref, s->bmax + s->snow_bound - s->zref}},
+      {{0, 0}, {0, 0}, {0, 0}}};
+  int nbox = 1;
+  if (s->nv > 0) {
+    /* The objects, but no further than half the grid beyond it: an object
+     * far away would coarsen the view of the terrain. */
+    double lox = s->ob_lo[0] - g->x0, hix = s->ob_hi[0] - g->x0;
+    double loy = s->ob_lo[1] - g->y0, hiy = s->ob_hi[1] - g->y0;
+    box[1][0][0] = fmax(lox, -0.5 * W - g->dx), box[1][0][1] = fmin(hix, 1.5 * W + g->dx);
+    box[1][1][0] = fmax(loy, -0.5 * H - g->dy), box[1][1][1] = fmin(hiy, 1.5 * H + g->dy);
+    box[1][2][0] = s->ob_lo[2] - s->zref, box[1][2][1] = s->ob_hi[2] - s->zref;
+    nbox = box[1][0][0] <= box[1][0][1] && box[1][1][0] <= box[1][1][1] ? 2 : 1;
+  }
+  double qlo[2] = {HUGE_VAL, HUGE_VAL}, qhi[2] = {-HUGE_VAL, -HUGE_VAL};
+  for (int b = 0; b < nbox; ++b)
+    for (int k = 0; k < 8; ++k) {
+      double x = box[b][0][k & 1], y = box[b][1][(k >> 1) & 1], z = box[b][2][(k >> 2) & 1];
+      double q[2] = {x + z * tx, y + z * ty};
+      for (int a = 0; a < 2; ++a)
+        qlo[a] = fmin(qlo[a], q[a]), qhi[a] = fmax(qhi[a], q[a]);
+    }
+  int res = s->params.exposure_resolution;
+  double span = fmax(qhi[0] - qlo[0], qhi[1] - qlo[1]);
+  double texel = span > 0.0 ? span / res : fmax(g->dx, g->dy) / res;
+  int m = GR_SNAC_VIEW_MARGIN;
+  v->tau_x = (float)tx, v->tau_y = (float)ty;
+  v->texel = (float)texel;
+  v->inv_texel = (float)(1.0 / texel);
+  v->qx0 = (float)(qlo[0] - m * texel);
+  v->qy0 = (float)(qlo[1] - m * texel);
+  v->vw = (int)fmin(ceil((qhi[0] - qlo[0]) / texel), (double)res) + 2 * m + 1;
+  v->vh = (int)fmin(ceil((qhi[1] - qlo[1]) / texel), (double)res) + 2 * m + 1;
+}
+
+static gr_status gr_snac_step_impl(gr_snow_accumulation *s, double dt) {
+  gr_context *ctx = s->ctx;
+  const gr_grid *g = &s->grid;
+  double t0 = gr_snac_now_ms();
+  if (s->timing) {
+    gr_status st = gr_finish(ctx);
+    if (st != GR_OK)
+      return st;
+    t0 = s->t_mark = gr_snac_now_ms();
+  }
+  double dd[3];
+  gr_snac_direction(s, dd);
+  gr_snac_view v;
+  gr_snac_view_of(s, dd, &v);
+  cl_int nx = g->nx, ny = g->ny, vw = v.vw, vh = v.vh;
+  float dx = (float)g->dx, dy = (float)g->dy, zref = (float)s->zref;
+  float dir_x = (float)dd[0], dir_y = (float)dd[1], dir_z = (float)dd[2];
+  const gr_snow_accumulation_params *p = &s->params;
+  float rate_dt = (float)(p->snowfall_rate * dt), amplitude = (float)p->noise_amplitude;
+  float max_depth = (float)p->max_depth;
+  float keep = (float)pow(1.0 - p->stability_factor, dt);
+  cl_uint seed = (cl_uint)p->seed;
+  double inv_scale = 1.0 / p->noise_scale;
+  float noise_x0 = (float)fmod(g->x0 * inv_scale, GR_SNAC_NOISE_PERIOD);
+  float noise_y0 = (float)fmod(g->y0 * inv_scale, GR_SNAC_NOISE_PERIOD);
+  float noise_dx = (float)(g->dx * inv_scale), noise_dy = (float)(g->dy * inv_scale);
+  if (s->timing)
+    s->tm.host_ms += gr_snac_now_ms() - t0, s->t_mark = gr_snac_now_ms();
+
+  /* 1. the view */
+  cl_int empty = GR_SNAC_EMPTY;
+  gr_status st =
+      gr_cl_check(ctx,
+                  clEnqueueFillBuffer(gr_context_queue(ctx), s->view, &empty, sizeof(empty), 0,
+                                      (size_t)vw * (size_t)vh * sizeof(cl_int), 0, NULL, NULL),
+                  "Clearing the exposure view");
+  const gr_snac_arg rt[] = {GR_SNAC_MEM("ground", s->ground),
+                            GR_SNAC_MEM("depth", s->arr[0]),
+                            GR_SNAC_VAL("nx", nx),
+                            GR_SNAC_VAL("ny", ny),
+                            GR_SNAC_VAL("dx", dx),
+                            GR_SNAC_VAL("dy", dy),
+                            GR_SNAC_VAL("zref", zref),
+                            GR_SNAC_VAL("tau_x", v.tau_x),
+                            GR_SNAC_VAL("tau_y", v.tau_y),
+                            GR_SNAC_VAL("qx0", v.qx0),
+                            GR_SNAC_VAL("qy0", v.qy0),
+                            GR_SNAC_VAL("inv_texel", v.inv_texel),
+                            GR_SNAC_VAL("vw", vw),
+                            GR_SNAC_VAL("vh", vh),
+                            GR_SNAC_MEM("view", s->view)};
+  if (st == GR_OK)
+    st = gr_snac_args(s, s->raster_terrain, rt, sizeof(rt) / sizeof(rt[0]));
+  if (st == GR_OK && nx > 1 && ny > 1)
+    st = gr_enqueue_2d(ctx, s->raster_terrain, 0, 0, (size_t)(nx - 1), (size_t)(ny - 1), NULL);
+  cl_int ntri = s->ntri;
+  if (st == GR_OK && ntri > 0) {
+    const gr_snac_arg ro[] = {GR_SNAC_MEM("tri", s->o_tri),
+                              GR_SNAC_VAL("ntri", ntri),
+                              GR_SNAC_VAL("tau_x", v.tau_x),
+                              GR_SNAC_VAL("tau_y", v.tau_y),
+                              GR_SNAC_VAL("qx0", v.qx0),
+                              GR_SNAC_VAL("qy0", v.qy0),
+                              GR_SNAC_VAL("inv_texel", v.inv_texel),
+                              GR_SNAC_VAL("vw", vw),
+                              GR_SNAC_VAL("vh", vh),
+                              GR_SNAC_MEM("view", s->view)};
+    st = gr_snac_args(s, s->raster_objects, ro, sizeof(ro) / sizeof(ro[0]));
+    if (st == GR_OK)
+      st = gr_enqueue_2d(ctx, s->raster_objects, 0, 0, (size_t)ntri, 1, NULL);
+  }
+  if (st == GR_OK)
+    st = gr_snac_mark(s, &s->tm.view_ms);
+
+  /* 2-3. exposure and growth of the grid points */
+  const gr_snac_arg ex[] = {GR_SNAC_MEM("ground", s->ground),
+                            GR_SNAC_MEM("depth", s->arr[0]),
+                            GR_SNAC_VAL("nx", nx),
+                            GR_SNAC_VAL("ny", ny),
+                            GR_SNAC_VAL("dx", dx),
+                            GR_SNAC_VAL("dy", dy),
+                            GR_SNAC_VAL("zref", zref),
+                            GR_SNAC_VAL("dir_x", dir_x),
+                            GR_SNAC_VAL("dir_y", dir_y),
+                            GR_SNAC_VAL("dir_z", dir_z),
+                            GR_SNAC_VAL("tau_x", v.tau_x),
+                            GR_SNAC_VAL("tau_y", v.tau_y),
+                            GR_SNAC_VAL("qx0", v.qx0),
+                            GR_SNAC_VAL("qy0", v.qy0),
+                            GR_SNAC_VAL("inv_texel", v.inv_texel),
+                            GR_SNAC_VAL("texel", v.texel),
+                            GR_SNAC_VAL("vw", vw),
+                            GR_SNAC_VAL("vh", vh),
+                            GR_SNAC_MEM("view", s->view),
+                            GR_SNAC_VAL("rate_dt", rate_dt),
+                            GR_SNAC_VAL("amplitude", amplitude),
+                            GR_SNAC_VAL("noise_x0", noise_x0),
+                            GR_SNAC_VAL("noise_y0", noise_y0),
+                            GR_SNAC_VAL("noise_dx", noise_dx),
+                            GR_SNAC_VAL("noise_dy", noise_dy),
+                            GR_SNAC_VAL("seed", seed),
+                            GR_SNAC_MEM("exposure", s->arr[6]),
+                            GR_SNAC_MEM("growth", s->growth)};
+  if (st == GR_OK)
+    st = gr_snac_args(s, s->exposure_k, ex, sizeof(ex) / sizeof(ex[0]));
+  if (st == GR_OK)
+    st = gr_enqueue_2d(ctx, s->exposure_k, 0, 0, (size_t)nx, (size_t)ny, NULL);
+  if (st == GR_OK)
+    st = gr_snac_mark(s, &s->tm.exposure_ms);
+
+  /* 4. blur and dilation, between growth and scratch */
+  cl_mem cur = s->growth, other = s->scratch;
+  cl_int radius = p->blur_radius;
+  for (cl_int axis = 0; st == GR_OK && radius > 0 && axis < 2; ++axis) {
+    const gr_snac_arg bl[] = {GR_SNAC_MEM("in", cur),    GR_SNAC_VAL("nx", nx),
+                              GR_SNAC_VAL("ny", ny),     GR_SNAC_VAL("radius", radius),
+                              GR_SNAC_VAL("axis", axis), GR_SNAC_MEM("w", s->weights),
+                              GR_SNAC_MEM("out", other)};
+    st = gr_snac_args(s, s->blur, bl, sizeof(bl) / sizeof(bl[0]));
+    if (st == GR_OK)
+      st = gr_enqueue_2d(ctx, s->blur, 0, 0, (size_t)nx, (size_t)ny, NULL);
+    cl_mem t = cur;
+    cur = other, other = t;
+  }
+  if (st == GR_OK && p->dilation) {
+    const gr_snac_arg dl[] = {GR_SNAC_MEM("in", cur), GR_SNAC_VAL("nx", nx), GR_SNAC_VAL("ny", ny),
+                              GR_SNAC_MEM("out", other)};
+    st = gr_snac_args(s, s->dilate, dl, sizeof(dl) / sizeof(dl[0]));
+    if (st == GR_OK)
+      st = gr_enqueue_2d(ctx, s->dilate, 0, 0, (size_t)nx, (size_t)ny, NULL);
+    cl_mem t = cur;
+    cur = other, other = t;
+  }
+  if (st == GR_OK)
+    st = gr_snac_mark(s, &s->tm.blur_ms);
+
+  /* 5. increment and stability */
+  const gr_snac_arg ap[] = {GR_SNAC_MEM("ground", s->ground),
+                            GR_SNAC_VAL("nx", nx),
+                            GR_SNAC_VAL("ny", ny),
+                            GR_SNAC_VAL("dx", dx),
+                            GR_SNAC_VAL("dy", dy),
+                            GR_SNAC_MEM("growth", cur),
+                            GR_SNAC_VAL("max_depth", max_depth),
+                            GR_SNAC_VAL("keep", keep),
+                            GR_SNAC_MEM("depth", s->arr[0]),
+                            GR_SNAC_MEM("depth_lo", s->arr[1]),
+                            GR_SNAC_MEM("fall", s->arr[2]),
+                            GR_SNAC_MEM("fall_lo", s->arr[3]),
+                            GR_SNAC_MEM("shed", s->arr[4]),
+                            GR_SNAC_MEM("shed_lo", s->arr[5])};
+  if (st == GR_OK)
+    st = gr_snac_args(s, s->apply, ap, sizeof(ap) / sizeof(ap[0]));
+  if (st == GR_OK)
+    st = gr_enqueue_2d(ctx, s->apply, 0, 0, (size_t)nx, (size_t)ny, NULL);
+  if (st == GR_OK)
+    st = gr_snac_mark(s, &s->tm.apply_ms);
+
+  /* the mesh points */
+  cl_int nv = s->nv;
+  if (st == GR_OK && nv > 0) {
+    const gr_snac_arg ob[] = {GR_SNAC_MEM("pos", s->o_pos),
+                              GR_SNAC_MEM("nrm", s->o_nrm),
+                              GR_SNAC_MEM("lattice", s->o_local),
+                              GR_SNAC_VAL("nv", nv),
+                              GR_SNAC_VAL("dir_x", dir_x),
+                              GR_SNAC_VAL("dir_y", dir_y),
+                              GR_SNAC_VAL("dir_z", dir_z),
+                              GR_SNAC_VAL("tau_x", v.tau_x),
+                              GR_SNAC_VAL("tau_y", v.tau_y),
+                              GR_SNAC_VAL("qx0", v.qx0),
+                              GR_SNAC_VAL("qy0", v.qy0),
+                              GR_SNAC_VAL("inv_texel", v.inv_texel),
+                              GR_SNAC_VAL("texel", v.texel),
+                              GR_SNAC_VAL("vw", vw),
+                              GR_SNAC_VAL("vh", vh),
+                              GR_SNAC_MEM("view", s->view),
+                              GR_SNAC_VAL("rate_dt", rate_dt),
+                              GR_SNAC_VAL("amplitude", amplitude),
+                              GR_SNAC_VAL("seed", seed),
+                              GR_SNAC_VAL("max_depth", max_depth),
+                              GR_SNAC_VAL("keep", keep),
+                              GR_SNAC_MEM("exposure", s->o_arr[6]),
+                              GR_SNAC_MEM("depth", s->o_arr[0]),
+                              GR_SNAC_MEM("depth_lo", s->o_arr[1]),
+                              GR_SNAC_MEM("fall", s->o_arr[2]),
+                              GR_SNAC_MEM("fall_lo", s->o_arr[3]),
+                              GR_SNAC_MEM("shed", s->o_arr[4]),
+                              GR_SNAC_MEM("shed_lo", s->o_arr[5])};
+    st = gr_snac_args(s, s->objects_k, ob, sizeof(ob) / sizeof(ob[0]));
+    if (st == GR_OK)
+      st = gr_enqueue_2d(ctx, s->objects_k, 0, 0, (size_t)nv, 1, NULL);
+    if (st == GR_OK)
+      st = gr_snac_mark(s, &s->tm.objects_ms);
+  }
+  if (st == GR_OK && s->timing)
+    s->tm.steps++;
+  if (st == GR_OK && (s->steps + 1) % GR_SNAC_SYNC_EVERY == 0)
+    st = gr_finish(ctx);
+  return st;
+}
+
+gr_status gr_snow_accumulation_step(gr_snow_accumulation *s, double dt) {
+  if (!s)
+    return gr_set_error(NULL, GR_ERR_INVALID_ARGUMENT,
+                        "gr_snow_accumulation_step needs a simulation.");
+  if (!(dt >= GR_SNAC_MIN_DT && dt <= GR_SNAC_MAX_DT))
+    return GR_SNAC_KEEP_ERROR(
+        s, gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
+                        "The snow accumulation time step must lie between 1e-6 and 86400 s (got "
+                        "%g s).",
+                        dt));
+  if (s->aborted)
+    return GR_SNAC_KEEP_ERROR(
+        s, gr_set_error(s->ctx, GR_ERR_ABORTED,
+                        "The snow accumulation was stopped by its progress callback; set the "
+                        "callback again or reset to go on."));
+  gr_status st = gr_snac_step_impl(s, dt);
+  if (st != GR_OK)
+    return GR_SNAC_KEEP_ERROR(s, st);
+  s->time += dt;
+  s->steps++;
+  /* The view's z range: snow never stands above this (it only grows by the
+   * fall, and with StabilityFactor 1 never above the larger of MaxDepth and
+   * the initial snow). */
+  double grow = s->params.snowfall_rate * (1.0 + s->params.noise_amplitude) * dt;
+  s->snow_bound += grow;
+  if (s->params.stability_factor >= 1.0)
+    s->snow_bound = fmin(s->snow_bound, fmax(s->params.max_depth, s->init_max) + grow);
+  if (s->progress && s->progress(s->progress_user, s->time) != 0)
+    s->aborted = 1;
+  return GR_OK;
+}
+
+gr_status gr_snow_accumulation_get_field(gr_snow_accumulation *s, gr_field f, float *host) {
+  if (!s)
+    return gr_set_error(NULL, GR_ERR_INVALID_ARGUMENT,
+                        "gr_snow_accumulation_get_field needs a simulation.");
+  if (!host)
+    return GR_SNAC_KEEP_ERROR(s, gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
+                                              "gr_snow_accumulation_get_field needs a place for "
+                                              "the values (got NULL)."));
+  size_t cells = gr_snac_cells(s), bytes = cells * sizeof(float);
+  cl_mem src = NULL;
+  gr_status st = GR_OK;
+  switch (f) {
+  case GR_FIELD_SNOW_DEPTH:
+    src = s->arr[0];
+    break;
+  case GR_FIELD_EXPOSURE:
+    src = s->arr[6];
+    break;
+  case GR_FIELD_ELEVATION:
+    src = s->ground;
+    break;
+  case GR_FIELD_SNOW_DENSITY:
+    for (size_t c = 0; c < cells; ++c)
+      host[c] = (float)s->params.snow_density;
+    return GR_OK;
+  case GR_FIELD_SNOW_SURFACE: {
+    cl_int n = (cl_int)cells;
+    const gr_snac_arg sa[] = {GR_SNAC_MEM("ground", s->ground), GR_SNAC_MEM("depth", s->arr[0]),
+                              GR_SNAC_VAL("n", n), GR_SNAC_MEM("out", s->scratch)};
+    st = gr_snac_args(s, s->surface, sa, sizeof(sa) / sizeof(sa[0]));
+    if (st == GR_OK)
+      st = gr_enqueue_2d(s->ctx, s->surface, 0, 0, cells, 1, NULL);
+    src = s->scratch;
+    break;
+  }
+  default: {
+    const char *name = gr_field_name(f);
+    return GR_SNAC_KEEP_ERROR(
+        s, gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
+                        "The snow accumulation simulation has no output field '%s'; it gives "
+                        "snow_depth, snow_surface, snow_density, exposure and elevation.",
+                        name ? name : "(unknown field)"));
+  }
+  }
+  if (st == GR_OK)
+    st = gr_buffer_read(s->ctx, src, 0, bytes, host);
+  return st == GR_OK ? GR_OK : GR_SNAC_KEEP_ERROR(s, st);
+}
+
+gr_status gr_snow_accumulation_ledger_get(gr_snow_accumulation *s,
+                                          gr_snow_accumulation_ledger *out) {
+  if (!s || !out)
+    return s ? GR_SNAC_KEEP_ERROR(s, gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
+                                                  "gr_snow_accumulation_ledger_get needs a place "
+                                                  "for the ledger."))
+             : gr_set_error(NULL, GR_ERR_INVALID_ARGUMENT,
+                            "gr_snow_accumulation_ledger_get needs a simulation.");
+  double gs[GR_SNAC_SUMS], os[GR_SNAC_SUMS];
+  gr_status st = gr_snac_sums(s, 0, 0, (int)gr_snac_cells(s), gs);
+  if (st == GR_OK)
+    st = gr_snac_sums(s, 1, 0, s->nv, os);
+  if (st != GR_OK)
+    return GR_SNAC_KEEP_ERROR(s, st);
+  double a = s->grid.dx * s->grid.dy;
+  memset(out, 0, sizeof(*out));
+  out->time = s->time;
+  out->steps = s->steps;
+  out->initial_volume = s->initial_volume;
+  out->stored_volume_terrain = gs[0] * a;
+  out->stored_volume_objects = os[0];
+  out->stored_volume = out->stored_volume_terrain + out->stored_volume_objects;
+  out->snowfall_volume = gs[1] * a + os[1] + s->retired_fall;
+  out->shed_volume = gs[2] * a + os[2] + s->retired_shed;
+  out->dropped_volume = s->dropped;
+  out->balance_error = out->initial_volume + out->snowfall_volume - out->shed_volume -
+                       out->dropped_volume - out->stored_volume;
+  return GR_OK;
+}
+
+void gr_snow_accumulation_set_progress(gr_snow_accumulation *s, gr_progress_fn fn, void *user) {
+  if (!s)
+    return;
+  s->progress = fn;
+  s->progress_user = user;
+  s->aborted = 0;
+}
+
+/* ---------------------------------------------------------- checkpoints */
+
+typedef struct gr_snac_state_header {
+  uint32_t magic, version;
+  int32_t nx, ny, nobjects, nv;
+  int64_t steps;
+  double time, initial_volume, retired_fall, retired_shed, dropped, snow_bound;
+} gr_snac_state_header;
+
+static size_t gr_snac_state_bytes(const gr_snow_accumulation *s) {
+  return sizeof(gr_snac_state_header) +
+         GR_SNAC_ARRAYS * (gr_snac_cells(s) + (size_t)s->nv) * sizeof(float);
+}
+
+gr_status gr_snow_accumulation_state_size(const gr_snow_accumulation *s, size_t *bytes) {
+  if (!s || !bytes)
+    return gr_set_error(NULL, GR_ERR_INVALID_ARGUMENT,
+                        "gr_snow_accumulation_state_size needs a simulation and a place for the "
+                        "size.");
+  *bytes = gr_snac_state_bytes(s);
+  return GR_OK;
+}
+
+gr_status gr_snow_accumulation_state_save(gr_snow_accumulation *s, void *host, size_t bytes) {
+  if (!s)
+    return gr_set_error(NULL, GR_ERR_INVALID_ARGUMENT,
+                        "gr_snow_accumulation_state_save needs a simulation.");
+  size_t need = gr_snac_state_bytes(s);
+  if (!host || bytes != need)
+    return GR_SNAC_KEEP_ERROR(
+        s, gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
+                        "The buffer for the snow accumulation state has %zu bytes but this "
+                        "simulation's state has %zu: size it with "
+                        "gr_snow_accumulation_state_size.",
+                        host ? bytes : 0, need));
+  gr_snac_state_header hd;
+  memset(&hd, 0, sizeof(hd));
+  hd.magic = GR_SNAC_STATE_MAGIC;
+  hd.version = GR_SNAC_STATE_VERSION;
+  hd.nx = s->grid.nx, hd.ny = s->grid.ny, hd.nobjects = s->nobjects, hd.nv = s->nv;
+  hd.steps = s->steps;
+  hd.time = s->time;
+  hd.initial_volume = s->initial_volume;
+  hd.retired_fall = s->retired_fall;
+  hd.retired_shed = s->retired_shed;
+  hd.dropped = s->dropped;
+  hd.snow_bound = s->snow_bound;
+  memcpy(host, &hd, sizeof(hd));
+  char *at = (char *)host + sizeof(hd);
+  size_t gb = gr_snac_cells(s) * sizeof(float), ob = (size_t)s->nv * sizeof(float);
+  gr_status st = GR_OK;
+  for (int a = 0; st == GR_OK && a < GR_SNAC_ARRAYS; ++a, at += gb)
+    st = gr_buffer_read(s->ctx, s->arr[a], 0, gb, at);
+  for (int a = 0; st == GR_OK && ob > 0 && a < GR_SNAC_ARRAYS; ++a, at += ob)
+    st = gr_buffer_read(s->ctx, s->o_arr[a], 0, ob, at);
+  return st == GR_OK ? GR_OK : GR_SNAC_KEEP_ERROR(s, st);
+}
+
+gr_status gr_snow_accumulation_state_load(gr_snow_accumulation *s, const void *host, size_t bytes) {
+  if (!s)
+    return gr_set_error(NULL, GR_ERR_INVALID_ARGUMENT,
+                        "gr_snow_accumulation_state_load needs a simulation.");
+  size_t need = gr_snac_state_bytes(s);
+  gr_snac_state_header hd;
+  if (!host || bytes != need)
+    return GR_SNAC_KEEP_ERROR(
+        s, gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
+                        "The snow accumulation state has %zu bytes but this simulation (%d x %d "
+                        "points, %d mesh points) needs %zu: load a state saved with the same grid "
+                        "and objects.",
+                        host ? bytes : 0, s->grid.nx, s->grid.ny, s->nv, need));
+  memcpy(&hd, host, sizeof(hd));
+  if (hd.magic != GR_SNAC_STATE_MAGIC || hd.version != GR_SNAC_STATE_VERSION ||
+      hd.nx != s->grid.nx || hd.ny != s->grid.ny || hd.nobjects != s->nobjects || hd.nv != s->nv)
+    return GR_SNAC_KEEP_ERROR(
+        s, gr_set_error(s->ctx, GR_ERR_FORMAT,
+                        "The bytes are not a snow accumulation state of a %d x %d grid with %d "
+                        "objects (version %u); load one saved by gr_snow_accumulation_state_save "
+                        "with the same objects set.",
+                        s->grid.nx, s->grid.ny, s->nobjects, GR_SNAC_STATE_VERSION));
+  const char *base = (const char *)host + sizeof(hd);
+  size_t gcells = gr_snac_cells(s), gb = gcells * sizeof(float), ob = (size_t)s->nv * sizeof(float);
+  /* Depths (the hi parts) must be finite and not negative. */
+  for (int part = 0; part < 2; ++part) {
+    const char *p = part ? base + GR_SNAC_ARRAYS * gb : base;
+    size_t n = part ? (size_t)s->nv : gcells;
+    for (size_t c = 0; c < n; ++c) {
+      float v;
+      memcpy(&v, p + c * sizeof(float), sizeof(v));
+      if (!isfinite(v) || v < -1e-6f)
+        return GR_SNAC_KEEP_ERROR(
+            s, gr_set_error(s->ctx, GR_ERR_FORMAT,
+                            "The snow accumulation state holds a snow depth of %g: it is "
+                            "damaged; load an intact one.",
+                            (double)v));
+    }
+  }
+  gr_status st = GR_OK;
+  const char *at = base;
+  for (int a = 0; st == GR_OK && a < GR_SNAC_ARRAYS; ++a, at += gb)
+    st = gr_buffer_write(s->ctx, s->arr[a], 0, gb, at);
+  for (int a = 0; st == GR_OK && ob > 0 && a < GR_SNAC_ARRAYS; ++a, at += ob)
+    st = gr_buffer_write(s->ctx, s->o_arr[a], 0, ob, at);
+  if (st != GR_OK)
+    return GR_SNAC_KEEP_ERROR(s, st);
+  s->steps = hd.steps;
+  s->time = hd.time;
+  s->initial_volume = hd.initial_volume;
+  s->retired_fall = hd.retired_fall;
+  s->retired_shed = hd.retired_shed;
+  s->dropped = hd.dropped;
+  s->snow_bound = hd.snow_bound;
+  s->aborted = 0;
+  return GR_OK;
+}
+
+gr_status gr_snow_accumulation_reset(gr_snow_accumulation *s) {
+  if (!s)
+    return gr_set_error(NULL, GR_ERR_INVALID_ARGUMENT,
+                        "gr_snow_accumulation_reset needs a simulation.");
+  gr_status st = gr_snac_initial_state(s);
+  return st == GR_OK ? GR_OK : GR_SNAC_KEEP_ERROR(s, st);
+}
