@@ -233,7 +233,7 @@ static void test_kernels(void) {
   cl_int n = N;
   CHECK(gr_kernel_args(ctx, k, sizeof(cl_mem), &buf, sizeof(cl_float), &a, sizeof(cl_float), &b,
                        sizeof(cl_int), &n, (size_t)0) == GR_OK);
-  CHECK(gr_enqueue_2d(ctx, k, 0, 0, N, 1, NULL) == GR_OK);
+  CHECK(gr_enqueue_1d(ctx, k, N) == GR_OK);
   memset(host, 0, sizeof(host));
   CHECK(gr_buffer_read(ctx, buf, 0, sizeof(host), host) == GR_OK);
   int wrong = 0;
@@ -322,7 +322,7 @@ static void test_kernel_arg(void) {
     CHECK(GR_KERNEL_ARG(ctx, k, x) == GR_OK);
     CHECK(GR_KERNEL_ARG(ctx, k, a) == GR_OK);
     CHECK(gr_buffer_write(ctx, x, 0, sizeof(host), host) == GR_OK);
-    CHECK(gr_enqueue_2d(ctx, k, 0, 0, N, 1, NULL) == GR_OK);
+    CHECK(gr_enqueue_1d(ctx, k, N) == GR_OK);
     float out[N];
     CHECK(gr_buffer_read(ctx, x, 0, sizeof(out), out) == GR_OK);
     int wrong = 0;
@@ -574,7 +574,7 @@ static void test_memcheck_kernels(void) {
   CHECK(gr_kernel_create(ctx, prog, "axpb", &k) == GR_OK);
   CHECK(gr_kernel_args(ctx, k, sizeof(cl_mem), &x, sizeof(cl_float), &a, sizeof(cl_float), &b,
                        sizeof(cl_int), &n, (size_t)0) == GR_OK);
-  CHECK(gr_enqueue_2d(ctx, k, 0, 0, N, 1, NULL) == GR_OK);
+  CHECK(gr_enqueue_1d(ctx, k, N) == GR_OK);
   CHECK(gr_buffer_read(ctx, x, 0, sizeof(out), out) == GR_OK);
   int wrong = 0;
   for (int i = 0; i < N; ++i)
@@ -615,7 +615,7 @@ static void test_memcheck_kernels(void) {
     CHECK(GR_KERNEL_ARG(ctx, kept[r], a) == GR_OK);
     CHECK(GR_KERNEL_ARG(ctx, kept[r], b) == GR_OK);
     CHECK(gr_buffer_write(ctx, x, 0, sizeof(host), host) == GR_OK);
-    CHECK(gr_enqueue_2d(ctx, kept[r], 0, 0, N, 1, NULL) == GR_OK);
+    CHECK(gr_enqueue_1d(ctx, kept[r], N) == GR_OK);
     CHECK(gr_buffer_read(ctx, x, 0, sizeof(out), out) == GR_OK);
     wrong = 0;
     for (int i = 0; i < N; ++i)
@@ -635,7 +635,7 @@ static void test_memcheck_kernels(void) {
     CHECK(GR_KERNEL_ARG(ctx, k, n) == GR_OK && GR_KERNEL_ARG(ctx, k, x) == GR_OK);
     CHECK(GR_KERNEL_ARG(ctx, k, a) == GR_OK && GR_KERNEL_ARG(ctx, k, b) == GR_OK);
     CHECK(gr_buffer_write(ctx, x, 0, sizeof(host), host) == GR_OK);
-    CHECK(gr_enqueue_2d(ctx, k, 0, 0, N, 1, NULL) == GR_OK);
+    CHECK(gr_enqueue_1d(ctx, k, N) == GR_OK);
     CHECK(gr_buffer_read(ctx, x, 0, sizeof(out), out) == GR_OK);
     wrong = 0;
     for (int i = 0; i < N; ++i)
@@ -697,6 +697,44 @@ static int have_device(void) {
   return 1;
 }
 
+/* gr_enqueue_1d runs every item once (a 2-D launch of n x 1 runs each 16
+ * times on a GPU, which a read-modify-write kernel must not see): an
+ * integer count per item. */
+static void test_enqueue_1d(void) {
+  gr_context *ctx = NULL;
+  CHECK(gr_context_create(NULL, &ctx) == GR_OK);
+  if (!ctx)
+    return;
+  const char *src = "__kernel void tally(__global int *count, int n) {"
+                    " int i = get_global_id(0); if (i < n) atomic_inc(count + i); }";
+  cl_program prog = NULL;
+  cl_kernel k = NULL;
+  CHECK(gr_program_build_source(ctx, src, NULL, &prog) == GR_OK);
+  if (prog)
+    CHECK(gr_kernel_create(ctx, prog, "tally", &k) == GR_OK);
+  enum { N = 1000 };
+  int host[N] = {0};
+  cl_mem count = NULL;
+  CHECK(gr_buffer_create(ctx, CL_MEM_READ_WRITE, sizeof(host), host, &count) == GR_OK);
+  cl_int n = N;
+  if (k && count) {
+    CHECK(GR_KERNEL_ARG(ctx, k, count) == GR_OK);
+    CHECK(GR_KERNEL_ARG(ctx, k, n) == GR_OK);
+    CHECK(gr_enqueue_1d(ctx, k, N) == GR_OK);
+    CHECK(gr_enqueue_1d(ctx, k, 0) == GR_OK); /* nothing */
+    CHECK(gr_buffer_read(ctx, count, 0, sizeof(host), host) == GR_OK);
+    int wrong = 0;
+    for (int i = 0; i < N; ++i)
+      wrong += host[i] != 1;
+    printf("enqueue_1d: %d of %d items ran other than once\n", wrong, N);
+    CHECK(wrong == 0);
+  }
+  gr_buffer_release(&count);
+  if (k)
+    clReleaseKernel(k);
+  gr_context_release(ctx);
+}
+
 static const gr_subtest tests[] = {
     {"no_platform", test_no_platform, 1}, /* only with OCL_ICD_VENDORS at an empty folder */
     {"names", test_names, 0},
@@ -705,6 +743,7 @@ static const gr_subtest tests[] = {
     {"embed", test_embed, 0},
     {"kernels", test_kernels, 0},
     {"kernel_arg", test_kernel_arg, 0},
+    {"enqueue_1d", test_enqueue_1d, 0},
     {"errors_per_thread", test_errors_per_thread, 0},
     {"mesh", test_mesh, 0},
     {"points", test_points, 0},

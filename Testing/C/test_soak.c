@@ -99,7 +99,7 @@ static void soak_runtime(long n_cycles) {
     if (st == GR_OK)
       st = GR_KERNEL_ARG(ctx, k, x);
     if (st == GR_OK)
-      st = gr_enqueue_2d(ctx, k, 0, 0, 256, 1, NULL);
+      st = gr_enqueue_1d(ctx, k, 256);
     if (st == GR_OK)
       st = gr_buffer_read(ctx, buf, 0, sizeof(host), host);
     CHECK_MSG(st == GR_OK, "cycle %ld: %s", c, gr_last_error(ctx));

@@ -1256,6 +1256,14 @@ gr_status gr_enqueue_2d(gr_context *ctx, cl_kernel k, size_t x0, size_t y0, size
   return gr_cl_check(ctx, err, "Enqueueing a kernel");
 }
 
+gr_status gr_enqueue_1d(gr_context *ctx, cl_kernel k, size_t n) {
+  if (n == 0)
+    return GR_OK;
+  size_t local = 64, global = (n + local - 1) / local * local;
+  cl_int err = clEnqueueNDRangeKernel(ctx->queue, k, 1, NULL, &global, &local, 0, NULL, NULL);
+  return gr_cl_check(ctx, err, "Enqueueing a kernel");
+}
+
 gr_status gr_finish(gr_context *ctx) {
   return gr_cl_check(ctx, clFinish(ctx->queue), "Waiting for the device");
 }

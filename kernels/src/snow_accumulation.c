@@ -1029,7 +1029,7 @@ static gr_status gr_snac_step_impl(gr_snow_accumulation *s, double dt) {
                               GR_SNAC_MEM("view", s->view)};
     st = gr_snac_args(s, s->raster_objects, ro, sizeof(ro) / sizeof(ro[0]));
     if (st == GR_OK)
-      st = gr_enqueue_2d(ctx, s->raster_objects, 0, 0, (size_t)ntri, 1, NULL);
+      st = gr_enqueue_1d(ctx, s->raster_objects, (size_t)ntri);
   }
   if (st == GR_OK)
     st = gr_snac_mark(s, &s->tm.view_ms);
@@ -1151,7 +1151,7 @@ static gr_status gr_snac_step_impl(gr_snow_accumulation *s, double dt) {
                               GR_SNAC_MEM("shed_lo", s->o_arr[5])};
     st = gr_snac_args(s, s->objects_k, ob, sizeof(ob) / sizeof(ob[0]));
     if (st == GR_OK)
-      st = gr_enqueue_2d(ctx, s->objects_k, 0, 0, (size_t)nv, 1, NULL);
+      st = gr_enqueue_1d(ctx, s->objects_k, (size_t)nv);
     if (st == GR_OK)
       st = gr_snac_mark(s, &s->tm.objects_ms);
   }
@@ -1225,7 +1225,7 @@ gr_status gr_snow_accumulation_get_field(gr_snow_accumulation *s, gr_field f, fl
                               GR_SNAC_VAL("n", n), GR_SNAC_MEM("out", s->scratch)};
     st = gr_snac_args(s, s->surface, sa, sizeof(sa) / sizeof(sa[0]));
     if (st == GR_OK)
-      st = gr_enqueue_2d(s->ctx, s->surface, 0, 0, cells, 1, NULL);
+      st = gr_enqueue_1d(s->ctx, s->surface, cells);
     src = s->scratch;
     break;
   }

@@ -245,7 +245,7 @@ static gr_status gr_snow_quantize(gr_snow_deformation *s, cl_mem depth) {
   if (st == GR_OK)
     st = GR_SNOW_ARG(s, s->quantize, "depth", depth);
   if (st == GR_OK)
-    st = gr_enqueue_2d(s->ctx, s->quantize, 0, 0, (size_t)n, 1, NULL);
+    st = gr_enqueue_1d(s->ctx, s->quantize, (size_t)n);
   return st;
 }
 
@@ -846,9 +846,8 @@ static gr_status gr_snow_object_step(gr_snow_deformation *s, int o, double dt) {
                                 {"under", sizeof(cl_mem), &s->under}};
   if (st == GR_OK)
     st = gr_snow_args(s, s->raster, raster, sizeof(raster) / sizeof(raster[0]));
-  const size_t line[2] = {64, 1}; /* one work-item per triangle */
   if (st == GR_OK && count > 0)
-    st = gr_enqueue_2d(ctx, s->raster, 0, 0, (size_t)count, 1, line);
+    st = gr_enqueue_1d(ctx, s->raster, (size_t)count); /* one work-item per triangle */
   if (st == GR_OK)
     st = gr_snow_mark(s, &s->tm.raster_ms);
   /* overlap */
@@ -1345,7 +1344,7 @@ gr_status gr_snow_deformation_get_field(gr_snow_deformation *s, gr_field f, floa
     if (st == GR_OK)
       st = GR_SNOW_ARG(s, s->surface, "out", s->scratch);
     if (st == GR_OK)
-      st = gr_enqueue_2d(s->ctx, s->surface, 0, 0, (size_t)n, 1, NULL);
+      st = gr_enqueue_1d(s->ctx, s->surface, (size_t)n);
     src = s->scratch;
     break;
   }

@@ -120,6 +120,15 @@ GR_API gr_status gr_kernel_args(gr_context *ctx, cl_kernel k, ...);
 GR_API gr_status gr_enqueue_2d(gr_context *ctx, cl_kernel k, size_t x0, size_t y0, size_t nx,
                                size_t ny, const size_t *local);
 
+/**
+ * Enqueues a 1-D kernel over n work-items (groups of 64, the size rounded
+ * up to them: kernels guard their own bounds). For per-item kernels
+ * (triangles, mesh points, a flat run of cells): a 2-D launch of n x 1
+ * takes the GPUs' 16 x 16 groups and runs every item 16 times. Does not
+ * wait.
+ */
+GR_API gr_status gr_enqueue_1d(gr_context *ctx, cl_kernel k, size_t n);
+
 /** Waits for the context's queue to drain. */
 GR_API gr_status gr_finish(gr_context *ctx);
 
