@@ -168,13 +168,27 @@ GR_INLINE float3 snac_normal(__global const float *restrict b, __global const fl
 
 /* Exposure and growth of every grid point: the snow surface's point is
  * tested against the view; the growth faces the ground's normal. */
-__kernel void snow_accumulation_exposure(
-    __global const float *restrict ground, __global const float *restrict depth, int nx, int ny,
-    float dx, float dy, float zref, float dir_x, float dir_y, float dir_z, float tau_x, float tau_y,
-    float qx0, float qy0, float inv_texel, float texel, int vw, int vh,
-    __global const int *restrict view, float rate_dt, float amplitude, float noise_x0,
-    float noise_y0, float noise_dx, float noise_dy, uint seed, __global float *restrict exposure,
-    __global float *restrict growth) {
+/* The noise of every grid point, fixed in space: computed once per seed and
+ * scale (snow_accumulation_noise), read every step. */
+__kernel void snow_accumulation_noise(int nx, int ny, float noise_x0, float noise_y0,
+                                      float noise_dx, float noise_dy, uint seed,
+                                      __global float *restrict noise) {
+  int i = get_global_id(0), j = get_global_id(1);
+  if (!gr_inside(i, j, nx, ny))
+    return;
+  noise[gr_idx(i, j, nx)] =
+      snac_noise(noise_x0 + (float)i * noise_dx, noise_y0 + (float)j * noise_dy, 0.0f, seed);
+}
+
+__kernel void snow_accumulation_exposure(__global const float *restrict ground,
+                                         __global const float *restrict depth, int nx, int ny,
+                                         float dx, float dy, float zref, float dir_x, float dir_y,
+                                         float dir_z, float tau_x, float tau_y, float qx0,
+                                         float qy0, float inv_texel, float texel, int vw, int vh,
+                                         __global const int *restrict view, float rate_dt,
+                                         float amplitude, __global const float *restrict noise,
+                                         __global float *restrict exposure,
+                                         __global float *restrict growth) {
   int i = get_global_id(0), j = get_global_id(1);
   if (!gr_inside(i, j, nx, ny))
     return;
@@ -184,10 +198,8 @@ __kernel void snow_accumulation_exposure(
   float e = snac_exposed(view, vw, vh, (float)i * dx, (float)j * dy, (ground[c] + depth[c]) - zref,
                          nh, d, tau_x, tau_y, qx0, qy0, inv_texel, texel);
   float3 nb = snac_normal(ground, (__global const float *)0, i, j, nx, ny, dx, dy);
-  float noise =
-      snac_noise(noise_x0 + (float)i * noise_dx, noise_y0 + (float)j * noise_dy, 0.0f, seed);
   exposure[c] = e;
-  growth[c] = rate_dt * e * fmax(0.0f, -dot(nb, d)) * (1.0f + amplitude * noise);
+  growth[c] = rate_dt * e * fmax(0.0f, -dot(nb, d)) * (1.0f + amplitude * noise[c]);
 }
 
 /* One pass of the separable blur along axis 0 (x) or 1 (y): weights w[|k|]

@@ -66,11 +66,17 @@ struct gr_snow_accumulation {
   gr_context *ctx;
   gr_grid grid;
   gr_snow_accumulation_params params;
-  cl_kernel raster_terrain, raster_objects, exposure_k, blur, dilate, apply, objects_k, reduce,
-      surface;
+  cl_kernel raster_terrain, raster_objects, exposure_k, noise_k, blur, dilate, apply, objects_k,
+      reduce, surface;
   /* The grid: ground, initial snow, the state pairs, exposure, growth and
    * a scratch array, the blur weights and the view. */
   cl_mem ground, depth0, arr[GR_SNAC_ARRAYS], growth, scratch, weights, view;
+  /* The grid's noise and what it was made for (seed, then the lattice's
+   * origin and spacing); noise_made 0 until the first step. */
+  cl_mem noise;
+  int noise_made;
+  cl_uint noise_seed;
+  float noise_key[4];
   size_t view_cap; /* ints */
   /* The objects: world triangles, per mesh point the world position and
    * normal, the noise coordinates, the area and the state arrays. */
@@ -442,10 +448,11 @@ gr_status gr_snow_accumulation_create(gr_context *ctx, const gr_grid *grid,
             {"snow_accumulation_apply", &s->apply},
             {"snow_accumulation_objects", &s->objects_k},
             {"snow_accumulation_reduce", &s->reduce},
-            {"snow_accumulation_surface", &s->surface}};
+            {"snow_accumulation_surface", &s->surface},
+            {"snow_accumulation_noise", &s->noise_k}};
   for (size_t i = 0; st == GR_OK && i < sizeof(ks) / sizeof(ks[0]); ++i)
     st = gr_kernel_create(ctx, prog, ks[i].name, ks[i].k);
-  cl_mem *bufs[] = {&s->ground, &s->depth0, &s->growth, &s->scratch};
+  cl_mem *bufs[] = {&s->ground, &s->depth0, &s->growth, &s->scratch, &s->noise};
   for (size_t i = 0; st == GR_OK && i < sizeof(bufs) / sizeof(bufs[0]); ++i)
     st = gr_buffer_create(ctx, CL_MEM_READ_WRITE, bytes, NULL, bufs[i]);
   for (int a = 0; st == GR_OK && a < GR_SNAC_ARRAYS; ++a)
@@ -482,12 +489,13 @@ static void gr_snac_release_objects(gr_snow_accumulation *s) {
 void gr_snow_accumulation_destroy(gr_snow_accumulation *s) {
   if (!s)
     return;
-  cl_kernel ks[] = {s->raster_terrain, s->raster_objects, s->exposure_k, s->blur,   s->dilate,
-                    s->apply,          s->objects_k,      s->reduce,     s->surface};
+  cl_kernel ks[] = {s->raster_terrain, s->raster_objects, s->exposure_k, s->blur,    s->dilate,
+                    s->apply,          s->objects_k,      s->reduce,     s->surface, s->noise_k};
   for (size_t i = 0; i < sizeof(ks) / sizeof(ks[0]); ++i)
     if (ks[i])
       clReleaseKernel(ks[i]);
-  cl_mem *bufs[] = {&s->ground, &s->depth0, &s->growth, &s->scratch, &s->weights, &s->view};
+  cl_mem *bufs[] = {&s->ground,  &s->depth0, &s->growth, &s->scratch,
+                    &s->weights, &s->view,   &s->noise};
   for (size_t i = 0; i < sizeof(bufs) / sizeof(bufs[0]); ++i)
     gr_buffer_release(bufs[i]);
   for (int a = 0; a < GR_SNAC_ARRAYS; ++a)
@@ -986,8 +994,33 @@ static gr_status gr_snac_step_impl(gr_snow_accumulation *s, double dt) {
   float noise_x0 = (float)fmod(g->x0 * inv_scale, GR_SNAC_NOISE_PERIOD);
   float noise_y0 = (float)fmod(g->y0 * inv_scale, GR_SNAC_NOISE_PERIOD);
   float noise_dx = (float)(g->dx * inv_scale), noise_dy = (float)(g->dy * inv_scale);
+  /* The noise is fixed in space: made again only for another seed or
+   * scale. */
+  gr_status nst = GR_OK;
+  if (!s->noise_made || s->noise_seed != seed || s->noise_key[0] != noise_x0 ||
+      s->noise_key[1] != noise_y0 || s->noise_key[2] != noise_dx || s->noise_key[3] != noise_dy) {
+    const gr_snac_arg na[] = {GR_SNAC_VAL("nx", nx),
+                              GR_SNAC_VAL("ny", ny),
+                              GR_SNAC_VAL("noise_x0", noise_x0),
+                              GR_SNAC_VAL("noise_y0", noise_y0),
+                              GR_SNAC_VAL("noise_dx", noise_dx),
+                              GR_SNAC_VAL("noise_dy", noise_dy),
+                              GR_SNAC_VAL("seed", seed),
+                              GR_SNAC_MEM("noise", s->noise)};
+    nst = gr_snac_args(s, s->noise_k, na, sizeof(na) / sizeof(na[0]));
+    if (nst == GR_OK)
+      nst = gr_enqueue_2d(ctx, s->noise_k, 0, 0, (size_t)nx, (size_t)ny, NULL);
+    if (nst == GR_OK) {
+      s->noise_made = 1;
+      s->noise_seed = seed;
+      s->noise_key[0] = noise_x0, s->noise_key[1] = noise_y0;
+      s->noise_key[2] = noise_dx, s->noise_key[3] = noise_dy;
+    }
+  }
   if (s->timing)
     s->tm.host_ms += gr_snac_now_ms() - t0, s->t_mark = gr_snac_now_ms();
+  if (nst != GR_OK)
+    return nst;
 
   /* 1. the view */
   cl_int empty = GR_SNAC_EMPTY;
@@ -1056,11 +1089,7 @@ static gr_status gr_snac_step_impl(gr_snow_accumulation *s, double dt) {
                             GR_SNAC_MEM("view", s->view),
                             GR_SNAC_VAL("rate_dt", rate_dt),
                             GR_SNAC_VAL("amplitude", amplitude),
-                            GR_SNAC_VAL("noise_x0", noise_x0),
-                            GR_SNAC_VAL("noise_y0", noise_y0),
-                            GR_SNAC_VAL("noise_dx", noise_dx),
-                            GR_SNAC_VAL("noise_dy", noise_dy),
-                            GR_SNAC_VAL("seed", seed),
+                            GR_SNAC_MEM("noise", s->noise),
                             GR_SNAC_MEM("exposure", s->arr[6]),
                             GR_SNAC_MEM("growth", s->growth)};
   if (st == GR_OK)
