@@ -1,0 +1,810 @@
+#include "vtkSnowAccumulationFilter.h"
+
+#include "vtkAlgorithmOutput.h"
+#include "vtkCellArray.h"
+#include "vtkCellData.h"
+#include "vtkCompositeDataIterator.h"
+#include "vtkCompositeDataSet.h"
+#include "vtkDemandDrivenPipeline.h"
+#include "vtkDoubleArray.h"
+#include "vtkExecutive.h"
+#include "vtkFieldData.h"
+#include "vtkFloatArray.h"
+#include "vtkIdList.h"
+#include "vtkImageData.h"
+#include "vtkInformation.h"
+#include "vtkInformationVector.h"
+#include "vtkMultiBlockDataSet.h"
+#include "vtkNew.h"
+#include "vtkObjectFactory.h"
+#include "vtkPointData.h"
+#include "vtkPoints.h"
+#include "vtkPolyData.h"
+#include "vtkSmartPointer.h"
+#include "vtkStreamingDemandDrivenPipeline.h"
+
+#include "graupel/snow_accumulation.h"
+
+#include "GraupelArrays.h"
+#include "GraupelParameterTable.h"
+
+#include <chrono>
+#include <cmath>
+#include <string>
+#include <vector>
+
+vtkStandardNewMacro(vtkSnowAccumulationFilter);
+
+namespace {
+using graupel::AddValue;
+using graupel::AsFloat;
+const gr_param_bound *Bound(const char *property) {
+  int count = 0;
+  const gr_param_bound *table = gr_snow_accumulation_param_bounds(&count);
+  return gr_param_find(table, count, property);
+}
+
+double TableDefault(const char *property, double fallback) {
+  const gr_param_bound *b = Bound(property);
+  return b ? b->default_value : fallback;
+}
+
+double TableToCore(const char *property) {
+  const gr_param_bound *b = Bound(property);
+  return b ? b->to_core : 1.0;
+}
+
+// The leaves of an Objects input in order: the polydata itself, or every
+// non-empty leaf of a composite.
+std::vector<vtkPolyData *> Leaves(vtkDataObject *objects, bool *other) {
+  std::vector<vtkPolyData *> leaves;
+  *other = false;
+  if (auto *cd = vtkCompositeDataSet::SafeDownCast(objects)) {
+    vtkSmartPointer<vtkCompositeDataIterator> it;
+    it.TakeReference(cd->NewIterator());
+    for (it->InitTraversal(); !it->IsDoneWithTraversal(); it->GoToNextItem()) {
+      auto *pd = vtkPolyData::SafeDownCast(it->GetCurrentDataObject());
+      if (pd && pd->GetNumberOfPoints() > 0) {
+        leaves.push_back(pd);
+      } else if (!pd && it->GetCurrentDataObject()) {
+        *other = true;
+      }
+    }
+  } else if (auto *pd = vtkPolyData::SafeDownCast(objects)) {
+    if (pd->GetNumberOfPoints() > 0) {
+      leaves.push_back(pd); // an empty polydata is no object
+    }
+  } else if (objects) {
+    *other = true;
+  }
+  return leaves;
+}
+
+// Vectors (normals) turned by the pose's rotation.
+vtkSmartPointer<vtkDataArray> Turned(vtkDataArray *v, const double m[16]) {
+  if (!v || v->GetNumberOfComponents() != 3) {
+    return v;
+  }
+  auto out = vtkSmartPointer<vtkFloatArray>::New();
+  out->SetName(v->GetName());
+  out->SetNumberOfComponents(3);
+  out->SetNumberOfTuples(v->GetNumberOfTuples());
+  for (vtkIdType i = 0; i < v->GetNumberOfTuples(); ++i) {
+    double a[3];
+    v->GetTuple(i, a);
+    out->SetTuple3(i, m[0] * a[0] + m[4] * a[1] + m[8] * a[2],
+                   m[1] * a[0] + m[5] * a[1] + m[9] * a[2],
+                   m[2] * a[0] + m[6] * a[1] + m[10] * a[2]);
+  }
+  return out;
+}
+
+// A copy of pd's geometry moved by the pose: world = M (p - centre).
+vtkSmartPointer<vtkPolyData> Posed(vtkPolyData *pd, const double centre[3], const double m[16]) {
+  auto out = vtkSmartPointer<vtkPolyData>::New();
+  out->ShallowCopy(pd);
+  vtkNew<vtkPoints> points;
+  points->SetDataTypeToDouble();
+  const vtkIdType n = pd->GetNumberOfPoints();
+  points->SetNumberOfPoints(n);
+  for (vtkIdType i = 0; i < n; ++i) {
+    double p[3];
+    pd->GetPoint(i, p);
+    const double x = p[0] - centre[0], y = p[1] - centre[1], z = p[2] - centre[2];
+    points->SetPoint(i, m[0] * x + m[4] * y + m[8] * z + m[12],
+                     m[1] * x + m[5] * y + m[9] * z + m[13],
+                     m[2] * x + m[6] * y + m[10] * z + m[14]);
+  }
+  out->SetPoints(points);
+  if (vtkDataArray *normals = pd->GetPointData()->GetNormals()) {
+    out->GetPointData()->SetNormals(Turned(normals, m));
+  }
+  if (vtkDataArray *normals = pd->GetCellData()->GetNormals()) {
+    out->GetCellData()->SetNormals(Turned(normals, m));
+  }
+  vtkNew<vtkFieldData> fd;
+  fd->ShallowCopy(pd->GetFieldData());
+  out->SetFieldData(fd);
+  return out;
+}
+} // namespace
+
+vtkSnowAccumulationFilter::vtkSnowAccumulationFilter() {
+  this->SetNumberOfInputPorts(2);
+  this->SetNumberOfOutputPorts(2);
+  // Objects with time steps are read in time; others stand or move by ObjectVelocity.
+  this->SetInputPortPolicy(1, TEMPORAL_INPUT);
+  // A snowfall of a few hours: 6 h of 15 min outputs, three 5 min steps
+  // each (72 exposure views). Growth is a rate times dt, so longer steps
+  // give the same snow; they only see the exposure change less often.
+  this->SetTimeDefaults(21600.0, 900.0);
+  this->Flutter = TableDefault("Flutter", 0.0);
+  this->SnowfallRate = TableDefault("SnowfallRate", 2.0);
+  this->NoiseAmplitude = TableDefault("NoiseAmplitude", 0.2);
+  this->NoiseScale = TableDefault("NoiseScale", 1.0);
+  this->Seed = static_cast<int>(TableDefault("Seed", 0.0));
+  this->ExposureResolution = static_cast<int>(TableDefault("ExposureResolution", 1024.0));
+  this->BlurRadius = static_cast<int>(TableDefault("BlurRadius", 1.0));
+  this->Dilation = static_cast<int>(TableDefault("Dilation", 0.0));
+  this->MaxDepth = TableDefault("MaxDepth", 1.0);
+  this->StabilityFactor = TableDefault("StabilityFactor", 1.0);
+  this->SnowDensity = TableDefault("SnowDensity", 100.0);
+}
+
+vtkSnowAccumulationFilter::~vtkSnowAccumulationFilter() {
+  this->ReleaseState();
+}
+
+GRAUPEL_TABLE_SETTER(vtkSnowAccumulationFilter, Flutter, double, gr_snow_accumulation_param_bounds)
+GRAUPEL_TABLE_SETTER(vtkSnowAccumulationFilter, SnowfallRate, double,
+                     gr_snow_accumulation_param_bounds)
+GRAUPEL_TABLE_SETTER(vtkSnowAccumulationFilter, NoiseAmplitude, double,
+                     gr_snow_accumulation_param_bounds)
+GRAUPEL_TABLE_SETTER(vtkSnowAccumulationFilter, NoiseScale, double,
+                     gr_snow_accumulation_param_bounds)
+GRAUPEL_TABLE_SETTER(vtkSnowAccumulationFilter, Seed, int, gr_snow_accumulation_param_bounds)
+GRAUPEL_TABLE_SETTER(vtkSnowAccumulationFilter, ExposureResolution, int,
+                     gr_snow_accumulation_param_bounds)
+GRAUPEL_TABLE_SETTER(vtkSnowAccumulationFilter, BlurRadius, int, gr_snow_accumulation_param_bounds)
+GRAUPEL_TABLE_SETTER(vtkSnowAccumulationFilter, Dilation, int, gr_snow_accumulation_param_bounds)
+GRAUPEL_TABLE_SETTER(vtkSnowAccumulationFilter, MaxDepth, double, gr_snow_accumulation_param_bounds)
+GRAUPEL_TABLE_SETTER(vtkSnowAccumulationFilter, StabilityFactor, double,
+                     gr_snow_accumulation_param_bounds)
+GRAUPEL_TABLE_SETTER(vtkSnowAccumulationFilter, SnowDensity, double,
+                     gr_snow_accumulation_param_bounds)
+
+void vtkSnowAccumulationFilter::SetObjectsConnection(vtkAlgorithmOutput *output) {
+  this->SetInputConnection(1, output);
+}
+
+int vtkSnowAccumulationFilter::FillInputPortInformation(int port, vtkInformation *info) {
+  if (port == 0) {
+    info->Set(vtkAlgorithm::INPUT_REQUIRED_DATA_TYPE(), "vtkImageData");
+    return 1;
+  }
+  // A multiblock is taken whole (one object per leaf): a composite pipeline
+  // would otherwise run the filter once per block.
+  info->Set(vtkAlgorithm::INPUT_REQUIRED_DATA_TYPE(), "vtkPolyData");
+  info->Append(vtkAlgorithm::INPUT_REQUIRED_DATA_TYPE(), "vtkMultiBlockDataSet");
+  info->Set(vtkAlgorithm::INPUT_IS_OPTIONAL(), 1);
+  return 1;
+}
+
+int vtkSnowAccumulationFilter::FillOutputPortInformation(int port, vtkInformation *info) {
+  // Port 1 follows the Objects input's type (REQUEST_DATA_OBJECT below).
+  info->Set(vtkDataObject::DATA_TYPE_NAME(), port == 0 ? "vtkImageData" : "vtkDataObject");
+  return 1;
+}
+
+vtkTypeBool vtkSnowAccumulationFilter::ProcessRequest(vtkInformation *request,
+                                                      vtkInformationVector **inInfo,
+                                                      vtkInformationVector *outInfo) {
+  if (request->Has(vtkDemandDrivenPipeline::REQUEST_DATA_OBJECT())) {
+    vtkInformation *objInfo = inInfo[1]->GetInformationObject(0);
+    vtkDataObject *objects = objInfo ? objInfo->Get(vtkDataObject::DATA_OBJECT()) : nullptr;
+    const bool composite = vtkCompositeDataSet::SafeDownCast(objects) != nullptr;
+    vtkInformation *info = outInfo->GetInformationObject(1);
+    vtkDataObject *current = info->Get(vtkDataObject::DATA_OBJECT());
+    const bool fits =
+        current && (composite ? current->IsA("vtkMultiBlockDataSet") : current->IsA("vtkPolyData"));
+    if (!fits) {
+      vtkSmartPointer<vtkDataObject> made;
+      if (composite) {
+        made = vtkSmartPointer<vtkMultiBlockDataSet>::New();
+      } else {
+        made = vtkSmartPointer<vtkPolyData>::New();
+      }
+      info->Set(vtkDataObject::DATA_OBJECT(), made);
+    }
+    return this->Superclass::ProcessRequest(request, inInfo, outInfo);
+  }
+  if ((request->Has(vtkStreamingDemandDrivenPipeline::REQUEST_UPDATE_EXTENT()) ||
+       request->Has(vtkDemandDrivenPipeline::REQUEST_DATA())) &&
+      request->Has(vtkExecutive::FROM_OUTPUT_PORT())) {
+    const int port = request->Get(vtkExecutive::FROM_OUTPUT_PORT());
+    vtkInformation *from = port >= 0 ? outInfo->GetInformationObject(port) : nullptr;
+    const int outputs = this->GetNumberOfOutputTimes();
+    // A consumer that asks for no time reads this output once (Snow
+    // Deformation's Input, a writer): it wants the snow that fell, so it
+    // gets the last output, not the bare ground of time 0.
+    if (from && outputs > 0 && !from->Has(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP())) {
+      from->Set(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP(),
+                this->GetOutputTime(outputs - 1));
+    }
+    // A request from the objects' port asks for the same time of the
+    // simulation, which the base reads from port 0.
+    if (port == 1 && from->Has(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP())) {
+      outInfo->GetInformationObject(0)->Set(
+          vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP(),
+          from->Get(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP()));
+    }
+  }
+  return this->Superclass::ProcessRequest(request, inInfo, outInfo);
+}
+
+int vtkSnowAccumulationFilter::RequestInformation(vtkInformation *request,
+                                                  vtkInformationVector **inputVector,
+                                                  vtkInformationVector *outputVector) {
+  const int ok = this->Superclass::RequestInformation(request, inputVector, outputVector);
+  // The objects' output has the simulation's times, not the input's.
+  vtkInformation *image = outputVector->GetInformationObject(0);
+  vtkInformation *objects = outputVector->GetInformationObject(1);
+  objects->Remove(vtkStreamingDemandDrivenPipeline::TIME_STEPS());
+  objects->Remove(vtkStreamingDemandDrivenPipeline::TIME_RANGE());
+  if (image->Has(vtkStreamingDemandDrivenPipeline::TIME_STEPS())) {
+    objects->CopyEntry(image, vtkStreamingDemandDrivenPipeline::TIME_STEPS());
+    objects->CopyEntry(image, vtkStreamingDemandDrivenPipeline::TIME_RANGE());
+  }
+  return ok;
+}
+
+int vtkSnowAccumulationFilter::RequestData(vtkInformation *request,
+                                           vtkInformationVector **inputVector,
+                                           vtkInformationVector *outputVector) {
+  vtkInformation *objInfo = outputVector->GetInformationObject(1);
+  if (vtkDataObject *objects = objInfo->Get(vtkDataObject::DATA_OBJECT())) {
+    objects->Initialize();
+  }
+  this->OutputVector = outputVector;
+  this->ObjectsFilled = false;
+  const int ok = this->Superclass::RequestData(request, inputVector, outputVector);
+  this->OutputVector = nullptr;
+  if (ok && this->ObjectsFilled) {
+    vtkDataObject *image = outputVector->GetInformationObject(0)->Get(vtkDataObject::DATA_OBJECT());
+    vtkDataObject *objects = objInfo->Get(vtkDataObject::DATA_OBJECT());
+    if (image->GetInformation()->Has(vtkDataObject::DATA_TIME_STEP())) {
+      objects->GetInformation()->Set(vtkDataObject::DATA_TIME_STEP(),
+                                     image->GetInformation()->Get(vtkDataObject::DATA_TIME_STEP()));
+    }
+  }
+  return ok;
+}
+
+int vtkSnowAccumulationFilter::CheckParameters() {
+  const struct {
+    const char *property;
+    double value;
+  } values[] = {{"Flutter", this->Flutter},
+                {"SnowfallRate", this->SnowfallRate},
+                {"NoiseAmplitude", this->NoiseAmplitude},
+                {"NoiseScale", this->NoiseScale},
+                {"Seed", double(this->Seed)},
+                {"ExposureResolution", double(this->ExposureResolution)},
+                {"BlurRadius", double(this->BlurRadius)},
+                {"Dilation", double(this->Dilation)},
+                {"MaxDepth", this->MaxDepth},
+                {"StabilityFactor", this->StabilityFactor},
+                {"SnowDensity", this->SnowDensity}};
+  for (const auto &p : values) {
+    const gr_param_bound *b = Bound(p.property);
+    if (!b || gr_param_accepts(b, p.value * b->to_core)) {
+      continue;
+    }
+    const char *unit = (b->unit && *b->unit) ? b->unit : "";
+    const char *space = *unit ? " " : "";
+    vtkErrorMacro("Snow Accumulation: " << p.property << " must be "
+                                        << (b->min_open ? "above " : "from ") << b->min << space
+                                        << unit << (b->min_open ? " and up to " : " to ") << b->max
+                                        << space << unit << "; it is " << p.value << space << unit
+                                        << ". Set it within that range.");
+    return 0;
+  }
+  if (!(this->TimeStep >= 1.0e-6 && this->TimeStep <= 86400.0)) {
+    vtkErrorMacro("Snow Accumulation: TimeStep must be from 1e-6 s to 86400 s; it is "
+                  << this->TimeStep << " s. Set it within that range.");
+    return 0;
+  }
+  const double *v = this->ObjectVelocity;
+  if (!std::isfinite(v[0]) || !std::isfinite(v[1]) || !std::isfinite(v[2])) {
+    vtkErrorMacro("Snow Accumulation: ObjectVelocity (" << v[0] << " " << v[1] << " " << v[2]
+                                                        << " m/s) must be finite; set it so.");
+    return 0;
+  }
+  return 1;
+}
+
+int vtkSnowAccumulationFilter::ReadObjects(vtkDataObject *objects) {
+  this->Objects.clear();
+  bool other = false;
+  const std::vector<vtkPolyData *> leaves = Leaves(objects, &other);
+  if (other) {
+    vtkErrorMacro("Snow Accumulation's Objects must be vtkPolyData or a multiblock of them; "
+                  "convert the other blocks with Extract Surface.");
+    return 0;
+  }
+  if (leaves.size() > GR_SNOW_ACCUMULATION_MAX_OBJECTS) {
+    vtkErrorMacro("Snow Accumulation's Objects has " << leaves.size() << " blocks; at most "
+                                                     << GR_SNOW_ACCUMULATION_MAX_OBJECTS
+                                                     << " objects are simulated. Merge some.");
+    return 0;
+  }
+  for (size_t k = 0; k < leaves.size(); ++k) {
+    vtkPolyData *pd = leaves[k];
+    Object o;
+    double b[6];
+    pd->GetBounds(b);
+    for (int c = 0; c < 3; ++c) {
+      o.centre[c] = 0.5 * (b[2 * c] + b[2 * c + 1]);
+      o.velocity[c] = this->ObjectVelocity[c];
+    }
+    vtkDataArray *v = pd->GetFieldData()->GetArray("velocity");
+    if (v) {
+      if (v->GetNumberOfComponents() != 3 || v->GetNumberOfTuples() < 1) {
+        vtkErrorMacro("Snow Accumulation's Objects block "
+                      << k << " has a field array 'velocity' that is not one 3-component "
+                      << "value (m/s); give it 3 components or remove it.");
+        return 0;
+      }
+      v->GetTuple(0, o.velocity);
+    }
+    // One mesh point per point of the polydata, unmerged: the snow is
+    // handed back per point, and a box's faces keep their own corners (and
+    // flat normals), so its top holds a flat cap and its sides none.
+    const vtkIdType n = pd->GetNumberOfPoints();
+    o.vertices.resize(3 * static_cast<size_t>(n));
+    for (vtkIdType i = 0; i < n; ++i) {
+      double p[3];
+      pd->GetPoint(i, p);
+      for (int c = 0; c < 3; ++c) {
+        o.vertices[3 * static_cast<size_t>(i) + c] = static_cast<float>(p[c] - o.centre[c]);
+      }
+    }
+    // An id out of range becomes -1, which gr_mesh_validate names.
+    auto vertex = [&](vtkIdType id) { return id >= 0 && id < n ? static_cast<int>(id) : -1; };
+    // Polygons as fans, strips with alternating winding: the triangles the
+    // core takes, without a dependency on VTK's filters.
+    vtkNew<vtkIdList> ids;
+    vtkCellArray *polys = pd->GetPolys();
+    for (polys->InitTraversal(); polys->GetNextCell(ids);) {
+      for (vtkIdType j = 2; j < ids->GetNumberOfIds(); ++j) {
+        o.triangles.insert(o.triangles.end(), {vertex(ids->GetId(0)), vertex(ids->GetId(j - 1)),
+                                               vertex(ids->GetId(j))});
+      }
+    }
+    vtkCellArray *strips = pd->GetStrips();
+    for (strips->InitTraversal(); strips->GetNextCell(ids);) {
+      for (vtkIdType j = 2; j < ids->GetNumberOfIds(); ++j) {
+        const int a = vertex(ids->GetId(j - 2));
+        const int b1 = vertex(ids->GetId(j - 1));
+        const int c = vertex(ids->GetId(j));
+        if (j % 2 == 0) {
+          o.triangles.insert(o.triangles.end(), {a, b1, c});
+        } else {
+          o.triangles.insert(o.triangles.end(), {b1, a, c});
+        }
+      }
+    }
+    gr_mesh mesh = {};
+    mesh.vertices = o.vertices.data();
+    mesh.nvertices = static_cast<int>(n);
+    mesh.triangles = o.triangles.data();
+    mesh.ntriangles = static_cast<int>(o.triangles.size() / 3);
+    for (int i = 0; i < 16; ++i) {
+      mesh.transform[i] = (i % 5 == 0) ? 1.0 : 0.0;
+    }
+    char msg[512];
+    if (gr_mesh_validate(&mesh, 0, msg, sizeof(msg)) != GR_OK) {
+      vtkErrorMacro("Snow Accumulation's Objects"
+                    << (leaves.size() > 1 ? " block " + std::to_string(k) : std::string()) << ": "
+                    << msg);
+      return 0;
+    }
+    this->Objects.push_back(std::move(o));
+  }
+  this->ObjectsTemporal = this->IsInputTemporal(1);
+  return 1;
+}
+
+void vtkSnowAccumulationFilter::Pose(size_t k, double t, double m[16]) const {
+  const Object &o = this->Objects[k];
+  for (int i = 0; i < 16; ++i) {
+    m[i] = (i % 5 == 0) ? 1.0 : 0.0;
+  }
+  // Temporal objects: the geometry is the pose, back to where it was read.
+  const double s = this->ObjectsTemporal ? 0.0 : t;
+  for (int c = 0; c < 3; ++c) {
+    m[12 + c] = o.centre[c] + o.velocity[c] * s;
+  }
+}
+
+bool vtkSnowAccumulationFilter::ObjectsMove() const {
+  if (this->ObjectsTemporal) {
+    return false;
+  }
+  for (const Object &o : this->Objects) {
+    if (o.velocity[0] != 0.0 || o.velocity[1] != 0.0 || o.velocity[2] != 0.0) {
+      return true;
+    }
+  }
+  return false;
+}
+
+int vtkSnowAccumulationFilter::SetObjects(double t) {
+  const size_t n = this->Objects.size();
+  std::vector<gr_mesh> meshes(n);
+  for (size_t k = 0; k < n; ++k) {
+    const Object &o = this->Objects[k];
+    gr_mesh &m = meshes[k];
+    m.vertices = o.vertices.data();
+    m.nvertices = static_cast<int>(o.vertices.size() / 3);
+    m.triangles = o.triangles.data();
+    m.ntriangles = static_cast<int>(o.triangles.size() / 3);
+    this->Pose(k, t, m.transform);
+  }
+  const gr_status st =
+      gr_snow_accumulation_set_objects(this->Simulation, meshes.data(), static_cast<int>(n));
+  if (st != GR_OK) {
+    return this->ReportFailure(st, "Snow Accumulation's Objects",
+                               gr_snow_accumulation_last_error(this->Simulation));
+  }
+  return 1;
+}
+
+int vtkSnowAccumulationFilter::StepProgress(void *user, double time) {
+  auto *self = static_cast<vtkSnowAccumulationFilter *>(user);
+  if (self->GetAbortExecute()) {
+    return 1;
+  }
+  // Every step reports; the text and the event only a few times a second.
+  const double now =
+      std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+  if (now - self->LastProgressWall < 0.1) {
+    return 0;
+  }
+  self->LastProgressWall = now;
+  return vtkGraupelSimulation::CoreProgress(user, time);
+}
+
+int vtkSnowAccumulationFilter::SetUpState(vtkInformationVector **inputVector) {
+  vtkImageData *terrain = vtkImageData::GetData(inputVector[0]);
+  if (!terrain) {
+    vtkErrorMacro("Snow Accumulation needs a terrain image on its Input.");
+    return 0;
+  }
+  int dims[3];
+  terrain->GetDimensions(dims);
+  double spacing[3];
+  terrain->GetSpacing(spacing);
+  if (dims[0] < 2 || dims[1] < 2 || dims[2] != 1) {
+    vtkErrorMacro("Snow Accumulation needs a 2-D terrain of at least 2 x 2 points on its Input; "
+                  "it got "
+                  << dims[0] << " x " << dims[1] << " x " << dims[2]
+                  << ". Slice a volume or resample the terrain first.");
+    return 0;
+  }
+  if (!(spacing[0] > 0.0) || !(spacing[1] > 0.0)) {
+    vtkErrorMacro("Snow Accumulation needs a terrain spacing above 0 m in x and y; the Input has "
+                  << spacing[0] << " x " << spacing[1] << " m. Set the spacing on the source.");
+    return 0;
+  }
+  vtkDataArray *elevationArray = this->GetElevation(terrain, "Input");
+  if (!elevationArray || !this->CheckParameters()) {
+    return 0;
+  }
+  const size_t npoints = static_cast<size_t>(dims[0]) * static_cast<size_t>(dims[1]);
+  struct Upload {
+    gr_field field;
+    vtkSmartPointer<vtkFloatArray> values;
+  };
+  std::vector<Upload> uploads;
+  uploads.push_back({GR_FIELD_ELEVATION, AsFloat(elevationArray)});
+  if (vtkDataArray *depth = terrain->GetPointData()->GetArray("snow_depth")) {
+    uploads.push_back({GR_FIELD_SNOW_DEPTH, AsFloat(depth)});
+  }
+  char msg[512];
+  for (const Upload &u : uploads) {
+    if (u.values->GetNumberOfComponents() != 1 ||
+        static_cast<size_t>(u.values->GetNumberOfTuples()) != npoints) {
+      vtkErrorMacro("Snow Accumulation's Input array '"
+                    << gr_field_name(u.field) << "' has " << u.values->GetNumberOfTuples()
+                    << " tuples of " << u.values->GetNumberOfComponents()
+                    << " component(s); it must have one value per point (" << npoints
+                    << "): resample it onto the terrain's grid or remove it.");
+      return 0;
+    }
+    // Checked on the host, before the device is touched.
+    if (gr_snow_accumulation_field_validate(u.field, u.values->GetPointer(0), npoints,
+                                            static_cast<size_t>(dims[0]), msg,
+                                            sizeof(msg)) != GR_OK) {
+      vtkErrorMacro("Snow Accumulation's Input: " << msg);
+      return 0;
+    }
+  }
+  if (!this->ReadObjects(this->GetNumberOfInputConnections(1)
+                             ? vtkDataObject::GetData(inputVector[1])
+                             : nullptr)) {
+    return 0;
+  }
+  this->ObjectsReadAt = this->GetTemporalInputTime(1);
+
+  gr_snow_accumulation_params p;
+  gr_snow_accumulation_params_init(&p);
+  for (int c = 0; c < 3; ++c) {
+    p.direction[c] = this->SnowDirection[c];
+  }
+  p.flutter = this->Flutter * TableToCore("Flutter");
+  p.snowfall_rate = this->SnowfallRate * TableToCore("SnowfallRate");
+  p.noise_amplitude = this->NoiseAmplitude * TableToCore("NoiseAmplitude");
+  p.noise_scale = this->NoiseScale * TableToCore("NoiseScale");
+  p.seed = this->Seed;
+  p.exposure_resolution = this->ExposureResolution;
+  p.blur_radius = this->BlurRadius;
+  p.dilation = this->Dilation;
+  p.max_depth = this->MaxDepth * TableToCore("MaxDepth");
+  p.stability_factor = this->StabilityFactor * TableToCore("StabilityFactor");
+  p.snow_density = this->SnowDensity * TableToCore("SnowDensity");
+  if (gr_snow_accumulation_params_validate(&p, msg, sizeof(msg)) != GR_OK) {
+    vtkErrorMacro("Snow Accumulation: " << msg);
+    return 0;
+  }
+  gr_context *ctx = this->GetContext();
+  if (!ctx) {
+    return 0;
+  }
+  // The device's limit first, so the sentence names ExposureResolution
+  // rather than a failed allocation.
+  int limit = 0;
+  gr_status st = gr_snow_accumulation_max_resolution(ctx, &limit);
+  if (st != GR_OK) {
+    return this->ReportFailure(st, "Snow Accumulation could not query the device");
+  }
+  if (this->ExposureResolution > limit) {
+    vtkErrorMacro("Snow Accumulation: ExposureResolution "
+                  << this->ExposureResolution << " is beyond the device '" << this->GetDeviceName()
+                  << "': its exposure view can be at most " << limit
+                  << " texels across; lower ExposureResolution or pick another Device.");
+    return 0;
+  }
+  gr_grid grid;
+  TerrainGrid(terrain, &grid);
+  st = gr_snow_accumulation_create(ctx, &grid, &p, &this->Simulation);
+  if (st != GR_OK) {
+    return this->ReportFailure(st, "Snow Accumulation could not set up the simulation");
+  }
+  for (const Upload &u : uploads) {
+    st = gr_snow_accumulation_set_field(this->Simulation, u.field, u.values->GetPointer(0));
+    if (st != GR_OK) {
+      vtkErrorMacro(
+          "Snow Accumulation's Input: " << gr_snow_accumulation_last_error(this->Simulation));
+      return 0;
+    }
+  }
+  gr_snow_accumulation_set_progress(this->Simulation, &vtkSnowAccumulationFilter::StepProgress,
+                                    this);
+  return this->SetObjects(0.0);
+}
+
+int vtkSnowAccumulationFilter::ResetState() {
+  gr_status st = gr_snow_accumulation_reset(this->Simulation);
+  gr_snow_accumulation_set_progress(this->Simulation, &vtkSnowAccumulationFilter::StepProgress,
+                                    this);
+  if (st != GR_OK) {
+    return this->ReportFailure(st, "Snow Accumulation could not restart",
+                               gr_snow_accumulation_last_error(this->Simulation));
+  }
+  // Moving objects back to their place at time 0 (reset keeps the poses).
+  return this->ObjectsMove() ? this->SetObjects(0.0) : 1;
+}
+
+int vtkSnowAccumulationFilter::AdvanceState(double t0, double t1) {
+  if (this->ObjectsTemporal && this->GetTemporalInputTime(1) != this->ObjectsReadAt) {
+    // The objects' next time step holds from t0 on.
+    if (!this->ReadObjects(this->GetTemporalInput(1)) || !this->SetObjects(t0)) {
+      return ADVANCE_FAILED;
+    }
+    this->ObjectsReadAt = this->GetTemporalInputTime(1);
+  }
+  // A progress callback that asked to stop leaves the core refusing steps
+  // until it is set again; an abort consumed since must not stop this call.
+  gr_snow_accumulation_set_progress(this->Simulation, &vtkSnowAccumulationFilter::StepProgress,
+                                    this);
+  // Steps of TimeStep from t0, the last one ending on t1; the step ends are
+  // t0 + k dt (not a running sum), so they depend on t0, t1 and dt only.
+  const double dt = this->TimeStep;
+  const double count = std::ceil((t1 - t0) / dt - 1e-9);
+  const long long n = count < 1.0 ? 1 : static_cast<long long>(count);
+  const bool moving = this->ObjectsMove();
+  double t = t0;
+  for (long long k = 1; k <= n; ++k) {
+    const double next = k == n ? t1 : t0 + static_cast<double>(k) * dt;
+    if (moving && !this->SetObjects(next)) {
+      return ADVANCE_FAILED;
+    }
+    const gr_status st = gr_snow_accumulation_step(this->Simulation, next - t);
+    if (st == GR_ERR_ABORTED) {
+      return ADVANCE_ABORTED;
+    }
+    if (st != GR_OK) {
+      return this->ReportFailure(st, "Snow Accumulation could not advance",
+                                 gr_snow_accumulation_last_error(this->Simulation));
+    }
+    t = next;
+  }
+  return ADVANCE_DONE;
+}
+
+int vtkSnowAccumulationFilter::SaveState(std::vector<unsigned char> &bytes) {
+  size_t size = 0;
+  if (gr_snow_accumulation_state_size(this->Simulation, &size) != GR_OK) {
+    return 0;
+  }
+  bytes.resize(size);
+  return gr_snow_accumulation_state_save(this->Simulation, bytes.data(), size) == GR_OK;
+}
+
+int vtkSnowAccumulationFilter::LoadState(const std::vector<unsigned char> &bytes) {
+  // An abort inside a step leaves the core refusing until set_progress.
+  gr_snow_accumulation_set_progress(this->Simulation, &vtkSnowAccumulationFilter::StepProgress,
+                                    this);
+  return gr_snow_accumulation_state_load(this->Simulation, bytes.data(), bytes.size()) == GR_OK;
+}
+
+int vtkSnowAccumulationFilter::FillObjects(vtkDataObject *output, double t) {
+  vtkDataObject *input = this->GetNumberOfInputConnections(1) ? this->GetTemporalInput(1) : nullptr;
+  if (!input || !output) {
+    return 1;
+  }
+  const size_t n = this->Objects.size();
+  bool other = false;
+  const std::vector<vtkPolyData *> leaves = Leaves(input, &other);
+  if (leaves.size() != n) {
+    return 1; // the objects changed since the state was made; nothing to pose
+  }
+  // One object at its pose with its snow per point.
+  auto snowy = [this, t](size_t k, vtkPolyData *leaf) -> vtkSmartPointer<vtkPolyData> {
+    double matrix[16];
+    this->Pose(k, t, matrix);
+    vtkSmartPointer<vtkPolyData> posed = Posed(leaf, this->Objects[k].centre, matrix);
+    const int points = static_cast<int>(leaf->GetNumberOfPoints());
+    vtkNew<vtkFloatArray> depth;
+    depth->SetName("snow_depth");
+    depth->SetNumberOfTuples(points);
+    vtkNew<vtkFloatArray> offset;
+    offset->SetName("snow_offset");
+    offset->SetNumberOfComponents(3);
+    offset->SetNumberOfTuples(points);
+    const int o = static_cast<int>(k);
+    gr_status st = gr_snow_accumulation_get_object_field(this->Simulation, o, GR_FIELD_SNOW_DEPTH,
+                                                         depth->GetPointer(0), points);
+    if (st == GR_OK) {
+      st = gr_snow_accumulation_get_object_offsets(this->Simulation, o, offset->GetPointer(0),
+                                                   points);
+    }
+    if (st != GR_OK) {
+      this->ReportFailure(st, "Snow Accumulation could not read the objects' snow",
+                          gr_snow_accumulation_last_error(this->Simulation));
+      return nullptr;
+    }
+    posed->GetPointData()->AddArray(depth);
+    posed->GetPointData()->AddArray(offset);
+    posed->GetPointData()->SetActiveScalars("snow_depth");
+    posed->GetPointData()->SetActiveVectors("snow_offset");
+    return posed;
+  };
+  if (auto *pd = vtkPolyData::SafeDownCast(output)) {
+    if (n == 1) {
+      vtkSmartPointer<vtkPolyData> posed = snowy(0, leaves[0]);
+      if (!posed) {
+        return 0;
+      }
+      pd->ShallowCopy(posed);
+    }
+    return 1;
+  }
+  auto *mb = vtkMultiBlockDataSet::SafeDownCast(output);
+  auto *in = vtkCompositeDataSet::SafeDownCast(input);
+  if (!mb || !in) {
+    return 1;
+  }
+  mb->CopyStructure(in);
+  vtkSmartPointer<vtkCompositeDataIterator> it;
+  it.TakeReference(in->NewIterator());
+  size_t k = 0;
+  for (it->InitTraversal(); !it->IsDoneWithTraversal() && k < n; it->GoToNextItem()) {
+    auto *leaf = vtkPolyData::SafeDownCast(it->GetCurrentDataObject());
+    if (!leaf || leaf->GetNumberOfPoints() == 0) {
+      continue;
+    }
+    vtkSmartPointer<vtkPolyData> posed = snowy(k, leaf);
+    if (!posed) {
+      return 0;
+    }
+    mb->SetDataSet(it, posed);
+    ++k;
+  }
+  return 1;
+}
+
+int vtkSnowAccumulationFilter::FillOutput(vtkDataObject *outputObject, vtkInformation *outInfo) {
+  const int fields[] = {GR_FIELD_SNOW_DEPTH, GR_FIELD_SNOW_SURFACE, GR_FIELD_SNOW_DENSITY,
+                        GR_FIELD_EXPOSURE, GR_FIELD_ELEVATION};
+  if (!this->FillImage(
+          outputObject, outInfo, fields, static_cast<int>(sizeof(fields) / sizeof(fields[0])),
+          [this](int f, float *values) {
+            return static_cast<int>(
+                gr_snow_accumulation_get_field(this->Simulation, static_cast<gr_field>(f), values));
+          },
+          [this]() { return gr_snow_accumulation_last_error(this->Simulation); })) {
+    return 0;
+  }
+  vtkImageData *output = vtkImageData::SafeDownCast(outputObject);
+
+  gr_snow_accumulation_ledger ledger;
+  const gr_status st = gr_snow_accumulation_ledger_get(this->Simulation, &ledger);
+  if (st != GR_OK) {
+    return this->ReportFailure(st, "Snow Accumulation could not read its ledger",
+                               gr_snow_accumulation_last_error(this->Simulation));
+  }
+  vtkFieldData *fd = output->GetFieldData();
+  // The state's absolute time: the ledger's sum of steps drifts by rounding.
+  AddValue(fd, "time", this->GetStateTime());
+  AddValue(fd, "steps", static_cast<double>(ledger.steps));
+  AddValue(fd, "initial_volume", ledger.initial_volume);
+  AddValue(fd, "snowfall_volume", ledger.snowfall_volume);
+  AddValue(fd, "stored_volume", ledger.stored_volume);
+  AddValue(fd, "stored_volume_terrain", ledger.stored_volume_terrain);
+  AddValue(fd, "stored_volume_objects", ledger.stored_volume_objects);
+  AddValue(fd, "shed_volume", ledger.shed_volume);
+  AddValue(fd, "dropped_volume", ledger.dropped_volume);
+  AddValue(fd, "balance_error", ledger.balance_error);
+
+  // The objects' output, at the same time; only piece 0 carries them, so
+  // an MPI run shows each object once.
+  if (this->OutputVector) {
+    vtkInformation *objInfo = this->OutputVector->GetInformationObject(1);
+    vtkDataObject *objects = objInfo->Get(vtkDataObject::DATA_OBJECT());
+    const int piece = objInfo->Has(vtkStreamingDemandDrivenPipeline::UPDATE_PIECE_NUMBER())
+                          ? objInfo->Get(vtkStreamingDemandDrivenPipeline::UPDATE_PIECE_NUMBER())
+                          : 0;
+    if (piece == 0 && !this->FillObjects(objects, this->GetStateTime())) {
+      return 0;
+    }
+    this->ObjectsFilled = true;
+  }
+  return 1;
+}
+
+void vtkSnowAccumulationFilter::ReleaseState() {
+  gr_snow_accumulation_destroy(this->Simulation);
+  this->Simulation = nullptr;
+}
+
+void vtkSnowAccumulationFilter::PrintSelf(ostream &os, vtkIndent indent) {
+  this->Superclass::PrintSelf(os, indent);
+  os << indent << "TimeStep: " << this->TimeStep << " s\n";
+  os << indent << "SnowDirection: " << this->SnowDirection[0] << " " << this->SnowDirection[1]
+     << " " << this->SnowDirection[2] << "\n";
+  os << indent << "Flutter: " << this->Flutter << " deg\n";
+  os << indent << "SnowfallRate: " << this->SnowfallRate << " cm/h\n";
+  os << indent << "NoiseAmplitude: " << this->NoiseAmplitude << "\n";
+  os << indent << "NoiseScale: " << this->NoiseScale << " m\n";
+  os << indent << "Seed: " << this->Seed << "\n";
+  os << indent << "ExposureResolution: " << this->ExposureResolution << "\n";
+  os << indent << "BlurRadius: " << this->BlurRadius << "\n";
+  os << indent << "Dilation: " << this->Dilation << "\n";
+  os << indent << "MaxDepth: " << this->MaxDepth << " m\n";
+  os << indent << "StabilityFactor: " << this->StabilityFactor << " 1/s\n";
+  os << indent << "SnowDensity: " << this->SnowDensity << " kg/m^3\n";
+  os << indent << "ObjectVelocity: " << this->ObjectVelocity[0] << " " << this->ObjectVelocity[1]
+     << " " << this->ObjectVelocity[2] << " m/s\n";
+}

@@ -1,0 +1,233 @@
+/**
+ * @class   vtkSnowAccumulationFilter
+ * @brief   Snowfall from a direction onto terrain and objects (seed 002:
+ *          occlusion-based accumulation), stepped on OpenCL.
+ *
+ * Input 0 (`Input`) is the terrain: a 2-D vtkImageData with the point array
+ * `elevation` (m) and, optionally, `snow_depth` (m), the snow at time 0.
+ *
+ * Input 1 (`Objects`, optional) is triangle meshes (vtkPolyData, whose
+ * polygons and strips are split into triangles here; open surfaces such as
+ * a roof are fine) or a multiblock of them, one object per non-empty leaf.
+ * They shadow the terrain and each other and keep their own snow, one
+ * depth per point of the polydata (so the output's point arrays match the
+ * input's points). Polygons wound counter-clockwise seen from outside (VTK's
+ * sources are) receive snow on their outer side. Each object is handed to
+ * the core in its own frame, about the centre of its bounds, with a pose
+ * that puts it in the world.
+ * - Objects that do not advertise time steps stand still, or move at
+ *   ObjectVelocity (m/s; a leaf's field data `velocity`, 3 values, replaces
+ *   it for that object); their snow moves with them.
+ * - Objects that advertise time steps are read at each (sample and hold,
+ *   see vtkGraupelSimulation): their geometry is the pose. An object keeps
+ *   its snow from one time step to the next while it keeps its number of
+ *   points.
+ *
+ * Time: every interval between the simulation's knots (output times, the
+ * objects' time steps) is stepped in TimeStep-sized steps, the last one
+ * shortened to end on the knot; each step takes the objects at their pose at
+ * the step's end. A request without a time (a consumer that reads this
+ * output once, such as Snow Deformation's Input) gets the last output,
+ * EndTime: the snow that has fallen, not the bare ground of time 0.
+ *
+ * Output 0 has the terrain's geometry and the point arrays `snow_depth` (m,
+ * active scalars), `snow_surface` (m), `snow_density` (kg/m^3: SnowDensity),
+ * `exposure` (0 or 1, the last step's) and `elevation`, the arrays Snow
+ * Deformation reads; field data `time` (s), `steps`, `initial_volume`,
+ * `snowfall_volume`, `stored_volume`, `stored_volume_terrain`,
+ * `stored_volume_objects`, `shed_volume`, `dropped_volume` (m^3) and
+ * `balance_error` (m^3: initial + snowfall - shed - dropped - stored).
+ * Output 1 is the objects at their pose at the output time (vtkPolyData, or
+ * a multiblock of the same structure as the input) with the point arrays
+ * `snow_depth` (m, along the point's normal) and `snow_offset` (3
+ * components, m: the world normal times the depth, for Warp By Vector).
+ *
+ * Time defaults (SetTimeDefaults): EndTime 6 h (21600 s), OutputInterval
+ * 15 min (900 s), in TimeSteps of 5 min: a snowfall of a few hours.
+ *
+ * The model is described in kernels/include/graupel/snow_accumulation.h;
+ * the setters clamp to its parameter table
+ * (gr_snow_accumulation_param_bounds).
+ */
+#ifndef vtkSnowAccumulationFilter_h
+#define vtkSnowAccumulationFilter_h
+
+#include "GraupelFiltersModule.h"
+#include "vtkGraupelSimulation.h"
+
+#include <vector>
+
+struct gr_snow_accumulation;
+class vtkDataObject;
+
+class GRAUPELFILTERS_EXPORT vtkSnowAccumulationFilter : public vtkGraupelSimulation {
+public:
+  static vtkSnowAccumulationFilter *New();
+  vtkTypeMacro(vtkSnowAccumulationFilter, vtkGraupelSimulation);
+  void PrintSelf(ostream &os, vtkIndent indent) override;
+
+  ///@{
+  /** Length of one simulation step, s (default 300; from 1e-6 to 86400). */
+  vtkSetClampMacro(TimeStep, double, 1.0e-6, 86400.0);
+  vtkGetMacro(TimeStep, double);
+  ///@}
+
+  ///@{
+  /**
+   * The direction the snow falls, any length (default 0 0 -1); wind tilts
+   * it, at most 75 degrees from straight down.
+   */
+  vtkSetVector3Macro(SnowDirection, double);
+  vtkGetVector3Macro(SnowDirection, double);
+  ///@}
+
+  ///@{
+  /** The largest random turn of the direction per step, deg (default 0). */
+  virtual void SetFlutter(double value);
+  vtkGetMacro(Flutter, double);
+  ///@}
+
+  ///@{
+  /** Fresh snow per hour on an exposed surface facing the snow, cm/h (default 2). */
+  virtual void SetSnowfallRate(double value);
+  vtkGetMacro(SnowfallRate, double);
+  ///@}
+
+  ///@{
+  /** A of the growth's noise modulation (1 + A N), 0 to 1 (default 0.2). */
+  virtual void SetNoiseAmplitude(double value);
+  vtkGetMacro(NoiseAmplitude, double);
+  ///@}
+
+  ///@{
+  /** The noise lattice, m (default 1). */
+  virtual void SetNoiseScale(double value);
+  vtkGetMacro(NoiseScale, double);
+  ///@}
+
+  ///@{
+  /** Seed of the noise and of the flutter (default 0). */
+  virtual void SetSeed(int value);
+  vtkGetMacro(Seed, int);
+  ///@}
+
+  ///@{
+  /** Texels across the exposure view (default 1024). */
+  virtual void SetExposureResolution(int value);
+  vtkGetMacro(ExposureResolution, int);
+  ///@}
+
+  ///@{
+  /** Radius of the growth's blur, grid points (default 1; 0: none). */
+  virtual void SetBlurRadius(int value);
+  vtkGetMacro(BlurRadius, int);
+  ///@}
+
+  ///@{
+  /** 1: the growth is dilated over 3 x 3 points (the thesis' dilation); default 0. */
+  virtual void SetDilation(int value);
+  vtkGetMacro(Dilation, int);
+  vtkBooleanMacro(Dilation, int);
+  ///@}
+
+  ///@{
+  /** Capacity of a horizontal surface, m (default 1): MaxDepth cos(slope) on a slope. */
+  virtual void SetMaxDepth(double value);
+  vtkGetMacro(MaxDepth, double);
+  ///@}
+
+  ///@{
+  /** Fraction of the excess over the capacity shed per second, 0 to 1 (default 1). */
+  virtual void SetStabilityFactor(double value);
+  vtkGetMacro(StabilityFactor, double);
+  ///@}
+
+  ///@{
+  /** Density of the fresh snow, kg/m^3 (default 100), written as `snow_density`. */
+  virtual void SetSnowDensity(double value);
+  vtkGetMacro(SnowDensity, double);
+  ///@}
+
+  ///@{
+  /** Velocity of the objects that have no time steps, m/s (default 0 0 0). */
+  vtkSetVector3Macro(ObjectVelocity, double);
+  vtkGetVector3Macro(ObjectVelocity, double);
+  ///@}
+
+  /** Connects the objects (input port 1). */
+  void SetObjectsConnection(vtkAlgorithmOutput *output);
+
+  /** Dispatches requests; see the .cxx for what the second output and a request without time need.
+   */
+  vtkTypeBool ProcessRequest(vtkInformation *request, vtkInformationVector **inInfo,
+                             vtkInformationVector *outInfo) override;
+
+protected:
+  vtkSnowAccumulationFilter();
+  ~vtkSnowAccumulationFilter() override;
+
+  int FillInputPortInformation(int port, vtkInformation *info) override;
+  int FillOutputPortInformation(int port, vtkInformation *info) override;
+
+  int RequestInformation(vtkInformation *, vtkInformationVector **,
+                         vtkInformationVector *) override;
+  int RequestData(vtkInformation *, vtkInformationVector **, vtkInformationVector *) override;
+
+  int SetUpState(vtkInformationVector **inputVector) override;
+  int ResetState() override;
+  int AdvanceState(double t0, double t1) override;
+  int FillOutput(vtkDataObject *output, vtkInformation *outInfo) override;
+  void ReleaseState() override;
+  int SaveState(std::vector<unsigned char> &bytes) override;
+  int LoadState(const std::vector<unsigned char> &bytes) override;
+  const char *GetSimulationLabel() override { return "Snow Accumulation"; }
+
+  double TimeStep = 300.0;
+  double SnowDirection[3] = {0.0, 0.0, -1.0};
+  double Flutter = 0.0; // the table's defaults, set in the constructor
+  double SnowfallRate = 0.0;
+  double NoiseAmplitude = 0.0;
+  double NoiseScale = 0.0;
+  int Seed = 0;
+  int ExposureResolution = 0;
+  int BlurRadius = 0;
+  int Dilation = 0;
+  double MaxDepth = 0.0;
+  double StabilityFactor = 0.0;
+  double SnowDensity = 0.0;
+  double ObjectVelocity[3] = {0.0, 0.0, 0.0};
+
+private:
+  vtkSnowAccumulationFilter(const vtkSnowAccumulationFilter &) = delete;
+  void operator=(const vtkSnowAccumulationFilter &) = delete;
+
+  /** One object as the core sees it: its points about its centre, one mesh point each. */
+  struct Object {
+    std::vector<float> vertices;
+    std::vector<int> triangles;
+    double centre[3];
+    double velocity[3]; // m/s: the leaf's `velocity`, else ObjectVelocity
+  };
+
+  int CheckParameters();
+  /** Reads the objects into Objects; 0 after one sentence. */
+  int ReadObjects(vtkDataObject *objects);
+  /** The pose (column-major) of object k at time t. */
+  void Pose(size_t k, double t, double matrix[16]) const;
+  /** Whether any object moves by its velocity (poses change between steps). */
+  bool ObjectsMove() const;
+  /** Hands the objects at their poses at time t to the core. */
+  int SetObjects(double t);
+  int FillObjects(vtkDataObject *output, double t);
+
+  gr_snow_accumulation *Simulation = nullptr;
+  std::vector<Object> Objects;
+  bool ObjectsTemporal = false;
+  double ObjectsReadAt = 0.0;
+  vtkInformationVector *OutputVector = nullptr; // during RequestData only
+  bool ObjectsFilled = false;
+  double LastProgressWall = 0.0;
+  static int StepProgress(void *user, double time);
+};
+
+#endif
