@@ -888,6 +888,45 @@ static void test_time_step(void) {
   free(a), free(b);
 }
 
+/* A box the size of one point pressed into that point's snow, one quantum
+ * (2^-20 m) deep, on bare ground: the quantum displaced, shared over the 8
+ * contour points, is an eighth of a quantum each and rounds to nothing
+ * (it waits as pending snow); the bare contour stays bare and its density
+ * finite (it was 0/0 = NaN, found by the accumulation demo's sledge beside
+ * bare ground), and the ledger closes. */
+static void test_bare_ground(void) {
+  gr_snow_deformation_params p;
+  gr_snow_deformation_params_init(&p);
+  p.initial_density = p.max_density; /* all of the overlap displaced */
+  gr_snow_deformation *s = make_sim(40, 40, 0.05, &p);
+  if (!s)
+    return;
+  float *d0 = calloc(40 * 40, sizeof(float));
+  d0[20 * 40 + 20] = 1.0f / 1048576.0f;
+  CHECK(gr_snow_deformation_set_field(s, GR_FIELD_SNOW_DEPTH, d0) == GR_OK);
+  test_mesh box;
+  mesh_box(&box, 0.02, 0.02, 0.1);
+  mesh_pose(&box, 20 * 0.05, 20 * 0.05, 0.1 - 0.05); /* its bottom 5 cm below the ground */
+  double v[3] = {0.0, 0.0, -1.0};
+  CHECK(gr_snow_deformation_set_objects(s, &box.m, 1, v) == GR_OK);
+  CHECK(gr_snow_deformation_step(s, 0.1) == GR_OK);
+  float *rho = get(s, GR_FIELD_SNOW_DENSITY, 40 * 40), *d = get(s, GR_FIELD_SNOW_DEPTH, 40 * 40);
+  int bad = 0;
+  for (int c = 0; c < 40 * 40; ++c)
+    bad += !(rho[c] >= 100.0f && rho[c] <= 400.0f) || !(d[c] >= 0.0f);
+  gr_snow_deformation_ledger l;
+  CHECK(gr_snow_deformation_ledger_get(s, &l) == GR_OK);
+  printf("bare ground: %d points with a density or depth out of range; displaced %.3g m^3, "
+         "volume %.6g of %.6g, mass error %.3g kg\n",
+         bad, l.displaced_volume, l.snow_volume, l.initial_volume, l.balance_error);
+  CHECK(bad == 0);
+  CHECK(l.displaced_volume > 0.0);
+  CHECK(isfinite(l.balance_error) && fabs(l.snow_volume - l.initial_volume) <= 1e-12);
+  free(rho), free(d), free(d0);
+  mesh_free(&box);
+  gr_snow_deformation_destroy(s);
+}
+
 /* Every OpenCL device here ploughs the same trail (the box drag of the
  * trail test, 40 steps, the talus converged each step): surfaces within
  * 1e-5 m of the first device's (issue 8). Measured on the H200 against
@@ -1023,6 +1062,7 @@ static const gr_subtest tests[] = {
     {"time_step", test_time_step, 0},
     {"blocked", test_blocked, 0},
     {"devices_agree", test_devices_agree, 0},
+    {"bare_ground", test_bare_ground, 0},
     {"memcheck", test_memcheck, 1},
 };
 

@@ -227,7 +227,10 @@ __kernel void snow_apply(__global const float *restrict ground, __global float *
      * density leaves the density bit for bit as it was. */
     float add = snow_q(cw * add_depth), s1 = s + add;
     depth[c] = s1;
-    density[c] = rho + add * ((add_rho - rho) / s1);
+    /* A share below one quantum rounds to nothing: bare ground stays bare
+     * (and its density is not 0/0). */
+    if (add > 0.0f)
+      density[c] = rho + add * ((add_rho - rho) / s1);
   }
 }
 
