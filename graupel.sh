@@ -2,7 +2,8 @@
 # Graupel's one entry point for set-up, demo and tests.
 #
 #   ./graupel.sh demo   install what the demo needs, build the plugin, run
-#                       Examples/demo_terrain.py and demo_snow_deformation.py -> out/
+#                       Examples/demo_terrain.py, demo_snow_deformation.py and
+#                       demo_snow_accumulation.py -> out/
 #   ./graupel.sh test   install what is missing, build all four configurations, run ctest
 #   ./graupel.sh build  install what the plugin needs and build the plugin only
 #   ./graupel.sh soak   the long soak runs (ctest label "soak", kept out of "test")
@@ -117,6 +118,13 @@ case "$cmd" in
     PYTHONPATH="$ROOT/build/lib/python3/site-packages${PYTHONPATH:+:$PYTHONPATH}" \
     PV_PLUGIN_PATH="$ROOT/build/lib/paraview-5.11/plugins/Graupel" \
       xvfb-run -a -s "-screen 0 1280x1024x24" pvbatch Examples/demo_snow_deformation.py --out out
+    # Snow on a hut and trees under wind, then a sledge across it:
+    # out/snow_accumulation.png (the snowfall: depth, lee-side shadows, bare
+    # ground under the roof, snow caps), snow_accumulation_sledge.png (the
+    # sledge's trail) and snow_accumulation.vti.
+    PYTHONPATH="$ROOT/build/lib/python3/site-packages${PYTHONPATH:+:$PYTHONPATH}" \
+    PV_PLUGIN_PATH="$ROOT/build/lib/paraview-5.11/plugins/Graupel" \
+      xvfb-run -a -s "-screen 0 1280x1024x24" pvbatch Examples/demo_snow_accumulation.py --out out
     ;;
   test)
     ensure_packages "${PACKAGES[@]}" "${TEST_PACKAGES[@]}"

@@ -5,6 +5,9 @@ Testing/Baseline/ by VTK's image comparison.
                    Runoff), warped by the water surface, coloured by depth
   --scene snow     a wheel rolled along an S through snow (Snow Deformation,
                    Examples/snow_scene.py on a 160 x 160 grid), seen whole
+  --scene accumulation  4 h of wind-driven snow on a hut and trees (Snow
+                   Accumulation), then a sledge across it (Snow Deformation):
+                   snow_scene.build_accumulation on a 128 x 128 grid, seen whole
 Regenerate a baseline only on purpose (--generate-baseline, or
 GRAUPEL_GENERATE_BASELINE=1 in ctest's environment), and look at it."""
 import os
@@ -14,7 +17,8 @@ import sys
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import gr_check as T  # noqa: E402
 
-a = T.args(lambda p: p.add_argument("--scene", choices=("terrain", "rain", "snow"),
+a = T.args(lambda p: p.add_argument("--scene", choices=("terrain", "rain", "snow",
+                                                          "accumulation"),
                                     default="terrain"))
 
 from paraview.simple import *  # noqa: E402,F401,F403
@@ -51,6 +55,84 @@ elif a.scene == "snow":
     mass = fd.GetArray("snow_mass").GetValue(0)
     T.check(abs(fd.GetArray("balance_error").GetValue(0)) < 1e-6 * mass, "snow mass kept")
     view = snow_scene.show(snow, times[-1], size=(400, 300), bar=False, label=False)
+elif a.scene == "accumulation":
+    import numpy as np  # noqa: E402
+    import snow_scene as S  # noqa: E402
+    from paraview import servermanager  # noqa: E402
+    from vtkmodules.util.numpy_support import vtk_to_numpy  # noqa: E402
+
+    # The demo's 14.35 m patch at 11 cm, 12 steps of 20 min, then the
+    # sledge in steps of 0.04 s.
+    acc, sledge, crossing, path = S.build_accumulation(cells=128, spacing=0.05 * 287 / 127,
+                                                       time_step=1200.0, resolution=256,
+                                                       sledge_step=0.04)
+    end = acc.EndTime
+    out = servermanager.Fetch(acc)
+    nx = out.GetDimensions()[0]
+    dx = out.GetSpacing()[0]
+    j, i = np.mgrid[0:nx, 0:nx]
+    X, Y = i * dx, j * dx
+    depth = vtk_to_numpy(out.GetPointData().GetArray("snow_depth")).reshape(nx, nx)
+    field = lambda data, name: data.GetFieldData().GetArray(name).GetValue(0)  # noqa: E731
+    fall = field(out, "snowfall_volume")
+    stored, shed = field(out, "stored_volume"), field(out, "shed_volume")
+    T.check(field(out, "time") == end and fall > 0, "the snowfall's %g m^3 at %g s" % (fall, end))
+    T.check(abs(field(out, "balance_error")) <= 1e-6 * fall
+            and abs(fall - stored - shed) <= 1e-6 * fall,
+            "ledger: snowfall %r = stored %r + shed %r" % (fall, stored, shed))
+    # Under the roof: the walls, and the porch but for the strips the
+    # slanting snow reaches from its eaves (eave height x tan(tilt +
+    # flutter) from the west, x tan(flutter) from the south), two cells in
+    # from every edge for the blur.
+    H = S.HUT
+    x0, x1 = H["x"] - 0.5 * H["width"], H["x"] + 0.5 * H["width"]
+    y0, y1 = H["y"] - 0.5 * H["length"], H["y"] + 0.5 * H["length"]
+    rx0, rx1, ry0 = x0 - H["overhang"], x1 + H["overhang"], y0 - H["porch"]
+    reach = H["eave"] * np.tan(np.radians(S.TILT + S.FLUTTER)) + 2 * dx
+    front = H["eave"] * np.tan(np.radians(S.FLUTTER)) + 2 * dx
+    roofed = (((X > x0 + 2 * dx) & (X < x1 - 2 * dx) & (Y > y0 + 2 * dx) & (Y < y1 - 2 * dx))
+              | ((X > rx0 + reach) & (X < x1 - 2 * dx) & (Y > ry0 + front)
+                 & (Y <= y0 + 2 * dx)))
+    T.check(roofed.sum() > 300 and np.all(depth[roofed] == 0.0),
+            "exactly no snow on the %d points under the roof (max %g m)"
+            % (roofed.sum(), depth[roofed].max()))
+    # The wind's lee: 0.2-0.8 m east of the east eave against as far west
+    # of the west eave, along the walls.
+    side = (Y > y0) & (Y < y1)
+    lee = depth[side & (X > rx1 + 0.2) & (X < rx1 + 0.8)].mean()
+    windward = depth[side & (X > rx0 - 0.8) & (X < rx0 - 0.2)].mean()
+    full = S.RATE * 0.01 * S.HOURS
+    T.check(windward > 0.7 * full * np.cos(np.radians(S.TILT)) and lee < 0.25 * windward,
+            "lee %.3f m, windward %.3f m of snow beside the hut" % (lee, windward))
+    # The caps: the roof's slopes, 30 degrees, catch cos(30 - tilt) and
+    # cos(30 + tilt) of the snow: the lee slope half the windward's.
+    roof = servermanager.Fetch(acc, idx=1).GetBlock(1)
+    cap = vtk_to_numpy(roof.GetPointData().GetArray("snow_depth"))
+    normal_x = vtk_to_numpy(roof.GetPointData().GetArray("snow_offset"))[:, 0]
+    west, east = cap[normal_x < -1e-6].mean(), cap[normal_x > 1e-6].mean()
+    pitch = np.arctan2(H["ridge"] - H["eave"], 0.5 * H["width"] + H["overhang"])
+    want = np.cos(pitch + np.radians(S.TILT)) / np.cos(pitch - np.radians(S.TILT))
+    T.check(abs(east / west - want) < 0.1,
+            "roof caps: windward %.3f m, lee %.3f m, ratio %.3f (cosines %.3f)"
+            % (west, east, east / west, want))
+    # The sledge: its trail below the snow it crossed, the snow's mass kept
+    # from what fell.
+    sledge.UpdatePipeline(crossing)
+    after = servermanager.Fetch(sledge)
+    mass = float(np.sum(depth.astype(np.float64) * vtk_to_numpy(
+        out.GetPointData().GetArray("snow_density")).reshape(nx, nx)) * dx * dx)
+    T.check(abs(field(after, "initial_mass") - mass) <= 1e-5 * mass
+            and abs(field(after, "balance_error")) <= 1e-6 * mass,
+            "the sledge's snow starts at the accumulated %.6g kg (%r) and keeps it (error %g)"
+            % (mass, field(after, "initial_mass"), field(after, "balance_error")))
+    u = len(path)
+    x, y = path[u // 5:4 * u // 5, 0], path[u // 5:4 * u // 5, 1]
+    sunk = S._sample(out, "snow_surface", x, y) - S._sample(after, "snow_surface", x, y)
+    T.check(np.median(sunk) > 0.5 * S.SLEDGE_SINK and sunk.min() > 0.0,
+            "the trail lies %.3f m (median; least %.3f m) below the accumulated snow"
+            % (np.median(sunk), sunk.min()))
+    view = S.show_accumulation(acc, end, sledge, crossing, size=(400, 300), bar=False,
+                               label=False)
 else:
     terrain = ProceduralTerrain(Dimensions=[128, 128], Spacing=4.0, Seed=2026, HeightScale=40.0)
     rain = RainRunoff(Input=terrain, RainRate=100.0, EndTime=600.0, OutputInterval=600.0,
