@@ -90,6 +90,33 @@ __kernel void snow_accumulation_raster_terrain(__global const float *restrict gr
   snac_raster(view, vw, vh, p[0], p[3], p[2]);
 }
 
+/* The steepest rise of the snow surface between neighbouring grid points,
+ * along x and along y (two maxima, m/m). A triangle of the surface slopes
+ * at most sqrt(gx^2 + gy^2) of them: where that is below the snow's
+ * descent (|d_z| / |d_xy|), no surface point can stand above the ray from
+ * another, and the terrain need not be drawn into the view. */
+__kernel void snow_accumulation_slope_reduce(__global const float *restrict ground,
+                                             __global const float *restrict depth, int nx, int ny,
+                                             float dx, float dy, int n,
+                                             __global float *restrict partial,
+                                             __local float *restrict scratch) {
+  int lid = get_local_id(0), wg = get_local_size(0), start, end;
+  gr_reduce_block(n, &start, &end);
+  float gx = 0.0f, gy = 0.0f;
+  for (int c = start + lid; c < end; c += wg) {
+    int i = c % nx, j = c / nx;
+    float h = ground[c] + depth[c];
+    if (i + 1 < nx)
+      gx = fmax(gx, fabs((ground[c + 1] + depth[c + 1]) - h) / dx);
+    if (j + 1 < ny)
+      gy = fmax(gy, fabs((ground[c + nx] + depth[c + nx]) - h) / dy);
+  }
+  __local float *mine = gr_reduce_slots(scratch, 0, 2);
+  mine[0] = gx;
+  mine[1] = gy;
+  gr_reduce_group(scratch, 0, 2, partial);
+}
+
 /* The objects' triangles at their poses (9 floats each, relative to grid
  * point (0, 0) and zref). */
 __kernel void snow_accumulation_raster_objects(__global const float *restrict tri, int ntri,
@@ -288,16 +315,17 @@ snow_accumulation_apply(__global const float *restrict ground, int nx, int ny, f
  * increment and stability, like the grid's but without blur. pos and nrm
  * are world (pos relative to grid point (0, 0) and zref), lattice the
  * object's own frame in noise lattice units. */
-__kernel void
-snow_accumulation_objects(__global const float *restrict pos, __global const float *restrict nrm,
-                          __global const float *restrict lattice, int nv, float dir_x, float dir_y,
-                          float dir_z, float tau_x, float tau_y, float qx0, float qy0,
-                          float inv_texel, float texel, int vw, int vh,
-                          __global const int *restrict view, float rate_dt, float amplitude,
-                          uint seed, float max_depth, float keep, __global float *restrict exposure,
-                          __global float *restrict depth, __global float *restrict depth_lo,
-                          __global float *restrict fall, __global float *restrict fall_lo,
-                          __global float *restrict shed, __global float *restrict shed_lo) {
+__kernel void snow_accumulation_objects(
+    __global const float *restrict pos, __global const float *restrict nrm,
+    __global const float *restrict lattice, int nv, float dir_x, float dir_y, float dir_z,
+    float tau_x, float tau_y, float qx0, float qy0, float inv_texel, float texel, int vw, int vh,
+    __global const int *restrict view, float rate_dt, float amplitude, uint seed, float max_depth,
+    float keep, int terrain_drawn, __global const float *restrict ground,
+    __global const float *restrict gdepth, int gnx, int gny, float gdx, float gdy, float zref,
+    __global float *restrict exposure, __global float *restrict depth,
+    __global float *restrict depth_lo, __global float *restrict fall,
+    __global float *restrict fall_lo, __global float *restrict shed,
+    __global float *restrict shed_lo) {
   int v = get_global_id(0);
   if (v >= nv)
     return;
@@ -307,6 +335,24 @@ snow_accumulation_objects(__global const float *restrict pos, __global const flo
       (float3)(pos[3 * v], pos[3 * v + 1], pos[3 * v + 2]) + n * (GR_SNAC_NORMAL_OFFSET * texel);
   float e =
       snac_exposed(view, vw, vh, p.x, p.y, p.z, n, d, tau_x, tau_y, qx0, qy0, inv_texel, texel);
+  /* Without the terrain in the view, a point under the snow surface (an
+   * object sunk into the ground) is hidden by it: the surface at its
+   * place, bilinear between the grid points. */
+  if (!terrain_drawn && e > 0.0f) {
+    float fx = clamp(p.x / gdx, 0.0f, (float)(gnx - 1)),
+          fy = clamp(p.y / gdy, 0.0f, (float)(gny - 1));
+    int i0 = min((int)fx, gnx - 2 >= 0 ? gnx - 2 : 0),
+        j0 = min((int)fy, gny - 2 >= 0 ? gny - 2 : 0);
+    int i1 = min(i0 + 1, gnx - 1), j1 = min(j0 + 1, gny - 1);
+    float tx = fx - (float)i0, ty = fy - (float)j0;
+    float h00 = ground[gr_idx(i0, j0, gnx)] + gdepth[gr_idx(i0, j0, gnx)];
+    float h10 = ground[gr_idx(i1, j0, gnx)] + gdepth[gr_idx(i1, j0, gnx)];
+    float h01 = ground[gr_idx(i0, j1, gnx)] + gdepth[gr_idx(i0, j1, gnx)];
+    float h11 = ground[gr_idx(i1, j1, gnx)] + gdepth[gr_idx(i1, j1, gnx)];
+    float hs = mix(mix(h00, h10, tx), mix(h01, h11, tx), ty) - zref;
+    if (p.z < hs)
+      e = 0.0f;
+  }
   float noise = snac_noise(lattice[3 * v], lattice[3 * v + 1], lattice[3 * v + 2], seed);
   float g = rate_dt * e * fmax(0.0f, -dot(n, d)) * (1.0f + amplitude * noise);
   exposure[v] = e;

@@ -33,4 +33,10 @@
 /* The noise lattice repeats after this many cells in each direction. */
 #define GR_SNAC_NOISE_PERIOD 65536.0
 
+/* The terrain is left out of the exposure view when its steepest surface
+ * triangle, with this relative margin, rises slower than the snow falls
+ * (rise over run of the direction): then no surface point can hide
+ * another. */
+#define GR_SNAC_SLOPE_MARGIN 0.01
+
 #endif

@@ -66,8 +66,8 @@ struct gr_snow_accumulation {
   gr_context *ctx;
   gr_grid grid;
   gr_snow_accumulation_params params;
-  cl_kernel raster_terrain, raster_objects, exposure_k, noise_k, blur, dilate, apply, objects_k,
-      reduce, surface;
+  cl_kernel raster_terrain, raster_objects, exposure_k, noise_k, slope_k, blur, dilate, apply,
+      objects_k, reduce, surface;
   /* The grid: ground, initial snow, the state pairs, exposure, growth and
    * a scratch array, the blur weights and the view. */
   cl_mem ground, depth0, arr[GR_SNAC_ARRAYS], growth, scratch, weights, view;
@@ -87,7 +87,7 @@ struct gr_snow_accumulation {
   int *ht;                   /* triangles, indices into hv */
   float *hnrm;               /* world normals, 3 per mesh point */
   double ob_lo[3], ob_hi[3]; /* the objects' world box */
-  gr_reduction red;
+  gr_reduction red, red_slope;
   double zref, bmin, bmax, init_max, snow_bound;
   double time, initial_volume, retired_fall, retired_shed, dropped;
   long long steps;
@@ -449,7 +449,8 @@ gr_status gr_snow_accumulation_create(gr_context *ctx, const gr_grid *grid,
             {"snow_accumulation_objects", &s->objects_k},
             {"snow_accumulation_reduce", &s->reduce},
             {"snow_accumulation_surface", &s->surface},
-            {"snow_accumulation_noise", &s->noise_k}};
+            {"snow_accumulation_noise", &s->noise_k},
+            {"snow_accumulation_slope_reduce", &s->slope_k}};
   for (size_t i = 0; st == GR_OK && i < sizeof(ks) / sizeof(ks[0]); ++i)
     st = gr_kernel_create(ctx, prog, ks[i].name, ks[i].k);
   cl_mem *bufs[] = {&s->ground, &s->depth0, &s->growth, &s->scratch, &s->noise};
@@ -464,6 +465,8 @@ gr_status gr_snow_accumulation_create(gr_context *ctx, const gr_grid *grid,
     st = gr_snac_prepare(s, p);
   if (st == GR_OK)
     st = gr_reduction_init(ctx, s->reduce, cells, GR_SNAC_SUMS, 0, &s->red);
+  if (st == GR_OK)
+    st = gr_reduction_init(ctx, s->slope_k, cells, 0, 2, &s->red_slope);
   if (st == GR_OK)
     st = gr_snac_fill(s, s->ground, cells, 0.0f);
   if (st == GR_OK)
@@ -489,8 +492,9 @@ static void gr_snac_release_objects(gr_snow_accumulation *s) {
 void gr_snow_accumulation_destroy(gr_snow_accumulation *s) {
   if (!s)
     return;
-  cl_kernel ks[] = {s->raster_terrain, s->raster_objects, s->exposure_k, s->blur,    s->dilate,
-                    s->apply,          s->objects_k,      s->reduce,     s->surface, s->noise_k};
+  cl_kernel ks[] = {s->raster_terrain, s->raster_objects, s->exposure_k, s->blur,
+                    s->dilate,         s->apply,          s->objects_k,  s->reduce,
+                    s->surface,        s->noise_k,        s->slope_k};
   for (size_t i = 0; i < sizeof(ks) / sizeof(ks[0]); ++i)
     if (ks[i])
       clReleaseKernel(ks[i]);
@@ -502,6 +506,7 @@ void gr_snow_accumulation_destroy(gr_snow_accumulation *s) {
     gr_buffer_release(&s->arr[a]);
   gr_snac_release_objects(s);
   gr_reduction_release(&s->red);
+  gr_reduction_release(&s->red_slope);
   free(s->hv);
   free(s->ht);
   free(s->hnrm);
@@ -1022,7 +1027,31 @@ static gr_status gr_snac_step_impl(gr_snow_accumulation *s, double dt) {
   if (nst != GR_OK)
     return nst;
 
-  /* 1. the view */
+  /* 1. the view. The terrain is drawn into it only where it could hide
+   * itself: where a triangle of the snow surface rises faster than the
+   * snow falls steeply (snow_accumulation_slope_reduce). Snow straight
+   * down, or a surface gentler than the snow's descent, leaves a view of
+   * the objects alone, and a far cheaper step. */
+  cl_int terrain_drawn = 1;
+  {
+    double g2[2] = {0.0, 0.0}, horiz = hypot(dd[0], dd[1]);
+    cl_int cells = nx * ny;
+    const gr_snac_arg sa[] = {GR_SNAC_MEM("ground", s->ground),
+                              GR_SNAC_MEM("depth", s->arr[0]),
+                              GR_SNAC_VAL("nx", nx),
+                              GR_SNAC_VAL("ny", ny),
+                              GR_SNAC_VAL("dx", dx),
+                              GR_SNAC_VAL("dy", dy),
+                              GR_SNAC_VAL("n", cells)};
+    gr_status sst = gr_snac_args(s, s->slope_k, sa, sizeof(sa) / sizeof(sa[0]));
+    if (sst == GR_OK)
+      sst = gr_reduction_run(ctx, &s->red_slope, s->slope_k, NULL, g2);
+    if (sst != GR_OK)
+      return sst;
+    double steepest = sqrt(g2[0] * g2[0] + g2[1] * g2[1]);
+    if (horiz == 0.0 || steepest * (1.0 + GR_SNAC_SLOPE_MARGIN) * horiz < fabs(dd[2]))
+      terrain_drawn = 0;
+  }
   cl_int empty = GR_SNAC_EMPTY;
   gr_status st =
       gr_cl_check(ctx,
@@ -1046,7 +1075,7 @@ static gr_status gr_snac_step_impl(gr_snow_accumulation *s, double dt) {
                             GR_SNAC_MEM("view", s->view)};
   if (st == GR_OK)
     st = gr_snac_args(s, s->raster_terrain, rt, sizeof(rt) / sizeof(rt[0]));
-  if (st == GR_OK && nx > 1 && ny > 1)
+  if (st == GR_OK && nx > 1 && ny > 1 && terrain_drawn)
     st = gr_enqueue_2d(ctx, s->raster_terrain, 0, 0, (size_t)(nx - 1), (size_t)(ny - 1), NULL);
   cl_int ntri = s->ntri;
   if (st == GR_OK && ntri > 0) {
@@ -1171,6 +1200,14 @@ static gr_status gr_snac_step_impl(gr_snow_accumulation *s, double dt) {
                               GR_SNAC_VAL("seed", seed),
                               GR_SNAC_VAL("max_depth", max_depth),
                               GR_SNAC_VAL("keep", keep),
+                              GR_SNAC_VAL("terrain_drawn", terrain_drawn),
+                              GR_SNAC_MEM("ground", s->ground),
+                              GR_SNAC_MEM("gdepth", s->arr[0]),
+                              GR_SNAC_VAL("gnx", nx),
+                              GR_SNAC_VAL("gny", ny),
+                              GR_SNAC_VAL("gdx", dx),
+                              GR_SNAC_VAL("gdy", dy),
+                              GR_SNAC_VAL("zref", zref),
                               GR_SNAC_MEM("exposure", s->o_arr[6]),
                               GR_SNAC_MEM("depth", s->o_arr[0]),
                               GR_SNAC_MEM("depth_lo", s->o_arr[1]),
