@@ -131,7 +131,7 @@ vtkSmartPointer<vtkPolyData> Posed(vtkPolyData *pd, const double centre[3], cons
 
 vtkSnowAccumulationFilter::vtkSnowAccumulationFilter() {
   this->SetNumberOfInputPorts(2);
-  this->SetNumberOfOutputPorts(2);
+  this->SetNumberOfOutputPorts(3);
   // Objects with time steps are read in time; others stand or move by ObjectVelocity.
   this->SetInputPortPolicy(1, TEMPORAL_INPUT);
   // A snowfall of a few hours: 6 h of 15 min outputs, three 5 min steps
@@ -149,6 +149,7 @@ vtkSnowAccumulationFilter::vtkSnowAccumulationFilter() {
   this->MaxDepth = TableDefault("MaxDepth", 1.0);
   this->StabilityFactor = TableDefault("StabilityFactor", 1.0);
   this->SnowDensity = TableDefault("SnowDensity", 100.0);
+  this->AccumulationTextureSize = static_cast<int>(TableDefault("AccumulationTextureSize", 256.0));
 }
 
 vtkSnowAccumulationFilter::~vtkSnowAccumulationFilter() {
@@ -172,6 +173,8 @@ GRAUPEL_TABLE_SETTER(vtkSnowAccumulationFilter, StabilityFactor, double,
                      gr_snow_accumulation_param_bounds)
 GRAUPEL_TABLE_SETTER(vtkSnowAccumulationFilter, SnowDensity, double,
                      gr_snow_accumulation_param_bounds)
+GRAUPEL_TABLE_SETTER(vtkSnowAccumulationFilter, AccumulationTextureSize, int,
+                     gr_snow_accumulation_param_bounds)
 
 void vtkSnowAccumulationFilter::SetObjectsConnection(vtkAlgorithmOutput *output) {
   this->SetInputConnection(1, output);
@@ -192,7 +195,9 @@ int vtkSnowAccumulationFilter::FillInputPortInformation(int port, vtkInformation
 
 int vtkSnowAccumulationFilter::FillOutputPortInformation(int port, vtkInformation *info) {
   // Port 1 follows the Objects input's type (REQUEST_DATA_OBJECT below).
-  info->Set(vtkDataObject::DATA_TYPE_NAME(), port == 0 ? "vtkImageData" : "vtkDataObject");
+  info->Set(vtkDataObject::DATA_TYPE_NAME(), port == 0   ? "vtkImageData"
+                                             : port == 1 ? "vtkDataObject"
+                                                         : "vtkMultiBlockDataSet");
   return 1;
 }
 
@@ -231,9 +236,10 @@ vtkTypeBool vtkSnowAccumulationFilter::ProcessRequest(vtkInformation *request,
       from->Set(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP(),
                 this->GetOutputTime(outputs - 1));
     }
-    // A request from the objects' port asks for the same time of the
-    // simulation, which the base reads from port 0.
-    if (port == 1 && from->Has(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP())) {
+    // A request from the objects' or the textures' port asks for the same
+    // time of the simulation, which the base reads from port 0.
+    if ((port == 1 || port == 2) &&
+        from->Has(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP())) {
       outInfo->GetInformationObject(0)->Set(
           vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP(),
           from->Get(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP()));
@@ -248,12 +254,14 @@ int vtkSnowAccumulationFilter::RequestInformation(vtkInformation *request,
   const int ok = this->Superclass::RequestInformation(request, inputVector, outputVector);
   // The objects' output has the simulation's times, not the input's.
   vtkInformation *image = outputVector->GetInformationObject(0);
-  vtkInformation *objects = outputVector->GetInformationObject(1);
-  objects->Remove(vtkStreamingDemandDrivenPipeline::TIME_STEPS());
-  objects->Remove(vtkStreamingDemandDrivenPipeline::TIME_RANGE());
-  if (image->Has(vtkStreamingDemandDrivenPipeline::TIME_STEPS())) {
-    objects->CopyEntry(image, vtkStreamingDemandDrivenPipeline::TIME_STEPS());
-    objects->CopyEntry(image, vtkStreamingDemandDrivenPipeline::TIME_RANGE());
+  for (int port = 1; port < 3; ++port) {
+    vtkInformation *objects = outputVector->GetInformationObject(port);
+    objects->Remove(vtkStreamingDemandDrivenPipeline::TIME_STEPS());
+    objects->Remove(vtkStreamingDemandDrivenPipeline::TIME_RANGE());
+    if (image->Has(vtkStreamingDemandDrivenPipeline::TIME_STEPS())) {
+      objects->CopyEntry(image, vtkStreamingDemandDrivenPipeline::TIME_STEPS());
+      objects->CopyEntry(image, vtkStreamingDemandDrivenPipeline::TIME_RANGE());
+    }
   }
   return ok;
 }
@@ -262,8 +270,11 @@ int vtkSnowAccumulationFilter::RequestData(vtkInformation *request,
                                            vtkInformationVector **inputVector,
                                            vtkInformationVector *outputVector) {
   vtkInformation *objInfo = outputVector->GetInformationObject(1);
-  if (vtkDataObject *objects = objInfo->Get(vtkDataObject::DATA_OBJECT())) {
-    objects->Initialize();
+  for (int port = 1; port < 3; ++port) {
+    if (vtkDataObject *objects =
+            outputVector->GetInformationObject(port)->Get(vtkDataObject::DATA_OBJECT())) {
+      objects->Initialize();
+    }
   }
   this->OutputVector = outputVector;
   this->ObjectsFilled = false;
@@ -271,10 +282,14 @@ int vtkSnowAccumulationFilter::RequestData(vtkInformation *request,
   this->OutputVector = nullptr;
   if (ok && this->ObjectsFilled) {
     vtkDataObject *image = outputVector->GetInformationObject(0)->Get(vtkDataObject::DATA_OBJECT());
-    vtkDataObject *objects = objInfo->Get(vtkDataObject::DATA_OBJECT());
-    if (image->GetInformation()->Has(vtkDataObject::DATA_TIME_STEP())) {
-      objects->GetInformation()->Set(vtkDataObject::DATA_TIME_STEP(),
-                                     image->GetInformation()->Get(vtkDataObject::DATA_TIME_STEP()));
+    for (int port = 1; port < 3; ++port) {
+      vtkDataObject *objects =
+          outputVector->GetInformationObject(port)->Get(vtkDataObject::DATA_OBJECT());
+      if (objects && image->GetInformation()->Has(vtkDataObject::DATA_TIME_STEP())) {
+        objects->GetInformation()->Set(
+            vtkDataObject::DATA_TIME_STEP(),
+            image->GetInformation()->Get(vtkDataObject::DATA_TIME_STEP()));
+      }
     }
   }
   return ok;
@@ -294,7 +309,8 @@ int vtkSnowAccumulationFilter::CheckParameters() {
                 {"Dilation", double(this->Dilation)},
                 {"MaxDepth", this->MaxDepth},
                 {"StabilityFactor", this->StabilityFactor},
-                {"SnowDensity", this->SnowDensity}};
+                {"SnowDensity", this->SnowDensity},
+                {"AccumulationTextureSize", double(this->AccumulationTextureSize)}};
   for (const auto &p : values) {
     const gr_param_bound *b = Bound(p.property);
     if (!b || gr_param_accepts(b, p.value * b->to_core)) {
@@ -367,6 +383,18 @@ int vtkSnowAccumulationFilter::ReadObjects(vtkDataObject *objects) {
       pd->GetPoint(i, p);
       for (int c = 0; c < 3; ++c) {
         o.vertices[3 * static_cast<size_t>(i) + c] = static_cast<float>(p[c] - o.centre[c]);
+      }
+    }
+    // Texture coordinates (the first two components) give the object an
+    // accumulation texture.
+    if (vtkDataArray *tc = pd->GetPointData()->GetTCoords()) {
+      if (tc->GetNumberOfComponents() >= 2 && tc->GetNumberOfTuples() == n) {
+        o.uv.resize(2 * static_cast<size_t>(n));
+        for (vtkIdType i = 0; i < n; ++i) {
+          for (int c = 0; c < 2; ++c) {
+            o.uv[2 * static_cast<size_t>(i) + c] = static_cast<float>(tc->GetComponent(i, c));
+          }
+        }
       }
     }
     // An id out of range becomes -1, which gr_mesh_validate names.
@@ -451,8 +479,16 @@ int vtkSnowAccumulationFilter::SetObjects(double t) {
     m.ntriangles = static_cast<int>(o.triangles.size() / 3);
     this->Pose(k, t, m.transform);
   }
-  const gr_status st =
+  gr_status st =
       gr_snow_accumulation_set_objects(this->Simulation, meshes.data(), static_cast<int>(n));
+  // The same texture again keeps its snow: the core compares.
+  for (size_t k = 0; st == GR_OK && k < n; ++k) {
+    const Object &o = this->Objects[k];
+    const bool textured = !o.uv.empty() && this->AccumulationTextureSize > 0;
+    st = gr_snow_accumulation_set_object_texture(this->Simulation, static_cast<int>(k),
+                                                 textured ? o.uv.data() : nullptr,
+                                                 textured ? this->AccumulationTextureSize : 0);
+  }
   if (st != GR_OK) {
     return this->ReportFailure(st, "Snow Accumulation's Objects",
                                gr_snow_accumulation_last_error(this->Simulation));
@@ -553,6 +589,7 @@ int vtkSnowAccumulationFilter::SetUpState(vtkInformationVector **inputVector) {
   p.max_depth = this->MaxDepth * TableToCore("MaxDepth");
   p.stability_factor = this->StabilityFactor * TableToCore("StabilityFactor");
   p.snow_density = this->SnowDensity * TableToCore("SnowDensity");
+  p.texture_size = this->AccumulationTextureSize;
   if (gr_snow_accumulation_params_validate(&p, msg, sizeof(msg)) != GR_OK) {
     vtkErrorMacro("Snow Accumulation: " << msg);
     return 0;
@@ -779,7 +816,41 @@ int vtkSnowAccumulationFilter::FillOutput(vtkDataObject *outputObject, vtkInform
     if (piece == 0 && !this->FillObjects(objects, this->GetStateTime())) {
       return 0;
     }
+    auto *textures = vtkMultiBlockDataSet::SafeDownCast(
+        this->OutputVector->GetInformationObject(2)->Get(vtkDataObject::DATA_OBJECT()));
+    if (piece == 0 && textures && !this->FillTextures(textures)) {
+      return 0;
+    }
     this->ObjectsFilled = true;
+  }
+  return 1;
+}
+
+int vtkSnowAccumulationFilter::FillTextures(vtkMultiBlockDataSet *output) {
+  const unsigned int n = static_cast<unsigned int>(this->Objects.size());
+  output->SetNumberOfBlocks(n);
+  for (unsigned int k = 0; k < n; ++k) {
+    vtkNew<vtkImageData> image;
+    const Object &o = this->Objects[k];
+    const int size = this->AccumulationTextureSize;
+    if (!o.uv.empty() && size > 0) {
+      // Texel centres in UV units: texel (i, j) at ((i + 0.5) / size, (j + 0.5) / size).
+      image->SetDimensions(size, size, 1);
+      image->SetSpacing(1.0 / size, 1.0 / size, 1.0);
+      image->SetOrigin(0.5 / size, 0.5 / size, 0.0);
+      vtkNew<vtkFloatArray> depth;
+      depth->SetName("snow_depth");
+      depth->SetNumberOfTuples(static_cast<vtkIdType>(size) * size);
+      const gr_status st = gr_snow_accumulation_get_object_texture(
+          this->Simulation, static_cast<int>(k), depth->GetPointer(0), size);
+      if (st != GR_OK) {
+        return this->ReportFailure(st, "Snow Accumulation could not read an accumulation texture",
+                                   gr_snow_accumulation_last_error(this->Simulation));
+      }
+      image->GetPointData()->AddArray(depth);
+      image->GetPointData()->SetActiveScalars("snow_depth");
+    }
+    output->SetBlock(k, image);
   }
   return 1;
 }
@@ -805,6 +876,7 @@ void vtkSnowAccumulationFilter::PrintSelf(ostream &os, vtkIndent indent) {
   os << indent << "MaxDepth: " << this->MaxDepth << " m\n";
   os << indent << "StabilityFactor: " << this->StabilityFactor << " 1/s\n";
   os << indent << "SnowDensity: " << this->SnowDensity << " kg/m^3\n";
+  os << indent << "AccumulationTextureSize: " << this->AccumulationTextureSize << "\n";
   os << indent << "ObjectVelocity: " << this->ObjectVelocity[0] << " " << this->ObjectVelocity[1]
      << " " << this->ObjectVelocity[2] << " m/s\n";
 }

@@ -41,6 +41,16 @@
  * a multiblock of the same structure as the input) with the point arrays
  * `snow_depth` (m, along the point's normal) and `snow_offset` (3
  * components, m: the world normal times the depth, for Warp By Vector).
+ * Output 2, Textures, is a multiblock with one vtkImageData per object:
+ * for an object whose polydata has texture coordinates (its point data's
+ * TCoords), its accumulation texture (the thesis' per-object texture:
+ * AccumulationTextureSize x AccumulationTextureSize texels spanning UV
+ * [0, 1]^2, origin and spacing in UV units, point array `snow_depth` in m,
+ * 0 on texels no triangle covers); an empty image for the others, or for
+ * all with AccumulationTextureSize 0. See
+ * gr_snow_accumulation_set_object_texture: the texels are samples on the
+ * surface stepped like the mesh points, a finer picture of the same snow
+ * kept out of the ledger.
  *
  * Time defaults (SetTimeDefaults): EndTime 6 h (21600 s), OutputInterval
  * 15 min (900 s), in TimeSteps of 5 min: a snowfall of a few hours.
@@ -59,6 +69,7 @@
 
 struct gr_snow_accumulation;
 class vtkDataObject;
+class vtkMultiBlockDataSet;
 
 class GRAUPELFILTERS_EXPORT vtkSnowAccumulationFilter : public vtkGraupelSimulation {
 public:
@@ -149,6 +160,12 @@ public:
   ///@}
 
   ///@{
+  /** Texels across each textured object's accumulation texture (default 256; 0: none). */
+  virtual void SetAccumulationTextureSize(int value);
+  vtkGetMacro(AccumulationTextureSize, int);
+  ///@}
+
+  ///@{
   /** Velocity of the objects that have no time steps, m/s (default 0 0 0). */
   vtkSetVector3Macro(ObjectVelocity, double);
   vtkGetVector3Macro(ObjectVelocity, double);
@@ -195,6 +212,7 @@ protected:
   double MaxDepth = 0.0;
   double StabilityFactor = 0.0;
   double SnowDensity = 0.0;
+  int AccumulationTextureSize = 0;
   double ObjectVelocity[3] = {0.0, 0.0, 0.0};
 
 private:
@@ -205,6 +223,7 @@ private:
   struct Object {
     std::vector<float> vertices;
     std::vector<int> triangles;
+    std::vector<float> uv; // 2 per mesh point, empty without texture coordinates
     double centre[3];
     double velocity[3]; // m/s: the leaf's `velocity`, else ObjectVelocity
   };
@@ -219,6 +238,8 @@ private:
   /** Hands the objects at their poses at time t to the core. */
   int SetObjects(double t);
   int FillObjects(vtkDataObject *output, double t);
+  /** One image per object, its accumulation texture or empty. */
+  int FillTextures(vtkMultiBlockDataSet *output);
 
   gr_snow_accumulation *Simulation = nullptr;
   std::vector<Object> Objects;

@@ -3,7 +3,8 @@
  * tilted snow), growth (rate x t within the noise, the cap MaxDepth x cos
  * of the slope, the thesis' zeroing branch not copied), independence of
  * the number of steps, snow on objects that moves with them, determinism,
- * checkpoints, the parameter table and the error paths. */
+ * checkpoints, accumulation textures, the parameter table and the error
+ * paths. */
 #include "gr_test.h"
 
 #include "graupel/snow_accumulation.h"
@@ -139,11 +140,12 @@ static void plain(gr_snow_accumulation_params *p, double rate, double max_depth)
 static void test_param_table(void) {
   int n = 0;
   const gr_param_bound *t = gr_snow_accumulation_param_bounds(&n);
-  CHECK(n == 11);
-  const char *names[] = {"Flutter",  "SnowfallRate",       "NoiseAmplitude", "NoiseScale",
-                         "Seed",     "ExposureResolution", "BlurRadius",     "Dilation",
-                         "MaxDepth", "StabilityFactor",    "SnowDensity"};
-  for (int r = 0; r < n && r < 11; ++r)
+  CHECK(n == 12);
+  const char *names[] = {"Flutter",         "SnowfallRate", "NoiseAmplitude",
+                         "NoiseScale",      "Seed",         "ExposureResolution",
+                         "BlurRadius",      "Dilation",     "MaxDepth",
+                         "StabilityFactor", "SnowDensity",  "AccumulationTextureSize"};
+  for (int r = 0; r < n && r < 12; ++r)
     CHECK(strcmp(t[r].property, names[r]) == 0);
   gr_snow_accumulation_params p, q;
   gr_snow_accumulation_params_init(&p);
@@ -193,8 +195,11 @@ static void test_param_table(void) {
       case 9:
         q.stability_factor = v;
         break;
-      default:
+      case 10:
         q.snow_density = v;
+        break;
+      default:
+        q.texture_size = (int)v;
       }
       msg[0] = 0;
       gr_status st = gr_snow_accumulation_params_validate(&q, msg, sizeof(msg));
@@ -859,6 +864,188 @@ static void test_memcheck(void) {
   CHECK(strcmp(gr_snow_accumulation_last_error(NULL), "") == 0);
 }
 
+/* A flat 2 x 2 m quad at z = 0.5 (4 points, 2 triangles) whose UVs span
+ * [0.125, 0.875]^2 of a 16 x 16 texture. */
+static void mesh_quad(test_mesh *tm, float *uv) {
+  static const float v[] = {-1, -1, 0, 1, -1, 0, 1, 1, 0, -1, 1, 0};
+  static const int tri[] = {0, 1, 2, 0, 2, 3};
+  tm->v = malloc(sizeof(v));
+  tm->t = malloc(sizeof(tri));
+  memcpy(tm->v, v, sizeof(v));
+  memcpy(tm->t, tri, sizeof(tri));
+  tm->m.vertices = tm->v;
+  tm->m.nvertices = 4;
+  tm->m.triangles = tm->t;
+  tm->m.ntriangles = 2;
+  mesh_pose(tm, 2.0, 2.0, 0.5);
+  for (int k = 0; k < 4; ++k) {
+    uv[2 * k] = v[3 * k] > 0 ? 0.875f : 0.125f;
+    uv[2 * k + 1] = v[3 * k + 1] > 0 ? 0.875f : 0.125f;
+  }
+}
+
+static float *get_texture(gr_snow_accumulation *s, int o, int size) {
+  float *a = malloc((size_t)size * size * sizeof(float));
+  gr_status st = gr_snow_accumulation_get_object_texture(s, o, a, size);
+  CHECK_MSG(st == GR_OK, "get_object_texture: %s", gr_snow_accumulation_last_error(s));
+  return a;
+}
+
+/* Accumulation textures: on a flat quad under vertical snow every covered
+ * texel grows rate x t (exactly without noise, within the noise amplitude
+ * with it), the rest stay 0, the texel at a mesh point's UV matches its
+ * snow, the texture moves with the quad, stays out of the ledger and
+ * survives a checkpoint; a box's top under a lid stays 0 in its texture. */
+static void test_textures(void) {
+  const int R = 16;
+  for (int noisy = 0; noisy < 2; ++noisy) {
+    gr_snow_accumulation_params p;
+    plain(&p, 1e-4, 1.0);
+    p.noise_amplitude = noisy ? 0.2 : 0.0;
+    p.noise_scale = 0.25;
+    gr_snow_accumulation *s = make_sim(40, 40, 0.1, &p);
+    if (!s)
+      return;
+    test_mesh q;
+    float uv[8];
+    mesh_quad(&q, uv);
+    CHECK(gr_snow_accumulation_set_objects(s, &q.m, 1) == GR_OK);
+    gr_snow_accumulation_ledger l0, l1;
+    run(s, 5, 100.0);
+    CHECK(gr_snow_accumulation_ledger_get(s, &l0) == GR_OK);
+    CHECK(gr_snow_accumulation_set_object_texture(s, 0, uv, R) == GR_OK);
+    run(s, 5, 100.0); /* the texture from now on: 0.05 m */
+    CHECK(gr_snow_accumulation_ledger_get(s, &l1) == GR_OK);
+    float *t = get_texture(s, 0, R), *od = get_object(s, 0, GR_FIELD_SNOW_DEPTH, 4);
+    int covered = 0, outside_bare = 0;
+    double lo = 1e9, hi = -1e9;
+    for (int j = 0; j < R; ++j)
+      for (int i = 0; i < R; ++i) {
+        int in = i >= 2 && i <= 13 && j >= 2 && j <= 13;
+        float v = t[j * R + i];
+        if (in)
+          covered++, lo = fmin(lo, v), hi = fmax(hi, v);
+        else
+          outside_bare += v == 0.0f;
+      }
+    printf("textures (noise %.1f): %d covered texels %.6f to %.6f m (rate t = 0.05), %d of %d "
+           "outside at 0; mesh points %.6f m\n",
+           p.noise_amplitude, covered, lo, hi, outside_bare, R * R - covered, od[0]);
+    CHECK(outside_bare == R * R - covered);
+    if (!noisy) {
+      CHECK(fabs(lo - 0.05) <= 1e-6 && fabs(hi - 0.05) <= 1e-6);
+      /* The texel nearest each corner's UV: the corner's snow less the 5
+       * steps before the texture, as uniform exposure gives. */
+      int corner[4] = {2 * R + 2, 2 * R + 13, 13 * R + 13, 13 * R + 2};
+      for (int k = 0; k < 4; ++k)
+        CHECK_NEAR(t[corner[k]], od[k] - 0.05, 1e-6);
+      /* Out of the ledger: the objects' stored volume is the mesh points'
+       * (2 x 2 m at 0.1 m) and the books balance. */
+      CHECK_NEAR(l1.stored_volume_objects, 0.4, 1e-5);
+      CHECK(fabs(l1.balance_error) <= 1e-6 * l1.snowfall_volume);
+    } else {
+      CHECK(lo >= 0.8 * 0.05 - 1e-7 && hi <= 1.2 * 0.05 + 1e-7);
+      CHECK(hi - lo > 0.2 * 0.2 * 0.05); /* the noise is there, per texel */
+    }
+    /* Moved (the same mesh at a new pose), and the same texture again: it
+     * keeps its snow. */
+    mesh_pose(&q, 2.5, 2.0, 0.5);
+    CHECK(gr_snow_accumulation_set_objects(s, &q.m, 1) == GR_OK);
+    CHECK(gr_snow_accumulation_set_object_texture(s, 0, uv, R) == GR_OK);
+    float *t2 = get_texture(s, 0, R);
+    CHECK(memcmp(t, t2, (size_t)R * R * sizeof(float)) == 0);
+    /* A checkpoint holds it: 3 steps from the saved state twice agree. */
+    size_t bytes = 0;
+    CHECK(gr_snow_accumulation_state_size(s, &bytes) == GR_OK);
+    void *buf = malloc(bytes);
+    CHECK(gr_snow_accumulation_state_save(s, buf, bytes) == GR_OK);
+    run(s, 3, 100.0);
+    float *a = get_texture(s, 0, R);
+    CHECK(gr_snow_accumulation_state_load(s, buf, bytes) == GR_OK);
+    float *b = get_texture(s, 0, R);
+    CHECK(memcmp(b, t2, (size_t)R * R * sizeof(float)) == 0);
+    run(s, 3, 100.0);
+    free(b);
+    b = get_texture(s, 0, R);
+    CHECK(memcmp(a, b, (size_t)R * R * sizeof(float)) == 0);
+    if (!noisy)
+      CHECK_NEAR(a[5 * R + 5], 0.08, 1e-6);
+    /* Reset clears it; size 0 removes it. */
+    CHECK(gr_snow_accumulation_reset(s) == GR_OK);
+    free(b);
+    b = get_texture(s, 0, R);
+    float bmax = 0.0f;
+    for (int k = 0; k < R * R; ++k)
+      bmax = fmaxf(bmax, b[k]);
+    CHECK(bmax == 0.0f);
+    CHECK(gr_snow_accumulation_set_object_texture(s, 0, NULL, 0) == GR_OK);
+    CHECK(gr_snow_accumulation_get_object_texture(s, 0, b, R) == GR_ERR_INVALID_ARGUMENT);
+    CHECK(strstr(gr_snow_accumulation_last_error(s), "no texture") != NULL);
+    /* Bad input: a size beyond the row, a NaN coordinate, no object. */
+    CHECK(gr_snow_accumulation_set_object_texture(s, 0, uv, 5000) == GR_ERR_INVALID_ARGUMENT);
+    CHECK(strstr(gr_snow_accumulation_last_error(s), "AccumulationTextureSize") != NULL);
+    uv[3] = NAN;
+    CHECK(gr_snow_accumulation_set_object_texture(s, 0, uv, R) == GR_ERR_INVALID_ARGUMENT);
+    CHECK(strstr(gr_snow_accumulation_last_error(s), "finite") != NULL);
+    CHECK(gr_snow_accumulation_set_object_texture(s, 1, uv, R) == GR_ERR_INVALID_ARGUMENT);
+    CHECK(gr_snow_accumulation_set_object_texture(NULL, 0, uv, R) == GR_ERR_INVALID_ARGUMENT);
+    free(t), free(t2), free(od), free(a), free(b), free(buf);
+    mesh_free(&q);
+    gr_snow_accumulation_destroy(s);
+  }
+
+  /* A box (its top the first 25 points, 4 x 4 cells) under a lid, and the
+   * same box in the open: top in UV [0, 0.5]^2, bottom [0.5, 1] x [0, 0.5],
+   * the sides in columns of [0, 1] x [0.5, 1]. */
+  for (int covered_box = 0; covered_box < 2; ++covered_box) {
+    gr_snow_accumulation_params p;
+    plain(&p, 1e-4, 1.0);
+    gr_snow_accumulation *s = make_sim(40, 40, 0.1, &p);
+    if (!s)
+      return;
+    test_mesh m[2];
+    mesh_faces(&m[0], 0.4, 0.4, 0.3, 4);
+    mesh_pose(&m[0], 2.0, 2.0, 0.35);
+    mesh_faces(&m[1], 1.0, 1.0, 0.1, 4);
+    mesh_pose(&m[1], 2.0, 2.0, 1.0);
+    int nv = m[0].m.nvertices, per = 25;
+    float *uv = malloc((size_t)nv * 2 * sizeof(float));
+    for (int f = 0; f < 6; ++f)
+      for (int k = 0; k < per; ++k) {
+        float a = (float)(k % 5) / 4.0f, b = (float)(k / 5) / 4.0f;
+        float *u = uv + 2 * (f * per + k);
+        if (f < 2)
+          u[0] = 0.5f * f + 0.5f * a, u[1] = 0.5f * b;
+        else
+          u[0] = 0.25f * (f - 2) + 0.25f * a, u[1] = 0.5f + 0.5f * b;
+      }
+    gr_mesh ms[2] = {m[0].m, m[1].m};
+    CHECK(gr_snow_accumulation_set_objects(s, ms, covered_box ? 2 : 1) == GR_OK);
+    CHECK(gr_snow_accumulation_set_object_texture(s, 0, uv, R) == GR_OK);
+    run(s, 10, 100.0);
+    float *t = get_texture(s, 0, R);
+    double top_lo = 1e9, top_hi = -1e9, side_max = 0.0;
+    for (int j = 0; j < R; ++j)
+      for (int i = 0; i < R; ++i) {
+        float v = t[j * R + i];
+        if (i < R / 2 && j < R / 2)
+          top_lo = fmin(top_lo, v), top_hi = fmax(top_hi, v);
+        else if (j >= R / 2)
+          side_max = fmax(side_max, v);
+      }
+    printf("textured box %s: top texels %.6f to %.6f m, sides at most %.3g m\n",
+           covered_box ? "under a lid" : "in the open", top_lo, top_hi, side_max);
+    if (covered_box)
+      CHECK(top_lo == 0.0 && top_hi == 0.0);
+    else
+      CHECK(fabs(top_lo - 0.1) <= 1e-6 && fabs(top_hi - 0.1) <= 1e-6);
+    CHECK(side_max <= 1e-9);
+    free(t), free(uv);
+    mesh_free(&m[0]), mesh_free(&m[1]);
+    gr_snow_accumulation_destroy(s);
+  }
+}
+
 static const gr_subtest tests[] = {
     {"param_table", test_param_table, 0},
     {"flat_growth", test_flat_growth, 0},
@@ -872,6 +1059,7 @@ static const gr_subtest tests[] = {
     {"devices_agree", test_devices_agree, 0},
     {"checkpoint", test_checkpoint, 0},
     {"persistence", test_persistence, 0},
+    {"textures", test_textures, 0},
     {"errors", test_errors, 0},
     {"memcheck", test_memcheck, 1},
 };

@@ -61,7 +61,9 @@ static int params_documented(const gr_snow_accumulation_params *p) {
          in_row("ExposureResolution", (double)p->exposure_resolution) &&
          in_row("BlurRadius", (double)p->blur_radius) && in_row("Dilation", (double)p->dilation) &&
          in_row("MaxDepth", p->max_depth) && in_row("StabilityFactor", p->stability_factor) &&
-         in_row("SnowDensity", p->snow_density) && direction_documented(p->direction);
+         in_row("SnowDensity", p->snow_density) &&
+         in_row("AccumulationTextureSize", (double)p->texture_size) &&
+         direction_documented(p->direction);
 }
 
 static int field_documented(gr_field f, const float *v, size_t n) {
@@ -89,7 +91,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
   const gr_field f = (gr_field)(take_byte(&r) % (GR_FIELD_COUNT + 1));
   const size_t nx = take_byte(&r) % 17;
   double *d[10];
-  int *in[4];
+  int *in[5];
 
   memset(&p, 0, sizeof p);
   d[0] = &p.direction[0];
@@ -106,13 +108,14 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
   in[1] = &p.exposure_resolution;
   in[2] = &p.blur_radius;
   in[3] = &p.dilation;
+  in[4] = &p.texture_size;
   for (int k = 0; k < 10; ++k) {
     if (mode == 0)
       take(&r, d[k], sizeof(double));
     else
       *d[k] = edge_double(take_byte(&r));
   }
-  for (int k = 0; k < 4; ++k) {
+  for (int k = 0; k < 5; ++k) {
     if (mode == 0) {
       take(&r, in[k], sizeof(int));
     } else {

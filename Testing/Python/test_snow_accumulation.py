@@ -7,6 +7,8 @@ and rough terrain, the lee-side bare patch behind a wall under wind, the same
 snow whatever the OutputInterval and TimeStep, results bit-identical whatever
 the order of requested times, a moving object carrying its snow, chaining into
 Snow Deformation (its mass ledger starts from this filter's snow mass), the
+accumulation textures of textured objects (port 2: rate x t in the open, 0
+under a lid, the ledger untouched), the
 defaults (and, under pvpython, the proxy's), and bad input (no or NaN
 elevation, a degenerate direction, objects that are not polydata, an
 ExposureResolution beyond the device): one sentence, empty outputs, and the
@@ -146,8 +148,9 @@ T.check(f.GetSnowDirection() == (0.0, 0.0, -1.0) and f.GetTimeStep() == 300.0,
         % (f.GetSnowDirection(), f.GetTimeStep()))
 T.check((f.GetSnowfallRate(), f.GetSnowDensity(), f.GetMaxDepth(), f.GetStabilityFactor(),
          f.GetExposureResolution(), f.GetBlurRadius(), f.GetDilation())
-        == (2.0, 100.0, 1.0, 1.0, 1024, 1, 0),
-        "defaults 2 cm/h, 100 kg/m^3, MaxDepth 1 m, factor 1, 1024 texels, blur 1, no dilation")
+        == (2.0, 100.0, 1.0, 1.0, 1024, 1, 0) and f.GetAccumulationTextureSize() == 256,
+        "defaults 2 cm/h, 100 kg/m^3, MaxDepth 1 m, factor 1, 1024 texels, blur 1, no dilation, "
+        "256-texel accumulation textures")
 T.check((f.GetEndTime(), f.GetOutputInterval()) == (6 * HOUR, 900.0)
         and (f.GetDefaultEndTime(), f.GetDefaultOutputInterval()) == (6 * HOUR, 900.0),
         "time defaults EndTime 6 h, OutputInterval 15 min: %r"
@@ -175,7 +178,8 @@ if plugin is not None:
     T.check((sa.EndTime, sa.OutputInterval, sa.TimeStep) == (6 * HOUR, 900.0, 300.0)
             and list(sa.SnowDirection) == [0.0, 0.0, -1.0] and sa.SnowfallRate == 2.0,
             "proxy defaults are the class's: %r" % ((sa.EndTime, sa.OutputInterval, sa.TimeStep),))
-    T.check(sa.ListProperties().count("Device") == 1 and "ExposureResolution" in sa.ListProperties(),
+    T.check(sa.ListProperties().count("Device") == 1 and "ExposureResolution" in sa.ListProperties()
+            and sa.AccumulationTextureSize == 256,
             "proxy properties keep their names (no units in labels): %r" % sa.ListProperties())
 
 # ---- a box on flat ground: nothing under it, a cap on top, the ledger ---------------
@@ -449,6 +453,81 @@ print("chaining: accumulated %.6f kg, Snow Deformation's initial mass %.6f kg"
 T.check(mass > 0 and abs(field(dout, "initial_mass") - mass) <= 1e-5 * mass,
         "its mass ledger starts from the accumulation's %g kg: %r" % (mass, field(dout, "initial_mass")))
 
+# ---- accumulation textures: port 2, one image per object ------------------------------
+from vtkmodules.vtkFiltersCore import vtkTriangleFilter  # noqa: E402
+from vtkmodules.vtkFiltersSources import vtkPlaneSource  # noqa: E402
+
+
+def plane(origin, p1, p2, res=4):
+    ps = vtkPlaneSource()
+    ps.SetOrigin(*origin)
+    ps.SetPoint1(*p1)
+    ps.SetPoint2(*p2)
+    ps.SetResolution(res, res)
+    tf = vtkTriangleFilter()
+    tf.SetInputConnection(ps.GetOutputPort())
+    tf.Update()
+    out = vtkPolyData()
+    out.DeepCopy(tf.GetOutput())
+    return out
+
+
+# A textured plane at z = 0.5 (x, y 1 to 5 m, u along x), its half x > 3 m
+# under a lid; the lid has no texture coordinates.
+R = 32
+lid = box((3.0, 6.0, 0.0, 6.0, 1.5, 1.7))
+lid.GetPointData().SetTCoords(None)
+sheet = plane((1.0, 1.0, 0.5), (5.0, 1.0, 0.5), (1.0, 5.0, 0.5))
+T.check(sheet.GetPointData().GetTCoords() is not None, "vtkPlaneSource gives texture coordinates")
+tx = snow(blocks(sheet, lid), NoiseAmplitude=0.0, AccumulationTextureSize=R)
+d_tx, out_tx = at(tx, 2 * HOUR)
+texs = tx.GetOutputDataObject(2)
+T.check(texs is not None and texs.IsA("vtkMultiBlockDataSet") and texs.GetNumberOfBlocks() == 2,
+        "port 2: a multiblock with one image per object")
+img = texs.GetBlock(0)
+T.check(img.IsA("vtkImageData") and img.GetDimensions() == (R, R, 1)
+        and texs.GetBlock(1).GetNumberOfPoints() == 0,
+        "the plane's texture is %d x %d, the lid without UVs has an empty image: %r, %d"
+        % (R, R, img.GetDimensions(), texs.GetBlock(1).GetNumberOfPoints()))
+tex = vtk_to_numpy(img.GetPointData().GetArray("snow_depth")).reshape(R, R)
+u = (np.arange(R) + 0.5) / R
+x_of = 1.0 + 4.0 * u  # the plane's x at each texel column
+open_cols, lid_cols = x_of < 2.8, x_of > 3.2
+want = RATE * 0.01 * 2.0
+print("textures: open texels %.6f..%.6f m (want %g), under the lid at most %g m"
+      % (tex[:, open_cols].min(), tex[:, open_cols].max(), want, tex[:, lid_cols].max()))
+T.check(np.allclose(tex[:, open_cols], want, rtol=1e-5),
+        "open texels grow as rate x t: %g..%g m, want %g"
+        % (tex[:, open_cols].min(), tex[:, open_cols].max(), want))
+T.check(lid_cols.sum() >= 10 and np.all(tex[:, lid_cols] == 0.0),
+        "texels under the lid stay exactly 0 (max %g m)" % tex[:, lid_cols].max())
+# The texture is a finer picture of the same snow: the plane's points agree
+# where they are open, and the ledger is that of the run without textures.
+sheet_out = tx.GetOutputDataObject(1).GetBlock(0)
+pd_depth = vtk_to_numpy(sheet_out.GetPointData().GetArray("snow_depth"))
+px = vtk_to_numpy(sheet_out.GetPoints().GetData())[:, 0]
+T.check(np.allclose(pd_depth[px < 2.8], want, rtol=1e-5) and np.all(pd_depth[px > 3.2] == 0.0),
+        "the plane's points: %g m in the open, 0 under the lid" % want)
+nt = snow(blocks(sheet, lid), NoiseAmplitude=0.0, AccumulationTextureSize=0)
+d_nt, out_nt = at(nt, 2 * HOUR)
+nt_texs = nt.GetOutputDataObject(2)
+T.check(nt_texs.GetNumberOfBlocks() == 2 and nt_texs.GetBlock(0).GetNumberOfPoints() == 0,
+        "AccumulationTextureSize 0: empty images")
+T.check(np.array_equal(d_tx, d_nt)
+        and field(out_tx, "stored_volume_objects") == field(out_nt, "stored_volume_objects")
+        and abs(field(out_tx, "balance_error")) <= 1e-6 * field(out_tx, "snowfall_volume"),
+        "textures leave the terrain and the ledger as they are: %r vs %r"
+        % (field(out_tx, "stored_volume_objects"), field(out_nt, "stored_volume_objects")))
+# A single textured polydata (not a multiblock) and times requested out of
+# order: the texture at 1 h is half of that at 2 h.
+single = snow(sheet, NoiseAmplitude=0.0, AccumulationTextureSize=16)
+at(single, 2 * HOUR)
+at(single, HOUR)
+t1 = vtk_to_numpy(single.GetOutputDataObject(2).GetBlock(0).GetPointData()
+                  .GetArray("snow_depth")).copy()
+T.check(t1.size == 256 and np.allclose(t1, want / 2, rtol=1e-5),
+        "a single polydata at 1 h: 16 x 16 texels of %g m (%g..%g)" % (want / 2, t1.min(), t1.max()))
+
 # ---- bad input: one sentence, empty outputs, the next good update works ------------
 nan_ground = np.zeros((N, N))
 nan_ground[5, 7] = np.nan
@@ -476,7 +555,8 @@ for what, case, words in cases:
     objects_out = g.GetOutputDataObject(1)
     T.check(s is None and (objects_out.GetNumberOfPoints() == 0
                            if objects_out.IsA("vtkPolyData") else
-                           objects_out.GetNumberOfBlocks() == 0),
+                           objects_out.GetNumberOfBlocks() == 0)
+            and g.GetOutputDataObject(2).GetNumberOfBlocks() == 0,
             "%s: empty outputs" % what)
     T.check(len(errs.messages) == 1 and all(w in errs.text() for w in words),
             "%s: one sentence naming %r: %r" % (what, words, errs.text()[:300]))

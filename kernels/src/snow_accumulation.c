@@ -22,10 +22,12 @@
 #define GR_SNAC_PI 3.14159265358979323846
 /* Checkpoints: "GSA1". */
 #define GR_SNAC_STATE_MAGIC 0x31415347u
-#define GR_SNAC_STATE_VERSION 1u
+#define GR_SNAC_STATE_VERSION 2u
 /* Per-point arrays of the state: depth, its low part, fallen and shed
  * snow (pairs) and the exposure. */
 #define GR_SNAC_ARRAYS 7
+/* The largest accumulation texture, texels across. */
+#define GR_SNAC_MAX_TEXTURE 4096
 /* The step waits for the device every this many steps, so that a long
  * loop of steps does not queue without bound. */
 #define GR_SNAC_SYNC_EVERY 8
@@ -42,6 +44,7 @@ enum {
   GR_SNAC_P_MAX_DEPTH,
   GR_SNAC_P_STABILITY,
   GR_SNAC_P_DENSITY,
+  GR_SNAC_P_TEXTURE,
   GR_SNAC_P_COUNT
 };
 
@@ -60,6 +63,7 @@ static const gr_param_bound gr_snac_bounds[GR_SNAC_P_COUNT] = {
     {"MaxDepth", "m", 0.0, 100.0, 1.0, 1.0, 1, 0},
     {"StabilityFactor", "1/s", 0.0, 1.0, 1.0, 1.0, 0, 0},
     {"SnowDensity", "kg/m^3", 1.0, 1000.0, 100.0, 1.0, 0, 0},
+    {"AccumulationTextureSize", "", 0.0, (double)GR_SNAC_MAX_TEXTURE, 256.0, 1.0, 0, 1},
 };
 
 struct gr_snow_accumulation {
@@ -83,6 +87,18 @@ struct gr_snow_accumulation {
   int nobjects, nv, ntri;
   int first[GR_SNOW_ACCUMULATION_MAX_OBJECTS + 1], nverts[GR_SNOW_ACCUMULATION_MAX_OBJECTS];
   cl_mem o_tri, o_pos, o_nrm, o_local, o_area, o_arr[GR_SNAC_ARRAYS];
+  /* Accumulation textures: per object its size (0: none) and UVs, its
+   * samples (first .. first + count - 1 of the sample arrays) and per
+   * sample its texel, triangle and barycentric weights; the samples'
+   * world positions (absolute) and the device arrays, like the mesh
+   * points'. hlocal: the mesh points in their objects' frames. */
+  int tsize[GR_SNOW_ACCUMULATION_MAX_OBJECTS], tfirst[GR_SNOW_ACCUMULATION_MAX_OBJECTS + 1];
+  int trifirst[GR_SNOW_ACCUMULATION_MAX_OBJECTS + 1];
+  float *tuv[GR_SNOW_ACCUMULATION_MAX_OBJECTS];
+  int ns, tobjects, *stexel, *stri;
+  float *sbar, *hlocal;
+  double *sv;
+  cl_mem t_pos, t_nrm, t_local, t_arr[GR_SNAC_ARRAYS];
   double *hv;                /* world vertices, 3 per mesh point, absolute */
   int *ht;                   /* triangles, indices into hv */
   float *hnrm;               /* world normals, 3 per mesh point */
@@ -149,6 +165,7 @@ void gr_snow_accumulation_params_init(gr_snow_accumulation_params *p) {
   p->max_depth = t[GR_SNAC_P_MAX_DEPTH].default_value;
   p->stability_factor = t[GR_SNAC_P_STABILITY].default_value;
   p->snow_density = t[GR_SNAC_P_DENSITY].default_value;
+  p->texture_size = (int)t[GR_SNAC_P_TEXTURE].default_value;
 }
 
 static double gr_snac_param_value(const gr_snow_accumulation_params *p, int row) {
@@ -173,8 +190,10 @@ static double gr_snac_param_value(const gr_snow_accumulation_params *p, int row)
     return p->max_depth;
   case GR_SNAC_P_STABILITY:
     return p->stability_factor;
-  default:
+  case GR_SNAC_P_DENSITY:
     return p->snow_density;
+  default:
+    return (double)p->texture_size;
   }
 }
 
@@ -390,6 +409,8 @@ static gr_status gr_snac_initial_state(gr_snow_accumulation *s) {
     st = gr_snac_fill(s, s->arr[a], cells, 0.0f);
   for (int a = 0; st == GR_OK && a < GR_SNAC_ARRAYS && s->nv > 0; ++a)
     st = gr_snac_fill(s, s->o_arr[a], (size_t)s->nv, 0.0f);
+  for (int a = 0; st == GR_OK && a < GR_SNAC_ARRAYS && s->ns > 0; ++a)
+    st = gr_snac_fill(s, s->t_arr[a], (size_t)s->ns, 0.0f);
   s->time = s->retired_fall = s->retired_shed = s->dropped = 0.0;
   s->steps = 0;
   s->aborted = 0;
@@ -481,6 +502,8 @@ gr_status gr_snow_accumulation_create(gr_context *ctx, const gr_grid *grid,
   return GR_OK;
 }
 
+static void gr_snac_release_textures(cl_mem *pos, cl_mem *nrm, cl_mem *local, cl_mem *arr);
+
 static void gr_snac_release_objects(gr_snow_accumulation *s) {
   cl_mem *bufs[] = {&s->o_tri, &s->o_pos, &s->o_nrm, &s->o_local, &s->o_area};
   for (size_t i = 0; i < sizeof(bufs) / sizeof(bufs[0]); ++i)
@@ -505,6 +528,10 @@ void gr_snow_accumulation_destroy(gr_snow_accumulation *s) {
   for (int a = 0; a < GR_SNAC_ARRAYS; ++a)
     gr_buffer_release(&s->arr[a]);
   gr_snac_release_objects(s);
+  gr_snac_release_textures(&s->t_pos, &s->t_nrm, &s->t_local, s->t_arr);
+  for (int o = 0; o < GR_SNOW_ACCUMULATION_MAX_OBJECTS; ++o)
+    free(s->tuv[o]);
+  free(s->sv), free(s->stexel), free(s->stri), free(s->sbar), free(s->hlocal);
   gr_reduction_release(&s->red);
   gr_reduction_release(&s->red_slope);
   free(s->hv);
@@ -551,6 +578,17 @@ static gr_status gr_snac_upload_geometry(gr_snow_accumulation *s) {
   if (st == GR_OK && nt)
     st = gr_buffer_write(s->ctx, s->o_tri, 0, nt * 9 * sizeof(float), tri);
   free(pos), free(tri);
+  if (st != GR_OK || s->ns == 0)
+    return st;
+  size_t ns = (size_t)s->ns;
+  float *sp = malloc(ns * 3 * sizeof(float));
+  if (!sp)
+    return gr_set_error(s->ctx, GR_ERR_OUT_OF_MEMORY, "Out of host memory.");
+  for (size_t k = 0; k < ns; ++k)
+    for (int a = 0; a < 3; ++a)
+      sp[3 * k + a] = (float)(s->sv[3 * k + a] - off[a]);
+  st = gr_buffer_write(s->ctx, s->t_pos, 0, ns * 3 * sizeof(float), sp);
+  free(sp);
   return st;
 }
 
@@ -613,12 +651,12 @@ gr_status gr_snow_accumulation_set_field(gr_snow_accumulation *s, gr_field f, co
 typedef struct gr_snac_geometry {
   double *hv;
   int *ht;
-  float *nrm, *local, *area;
+  float *nrm, *local, *area, *hlocal;
   double lo[3], hi[3];
 } gr_snac_geometry;
 
 static void gr_snac_geometry_free(gr_snac_geometry *g) {
-  free(g->hv), free(g->ht), free(g->nrm), free(g->local), free(g->area);
+  free(g->hv), free(g->ht), free(g->nrm), free(g->local), free(g->area), free(g->hlocal);
 }
 
 static gr_status gr_snac_build_geometry(gr_snow_accumulation *s, const gr_mesh *meshes, int n,
@@ -629,8 +667,9 @@ static gr_status gr_snac_build_geometry(gr_snow_accumulation *s, const gr_mesh *
   g->nrm = calloc(V * 3, sizeof(float));
   g->local = malloc(V * 3 * sizeof(float));
   g->area = calloc(V, sizeof(float));
+  g->hlocal = malloc(V * 3 * sizeof(float));
   double *acc = calloc(V * 3, sizeof(double)), *area = calloc(V, sizeof(double));
-  if (!g->hv || !g->ht || !g->nrm || !g->local || !g->area || !acc || !area) {
+  if (!g->hv || !g->ht || !g->nrm || !g->local || !g->area || !g->hlocal || !acc || !area) {
     free(acc), free(area);
     return gr_set_error(s->ctx, GR_ERR_OUT_OF_MEMORY, "Out of host memory.");
   }
@@ -644,6 +683,7 @@ static gr_status gr_snac_build_geometry(gr_snow_accumulation *s, const gr_mesh *
     for (int v = 0; v < m->nvertices; ++v) {
       const float *p = m->vertices + 3 * v;
       size_t k = (size_t)(first[o] + v);
+      memcpy(g->hlocal + 3 * k, p, 3 * sizeof(float));
       for (int a = 0; a < 3; ++a) {
         double w = T4[a] * p[0] + T4[4 + a] * p[1] + T4[8 + a] * p[2] + T4[12 + a];
         g->hv[3 * k + a] = w;
@@ -692,6 +732,199 @@ static gr_status gr_snac_build_geometry(gr_snow_accumulation *s, const gr_mesh *
   return GR_OK;
 }
 
+/* ------------------------------------------------- accumulation textures */
+
+static void gr_snac_release_textures(cl_mem *pos, cl_mem *nrm, cl_mem *local, cl_mem *arr) {
+  gr_buffer_release(pos);
+  gr_buffer_release(nrm);
+  gr_buffer_release(local);
+  for (int a = 0; a < GR_SNAC_ARRAYS; ++a)
+    gr_buffer_release(&arr[a]);
+}
+
+/* The samples being built: per sample its texel, triangle and barycentric
+ * weights. */
+typedef struct gr_snac_samples {
+  size_t n, cap;
+  int *texel, *tri;
+  float *bar;
+} gr_snac_samples;
+
+static int gr_snac_push(gr_snac_samples *q, int texel, int tri, double l0, double l1, double l2) {
+  if (q->n == q->cap) {
+    size_t cap = q->cap ? 2 * q->cap : 1024;
+    int *a = realloc(q->texel, cap * sizeof(int));
+    if (a)
+      q->texel = a;
+    int *b = a ? realloc(q->tri, cap * sizeof(int)) : NULL;
+    if (b)
+      q->tri = b;
+    float *c = b ? realloc(q->bar, cap * 3 * sizeof(float)) : NULL;
+    if (!c)
+      return 0;
+    q->bar = c;
+    q->cap = cap;
+  }
+  q->texel[q->n] = texel;
+  q->tri[q->n] = tri;
+  q->bar[3 * q->n] = (float)l0, q->bar[3 * q->n + 1] = (float)l1, q->bar[3 * q->n + 2] = (float)l2;
+  q->n++;
+  return 1;
+}
+
+/* Object o's samples: one per texel whose centre falls in one of its
+ * triangles' UV triangles (the first such triangle; texels on no triangle
+ * get none). */
+static int gr_snac_object_samples(const gr_snow_accumulation *s, int o, gr_snac_samples *q) {
+  int R = s->tsize[o];
+  unsigned char *cov = calloc((size_t)R * (size_t)R, 1);
+  if (!cov)
+    return 0;
+  const float *uv = s->tuv[o];
+  const double eps = 1e-9;
+  for (int t = s->trifirst[o]; t < s->trifirst[o + 1]; ++t) {
+    const float *a = uv + 2 * (size_t)(s->ht[3 * t] - s->first[o]),
+                *b = uv + 2 * (size_t)(s->ht[3 * t + 1] - s->first[o]),
+                *c = uv + 2 * (size_t)(s->ht[3 * t + 2] - s->first[o]);
+    double e1u = (double)b[0] - a[0], e1v = (double)b[1] - a[1];
+    double e2u = (double)c[0] - a[0], e2v = (double)c[1] - a[1];
+    double det = e1u * e2v - e1v * e2u;
+    if (fabs(det) < 1e-20)
+      continue;
+    double umin = fmin(a[0], fmin(b[0], c[0])), umax = fmax(a[0], fmax(b[0], c[0]));
+    double vmin = fmin(a[1], fmin(b[1], c[1])), vmax = fmax(a[1], fmax(b[1], c[1]));
+    int i0 = (int)fmax(0.0, ceil(umin * R - 0.5)), i1 = (int)fmin(R - 1.0, floor(umax * R - 0.5));
+    int j0 = (int)fmax(0.0, ceil(vmin * R - 0.5)), j1 = (int)fmin(R - 1.0, floor(vmax * R - 0.5));
+    for (int j = j0; j <= j1; ++j)
+      for (int i = i0; i <= i1; ++i) {
+        int texel = j * R + i;
+        if (cov[texel])
+          continue;
+        double du = (i + 0.5) / R - a[0], dv = (j + 0.5) / R - a[1];
+        double l1 = (du * e2v - dv * e2u) / det, l2 = (e1u * dv - e1v * du) / det;
+        double l0 = 1.0 - l1 - l2;
+        if (l0 < -eps || l1 < -eps || l2 < -eps)
+          continue;
+        cov[texel] = 1;
+        if (!gr_snac_push(q, texel, t, l0, l1, l2)) {
+          free(cov);
+          return 0;
+        }
+      }
+  }
+  free(cov);
+  return 1;
+}
+
+/* Rebuilds the samples of every textured object from the objects set now;
+ * object o's samples keep their snow when kept[o] and it has as many as
+ * before, else start at 0. All or nothing: a failure leaves the textures
+ * as they were. The positions go up with gr_snac_upload_geometry. */
+static gr_status gr_snac_textures(gr_snow_accumulation *s, const unsigned char *kept) {
+  gr_snac_samples q;
+  memset(&q, 0, sizeof(q));
+  int tfirst[GR_SNOW_ACCUMULATION_MAX_OBJECTS + 1];
+  for (int o = 0; o < s->nobjects; ++o) {
+    tfirst[o] = (int)q.n;
+    if (s->tsize[o] > 0 && !gr_snac_object_samples(s, o, &q)) {
+      free(q.texel), free(q.tri), free(q.bar);
+      return gr_set_error(s->ctx, GR_ERR_OUT_OF_MEMORY, "Out of host memory.");
+    }
+    if (q.n > (size_t)(INT_MAX / 4)) {
+      free(q.texel), free(q.tri), free(q.bar);
+      return gr_set_error(s->ctx, GR_ERR_TOO_LARGE,
+                          "The accumulation textures have more than %d covered texels, more "
+                          "than the core addresses; lower AccumulationTextureSize.",
+                          INT_MAX / 4);
+    }
+  }
+  tfirst[s->nobjects] = (int)q.n;
+  size_t ns = q.n, S = ns ? ns : 1;
+  double *sv = malloc(S * 3 * sizeof(double));
+  float *nrm = calloc(S * 3, sizeof(float)), *lat = malloc(S * 3 * sizeof(float));
+  gr_status st = GR_OK;
+  if (!sv || !nrm || !lat)
+    st = gr_set_error(s->ctx, GR_ERR_OUT_OF_MEMORY, "Out of host memory.");
+  double inv_scale = 1.0 / s->params.noise_scale;
+  for (int o = 0; st == GR_OK && o < s->nobjects; ++o)
+    for (int k = tfirst[o]; k < tfirst[o + 1]; ++k) {
+      const int *ix = s->ht + 3 * (size_t)q.tri[k];
+      const float *b = q.bar + 3 * (size_t)k;
+      /* The triangle's own normal: a texel lies on one face (the mesh
+       * points' normals average their faces). */
+      const double *A = s->hv + 3 * (size_t)ix[0], *B = s->hv + 3 * (size_t)ix[1],
+                   *C = s->hv + 3 * (size_t)ix[2];
+      double u[3] = {B[0] - A[0], B[1] - A[1], B[2] - A[2]};
+      double w[3] = {C[0] - A[0], C[1] - A[1], C[2] - A[2]};
+      double cr[3] = {u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2],
+                      u[0] * w[1] - u[1] * w[0]};
+      double len = sqrt(cr[0] * cr[0] + cr[1] * cr[1] + cr[2] * cr[2]);
+      for (int a = 0; a < 3; ++a) {
+        sv[3 * (size_t)k + a] = b[0] * A[a] + b[1] * B[a] + b[2] * C[a];
+        nrm[3 * (size_t)k + a] = len > 0.0 ? (float)(cr[a] / len) : 0.0f;
+        double p = b[0] * (double)s->hlocal[3 * (size_t)ix[0] + a] +
+                   b[1] * (double)s->hlocal[3 * (size_t)ix[1] + a] +
+                   b[2] * (double)s->hlocal[3 * (size_t)ix[2] + a];
+        lat[3 * (size_t)k + a] =
+            (float)fmod(p * inv_scale + 97.0 * (double)o, GR_SNAC_NOISE_PERIOD);
+      }
+    }
+  /* The same layout keeps the buffers; otherwise new ones, the kept
+   * objects' snow copied over. */
+  int same = (int)ns == s->ns && s->t_arr[0] != NULL;
+  for (int o = 0; same && o < s->nobjects; ++o)
+    same = kept[o] && o < s->tobjects && tfirst[o] == s->tfirst[o] &&
+           tfirst[o + 1] == s->tfirst[o + 1];
+  cl_mem tp = NULL, tn = NULL, tl = NULL, ta[GR_SNAC_ARRAYS];
+  memset(ta, 0, sizeof(ta));
+  if (st == GR_OK && !same && ns > 0) {
+    st = gr_buffer_create(s->ctx, CL_MEM_READ_WRITE, S * 3 * sizeof(float), NULL, &tp);
+    if (st == GR_OK)
+      st = gr_buffer_create(s->ctx, CL_MEM_READ_WRITE, S * 3 * sizeof(float), NULL, &tn);
+    if (st == GR_OK)
+      st = gr_buffer_create(s->ctx, CL_MEM_READ_WRITE, S * 3 * sizeof(float), NULL, &tl);
+    for (int a = 0; st == GR_OK && a < GR_SNAC_ARRAYS; ++a) {
+      st = gr_buffer_create(s->ctx, CL_MEM_READ_WRITE, S * sizeof(float), NULL, &ta[a]);
+      if (st == GR_OK)
+        st = gr_snac_fill(s, ta[a], S, 0.0f);
+    }
+    for (int o = 0; st == GR_OK && o < s->nobjects && o < s->tobjects; ++o) {
+      int cnt = tfirst[o + 1] - tfirst[o];
+      if (!kept[o] || cnt == 0 || cnt != s->tfirst[o + 1] - s->tfirst[o] || !s->t_arr[0])
+        continue;
+      for (int a = 0; st == GR_OK && a < GR_SNAC_ARRAYS; ++a)
+        st = gr_cl_check(s->ctx,
+                         clEnqueueCopyBuffer(gr_context_queue(s->ctx), s->t_arr[a], ta[a],
+                                             (size_t)s->tfirst[o] * sizeof(float),
+                                             (size_t)tfirst[o] * sizeof(float),
+                                             (size_t)cnt * sizeof(float), 0, NULL, NULL),
+                         "Copying an object's accumulation texture");
+    }
+  }
+  if (st == GR_OK && ns > 0) {
+    st = gr_buffer_write(s->ctx, same ? s->t_nrm : tn, 0, ns * 3 * sizeof(float), nrm);
+    if (st == GR_OK)
+      st = gr_buffer_write(s->ctx, same ? s->t_local : tl, 0, ns * 3 * sizeof(float), lat);
+  }
+  free(nrm), free(lat);
+  if (st != GR_OK) {
+    gr_snac_release_textures(&tp, &tn, &tl, ta);
+    free(sv), free(q.texel), free(q.tri), free(q.bar);
+    return st;
+  }
+  if (!same) {
+    gr_snac_release_textures(&s->t_pos, &s->t_nrm, &s->t_local, s->t_arr);
+    s->t_pos = tp, s->t_nrm = tn, s->t_local = tl;
+    memcpy(s->t_arr, ta, sizeof(ta));
+  }
+  free(s->sv), free(s->stexel), free(s->stri), free(s->sbar);
+  s->sv = sv, s->stexel = q.texel, s->stri = q.tri, s->sbar = q.bar;
+  s->ns = (int)ns;
+  s->tobjects = s->nobjects;
+  memcpy(s->tfirst, tfirst, (size_t)(s->nobjects + 1) * sizeof(int));
+  return GR_OK;
+}
+
 static gr_status gr_snac_set_objects_impl(gr_snow_accumulation *s, const gr_mesh *meshes, int n) {
   char msg[320];
   if (n < 0 || n > GR_SNOW_ACCUMULATION_MAX_OBJECTS || (n > 0 && !meshes))
@@ -719,6 +952,13 @@ static gr_status gr_snac_set_objects_impl(gr_snow_accumulation *s, const gr_mesh
   int same = n == s->nobjects;
   for (int o = 0; same && o < n; ++o)
     same = meshes[o].nvertices == s->nverts[o];
+  unsigned char kept[GR_SNOW_ACCUMULATION_MAX_OBJECTS];
+  int trifirst[GR_SNOW_ACCUMULATION_MAX_OBJECTS + 1];
+  trifirst[0] = 0;
+  for (int o = 0; o < n; ++o) {
+    kept[o] = (unsigned char)(o < s->nobjects && meshes[o].nvertices == s->nverts[o]);
+    trifirst[o + 1] = trifirst[o] + meshes[o].ntriangles;
+  }
   gr_snac_geometry g;
   memset(&g, 0, sizeof(g));
   gr_status st = gr_snac_build_geometry(s, meshes, n, first, (int)nv, (int)nt, &g);
@@ -776,8 +1016,8 @@ static gr_status gr_snac_set_objects_impl(gr_snow_accumulation *s, const gr_mesh
     s->o_tri = nb[0], s->o_pos = nb[1], s->o_nrm = nb[2], s->o_local = nb[3], s->o_area = nb[4];
     memcpy(s->o_arr, na, sizeof(na));
   }
-  free(s->hv), free(s->ht), free(s->hnrm);
-  s->hv = g.hv, s->ht = g.ht, s->hnrm = g.nrm;
+  free(s->hv), free(s->ht), free(s->hnrm), free(s->hlocal);
+  s->hv = g.hv, s->ht = g.ht, s->hnrm = g.nrm, s->hlocal = g.hlocal;
   s->nobjects = n;
   s->nv = (int)nv;
   s->ntri = (int)nt;
@@ -786,7 +1026,17 @@ static gr_status gr_snac_set_objects_impl(gr_snow_accumulation *s, const gr_mesh
   memcpy(s->first, first, (size_t)(n + 1) * sizeof(int));
   memcpy(s->ob_lo, g.lo, sizeof(g.lo));
   memcpy(s->ob_hi, g.hi, sizeof(g.hi));
-  if (nv > 0) {
+  memcpy(s->trifirst, trifirst, (size_t)(n + 1) * sizeof(int));
+  /* A texture goes with its object; a kept object keeps its texture (its
+   * samples move with it). */
+  for (int o = 0; o < GR_SNOW_ACCUMULATION_MAX_OBJECTS; ++o)
+    if (s->tsize[o] > 0 && (o >= n || !kept[o])) {
+      free(s->tuv[o]);
+      s->tuv[o] = NULL;
+      s->tsize[o] = 0;
+    }
+  st = gr_snac_textures(s, kept);
+  if (st == GR_OK && nv > 0) {
     st = gr_buffer_write(s->ctx, s->o_nrm, 0, (size_t)nv * 3 * sizeof(float), g.nrm);
     if (st == GR_OK)
       st = gr_buffer_write(s->ctx, s->o_local, 0, (size_t)nv * 3 * sizeof(float), g.local);
@@ -887,6 +1137,101 @@ gr_status gr_snow_accumulation_set_object_snow(gr_snow_accumulation *s, int o, c
     st = gr_snac_sums(s, 1, s->first[o], n, after);
   if (st == GR_OK)
     s->initial_volume += after[0] - before[0];
+  return st == GR_OK ? GR_OK : GR_SNAC_KEEP_ERROR(s, st);
+}
+
+gr_status gr_snow_accumulation_set_object_texture(gr_snow_accumulation *s, int o, const float *uv,
+                                                  int size) {
+  if (!s)
+    return gr_set_error(NULL, GR_ERR_INVALID_ARGUMENT,
+                        "gr_snow_accumulation_set_object_texture needs a simulation.");
+  const char *what = "gr_snow_accumulation_set_object_texture";
+  gr_status st = GR_OK;
+  char msg[400];
+  if (o < 0 || o >= s->nobjects)
+    st = gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
+                      "%s: there is no object %d (%d are set); pass an index from 0 to %d.", what,
+                      o, s->nobjects, s->nobjects - 1);
+  else if (!gr_param_accepts(&gr_snac_bounds[GR_SNAC_P_TEXTURE], (double)size)) {
+    gr_param_explain(&gr_snac_bounds[GR_SNAC_P_TEXTURE], (double)size,
+                     "Invalid accumulation texture", msg, sizeof(msg));
+    st = gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT, "Object %d: %s", o, msg);
+  } else if (size > 0 && !uv && s->nverts[o] > 0)
+    st = gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
+                      "%s: object %d needs texture coordinates, 2 per mesh point (%d); pass "
+                      "them or size 0 for no texture.",
+                      what, o, s->nverts[o]);
+  for (int k = 0; st == GR_OK && size > 0 && k < 2 * s->nverts[o]; ++k)
+    if (!isfinite(uv[k]))
+      st = gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
+                        "Object %d: texture coordinate %d of mesh point %d is %g; give finite "
+                        "texture coordinates.",
+                        o, k % 2, k / 2, (double)uv[k]);
+  if (st != GR_OK)
+    return GR_SNAC_KEEP_ERROR(s, st);
+  size_t bytes = (size_t)s->nverts[o] * 2 * sizeof(float);
+  /* The same texture again keeps its snow. */
+  if (size == s->tsize[o] && (size == 0 || bytes == 0 || memcmp(uv, s->tuv[o], bytes) == 0))
+    return GR_OK;
+  float *copy = NULL;
+  if (size > 0) {
+    copy = malloc(bytes ? bytes : 1);
+    if (!copy)
+      return GR_SNAC_KEEP_ERROR(s,
+                                gr_set_error(s->ctx, GR_ERR_OUT_OF_MEMORY, "Out of host memory."));
+    if (bytes)
+      memcpy(copy, uv, bytes);
+  }
+  float *old_uv = s->tuv[o];
+  int old_size = s->tsize[o];
+  unsigned char kept[GR_SNOW_ACCUMULATION_MAX_OBJECTS];
+  memset(kept, 1, sizeof(kept));
+  kept[o] = 0;
+  s->tuv[o] = copy, s->tsize[o] = size;
+  st = gr_snac_textures(s, kept);
+  if (st == GR_OK)
+    st = gr_snac_upload_geometry(s);
+  if (st != GR_OK) {
+    s->tuv[o] = old_uv, s->tsize[o] = old_size;
+    free(copy);
+    return GR_SNAC_KEEP_ERROR(s, st);
+  }
+  free(old_uv);
+  return GR_OK;
+}
+
+gr_status gr_snow_accumulation_get_object_texture(gr_snow_accumulation *s, int o, float *texels,
+                                                  int size) {
+  if (!s)
+    return gr_set_error(NULL, GR_ERR_INVALID_ARGUMENT,
+                        "gr_snow_accumulation_get_object_texture needs a simulation.");
+  gr_status st = GR_OK;
+  if (o < 0 || o >= s->nobjects)
+    st = gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
+                      "gr_snow_accumulation_get_object_texture: there is no object %d (%d are "
+                      "set); pass an index from 0 to %d.",
+                      o, s->nobjects, s->nobjects - 1);
+  else if (s->tsize[o] == 0 || size != s->tsize[o] || !texels)
+    st = gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
+                      "gr_snow_accumulation_get_object_texture: object %d has %s%d texels "
+                      "across but %d were asked for%s; pass its size and size x size floats.",
+                      o, s->tsize[o] ? "" : "no texture, ", s->tsize[o], size,
+                      texels ? "" : " (and no array)");
+  if (st != GR_OK)
+    return GR_SNAC_KEEP_ERROR(s, st);
+  size_t R = (size_t)size;
+  memset(texels, 0, R * R * sizeof(float));
+  int first = s->tfirst[o], cnt = s->tfirst[o + 1] - first;
+  if (cnt == 0)
+    return GR_OK;
+  float *d = malloc((size_t)cnt * sizeof(float));
+  if (!d)
+    return GR_SNAC_KEEP_ERROR(s, gr_set_error(s->ctx, GR_ERR_OUT_OF_MEMORY, "Out of host memory."));
+  st = gr_buffer_read(s->ctx, s->t_arr[0], (size_t)first * sizeof(float),
+                      (size_t)cnt * sizeof(float), d);
+  for (int k = 0; st == GR_OK && k < cnt; ++k)
+    texels[s->stexel[first + k]] = d[k];
+  free(d);
   return st == GR_OK ? GR_OK : GR_SNAC_KEEP_ERROR(s, st);
 }
 
@@ -1177,11 +1522,18 @@ static gr_status gr_snac_step_impl(gr_snow_accumulation *s, double dt) {
     st = gr_snac_mark(s, &s->tm.apply_ms);
 
   /* the mesh points */
-  cl_int nv = s->nv;
-  if (st == GR_OK && nv > 0) {
-    const gr_snac_arg ob[] = {GR_SNAC_MEM("pos", s->o_pos),
-                              GR_SNAC_MEM("nrm", s->o_nrm),
-                              GR_SNAC_MEM("lattice", s->o_local),
+  /* the mesh points, then the accumulation textures' samples: the same
+   * exposure, growth and stability, on their own arrays */
+  for (int pass = 0; pass < 2; ++pass) {
+    cl_int nv = pass ? s->ns : s->nv;
+    if (st != GR_OK || nv == 0)
+      continue;
+    const cl_mem *A = pass ? s->t_arr : s->o_arr;
+    const cl_mem *P = pass ? &s->t_pos : &s->o_pos, *N = pass ? &s->t_nrm : &s->o_nrm,
+                 *L = pass ? &s->t_local : &s->o_local;
+    const gr_snac_arg ob[] = {GR_SNAC_MEM("pos", *P),
+                              GR_SNAC_MEM("nrm", *N),
+                              GR_SNAC_MEM("lattice", *L),
                               GR_SNAC_VAL("nv", nv),
                               GR_SNAC_VAL("dir_x", dir_x),
                               GR_SNAC_VAL("dir_y", dir_y),
@@ -1208,13 +1560,13 @@ static gr_status gr_snac_step_impl(gr_snow_accumulation *s, double dt) {
                               GR_SNAC_VAL("gdx", dx),
                               GR_SNAC_VAL("gdy", dy),
                               GR_SNAC_VAL("zref", zref),
-                              GR_SNAC_MEM("exposure", s->o_arr[6]),
-                              GR_SNAC_MEM("depth", s->o_arr[0]),
-                              GR_SNAC_MEM("depth_lo", s->o_arr[1]),
-                              GR_SNAC_MEM("fall", s->o_arr[2]),
-                              GR_SNAC_MEM("fall_lo", s->o_arr[3]),
-                              GR_SNAC_MEM("shed", s->o_arr[4]),
-                              GR_SNAC_MEM("shed_lo", s->o_arr[5])};
+                              GR_SNAC_MEM("exposure", A[6]),
+                              GR_SNAC_MEM("depth", A[0]),
+                              GR_SNAC_MEM("depth_lo", A[1]),
+                              GR_SNAC_MEM("fall", A[2]),
+                              GR_SNAC_MEM("fall_lo", A[3]),
+                              GR_SNAC_MEM("shed", A[4]),
+                              GR_SNAC_MEM("shed_lo", A[5])};
     st = gr_snac_args(s, s->objects_k, ob, sizeof(ob) / sizeof(ob[0]));
     if (st == GR_OK)
       st = gr_enqueue_1d(ctx, s->objects_k, (size_t)nv);
@@ -1351,14 +1703,14 @@ void gr_snow_accumulation_set_progress(gr_snow_accumulation *s, gr_progress_fn f
 
 typedef struct gr_snac_state_header {
   uint32_t magic, version;
-  int32_t nx, ny, nobjects, nv;
+  int32_t nx, ny, nobjects, nv, ns, pad;
   int64_t steps;
   double time, initial_volume, retired_fall, retired_shed, dropped, snow_bound;
 } gr_snac_state_header;
 
 static size_t gr_snac_state_bytes(const gr_snow_accumulation *s) {
   return sizeof(gr_snac_state_header) +
-         GR_SNAC_ARRAYS * (gr_snac_cells(s) + (size_t)s->nv) * sizeof(float);
+         GR_SNAC_ARRAYS * (gr_snac_cells(s) + (size_t)s->nv + (size_t)s->ns) * sizeof(float);
 }
 
 gr_status gr_snow_accumulation_state_size(const gr_snow_accumulation *s, size_t *bytes) {
@@ -1387,6 +1739,7 @@ gr_status gr_snow_accumulation_state_save(gr_snow_accumulation *s, void *host, s
   hd.magic = GR_SNAC_STATE_MAGIC;
   hd.version = GR_SNAC_STATE_VERSION;
   hd.nx = s->grid.nx, hd.ny = s->grid.ny, hd.nobjects = s->nobjects, hd.nv = s->nv;
+  hd.ns = s->ns;
   hd.steps = s->steps;
   hd.time = s->time;
   hd.initial_volume = s->initial_volume;
@@ -1397,11 +1750,17 @@ gr_status gr_snow_accumulation_state_save(gr_snow_accumulation *s, void *host, s
   memcpy(host, &hd, sizeof(hd));
   char *at = (char *)host + sizeof(hd);
   size_t gb = gr_snac_cells(s) * sizeof(float), ob = (size_t)s->nv * sizeof(float);
+  size_t tb = (size_t)s->ns * sizeof(float);
   gr_status st = GR_OK;
   for (int a = 0; st == GR_OK && a < GR_SNAC_ARRAYS; ++a, at += gb)
     st = gr_buffer_read(s->ctx, s->arr[a], 0, gb, at);
-  for (int a = 0; st == GR_OK && ob > 0 && a < GR_SNAC_ARRAYS; ++a, at += ob)
-    st = gr_buffer_read(s->ctx, s->o_arr[a], 0, ob, at);
+  /* Per array the mesh points, then the textures' samples. */
+  for (int a = 0; st == GR_OK && ob + tb > 0 && a < GR_SNAC_ARRAYS; ++a, at += ob + tb) {
+    if (ob > 0)
+      st = gr_buffer_read(s->ctx, s->o_arr[a], 0, ob, at);
+    if (st == GR_OK && tb > 0)
+      st = gr_buffer_read(s->ctx, s->t_arr[a], 0, tb, at + ob);
+  }
   return st == GR_OK ? GR_OK : GR_SNAC_KEEP_ERROR(s, st);
 }
 
@@ -1420,7 +1779,8 @@ gr_status gr_snow_accumulation_state_load(gr_snow_accumulation *s, const void *h
                         host ? bytes : 0, s->grid.nx, s->grid.ny, s->nv, need));
   memcpy(&hd, host, sizeof(hd));
   if (hd.magic != GR_SNAC_STATE_MAGIC || hd.version != GR_SNAC_STATE_VERSION ||
-      hd.nx != s->grid.nx || hd.ny != s->grid.ny || hd.nobjects != s->nobjects || hd.nv != s->nv)
+      hd.nx != s->grid.nx || hd.ny != s->grid.ny || hd.nobjects != s->nobjects || hd.nv != s->nv ||
+      hd.ns != s->ns)
     return GR_SNAC_KEEP_ERROR(
         s, gr_set_error(s->ctx, GR_ERR_FORMAT,
                         "The bytes are not a snow accumulation state of a %d x %d grid with %d "
@@ -1429,10 +1789,11 @@ gr_status gr_snow_accumulation_state_load(gr_snow_accumulation *s, const void *h
                         s->grid.nx, s->grid.ny, s->nobjects, GR_SNAC_STATE_VERSION));
   const char *base = (const char *)host + sizeof(hd);
   size_t gcells = gr_snac_cells(s), gb = gcells * sizeof(float), ob = (size_t)s->nv * sizeof(float);
+  size_t tb = (size_t)s->ns * sizeof(float);
   /* Depths (the hi parts) must be finite and not negative. */
   for (int part = 0; part < 2; ++part) {
     const char *p = part ? base + GR_SNAC_ARRAYS * gb : base;
-    size_t n = part ? (size_t)s->nv : gcells;
+    size_t n = part ? (size_t)s->nv + (size_t)s->ns : gcells;
     for (size_t c = 0; c < n; ++c) {
       float v;
       memcpy(&v, p + c * sizeof(float), sizeof(v));
@@ -1448,8 +1809,12 @@ gr_status gr_snow_accumulation_state_load(gr_snow_accumulation *s, const void *h
   const char *at = base;
   for (int a = 0; st == GR_OK && a < GR_SNAC_ARRAYS; ++a, at += gb)
     st = gr_buffer_write(s->ctx, s->arr[a], 0, gb, at);
-  for (int a = 0; st == GR_OK && ob > 0 && a < GR_SNAC_ARRAYS; ++a, at += ob)
-    st = gr_buffer_write(s->ctx, s->o_arr[a], 0, ob, at);
+  for (int a = 0; st == GR_OK && ob + tb > 0 && a < GR_SNAC_ARRAYS; ++a, at += ob + tb) {
+    if (ob > 0)
+      st = gr_buffer_write(s->ctx, s->o_arr[a], 0, ob, at);
+    if (st == GR_OK && tb > 0)
+      st = gr_buffer_write(s->ctx, s->t_arr[a], 0, tb, at + ob);
+  }
   if (st != GR_OK)
     return GR_SNAC_KEEP_ERROR(s, st);
   s->steps = hd.steps;

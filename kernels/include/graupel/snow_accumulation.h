@@ -50,8 +50,10 @@
  * fixed pattern in space (not re-drawn per step), so the same simulated
  * time gives the same snow whether it is taken in 10 steps or 100 (exactly
  * with f = 1 while the exposure does not change). Its "5x5" blur is the 9-tap
- * kernel above. Its per-object UV textures become per-mesh-point depths
- * (no UV unwrap needed).
+ * kernel above. Its per-object UV textures are here per-mesh-point depths
+ * (no UV unwrap needed) and, for objects given texture coordinates, an
+ * accumulation texture whose texels are samples like the mesh points
+ * (gr_snow_accumulation_set_object_texture).
  *
  * Book-keeping: every grid point and mesh point keeps its depth, the snow
  * that fell on it and the snow it shed as double-float pairs, so
@@ -105,6 +107,9 @@ typedef struct gr_snow_accumulation_params {
   double max_depth;        /**< m, the capacity of a horizontal surface (row MaxDepth) */
   double stability_factor; /**< f, per second (row StabilityFactor) */
   double snow_density;     /**< kg/m^3 of the fresh snow (row SnowDensity) */
+  /** Texels across an accumulation texture, 0: none (row AccumulationTextureSize): the
+   *  size callers pass to set_object_texture; validated with the rest. */
+  int texture_size;
 } gr_snow_accumulation_params;
 
 /** The table's defaults, direction 0 0 -1. */
@@ -120,7 +125,8 @@ GR_API gr_status gr_snow_accumulation_params_validate(const gr_snow_accumulation
 /**
  * The parameter table (Flutter deg, SnowfallRate cm/h, NoiseAmplitude,
  * NoiseScale m, Seed, ExposureResolution, BlurRadius, Dilation, MaxDepth m,
- * StabilityFactor 1/s, SnowDensity kg/m^3); *count gets the number of rows.
+ * StabilityFactor 1/s, SnowDensity kg/m^3, AccumulationTextureSize);
+ * *count gets the number of rows.
  */
 GR_API const gr_param_bound *gr_snow_accumulation_param_bounds(int *count);
 
@@ -200,6 +206,34 @@ GR_API gr_status gr_snow_accumulation_get_object_offsets(gr_snow_accumulation *s
 /** Sets object o's snow per mesh point (m, 0 to 1e4); the initial volume moves by the change. */
 GR_API gr_status gr_snow_accumulation_set_object_snow(gr_snow_accumulation *s, int o,
                                                       const float *depth, int n);
+
+/**
+ * Gives object o an accumulation texture of size x size texels (the thesis'
+ * per-object texture, notes/002.md 2.3; size 0 removes it; the row
+ * AccumulationTextureSize bounds it), uv holding 2 texture coordinates per
+ * mesh point. Every texel whose centre falls in the UV triangle of one of
+ * the object's triangles becomes a sample on that triangle (barycentric;
+ * the first triangle in mesh order wins where UV triangles overlap) with
+ * the triangle's own normal, and goes through the same exposure, growth,
+ * noise (the object's frame) and stability as the mesh points each step,
+ * moving with the object. Texels on no triangle stay 0. The samples are a
+ * finer picture of the same snow, not more of it: they stay out of the
+ * ledger (the mesh points carry the object's volume), set_object_snow and
+ * reset leave them at / bring them to 0, checkpoints include them. The
+ * same size and coordinates again keep the texture's snow; set_objects
+ * keeps a kept object's texture (its samples move with it) and drops the
+ * texture of an object it replaces.
+ */
+GR_API gr_status gr_snow_accumulation_set_object_texture(gr_snow_accumulation *s, int o,
+                                                         const float *uv, int size);
+
+/**
+ * Object o's accumulation texture: size x size floats (size its texture's
+ * size), snow depth in m, row-major with u along a row (texel (i, j) at
+ * j x size + i, centre ((i + 0.5) / size, (j + 0.5) / size)).
+ */
+GR_API gr_status gr_snow_accumulation_get_object_texture(gr_snow_accumulation *s, int o,
+                                                         float *texels, int size);
 
 /** One step of dt seconds (finite, 1e-6 to 86400); enqueues and does not wait. */
 GR_API gr_status gr_snow_accumulation_step(gr_snow_accumulation *s, double dt);
