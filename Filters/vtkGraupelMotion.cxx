@@ -1,6 +1,10 @@
 #include "vtkGraupelMotion.h"
 
+#include "vtkCellArray.h"
+#include "vtkIdList.h"
+#include "vtkNew.h"
 #include "vtkObjectFactory.h"
+#include "vtkPolyData.h"
 
 #include <glm/glm.hpp>
 #include <glm/gtc/matrix_transform.hpp>
@@ -8,6 +12,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <sstream>
 
 vtkStandardNewMacro(vtkGraupelMotion);
 
@@ -85,6 +90,99 @@ void vtkGraupelMotion::TransformPoint(double t, const double in[3], double out[3
   out[0] = p.x;
   out[1] = p.y;
   out[2] = p.z;
+}
+
+std::string vtkGraupelMotion::CheckObjectMotion(const char *filter, const double v[3],
+                                                double angularVelocity, const double axis[3]) {
+  if (std::isfinite(v[0]) && std::isfinite(v[1]) && std::isfinite(v[2]) &&
+      std::isfinite(angularVelocity) && std::isfinite(axis[0]) && std::isfinite(axis[1]) &&
+      std::isfinite(axis[2])) {
+    return std::string();
+  }
+  std::ostringstream msg;
+  msg << filter << ": ObjectVelocity (" << v[0] << " " << v[1] << " " << v[2]
+      << " m/s), ObjectAngularVelocity (" << angularVelocity
+      << " deg/s) and RotationAxis must be finite numbers; set them so.";
+  return msg.str();
+}
+
+std::string vtkGraupelMotion::ReadPath(const char *filter, vtkPolyData *path,
+                                       std::vector<double> &xyz) {
+  xyz.clear();
+  if (!path) {
+    return std::string();
+  }
+  // The first polyline in its order; without lines, the points in theirs.
+  vtkNew<vtkIdList> ids;
+  vtkCellArray *lines = path->GetLines();
+  if (lines && lines->GetNumberOfCells() > 0) {
+    lines->InitTraversal();
+    lines->GetNextCell(ids);
+  } else {
+    for (vtkIdType i = 0; i < path->GetNumberOfPoints(); ++i) {
+      ids->InsertNextId(i);
+    }
+  }
+  std::ostringstream msg;
+  double length = 0.0;
+  for (vtkIdType k = 0; k < ids->GetNumberOfIds(); ++k) {
+    double p[3];
+    path->GetPoint(ids->GetId(k), p);
+    if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2])) {
+      xyz.clear();
+      msg << filter << "'s Path has a point that is not finite (point " << ids->GetId(k)
+          << "); fix or remove it.";
+      return msg.str();
+    }
+    if (k > 0) {
+      const double *q = &xyz[xyz.size() - 3];
+      length += std::sqrt((p[0] - q[0]) * (p[0] - q[0]) + (p[1] - q[1]) * (p[1] - q[1]) +
+                          (p[2] - q[2]) * (p[2] - q[2]));
+    }
+    xyz.insert(xyz.end(), {p[0], p[1], p[2]});
+  }
+  if (xyz.size() < 6 || !(length > 0.0)) {
+    msg << filter << "'s Path must be a polyline of at least two distinct points; it has "
+        << xyz.size() / 3 << " point(s) and a length of " << length
+        << " m. Give it a polyline (e.g. a Poly Line Source) or disconnect it.";
+    xyz.clear();
+    return msg.str();
+  }
+  return std::string();
+}
+
+std::string vtkGraupelMotion::CheckPathSpeed(const char *filter, size_t object, const double v[3]) {
+  if (std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]) > 0.0) {
+    return std::string();
+  }
+  std::ostringstream msg;
+  msg << filter
+      << ": along the Path the objects move at the speed of ObjectVelocity (or of a block's "
+         "'velocity'), and object "
+      << object << "'s is 0 m/s; set ObjectVelocity to the speed wanted.";
+  return msg.str();
+}
+
+void vtkGraupelMotion::PoseObject(const double centre[3], const double v[3], double angularVelocity,
+                                  const double axis[3], const std::vector<double> &path, double t,
+                                  double m[16]) {
+  vtkNew<vtkGraupelMotion> motion;
+  motion->SetAngularVelocity(angularVelocity);
+  motion->SetRotationAxis(axis[0], axis[1], axis[2]);
+  if (path.size() >= 6) {
+    for (size_t p = 0; p + 2 < path.size(); p += 3) {
+      motion->AddPathPoint(path[p], path[p + 1], path[p + 2]);
+    }
+    motion->SetPathSpeed(std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]));
+    motion->EvaluatePose(t, m);
+    return;
+  }
+  motion->SetVelocity(v[0], v[1], v[2]);
+  motion->EvaluatePose(t, m);
+  // The motion starts from the object's own place.
+  m[12] += centre[0];
+  m[13] += centre[1];
+  m[14] += centre[2];
 }
 
 void vtkGraupelMotion::PrintSelf(ostream &os, vtkIndent indent) {

@@ -26,7 +26,10 @@
 #include "GraupelFiltersModule.h"
 #include "vtkObject.h"
 
+#include <string>
 #include <vector>
+
+class vtkPolyData;
 
 class GRAUPELFILTERS_EXPORT vtkGraupelMotion : public vtkObject {
 public:
@@ -78,6 +81,35 @@ public:
 
   /** A point of the object frame moved to the world at time t. */
   void TransformPoint(double t, const double in[3], double out[3]);
+
+  ///@{
+  /**
+   * What the filters that pose objects by properties share (Snow
+   * Accumulation, Snow Deformation). Each check returns an empty string, or
+   * one sentence that starts with `filter` (e.g. "Snow Deformation").
+   */
+  /** ObjectVelocity (m/s), ObjectAngularVelocity (deg/s) and RotationAxis are finite. */
+  static std::string CheckObjectMotion(const char *filter, const double velocity[3],
+                                       double angularVelocity, const double axis[3]);
+  /**
+   * Reads a Path input into xyz (3 per point; cleared, and left empty
+   * without a path): its first polyline, or without lines its points in
+   * order. Refuses a non-finite point and fewer than two distinct points.
+   */
+  static std::string ReadPath(const char *filter, vtkPolyData *path, std::vector<double> &xyz);
+  /** Along a path object k moves at |velocity|, which must be above 0. */
+  static std::string CheckPathSpeed(const char *filter, size_t object, const double velocity[3]);
+  /**
+   * The pose (column-major) at time t (s) of an object whose frame is
+   * centred on `centre` (world, m): without a path the centre moves at
+   * `velocity`; along `path` (xyz, 2 points or more) it follows the path at
+   * |velocity| with +x along the tangent; both turn at angularVelocity
+   * (deg/s) about `axis` through the centre.
+   */
+  static void PoseObject(const double centre[3], const double velocity[3], double angularVelocity,
+                         const double axis[3], const std::vector<double> &path, double t,
+                         double matrix[16]);
+  ///@}
 
 protected:
   vtkGraupelMotion() = default;

@@ -10,6 +10,7 @@
 #include "vtkExecutive.h"
 #include "vtkFieldData.h"
 #include "vtkFloatArray.h"
+#include "vtkGraupelMotion.h"
 #include "vtkIdList.h"
 #include "vtkImageData.h"
 #include "vtkInformation.h"
@@ -130,9 +131,9 @@ vtkSmartPointer<vtkPolyData> Posed(vtkPolyData *pd, const double centre[3], cons
 } // namespace
 
 vtkSnowAccumulationFilter::vtkSnowAccumulationFilter() {
-  this->SetNumberOfInputPorts(2);
+  this->SetNumberOfInputPorts(3);
   this->SetNumberOfOutputPorts(3);
-  // Objects with time steps are read in time; others stand or move by ObjectVelocity.
+  // Objects with time steps are read in time; others stand or are posed by the properties.
   this->SetInputPortPolicy(1, TEMPORAL_INPUT);
   // A snowfall of a few hours: 6 h of 15 min outputs, three 5 min steps
   // each (72 exposure views). Growth is a rate times dt, so longer steps
@@ -180,6 +181,10 @@ void vtkSnowAccumulationFilter::SetObjectsConnection(vtkAlgorithmOutput *output)
   this->SetInputConnection(1, output);
 }
 
+void vtkSnowAccumulationFilter::SetPathConnection(vtkAlgorithmOutput *output) {
+  this->SetInputConnection(2, output);
+}
+
 int vtkSnowAccumulationFilter::FillInputPortInformation(int port, vtkInformation *info) {
   if (port == 0) {
     info->Set(vtkAlgorithm::INPUT_REQUIRED_DATA_TYPE(), "vtkImageData");
@@ -188,7 +193,9 @@ int vtkSnowAccumulationFilter::FillInputPortInformation(int port, vtkInformation
   // A multiblock is taken whole (one object per leaf): a composite pipeline
   // would otherwise run the filter once per block.
   info->Set(vtkAlgorithm::INPUT_REQUIRED_DATA_TYPE(), "vtkPolyData");
-  info->Append(vtkAlgorithm::INPUT_REQUIRED_DATA_TYPE(), "vtkMultiBlockDataSet");
+  if (port == 1) {
+    info->Append(vtkAlgorithm::INPUT_REQUIRED_DATA_TYPE(), "vtkMultiBlockDataSet");
+  }
   info->Set(vtkAlgorithm::INPUT_IS_OPTIONAL(), 1);
   return 1;
 }
@@ -330,10 +337,10 @@ int vtkSnowAccumulationFilter::CheckParameters() {
                   << this->TimeStep << " s. Set it within that range.");
     return 0;
   }
-  const double *v = this->ObjectVelocity;
-  if (!std::isfinite(v[0]) || !std::isfinite(v[1]) || !std::isfinite(v[2])) {
-    vtkErrorMacro("Snow Accumulation: ObjectVelocity (" << v[0] << " " << v[1] << " " << v[2]
-                                                        << " m/s) must be finite; set it so.");
+  const std::string motion = vtkGraupelMotion::CheckObjectMotion(
+      "Snow Accumulation", this->ObjectVelocity, this->ObjectAngularVelocity, this->RotationAxis);
+  if (!motion.empty()) {
+    vtkErrorMacro(<< motion);
     return 0;
   }
   return 1;
@@ -440,24 +447,51 @@ int vtkSnowAccumulationFilter::ReadObjects(vtkDataObject *objects) {
     this->Objects.push_back(std::move(o));
   }
   this->ObjectsTemporal = this->IsInputTemporal(1);
+  if (!this->Path.empty() && !this->ObjectsTemporal) {
+    for (size_t k = 0; k < this->Objects.size(); ++k) {
+      const std::string error =
+          vtkGraupelMotion::CheckPathSpeed("Snow Accumulation", k, this->Objects[k].velocity);
+      if (!error.empty()) {
+        vtkErrorMacro(<< error);
+        return 0;
+      }
+    }
+  }
+  return 1;
+}
+
+int vtkSnowAccumulationFilter::ReadPath(vtkPolyData *path) {
+  const std::string error = vtkGraupelMotion::ReadPath("Snow Accumulation", path, this->Path);
+  if (!error.empty()) {
+    vtkErrorMacro(<< error);
+    return 0;
+  }
   return 1;
 }
 
 void vtkSnowAccumulationFilter::Pose(size_t k, double t, double m[16]) const {
   const Object &o = this->Objects[k];
-  for (int i = 0; i < 16; ++i) {
-    m[i] = (i % 5 == 0) ? 1.0 : 0.0;
+  if (this->ObjectsTemporal) {
+    // The geometry is the pose: back to where it was read.
+    for (int i = 0; i < 16; ++i) {
+      m[i] = (i % 5 == 0) ? 1.0 : 0.0;
+    }
+    for (int c = 0; c < 3; ++c) {
+      m[12 + c] = o.centre[c];
+    }
+    return;
   }
-  // Temporal objects: the geometry is the pose, back to where it was read.
-  const double s = this->ObjectsTemporal ? 0.0 : t;
-  for (int c = 0; c < 3; ++c) {
-    m[12 + c] = o.centre[c] + o.velocity[c] * s;
-  }
+  vtkGraupelMotion::PoseObject(o.centre, o.velocity, this->ObjectAngularVelocity,
+                               this->RotationAxis, this->Path, t, m);
 }
 
 bool vtkSnowAccumulationFilter::ObjectsMove() const {
-  if (this->ObjectsTemporal) {
+  if (this->ObjectsTemporal || this->Objects.empty()) {
     return false;
+  }
+  // A path places the objects on it, so their poses change even at rest.
+  if (!this->Path.empty() || this->ObjectAngularVelocity != 0.0) {
+    return true;
   }
   for (const Object &o : this->Objects) {
     if (o.velocity[0] != 0.0 || o.velocity[1] != 0.0 || o.velocity[2] != 0.0) {
@@ -566,9 +600,11 @@ int vtkSnowAccumulationFilter::SetUpState(vtkInformationVector **inputVector) {
       return 0;
     }
   }
-  if (!this->ReadObjects(this->GetNumberOfInputConnections(1)
-                             ? vtkDataObject::GetData(inputVector[1])
-                             : nullptr)) {
+  vtkPolyData *path =
+      this->GetNumberOfInputConnections(2) ? vtkPolyData::GetData(inputVector[2]) : nullptr;
+  if (!this->ReadPath(path) || !this->ReadObjects(this->GetNumberOfInputConnections(1)
+                                                      ? vtkDataObject::GetData(inputVector[1])
+                                                      : nullptr)) {
     return 0;
   }
   this->ObjectsReadAt = this->GetTemporalInputTime(1);
@@ -879,4 +915,7 @@ void vtkSnowAccumulationFilter::PrintSelf(ostream &os, vtkIndent indent) {
   os << indent << "AccumulationTextureSize: " << this->AccumulationTextureSize << "\n";
   os << indent << "ObjectVelocity: " << this->ObjectVelocity[0] << " " << this->ObjectVelocity[1]
      << " " << this->ObjectVelocity[2] << " m/s\n";
+  os << indent << "ObjectAngularVelocity: " << this->ObjectAngularVelocity << " deg/s\n";
+  os << indent << "RotationAxis: " << this->RotationAxis[0] << " " << this->RotationAxis[1] << " "
+     << this->RotationAxis[2] << "\n";
 }

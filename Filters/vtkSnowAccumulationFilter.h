@@ -15,9 +15,14 @@
  * sources are) receive snow on their outer side. Each object is handed to
  * the core in its own frame, about the centre of its bounds, with a pose
  * that puts it in the world.
- * - Objects that do not advertise time steps stand still, or move at
- *   ObjectVelocity (m/s; a leaf's field data `velocity`, 3 values, replaces
- *   it for that object); their snow moves with them.
+ * - Objects that do not advertise time steps stand still, or move by the
+ *   properties (vtkGraupelMotion): the centre moves at ObjectVelocity (m/s)
+ *   and the object turns at ObjectAngularVelocity (deg/s) about
+ *   RotationAxis through its centre; with a Path (input 2, a polyline) the
+ *   centre follows the path at the speed |ObjectVelocity|, the object's +x
+ *   turned along the path's tangent. A leaf's field data `velocity` (3
+ *   values, m/s) replaces ObjectVelocity for that object. Their snow moves
+ *   with them.
  * - Objects that advertise time steps are read at each (sample and hold,
  *   see vtkGraupelSimulation): their geometry is the pose. An object keeps
  *   its snow from one time step to the next while it keeps its number of
@@ -70,6 +75,7 @@
 struct gr_snow_accumulation;
 class vtkDataObject;
 class vtkMultiBlockDataSet;
+class vtkPolyData;
 
 class GRAUPELFILTERS_EXPORT vtkSnowAccumulationFilter : public vtkGraupelSimulation {
 public:
@@ -166,13 +172,30 @@ public:
   ///@}
 
   ///@{
-  /** Velocity of the objects that have no time steps, m/s (default 0 0 0). */
+  /**
+   * Velocity of the centres of the objects that have no time steps, m/s
+   * (default 0 0 0); along a Path its length is the speed.
+   */
   vtkSetVector3Macro(ObjectVelocity, double);
   vtkGetVector3Macro(ObjectVelocity, double);
   ///@}
 
+  ///@{
+  /** Rotation speed of the objects about RotationAxis through their centres, deg/s (default 0). */
+  vtkSetMacro(ObjectAngularVelocity, double);
+  vtkGetMacro(ObjectAngularVelocity, double);
+  ///@}
+
+  ///@{
+  /** Axis of that rotation, object frame (default 0 1 0). */
+  vtkSetVector3Macro(RotationAxis, double);
+  vtkGetVector3Macro(RotationAxis, double);
+  ///@}
+
   /** Connects the objects (input port 1). */
   void SetObjectsConnection(vtkAlgorithmOutput *output);
+  /** Connects the optional path (input port 2). */
+  void SetPathConnection(vtkAlgorithmOutput *output);
 
   /** Dispatches requests; see the .cxx for what the second output and a request without time need.
    */
@@ -214,6 +237,8 @@ protected:
   double SnowDensity = 0.0;
   int AccumulationTextureSize = 0;
   double ObjectVelocity[3] = {0.0, 0.0, 0.0};
+  double ObjectAngularVelocity = 0.0;
+  double RotationAxis[3] = {0.0, 1.0, 0.0};
 
 private:
   vtkSnowAccumulationFilter(const vtkSnowAccumulationFilter &) = delete;
@@ -231,9 +256,11 @@ private:
   int CheckParameters();
   /** Reads the objects into Objects; 0 after one sentence. */
   int ReadObjects(vtkDataObject *objects);
+  /** Reads the optional path into Path; 0 after one sentence. */
+  int ReadPath(vtkPolyData *path);
   /** The pose (column-major) of object k at time t. */
   void Pose(size_t k, double t, double matrix[16]) const;
-  /** Whether any object moves by its velocity (poses change between steps). */
+  /** Whether any object moves by the properties (poses change between steps). */
   bool ObjectsMove() const;
   /** Hands the objects at their poses at time t to the core. */
   int SetObjects(double t);
@@ -243,6 +270,7 @@ private:
 
   gr_snow_accumulation *Simulation = nullptr;
   std::vector<Object> Objects;
+  std::vector<double> Path; // xyz per point; empty when none
   bool ObjectsTemporal = false;
   double ObjectsReadAt = 0.0;
   vtkInformationVector *OutputVector = nullptr; // during RequestData only

@@ -374,57 +374,19 @@ int vtkSnowDeformationFilter::CheckParameters() {
                   << " kg/m^3); set it within the range or pick a DensityPreset.");
     return 0;
   }
-  const double *v = this->ObjectVelocity;
-  if (!std::isfinite(v[0]) || !std::isfinite(v[1]) || !std::isfinite(v[2]) ||
-      !std::isfinite(this->ObjectAngularVelocity) || !std::isfinite(this->RotationAxis[0]) ||
-      !std::isfinite(this->RotationAxis[1]) || !std::isfinite(this->RotationAxis[2])) {
-    vtkErrorMacro("Snow Deformation: ObjectVelocity ("
-                  << v[0] << " " << v[1] << " " << v[2] << " m/s), ObjectAngularVelocity ("
-                  << this->ObjectAngularVelocity
-                  << " deg/s) and RotationAxis must be finite numbers; set them so.");
+  const std::string motion = vtkGraupelMotion::CheckObjectMotion(
+      "Snow Deformation", this->ObjectVelocity, this->ObjectAngularVelocity, this->RotationAxis);
+  if (!motion.empty()) {
+    vtkErrorMacro(<< motion);
     return 0;
   }
   return 1;
 }
 
 int vtkSnowDeformationFilter::ReadPath(vtkPolyData *path) {
-  this->Path.clear();
-  if (!path) {
-    return 1;
-  }
-  // The first polyline in its order; without lines, the points in theirs.
-  vtkNew<vtkIdList> ids;
-  vtkCellArray *lines = path->GetLines();
-  if (lines && lines->GetNumberOfCells() > 0) {
-    lines->InitTraversal();
-    lines->GetNextCell(ids);
-  } else {
-    for (vtkIdType i = 0; i < path->GetNumberOfPoints(); ++i) {
-      ids->InsertNextId(i);
-    }
-  }
-  double length = 0.0;
-  for (vtkIdType k = 0; k < ids->GetNumberOfIds(); ++k) {
-    double p[3];
-    path->GetPoint(ids->GetId(k), p);
-    if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2])) {
-      vtkErrorMacro("Snow Deformation's Path has a point that is not finite (point "
-                    << ids->GetId(k) << "); fix or remove it.");
-      return 0;
-    }
-    if (k > 0) {
-      const double *q = &this->Path[this->Path.size() - 3];
-      length += std::sqrt((p[0] - q[0]) * (p[0] - q[0]) + (p[1] - q[1]) * (p[1] - q[1]) +
-                          (p[2] - q[2]) * (p[2] - q[2]));
-    }
-    this->Path.insert(this->Path.end(), {p[0], p[1], p[2]});
-  }
-  if (this->Path.size() < 6 || !(length > 0.0)) {
-    vtkErrorMacro("Snow Deformation's Path must be a polyline of at least two distinct points; "
-                  "it has "
-                  << this->Path.size() / 3 << " point(s) and a length of " << length
-                  << " m. Give it a polyline (e.g. a Poly Line Source) or disconnect it.");
-    this->Path.clear();
+  const std::string error = vtkGraupelMotion::ReadPath("Snow Deformation", path, this->Path);
+  if (!error.empty()) {
+    vtkErrorMacro(<< error);
     return 0;
   }
   return 1;
@@ -528,11 +490,10 @@ int vtkSnowDeformationFilter::ReadObjects(vtkDataObject *objects) {
   this->ObjectsTemporal = this->IsInputTemporal(1);
   if (!this->Path.empty() && !this->ObjectsTemporal) {
     for (size_t k = 0; k < this->Objects.size(); ++k) {
-      const double *v = this->Objects[k].velocity;
-      if (!(std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]) > 0.0)) {
-        vtkErrorMacro("Snow Deformation: along the Path the objects move at the speed of "
-                      "ObjectVelocity (or of a block's 'velocity'), and object "
-                      << k << "'s is 0 m/s; set ObjectVelocity to the speed wanted.");
+      const std::string error =
+          vtkGraupelMotion::CheckPathSpeed("Snow Deformation", k, this->Objects[k].velocity);
+      if (!error.empty()) {
+        vtkErrorMacro(<< error);
         return 0;
       }
     }
@@ -634,24 +595,8 @@ void vtkSnowDeformationFilter::Pose(size_t k, double t, double m[16]) const {
     m[14] = o.centre[2];
     return;
   }
-  vtkNew<vtkGraupelMotion> motion;
-  motion->SetAngularVelocity(this->ObjectAngularVelocity);
-  motion->SetRotationAxis(this->RotationAxis[0], this->RotationAxis[1], this->RotationAxis[2]);
-  if (!this->Path.empty()) {
-    for (size_t p = 0; p + 2 < this->Path.size(); p += 3) {
-      motion->AddPathPoint(this->Path[p], this->Path[p + 1], this->Path[p + 2]);
-    }
-    motion->SetPathSpeed(std::sqrt(o.velocity[0] * o.velocity[0] + o.velocity[1] * o.velocity[1] +
-                                   o.velocity[2] * o.velocity[2]));
-    motion->EvaluatePose(t, m);
-    return;
-  }
-  motion->SetVelocity(o.velocity[0], o.velocity[1], o.velocity[2]);
-  motion->EvaluatePose(t, m);
-  // The motion starts from the object's own place.
-  m[12] += o.centre[0];
-  m[13] += o.centre[1];
-  m[14] += o.centre[2];
+  vtkGraupelMotion::PoseObject(o.centre, o.velocity, this->ObjectAngularVelocity,
+                               this->RotationAxis, this->Path, t, m);
 }
 
 int vtkSnowDeformationFilter::SetObjects(double t, double h) {

@@ -5,14 +5,15 @@ its top (the objects' output with snow_depth and snow_offset), the exposure
 against an independent ray caster (vtkOBBTree) on a scene with a hut, trees
 and rough terrain, the lee-side bare patch behind a wall under wind, the same
 snow whatever the OutputInterval and TimeStep, results bit-identical whatever
-the order of requested times, a moving object carrying its snow, chaining into
+the order of requested times, a moving object carrying its snow (also along a
+curved Path, turned along its tangent), chaining into
 Snow Deformation (its mass ledger starts from this filter's snow mass), the
 accumulation textures of textured objects (port 2: rate x t in the open, 0
 under a lid, the ledger untouched), the
 defaults (and, under pvpython, the proxy's), and bad input (no or NaN
 elevation, a degenerate direction, objects that are not polydata, an
-ExposureResolution beyond the device): one sentence, empty outputs, and the
-next good update works."""
+ExposureResolution beyond the device, a Path at zero speed): one sentence,
+empty outputs, and the next good update works."""
 import math
 import os
 import sys
@@ -374,6 +375,53 @@ T.check(np.allclose(mpts[:, 0].min(), 7.0) and np.allclose(
         vtk_to_numpy(mo.GetPointData().GetArray("snow_depth"))[mtop], want, rtol=1e-5),
         "the box moved 5 m and kept its cap of %g m" % want)
 
+# ---- an object following a curved Path carries its snow ----------------------------
+# A 1 x 0.4 x 0.4 m box on a quarter circle (radius 3 m about (6, 6)), its
+# centre 0.2 m up so that it rests on the ground; at 80 % of the path's
+# length at 2 h it ends inside a segment, which the walk below finds
+# independently of vtkGraupelMotion.
+arc = np.array([(6.0 + 3.0 * math.cos(a), 6.0 + 3.0 * math.sin(a), 0.2)
+                for a in np.linspace(-0.5 * math.pi, 0.0, 13)])
+seg = np.linalg.norm(np.diff(arc, axis=0), axis=1)
+speed = 0.8 * seg.sum() / (2 * HOUR)
+arc_path = polys([tuple(p) for p in arc], [])
+arc_line = vtkCellArray()
+arc_line.InsertNextCell(len(arc), list(range(len(arc))))
+arc_path.SetLines(arc_line)
+cart = box((-0.5, 0.5, -0.2, 0.2, -0.2, 0.2))
+tag = numpy_to_vtk(np.array([7.0]), deep=1)
+tag.SetName("tag")
+cart.GetFieldData().AddArray(tag)
+pf = snow(cart, ObjectVelocity=(speed, 0.0, 0.0), NoiseAmplitude=0.0, BlurRadius=0)
+pf.SetPathConnection(producer(arc_path))
+_, pout = at(pf, 2 * HOUR)
+s_left, k = speed * 2 * HOUR, 0
+while s_left > seg[k]:
+    s_left -= seg[k]
+    k += 1
+tangent = (arc[k + 1] - arc[k]) / seg[k]
+end = arc[k] + tangent * s_left
+po = pf.GetOutputDataObject(1)
+ppts = vtk_to_numpy(po.GetPoints().GetData())
+centre = ppts.mean(axis=0)
+# The box's long axis (its +x) lies along the tangent.
+_, _, axes = np.linalg.svd(ppts - centre)
+ptop = vtk_to_numpy(po.GetPointData().GetNormals())[:, 2] > 0.5
+pdepth = vtk_to_numpy(po.GetPointData().GetArray("snow_depth"))
+print("path: the box ends at (%.6f, %.6f, %.6f), the path says (%.6f, %.6f, %.6f); cap %g m"
+      % (tuple(centre) + tuple(end) + (pdepth[ptop].min(),)))
+T.check(0 < k < len(seg) - 1 and np.linalg.norm(centre - end) <= 1e-3,
+        "along the Path the box ends where the path says at 2 h (segment %d, off by %.2e m)"
+        % (k, np.linalg.norm(centre - end)))
+T.check(abs(np.dot(axes[0], tangent)) >= 0.999,
+        "the box's +x lies along the path's tangent (cos %.6f)" % abs(np.dot(axes[0], tangent)))
+T.check(ptop.sum() == 4 and np.all(pdepth[ptop] > 0.0)
+        and np.allclose(pdepth[ptop], want, rtol=1e-3),
+        "the box carried its cap along the Path: %r m (want %g m)" % (pdepth[ptop], want))
+T.check(po.GetFieldData().GetArray("tag") is not None
+        and po.GetFieldData().GetArray("tag").GetTuple1(0) == 7.0
+        and field(pout, "time") == 2 * HOUR, "port 1 keeps the object's field data at 2 h")
+
 # ---- objects with time steps: a crate carried under a roof keeps its snow -----------
 from vtkmodules.util.vtkAlgorithm import VTKPythonAlgorithmBase  # noqa: E402
 from vtkmodules.vtkCommonExecutionModel import vtkStreamingDemandDrivenPipeline as SDDP  # noqa
@@ -544,9 +592,12 @@ cases = [
      ["Objects", "zero area"]),
     ("ExposureResolution beyond the device", {"props": {"ExposureResolution": 65536}},
      ["ExposureResolution 65536", "beyond the device", "Device"]),
+    ("zero-speed path", {"path": True}, ["Path", "ObjectVelocity", "0 m/s"]),
 ]
 for what, case, words in cases:
     g = snow(case.get("objects", box(B)), case.get("ground"), NoiseAmplitude=0.0)
+    if case.get("path"):
+        g.SetPathConnection(producer(arc_path))
     for k, v in case.get("props", {}).items():
         getattr(g, "Set" + k)(*(v if isinstance(v, tuple) else (v,)))
     errs = T.ErrorCatcher(g)
@@ -565,6 +616,7 @@ for what, case, words in cases:
     g.SetObjectsConnection(producer(box(B)))
     g.SetSnowDirection(0.0, 0.0, -1.0)
     g.SetExposureResolution(256)
+    g.SetInputConnection(2, None)
     s, _ = at(g, 2 * HOUR)
     T.check(s is not None and np.array_equal(s, ref_d), "%s: fixed, it works again" % what)
 
