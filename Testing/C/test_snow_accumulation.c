@@ -6,6 +6,7 @@
  * checkpoints, accumulation textures, the parameter table and the error
  * paths. */
 #include "gr_test.h"
+#include "gr_test_mesh.h"
 
 #include "graupel/snow_accumulation.h"
 
@@ -19,40 +20,6 @@
 #endif
 
 static gr_context *ctx;
-
-/* A mesh owned by the test: vertices, triangles and the pose. */
-typedef struct test_mesh {
-  float *v;
-  int *t;
-  gr_mesh m;
-} test_mesh;
-
-static void mesh_pose(test_mesh *tm, double x, double y, double z) {
-  for (int k = 0; k < 16; ++k)
-    tm->m.transform[k] = (k % 5 == 0) ? 1.0 : 0.0;
-  tm->m.transform[12] = x;
-  tm->m.transform[13] = y;
-  tm->m.transform[14] = z;
-}
-
-/* A closed box of half sizes (hx, hy, hz) about its centre: 8 corners. */
-static void mesh_box(test_mesh *tm, double hx, double hy, double hz) {
-  static const int tri[] = {0, 2, 1, 0, 3, 2, 4, 5, 6, 4, 6, 7, 0, 1, 5, 0, 5, 4,
-                            1, 2, 6, 1, 6, 5, 2, 3, 7, 2, 7, 6, 3, 0, 4, 3, 4, 7};
-  tm->v = malloc(24 * sizeof(float));
-  tm->t = malloc(sizeof(tri));
-  for (int k = 0; k < 8; ++k) {
-    tm->v[3 * k + 0] = (float)((k == 1 || k == 2 || k == 5 || k == 6) ? hx : -hx);
-    tm->v[3 * k + 1] = (float)((k == 2 || k == 3 || k == 6 || k == 7) ? hy : -hy);
-    tm->v[3 * k + 2] = (float)(k >= 4 ? hz : -hz);
-  }
-  memcpy(tm->t, tri, sizeof(tri));
-  tm->m.vertices = tm->v;
-  tm->m.nvertices = 8;
-  tm->m.triangles = tm->t;
-  tm->m.ntriangles = 12;
-  mesh_pose(tm, 0, 0, 0);
-}
 
 /* A box whose six faces are m x m grids of their own points, so that every
  * point has its face's normal: face 0 is the top ((m + 1)^2 points first),
@@ -86,11 +53,6 @@ static void mesh_faces(test_mesh *tm, double hx, double hy, double hz, int m) {
   tm->m.triangles = tm->t;
   tm->m.ntriangles = k / 3;
   mesh_pose(tm, 0, 0, 0);
-}
-
-static void mesh_free(test_mesh *tm) {
-  free(tm->v);
-  free(tm->t);
 }
 
 static gr_snow_accumulation *make_sim(int nx, int ny, double dx,

@@ -1388,8 +1388,11 @@ static gr_status gr_snac_step_impl(gr_snow_accumulation *s, double dt) {
                               GR_SNAC_VAL("dx", dx),
                               GR_SNAC_VAL("dy", dy),
                               GR_SNAC_VAL("n", cells)};
-    gr_status sst = gr_snac_args(s, s->slope_k, sa, sizeof(sa) / sizeof(sa[0]));
-    if (sst == GR_OK)
+    /* Snow straight down cannot be hidden by the surface: no reduction
+     * (and no read-back) that step. */
+    gr_status sst =
+        horiz == 0.0 ? GR_OK : gr_snac_args(s, s->slope_k, sa, sizeof(sa) / sizeof(sa[0]));
+    if (sst == GR_OK && horiz > 0.0)
       sst = gr_reduction_run(ctx, &s->red_slope, s->slope_k, NULL, g2);
     if (sst != GR_OK)
       return sst;
