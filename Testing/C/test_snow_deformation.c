@@ -889,6 +889,68 @@ static void test_bare_ground(void) {
   gr_snow_deformation_destroy(s);
 }
 
+/* Snow slides in under an object but never up to it: snow on a ledge 0.5 m
+ * high, a box hovering beside it with its underside 0.3 m above the lower
+ * ground. The ledge's snow falls into the space under the box, which fills
+ * to the box's underside less the clearance (twice
+ * GR_SNOW_DEFORMATION_CONTACT_GAP) and no higher, so the talus neither
+ * touches the box nor counts as contact. (The rule it replaced, no snow
+ * into a point whose underside is below the giver's surface, left the
+ * ledge full and the space empty: every giver stands above 0.3 m.) */
+static void test_talus_room(void) {
+  const int nx = 30, ny = 8, ledge = 9;
+  const double dx = 0.1, under = 0.3;
+  gr_snow_deformation_params p;
+  gr_snow_deformation_params_init(&p);
+  p.initial_snow_depth = 0.0;
+  p.max_relax_iterations = 100000;
+  p.relax_tolerance = 1e-5;
+  gr_snow_deformation *s = make_sim(nx, ny, dx, &p);
+  if (!s)
+    return;
+  float *g0 = calloc((size_t)nx * ny, sizeof(float)), *d0 = calloc((size_t)nx * ny, sizeof(float));
+  for (int j = 0; j < ny; ++j)
+    for (int i = 0; i <= ledge; ++i)
+      g0[j * nx + i] = d0[j * nx + i] = 0.5f;
+  CHECK(gr_snow_deformation_set_field(s, GR_FIELD_ELEVATION, g0) == GR_OK);
+  CHECK(gr_snow_deformation_set_field(s, GR_FIELD_SNOW_DEPTH, d0) == GR_OK);
+  test_mesh box; /* x from 0.95 (between the ledge and the next point) to 2.95 m */
+  mesh_box(&box, 1.0, 0.6, 0.1);
+  mesh_pose(&box, 1.95, 0.35, under + 0.1);
+  double v[3] = {0.0, 0.0, 0.0};
+  CHECK(gr_snow_deformation_set_objects(s, &box.m, 1, v) == GR_OK);
+  CHECK(gr_snow_deformation_step(s, 0.1) == GR_OK);
+  gr_snow_deformation_ledger l;
+  CHECK(gr_snow_deformation_ledger_get(s, &l) == GR_OK);
+  float *h = get(s, GR_FIELD_SNOW_SURFACE, nx * ny), *c = get(s, GR_FIELD_CONTACT, nx * ny);
+  double ceiling = under - 2.0 * GR_SNOW_DEFORMATION_CONTACT_GAP, highest = 0.0, worst = -1.0;
+  double first = 0.0; /* the lowest of the first column under the box */
+  int touching = 0;
+  for (int j = 0; j < ny; ++j) {
+    first = j == 0 ? h[j * nx + ledge + 1] : fmin(first, h[j * nx + ledge + 1]);
+    for (int i = ledge + 1; i < nx; ++i) {
+      highest = fmax(highest, h[j * nx + i]);
+      touching += c[j * nx + i] != 0.0f;
+    }
+    /* the ledge's own pairs, whose lower end is not under the box */
+    for (int i = 0; i < ledge; ++i)
+      worst = fmax(worst, fabs(h[j * nx + i] - h[j * nx + i + 1]) - p.max_slope * dx);
+  }
+  printf("talus room: the first column under the box filled to %.4f m (ceiling %.4f m), the "
+         "highest %.6f m; %d points in contact; ledge excess %.3g m; volume %.9g of %.9g; %d "
+         "iterations\n",
+         first, ceiling, highest, touching, worst, l.snow_volume, l.initial_volume,
+         l.relax_iterations);
+  CHECK(first > ceiling - 0.01);    /* the space under the box filled */
+  CHECK(highest <= ceiling + 1e-6); /* and no higher than the clearance */
+  CHECK(touching == 0);
+  CHECK(worst <= 1e-4);
+  CHECK(l.snow_volume == l.initial_volume);
+  free(h), free(c), free(g0), free(d0);
+  mesh_free(&box);
+  gr_snow_deformation_destroy(s);
+}
+
 /* Every OpenCL device here ploughs the same trail (the box drag of the
  * trail test, 40 steps, the talus converged each step): surfaces within
  * 1e-5 m of the first device's (issue 8). Measured on the H200 against
@@ -1025,6 +1087,7 @@ static const gr_subtest tests[] = {
     {"blocked", test_blocked, 0},
     {"devices_agree", test_devices_agree, 0},
     {"bare_ground", test_bare_ground, 0},
+    {"talus_room", test_talus_room, 0},
     {"memcheck", test_memcheck, 1},
 };
 

@@ -275,12 +275,23 @@ __kernel void snow_reset(int nx, int ny, int x_end, int y_end, __global float *r
 }
 
 /* Talus: the excess of point a (height ha) over its neighbour b (height hb,
- * lowest underside ub) at the distance whose threshold is thr. Zero when b
- * is under an object below ha: snow must not flow into the imprint. */
-GR_INLINE float snow_excess(float ha, float hb, float ub, float thr) {
-  if (ub <= ha)
-    return 0.0f;
-  return fmax(0.0f, ha - hb - thr);
+ * ceiling cb: the lowest underside above b less a clearance of twice
+ * GR_SNOW_DEFORMATION_CONTACT_GAP, +inf where no object covers b) at the distance whose threshold
+ * is thr, never more than the room under b's ceiling: snow slides in under an object (the gap a
+ * ploughing object leaves behind it fills as the trench walls collapse) but never rises to touch
+ * it, so talus never makes contact (only an object's press does) and never undoes an imprint. The
+ * excess is continuous in the heights: a point never hides an excess that a small change would
+ * reveal whole (what a bare "not if cb <= ha" did: there the trench walls under a ploughing sphere
+ * crept for hundreds of iterations). */
+GR_INLINE float snow_excess(float ha, float hb, float cb, float thr) {
+  return fmin(fmax(0.0f, ha - hb - thr), fmax(0.0f, cb - hb));
+}
+
+/* The talus share for a largest excess big (see GR_SNOW_TALUS_SHARE): an
+ * excess up to the threshold thr is carried on at GR_SNOW_TALUS_SHARE_SMALL,
+ * a larger one (a collapse) at GR_SNOW_TALUS_SHARE. */
+GR_INLINE float snow_share(float big, float thr) {
+  return big <= thr ? GR_SNOW_TALUS_SHARE_SMALL : GR_SNOW_TALUS_SHARE;
 }
 
 /* The threshold of the offset (di, dj). */
@@ -323,9 +334,9 @@ GR_INLINE void snow_rate_at(float s, float g, float u, const float *sn, const fl
   }
   float m = giver && s > 0.0f ? fmin(s, big) : 0.0f, k = 0.0f;
   if (m > tol && sum > 0.0f)
-    k = fmin(GR_SNOW_TALUS_SHARE * (big / sum), GR_SNOW_KEEP * s / sum);
+    k = fmin(snow_share(big, fmin(tx, ty)) * (big / sum), GR_SNOW_KEEP * s / sum);
   *k_out = k;
-  *k_in = sum_in > 0.0f ? GR_SNOW_TALUS_SHARE * (big_in / sum_in) : 0.0f;
+  *k_in = sum_in > 0.0f ? snow_share(big_in, fmin(tx, ty)) * (big_in / sum_in) : 0.0f;
   *mv = m;
 }
 
@@ -375,9 +386,9 @@ GR_INLINE int snow_giver(int i, int j, int t, int gx0, int gy0, int gx_end, int 
  * at t = 0 the movable amounts for the check. */
 __kernel void snow_relax_rate(__global const float *restrict ground,
                               __global const float *restrict depth,
-                              __global const float *restrict under_min, int nx, int ny, float tx,
-                              float ty, float td, float tol, int gx0, int gy0, int gx_end,
-                              int gy_end, int t, int x_end, int y_end,
+                              __global const float *restrict under_min, float clearance, int nx,
+                              int ny, float tx, float ty, float td, float tol, int gx0, int gy0,
+                              int gx_end, int gy_end, int t, int x_end, int y_end,
                               __global float *restrict rate, __global float *restrict rate_in,
                               __global float *restrict movable) {
   /* Launched on a window from its offset: the launch is rounded up to the
@@ -392,9 +403,9 @@ __kernel void snow_relax_rate(__global const float *restrict ground,
     int m = snow_neighbour(i, j, q, nx, ny);
     sn[q] = depth[m];
     gn[q] = ground[m];
-    un[q] = under_min[m];
+    un[q] = under_min[m] - clearance; /* the ceiling (snow_excess) */
   }
-  snow_rate_at(depth[c], ground[c], under_min[c], sn, gn, un, tx, ty, td,
+  snow_rate_at(depth[c], ground[c], under_min[c] - clearance, sn, gn, un, tx, ty, td,
                snow_giver(i, j, t, gx0, gy0, gx_end, gy_end), tol, &k, &kin, &mv);
   rate[c] = k;
   rate_in[c] = kin;
@@ -406,8 +417,8 @@ __kernel void snow_relax_rate(__global const float *restrict ground,
 __kernel void
 snow_relax_move(__global const float *restrict ground, __global const float *restrict depth,
                 __global const float *restrict density, __global const float *restrict under_min,
-                __global const float *restrict rate, __global const float *restrict rate_in, int nx,
-                int ny, float tx, float ty, float td, int x_end, int y_end,
+                __global const float *restrict rate, __global const float *restrict rate_in,
+                float clearance, int nx, int ny, float tx, float ty, float td, int x_end, int y_end,
                 __global float *restrict depth_out, __global float *restrict density_out) {
   int i = get_global_id(0), j = get_global_id(1);
   if (!gr_inside(i, j, nx, ny) || i >= x_end || j >= y_end)
@@ -418,13 +429,13 @@ snow_relax_move(__global const float *restrict ground, __global const float *res
     int m = snow_neighbour(i, j, q, nx, ny);
     sn[q] = depth[m];
     gn[q] = ground[m];
-    un[q] = under_min[m];
+    un[q] = under_min[m] - clearance;
     rn[q] = density[m];
     kon[q] = rate[m];
     kinn[q] = rate_in[m];
   }
-  snow_move_at(depth[c], density[c], ground[c], under_min[c], rate[c], rate_in[c], sn, gn, un, rn,
-               kon, kinn, tx, ty, td, &s1, &r1);
+  snow_move_at(depth[c], density[c], ground[c], under_min[c] - clearance, rate[c], rate_in[c], sn,
+               gn, un, rn, kon, kinn, tx, ty, td, &s1, &r1);
   depth_out[c] = s1;
   density_out[c] = r1;
 }
@@ -445,8 +456,8 @@ snow_relax_move(__global const float *restrict ground, __global const float *res
 __kernel void
 snow_relax_block(__global const float *restrict ground, __global const float *restrict depth,
                  __global const float *restrict density, __global const float *restrict under_min,
-                 int nx, int ny, float tx, float ty, float td, float tol, int gx0, int gy0,
-                 int gx_end, int gy_end, int x_end, int y_end, int iters,
+                 float clearance, int nx, int ny, float tx, float ty, float td, float tol, int gx0,
+                 int gy0, int gx_end, int gy_end, int x_end, int y_end, int iters,
                  __global float *restrict depth_out, __global float *restrict density_out,
                  __global float *restrict movable, __local float *restrict lmem) {
   const int lx = get_local_size(0), ly = get_local_size(1), halo = 2 * GR_SNOW_BLOCK_ITERATIONS;
@@ -462,7 +473,7 @@ snow_relax_block(__global const float *restrict ground, __global const float *re
     int on = i >= 0 && j >= 0 && i < nx && j < ny;
     int c = on ? gr_idx(i, j, nx) : 0;
     G[q] = on ? ground[c] : 0.0f;
-    U[q] = on ? under_min[c] : INFINITY;
+    U[q] = on ? under_min[c] - clearance : INFINITY; /* the ceiling (snow_excess) */
     S[q] = on ? depth[c] : 0.0f;
     R[q] = on ? density[c] : 0.0f;
     KO[q] = KI[q] = 0.0f;

@@ -1070,9 +1070,11 @@ static gr_status gr_snow_relax_once(gr_snow_deformation *s, cl_int gx0, cl_int g
   cl_int mx0 = gx0 - t - 1 > 0 ? gx0 - t - 1 : 0, my0 = gy0 - t - 1 > 0 ? gy0 - t - 1 : 0;
   cl_int mx_end = gx_end + t + 1 < nx ? gx_end + t + 1 : nx,
          my_end = gy_end + t + 1 < ny ? gy_end + t + 1 : ny;
+  float clearance = (float)(2.0 * GR_SNOW_DEFORMATION_CONTACT_GAP); /* snow_excess */
   const gr_snow_arg rate[] = {{"ground", sizeof(cl_mem), &s->ground},
                               {"depth", sizeof(cl_mem), &s->depth[s->cur]},
                               {"under_min", sizeof(cl_mem), &s->under_min},
+                              {"clearance", sizeof(clearance), &clearance},
                               {"nx", sizeof(nx), &nx},
                               {"ny", sizeof(ny), &ny},
                               {"tx", sizeof(float), &thr[0]},
@@ -1097,6 +1099,7 @@ static gr_status gr_snow_relax_once(gr_snow_deformation *s, cl_int gx0, cl_int g
                               {"depth", sizeof(cl_mem), &s->depth[s->cur]},
                               {"density", sizeof(cl_mem), &s->density[s->cur]},
                               {"under_min", sizeof(cl_mem), &s->under_min},
+                              {"clearance", sizeof(clearance), &clearance},
                               {"rate", sizeof(cl_mem), &s->rate},
                               {"rate_in", sizeof(cl_mem), &s->rate_in},
                               {"nx", sizeof(nx), &nx},
@@ -1127,12 +1130,14 @@ static gr_status gr_snow_relax_blocked(gr_snow_deformation *s, cl_int gx0, cl_in
   float thr[3];
   gr_snow_thresholds(s, thr);
   size_t bw = s->block[0], bh = s->block[1];
+  float clearance = (float)(2.0 * GR_SNOW_DEFORMATION_CONTACT_GAP); /* snow_excess */
   size_t lbytes = 8 * (bw + 4 * GR_SNOW_BLOCK_ITERATIONS) * (bh + 4 * GR_SNOW_BLOCK_ITERATIONS) *
                   sizeof(cl_float);
   const gr_snow_arg args[] = {{"ground", sizeof(cl_mem), &s->ground},
                               {"depth", sizeof(cl_mem), &s->depth[s->cur]},
                               {"density", sizeof(cl_mem), &s->density[s->cur]},
                               {"under_min", sizeof(cl_mem), &s->under_min},
+                              {"clearance", sizeof(clearance), &clearance},
                               {"nx", sizeof(nx), &nx},
                               {"ny", sizeof(ny), &ny},
                               {"tx", sizeof(float), &thr[0]},

@@ -56,16 +56,27 @@
  * mass are conserved and reruns are bit-identical). Point a gives to each
  * 8-neighbour b the excess x_ab = max(0, H_a - H_b - MaxSlope d_ab), d_ab
  * the pair's distance (dx, dy or the diagonal: the slope is a true slope,
- * unlike the thesis' per-cell constant), times min(k_a, k_in_b), the
- * thermal-erosion limits on both sides of the pair: a gives at most 3/4 of
- * its largest excess in all (and no more than S_a), b takes at most 3/4 of
- * its largest incoming excess: a lone pair with excess x ends at the
- * threshold minus x/2, an over-relaxation that settles long slopes in a
- * third of the iterations of exact levelling (see GR_SNOW_TALUS_SHARE; a
- * pair overshoots past level only where x exceeds twice the threshold, and
- * the next iteration sends the overshoot back); never to a point under an
- * object whose underside is below H_a (U_b <= H_a), which holds the
- * imprint. Moved snow carries its density
+ * unlike the thesis' per-cell constant), but never more than the room under
+ * b's ceiling C_b - H_b (C_b: the lowest underside above b less a clearance
+ * of twice GR_SNOW_DEFORMATION_CONTACT_GAP; +inf where no object covers b),
+ * times min(k_a, k_in_b), the thermal-erosion limits on both sides of the
+ * pair: a gives at most 3/4 of its largest excess in all (and no more than
+ * S_a), b takes at most 3/4 of its largest incoming excess: a lone pair with
+ * excess x ends at the threshold minus x/2, an over-relaxation that settles
+ * long slopes in a third of the iterations of exact levelling (see
+ * GR_SNOW_TALUS_SHARE; a pair overshoots past level only where x exceeds
+ * twice the threshold, and the next iteration sends the overshoot back).
+ * Excesses no larger than the threshold (the creep of a slight excess down a
+ * slope already at the talus angle) move at 0.95 instead of 3/4: there a
+ * slope relaxes like a diffusion of its excess, and the share is its speed.
+ * The room: snow slides in under an object (the gap behind a ploughing
+ * sphere fills as the trench walls collapse) but never rises to touch it,
+ * so the imprint holds and talus never makes contact. (notes/000.md's rule,
+ * never into a cell an object occupies, would leave the space under any
+ * overhang empty; a bare "not where U_b <= H_a", this core's first rule,
+ * hid an excess whole until a small change revealed it, and trench walls
+ * under a ploughing sphere crept for hundreds of iterations.) Moved snow
+ * carries its density
  * (mass mixes). Only a point that can move more than RelaxTolerance gives
  * (min(S_a, largest x_ab)), and the relaxation stops when none can (read
  * every 4 iterations, with the box of those points, which bounds the next
