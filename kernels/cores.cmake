@@ -12,4 +12,5 @@ set(GRAUPEL_CORES
   rain_runoff
   snow_accumulation
   snow_deformation
+  terrain_analysis
 )

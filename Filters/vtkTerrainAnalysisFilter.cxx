@@ -1,0 +1,263 @@
+#include "vtkTerrainAnalysisFilter.h"
+
+#include "vtkDataArray.h"
+#include "vtkFloatArray.h"
+#include "vtkImageData.h"
+#include "vtkInformation.h"
+#include "vtkInformationVector.h"
+#include "vtkNew.h"
+#include "vtkObjectFactory.h"
+#include "vtkPointData.h"
+#include "vtkStreamingDemandDrivenPipeline.h"
+#include "vtkUnsignedCharArray.h"
+
+#include "graupel/cl_runtime.h"
+#include "graupel/terrain_analysis.h"
+
+#include "GraupelArrays.h"
+#include "GraupelParameterTable.h"
+
+#include <algorithm>
+#include <string>
+#include <vector>
+
+vtkStandardNewMacro(vtkTerrainAnalysisFilter);
+
+// The core's parameter table clamps every ranged property: the class writes
+// no range of its own.
+GRAUPEL_TABLE_SETTER(vtkTerrainAnalysisFilter, SunAzimuth, double, gr_terrain_analysis_param_bounds)
+GRAUPEL_TABLE_SETTER(vtkTerrainAnalysisFilter, SunElevation, double,
+                     gr_terrain_analysis_param_bounds)
+GRAUPEL_TABLE_SETTER(vtkTerrainAnalysisFilter, PenumbraWidth, double,
+                     gr_terrain_analysis_param_bounds)
+GRAUPEL_TABLE_SETTER(vtkTerrainAnalysisFilter, CoverMode, int, gr_terrain_analysis_param_bounds)
+GRAUPEL_TABLE_SETTER(vtkTerrainAnalysisFilter, SnowExponent, double,
+                     gr_terrain_analysis_param_bounds)
+GRAUPEL_TABLE_SETTER(vtkTerrainAnalysisFilter, SnowCoverLimit, double,
+                     gr_terrain_analysis_param_bounds)
+GRAUPEL_TABLE_SETTER(vtkTerrainAnalysisFilter, RockSlope, double, gr_terrain_analysis_param_bounds)
+GRAUPEL_TABLE_SETTER(vtkTerrainAnalysisFilter, WaterLevel, double, gr_terrain_analysis_param_bounds)
+
+vtkTerrainAnalysisFilter::vtkTerrainAnalysisFilter() {
+  gr_terrain_analysis_params p;
+  gr_terrain_analysis_params_init(&p);
+  this->SunAzimuth = p.sun_azimuth;
+  this->SunElevation = p.sun_elevation;
+  this->PenumbraWidth = p.penumbra_width;
+  this->ModelShadows = p.model_shadows != 0;
+  this->CoverMode = p.cover_mode;
+  this->SnowExponent = p.snow_exponent;
+  this->SnowCoverLimit = p.snow_cover_limit;
+  this->RockSlope = p.rock_slope;
+  this->WaterLevel = p.water_level;
+  this->SetInputArrayToProcess(0, 0, 0, vtkDataObject::FIELD_ASSOCIATION_POINTS, "elevation");
+}
+
+int vtkTerrainAnalysisFilter::RequestUpdateExtent(vtkInformation *,
+                                                  vtkInformationVector **inputVector,
+                                                  vtkInformationVector *) {
+  // The whole terrain: derivatives need neighbours and shadow rays cross it.
+  vtkInformation *inInfo = inputVector[0]->GetInformationObject(0);
+  if (inInfo) {
+    inInfo->Set(vtkStreamingDemandDrivenPipeline::UPDATE_PIECE_NUMBER(), 0);
+    inInfo->Set(vtkStreamingDemandDrivenPipeline::UPDATE_NUMBER_OF_PIECES(), 1);
+    inInfo->Set(vtkStreamingDemandDrivenPipeline::UPDATE_NUMBER_OF_GHOST_LEVELS(), 0);
+    if (inInfo->Has(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT())) {
+      inInfo->Set(vtkStreamingDemandDrivenPipeline::UPDATE_EXTENT(),
+                  inInfo->Get(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT()), 6);
+    }
+  }
+  return 1;
+}
+
+namespace {
+// A float output of the core as a named VTK array; nullptr when reading failed.
+vtkSmartPointer<vtkFloatArray> ReadOutput(gr_terrain_analysis *t, gr_terrain_output o,
+                                          vtkIdType npoints, gr_status *st) {
+  auto a = vtkSmartPointer<vtkFloatArray>::New();
+  a->SetName(gr_terrain_output_name(o));
+  a->SetNumberOfComponents(o == GR_TERRAIN_NORMAL ? 3 : 1);
+  a->SetNumberOfTuples(npoints);
+  *st = gr_terrain_analysis_get_output(t, o, a->GetPointer(0));
+  return *st == GR_OK ? a : nullptr;
+}
+} // namespace
+
+int vtkTerrainAnalysisFilter::RequestData(vtkInformation *, vtkInformationVector **inputVector,
+                                          vtkInformationVector *outputVector) {
+  const char *label = this->GetLabel();
+  vtkImageData *input = vtkImageData::GetData(inputVector[0]);
+  vtkImageData *output = vtkImageData::GetData(outputVector);
+  output->Initialize();
+  if (!input) {
+    vtkErrorMacro(<< label << " needs a terrain image on its Input.");
+    return 0;
+  }
+  int dims[3];
+  input->GetDimensions(dims);
+  if (input->GetNumberOfPoints() < 1 || dims[2] != 1) {
+    vtkErrorMacro(<< label << " needs a 2-D terrain (nx x ny x 1 points) on its Input; it got "
+                  << dims[0] << " x " << dims[1] << " x " << dims[2] << " points.");
+    return 0;
+  }
+  double spacing[3];
+  input->GetSpacing(spacing);
+  if (!(spacing[0] > 0.0) || !(spacing[1] > 0.0)) {
+    vtkErrorMacro(<< label << " needs a terrain spacing above 0 m in x and y; the Input has "
+                  << spacing[0] << " and " << spacing[1] << " m.");
+    return 0;
+  }
+  // No name (a proxy made before its input had arrays to list) means the
+  // default, elevation.
+  vtkInformation *arrayInfo = this->GetInputArrayInformation(0);
+  const char *name = arrayInfo && arrayInfo->Has(vtkDataObject::FIELD_NAME())
+                         ? arrayInfo->Get(vtkDataObject::FIELD_NAME())
+                         : nullptr;
+  if (!name || !*name) {
+    name = "elevation";
+  }
+  vtkDataArray *heights = input->GetPointData()->GetArray(name);
+  if (!heights || heights->GetNumberOfComponents() != 1) {
+    vtkErrorMacro(<< label << "'s Input has no one-component point array '" << name
+                  << "'; give the terrain heights (m) that name, or choose the array of heights "
+                     "(e.g. elevation or snow_surface) as the Height Array.");
+    return 0;
+  }
+
+  gr_terrain_analysis_params p;
+  gr_terrain_analysis_params_init(&p);
+  p.sun_azimuth = this->SunAzimuth;
+  p.sun_elevation = this->SunElevation;
+  p.penumbra_width = this->PenumbraWidth;
+  p.model_shadows = this->ModelShadows ? 1 : 0;
+  p.cover_mode = this->CoverMode;
+  p.snow_exponent = this->SnowExponent;
+  p.snow_cover_limit = this->SnowCoverLimit;
+  p.rock_slope = this->RockSlope;
+  p.water_level = this->WaterLevel;
+  char msg[256];
+  if (gr_terrain_analysis_params_validate(&p, msg, sizeof(msg)) != GR_OK) {
+    vtkErrorMacro(<< label << ": " << msg);
+    return 0;
+  }
+
+  gr_grid grid = {};
+  grid.nx = dims[0];
+  grid.ny = dims[1];
+  grid.dx = spacing[0];
+  grid.dy = spacing[1];
+  double origin[3];
+  input->GetOrigin(origin);
+  grid.x0 = origin[0];
+  grid.y0 = origin[1];
+
+  gr_context *ctx = this->GetContext();
+  if (!ctx) {
+    return 0;
+  }
+  gr_terrain_analysis *t = nullptr;
+  gr_status st = gr_terrain_analysis_create(ctx, &grid, &p, &t);
+  if (st != GR_OK) {
+    return this->ReportFailure(st, (std::string(label) + " could not set up").c_str(),
+                               gr_terrain_analysis_last_error(nullptr));
+  }
+  std::string what = std::string(label) + "'s Input array '" + name + "'";
+  st = gr_terrain_analysis_set_heights(t, graupel::AsFloat(heights)->GetPointer(0));
+  if (st != GR_OK) {
+    std::string why = gr_terrain_analysis_last_error(t);
+    gr_terrain_analysis_destroy(t);
+    vtkErrorMacro(<< what << ": " << why);
+    return 0;
+  }
+
+  // The shadow band by band (about a million points each), so that a large
+  // terrain reports progress and can be aborted between bands.
+  const bool shadow = this->GetShadowOnly() || this->ModelShadows;
+  const int band = std::max(1, (1 << 20) / grid.nx);
+  this->UpdateProgress(0.0);
+  for (int row = 0; shadow && row < grid.ny && st == GR_OK; row += band) {
+    const int rows = std::min(band, grid.ny - row);
+    st = gr_terrain_analysis_compute_shadow_rows(t, row, rows);
+    if (st == GR_OK) {
+      st = gr_finish(ctx);
+    }
+    this->UpdateProgress(0.9 * (row + rows) / grid.ny);
+    if (st == GR_OK && this->GetAbortExecute()) {
+      gr_terrain_analysis_destroy(t);
+      vtkWarningMacro(<< label << ": the update was aborted; the output is empty.");
+      // Honoured: cleared, and the filter marked modified so that the next
+      // update computes again instead of keeping the empty output.
+      this->SetAbortExecute(0);
+      this->Modified();
+      return 1;
+    }
+  }
+  if (st == GR_OK && !this->GetShadowOnly()) {
+    st = gr_terrain_analysis_compute(t);
+  }
+
+  const vtkIdType npoints = static_cast<vtkIdType>(grid.nx) * grid.ny;
+  std::vector<vtkSmartPointer<vtkDataArray>> arrays;
+  if (st == GR_OK && shadow) {
+    arrays.emplace_back(ReadOutput(t, GR_TERRAIN_SHADOW, npoints, &st));
+  }
+  if (!this->GetShadowOnly()) {
+    const gr_terrain_output outputs[] = {GR_TERRAIN_NORMAL, GR_TERRAIN_SLOPE, GR_TERRAIN_ASPECT,
+                                         GR_TERRAIN_SNOW_COVER, GR_TERRAIN_HILLSHADE};
+    for (gr_terrain_output o : outputs) {
+      if (st == GR_OK) {
+        arrays.emplace_back(ReadOutput(t, o, npoints, &st));
+      }
+    }
+    if (st == GR_OK) {
+      vtkNew<vtkUnsignedCharArray> classes;
+      classes->SetName(gr_terrain_output_name(GR_TERRAIN_COVER_CLASS));
+      classes->SetNumberOfTuples(npoints);
+      st = gr_terrain_analysis_get_cover_class(t, classes->GetPointer(0));
+      arrays.emplace_back(classes.Get());
+    }
+  }
+  if (st != GR_OK) {
+    std::string why = gr_terrain_analysis_last_error(t);
+    if (why.empty()) {
+      why = gr_last_error(ctx);
+    }
+    gr_terrain_analysis_destroy(t);
+    return this->ReportFailure(st, (std::string(label) + " could not compute").c_str(),
+                               why.c_str());
+  }
+  gr_terrain_analysis_destroy(t);
+  this->UpdateProgress(1.0);
+
+  output->ShallowCopy(input);
+  vtkPointData *pd = output->GetPointData();
+  for (const auto &a : arrays) {
+    pd->AddArray(a);
+  }
+  // Shown on Apply: Terrain Shadow's output coloured by the shadow; Terrain
+  // Analysis's keeps the input's active scalars (elevation, on Graupel's
+  // terrains) and is lit by the terrain's true normals, a shaded relief even
+  // before a warp. Were hillshade the active scalars, a Terrain Shadow
+  // applied to this output would take it as its heights (ParaView picks the
+  // active scalars for the Height Array).
+  if (this->GetShadowOnly()) {
+    pd->SetActiveScalars("shadow");
+  } else {
+    pd->SetActiveNormals("normal");
+  }
+  this->AddDeviceFieldData(output);
+  return 1;
+}
+
+void vtkTerrainAnalysisFilter::PrintSelf(ostream &os, vtkIndent indent) {
+  this->Superclass::PrintSelf(os, indent);
+  os << indent << "SunAzimuth: " << this->SunAzimuth << "\n";
+  os << indent << "SunElevation: " << this->SunElevation << "\n";
+  os << indent << "PenumbraWidth: " << this->PenumbraWidth << "\n";
+  os << indent << "ModelShadows: " << this->ModelShadows << "\n";
+  os << indent << "CoverMode: " << this->CoverMode << "\n";
+  os << indent << "SnowExponent: " << this->SnowExponent << "\n";
+  os << indent << "SnowCoverLimit: " << this->SnowCoverLimit << "\n";
+  os << indent << "RockSlope: " << this->RockSlope << "\n";
+  os << indent << "WaterLevel: " << this->WaterLevel << "\n";
+}
