@@ -350,6 +350,23 @@ static void test_contour_direction(void) {
 
 /* A tall column on flat ground: afterwards no pair exceeds MaxSlope and the
  * volume is kept; its top is near the cone of that volume. */
+/* The largest amount by which a surface h (nx x ny, spacing dx) stands
+ * above an 8-neighbour beyond the talus slope. */
+static double worst_excess(const float *h, int nx, int ny, double dx, double slope) {
+  double worst = -1.0;
+  for (int j = 0; j < ny; ++j)
+    for (int i = 0; i < nx; ++i)
+      for (int dj = -1; dj <= 1; ++dj)
+        for (int di = -1; di <= 1; ++di) {
+          int a = i + di, b = j + dj;
+          if ((di | dj) == 0 || a < 0 || b < 0 || a >= nx || b >= ny)
+            continue;
+          double dist = dx * sqrt((double)(di * di + dj * dj));
+          worst = fmax(worst, (h[j * nx + i] - h[b * nx + a]) - slope * dist);
+        }
+  return worst;
+}
+
 static void test_talus_column(void) {
   gr_snow_deformation_params p;
   gr_snow_deformation_params_init(&p);
@@ -368,17 +385,7 @@ static void test_talus_column(void) {
   gr_snow_deformation_ledger l;
   CHECK(gr_snow_deformation_ledger_get(s, &l) == GR_OK);
   float *h = get(s, GR_FIELD_SNOW_SURFACE, n * n);
-  double worst = -1.0;
-  for (int j = 0; j < n; ++j)
-    for (int i = 0; i < n; ++i)
-      for (int dj = -1; dj <= 1; ++dj)
-        for (int di = -1; di <= 1; ++di) {
-          int a = i + di, b = j + dj;
-          if ((di | dj) == 0 || a < 0 || b < 0 || a >= n || b >= n)
-            continue;
-          double dist = dx * sqrt((double)(di * di + dj * dj));
-          worst = fmax(worst, (h[j * n + i] - h[b * n + a]) - p.max_slope * dist);
-        }
+  double worst = worst_excess(h, n, n, dx, p.max_slope);
   double vol = 2.0 * dx * dx, r = cbrt(3.0 * vol / (M_PI * p.max_slope));
   double cone_top = p.max_slope * r;
   printf("talus: %d iterations, worst excess %.3g m, volume %.9g of %.9g, top %.4g (cone %.4g)\n",
@@ -391,6 +398,60 @@ static void test_talus_column(void) {
   CHECK(l.relax_iterations > 1 && l.relax_iterations <= 40);
   free(h);
   free(d0);
+  gr_snow_deformation_destroy(s);
+}
+
+/* A relaxation cut short by MaxRelaxIterations goes on where it stopped in
+ * the next steps, with no object anywhere: the talus column, 2 iterations
+ * a step, ends the cone of the uncut relaxation, to the bit. (Before, the next step's
+ * window was the objects' boxes alone: the column stayed a spike.) */
+static void test_talus_resumes(void) {
+  gr_snow_deformation_params p;
+  gr_snow_deformation_params_init(&p);
+  p.initial_snow_depth = 0.0;
+  p.max_relax_iterations = 2;
+  p.relax_tolerance = 1e-5;
+  int n = 41, steps = 0, last = -1;
+  double dx = 0.1;
+  gr_snow_deformation *s = make_sim(n, n, dx, &p);
+  if (!s)
+    return;
+  float *d0 = calloc((size_t)n * n, sizeof(float));
+  d0[20 * n + 20] = 2.0f;
+  CHECK(gr_snow_deformation_set_field(s, GR_FIELD_SNOW_DEPTH, d0) == GR_OK);
+  CHECK(gr_snow_deformation_set_objects(s, NULL, 0, NULL) == GR_OK);
+  gr_snow_deformation_ledger l;
+  while (last != 0 && steps < 40) {
+    CHECK(gr_snow_deformation_step(s, 0.1) == GR_OK);
+    CHECK(gr_snow_deformation_ledger_get(s, &l) == GR_OK);
+    last = l.relax_iterations;
+    ++steps;
+  }
+  float *h = get(s, GR_FIELD_SNOW_SURFACE, n * n);
+  double worst = worst_excess(h, n, n, dx, p.max_slope);
+  printf("talus resumes: %d steps of at most 2 iterations, the last %d; worst excess %.3g m, "
+         "top %.4g m, volume %.9g\n",
+         steps, last, worst, (double)h[20 * n + 20], l.snow_volume);
+  /* the same iterations as one uncut relaxation: the same bits */
+  p.max_relax_iterations = 100000;
+  gr_snow_deformation *u = make_sim(n, n, dx, &p);
+  float *hu = NULL;
+  int differ = -1;
+  if (u) {
+    CHECK(gr_snow_deformation_set_field(u, GR_FIELD_SNOW_DEPTH, d0) == GR_OK);
+    CHECK(gr_snow_deformation_step(u, 0.1) == GR_OK);
+    hu = get(u, GR_FIELD_SNOW_SURFACE, n * n);
+    differ = 0;
+    for (int c = 0; c < n * n; ++c)
+      differ += h[c] != hu[c];
+  }
+  printf("talus resumes: %d points differ from the uncut relaxation's\n", differ);
+  CHECK(steps >= 2 && last == 0);
+  CHECK(worst <= 1e-4);
+  CHECK(l.snow_volume == l.initial_volume);
+  CHECK(differ == 0);
+  free(h), free(hu), free(d0);
+  gr_snow_deformation_destroy(u);
   gr_snow_deformation_destroy(s);
 }
 
@@ -1088,6 +1149,7 @@ static const gr_subtest tests[] = {
     {"devices_agree", test_devices_agree, 0},
     {"bare_ground", test_bare_ground, 0},
     {"talus_room", test_talus_room, 0},
+    {"talus_resumes", test_talus_resumes, 0},
     {"memcheck", test_memcheck, 1},
 };
 

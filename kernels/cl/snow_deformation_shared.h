@@ -46,6 +46,10 @@
  * moving, which becomes the window) runs after every launch. */
 #define GR_SNOW_BLOCK_ITERATIONS 4
 
+/* On GPUs (blocked talus) the check of a launch is read back this many
+ * launches later, so the device never idles waiting for the host. */
+#define GR_SNOW_CHECK_LAG 2
+
 /* The 8 neighbours' offsets, in the order the talus adds them up:
  * row by row from (-1, -1), the point itself left out. */
 #define GR_SNOW_NEIGHBOUR_DI(q) ((q) < 3 ? (q)-1 : (q) < 5 ? 2 * ((q)-3) - 1 : (q)-6)

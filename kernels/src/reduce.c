@@ -50,28 +50,47 @@ gr_status gr_reduction_init(gr_context *ctx, cl_kernel k, size_t items, int nsum
   return st;
 }
 
-gr_status gr_reduction_run(gr_context *ctx, gr_reduction *r, cl_kernel k, double *sums,
-                           double *maxes) {
-  if (!ctx || !r || !r->partial || !k || (r->nsum > 0 && !sums) || (r->nmax > 0 && !maxes))
+gr_status gr_reduction_start(gr_context *ctx, gr_reduction *r, cl_kernel k) {
+  if (!ctx || !r || !r->partial || !k || r->pending)
     return gr_set_error(ctx, GR_ERR_INVALID_ARGUMENT,
-                        "gr_reduction_run needs a context, an initialised reduction, its kernel "
-                        "and room for the results.");
+                        "gr_reduction_start needs a context, an initialised reduction that is not "
+                        "already started, and its kernel.");
   const int slots = 2 * r->nsum + r->nmax;
   gr_status st = gr_kernel_arg(ctx, k, "partial", sizeof(cl_mem), &r->partial);
   if (st == GR_OK)
     st = gr_kernel_arg(ctx, k, "scratch", r->local * (size_t)slots * sizeof(cl_float), NULL);
   size_t global = r->groups * r->local;
+  cl_command_queue q = gr_context_queue(ctx);
   if (st == GR_OK)
-    st = gr_cl_check(ctx,
-                     clEnqueueNDRangeKernel(gr_context_queue(ctx), k, 1, NULL, &global, &r->local,
-                                            0, NULL, NULL),
+    st = gr_cl_check(ctx, clEnqueueNDRangeKernel(q, k, 1, NULL, &global, &r->local, 0, NULL, NULL),
                      "Enqueueing a reduction");
   if (st == GR_OK)
-    st = gr_buffer_read(ctx, r->partial, 0, r->groups * (size_t)slots * sizeof(cl_float), r->host);
-  if (st != GR_OK)
+    st = gr_cl_check(ctx,
+                     clEnqueueReadBuffer(q, r->partial, CL_FALSE, 0,
+                                         r->groups * (size_t)slots * sizeof(cl_float), r->host, 0,
+                                         NULL, &r->pending),
+                     "Reading a reduction's partials back");
+  if (st == GR_OK)
+    st = gr_cl_check(ctx, clFlush(q), "Flushing the queue after a reduction");
+  return st;
+}
+
+gr_status gr_reduction_finish(gr_context *ctx, gr_reduction *r, double *sums, double *maxes) {
+  if (!ctx || !r || !r->pending)
+    return gr_set_error(ctx, GR_ERR_INVALID_ARGUMENT,
+                        "gr_reduction_finish needs a context and a started reduction.");
+  gr_status st =
+      gr_cl_check(ctx, clWaitForEvents(1, &r->pending), "Waiting for a reduction's partials");
+  clReleaseEvent(r->pending);
+  r->pending = NULL;
+  if (st != GR_OK || (!sums && !maxes))
     return st;
+  if ((r->nsum > 0 && !sums) || (r->nmax > 0 && !maxes))
+    return gr_set_error(ctx, GR_ERR_INVALID_ARGUMENT,
+                        "gr_reduction_finish needs room for the results.");
   /* In group order, in double: the same partials give the same bits. The
    * maxima start at -inf, below every group's own start value. */
+  const int slots = 2 * r->nsum + r->nmax;
   for (int q = 0; q < r->nsum; ++q)
     sums[q] = 0.0;
   for (int q = 0; q < r->nmax; ++q)
@@ -86,9 +105,29 @@ gr_status gr_reduction_run(gr_context *ctx, gr_reduction *r, cl_kernel k, double
   return GR_OK;
 }
 
+gr_status gr_reduction_run(gr_context *ctx, gr_reduction *r, cl_kernel k, double *sums,
+                           double *maxes) {
+  if (!ctx || !r || !r->partial || !k || (r->nsum > 0 && !sums) || (r->nmax > 0 && !maxes))
+    return gr_set_error(ctx, GR_ERR_INVALID_ARGUMENT,
+                        "gr_reduction_run needs a context, an initialised reduction, its kernel "
+                        "and room for the results.");
+  gr_status st = gr_reduction_start(ctx, r, k);
+  if (st != GR_OK) {
+    if (r->pending)
+      gr_reduction_finish(ctx, r, NULL, NULL);
+    return st;
+  }
+  return gr_reduction_finish(ctx, r, sums, maxes);
+}
+
 void gr_reduction_release(gr_reduction *r) {
   if (!r)
     return;
+  if (r->pending) {
+    clWaitForEvents(1, &r->pending);
+    clReleaseEvent(r->pending);
+    r->pending = NULL;
+  }
   gr_buffer_release(&r->partial);
   free(r->host);
   r->host = NULL;

@@ -21,7 +21,7 @@
 #define GR_SNOW_MAX_DT 3600.0
 /* Checkpoints: "GSD1". */
 #define GR_SNOW_STATE_MAGIC 0x31445347u
-#define GR_SNOW_STATE_VERSION 2u
+#define GR_SNOW_STATE_VERSION 3u /* 3: the relaxation's rest box */
 /* Per-point arrays of a checkpoint: depth, density, overlap sum, contact. */
 #define GR_SNOW_STATE_ARRAYS 4
 
@@ -72,7 +72,7 @@ struct gr_snow_deformation {
   int blocked;     /* the talus in blocked launches (GPUs) or one launch per iteration */
   cl_mem tri;      /* world triangles, 9 floats each */
   size_t tri_cap;
-  gr_reduction red_obj, red_check, red_ledger, red_added;
+  gr_reduction red_obj, red_check[GR_SNOW_CHECK_LAG + 1], red_ledger, red_added;
   gr_snow_object objects[GR_SNOW_DEFORMATION_MAX_OBJECTS];
   int nobjects;
   double force[GR_SNOW_DEFORMATION_MAX_OBJECTS][3], area[GR_SNOW_DEFORMATION_MAX_OBJECTS];
@@ -83,6 +83,10 @@ struct gr_snow_deformation {
   long long steps;
   int relax_iterations;
   int relax_full; /* the next relaxation covers the whole grid */
+  /* x0 y0 x1 y1: the box where the last relaxation stopped at its cap with
+   * snow still able to move (x0 > x1: nowhere); the next one starts there
+   * too, so that no window ever leaves out a point that can move. */
+  int rest[4];
   int sync_full;  /* the state's other buffer may differ anywhere */
   int dirty[4];   /* x0 y0 x1 y1: where the last step's objects wrote */
   int reset_full; /* the next step clears the per-step arrays everywhere */
@@ -298,6 +302,8 @@ static gr_status gr_snow_initial_state(gr_snow_deformation *s) {
   s->steps = 0;
   s->relax_iterations = 0;
   s->relax_full = 1;
+  s->rest[0] = s->rest[1] = 0;
+  s->rest[2] = s->rest[3] = -1;
   s->sync_full = 1;
   s->reset_full = 1;
   s->aborted = 0;
@@ -421,7 +427,8 @@ gr_status gr_snow_deformation_create(gr_context *ctx, const gr_grid *grid,
   if (st == GR_OK)
     st = gr_reduction_init(ctx, s->obj_reduce, cells, GR_SNOW_OBJ_SUMS, 0, &s->red_obj);
   if (st == GR_OK)
-    st = gr_reduction_init(ctx, s->check_reduce, cells, 0, GR_SNOW_CHECK_MAXES, &s->red_check);
+    for (int q = 0; st == GR_OK && q <= GR_SNOW_CHECK_LAG; ++q)
+      st = gr_reduction_init(ctx, s->check_reduce, cells, 0, GR_SNOW_CHECK_MAXES, &s->red_check[q]);
   if (st == GR_OK)
     st = gr_reduction_init(ctx, s->ledger_reduce, cells, GR_SNOW_LEDGER_SUMS, 0, &s->red_ledger);
   if (st == GR_OK)
@@ -463,7 +470,8 @@ void gr_snow_deformation_destroy(gr_snow_deformation *s) {
   for (size_t i = 0; i < sizeof(bufs) / sizeof(bufs[0]); ++i)
     gr_buffer_release(bufs[i]);
   gr_reduction_release(&s->red_obj);
-  gr_reduction_release(&s->red_check);
+  for (int q = 0; q <= GR_SNOW_CHECK_LAG; ++q)
+    gr_reduction_release(&s->red_check[q]);
   gr_reduction_release(&s->red_ledger);
   gr_reduction_release(&s->red_added);
   gr_context_release(s->ctx);
@@ -1023,9 +1031,10 @@ static float gr_snow_tolerance(const gr_snow_deformation *s) {
 
 /* The check: the largest amount a point of the givers' window R can still
  * move, and the box of the points that can move more than the tolerance
- * (out[1..4]: -x0, x1, -y0, y1). */
-static gr_status gr_snow_relax_check(gr_snow_deformation *s, int x0, int y0, int x1, int y1,
-                                     double out[GR_SNOW_CHECK_MAXES]) {
+ * (gr_reduction_finish's maxes[1..4]: -x0, x1, -y0, y1), started on r
+ * without waiting for it. */
+static gr_status gr_snow_relax_check_start(gr_snow_deformation *s, gr_reduction *r, int x0, int y0,
+                                           int x1, int y1) {
   cl_kernel k = s->check_reduce;
   cl_int nx = s->grid.nx, w = x1 - x0 + 1, cnt = w * (y1 - y0 + 1);
   float tol = gr_snow_tolerance(s);
@@ -1043,7 +1052,7 @@ static gr_status gr_snow_relax_check(gr_snow_deformation *s, int x0, int y0, int
   if (st == GR_OK)
     st = GR_SNOW_ARG(s, k, "tol", tol);
   if (st == GR_OK)
-    st = gr_reduction_run(s->ctx, &s->red_check, k, NULL, out);
+    st = gr_reduction_start(s->ctx, r, k);
   return st;
 }
 
@@ -1207,9 +1216,19 @@ static gr_status gr_snow_relax(gr_snow_deformation *s) {
       y0 = y0 < ob->bj0 - 2 ? y0 : ob->bj0 - 2;
       y1 = y1 > ob->bj1 + 2 ? y1 : ob->bj1 + 2;
     }
+    if (s->rest[0] <= s->rest[2] && s->rest[1] <= s->rest[3]) {
+      x0 = x0 < s->rest[0] ? x0 : s->rest[0];
+      y0 = y0 < s->rest[1] ? y0 : s->rest[1];
+      x1 = x1 > s->rest[2] ? x1 : s->rest[2];
+      y1 = y1 > s->rest[3] ? y1 : s->rest[3];
+    }
   }
   if (s->params.max_relax_iterations == 0) {
-    s->sync_full |= x0 <= x1; /* the objects changed the state alone */
+    s->sync_full |= x0 <= x1;   /* the objects changed the state alone */
+    if (x0 <= x1 && y0 <= y1) { /* all of it may still move */
+      s->rest[0] = x0 > 0 ? x0 : 0, s->rest[1] = y0 > 0 ? y0 : 0;
+      s->rest[2] = x1 < nx - 1 ? x1 : nx - 1, s->rest[3] = y1 < ny - 1 ? y1 : ny - 1;
+    }
     return GR_OK;
   }
   if (x0 > x1 || y0 > y1)
@@ -1224,44 +1243,84 @@ static gr_status gr_snow_relax(gr_snow_deformation *s) {
     st = gr_snow_sync_rect(s, x0, y0, x1, y1);
   s->relax_full = s->sync_full = 0;
   int lx0 = 0, ly0 = 0, lx1 = -1, ly1 = -1; /* the last launch's window */
-  while (st == GR_OK && it < s->params.max_relax_iterations) {
-    int left = s->params.max_relax_iterations - it;
-    cl_int iters = left < GR_SNOW_BLOCK_ITERATIONS ? left : GR_SNOW_BLOCK_ITERATIONS;
-    x0 = x0 > 0 ? x0 : 0;
-    y0 = y0 > 0 ? y0 : 0;
-    x1 = x1 < nx - 1 ? x1 : nx - 1;
-    y1 = y1 < ny - 1 ? y1 : ny - 1;
-    cl_int gx0 = x0, gy0 = y0, gx_end = x1 + 1, gy_end = y1 + 1;
-    /* The launch's window: R grown by the iterations. */
-    int mx0 = x0 - iters > 0 ? x0 - iters : 0, my0 = y0 - iters > 0 ? y0 - iters : 0;
-    cl_int mx_end = x1 + iters + 1 < nx ? x1 + iters + 1 : nx,
-           my_end = y1 + iters + 1 < ny ? y1 + iters + 1 : ny;
-    /* The buffer the first write goes to lags the state on the last
-     * window; it must not where that write does not reach: all of the
-     * launch's window in one blocked launch, R grown by one in the first of
-     * the one-launch iterations (each later one covers its predecessor's). */
-    int grow = s->blocked ? iters : 1;
-    int fx0 = x0 - grow > 0 ? x0 - grow : 0, fy0 = y0 - grow > 0 ? y0 - grow : 0;
-    int fx1 = x1 + grow < nx - 1 ? x1 + grow : nx - 1,
-        fy1 = y1 + grow < ny - 1 ? y1 + grow : ny - 1;
-    if (lx0 < fx0 || ly0 < fy0 || lx1 > fx1 || ly1 > fy1)
-      st = gr_snow_sync_rect(s, lx0, ly0, lx1, ly1);
-    if (st == GR_OK && s->blocked)
-      st = gr_snow_relax_blocked(s, gx0, gy0, gx_end, gy_end, mx0, my0, mx_end, my_end, iters, tol);
-    for (cl_int t = 0; st == GR_OK && !s->blocked && t < iters; ++t)
-      st = gr_snow_relax_once(s, gx0, gy0, gx_end, gy_end, t, tol);
-    if (st == GR_OK)
-      lx0 = mx0, ly0 = my0, lx1 = mx_end - 1, ly1 = my_end - 1;
-    double m[GR_SNOW_CHECK_MAXES];
-    if (st == GR_OK)
-      st = gr_snow_relax_check(s, x0, y0, x1, y1, m);
-    if (st == GR_OK && m[0] <= tol)
-      break; /* nothing could move: the launch changed nothing */
-    if (st == GR_OK) {
-      it += iters;
-      x0 = (int)-m[1] - iters, x1 = (int)m[2] + iters;
-      y0 = (int)-m[3] - iters, y1 = (int)m[4] + iters;
+  /* Launches in flight: their checks are read back up to `lag` launches
+   * later (on GPUs, where waiting for each read-back between launches
+   * costs more than the launch), so the window of a launch is the last
+   * box read grown by every iteration launched since. A launch after the
+   * one whose check says nothing could move changes nothing (no point
+   * gives), so the lag changes what is computed, never the result or the
+   * iteration count. */
+  const int lag = s->blocked ? GR_SNOW_CHECK_LAG : 0, cap = s->params.max_relax_iterations;
+  int before[GR_SNOW_CHECK_LAG + 1], count[GR_SNOW_CHECK_LAG + 1]; /* per launch in flight */
+  int launched = 0, read = 0, it_launched = 0, done = 0;
+  while (st == GR_OK && !done) {
+    if (it_launched < cap && launched - read <= lag) {
+      int left = cap - it_launched;
+      cl_int iters = left < GR_SNOW_BLOCK_ITERATIONS ? left : GR_SNOW_BLOCK_ITERATIONS;
+      x0 = x0 > 0 ? x0 : 0;
+      y0 = y0 > 0 ? y0 : 0;
+      x1 = x1 < nx - 1 ? x1 : nx - 1;
+      y1 = y1 < ny - 1 ? y1 : ny - 1;
+      cl_int gx0 = x0, gy0 = y0, gx_end = x1 + 1, gy_end = y1 + 1;
+      /* The launch's window: R grown by the iterations. */
+      int mx0 = x0 - iters > 0 ? x0 - iters : 0, my0 = y0 - iters > 0 ? y0 - iters : 0;
+      cl_int mx_end = x1 + iters + 1 < nx ? x1 + iters + 1 : nx,
+             my_end = y1 + iters + 1 < ny ? y1 + iters + 1 : ny;
+      /* The buffer the first write goes to lags the state on the last
+       * window; it must not where that write does not reach: all of the
+       * launch's window in one blocked launch, R grown by one in the first
+       * of the one-launch iterations (each later one covers its
+       * predecessor's). */
+      int grow = s->blocked ? iters : 1;
+      int fx0 = x0 - grow > 0 ? x0 - grow : 0, fy0 = y0 - grow > 0 ? y0 - grow : 0;
+      int fx1 = x1 + grow < nx - 1 ? x1 + grow : nx - 1,
+          fy1 = y1 + grow < ny - 1 ? y1 + grow : ny - 1;
+      if (lx0 < fx0 || ly0 < fy0 || lx1 > fx1 || ly1 > fy1)
+        st = gr_snow_sync_rect(s, lx0, ly0, lx1, ly1);
+      if (st == GR_OK && s->blocked)
+        st = gr_snow_relax_blocked(s, gx0, gy0, gx_end, gy_end, mx0, my0, mx_end, my_end, iters,
+                                   tol);
+      for (cl_int t = 0; st == GR_OK && !s->blocked && t < iters; ++t)
+        st = gr_snow_relax_once(s, gx0, gy0, gx_end, gy_end, t, tol);
+      if (st == GR_OK)
+        lx0 = mx0, ly0 = my0, lx1 = mx_end - 1, ly1 = my_end - 1;
+      if (st == GR_OK)
+        st = gr_snow_relax_check_start(s, &s->red_check[launched % (lag + 1)], x0, y0, x1, y1);
+      if (st == GR_OK) {
+        before[launched % (lag + 1)] = it_launched;
+        count[launched % (lag + 1)] = iters;
+        it_launched += iters;
+        ++launched;
+        x0 -= iters, x1 += iters, y0 -= iters, y1 += iters; /* until a box is read */
+      }
+      continue;
     }
+    if (read == launched)
+      break; /* the cap, every check read */
+    double m[GR_SNOW_CHECK_MAXES];
+    int slot = read % (lag + 1);
+    st = gr_reduction_finish(s->ctx, &s->red_check[slot], NULL, m);
+    ++read;
+    if (st == GR_OK && m[0] <= tol) {
+      it = before[slot]; /* nothing could move: that launch and those after changed nothing */
+      done = 1;
+    } else if (st == GR_OK) {
+      it = before[slot] + count[slot];
+      int g = it_launched - before[slot]; /* iterations since that check's launch began */
+      x0 = (int)-m[1] - g, x1 = (int)m[2] + g;
+      y0 = (int)-m[3] - g, y1 = (int)m[4] + g;
+    }
+  }
+  /* Checks still in flight (after the end, or an error): wait for them. */
+  for (; read < launched; ++read)
+    gr_reduction_finish(s->ctx, &s->red_check[read % (lag + 1)], NULL, NULL);
+  /* Stopped by the cap: the last box read, grown by the iterations since,
+   * holds every point that may still move. */
+  s->rest[0] = s->rest[1] = 0;
+  s->rest[2] = s->rest[3] = -1;
+  if (st == GR_OK && !done) {
+    s->rest[0] = x0 > 0 ? x0 : 0, s->rest[1] = y0 > 0 ? y0 : 0;
+    s->rest[2] = x1 < nx - 1 ? x1 : nx - 1, s->rest[3] = y1 < ny - 1 ? y1 : ny - 1;
   }
   /* Both buffers equal again: the last window from the state. */
   if (st == GR_OK)
@@ -1429,7 +1488,7 @@ void gr_snow_deformation_set_progress(gr_snow_deformation *s, gr_progress_fn fn,
 
 typedef struct gr_snow_state_header {
   uint32_t magic, version;
-  int32_t nx, ny, relax_full, relax_iterations;
+  int32_t nx, ny, relax_full, relax_iterations, rest[4];
   int64_t steps;
   double time, initial_volume, initial_mass, compressed, displaced, pending, pending_mass;
   double force[GR_SNOW_DEFORMATION_MAX_OBJECTS][3], area[GR_SNOW_DEFORMATION_MAX_OBJECTS];
@@ -1473,6 +1532,8 @@ gr_status gr_snow_deformation_state_save(gr_snow_deformation *s, void *host, siz
   hd.ny = s->grid.ny;
   hd.relax_iterations = s->relax_iterations;
   hd.relax_full = s->relax_full;
+  for (int q = 0; q < 4; ++q)
+    hd.rest[q] = s->rest[q];
   hd.steps = s->steps;
   hd.time = s->time;
   hd.initial_volume = s->initial_volume;
@@ -1531,6 +1592,8 @@ gr_status gr_snow_deformation_state_load(gr_snow_deformation *s, const void *hos
     return GR_SNOW_KEEP_ERROR(s, st);
   s->relax_iterations = hd.relax_iterations;
   s->relax_full = hd.relax_full != 0;
+  for (int q = 0; q < 4; ++q)
+    s->rest[q] = hd.rest[q];
   s->sync_full = 1;
   s->reset_full = 1;
   s->steps = hd.steps;

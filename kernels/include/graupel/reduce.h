@@ -25,6 +25,7 @@ typedef struct gr_reduction {
   size_t local, groups; /**< work-group size (a power of two) and count */
   cl_mem partial;       /**< (2 nsum + nmax) floats per group */
   float *host;          /**< the partials, read back */
+  cl_event pending;     /**< the read-back of a started reduction, until it is finished */
 } gr_reduction;
 
 /**
@@ -43,7 +44,18 @@ GR_API gr_status gr_reduction_init(gr_context *ctx, cl_kernel k, size_t items, i
 GR_API gr_status gr_reduction_run(gr_context *ctx, gr_reduction *r, cl_kernel k, double *sums,
                                   double *maxes);
 
-/** Frees the buffers; a zeroed or released reduction is fine. */
+/**
+ * gr_reduction_run in two halves, so that the host need not wait for the
+ * device between them: start enqueues k and the read-back of its partials
+ * (and flushes the queue); finish waits for that read and returns what run
+ * returns. A started reduction must be finished (or released) before it is
+ * started again. finish with sums and maxes NULL only waits.
+ */
+GR_API gr_status gr_reduction_start(gr_context *ctx, gr_reduction *r, cl_kernel k);
+GR_API gr_status gr_reduction_finish(gr_context *ctx, gr_reduction *r, double *sums, double *maxes);
+
+/** Frees the buffers (waiting for a started read first); a zeroed or
+ * released reduction is fine. */
 GR_API void gr_reduction_release(gr_reduction *r);
 
 #ifdef __cplusplus
