@@ -1374,6 +1374,27 @@ static void test_pieces_x(void) {
     run_whole(whole, 0, steps, &lw, fw, aw);
     CHECK(lw.displaced_volume > 1e-3 && fw[0] < 0.0 && aw[0] > 0.0);
     check_pieces(pc, rn, whole, &dm, &lw, fw, aw, 1, "split in x, 40 steps");
+    /* Checkpoints of both pieces: 6 more steps from the live state and
+     * from the loaded one end on the same bits. */
+    void *saved[2];
+    size_t sb[2];
+    float *after[2][2];
+    for (int k = 0; k < 2; ++k) {
+      CHECK(gr_snow_deformation_state_size(pc[k].s, &sb[k]) == GR_OK);
+      saved[k] = malloc(sb[k]);
+      CHECK(gr_snow_deformation_state_save(pc[k].s, saved[k], sb[k]) == GR_OK);
+    }
+    for (int run = 0; run < 2; ++run) {
+      for (int k = 0; run == 1 && k < 2; ++k)
+        CHECK(gr_snow_deformation_state_load(pc[k].s, saved[k], sb[k]) == GR_OK);
+      run_team(pc, rn, GR_SNOW_DEFORMATION_EAST, 0, 6, -1, 0, 0);
+      for (int k = 0; k < 2; ++k)
+        after[run][k] = get(pc[k].s, GR_FIELD_SNOW_DEPTH, pc[k].g.nx * pc[k].g.ny);
+    }
+    for (int k = 0; k < 2; ++k) {
+      CHECK(memcmp(after[0][k], after[1][k], (size_t)pc[k].g.nx * pc[k].g.ny * sizeof(float)) == 0);
+      free(after[0][k]), free(after[1][k]), free(saved[k]);
+    }
     /* A piece with neighbours and no callbacks does not step. */
     gr_snow_deformation_set_allreduce(pc[0].s, NULL, NULL);
     gr_snow_deformation_set_halo_exchange(pc[0].s, NULL, NULL);
