@@ -9,6 +9,7 @@
 #include "graupel/snow_deformation.h"
 
 #include <math.h>
+#include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -18,6 +19,10 @@
 #endif
 
 static gr_context *ctx;
+
+static int has(const char *text, const char *word) {
+  return text && strstr(text, word) != NULL;
+}
 
 /* A latitude-longitude sphere of radius r: poles and st - 1 rings of sl. */
 static void mesh_sphere(test_mesh *tm, double r, int st, int sl) {
@@ -638,10 +643,10 @@ static void test_errors(void) {
   CHECK(gr_snow_deformation_create(ctx, &g, &p, &s) == GR_ERR_INVALID_ARGUMENT && !s);
   CHECK(strstr(gr_last_error(ctx), "MaxSlope") != NULL);
   gr_snow_deformation_params_init(&p);
-  gr_grid piece = g;
+  gr_grid piece = g; /* a piece with a neighbour to the east and no ring */
   piece.global_nx = 64;
   CHECK(gr_snow_deformation_create(ctx, &piece, &p, &s) == GR_ERR_INVALID_ARGUMENT && !s);
-  CHECK(strstr(gr_last_error(ctx), "whole grids") != NULL);
+  CHECK(strstr(gr_last_error(ctx), "ghost ring") != NULL);
   CHECK(gr_snow_deformation_create(ctx, &g, &p, &s) == GR_OK);
   if (!s)
     return;
@@ -1129,6 +1134,512 @@ static void test_memcheck(void) {
   CHECK(strcmp(gr_snow_deformation_last_error(NULL), "") == 0);
 }
 
+/* ------------------------------------------------------------- pieces */
+
+/* The whole domain for the split tests: 64 x 48 points of 5 cm, a bumpy
+ * ground and snow of varying depth and density (so the first step's talus
+ * runs over the whole domain, across the split). */
+typedef struct domain {
+  gr_grid g;
+  float *b, *d, *r;
+} domain;
+
+static double hash01(int i, int j, unsigned seed) {
+  unsigned h = (unsigned)i * 73856093u ^ (unsigned)j * 19349663u ^ seed * 83492791u;
+  h ^= h >> 13;
+  h *= 0x5bd1e995u;
+  h ^= h >> 15;
+  return (double)(h & 0xffffffu) / 16777216.0;
+}
+
+static domain make_domain(void) {
+  domain dm;
+  gr_grid g = {.nx = 64, .ny = 48, .dx = 0.05, .dy = 0.05, .x0 = -0.3, .y0 = 0.2};
+  dm.g = g;
+  size_t n = (size_t)g.nx * g.ny;
+  dm.b = malloc(n * sizeof(float));
+  dm.d = malloc(n * sizeof(float));
+  dm.r = malloc(n * sizeof(float));
+  for (int j = 0; j < g.ny; ++j)
+    for (int i = 0; i < g.nx; ++i) {
+      size_t c = (size_t)j * g.nx + i;
+      double x = i * g.dx, y = j * g.dy;
+      dm.b[c] = (float)(0.05 * sin(x / 0.7) * cos(y / 0.5) + 0.01 * hash01(i, j, 1));
+      dm.d[c] = (float)(0.45 + 0.1 * hash01(i, j, 2));
+      /* Two piles of 0.4 m more, astride the splits at x = 1.5 m and at
+       * y = 1.3 m: their talus takes dozens of iterations in the first
+       * step, across the split. */
+      if ((abs(i - 30) <= 2 && abs(j - 12) <= 2) || (abs(i - 42) <= 2 && abs(j - 26) <= 2))
+        dm.d[c] += 0.4f;
+      dm.r[c] = (float)(130.0 + 60.0 * hash01(i, j, 3));
+    }
+  return dm;
+}
+
+static void free_domain(domain *dm) {
+  free(dm->b), free(dm->d), free(dm->r);
+}
+
+/* The objects of the split tests at step k: a box dragged along x (pieces
+ * split in x), or a sphere rolling north-east and a box pressed straight
+ * down (pieces split in y); n objects, velocities v. */
+typedef struct scene {
+  int kind; /* 0: box along x; 1: sphere and box */
+  double dt;
+  test_mesh box, ball;
+} scene;
+
+static int scene_pose(scene *sc, int k, gr_mesh *m, double *v) {
+  if (sc->kind == 0) {
+    v[0] = 1.5, v[1] = 0.0, v[2] = 0.0;
+    mesh_pose(&sc->box, 0.3 + 1.5 * sc->dt * k, 1.0, 0.3 + 0.25); /* the domain's x0 = -0.3 */
+    m[0] = sc->box.m;
+    return 1;
+  }
+  v[0] = 0.4, v[1] = 1.2, v[2] = -0.2;
+  mesh_pose(&sc->ball, 1.0 + 0.4 * sc->dt * k, 0.6 + 1.2 * sc->dt * k, 0.2 + 0.25 + 0.3);
+  v[3] = 0.0, v[4] = 0.0, v[5] = -1.0;
+  mesh_pose(&sc->box, 2.2, 1.35, 0.35 + 0.25); /* astride the split, 1.3 m from y0 */
+  m[0] = sc->ball.m;
+  m[1] = sc->box.m;
+  return 2;
+}
+
+static void scene_init(scene *sc, int kind) {
+  sc->kind = kind;
+  sc->dt = 1.0 / 60.0;
+  mesh_box(&sc->box, 0.3, 0.2, 0.25);
+  mesh_sphere(&sc->ball, 0.3, 8, 12);
+}
+
+static void scene_free(scene *sc) {
+  mesh_free(&sc->box);
+  mesh_free(&sc->ball);
+}
+
+/* One piece: its grid, rings, local size and simulation. */
+typedef struct piece {
+  gr_grid g;
+  int ring[4], nxl, nyl;
+  gr_snow_deformation *s;
+} piece;
+
+static float *cut(const float *global, int gnx, int x0, int y0, int w, int h) {
+  float *out = malloc((size_t)w * (size_t)h * sizeof(float));
+  for (int j = 0; j < h; ++j)
+    memcpy(out + (size_t)j * w, global + (size_t)(y0 + j) * gnx + x0, (size_t)w * sizeof(float));
+  return out;
+}
+
+static int make_piece(piece *p, const domain *dm, const gr_snow_deformation_params *prm, int i0,
+                      int j0, int nx, int ny) {
+  const int G = GR_SNOW_DEFORMATION_GHOST;
+  memset(p, 0, sizeof(*p));
+  p->g = dm->g;
+  p->g.nx = nx, p->g.ny = ny, p->g.i0 = i0, p->g.j0 = j0;
+  p->g.global_nx = dm->g.nx, p->g.global_ny = dm->g.ny, p->g.ghost = G;
+  p->ring[0] = i0 > 0 ? G : 0;
+  p->ring[1] = i0 + nx < dm->g.nx ? G : 0;
+  p->ring[2] = j0 > 0 ? G : 0;
+  p->ring[3] = j0 + ny < dm->g.ny ? G : 0;
+  p->nxl = nx + p->ring[0] + p->ring[1];
+  p->nyl = ny + p->ring[2] + p->ring[3];
+  gr_status st = gr_snow_deformation_create(ctx, &p->g, prm, &p->s);
+  CHECK_MSG(st == GR_OK, "piece: %s", gr_last_error(ctx));
+  const float *fields[] = {dm->b, dm->d, dm->r};
+  const gr_field names[] = {GR_FIELD_ELEVATION, GR_FIELD_SNOW_DEPTH, GR_FIELD_SNOW_DENSITY};
+  for (int f = 0; st == GR_OK && f < 3; ++f) {
+    float *local = cut(fields[f], dm->g.nx, i0 - p->ring[0], j0 - p->ring[2], p->nxl, p->nyl);
+    st = gr_snow_deformation_set_field(p->s, names[f], local);
+    CHECK_MSG(st == GR_OK, "piece field: %s", gr_snow_deformation_last_error(p->s));
+    free(local);
+  }
+  return st == GR_OK;
+}
+
+static gr_snow_deformation *make_whole(const domain *dm, const gr_snow_deformation_params *prm) {
+  gr_snow_deformation *s = NULL;
+  gr_status st = gr_snow_deformation_create(ctx, &dm->g, prm, &s);
+  CHECK_MSG(st == GR_OK, "whole: %s", gr_last_error(ctx));
+  if (st == GR_OK)
+    st = gr_snow_deformation_set_field(s, GR_FIELD_ELEVATION, dm->b);
+  if (st == GR_OK)
+    st = gr_snow_deformation_set_field(s, GR_FIELD_SNOW_DEPTH, dm->d);
+  if (st == GR_OK)
+    st = gr_snow_deformation_set_field(s, GR_FIELD_SNOW_DENSITY, dm->r);
+  CHECK(st == GR_OK);
+  return s;
+}
+
+/* Two threads, one piece each: an allreduce through a barrier (combined in
+ * rank order, so both get the same bits) and a halo exchange through a
+ * mailbox, which the core calls inside its steps. */
+typedef struct team {
+  pthread_barrier_t barrier;
+  double slot[2][32];
+  void *mail[2];
+  size_t mail_bytes[2];
+} team;
+
+typedef struct runner {
+  team *t;
+  int rank, side, steps, stop_at, calls, exchanges, taken, fail_exchange;
+  piece *p;
+  scene sc;
+  gr_status st, last;
+  gr_snow_deformation_ledger l;
+  double force[6], area[2];
+} runner;
+
+static gr_status team_allreduce(void *user, double *values, int n, gr_reduce_op op) {
+  runner *r = user;
+  team *t = r->t;
+  if (n > 32)
+    return GR_ERR_INVALID_ARGUMENT;
+  memcpy(t->slot[r->rank], values, (size_t)n * sizeof(double));
+  pthread_barrier_wait(&t->barrier);
+  for (int q = 0; q < n; ++q) {
+    double a = t->slot[0][q], b = t->slot[1][q];
+    values[q] = op == GR_REDUCE_SUM ? a + b : op == GR_REDUCE_MAX ? fmax(a, b) : fmin(a, b);
+  }
+  pthread_barrier_wait(&t->barrier);
+  return GR_OK;
+}
+
+static gr_status team_exchange(void *user) {
+  runner *r = user;
+  team *t = r->t;
+  ++r->exchanges;
+  gr_status st =
+      gr_snow_deformation_halo_get(r->p->s, r->side, t->mail[r->rank], t->mail_bytes[r->rank]);
+  pthread_barrier_wait(&t->barrier);
+  if (st == GR_OK)
+    st = gr_snow_deformation_halo_set(r->p->s, r->side, t->mail[1 - r->rank],
+                                      t->mail_bytes[1 - r->rank]);
+  pthread_barrier_wait(&t->barrier);
+  if (r->fail_exchange && r->exchanges >= r->fail_exchange)
+    return GR_ERR_IO;
+  return st;
+}
+
+static int stop_at_step(void *user, double time) {
+  runner *r = user;
+  (void)time;
+  return ++r->calls >= r->stop_at;
+}
+
+/* Steps the piece through the scene until it has taken r->steps steps or a
+ * step fails (GR_ERR_ABORTED after a stop); then the (collective) ledger
+ * and the forces. */
+static void *runner_run(void *arg) {
+  runner *r = arg;
+  gr_mesh m[2];
+  double v[6];
+  gr_status st = GR_OK;
+  for (int k = 0; st == GR_OK && k < r->steps; ++k) {
+    int n = scene_pose(&r->sc, k, m, v);
+    st = gr_snow_deformation_set_objects(r->p->s, m, n, v);
+    if (st == GR_OK)
+      st = gr_snow_deformation_step(r->p->s, r->sc.dt);
+    if (st == GR_OK)
+      ++r->taken;
+  }
+  r->last = st;
+  gr_status s2 = gr_snow_deformation_ledger_get(r->p->s, &r->l);
+  if (st == GR_OK)
+    st = s2;
+  if (st == GR_OK)
+    st = gr_snow_deformation_object_forces(r->p->s, r->force, r->area, r->sc.kind == 0 ? 1 : 2);
+  r->st = st;
+  return NULL;
+}
+
+/* Runs both pieces on two threads; side0: piece 0's side toward piece 1. */
+static void run_team(piece pc[2], runner rn[2], int side0, int kind, int steps, int stop_rank,
+                     int stop_at, int fail_exchange) {
+  team t;
+  memset(&t, 0, sizeof(t));
+  pthread_barrier_init(&t.barrier, NULL, 2);
+  pthread_t th[2];
+  for (int k = 0; k < 2; ++k) {
+    memset(&rn[k], 0, sizeof(rn[k]));
+    rn[k].t = &t;
+    rn[k].rank = k;
+    rn[k].side = k == 0 ? side0 : side0 ^ 1;
+    rn[k].steps = steps;
+    rn[k].fail_exchange = fail_exchange;
+    rn[k].p = &pc[k];
+    scene_init(&rn[k].sc, kind);
+    CHECK(gr_snow_deformation_halo_size(pc[k].s, rn[k].side, &t.mail_bytes[k]) == GR_OK);
+    CHECK(t.mail_bytes[k] > 0);
+    t.mail[k] = malloc(t.mail_bytes[k]);
+    gr_snow_deformation_set_allreduce(pc[k].s, team_allreduce, &rn[k]);
+    gr_snow_deformation_set_halo_exchange(pc[k].s, team_exchange, &rn[k]);
+    if (k == stop_rank) {
+      rn[k].stop_at = stop_at;
+      gr_snow_deformation_set_progress(pc[k].s, stop_at_step, &rn[k]);
+    }
+  }
+  CHECK(t.mail_bytes[0] == t.mail_bytes[1]);
+  for (int k = 0; k < 2; ++k)
+    pthread_create(&th[k], NULL, runner_run, &rn[k]);
+  for (int k = 0; k < 2; ++k)
+    pthread_join(th[k], NULL);
+  for (int k = 0; k < 2; ++k) {
+    gr_snow_deformation_set_progress(pc[k].s, NULL, NULL);
+    free(t.mail[k]);
+    scene_free(&rn[k].sc);
+  }
+  pthread_barrier_destroy(&t.barrier);
+}
+
+/* The whole grid through the same scene. */
+static void run_whole(gr_snow_deformation *s, int kind, int steps, gr_snow_deformation_ledger *l,
+                      double *force, double *area) {
+  scene sc;
+  scene_init(&sc, kind);
+  gr_mesh m[2];
+  double v[6];
+  int n = 1;
+  for (int k = 0; k < steps; ++k) {
+    n = scene_pose(&sc, k, m, v);
+    CHECK(gr_snow_deformation_set_objects(s, m, n, v) == GR_OK);
+    gr_status st = gr_snow_deformation_step(s, sc.dt);
+    CHECK_MSG(st == GR_OK, "whole step %d: %s", k, gr_snow_deformation_last_error(s));
+    if (st != GR_OK)
+      break;
+  }
+  CHECK(gr_snow_deformation_ledger_get(s, l) == GR_OK);
+  CHECK(gr_snow_deformation_object_forces(s, force, area, n) == GR_OK);
+  scene_free(&sc);
+}
+
+/* The own points of piece p whose field f differs in any bit from the
+ * whole grid's. */
+static long piece_diff(piece *p, gr_snow_deformation *whole, const domain *dm, gr_field f) {
+  float *w = get(whole, f, dm->g.nx * dm->g.ny), *v = get(p->s, f, p->g.nx * p->g.ny);
+  long diff = 0;
+  for (int j = 0; j < p->g.ny; ++j)
+    for (int i = 0; i < p->g.nx; ++i)
+      diff += memcmp(&v[(size_t)j * p->g.nx + i],
+                     &w[(size_t)(p->g.j0 + j) * dm->g.nx + p->g.i0 + i], sizeof(float)) != 0;
+  free(w), free(v);
+  return diff;
+}
+
+/* Every own point of every field, the ledger, the forces and the contact
+ * areas of both pieces against the whole grid's, to the bit. */
+static void check_pieces(piece pc[2], runner rn[2], gr_snow_deformation *whole, const domain *dm,
+                         const gr_snow_deformation_ledger *lw, const double *fw, const double *aw,
+                         int nobj, const char *what) {
+  const gr_field fields[] = {GR_FIELD_SNOW_DEPTH, GR_FIELD_SNOW_DENSITY, GR_FIELD_SNOW_SURFACE,
+                             GR_FIELD_OVERLAP, GR_FIELD_CONTACT};
+  long total = 0;
+  for (int k = 0; k < 2; ++k) {
+    for (size_t f = 0; f < sizeof(fields) / sizeof(fields[0]); ++f) {
+      long d = piece_diff(&pc[k], whole, dm, fields[f]);
+      CHECK_MSG(d == 0, "%s: piece %d: %ld points of %s differ from the whole grid", what, k, d,
+                gr_field_name(fields[f]));
+      total += d;
+    }
+    const gr_snow_deformation_ledger *l = &rn[k].l;
+    CHECK_MSG(l->steps == lw->steps && l->time == lw->time && l->snow_volume == lw->snow_volume &&
+                  l->snow_mass == lw->snow_mass && l->initial_volume == lw->initial_volume &&
+                  l->initial_mass == lw->initial_mass &&
+                  l->compressed_volume == lw->compressed_volume &&
+                  l->displaced_volume == lw->displaced_volume &&
+                  l->relax_iterations == lw->relax_iterations,
+              "%s: piece %d's ledger: volume %.17g mass %.17g compressed %.17g displaced %.17g "
+              "(whole %.17g %.17g %.17g %.17g)",
+              what, k, l->snow_volume, l->snow_mass, l->compressed_volume, l->displaced_volume,
+              lw->snow_volume, lw->snow_mass, lw->compressed_volume, lw->displaced_volume);
+    int same = 1;
+    for (int o = 0; o < nobj; ++o) {
+      same &= rn[k].area[o] == aw[o];
+      for (int a = 0; a < 3; ++a)
+        same &= rn[k].force[3 * o + a] == fw[3 * o + a];
+    }
+    CHECK_MSG(same, "%s: piece %d's forces or contact areas differ from the whole grid's", what, k);
+  }
+  printf("%s: %ld points differ from the whole grid in any bit; ledger volume %.9g m^3, mass "
+         "%.9g kg, compressed %.6g m^3, displaced %.6g m^3 (equal: %d); force x %.6g N, contact "
+         "%.4g m^2; %d exchanges per piece\n",
+         what, total, lw->snow_volume, lw->snow_mass, lw->compressed_volume, lw->displaced_volume,
+         rn[0].l.snow_mass == lw->snow_mass && rn[1].l.snow_mass == lw->snow_mass, fw[0], aw[0],
+         rn[0].exchanges);
+}
+
+/* Halves split in x (30 + 34 points), the box dragged 40 steps across the
+ * split (its front passes the split, 1.5 m from the domain's edge, at step
+ * 24), the talus in one launch per iteration: bit for bit the whole
+ * grid's. Then the error paths of pieces. */
+static void test_pieces_x(void) {
+  domain dm = make_domain();
+  gr_snow_deformation_params prm;
+  gr_snow_deformation_params_init(&prm);
+  gr_snow_deformation *whole = make_whole(&dm, &prm);
+  piece pc[2];
+  int ok =
+      make_piece(&pc[0], &dm, &prm, 0, 0, 30, 48) && make_piece(&pc[1], &dm, &prm, 30, 0, 34, 48);
+  CHECK(pc[0].nxl == 38 && pc[1].nxl == 42 && pc[0].nyl == 48);
+  if (ok && whole) {
+    const int steps = 40;
+    gr_snow_deformation_ledger lw;
+    double fw[3], aw[1];
+    for (int k = 0; k < 2; ++k)
+      gr_snow_deformation_set_blocked(pc[k].s, 0);
+    gr_snow_deformation_set_blocked(whole, 0);
+    runner rn[2];
+    run_team(pc, rn, GR_SNOW_DEFORMATION_EAST, 0, steps, -1, 0, 0);
+    for (int k = 0; k < 2; ++k)
+      CHECK_MSG(rn[k].st == GR_OK && rn[k].taken == steps, "piece %d: %s", k,
+                gr_snow_deformation_last_error(pc[k].s));
+    run_whole(whole, 0, steps, &lw, fw, aw);
+    CHECK(lw.displaced_volume > 1e-3 && fw[0] < 0.0 && aw[0] > 0.0);
+    check_pieces(pc, rn, whole, &dm, &lw, fw, aw, 1, "split in x, 40 steps");
+    /* Checkpoints of both pieces: 6 more steps from the live state and
+     * from the loaded one end on the same bits. */
+    void *saved[2];
+    size_t sb[2];
+    float *after[2][2];
+    for (int k = 0; k < 2; ++k) {
+      CHECK(gr_snow_deformation_state_size(pc[k].s, &sb[k]) == GR_OK);
+      saved[k] = malloc(sb[k]);
+      CHECK(gr_snow_deformation_state_save(pc[k].s, saved[k], sb[k]) == GR_OK);
+    }
+    for (int run = 0; run < 2; ++run) {
+      for (int k = 0; run == 1 && k < 2; ++k)
+        CHECK(gr_snow_deformation_state_load(pc[k].s, saved[k], sb[k]) == GR_OK);
+      run_team(pc, rn, GR_SNOW_DEFORMATION_EAST, 0, 6, -1, 0, 0);
+      for (int k = 0; k < 2; ++k)
+        after[run][k] = get(pc[k].s, GR_FIELD_SNOW_DEPTH, pc[k].g.nx * pc[k].g.ny);
+    }
+    for (int k = 0; k < 2; ++k) {
+      CHECK(memcmp(after[0][k], after[1][k], (size_t)pc[k].g.nx * pc[k].g.ny * sizeof(float)) == 0);
+      free(after[0][k]), free(after[1][k]), free(saved[k]);
+    }
+    /* A piece with neighbours and no callbacks does not step. */
+    gr_snow_deformation_set_allreduce(pc[0].s, NULL, NULL);
+    gr_snow_deformation_set_halo_exchange(pc[0].s, NULL, NULL);
+    CHECK(gr_snow_deformation_step(pc[0].s, 0.01) == GR_ERR_INVALID_ARGUMENT);
+    CHECK(has(gr_snow_deformation_last_error(pc[0].s), "halo exchange"));
+    /* Halo calls on a side without a neighbour, and with a wrong size. */
+    size_t bytes = 1;
+    CHECK(gr_snow_deformation_halo_size(pc[0].s, GR_SNOW_DEFORMATION_WEST, &bytes) == GR_OK &&
+          bytes == 0);
+    CHECK(gr_snow_deformation_halo_size(pc[0].s, GR_SNOW_DEFORMATION_EAST, &bytes) == GR_OK &&
+          bytes == 2 * 8 * 48 * sizeof(float));
+    float strip[4];
+    CHECK(gr_snow_deformation_halo_get(pc[0].s, GR_SNOW_DEFORMATION_WEST, strip, sizeof(strip)) ==
+          GR_ERR_INVALID_ARGUMENT);
+    CHECK(has(gr_snow_deformation_last_error(pc[0].s), "no neighbour on side 0"));
+    CHECK(gr_snow_deformation_halo_set(pc[0].s, GR_SNOW_DEFORMATION_EAST, strip, sizeof(strip)) ==
+          GR_ERR_INVALID_ARGUMENT);
+    CHECK(has(gr_snow_deformation_last_error(pc[0].s), "gr_snow_deformation_halo_size"));
+    CHECK(gr_snow_deformation_halo_get(pc[0].s, GR_SNOW_DEFORMATION_EAST, NULL, bytes) ==
+          GR_ERR_INVALID_ARGUMENT);
+    /* A piece's checkpoint loads into itself only. */
+    size_t b0 = 0, b1 = 0;
+    CHECK(gr_snow_deformation_state_size(pc[0].s, &b0) == GR_OK);
+    CHECK(gr_snow_deformation_state_size(pc[1].s, &b1) == GR_OK);
+    void *buf = malloc(b0);
+    CHECK(gr_snow_deformation_state_save(pc[0].s, buf, b0) == GR_OK);
+    CHECK(gr_snow_deformation_state_load(pc[0].s, buf, b0) == GR_OK);
+    CHECK(b0 != b1 && gr_snow_deformation_state_load(pc[1].s, buf, b0) != GR_OK);
+    free(buf);
+  }
+  /* Pieces the core refuses: the wrong ring, beyond the domain, too narrow. */
+  gr_grid bad = pc[0].g;
+  gr_snow_deformation *s = NULL;
+  bad.ghost = 3;
+  CHECK(gr_snow_deformation_create(ctx, &bad, &prm, &s) == GR_ERR_INVALID_ARGUMENT && !s);
+  CHECK(has(gr_last_error(ctx), "ghost ring of 8"));
+  bad = pc[1].g;
+  bad.nx = 40;
+  CHECK(gr_snow_deformation_create(ctx, &bad, &prm, &s) == GR_ERR_INVALID_ARGUMENT && !s);
+  CHECK(has(gr_last_error(ctx), "beyond the domain"));
+  bad = pc[1].g;
+  bad.i0 = 58;
+  bad.nx = 6;
+  CHECK(gr_snow_deformation_create(ctx, &bad, &prm, &s) == GR_ERR_INVALID_ARGUMENT && !s);
+  CHECK(has(gr_last_error(ctx), "narrower than its ghost ring"));
+  for (int k = 0; k < 2; ++k)
+    gr_snow_deformation_destroy(pc[k].s);
+  gr_snow_deformation_destroy(whole);
+  free_domain(&dm);
+}
+
+/* Halves split in y (26 + 22 points), a sphere rolling north-east across
+ * the split and a box pressed down astride it, 40 steps, the talus in
+ * blocked launches: bit for bit the whole grid's. */
+static void test_pieces_y(void) {
+  domain dm = make_domain();
+  gr_snow_deformation_params prm;
+  gr_snow_deformation_params_init(&prm);
+  prm.compression_model = GR_SNOW_COMPRESSION_CONSTANT;
+  gr_snow_deformation *whole = make_whole(&dm, &prm);
+  piece pc[2];
+  int ok =
+      make_piece(&pc[0], &dm, &prm, 0, 0, 64, 26) && make_piece(&pc[1], &dm, &prm, 0, 26, 64, 22);
+  if (ok && whole) {
+    const int steps = 40;
+    gr_snow_deformation_ledger lw;
+    double fw[6], aw[2];
+    for (int k = 0; k < 2; ++k)
+      gr_snow_deformation_set_blocked(pc[k].s, 1);
+    gr_snow_deformation_set_blocked(whole, 1);
+    runner rn[2];
+    run_team(pc, rn, GR_SNOW_DEFORMATION_NORTH, 1, steps, -1, 0, 0);
+    for (int k = 0; k < 2; ++k)
+      CHECK_MSG(rn[k].st == GR_OK && rn[k].taken == steps, "piece %d: %s", k,
+                gr_snow_deformation_last_error(pc[k].s));
+    run_whole(whole, 1, steps, &lw, fw, aw);
+    CHECK(lw.displaced_volume > 1e-3 && lw.compressed_volume > 1e-4 && aw[0] > 0.0 && aw[1] > 0.0);
+    check_pieces(pc, rn, whole, &dm, &lw, fw, aw, 2, "split in y, blocked talus, 40 steps");
+  }
+  for (int k = 0; k < 2; ++k)
+    gr_snow_deformation_destroy(pc[k].s);
+  gr_snow_deformation_destroy(whole);
+  free_domain(&dm);
+}
+
+/* A stop asked by piece 1's progress callback after its 7th step stops
+ * both pieces after that step (piece 0 has no callback); a failing halo
+ * exchange on one piece returns its status with a sentence. */
+static void test_pieces_abort(void) {
+  domain dm = make_domain();
+  gr_snow_deformation_params prm;
+  gr_snow_deformation_params_init(&prm);
+  piece pc[2];
+  int ok =
+      make_piece(&pc[0], &dm, &prm, 0, 0, 30, 48) && make_piece(&pc[1], &dm, &prm, 30, 0, 34, 48);
+  if (ok) {
+    runner rn[2];
+    run_team(pc, rn, GR_SNOW_DEFORMATION_EAST, 0, 20, 1, 7, 0);
+    printf("abort: piece 0 took %d steps (%s), piece 1 %d (%s); ledgers at step %lld and %lld\n",
+           rn[0].taken, gr_status_string(rn[0].last), rn[1].taken, gr_status_string(rn[1].last),
+           rn[0].l.steps, rn[1].l.steps);
+    for (int k = 0; k < 2; ++k) {
+      CHECK(rn[k].taken == 7 && rn[k].last == GR_ERR_ABORTED && rn[k].l.steps == 7);
+      CHECK(has(gr_snow_deformation_last_error(pc[k].s), "another piece"));
+    }
+    CHECK(rn[0].l.snow_volume == rn[1].l.snow_volume && rn[0].l.time == rn[1].l.time);
+    /* Both pieces' exchanges fail at their 12th call (the stop cleared):
+     * the step returns the callback's status with a sentence, on both
+     * pieces in the same step. */
+    run_team(pc, rn, GR_SNOW_DEFORMATION_EAST, 0, 20, -1, 0, 12);
+    printf("failing exchange: pieces took %d and %d more steps (%s, %s)\n", rn[0].taken,
+           rn[1].taken, gr_status_string(rn[0].last), gr_status_string(rn[1].last));
+    for (int k = 0; k < 2; ++k) {
+      CHECK(rn[k].last == GR_ERR_IO && rn[k].taken < 20 && rn[k].taken == rn[0].taken);
+      CHECK(has(gr_snow_deformation_last_error(pc[k].s), "halo exchange"));
+    }
+  }
+  for (int k = 0; k < 2; ++k)
+    gr_snow_deformation_destroy(pc[k].s);
+  free_domain(&dm);
+}
+
 static const gr_subtest tests[] = {
     {"param_table", test_param_table, 0},
     {"mass_no_compression", test_mass_no_compression, 0},
@@ -1150,6 +1661,9 @@ static const gr_subtest tests[] = {
     {"bare_ground", test_bare_ground, 0},
     {"talus_room", test_talus_room, 0},
     {"talus_resumes", test_talus_resumes, 0},
+    {"pieces_x", test_pieces_x, 0},
+    {"pieces_y", test_pieces_y, 0},
+    {"pieces_abort", test_pieces_abort, 0},
     {"memcheck", test_memcheck, 1},
 };
 

@@ -85,4 +85,35 @@ GR_INLINE void gr_reduce_group(__local float *scratch, int nsum, int nmax,
       partial[slots * get_group_id(0) + q] = scratch[q];
 }
 
+/* Integer (fixed-point) sums, for totals that must not depend on how the
+ * cells are split into work-groups or among the pieces of a domain: integer
+ * addition is exact in any order. A reduction kernel of this kind has the
+ * arguments `__global long *partial` and `__local long *scratch` (set by
+ * gr_reduction_i64_run); each work-item stores its nsum longs at
+ * gr_reduce_slots_long(scratch, nsum) and calls gr_reduce_group_long. */
+GR_INLINE __local long *gr_reduce_slots_long(__local long *scratch, int nsum) {
+  return scratch + nsum * get_local_id(0);
+}
+
+/* Adds the work-items' slots (a binary tree; any order gives the same
+ * integers) and writes the group's nsum longs to partial[nsum * group ...].
+ * Every work-item of the group must call it. */
+GR_INLINE void gr_reduce_group_long(__local long *scratch, int nsum,
+                                    __global long *restrict partial) {
+  int lid = get_local_id(0), wg = get_local_size(0);
+  __local long *mine = scratch + nsum * lid;
+  barrier(CLK_LOCAL_MEM_FENCE);
+  for (int span = wg / 2; span > 0; span /= 2) {
+    if (lid < span) {
+      __local const long *other = scratch + nsum * (lid + span);
+      for (int q = 0; q < nsum; ++q)
+        mine[q] += other[q];
+    }
+    barrier(CLK_LOCAL_MEM_FENCE);
+  }
+  if (lid == 0)
+    for (int q = 0; q < nsum; ++q)
+      partial[nsum * get_group_id(0) + q] = scratch[q];
+}
+
 #endif

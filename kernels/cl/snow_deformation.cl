@@ -41,8 +41,12 @@ __kernel void snow_raster_clear(int nx, int ny, int x_end, int y_end,
   under[gr_idx(i, j, nx)] = snow_order(INFINITY);
 }
 
+/* The box [bi0, bi1] x [bj0, bj1] and the loop are in the whole domain's
+ * indices (the coordinates of point (i, j) are i dx, j dy there, the same
+ * floats on every piece); the point is stored at (i - ox, j - oy) of the
+ * local array, whose point (0, 0) is the domain's (ox, oy). */
 __kernel void snow_raster(__global const float *restrict tri, int first, int count, int nx,
-                          float dx, float dy, int bi0, int bi1, int bj0, int bj1,
+                          float dx, float dy, int bi0, int bi1, int bj0, int bj1, int ox, int oy,
                           __global int *restrict under) {
   int t = get_global_id(0);
   if (t >= count)
@@ -67,7 +71,7 @@ __kernel void snow_raster(__global const float *restrict tri, int first, int cou
       if (s * w0 < tol || s * w1 < tol || s * w2 < tol)
         continue;
       float z = (w0 * v[2] + w1 * v[5] + w2 * v[8]) / area;
-      atomic_min(under + gr_idx(i, j, nx), snow_order(z));
+      atomic_min(under + gr_idx(i - ox, j - oy, nx), snow_order(z));
     }
 }
 
@@ -128,7 +132,8 @@ __kernel void snow_contour(__global const float *restrict ground,
     if (any) {
       float len = sqrt((float)(ox * ox + oy * oy));
       float d = len > 0.0f ? (-(float)ox * vx - (float)oy * vy) / len : 0.0f;
-      cw = fmax(0.0f, d) + rest;
+      /* In whole units of 2^-20, so that their sum is an exact integer. */
+      cw = rint((fmax(0.0f, d) + rest) * GR_SNOW_WEIGHT_INV) / GR_SNOW_WEIGHT_INV;
     }
   }
   weight[c] = cw;
@@ -159,35 +164,34 @@ snow_object_reduce(__global const float *restrict ground, __global const float *
                    __global const float *restrict density, __global const float *restrict under,
                    __global const float *restrict overlap, __global const float *restrict weight,
                    float rho_min, float rho_max, float w_const, float gap, int nx, int x0, int y0,
-                   int w, int n, __global float *restrict partial,
-                   __local float *restrict scratch) {
-  /* Over the window [x0, x0 + w) x [y0, y0 + n / w). */
+                   int w, int n, __global long *restrict partial, __local long *restrict scratch) {
+  /* Over the window [x0, x0 + w) x [y0, y0 + n / w), in fixed point
+   * (snow_deformation_shared.h): e and D - e in quanta (exact), the weights
+   * in their units (exact), the masses e rho and D rho in 2^-32 kg/m^2. */
   int lid = get_local_id(0), wg = get_local_size(0), start, end;
   gr_reduce_block(n, &start, &end);
-  float hi[GR_SNOW_OBJ_SUMS], lo[GR_SNOW_OBJ_SUMS];
+  long acc[GR_SNOW_OBJ_SUMS];
   for (int q = 0; q < GR_SNOW_OBJ_SUMS; ++q)
-    hi[q] = lo[q] = 0.0f;
+    acc[q] = 0;
   for (int q = start + lid; q < end; q += wg) {
     int c = gr_idx(x0 + q % w, y0 + q / w, nx);
     float s = depth[c], rho = density[c], d = overlap[c], cw = weight[c];
     float e = snow_displaced(s, rho, d, rho_min, rho_max, w_const);
-    gr_df_add(&hi[0], &lo[0], e);
-    gr_df_add(&hi[1], &lo[1], e * rho);
+    acc[0] += (long)rint(e * GR_SNOW_QUANTUM_INV);
+    acc[1] += (long)rint((e * rho) * GR_SNOW_PRESS_MASS_INV);
     if (cw >= 0.0f) {
-      gr_df_add(&hi[2], &lo[2], cw);
-      gr_df_add(&hi[3], &lo[3], 1.0f);
+      acc[2] += (long)rint(cw * GR_SNOW_WEIGHT_INV);
+      acc[3] += 1;
     }
-    gr_df_add(&hi[4], &lo[4], d * rho);
-    gr_df_add(&hi[5], &lo[5], d - e);
+    acc[4] += (long)rint((d * rho) * GR_SNOW_PRESS_MASS_INV);
+    acc[5] += (long)rint((d - e) * GR_SNOW_QUANTUM_INV);
     if (ground[c] + s >= under[c] - gap)
-      gr_df_add(&hi[6], &lo[6], 1.0f);
+      acc[6] += 1;
   }
-  __local float *mine = gr_reduce_slots(scratch, GR_SNOW_OBJ_SUMS, 0);
-  for (int q = 0; q < GR_SNOW_OBJ_SUMS; ++q) {
-    mine[2 * q] = hi[q];
-    mine[2 * q + 1] = lo[q];
-  }
-  gr_reduce_group(scratch, GR_SNOW_OBJ_SUMS, 0, partial);
+  __local long *mine = gr_reduce_slots_long(scratch, GR_SNOW_OBJ_SUMS);
+  for (int q = 0; q < GR_SNOW_OBJ_SUMS; ++q)
+    mine[q] = acc[q];
+  gr_reduce_group_long(scratch, GR_SNOW_OBJ_SUMS, partial);
 }
 
 /* Press and deposit: an overlapped point drops to the underside keeping the
@@ -235,24 +239,23 @@ __kernel void snow_apply(__global const float *restrict ground, __global float *
 }
 
 /* What the contour of the window [x0, x0 + w) x [y0, y0 + n / w) received
- * in snow_apply (the same floats): one double-float sum. */
+ * in snow_apply (the same floats), in quanta. */
 __kernel void snow_added_reduce(__global const float *restrict overlap,
                                 __global const float *restrict weight, float add_depth, int nx,
-                                int x0, int y0, int w, int n, __global float *restrict partial,
-                                __local float *restrict scratch) {
+                                int x0, int y0, int w, int n, __global long *restrict partial,
+                                __local long *restrict scratch) {
   int lid = get_local_id(0), wg = get_local_size(0), start, end;
   gr_reduce_block(n, &start, &end);
-  float hi = 0.0f, lo = 0.0f;
+  long acc = 0;
   for (int q = start + lid; q < end; q += wg) {
     int c = gr_idx(x0 + q % w, y0 + q / w, nx);
     float cw = weight[c];
     if (overlap[c] <= 0.0f && cw > 0.0f)
-      gr_df_add(&hi, &lo, snow_q(cw * add_depth));
+      acc += (long)rint(snow_q(cw * add_depth) * GR_SNOW_QUANTUM_INV);
   }
-  __local float *mine = gr_reduce_slots(scratch, 1, 0);
-  mine[0] = hi;
-  mine[1] = lo;
-  gr_reduce_group(scratch, 1, 0, partial);
+  __local long *mine = gr_reduce_slots_long(scratch, 1);
+  mine[0] = acc;
+  gr_reduce_group_long(scratch, 1, partial);
 }
 
 /* Depths to the nearest whole quantum. */
@@ -570,25 +573,25 @@ __kernel void snow_check_reduce(__global const float *restrict movable, int nx, 
   gr_reduce_group(scratch, 0, GR_SNOW_CHECK_MAXES, partial);
 }
 
-/* The ledger: sum S and sum S rho. */
+/* The ledger over the window [x0, x0 + w) x [y0, y0 + n / w) (a piece's own
+ * points): sum S in quanta and sum S rho in 2^-24 kg/m^2. */
 __kernel void snow_ledger_reduce(__global const float *restrict depth,
-                                 __global const float *restrict density, int n,
-                                 __global float *restrict partial,
-                                 __local float *restrict scratch) {
+                                 __global const float *restrict density, int nx, int x0, int y0,
+                                 int w, int n, __global long *restrict partial,
+                                 __local long *restrict scratch) {
   int lid = get_local_id(0), wg = get_local_size(0), start, end;
   gr_reduce_block(n, &start, &end);
-  float v_hi = 0.0f, v_lo = 0.0f, m_hi = 0.0f, m_lo = 0.0f;
-  for (int c = start + lid; c < end; c += wg) {
+  long v = 0, m = 0;
+  for (int q = start + lid; q < end; q += wg) {
+    int c = gr_idx(x0 + q % w, y0 + q / w, nx);
     float s = depth[c];
-    gr_df_add(&v_hi, &v_lo, s);
-    gr_df_add(&m_hi, &m_lo, s * density[c]);
+    v += (long)rint(s * GR_SNOW_QUANTUM_INV);
+    m += (long)rint((s * density[c]) * GR_SNOW_LEDGER_MASS_INV);
   }
-  __local float *mine = gr_reduce_slots(scratch, GR_SNOW_LEDGER_SUMS, 0);
-  mine[0] = v_hi;
-  mine[1] = v_lo;
-  mine[2] = m_hi;
-  mine[3] = m_lo;
-  gr_reduce_group(scratch, GR_SNOW_LEDGER_SUMS, 0, partial);
+  __local long *mine = gr_reduce_slots_long(scratch, GR_SNOW_LEDGER_SUMS);
+  mine[0] = v;
+  mine[1] = m;
+  gr_reduce_group_long(scratch, GR_SNOW_LEDGER_SUMS, partial);
 }
 
 /* Snow surface B + S. */

@@ -41,6 +41,19 @@
 #define GR_SNOW_LEDGER_SUMS 2
 #define GR_SNOW_CHECK_MAXES 5
 
+/* The per-object and ledger sums are integers (fixed point, reduce.h's
+ * gr_reduce_group_long), so that the totals that steer a step (the
+ * displaced height, its mass, the contour weights) and the ledger come out
+ * to the bit whatever the split among work-groups or among the pieces of a
+ * domain: heights in quanta (GR_SNOW_QUANTUM), contour weights in units of
+ * 2^-20 (snow_contour rounds each weight to one), the masses of a press
+ * (e rho, D rho) in units of 2^-32 kg/m^2 and the ledger's mass (S rho) in
+ * units of 2^-24 kg/m^2 (int64 holds 2^39 kg/m^2 of snow summed over the
+ * points: 16 m of ice on 2^23 points). */
+#define GR_SNOW_WEIGHT_INV 1048576.0f
+#define GR_SNOW_PRESS_MASS_INV 4294967296.0f
+#define GR_SNOW_LEDGER_MASS_INV 16777216.0f
+
 /* Talus iterations per launch of snow_relax_block (temporal blocking);
  * the check (the largest movable amount, and the box of the points still
  * moving, which becomes the window) runs after every launch. */

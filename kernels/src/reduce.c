@@ -132,3 +132,76 @@ void gr_reduction_release(gr_reduction *r) {
   free(r->host);
   r->host = NULL;
 }
+
+/* ------------------------------------------------------ integer reductions */
+
+gr_status gr_reduction_i64_init(gr_context *ctx, cl_kernel k, size_t items, int nsum,
+                                gr_reduction_i64 *r) {
+  if (!ctx || !k || !r || nsum < 1 || nsum > GR_REDUCTION_MAX_SLOTS)
+    return gr_set_error(ctx, GR_ERR_INVALID_ARGUMENT,
+                        "gr_reduction_i64_init needs a context, a kernel, a reduction and 1 to %d "
+                        "sums (got %d).",
+                        GR_REDUCTION_MAX_SLOTS, nsum);
+  memset(r, 0, sizeof(*r));
+  r->nsum = nsum;
+  size_t kmax = 0;
+  gr_status st =
+      gr_cl_check(ctx,
+                  clGetKernelWorkGroupInfo(k, gr_context_device(ctx), CL_KERNEL_WORK_GROUP_SIZE,
+                                           sizeof(kmax), &kmax, NULL),
+                  "Querying a reduction's work-group size");
+  if (st != GR_OK)
+    return st;
+  r->local = 1;
+  while (r->local * 2 <= GR_REDUCE_LOCAL && r->local * 2 <= kmax)
+    r->local *= 2;
+  r->groups = (items + r->local - 1) / r->local;
+  if (r->groups > GR_REDUCE_GROUPS)
+    r->groups = GR_REDUCE_GROUPS;
+  if (r->groups < 1)
+    r->groups = 1;
+  size_t bytes = r->groups * (size_t)nsum * sizeof(cl_long);
+  st = gr_buffer_create(ctx, CL_MEM_WRITE_ONLY, bytes, NULL, &r->partial);
+  if (st == GR_OK) {
+    r->host = malloc(r->groups * (size_t)nsum * sizeof(long long));
+    if (!r->host)
+      st = gr_set_error(ctx, GR_ERR_OUT_OF_MEMORY, "Out of host memory.");
+  }
+  if (st != GR_OK)
+    gr_reduction_i64_release(r);
+  return st;
+}
+
+gr_status gr_reduction_i64_run(gr_context *ctx, gr_reduction_i64 *r, cl_kernel k, long long *sums) {
+  if (!ctx || !r || !r->partial || !k || !sums)
+    return gr_set_error(ctx, GR_ERR_INVALID_ARGUMENT,
+                        "gr_reduction_i64_run needs a context, an initialised reduction, its "
+                        "kernel and room for the sums.");
+  gr_status st = gr_kernel_arg(ctx, k, "partial", sizeof(cl_mem), &r->partial);
+  if (st == GR_OK)
+    st = gr_kernel_arg(ctx, k, "scratch", r->local * (size_t)r->nsum * sizeof(cl_long), NULL);
+  size_t global = r->groups * r->local;
+  if (st == GR_OK)
+    st = gr_cl_check(ctx,
+                     clEnqueueNDRangeKernel(gr_context_queue(ctx), k, 1, NULL, &global, &r->local,
+                                            0, NULL, NULL),
+                     "Enqueueing a reduction");
+  if (st == GR_OK)
+    st = gr_buffer_read(ctx, r->partial, 0, r->groups * (size_t)r->nsum * sizeof(cl_long), r->host);
+  if (st != GR_OK)
+    return st;
+  for (int q = 0; q < r->nsum; ++q)
+    sums[q] = 0;
+  for (size_t grp = 0; grp < r->groups; ++grp)
+    for (int q = 0; q < r->nsum; ++q)
+      sums[q] += r->host[(size_t)r->nsum * grp + q];
+  return GR_OK;
+}
+
+void gr_reduction_i64_release(gr_reduction_i64 *r) {
+  if (!r)
+    return;
+  gr_buffer_release(&r->partial);
+  free(r->host);
+  r->host = NULL;
+}

@@ -21,9 +21,13 @@
 #define GR_SNOW_MAX_DT 3600.0
 /* Checkpoints: "GSD1". */
 #define GR_SNOW_STATE_MAGIC 0x31445347u
-#define GR_SNOW_STATE_VERSION 3u /* 3: the relaxation's rest box */
+#define GR_SNOW_STATE_VERSION                                                                      \
+  4u /* 4: the piece's i0, j0, the ledger's start in fixed                                         \
+         point, the relaxation's rest box */
 /* Per-point arrays of a checkpoint: depth, density, overlap sum, contact. */
 #define GR_SNOW_STATE_ARRAYS 4
+/* Per point of a halo strip: depth and density. */
+#define GR_SNOW_HALO_ARRAYS 2
 
 enum {
   GR_SNOW_P_INITIAL_DEPTH,
@@ -60,7 +64,18 @@ typedef struct gr_snow_object {
 
 struct gr_snow_deformation {
   gr_context *ctx;
+  /* The local arrays' grid: for a piece of a split domain its points and
+   * its ring (nx, ny count both; see "Pieces" below), whose point (0, 0)
+   * is the domain's (ox, oy); for a whole grid the grid as given. */
   gr_grid grid;
+  int ring[4];               /* ring width per side: west, east, south, north */
+  int ox, oy;                /* the domain's index of local point (0, 0) */
+  int gnx, gny;              /* the whole domain's points */
+  int own_nx, own_ny;        /* the piece's own points */
+  gr_allreduce_fn allreduce; /* NULL: this simulation is the whole domain */
+  void *allreduce_user;
+  gr_halo_exchange_fn halo_exchange; /* a piece with a ring steps only with one */
+  void *halo_user;
   gr_snow_deformation_params params;
   cl_kernel raster, raster_clear, overlap_k, contour, obj_reduce, apply, relax_rate, relax_move,
       relax_block, check_reduce, ledger_reduce, surface, reset, added_reduce, quantize;
@@ -72,11 +87,15 @@ struct gr_snow_deformation {
   int blocked;     /* the talus in blocked launches (GPUs) or one launch per iteration */
   cl_mem tri;      /* world triangles, 9 floats each */
   size_t tri_cap;
-  gr_reduction red_obj, red_check[GR_SNOW_CHECK_LAG + 1], red_ledger, red_added;
+  gr_reduction red_check[GR_SNOW_CHECK_LAG + 1];
+  gr_reduction_i64 red_obj, red_ledger, red_added;
   gr_snow_object objects[GR_SNOW_DEFORMATION_MAX_OBJECTS];
   int nobjects;
   double force[GR_SNOW_DEFORMATION_MAX_OBJECTS][3], area[GR_SNOW_DEFORMATION_MAX_OBJECTS];
-  double time, initial_volume, initial_mass, compressed, displaced;
+  double time, compressed, displaced;
+  /* The snow at the start over the piece's own points: quanta, and
+   * 2^-24 kg/m^2 (snow_ledger_reduce's fixed point). */
+  long long initial_q, initial_m;
   /* Displaced snow not yet deposited (the rounding to whole quanta), per
    * unit cell area, and its mass. */
   double pending, pending_mass;
@@ -270,21 +289,30 @@ static gr_status gr_snow_sync_rect(gr_snow_deformation *s, int x0, int y0, int x
   return gr_cl_check(s->ctx, err, "Copying a window of the snow state");
 }
 
-/* sum S and sum S rho, per unit area. */
-static gr_status gr_snow_ledger_sums(gr_snow_deformation *s, double *vol, double *mass) {
-  int n = (int)gr_snow_cells(s);
-  gr_status st = GR_SNOW_ARG(s, s->ledger_reduce, "depth", s->depth[s->cur]);
+/* sum S (quanta) and sum S rho (2^-24 kg/m^2) over the piece's own points
+ * (every point of a whole grid). */
+static gr_status gr_snow_ledger_sums(gr_snow_deformation *s, long long *vol, long long *mass) {
+  cl_int nx = s->grid.nx, x0 = s->ring[0], y0 = s->ring[2], w = s->own_nx, n = w * s->own_ny;
+  const cl_kernel k = s->ledger_reduce;
+  gr_status st = GR_SNOW_ARG(s, k, "depth", s->depth[s->cur]);
   if (st == GR_OK)
-    st = GR_SNOW_ARG(s, s->ledger_reduce, "density", s->density[s->cur]);
+    st = GR_SNOW_ARG(s, k, "density", s->density[s->cur]);
   if (st == GR_OK)
-    st = GR_SNOW_ARG(s, s->ledger_reduce, "n", n);
-  double sums[GR_SNOW_LEDGER_SUMS];
+    st = GR_SNOW_ARG(s, k, "nx", nx);
   if (st == GR_OK)
-    st = gr_reduction_run(s->ctx, &s->red_ledger, s->ledger_reduce, sums, NULL);
+    st = GR_SNOW_ARG(s, k, "x0", x0);
+  if (st == GR_OK)
+    st = GR_SNOW_ARG(s, k, "y0", y0);
+  if (st == GR_OK)
+    st = GR_SNOW_ARG(s, k, "w", w);
+  if (st == GR_OK)
+    st = GR_SNOW_ARG(s, k, "n", n);
+  long long sums[GR_SNOW_LEDGER_SUMS];
+  if (st == GR_OK)
+    st = gr_reduction_i64_run(s->ctx, &s->red_ledger, k, sums);
   if (st == GR_OK) {
-    double a = s->grid.dx * s->grid.dy;
-    *vol = sums[0] * a;
-    *mass = sums[1] * a;
+    *vol = sums[0];
+    *mass = sums[1];
   }
   return st;
 }
@@ -310,8 +338,253 @@ static gr_status gr_snow_initial_state(gr_snow_deformation *s) {
   memset(s->force, 0, sizeof(s->force));
   memset(s->area, 0, sizeof(s->area));
   if (st == GR_OK)
-    st = gr_snow_ledger_sums(s, &s->initial_volume, &s->initial_mass);
+    st = gr_snow_ledger_sums(s, &s->initial_q, &s->initial_m);
   return st;
+}
+
+/* ------------------------------------------------------ pieces and halos */
+
+/* The piece contract (graupel.h, snow_deformation.h): which sides have a
+ * neighbour, and so a ring of GR_SNOW_DEFORMATION_GHOST points. */
+static gr_status gr_snow_piece_rings(const gr_grid *g, int ring[4], char *msg, size_t len) {
+  long long gnx = g->global_nx > 0 ? g->global_nx : g->nx;
+  long long gny = g->global_ny > 0 ? g->global_ny : g->ny;
+  int whole_x = g->global_nx <= 0, whole_y = g->global_ny <= 0;
+  const int G = GR_SNOW_DEFORMATION_GHOST;
+  memset(ring, 0, 4 * sizeof(int));
+  if (g->global_nx < 0 || g->global_ny < 0 || g->ghost < 0 || g->i0 < 0 || g->j0 < 0) {
+    snprintf(msg, len,
+             "Invalid grid: i0, j0, global_nx, global_ny and ghost must be 0 or more (got %d, "
+             "%d, %d, %d, %d).",
+             g->i0, g->j0, g->global_nx, g->global_ny, g->ghost);
+    return GR_ERR_INVALID_ARGUMENT;
+  }
+  if ((whole_x && g->i0 != 0) || (whole_y && g->j0 != 0) ||
+      (!whole_x && (long long)g->i0 + g->nx > gnx) ||
+      (!whole_y && (long long)g->j0 + g->ny > gny)) {
+    snprintf(msg, len,
+             "Invalid grid: the piece of %d x %d points at (%d, %d) reaches beyond the domain of "
+             "%lld x %lld points; give global_nx and global_ny of the whole domain.",
+             g->nx, g->ny, g->i0, g->j0, gnx, gny);
+    return GR_ERR_INVALID_ARGUMENT;
+  }
+  if (!whole_x) {
+    ring[0] = g->i0 > 0 ? G : 0;
+    ring[1] = (long long)g->i0 + g->nx < gnx ? G : 0;
+  }
+  if (!whole_y) {
+    ring[2] = g->j0 > 0 ? G : 0;
+    ring[3] = (long long)g->j0 + g->ny < gny ? G : 0;
+  }
+  int any = ring[0] || ring[1] || ring[2] || ring[3];
+  if (any && g->ghost != G) {
+    snprintf(msg, len,
+             "Invalid grid: a snow deformation piece with neighbours needs a ghost ring of %d "
+             "points (got ghost = %d); set grid.ghost to %d.",
+             G, g->ghost, G);
+    return GR_ERR_INVALID_ARGUMENT;
+  }
+  if (((ring[0] || ring[1]) && g->nx < G) || ((ring[2] || ring[3]) && g->ny < G)) {
+    snprintf(msg, len,
+             "Invalid grid: a snow deformation piece of %d x %d points is narrower than its "
+             "ghost ring of %d toward a neighbour; split the domain into fewer pieces.",
+             g->nx, g->ny, G);
+    return GR_ERR_INVALID_ARGUMENT;
+  }
+  return GR_OK;
+}
+
+static int gr_snow_has_ring(const gr_snow_deformation *s) {
+  return s->ring[0] || s->ring[1] || s->ring[2] || s->ring[3];
+}
+
+/* Cuts the window [*x0, *x1] x [*y0, *y1] of the local arrays to the
+ * piece's own points (nothing to cut on a whole grid). */
+static void gr_snow_own_clip(const gr_snow_deformation *s, int *x0, int *y0, int *x1, int *y1) {
+  int ax = s->ring[0], ay = s->ring[2];
+  int bx = s->grid.nx - 1 - s->ring[1], by = s->grid.ny - 1 - s->ring[3];
+  *x0 = *x0 > ax ? *x0 : ax;
+  *y0 = *y0 > ay ? *y0 : ay;
+  *x1 = *x1 < bx ? *x1 : bx;
+  *y1 = *y1 < by ? *y1 : by;
+}
+
+void gr_snow_deformation_set_allreduce(gr_snow_deformation *s, gr_allreduce_fn fn, void *user) {
+  if (!s)
+    return;
+  s->allreduce = fn;
+  s->allreduce_user = fn ? user : NULL;
+}
+
+void gr_snow_deformation_set_halo_exchange(gr_snow_deformation *s, gr_halo_exchange_fn fn,
+                                           void *user) {
+  if (!s)
+    return;
+  s->halo_exchange = fn;
+  s->halo_user = fn ? user : NULL;
+}
+
+static gr_status gr_snow_allreduce(gr_snow_deformation *s, double *values, int n, gr_reduce_op op) {
+  gr_status st = s->allreduce(s->allreduce_user, values, n, op);
+  if (st != GR_OK && st != GR_ERR_ABORTED)
+    return gr_set_error(s->ctx, st,
+                        "The snow deformation simulation's global reduction (the allreduce "
+                        "callback) failed: %s.",
+                        gr_status_string(st));
+  return st;
+}
+
+/* Integer sums over every piece (nothing to do without an allreduce): each
+ * int64 travels as two doubles, its high and its low 32 bits, whose sums
+ * are exact for fewer than 2^21 pieces, so the totals are the whole grid's
+ * integers however the domain is split. */
+#define GR_SNOW_ALLREDUCE_MAX 8
+static gr_status gr_snow_allreduce_i64(gr_snow_deformation *s, long long *v, int n) {
+  if (!s->allreduce)
+    return GR_OK;
+  double d[2 * GR_SNOW_ALLREDUCE_MAX];
+  for (int q = 0; q < n; ++q) {
+    long long hi = v[q] >= 0 ? v[q] / 4294967296LL : -((-v[q] + 4294967295LL) / 4294967296LL);
+    d[2 * q] = (double)hi;
+    d[2 * q + 1] = (double)(v[q] - hi * 4294967296LL); /* 0 .. 2^32 - 1 */
+  }
+  gr_status st = gr_snow_allreduce(s, d, 2 * n, GR_REDUCE_SUM);
+  for (int q = 0; st == GR_OK && q < n; ++q)
+    v[q] = (long long)d[2 * q] * 4294967296LL + (long long)d[2 * q + 1];
+  return st;
+}
+
+/* After a stage that used up a piece's ring (an object's press, a talus
+ * launch): the caller's exchange refreshes it. Nothing on a whole grid. */
+static gr_status gr_snow_piece_sync(gr_snow_deformation *s) {
+  if (!gr_snow_has_ring(s))
+    return GR_OK;
+  gr_status st = s->halo_exchange(s->halo_user);
+  if (st != GR_OK)
+    return gr_set_error(s->ctx, st,
+                        "The snow deformation piece's halo exchange (the callback given to "
+                        "gr_snow_deformation_set_halo_exchange) failed in step %lld with %s; the "
+                        "piece's ring is not fresh, so restore a checkpoint before stepping on.",
+                        s->steps + 1, gr_status_string(st));
+  return GR_OK;
+}
+
+/* The points of a halo strip on `side`: GR_SNOW_DEFORMATION_GHOST columns
+ * by the local arrays' rows (west, east), or their columns by
+ * GR_SNOW_DEFORMATION_GHOST rows (south, north); 0 where the side has no
+ * neighbour. */
+static size_t gr_snow_strip_cells(const gr_snow_deformation *s, int side, size_t *w, size_t *h) {
+  if (side < 0 || side > 3 || !s->ring[side])
+    return 0;
+  *w = side < 2 ? (size_t)GR_SNOW_DEFORMATION_GHOST : (size_t)s->grid.nx;
+  *h = side < 2 ? (size_t)s->grid.ny : (size_t)GR_SNOW_DEFORMATION_GHOST;
+  return *w * *h;
+}
+
+gr_status gr_snow_deformation_halo_size(const gr_snow_deformation *s, int side, size_t *bytes) {
+  if (!s || !bytes)
+    return gr_set_error(s ? s->ctx : NULL, GR_ERR_INVALID_ARGUMENT,
+                        "gr_snow_deformation_halo_size needs a simulation and a place for the "
+                        "size.");
+  size_t w = 0, h = 0;
+  *bytes = GR_SNOW_HALO_ARRAYS * gr_snow_strip_cells(s, side, &w, &h) * sizeof(cl_float);
+  return GR_OK;
+}
+
+/* Copies the floats of points [x0, x0+w) x [y0, y0+h) of a local array
+ * between the device and a packed host block; waits. */
+static gr_status gr_snow_rect(gr_snow_deformation *s, cl_mem buf, size_t x0, size_t y0, size_t w,
+                              size_t h, void *host, int write) {
+  const size_t f = sizeof(cl_float), pitch = (size_t)s->grid.nx * f;
+  size_t origin[3] = {x0 * f, y0, 0}, host_origin[3] = {0, 0, 0}, region[3] = {w * f, h, 1};
+  cl_command_queue q = gr_context_queue(s->ctx);
+  cl_int err = write ? clEnqueueWriteBufferRect(q, buf, CL_TRUE, origin, host_origin, region, pitch,
+                                                0, w * f, 0, host, 0, NULL, NULL)
+                     : clEnqueueReadBufferRect(q, buf, CL_TRUE, origin, host_origin, region, pitch,
+                                               0, w * f, 0, host, 0, NULL, NULL);
+  return gr_cl_check(s->ctx, err,
+                     write ? "Writing a halo strip to the device"
+                           : "Reading part of a field back from the device");
+}
+
+/* Reads the piece's own points of a local array (the whole array for a
+ * grid without a ring). */
+static gr_status gr_snow_read_own(gr_snow_deformation *s, cl_mem buf, float *host) {
+  if (!gr_snow_has_ring(s))
+    return gr_buffer_read(s->ctx, buf, 0, gr_snow_cells(s) * sizeof(float), host);
+  return gr_snow_rect(s, buf, (size_t)s->ring[0], (size_t)s->ring[2], (size_t)s->own_nx,
+                      (size_t)s->own_ny, host, 0);
+}
+
+/* Copies one side's strip between the device and the host: from the own
+ * points next to the side (get: the state's depth and density), or into
+ * the ring on that side (set: both buffers of each pair, so that the
+ * talus' second buffer equals the state there, as it must outside a
+ * launch's window). */
+static gr_status gr_snow_halo_copy(gr_snow_deformation *s, int side, void *host, size_t bytes,
+                                   int set) {
+  size_t w = 0, h = 0, cells = gr_snow_strip_cells(s, side, &w, &h);
+  if (cells == 0)
+    return gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
+                        "The snow deformation piece has no neighbour on side %d (0 west, 1 east, "
+                        "2 south, 3 north): only sides with a ring exchange a halo.",
+                        side);
+  size_t need = GR_SNOW_HALO_ARRAYS * cells * sizeof(cl_float);
+  if (bytes != need)
+    return gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
+                        "The halo buffer has %zu bytes but side %d's strip has %zu: size it with "
+                        "gr_snow_deformation_halo_size.",
+                        bytes, side, need);
+  const size_t g = GR_SNOW_DEFORMATION_GHOST, nxl = (size_t)s->grid.nx, nyl = (size_t)s->grid.ny;
+  size_t x0 = 0, y0 = 0;
+  switch (side) {
+  case 0:
+    x0 = set ? 0 : g;
+    break;
+  case 1:
+    x0 = set ? nxl - g : nxl - 2 * g;
+    break;
+  case 2:
+    y0 = set ? 0 : g;
+    break;
+  default:
+    y0 = set ? nyl - g : nyl - 2 * g;
+    break;
+  }
+  unsigned char *at = host;
+  gr_status st = GR_OK;
+  for (int a = 0; st == GR_OK && a < GR_SNOW_HALO_ARRAYS; ++a) {
+    cl_mem *pair = a ? s->density : s->depth;
+    st = gr_snow_rect(s, pair[s->cur], x0, y0, w, h, at, set);
+    if (st == GR_OK && set)
+      st = gr_snow_rect(s, pair[1 - s->cur], x0, y0, w, h, at, set);
+    at += cells * sizeof(cl_float);
+  }
+  return st;
+}
+
+gr_status gr_snow_deformation_halo_get(gr_snow_deformation *s, int side, void *host, size_t bytes) {
+  if (!s)
+    return gr_set_error(NULL, GR_ERR_INVALID_ARGUMENT,
+                        "gr_snow_deformation_halo_get needs a simulation and a buffer.");
+  if (!host)
+    return GR_SNOW_KEEP_ERROR(
+        s, gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
+                        "gr_snow_deformation_halo_get needs a simulation and a buffer."));
+  return GR_SNOW_KEEP_ERROR(s, gr_snow_halo_copy(s, side, host, bytes, 0));
+}
+
+gr_status gr_snow_deformation_halo_set(gr_snow_deformation *s, int side, const void *host,
+                                       size_t bytes) {
+  if (!s)
+    return gr_set_error(NULL, GR_ERR_INVALID_ARGUMENT,
+                        "gr_snow_deformation_halo_set needs a simulation and a buffer.");
+  if (!host)
+    return GR_SNOW_KEEP_ERROR(
+        s, gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
+                        "gr_snow_deformation_halo_set needs a simulation and a buffer."));
+  /* The copy only reads host (set = 1). */
+  return GR_SNOW_KEEP_ERROR(s, gr_snow_halo_copy(s, side, (void *)host, bytes, 1));
 }
 
 /* The talus launch's tile: 32 x 32 points on a CPU (its halo, 2 per
@@ -374,15 +647,12 @@ gr_status gr_snow_deformation_create(gr_context *ctx, const gr_grid *grid,
     return gr_set_error(ctx, GR_ERR_INVALID_ARGUMENT, "%s", msg);
   if (gr_snow_deformation_params_validate(p, msg, sizeof(msg)) != GR_OK)
     return gr_set_error(ctx, GR_ERR_INVALID_ARGUMENT, "%s", msg);
-  if (grid->i0 != 0 || grid->j0 != 0 || grid->ghost != 0 ||
-      (grid->global_nx != 0 && grid->global_nx != grid->nx) ||
-      (grid->global_ny != 0 && grid->global_ny != grid->ny))
-    return gr_set_error(ctx, GR_ERR_INVALID_ARGUMENT,
-                        "Snow deformation runs on whole grids only for now: this grid is a "
-                        "piece (i0 %d, j0 %d, ghost %d, global %d x %d); run it on the whole "
-                        "domain.",
-                        grid->i0, grid->j0, grid->ghost, grid->global_nx, grid->global_ny);
-  if ((double)grid->nx * (double)grid->ny > (double)INT_MAX / 2)
+  int ring[4];
+  if (gr_snow_piece_rings(grid, ring, msg, sizeof(msg)) != GR_OK)
+    return gr_set_error(ctx, GR_ERR_INVALID_ARGUMENT, "%s", msg);
+  if (((double)grid->nx + 2 * GR_SNOW_DEFORMATION_GHOST) *
+          ((double)grid->ny + 2 * GR_SNOW_DEFORMATION_GHOST) >
+      (double)INT_MAX / 2)
     return gr_set_error(ctx, GR_ERR_TOO_LARGE,
                         "The snow deformation grid of %d x %d points is too large: the kernels "
                         "address at most about 1e9 points; coarsen it.",
@@ -392,6 +662,15 @@ gr_status gr_snow_deformation_create(gr_context *ctx, const gr_grid *grid,
     return gr_set_error(ctx, GR_ERR_OUT_OF_MEMORY, "Out of host memory.");
   s->ctx = gr_context_retain(ctx);
   s->grid = *grid;
+  memcpy(s->ring, ring, sizeof(ring));
+  s->own_nx = grid->nx;
+  s->own_ny = grid->ny;
+  s->gnx = grid->global_nx > 0 ? grid->global_nx : grid->nx;
+  s->gny = grid->global_ny > 0 ? grid->global_ny : grid->ny;
+  s->ox = grid->i0 - ring[0];
+  s->oy = grid->j0 - ring[2];
+  s->grid.nx = grid->nx + ring[0] + ring[1];
+  s->grid.ny = grid->ny + ring[2] + ring[3];
   s->params = *p;
   size_t cells = gr_snow_cells(s), bytes = cells * sizeof(float);
   cl_program prog = NULL;
@@ -425,14 +704,14 @@ gr_status gr_snow_deformation_create(gr_context *ctx, const gr_grid *grid,
   if (st == GR_OK)
     st = gr_snow_block_shape(s);
   if (st == GR_OK)
-    st = gr_reduction_init(ctx, s->obj_reduce, cells, GR_SNOW_OBJ_SUMS, 0, &s->red_obj);
+    st = gr_reduction_i64_init(ctx, s->obj_reduce, cells, GR_SNOW_OBJ_SUMS, &s->red_obj);
   if (st == GR_OK)
     for (int q = 0; st == GR_OK && q <= GR_SNOW_CHECK_LAG; ++q)
       st = gr_reduction_init(ctx, s->check_reduce, cells, 0, GR_SNOW_CHECK_MAXES, &s->red_check[q]);
   if (st == GR_OK)
-    st = gr_reduction_init(ctx, s->ledger_reduce, cells, GR_SNOW_LEDGER_SUMS, 0, &s->red_ledger);
+    st = gr_reduction_i64_init(ctx, s->ledger_reduce, cells, GR_SNOW_LEDGER_SUMS, &s->red_ledger);
   if (st == GR_OK)
-    st = gr_reduction_init(ctx, s->added_reduce, cells, 1, 0, &s->red_added);
+    st = gr_reduction_i64_init(ctx, s->added_reduce, cells, 1, &s->red_added);
   if (st == GR_OK)
     st = gr_snow_fill(s, s->ground, 0.0f);
   if (st == GR_OK)
@@ -469,11 +748,11 @@ void gr_snow_deformation_destroy(gr_snow_deformation *s) {
                     &s->movable,     &s->scratch,  &s->tri};
   for (size_t i = 0; i < sizeof(bufs) / sizeof(bufs[0]); ++i)
     gr_buffer_release(bufs[i]);
-  gr_reduction_release(&s->red_obj);
+  gr_reduction_i64_release(&s->red_obj);
   for (int q = 0; q <= GR_SNOW_CHECK_LAG; ++q)
     gr_reduction_release(&s->red_check[q]);
-  gr_reduction_release(&s->red_ledger);
-  gr_reduction_release(&s->red_added);
+  gr_reduction_i64_release(&s->red_ledger);
+  gr_reduction_i64_release(&s->red_added);
   gr_context_release(s->ctx);
   free(s);
 }
@@ -564,7 +843,7 @@ static gr_status gr_snow_set_field_impl(gr_snow_deformation *s, gr_field f, cons
     return gr_buffer_write(s->ctx, s->ground, 0, bytes, host);
   /* The new snow replaces what is there: the ledger's initial volume and
    * mass move by the change, so the balance still closes. */
-  double v0, m0, v1, m1;
+  long long v0, m0, v1, m1;
   gr_status st = gr_snow_ledger_sums(s, &v0, &m0);
   cl_mem init = f == GR_FIELD_SNOW_DEPTH ? s->depth0 : s->density0;
   cl_mem now = f == GR_FIELD_SNOW_DEPTH ? s->depth[s->cur] : s->density[s->cur];
@@ -579,8 +858,8 @@ static gr_status gr_snow_set_field_impl(gr_snow_deformation *s, gr_field f, cons
   if (st == GR_OK)
     st = gr_snow_ledger_sums(s, &v1, &m1);
   if (st == GR_OK) {
-    s->initial_volume += v1 - v0;
-    s->initial_mass += m1 - m0;
+    s->initial_q += v1 - v0;
+    s->initial_m += m1 - m0;
   }
   return st;
 }
@@ -664,16 +943,19 @@ static gr_status gr_snow_set_objects_impl(gr_snow_deformation *s, const gr_mesh 
           hi[a] = w[a] > hi[a] ? w[a] : hi[a];
         }
       }
+    /* The box in the whole domain's points, kept in the local arrays'
+     * indices (for a piece it may lie partly or wholly beyond them: every
+     * piece steps every object the domain has). */
     double fi0 = ceil(lo[0] / g->dx - 1.0), fi1 = floor(hi[0] / g->dx + 1.0);
     double fj0 = ceil(lo[1] / g->dy - 1.0), fj1 = floor(hi[1] / g->dy + 1.0);
-    if (fi1 < 0 || fj1 < 0 || fi0 > g->nx - 1 || fj0 > g->ny - 1) {
+    if (fi1 < 0 || fj1 < 0 || fi0 > s->gnx - 1 || fj0 > s->gny - 1) {
       objs[o].bi0 = objs[o].bj0 = 1;
       objs[o].bi1 = objs[o].bj1 = 0; /* wholly outside: touches nothing */
     } else {
-      objs[o].bi0 = (int)fmax(0.0, fi0);
-      objs[o].bi1 = (int)fmin(g->nx - 1.0, fi1);
-      objs[o].bj0 = (int)fmax(0.0, fj0);
-      objs[o].bj1 = (int)fmin(g->ny - 1.0, fj1);
+      objs[o].bi0 = (int)fmax(0.0, fi0) - s->ox;
+      objs[o].bi1 = (int)fmin(s->gnx - 1.0, fi1) - s->ox;
+      objs[o].bj0 = (int)fmax(0.0, fj0) - s->oy;
+      objs[o].bj1 = (int)fmin(s->gny - 1.0, fj1) - s->oy;
     }
     for (int a = 0; a < 3; ++a)
       objs[o].v[a] = velocities ? velocities[3 * o + a] : 0.0;
@@ -810,37 +1092,46 @@ static gr_status gr_snow_object_step(gr_snow_deformation *s, int o, double dt) {
   float dx = (float)s->grid.dx, dy = (float)s->grid.dy;
   s->area[o] = 0.0;
   if (ob->bi0 > ob->bi1 || ob->bj0 > ob->bj1)
-    return GR_OK; /* wholly off the grid: it touches nothing */
+    return GR_OK; /* wholly off the (whole) grid: it touches nothing, on every piece */
   /* The kernels run on the object's box grown by two (W: the underside,
    * +inf beyond the box, and the overlap, 0 there) and by one (the contour
    * ring and everything that reads the contour). Outside W nothing changes,
-   * and the step's reset clears W again. */
+   * and the step's reset clears W again. On a piece the windows are cut to
+   * the local arrays, ring included, and may be empty there: the piece
+   * still takes part in the object's global sums and halo exchange. */
   int wx0 = ob->bi0 - 2 > 0 ? ob->bi0 - 2 : 0, wy0 = ob->bj0 - 2 > 0 ? ob->bj0 - 2 : 0;
   int wx1 = ob->bi1 + 2 < nx - 1 ? ob->bi1 + 2 : nx - 1,
       wy1 = ob->bj1 + 2 < ny - 1 ? ob->bj1 + 2 : ny - 1;
   int cx0 = ob->bi0 - 1 > 0 ? ob->bi0 - 1 : 0, cy0 = ob->bj0 - 1 > 0 ? ob->bj0 - 1 : 0;
   int cx1 = ob->bi1 + 1 < nx - 1 ? ob->bi1 + 1 : nx - 1,
       cy1 = ob->bj1 + 1 < ny - 1 ? ob->bj1 + 1 : ny - 1;
+  int w_on = wx0 <= wx1 && wy0 <= wy1, c_on = cx0 <= cx1 && cy0 <= cy1;
   size_t WX0 = (size_t)wx0, WY0 = (size_t)wy0, WW = (size_t)(wx1 - wx0 + 1),
          WH = (size_t)(wy1 - wy0 + 1), CX0 = (size_t)cx0, CY0 = (size_t)cy0,
          CW = (size_t)(cx1 - cx0 + 1), CH = (size_t)(cy1 - cy0 + 1);
   /* A launch is rounded up to whole work-groups: the kernels stop at the
    * window's end, as what lies beyond is another object's or step's. */
   cl_int wx_end = wx1 + 1, wy_end = wy1 + 1, cx_end = cx1 + 1, cy_end = cy1 + 1;
-  gr_snow_dirty(s, wx0, wy0, wx1, wy1);
-  cl_int first = ob->first, count = ob->count, bi0 = ob->bi0, bi1 = ob->bi1, bj0 = ob->bj0,
-         bj1 = ob->bj1;
-  gr_status st = GR_SNOW_ARG(s, s->raster_clear, "nx", nx);
-  if (st == GR_OK)
-    st = GR_SNOW_ARG(s, s->raster_clear, "ny", ny);
-  if (st == GR_OK)
-    st = GR_SNOW_ARG(s, s->raster_clear, "x_end", wx_end);
-  if (st == GR_OK)
-    st = GR_SNOW_ARG(s, s->raster_clear, "y_end", wy_end);
-  if (st == GR_OK)
-    st = GR_SNOW_ARG(s, s->raster_clear, "under", s->under);
-  if (st == GR_OK)
-    st = gr_enqueue_2d(ctx, s->raster_clear, WX0, WY0, WW, WH, NULL);
+  /* The raster's box and loop in the domain's indices (the same floats on
+   * every piece), cut to the local arrays. */
+  cl_int first = ob->first, count = ob->count, ox = s->ox, oy = s->oy;
+  cl_int bi0 = (ob->bi0 > 0 ? ob->bi0 : 0) + ox, bi1 = (ob->bi1 < nx - 1 ? ob->bi1 : nx - 1) + ox,
+         bj0 = (ob->bj0 > 0 ? ob->bj0 : 0) + oy, bj1 = (ob->bj1 < ny - 1 ? ob->bj1 : ny - 1) + oy;
+  gr_status st = GR_OK;
+  if (w_on) {
+    gr_snow_dirty(s, wx0, wy0, wx1, wy1);
+    st = GR_SNOW_ARG(s, s->raster_clear, "nx", nx);
+    if (st == GR_OK)
+      st = GR_SNOW_ARG(s, s->raster_clear, "ny", ny);
+    if (st == GR_OK)
+      st = GR_SNOW_ARG(s, s->raster_clear, "x_end", wx_end);
+    if (st == GR_OK)
+      st = GR_SNOW_ARG(s, s->raster_clear, "y_end", wy_end);
+    if (st == GR_OK)
+      st = GR_SNOW_ARG(s, s->raster_clear, "under", s->under);
+    if (st == GR_OK)
+      st = gr_enqueue_2d(ctx, s->raster_clear, WX0, WY0, WW, WH, NULL);
+  }
   const gr_snow_arg raster[] = {{"tri", sizeof(cl_mem), &s->tri},
                                 {"first", sizeof(first), &first},
                                 {"count", sizeof(count), &count},
@@ -851,32 +1142,36 @@ static gr_status gr_snow_object_step(gr_snow_deformation *s, int o, double dt) {
                                 {"bi1", sizeof(bi1), &bi1},
                                 {"bj0", sizeof(bj0), &bj0},
                                 {"bj1", sizeof(bj1), &bj1},
+                                {"ox", sizeof(ox), &ox},
+                                {"oy", sizeof(oy), &oy},
                                 {"under", sizeof(cl_mem), &s->under}};
-  if (st == GR_OK)
+  if (st == GR_OK && bi0 <= bi1 && bj0 <= bj1 && count > 0) {
     st = gr_snow_args(s, s->raster, raster, sizeof(raster) / sizeof(raster[0]));
-  if (st == GR_OK && count > 0)
-    st = gr_enqueue_1d(ctx, s->raster, (size_t)count); /* one work-item per triangle */
+    if (st == GR_OK)
+      st = gr_enqueue_1d(ctx, s->raster, (size_t)count); /* one work-item per triangle */
+  }
   if (st == GR_OK)
     st = gr_snow_mark(s, &s->tm.raster_ms);
   /* overlap */
-  if (st == GR_OK)
+  if (st == GR_OK && w_on) {
     st = GR_SNOW_ARG(s, s->overlap_k, "ground", s->ground);
-  if (st == GR_OK)
-    st = GR_SNOW_ARG(s, s->overlap_k, "depth", s->depth[s->cur]);
-  if (st == GR_OK)
-    st = GR_SNOW_ARG(s, s->overlap_k, "under", s->under);
-  if (st == GR_OK)
-    st = GR_SNOW_ARG(s, s->overlap_k, "nx", nx);
-  if (st == GR_OK)
-    st = GR_SNOW_ARG(s, s->overlap_k, "ny", ny);
-  if (st == GR_OK)
-    st = GR_SNOW_ARG(s, s->overlap_k, "overlap", s->overlap);
-  if (st == GR_OK)
-    st = GR_SNOW_ARG(s, s->overlap_k, "x_end", wx_end);
-  if (st == GR_OK)
-    st = GR_SNOW_ARG(s, s->overlap_k, "y_end", wy_end);
-  if (st == GR_OK)
-    st = gr_enqueue_2d(ctx, s->overlap_k, WX0, WY0, WW, WH, NULL);
+    if (st == GR_OK)
+      st = GR_SNOW_ARG(s, s->overlap_k, "depth", s->depth[s->cur]);
+    if (st == GR_OK)
+      st = GR_SNOW_ARG(s, s->overlap_k, "under", s->under);
+    if (st == GR_OK)
+      st = GR_SNOW_ARG(s, s->overlap_k, "nx", nx);
+    if (st == GR_OK)
+      st = GR_SNOW_ARG(s, s->overlap_k, "ny", ny);
+    if (st == GR_OK)
+      st = GR_SNOW_ARG(s, s->overlap_k, "overlap", s->overlap);
+    if (st == GR_OK)
+      st = GR_SNOW_ARG(s, s->overlap_k, "x_end", wx_end);
+    if (st == GR_OK)
+      st = GR_SNOW_ARG(s, s->overlap_k, "y_end", wy_end);
+    if (st == GR_OK)
+      st = gr_enqueue_2d(ctx, s->overlap_k, WX0, WY0, WW, WH, NULL);
+  }
   if (st == GR_OK)
     st = gr_snow_mark(s, &s->tm.press_ms);
   /* contour and weights */
@@ -889,59 +1184,76 @@ static gr_status gr_snow_object_step(gr_snow_deformation *s, int o, double dt) {
   }
   float vx = (float)ux, vy = (float)uy, rest = (float)(uz * uz / s->params.direction_falloff);
   float gap = (float)GR_SNOW_DEFORMATION_CONTACT_GAP;
-  if (st == GR_OK)
+  if (st == GR_OK && c_on) {
     st = GR_SNOW_ARG(s, s->contour, "ground", s->ground);
-  if (st == GR_OK)
-    st = GR_SNOW_ARG(s, s->contour, "depth", s->depth[s->cur]);
-  if (st == GR_OK)
-    st = GR_SNOW_ARG(s, s->contour, "under", s->under);
-  if (st == GR_OK)
-    st = GR_SNOW_ARG(s, s->contour, "gap", gap);
-  if (st == GR_OK)
-    st = GR_SNOW_ARG(s, s->contour, "overlap", s->overlap);
-  if (st == GR_OK)
-    st = GR_SNOW_ARG(s, s->contour, "nx", nx);
-  if (st == GR_OK)
-    st = GR_SNOW_ARG(s, s->contour, "ny", ny);
-  if (st == GR_OK)
-    st = GR_SNOW_ARG(s, s->contour, "vx", vx);
-  if (st == GR_OK)
-    st = GR_SNOW_ARG(s, s->contour, "vy", vy);
-  if (st == GR_OK)
-    st = GR_SNOW_ARG(s, s->contour, "rest", rest);
-  if (st == GR_OK)
-    st = GR_SNOW_ARG(s, s->contour, "weight", s->weight);
-  if (st == GR_OK)
-    st = GR_SNOW_ARG(s, s->contour, "x_end", cx_end);
-  if (st == GR_OK)
-    st = GR_SNOW_ARG(s, s->contour, "y_end", cy_end);
-  if (st == GR_OK)
-    st = gr_enqueue_2d(ctx, s->contour, CX0, CY0, CW, CH, NULL);
+    if (st == GR_OK)
+      st = GR_SNOW_ARG(s, s->contour, "depth", s->depth[s->cur]);
+    if (st == GR_OK)
+      st = GR_SNOW_ARG(s, s->contour, "under", s->under);
+    if (st == GR_OK)
+      st = GR_SNOW_ARG(s, s->contour, "gap", gap);
+    if (st == GR_OK)
+      st = GR_SNOW_ARG(s, s->contour, "overlap", s->overlap);
+    if (st == GR_OK)
+      st = GR_SNOW_ARG(s, s->contour, "nx", nx);
+    if (st == GR_OK)
+      st = GR_SNOW_ARG(s, s->contour, "ny", ny);
+    if (st == GR_OK)
+      st = GR_SNOW_ARG(s, s->contour, "vx", vx);
+    if (st == GR_OK)
+      st = GR_SNOW_ARG(s, s->contour, "vy", vy);
+    if (st == GR_OK)
+      st = GR_SNOW_ARG(s, s->contour, "rest", rest);
+    if (st == GR_OK)
+      st = GR_SNOW_ARG(s, s->contour, "weight", s->weight);
+    if (st == GR_OK)
+      st = GR_SNOW_ARG(s, s->contour, "x_end", cx_end);
+    if (st == GR_OK)
+      st = GR_SNOW_ARG(s, s->contour, "y_end", cy_end);
+    if (st == GR_OK)
+      st = gr_enqueue_2d(ctx, s->contour, CX0, CY0, CW, CH, NULL);
+  }
   if (st == GR_OK)
     st = gr_snow_mark(s, &s->tm.contour_ms);
-  /* totals */
-  double sums[GR_SNOW_OBJ_SUMS];
+  /* Totals over the piece's own points of the contour window (fixed point:
+   * the same integers however the domain is split), then over the
+   * domain. */
+  long long q[GR_SNOW_OBJ_SUMS];
+  int rx0 = cx0, ry0 = cy0, rx1 = cx1, ry1 = cy1;
+  gr_snow_own_clip(s, &rx0, &ry0, &rx1, &ry1);
+  cl_int cw = rx1 - rx0 + 1, cn = rx0 <= rx1 && ry0 <= ry1 ? cw * (ry1 - ry0 + 1) : 0;
+  cw = cw > 0 ? cw : 1;
   if (st == GR_OK)
     st = gr_snow_press_args(s, s->obj_reduce);
-  cl_int cw = cx1 - cx0 + 1, cn = cw * (cy1 - cy0 + 1);
   if (st == GR_OK)
     st = GR_SNOW_ARG(s, s->obj_reduce, "nx", nx);
   if (st == GR_OK)
-    st = GR_SNOW_ARG(s, s->obj_reduce, "x0", cx0);
+    st = GR_SNOW_ARG(s, s->obj_reduce, "x0", rx0);
   if (st == GR_OK)
-    st = GR_SNOW_ARG(s, s->obj_reduce, "y0", cy0);
+    st = GR_SNOW_ARG(s, s->obj_reduce, "y0", ry0);
   if (st == GR_OK)
     st = GR_SNOW_ARG(s, s->obj_reduce, "w", cw);
   if (st == GR_OK)
     st = GR_SNOW_ARG(s, s->obj_reduce, "n", cn);
   if (st == GR_OK)
-    st = gr_reduction_run(ctx, &s->red_obj, s->obj_reduce, sums, NULL);
+    st = gr_reduction_i64_run(ctx, &s->red_obj, s->obj_reduce, q);
+  if (st == GR_OK)
+    st = gr_snow_allreduce_i64(s, q, GR_SNOW_OBJ_SUMS);
   if (st == GR_OK)
     st = gr_snow_mark(s, &s->tm.press_ms);
   if (st != GR_OK)
     return st;
+  /* sums, per unit cell area: 0 e, 1 e rho, 2 weights, 3 contour points,
+   * 4 D rho, 5 D - e, 6 contact points */
+  const double quantum = 1.0 / GR_SNOW_QUANTUM_INV, press_mass = 1.0 / GR_SNOW_PRESS_MASS_INV;
+  double sums[GR_SNOW_OBJ_SUMS] = {(double)q[0] * quantum,
+                                   (double)q[1] * press_mass,
+                                   (double)q[2] / GR_SNOW_WEIGHT_INV,
+                                   (double)q[3],
+                                   (double)q[4] * press_mass,
+                                   (double)q[5] * quantum,
+                                   (double)q[6]};
   double area = s->grid.dx * s->grid.dy;
-  /* sums: 0 e, 1 e rho, 2 weights, 3 contour points, 4 D rho, 5 D - e, 6 contact */
   int press = sums[3] > 0.0 && sums[2] > 0.0 && sums[0] > 0.0;
   if (sums[0] <= 0.0 && sums[5] > 0.0)
     press = 1; /* all compressed, nothing to distribute */
@@ -965,35 +1277,36 @@ static gr_status gr_snow_object_step(gr_snow_deformation *s, int o, double dt) {
       s->force[o][a] += -m * ob->v[a] / dt;
   }
   s->area[o] = sums[6] * area;
-  if (st == GR_OK)
+  if (st == GR_OK && c_on) {
     st = gr_snow_press_args(s, s->apply);
-  if (st == GR_OK)
-    st = GR_SNOW_ARG(s, s->apply, "add_depth", add_depth);
-  if (st == GR_OK)
-    st = GR_SNOW_ARG(s, s->apply, "add_rho", add_rho);
-  if (st == GR_OK)
-    st = GR_SNOW_ARG(s, s->apply, "press", press);
-  if (st == GR_OK)
-    st = GR_SNOW_ARG(s, s->apply, "nx", nx);
-  if (st == GR_OK)
-    st = GR_SNOW_ARG(s, s->apply, "ny", ny);
-  if (st == GR_OK)
-    st = GR_SNOW_ARG(s, s->apply, "overlap_sum", s->overlap_sum);
-  if (st == GR_OK)
-    st = GR_SNOW_ARG(s, s->apply, "contact", s->contact);
-  if (st == GR_OK)
-    st = GR_SNOW_ARG(s, s->apply, "under_min", s->under_min);
-  if (st == GR_OK)
-    st = GR_SNOW_ARG(s, s->apply, "x_end", cx_end);
-  if (st == GR_OK)
-    st = GR_SNOW_ARG(s, s->apply, "y_end", cy_end);
-  if (st == GR_OK)
-    st = gr_enqueue_2d(ctx, s->apply, CX0, CY0, CW, CH, NULL);
+    if (st == GR_OK)
+      st = GR_SNOW_ARG(s, s->apply, "add_depth", add_depth);
+    if (st == GR_OK)
+      st = GR_SNOW_ARG(s, s->apply, "add_rho", add_rho);
+    if (st == GR_OK)
+      st = GR_SNOW_ARG(s, s->apply, "press", press);
+    if (st == GR_OK)
+      st = GR_SNOW_ARG(s, s->apply, "nx", nx);
+    if (st == GR_OK)
+      st = GR_SNOW_ARG(s, s->apply, "ny", ny);
+    if (st == GR_OK)
+      st = GR_SNOW_ARG(s, s->apply, "overlap_sum", s->overlap_sum);
+    if (st == GR_OK)
+      st = GR_SNOW_ARG(s, s->apply, "contact", s->contact);
+    if (st == GR_OK)
+      st = GR_SNOW_ARG(s, s->apply, "under_min", s->under_min);
+    if (st == GR_OK)
+      st = GR_SNOW_ARG(s, s->apply, "x_end", cx_end);
+    if (st == GR_OK)
+      st = GR_SNOW_ARG(s, s->apply, "y_end", cy_end);
+    if (st == GR_OK)
+      st = gr_enqueue_2d(ctx, s->apply, CX0, CY0, CW, CH, NULL);
+  }
   /* The contour received whole quanta, a little less than given: the rest
    * waits for the next press (and counts in the ledger meanwhile). */
   if (st == GR_OK && add_depth > 0.0f) {
     cl_kernel k = s->added_reduce;
-    double got = 0.0;
+    long long got = 0;
     st = GR_SNOW_ARG(s, k, "overlap", s->overlap);
     if (st == GR_OK)
       st = GR_SNOW_ARG(s, k, "weight", s->weight);
@@ -1002,21 +1315,27 @@ static gr_status gr_snow_object_step(gr_snow_deformation *s, int o, double dt) {
     if (st == GR_OK)
       st = GR_SNOW_ARG(s, k, "nx", nx);
     if (st == GR_OK)
-      st = GR_SNOW_ARG(s, k, "x0", cx0);
+      st = GR_SNOW_ARG(s, k, "x0", rx0);
     if (st == GR_OK)
-      st = GR_SNOW_ARG(s, k, "y0", cy0);
+      st = GR_SNOW_ARG(s, k, "y0", ry0);
     if (st == GR_OK)
       st = GR_SNOW_ARG(s, k, "w", cw);
     if (st == GR_OK)
       st = GR_SNOW_ARG(s, k, "n", cn);
     if (st == GR_OK)
-      st = gr_reduction_run(ctx, &s->red_added, k, &got, NULL);
+      st = gr_reduction_i64_run(ctx, &s->red_added, k, &got);
+    if (st == GR_OK)
+      st = gr_snow_allreduce_i64(s, &got, 1);
     if (st == GR_OK) {
-      double rest = give - got;
+      double rest = give - (double)got * quantum;
       s->pending_mass = rest > 0.0 ? rest * add_rho : 0.0;
       s->pending = rest > 0.0 ? rest : 0.0;
     }
   }
+  /* A piece's ring: the contour and the deposits beside its outer edge
+   * lacked their neighbours; the neighbours' own points replace them. */
+  if (st == GR_OK)
+    st = gr_snow_piece_sync(s);
   if (st == GR_OK)
     st = gr_snow_mark(s, &s->tm.distribution_ms);
   return st;
@@ -1031,10 +1350,19 @@ static float gr_snow_tolerance(const gr_snow_deformation *s) {
 
 /* The check: the largest amount a point of the givers' window R can still
  * move, and the box of the points that can move more than the tolerance
- * (gr_reduction_finish's maxes[1..4]: -x0, x1, -y0, y1), started on r
- * without waiting for it. */
+ * (out[1..4]: -x0, x1, -y0, y1), in two halves so that the host need not
+ * wait between them: start enqueues the reduction on r (on a piece, over
+ * its own points of the window; *empty when it has none), finish reads it
+ * back and, on a piece, takes the largest over every piece
+ * (GR_REDUCE_MAX), the box in the domain's indices and back in the local
+ * arrays': every piece goes on, and stops, with the whole grid's window. */
 static gr_status gr_snow_relax_check_start(gr_snow_deformation *s, gr_reduction *r, int x0, int y0,
-                                           int x1, int y1) {
+                                           int x1, int y1, int *empty) {
+  if (gr_snow_has_ring(s))
+    gr_snow_own_clip(s, &x0, &y0, &x1, &y1);
+  *empty = x0 > x1 || y0 > y1;
+  if (*empty)
+    return GR_OK;
   cl_kernel k = s->check_reduce;
   cl_int nx = s->grid.nx, w = x1 - x0 + 1, cnt = w * (y1 - y0 + 1);
   float tol = gr_snow_tolerance(s);
@@ -1053,6 +1381,31 @@ static gr_status gr_snow_relax_check_start(gr_snow_deformation *s, gr_reduction 
     st = GR_SNOW_ARG(s, k, "tol", tol);
   if (st == GR_OK)
     st = gr_reduction_start(s->ctx, r, k);
+  return st;
+}
+
+static gr_status gr_snow_relax_check_finish(gr_snow_deformation *s, gr_reduction *r, int empty,
+                                            double out[GR_SNOW_CHECK_MAXES]) {
+  gr_status st = GR_OK;
+  if (!empty) {
+    st = gr_reduction_finish(s->ctx, r, NULL, out);
+  } else {
+    out[0] = 0.0;
+    for (int q = 1; q < GR_SNOW_CHECK_MAXES; ++q)
+      out[q] = -1.0e9;
+  }
+  if (st != GR_OK || !gr_snow_has_ring(s))
+    return st;
+  const double shift[GR_SNOW_CHECK_MAXES] = {0.0, -(double)s->ox, (double)s->ox, -(double)s->oy,
+                                             (double)s->oy};
+  for (int q = 1; q < GR_SNOW_CHECK_MAXES; ++q)
+    if (out[q] > -1.0e8)
+      out[q] += shift[q];
+  if (s->allreduce)
+    st = gr_snow_allreduce(s, out, GR_SNOW_CHECK_MAXES, GR_REDUCE_MAX);
+  for (int q = 1; q < GR_SNOW_CHECK_MAXES; ++q)
+    if (out[q] > -1.0e8)
+      out[q] -= shift[q];
   return st;
 }
 
@@ -1101,7 +1454,7 @@ static gr_status gr_snow_relax_once(gr_snow_deformation *s, cl_int gx0, cl_int g
                               {"rate_in", sizeof(cl_mem), &s->rate_in},
                               {"movable", sizeof(cl_mem), &s->movable}};
   gr_status st = gr_snow_args(s, s->relax_rate, rate, sizeof(rate) / sizeof(rate[0]));
-  if (st == GR_OK)
+  if (st == GR_OK && rx_end > rx0 && ry_end > ry0) /* a piece's cut may be empty */
     st = gr_enqueue_2d(s->ctx, s->relax_rate, (size_t)rx0, (size_t)ry0, (size_t)(rx_end - rx0),
                        (size_t)(ry_end - ry0), NULL);
   const gr_snow_arg move[] = {{"ground", sizeof(cl_mem), &s->ground},
@@ -1122,7 +1475,7 @@ static gr_status gr_snow_relax_once(gr_snow_deformation *s, cl_int gx0, cl_int g
                               {"density_out", sizeof(cl_mem), &s->density[nxt]}};
   if (st == GR_OK)
     st = gr_snow_args(s, s->relax_move, move, sizeof(move) / sizeof(move[0]));
-  if (st == GR_OK)
+  if (st == GR_OK && mx_end > mx0 && my_end > my0)
     st = gr_enqueue_2d(s->ctx, s->relax_move, (size_t)mx0, (size_t)my0, (size_t)(mx_end - mx0),
                        (size_t)(my_end - my0), NULL);
   if (st == GR_OK)
@@ -1166,7 +1519,7 @@ static gr_status gr_snow_relax_blocked(gr_snow_deformation *s, cl_int gx0, cl_in
                               {"lmem", lbytes, NULL}};
   const size_t local[2] = {bw, bh};
   gr_status st = gr_snow_args(s, s->relax_block, args, sizeof(args) / sizeof(args[0]));
-  if (st == GR_OK)
+  if (st == GR_OK && mx_end > mx0 && my_end > my0) /* a piece's cut may be empty */
     st = gr_enqueue_2d(s->ctx, s->relax_block, (size_t)mx0, (size_t)my0, (size_t)(mx_end - mx0),
                        (size_t)(my_end - my0), local);
   if (st == GR_OK)
@@ -1251,7 +1604,8 @@ static gr_status gr_snow_relax(gr_snow_deformation *s) {
    * gives), so the lag changes what is computed, never the result or the
    * iteration count. */
   const int lag = s->blocked ? GR_SNOW_CHECK_LAG : 0, cap = s->params.max_relax_iterations;
-  int before[GR_SNOW_CHECK_LAG + 1], count[GR_SNOW_CHECK_LAG + 1]; /* per launch in flight */
+  /* per launch in flight: iterations before it, its own, an empty check */
+  int before[GR_SNOW_CHECK_LAG + 1], count[GR_SNOW_CHECK_LAG + 1], empty[GR_SNOW_CHECK_LAG + 1];
   int launched = 0, read = 0, it_launched = 0, done = 0;
   while (st == GR_OK && !done) {
     if (it_launched < cap && launched - read <= lag) {
@@ -1283,9 +1637,12 @@ static gr_status gr_snow_relax(gr_snow_deformation *s) {
       for (cl_int t = 0; st == GR_OK && !s->blocked && t < iters; ++t)
         st = gr_snow_relax_once(s, gx0, gy0, gx_end, gy_end, t, tol);
       if (st == GR_OK)
+        st = gr_snow_piece_sync(s); /* pieces: the ring the launch used up */
+      if (st == GR_OK)
         lx0 = mx0, ly0 = my0, lx1 = mx_end - 1, ly1 = my_end - 1;
       if (st == GR_OK)
-        st = gr_snow_relax_check_start(s, &s->red_check[launched % (lag + 1)], x0, y0, x1, y1);
+        st = gr_snow_relax_check_start(s, &s->red_check[launched % (lag + 1)], x0, y0, x1, y1,
+                                       &empty[launched % (lag + 1)]);
       if (st == GR_OK) {
         before[launched % (lag + 1)] = it_launched;
         count[launched % (lag + 1)] = iters;
@@ -1299,7 +1656,7 @@ static gr_status gr_snow_relax(gr_snow_deformation *s) {
       break; /* the cap, every check read */
     double m[GR_SNOW_CHECK_MAXES];
     int slot = read % (lag + 1);
-    st = gr_reduction_finish(s->ctx, &s->red_check[slot], NULL, m);
+    st = gr_snow_relax_check_finish(s, &s->red_check[slot], empty[slot], m);
     ++read;
     if (st == GR_OK && m[0] <= tol) {
       it = before[slot]; /* nothing could move: that launch and those after changed nothing */
@@ -1313,7 +1670,8 @@ static gr_status gr_snow_relax(gr_snow_deformation *s) {
   }
   /* Checks still in flight (after the end, or an error): wait for them. */
   for (; read < launched; ++read)
-    gr_reduction_finish(s->ctx, &s->red_check[read % (lag + 1)], NULL, NULL);
+    if (!empty[read % (lag + 1)])
+      gr_reduction_finish(s->ctx, &s->red_check[read % (lag + 1)], NULL, NULL);
   /* Stopped by the cap: the last box read, grown by the iterations since,
    * holds every point that may still move. */
   s->rest[0] = s->rest[1] = 0;
@@ -1342,8 +1700,17 @@ gr_status gr_snow_deformation_step(gr_snow_deformation *s, double dt) {
   if (s->aborted)
     return GR_SNOW_KEEP_ERROR(
         s, gr_set_error(s->ctx, GR_ERR_ABORTED,
-                        "The snow deformation was stopped by its progress callback; set the "
-                        "callback again or reset to go on."));
+                        "The snow deformation was stopped by its progress callback%s; set the "
+                        "callback again or reset to go on.",
+                        s->allreduce ? " (of this or another piece of the domain)" : ""));
+  if (gr_snow_has_ring(s) && (!s->allreduce || !s->halo_exchange))
+    return GR_SNOW_KEEP_ERROR(
+        s, gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
+                        "A snow deformation piece with neighbours steps only with a global "
+                        "reduction and a halo exchange (it has %s and %s): set them with "
+                        "gr_snow_deformation_set_allreduce and "
+                        "gr_snow_deformation_set_halo_exchange.",
+                        s->allreduce ? "one" : "none", s->halo_exchange ? "one" : "none"));
   gr_status st = gr_snow_reset(s);
   memset(s->force, 0, sizeof(s->force));
   if (st == GR_OK && s->timing) {
@@ -1366,9 +1733,17 @@ gr_status gr_snow_deformation_step(gr_snow_deformation *s, double dt) {
     return GR_SNOW_KEEP_ERROR(s, st);
   s->time += dt;
   s->steps++;
-  if (s->progress && s->progress(s->progress_user, s->time) != 0)
+  int stop = s->progress && s->progress(s->progress_user, s->time) != 0;
+  /* Pieces: a stop asked on any piece stops every piece after this step
+   * (every piece makes this call at every step, callback or not). */
+  if (s->allreduce) {
+    double flag = stop ? 1.0 : 0.0;
+    st = gr_snow_allreduce(s, &flag, 1, GR_REDUCE_MAX);
+    stop = flag != 0.0;
+  }
+  if (stop)
     s->aborted = 1;
-  return GR_OK;
+  return st == GR_OK ? GR_OK : GR_SNOW_KEEP_ERROR(s, st);
 }
 
 gr_status gr_snow_deformation_get_field(gr_snow_deformation *s, gr_field f, float *host) {
@@ -1379,7 +1754,6 @@ gr_status gr_snow_deformation_get_field(gr_snow_deformation *s, gr_field f, floa
     return GR_SNOW_KEEP_ERROR(s, gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
                                               "gr_snow_deformation_get_field needs a place for "
                                               "the values (got NULL)."));
-  size_t bytes = gr_snow_cells(s) * sizeof(float);
   cl_mem src = NULL;
   gr_status st = GR_OK;
   switch (f) {
@@ -1422,7 +1796,7 @@ gr_status gr_snow_deformation_get_field(gr_snow_deformation *s, gr_field f, floa
   }
   }
   if (st == GR_OK)
-    st = gr_buffer_read(s->ctx, src, 0, bytes, host);
+    st = gr_snow_read_own(s, src, host);
   return st == GR_OK ? GR_OK : GR_SNOW_KEEP_ERROR(s, st);
 }
 
@@ -1433,24 +1807,31 @@ gr_status gr_snow_deformation_ledger_get(gr_snow_deformation *s, gr_snow_deforma
                                                   "for the ledger."))
              : gr_set_error(NULL, GR_ERR_INVALID_ARGUMENT,
                             "gr_snow_deformation_ledger_get needs a simulation.");
-  double v, m;
-  gr_status st = gr_snow_ledger_sums(s, &v, &m);
+  /* Fixed point over the own points, then over every piece (collective):
+   * the whole grid's integers, so its very doubles. */
+  long long q[4] = {0, 0, s->initial_q, s->initial_m};
+  gr_status st = gr_snow_ledger_sums(s, &q[0], &q[1]);
+  if (st == GR_OK)
+    st = gr_snow_allreduce_i64(s, q, 4);
   if (st != GR_OK)
     return GR_SNOW_KEEP_ERROR(s, st);
+  const double a = s->grid.dx * s->grid.dy, quantum = 1.0 / GR_SNOW_QUANTUM_INV,
+               mass = 1.0 / GR_SNOW_LEDGER_MASS_INV;
+  double v = (double)q[0] * quantum * a, m = (double)q[1] * mass * a;
   memset(out, 0, sizeof(*out));
   out->time = s->time;
   out->steps = s->steps;
-  out->initial_volume = s->initial_volume;
-  out->initial_mass = s->initial_mass;
+  out->initial_volume = (double)q[2] * quantum * a;
+  out->initial_mass = (double)q[3] * mass * a;
   /* Displaced snow waiting for a contour is still snow. */
-  v += s->pending * s->grid.dx * s->grid.dy;
-  m += s->pending_mass * s->grid.dx * s->grid.dy;
+  v += s->pending * a;
+  m += s->pending_mass * a;
   out->snow_volume = v;
   out->snow_mass = m;
   out->compressed_volume = s->compressed;
   out->displaced_volume = s->displaced;
-  out->balance_error = m - s->initial_mass;
-  out->volume_error = s->initial_volume - s->compressed - v;
+  out->balance_error = m - out->initial_mass;
+  out->volume_error = out->initial_volume - s->compressed - v;
   out->relax_iterations = s->relax_iterations;
   return GR_OK;
 }
@@ -1489,8 +1870,9 @@ void gr_snow_deformation_set_progress(gr_snow_deformation *s, gr_progress_fn fn,
 typedef struct gr_snow_state_header {
   uint32_t magic, version;
   int32_t nx, ny, relax_full, relax_iterations, rest[4];
-  int64_t steps;
-  double time, initial_volume, initial_mass, compressed, displaced, pending, pending_mass;
+  int32_t i0, j0; /* the piece's first own point (0, 0 for a whole grid) */
+  int64_t steps, initial_q, initial_m;
+  double time, compressed, displaced, pending, pending_mass;
   double force[GR_SNOW_DEFORMATION_MAX_OBJECTS][3], area[GR_SNOW_DEFORMATION_MAX_OBJECTS];
 } gr_snow_state_header;
 
@@ -1536,8 +1918,10 @@ gr_status gr_snow_deformation_state_save(gr_snow_deformation *s, void *host, siz
     hd.rest[q] = s->rest[q];
   hd.steps = s->steps;
   hd.time = s->time;
-  hd.initial_volume = s->initial_volume;
-  hd.initial_mass = s->initial_mass;
+  hd.i0 = s->ox + s->ring[0];
+  hd.j0 = s->oy + s->ring[2];
+  hd.initial_q = s->initial_q;
+  hd.initial_m = s->initial_m;
   hd.compressed = s->compressed;
   hd.displaced = s->displaced;
   hd.pending = s->pending;
@@ -1573,6 +1957,13 @@ gr_status gr_snow_deformation_state_load(gr_snow_deformation *s, const void *hos
                         "The bytes are not a snow deformation state of a %d x %d grid (version "
                         "%u); load one saved by gr_snow_deformation_state_save.",
                         s->grid.nx, s->grid.ny, GR_SNOW_STATE_VERSION));
+  if (hd.i0 != s->ox + s->ring[0] || hd.j0 != s->oy + s->ring[2])
+    return GR_SNOW_KEEP_ERROR(
+        s, gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
+                        "The snow deformation state is of the piece whose first point is (%d, %d) "
+                        "but this simulation's piece starts at (%d, %d): load each piece's own "
+                        "state.",
+                        hd.i0, hd.j0, s->ox + s->ring[0], s->oy + s->ring[2]));
   size_t ab = gr_snow_cells(s) * sizeof(float);
   const char *base = (const char *)host + sizeof(hd);
   for (size_t c = 0; c < 2 * gr_snow_cells(s); ++c) {
@@ -1598,8 +1989,8 @@ gr_status gr_snow_deformation_state_load(gr_snow_deformation *s, const void *hos
   s->reset_full = 1;
   s->steps = hd.steps;
   s->time = hd.time;
-  s->initial_volume = hd.initial_volume;
-  s->initial_mass = hd.initial_mass;
+  s->initial_q = hd.initial_q;
+  s->initial_m = hd.initial_m;
   s->compressed = hd.compressed;
   s->displaced = hd.displaced;
   s->pending = hd.pending;

@@ -58,6 +58,34 @@ GR_API gr_status gr_reduction_finish(gr_context *ctx, gr_reduction *r, double *s
  * released reduction is fine. */
 GR_API void gr_reduction_release(gr_reduction *r);
 
+/**
+ * An integer reduction (cl/reduce.h's gr_reduce_group_long): nsum int64
+ * sums per work-group, added on the host in int64. Fixed-point totals that
+ * must come out the same however the cells are split (among work-groups, or
+ * among the pieces of a domain) use it: integer addition is exact in any
+ * order. Zero-initialise before init.
+ */
+typedef struct gr_reduction_i64 {
+  int nsum;             /**< int64 sums per group */
+  size_t local, groups; /**< work-group size (a power of two) and count */
+  cl_mem partial;       /**< nsum longs per group */
+  long long *host;      /**< the partials, read back */
+} gr_reduction_i64;
+
+/** As gr_reduction_init, for nsum (1 to GR_REDUCTION_MAX_SLOTS) integer sums. */
+GR_API gr_status gr_reduction_i64_init(gr_context *ctx, cl_kernel k, size_t items, int nsum,
+                                       gr_reduction_i64 *r);
+
+/**
+ * Runs k (its own arguments already set; this sets `partial` and `scratch`
+ * by name), waits, and returns the nsum totals.
+ */
+GR_API gr_status gr_reduction_i64_run(gr_context *ctx, gr_reduction_i64 *r, cl_kernel k,
+                                      long long *sums);
+
+/** Frees the buffers; a zeroed or released reduction is fine. */
+GR_API void gr_reduction_i64_release(gr_reduction_i64 *r);
+
 #ifdef __cplusplus
 }
 #endif

@@ -114,10 +114,8 @@
  * over the objects of D in the last step, m), CONTACT (1 where some object
  * touched the snow in the last step, else 0) and ELEVATION.
  *
- * Pieces: whole grids only, for now. A gr_grid with i0, j0, ghost or a
- * global size other than its own is refused with a sentence (the contour,
- * the distribution and the talus relaxation reach any distance in one step,
- * so a piece needs a global exchange the core does not do yet).
+ * Pieces of a split domain: see "Pieces of a split domain" below; a piece
+ * computes bit for bit what the whole grid computes at its points.
  */
 #ifndef GRAUPEL_SNOW_DEFORMATION_H
 #define GRAUPEL_SNOW_DEFORMATION_H
@@ -211,7 +209,8 @@ typedef struct gr_snow_deformation_ledger {
 typedef struct gr_snow_deformation gr_snow_deformation;
 
 /**
- * A simulation on one whole grid (see "Pieces" above): validates grid and
+ * A simulation on a whole grid or a piece of one (see "Pieces of a split
+ * domain" below): validates grid and
  * parameters, builds the kernels, allocates the state: flat ground at 0,
  * snow of initial_snow_depth and initial_density, no objects.
  */
@@ -227,7 +226,8 @@ GR_API gr_status gr_snow_deformation_set_params(gr_snow_deformation *s,
                                                 const gr_snow_deformation_params *p);
 
 /**
- * Uploads ELEVATION, SNOW_DEPTH or SNOW_DENSITY (nx*ny floats, row-major):
+ * Uploads ELEVATION, SNOW_DEPTH or SNOW_DENSITY (nx*ny floats, row-major;
+ * for a piece with neighbours its local array, ring included):
  * every value finite, elevations within +-1e6 m, depths 0 to 1e4 m,
  * densities within [min_density, max_density]; a refused field (a sentence
  * naming the field, the point (i, j) and the value) leaves the state as it
@@ -249,16 +249,24 @@ GR_API gr_status gr_snow_deformation_set_field(gr_snow_deformation *s, gr_field 
 GR_API gr_status gr_snow_deformation_set_objects(gr_snow_deformation *s, const gr_mesh *meshes,
                                                  int n, const double *velocities);
 
-/** One step of dt seconds (finite, 1e-9 to 3600); waits. */
+/**
+ * One step of dt seconds (finite, 1e-9 to 3600); waits. A piece with
+ * neighbours steps only with an allreduce and a halo exchange set, and
+ * every piece of the domain steps together (the calls are collective).
+ */
 GR_API gr_status gr_snow_deformation_step(gr_snow_deformation *s, double dt);
 
 /**
  * Reads a field back (waits): SNOW_DEPTH, SNOW_SURFACE, SNOW_DENSITY,
- * OVERLAP, CONTACT or ELEVATION, nx*ny floats.
+ * OVERLAP, CONTACT or ELEVATION, nx*ny floats (a piece: its own points).
  */
 GR_API gr_status gr_snow_deformation_get_field(gr_snow_deformation *s, gr_field f, float *host);
 
-/** The ledger now (waits; reduces volume and mass on the device). */
+/**
+ * The ledger now (waits; reduces volume and mass on the device, in fixed
+ * point). A piece with an allreduce gives the whole domain's ledger (a
+ * collective call); one without, its own points' volumes and masses.
+ */
 GR_API gr_status gr_snow_deformation_ledger_get(gr_snow_deformation *s,
                                                 gr_snow_deformation_ledger *out);
 
@@ -274,7 +282,8 @@ GR_API gr_status gr_snow_deformation_object_forces(gr_snow_deformation *s, doubl
  * Progress (see gr_progress_fn): called after each step with the time
  * reached; a non-zero return makes the next gr_snow_deformation_step
  * refuse with GR_ERR_ABORTED until set_progress or reset is called. NULL
- * removes it.
+ * removes it. On a piece with an allreduce the stop is global: see "Pieces
+ * of a split domain".
  */
 GR_API void gr_snow_deformation_set_progress(gr_snow_deformation *s, gr_progress_fn fn, void *user);
 
@@ -282,7 +291,9 @@ GR_API void gr_snow_deformation_set_progress(gr_snow_deformation *s, gr_progress
  * Checkpoints: depth, density, overlap, contact, the last forces, time,
  * steps and ledger as bytes. Loading into a simulation of the same grid,
  * inputs and objects makes every later step bit-identical. Inputs
- * (elevation), parameters and objects are not part of it.
+ * (elevation), parameters and objects are not part of it. A piece's state
+ * holds its local arrays, ring included, and its i0, j0; it loads only into
+ * the same piece, with no exchange (the ring is as fresh as when saved).
  */
 GR_API gr_status gr_snow_deformation_state_size(const gr_snow_deformation *s, size_t *bytes);
 GR_API gr_status gr_snow_deformation_state_save(gr_snow_deformation *s, void *host, size_t bytes);
@@ -292,6 +303,101 @@ GR_API gr_status gr_snow_deformation_state_load(gr_snow_deformation *s, const vo
 /** Back to the initial snow (the last SNOW_DEPTH/SNOW_DENSITY set, or the params'), ledger zeroed;
  * elevation and objects kept. */
 GR_API gr_status gr_snow_deformation_reset(gr_snow_deformation *s);
+
+/**
+ * @name Pieces of a split domain
+ *
+ * A simulation may hold one piece of a domain split among processes (the
+ * gr_grid piece fields: i0, j0, global_nx, global_ny, ghost). Only the
+ * domain's own edges are boundaries. On every side where the piece has a
+ * neighbour it keeps a ring of GR_SNOW_DEFORMATION_GHOST points, copies of
+ * the neighbour's points; grid.ghost must then be GR_SNOW_DEFORMATION_GHOST
+ * and the piece at least that many points wide toward the neighbour. The
+ * local arrays are the piece and its ring: (nx + rings) x (ny + rings)
+ * floats for set_field and checkpoints; get_field gives the own nx x ny.
+ *
+ * Why 8: a talus iteration reads points two away (a point's move reads its
+ * neighbours' rates, a rate its neighbours' heights), and the talus runs
+ * GR_SNOW_BLOCK_ITERATIONS (4) iterations per launch (or per group of
+ * one-launch iterations) on the local arrays, ring included: after a launch
+ * the outer 2 x 4 points of the ring are stale, every own point is the
+ * whole grid's. So the ring is refreshed after every launch, and after each
+ * object's press (whose contour reads one point away).
+ *
+ * The exchange is the caller's (gr_snow_deformation_set_halo_exchange),
+ * called by the core at those stages, so a step makes several: per ring
+ * point the state's depth and density (gr_snow_deformation_halo_get on the
+ * sending piece, the own points next to the side;
+ * gr_snow_deformation_halo_set on the receiving one); x sides (west, east)
+ * first, then y sides (south, north): an x strip spans the local arrays'
+ * rows and a y strip their columns, ring included, so corner points travel
+ * through the x neighbour.
+ *
+ * Every piece rasterizes every object over its local arrays (the
+ * coordinates of a point are the domain's, the same floats as on the whole
+ * grid). What steers a step is global through the allreduce callback and
+ * the same integers on every split: each object's displaced height, its
+ * mass, the contour weights and the deposits (fixed point, summed as
+ * int64 over the piece's own points, then GR_REDUCE_SUM over the pieces,
+ * each int64 as two doubles of 32 bits: exact), the talus check (the
+ * largest movable amount and the box of the points still moving, in the
+ * domain's indices, GR_REDUCE_MAX), so every piece takes the same decisions
+ * as the whole grid, and every own point, the resistance and the contact
+ * area are the whole grid's bit for bit. The ledger is global the same way.
+ *
+ * Stepping on pieces is collective: every piece sets the same objects and
+ * calls gr_snow_deformation_step with the same dt, and each step makes the
+ * same sequence of allreduce and exchange calls on every piece. Stop: a
+ * piece's progress callback (each piece may have its own, or none) only
+ * raises a flag, reduced by GR_REDUCE_MAX after every step, so a stop asked
+ * for on any one piece stops every piece after the same step (their next
+ * step refuses with GR_ERR_ABORTED). An error on one piece (a failed
+ * launch, a failed exchange) returns on that piece only: the others wait
+ * in their next collective call, which the caller's callbacks must end
+ * (MPI_Abort, or a status that is not GR_OK).
+ * @{
+ */
+
+/** Ring width of a piece toward each neighbour, points (2 per talus iteration x 4). */
+#define GR_SNOW_DEFORMATION_GHOST 8
+
+/** Sides of a piece, for the halo calls. */
+typedef enum gr_snow_deformation_side {
+  GR_SNOW_DEFORMATION_WEST = 0,  /**< toward i0 - 1 */
+  GR_SNOW_DEFORMATION_EAST = 1,  /**< toward i0 + nx */
+  GR_SNOW_DEFORMATION_SOUTH = 2, /**< toward j0 - 1 */
+  GR_SNOW_DEFORMATION_NORTH = 3  /**< toward j0 + ny */
+} gr_snow_deformation_side;
+
+/**
+ * The global reduction over the pieces (see gr_allreduce_fn); NULL (the
+ * default) for a simulation that is the whole domain. Values per call: at
+ * most 16.
+ */
+GR_API void gr_snow_deformation_set_allreduce(gr_snow_deformation *s, gr_allreduce_fn fn,
+                                              void *user);
+
+/**
+ * The halo exchange (see gr_halo_exchange_fn and above), called with user
+ * at every stage of a step that uses up the ring; NULL (the default)
+ * removes it. Never called for a simulation without a ring.
+ */
+GR_API void gr_snow_deformation_set_halo_exchange(gr_snow_deformation *s, gr_halo_exchange_fn fn,
+                                                  void *user);
+
+/** Bytes of the halo strip on `side` (a gr_snow_deformation_side); 0 where there is no neighbour.
+ */
+GR_API gr_status gr_snow_deformation_halo_size(const gr_snow_deformation *s, int side,
+                                               size_t *bytes);
+
+/** Copies the own points next to `side` out (for the neighbour on that side); waits. */
+GR_API gr_status gr_snow_deformation_halo_get(gr_snow_deformation *s, int side, void *host,
+                                              size_t bytes);
+
+/** Copies the neighbour's strip into the ring on `side`; waits. */
+GR_API gr_status gr_snow_deformation_halo_set(gr_snow_deformation *s, int side, const void *host,
+                                              size_t bytes);
+/** @} */
 
 /** The latest error of a call on this simulation ("" when none). Never NULL. */
 GR_API const char *gr_snow_deformation_last_error(const gr_snow_deformation *s);
