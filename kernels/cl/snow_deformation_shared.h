@@ -59,8 +59,13 @@
  * moving, which becomes the window) runs after every launch. */
 #define GR_SNOW_BLOCK_ITERATIONS 4
 
-/* On GPUs (blocked talus) the check of a launch is read back this many
- * launches later, so the device never idles waiting for the host. */
+/* On GPUs (blocked talus) every GR_SNOW_CHECK_EVERY-th launch is checked,
+ * and a check is read back GR_SNOW_CHECK_LAG checks later, so the device
+ * never idles waiting for the host; the launches after the one whose check
+ * finds nothing to move change nothing. */
+#ifndef GR_SNOW_CHECK_EVERY
+#define GR_SNOW_CHECK_EVERY 2
+#endif
 #define GR_SNOW_CHECK_LAG 2
 
 /* The 8 neighbours' offsets, in the order the talus adds them up:

@@ -1596,19 +1596,22 @@ static gr_status gr_snow_relax(gr_snow_deformation *s) {
     st = gr_snow_sync_rect(s, x0, y0, x1, y1);
   s->relax_full = s->sync_full = 0;
   int lx0 = 0, ly0 = 0, lx1 = -1, ly1 = -1; /* the last launch's window */
-  /* Launches in flight: their checks are read back up to `lag` launches
-   * later (on GPUs, where waiting for each read-back between launches
-   * costs more than the launch), so the window of a launch is the last
-   * box read grown by every iteration launched since. A launch after the
+  /* Launches in flight: on GPUs, where a read-back between launches costs
+   * more than the launch, only every GR_SNOW_CHECK_EVERY-th launch is
+   * checked and a check is read back GR_SNOW_CHECK_LAG checks later, so the
+   * window of a launch is the last box read grown by every iteration
+   * launched since. A launch after the
    * one whose check says nothing could move changes nothing (no point
    * gives), so the lag changes what is computed, never the result or the
    * iteration count. */
   const int lag = s->blocked ? GR_SNOW_CHECK_LAG : 0, cap = s->params.max_relax_iterations;
-  /* per launch in flight: iterations before it, its own, an empty check */
-  int before[GR_SNOW_CHECK_LAG + 1], count[GR_SNOW_CHECK_LAG + 1], empty[GR_SNOW_CHECK_LAG + 1];
-  int launched = 0, read = 0, it_launched = 0, done = 0;
+  const int every = s->blocked ? GR_SNOW_CHECK_EVERY : 1;
+  /* per check in flight: the iterations launched before its launch, and
+   * whether it is empty (a piece with none of the window) */
+  int before[GR_SNOW_CHECK_LAG + 1], empty[GR_SNOW_CHECK_LAG + 1];
+  int launched = 0, started = 0, read = 0, it_launched = 0, done = 0;
   while (st == GR_OK && !done) {
-    if (it_launched < cap && launched - read <= lag) {
+    if (it_launched < cap && started - read <= lag) {
       int left = cap - it_launched;
       cl_int iters = left < GR_SNOW_BLOCK_ITERATIONS ? left : GR_SNOW_BLOCK_ITERATIONS;
       x0 = x0 > 0 ? x0 : 0;
@@ -1640,19 +1643,20 @@ static gr_status gr_snow_relax(gr_snow_deformation *s) {
         st = gr_snow_piece_sync(s); /* pieces: the ring the launch used up */
       if (st == GR_OK)
         lx0 = mx0, ly0 = my0, lx1 = mx_end - 1, ly1 = my_end - 1;
-      if (st == GR_OK)
-        st = gr_snow_relax_check_start(s, &s->red_check[launched % (lag + 1)], x0, y0, x1, y1,
-                                       &empty[launched % (lag + 1)]);
+      int slot = started % (lag + 1);
+      if (st == GR_OK && launched % every == 0) {
+        st = gr_snow_relax_check_start(s, &s->red_check[slot], x0, y0, x1, y1, &empty[slot]);
+        before[slot] = it_launched;
+        started += st == GR_OK;
+      }
       if (st == GR_OK) {
-        before[launched % (lag + 1)] = it_launched;
-        count[launched % (lag + 1)] = iters;
         it_launched += iters;
         ++launched;
         x0 -= iters, x1 += iters, y0 -= iters, y1 += iters; /* until a box is read */
       }
       continue;
     }
-    if (read == launched)
+    if (read == started)
       break; /* the cap, every check read */
     double m[GR_SNOW_CHECK_MAXES];
     int slot = read % (lag + 1);
@@ -1662,14 +1666,14 @@ static gr_status gr_snow_relax(gr_snow_deformation *s) {
       it = before[slot]; /* nothing could move: that launch and those after changed nothing */
       done = 1;
     } else if (st == GR_OK) {
-      it = before[slot] + count[slot];
+      it = it_launched;
       int g = it_launched - before[slot]; /* iterations since that check's launch began */
       x0 = (int)-m[1] - g, x1 = (int)m[2] + g;
       y0 = (int)-m[3] - g, y1 = (int)m[4] + g;
     }
   }
   /* Checks still in flight (after the end, or an error): wait for them. */
-  for (; read < launched; ++read)
+  for (; read < started; ++read)
     if (!empty[read % (lag + 1)])
       gr_reduction_finish(s->ctx, &s->red_check[read % (lag + 1)], NULL, NULL);
   /* Stopped by the cap: the last box read, grown by the iterations since,
