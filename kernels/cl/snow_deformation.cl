@@ -483,9 +483,13 @@ snow_relax_block(__global const float *restrict ground, __global const float *re
   }
   barrier(CLK_LOCAL_MEM_FENCE);
   for (int t = 0; t < iters; ++t) {
+    /* Only what the tile's last iteration needs: its moves on the tile,
+     * its rates one further out, the iteration before two further, and so
+     * on (the halo goes stale from its edge two a step anyway). */
+    const int mr = halo - 2 * (iters - 1 - t) - 1, mm = mr + 1;
     for (int q = lid; q < n; q += wg) {
       int a = q % w, b = q / w, i = ox + a, j = oy + b;
-      if (a < 1 || b < 1 || a >= w - 1 || b >= h - 1 || i < 0 || j < 0 || i >= nx || j >= ny)
+      if (a < mr || b < mr || a >= w - mr || b >= h - mr || i < 0 || j < 0 || i >= nx || j >= ny)
         continue;
       float sn[8], gn[8], un[8], k, kin, mv;
       for (int e = 0; e < 8; ++e) {
@@ -507,7 +511,7 @@ snow_relax_block(__global const float *restrict ground, __global const float *re
     barrier(CLK_LOCAL_MEM_FENCE);
     for (int q = lid; q < n; q += wg) {
       int a = q % w, b = q / w, i = ox + a, j = oy + b;
-      if (a < 1 || b < 1 || a >= w - 1 || b >= h - 1 || i < 0 || j < 0 || i >= nx || j >= ny)
+      if (a < mm || b < mm || a >= w - mm || b >= h - mm || i < 0 || j < 0 || i >= nx || j >= ny)
         continue;
       float sn[8], gn[8], un[8], rn[8], kon[8], kinn[8], s1, r1;
       for (int e = 0; e < 8; ++e) {
