@@ -8,6 +8,7 @@
 # fuzz_<core>_params.c if present. Keep it sorted: graupel-params prints
 # the cores in this order.
 set(GRAUPEL_CORES
+  particles
   procedural_terrain
   rain_runoff
   snow_accumulation

@@ -50,9 +50,12 @@ from paraview import servermanager  # noqa: E402
 from paraview.simple import LoadPlugin  # noqa: E402
 
 # The proxy of a core is named after it (rain_runoff -> RainRunoff, one name
-# through every layer), a source or a filter; CORES maps core -> (proxy group,
-# proxy name, VTK class) and is filled from the plugin below, so a new core
-# needs no line here.
+# through every layer), a source or a filter; a core behind several proxies
+# and none of its own name (particles -> RainParticles, SnowfallParticles)
+# has the proxies whose names end in its name. CORES maps core -> [(proxy
+# group, proxy name, VTK class), ...] and is filled from the plugin below, so
+# a new core needs no line here. Each row of a core's table is checked on
+# every one of its proxies that has the property, and must be on one.
 CORES = {}
 INT_MIN, INT_MAX = -2 ** 31, 2 ** 31 - 1
 
@@ -82,13 +85,33 @@ def fmt(row):
 CORE_ONLY = set()
 LoadPlugin(a.plugin, ns=globals())
 pxm = servermanager.ProxyManager()
+
+
+def proxies_ending(suffix):
+    """(group, name) of every source and filter whose name ends in suffix."""
+    found = []
+    for group in ("sources", "filters"):
+        it = pxm.GetProxyDefinitionManager().NewSingleGroupIterator(group)
+        it.GoToFirstItem()
+        while not it.IsDoneWithTraversal():
+            if it.GetProxyName().endswith(suffix):
+                found.append((group, it.GetProxyName()))
+            it.GoToNextItem()
+    return found
+
+
 for core in tables:
     name = "".join(w.capitalize() for w in core.split("_"))
     for group in ("sources", "filters"):
         proto = pxm.GetPrototypeProxy(group, name)
         if proto is not None:
-            CORES[core] = (group, name, proto.GetVTKClassName())
+            CORES[core] = [(group, name, proto.GetVTKClassName())]
             break
+    if core not in CORES:
+        several = [(g, n, pxm.GetPrototypeProxy(g, n).GetVTKClassName())
+                   for g, n in proxies_ending(name) if n != name]
+        if several:
+            CORES[core] = several
     if core in CORE_ONLY:
         T.check(core not in CORES, "the core %s has its proxy %s now: take it off CORE_ONLY"
                 % (core, name))
@@ -101,7 +124,7 @@ for core in tables:
 # value. ELEMENT maps (core, row) -> (property, value index); the README row
 # is the property's, its default cell the values in order.
 ELEMENT = {}
-for core, (group, name, _) in CORES.items():
+for (group, name, _) in [px for pxs in CORES.values() for px in pxs]:
     proto = pxm.GetPrototypeProxy(group, name)
     it = proto.NewPropertyIterator()
     it.Begin()
@@ -110,14 +133,21 @@ for core, (group, name, _) in CORES.items():
         rows = hints.FindNestedElementByName("GraupelTableRows") if hints else None
         if rows is not None:
             for k, r in enumerate(rows.GetAttribute("rows").split()):
-                ELEMENT[(core, r)] = (it.GetKey(), k)
+                ELEMENT[(name, r)] = (it.GetKey(), k)
         it.Next()
 
 
-def check_xml(core, row):
-    group, name, _ = CORES[core]
+def has_row(proxy, row):
+    """The proxy has the row's property (itself, or a property of several values)."""
+    group, name, _ = proxy
+    p = ELEMENT.get((name, row["property"]), (row["property"], 0))[0]
+    return pxm.GetPrototypeProxy(group, name).GetProperty(p) is not None
+
+
+def check_xml(proxy, row):
+    group, name, _ = proxy
     proto = pxm.GetPrototypeProxy(group, name)
-    p, index = ELEMENT.get((core, row["property"]), (row["property"], 0))
+    p, index = ELEMENT.get((name, row["property"]), (row["property"], 0))
     prop = proto.GetProperty(p) if proto else None
     T.check(prop is not None, "%s has the property %s" % (name, p))
     if prop is None:
@@ -171,12 +201,12 @@ def check_xml(core, row):
 
 
 # ---------------------------------------------------------- the VTK classes
-def check_class(core, row):
-    cls = getattr(graupel, CORES[core][2])
+def check_class(proxy, row):
+    cls = getattr(graupel, proxy[2])
     obj = cls()
     p = row["property"]
     get, set_ = getattr(obj, "Get" + p), getattr(obj, "Set" + p)
-    where = "%s.Set%s (table %s)" % (CORES[core][2], p, fmt(row))
+    where = "%s.Set%s (table %s)" % (proxy[2], p, fmt(row))
     T.check(same(float(get()), row["default"]), "%s: class default %r" % (where, get()))
     if isinstance(get(), bool) or (row["min"] <= INT_MIN and row["max"] >= INT_MAX):
         return  # a bool or a whole int: no value lies outside
@@ -235,11 +265,11 @@ def parse_range(cell):
 readme = readme_rows(a.readme)
 
 
-def check_readme(core, row):
-    p, index = ELEMENT.get((core, row["property"]), (row["property"], -1))
-    found = readme.get((CORES[core][1], p), [])
+def check_readme(proxy, row):
+    p, index = ELEMENT.get((proxy[1], row["property"]), (row["property"], -1))
+    found = readme.get((proxy[1], p), [])
     T.check(len(found) == 1, "README: one table row for `%s` in the section of %s (found %d)"
-            % (p, CORES[core][1], len(found)))
+            % (p, proxy[1], len(found)))
     if len(found) != 1:
         return
     default_cell, range_cell = found[0]
@@ -272,8 +302,12 @@ for core, rows in sorted(tables.items()):
         T.check(row["min"] <= row["default"] <= row["max"] and
                 not (row["min_open"] and row["default"] == row["min"]),
                 "%s.%s: the default %g lies in %s" % (core, row["property"], row["default"], fmt(row)))
-        check_xml(core, row)
-        check_class(core, row)
-        check_readme(core, row)
+        on = [px for px in CORES[core] if has_row(px, row)]
+        T.check(len(on) > 0, "%s.%s is a property of %s" % (core, row["property"],
+                                                          [px[1] for px in CORES[core]]))
+        for proxy in on:
+            check_xml(proxy, row)
+            check_class(proxy, row)
+            check_readme(proxy, row)
 
 T.finish()
