@@ -380,7 +380,9 @@ static int gr_ws_lake(const gr_water_surface *s) {
 }
 
 /* Finds the wet points and the still surface from the inputs and the
- * parameters, and uploads them; refuses no water with a sentence. */
+ * parameters, and uploads them; refuses no water with a sentence. Water
+ * with no wet point is not refused: runoff that has not gathered yet is
+ * dry, and nothing moves. */
 static gr_status gr_ws_prepare(gr_water_surface *s) {
   if (s->water_ready)
     return GR_OK;
@@ -401,37 +403,21 @@ static gr_status gr_ws_prepare(gr_water_surface *s) {
   }
   float level = (float)p->lake_level, threshold = (float)p->wet_depth;
   long long count = 0;
-  double lowest = HUGE_VAL, deepest = 0.0;
   for (size_t c = 0; c < n; ++c) {
     float b = s->elevation[c];
     int w;
     if (lake) {
       w = b < level;
       base[c] = w ? level : b;
-      lowest = b < lowest ? b : lowest;
     } else {
       float d = s->depth[c];
       w = d > threshold;
       base[c] = b + d;
-      deepest = d > deepest ? d : deepest;
     }
     wet[c] = (unsigned char)w;
     count += w;
   }
   gr_status st = GR_OK;
-  if (count == 0) {
-    if (lake)
-      st = gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
-                        "The water surface has no wet point: no elevation lies below LakeLevel "
-                        "(%g m; the lowest ground is %g m); raise LakeLevel above the lowest "
-                        "ground.",
-                        p->lake_level, lowest);
-    else
-      st = gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
-                        "The water surface has no wet point: no water_depth exceeds WetDepth "
-                        "(%g m; the deepest water is %g m); lower WetDepth or give deeper water.",
-                        p->wet_depth, deepest);
-  }
   if (st == GR_OK)
     st = gr_buffer_write(s->ctx, s->wet, 0, n, wet);
   if (st == GR_OK)

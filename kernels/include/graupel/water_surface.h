@@ -13,7 +13,8 @@
  * where its elevation lies below LakeLevel, the still surface is LakeLevel
  * and the depth LakeLevel - elevation (a lake replaces any depth given).
  * Without either there is no water, and stepping is refused with a
- * sentence; so is water with no wet point.
+ * sentence. Water with no wet point is not refused (runoff early in a
+ * storm is dry): nothing moves then; the ledger's wet_points says so.
  *
  * Model (seed 003 leaves its solver to Klein's thesis, notes/001_003.md
  * B.2.1; this is the Gomez / Kass-Miller wave-equation height field those
