@@ -14,4 +14,5 @@ set(GRAUPEL_CORES
   snow_accumulation
   snow_deformation
   terrain_analysis
+  water_surface
 )

@@ -1,0 +1,219 @@
+/* Water surface (seed 003's height-field water, seed 004's ripples): the
+ * damped linear wave equation on the wet points of a grid, raindrop dimples,
+ * and the fields derived from the wave for rendering. The model and its
+ * discretisation are documented in graupel/water_surface.h. */
+#include "common.h"
+#include "reduce.h"
+#include "water_surface_shared.h"
+
+/* The hash that decides whether a raindrop falls at point (a, b) during step
+ * (step_hi, step_lo) of the simulation with this seed: a pure function, so a
+ * step computes the same drops whenever it is taken. */
+GR_INLINE uint gr_ws_drop_hash(int a, int b, uint step_lo, uint step_hi, uint seed) {
+  uint s = gr_hash_u32(step_lo ^ gr_hash_u32(step_hi ^ (seed * 0x27d4eb2dU)));
+  return gr_hash3(a, b, s);
+}
+
+/* A uniform number in (-0.5, 0.5) from the top 24 bits of a hash. */
+GR_INLINE float gr_ws_offset(uint h) {
+  return ((float)(h >> 8) + 0.5f) * (1.0f / 16777216.0f) - 0.5f;
+}
+
+/* g = the sum of the unit Gaussians exp(-r^2 / (2 sigma^2)) of this step's
+ * drops within reach_x, reach_y points of each wet point (0 on dry points).
+ * A drop falls at wet point (a, b) when the top 24 bits of its hash are below
+ * threshold (the chance rate dx dy dt times 2^24), at a position hashed
+ * uniformly within the point's cell. Every point's g is computed here once,
+ * so the step's Laplacian of g takes the same value from both sides of a
+ * face. */
+__kernel void water_surface_drops(__global const uchar *restrict wet, __global float *restrict g,
+                                  int nx, int ny, float dx, float dy, float inv_2sig2, int reach_x,
+                                  int reach_y, uint threshold, uint seed, uint step_lo,
+                                  uint step_hi) {
+  int i = get_global_id(0), j = get_global_id(1);
+  if (!gr_inside(i, j, nx, ny))
+    return;
+  int c = gr_idx(i, j, nx);
+  float sum = 0.0f;
+  if (wet[c]) {
+    int a0 = max(i - reach_x, 0), a1 = min(i + reach_x, nx - 1);
+    int b0 = max(j - reach_y, 0), b1 = min(j + reach_y, ny - 1);
+    for (int b = b0; b <= b1; ++b)
+      for (int a = a0; a <= a1; ++a) {
+        uint h = gr_ws_drop_hash(a, b, step_lo, step_hi, seed);
+        if ((h >> 8) >= threshold || !wet[gr_idx(a, b, nx)])
+          continue;
+        float ox = gr_ws_offset(gr_hash_u32(h ^ 0x68e31da4U));
+        float oy = gr_ws_offset(gr_hash_u32(h ^ 0xb5297a4dU));
+        float rx = ((float)(i - a) - ox) * dx, ry = ((float)(j - b) - oy) * dy;
+        sum += exp(-(rx * rx + ry * ry) * inv_2sig2);
+      }
+  }
+  g[c] = sum;
+}
+
+/* One step of the wave equation h_tt = c^2 lap(h) - gamma h_t on the wet
+ * points, symplectic Euler (the leapfrog scheme with v = h_t at half steps):
+ *   v' = (v + dt c^2 lap(h)) exp(-gamma dt),   h' = h + dt v' + drop
+ * lap sums (h_nb - h) / d^2 over the wet neighbours only: a face to a dry
+ * point or beyond the grid carries nothing (a reflecting shore), and each
+ * face's difference is the exact negative of its neighbour's, so the sum of
+ * h over the wet points stays constant to rounding. The drops add
+ * drop_coef * lap(g), the same masked Laplacian of this step's Gaussians:
+ * a dimple of depth DropAmplitude with a ring around it, whose sum is zero
+ * in the same way. Dry points hold no wave. */
+__kernel void water_surface_step(__global const float *restrict h_in,
+                                 __global float *restrict h_out, __global float *restrict v,
+                                 __global const uchar *restrict wet,
+                                 __global const float *restrict g, int nx, int ny, float inv_dx2,
+                                 float inv_dy2, float c2dt, float dt, float damp, int drops,
+                                 float drop_coef) {
+  int i = get_global_id(0), j = get_global_id(1);
+  if (!gr_inside(i, j, nx, ny))
+    return;
+  int c = gr_idx(i, j, nx);
+  if (!wet[c]) {
+    h_out[c] = 0.0f;
+    v[c] = 0.0f;
+    return;
+  }
+  float hc = h_in[c], lap = 0.0f, dlap = 0.0f;
+  float gc = drops ? g[c] : 0.0f;
+  if (i > 0 && wet[c - 1]) {
+    lap += (h_in[c - 1] - hc) * inv_dx2;
+    if (drops)
+      dlap += (g[c - 1] - gc) * inv_dx2;
+  }
+  if (i < nx - 1 && wet[c + 1]) {
+    lap += (h_in[c + 1] - hc) * inv_dx2;
+    if (drops)
+      dlap += (g[c + 1] - gc) * inv_dx2;
+  }
+  if (j > 0 && wet[c - nx]) {
+    lap += (h_in[c - nx] - hc) * inv_dy2;
+    if (drops)
+      dlap += (g[c - nx] - gc) * inv_dy2;
+  }
+  if (j < ny - 1 && wet[c + nx]) {
+    lap += (h_in[c + nx] - hc) * inv_dy2;
+    if (drops)
+      dlap += (g[c + nx] - gc) * inv_dy2;
+  }
+  float vn = (v[c] + c2dt * lap) * damp;
+  float hn = hc + dt * vn;
+  if (drops)
+    hn += drop_coef * dlap;
+  v[c] = vn;
+  h_out[c] = hn;
+}
+
+/* The ledger's sums over the wet points: the wave height; the energy that
+ * the scheme conserves without damping,
+ *   1/2 v^2 + 1/2 c^2 |grad h|^2 + 1/2 dt c^2 v L(h)
+ * (the last term is symplectic Euler's correction for v being half a step
+ * ahead of h; |grad h|^2 takes each wet-wet face once, on the point west or
+ * south of it; m^2/s^2, the host multiplies by dx dy), with half_dt_c2 =
+ * dt c^2 / 2 of the last step; and the count; and the largest |h|. */
+__kernel void water_surface_reduce(__global const float *restrict h,
+                                   __global const float *restrict v,
+                                   __global const uchar *restrict wet,
+                                   __global float *restrict partial,
+                                   __local float *restrict scratch, int n, int nx, float c2,
+                                   float half_dt_c2, float inv_dx2, float inv_dy2) {
+  int lid = get_local_id(0), wg = get_local_size(0), start, end;
+  gr_reduce_block(n, &start, &end);
+  float s_hi = 0.0f, s_lo = 0.0f, e_hi = 0.0f, e_lo = 0.0f, n_hi = 0.0f, n_lo = 0.0f;
+  float hmax = 0.0f;
+  for (int c = start + lid; c < end; c += wg) {
+    if (!wet[c])
+      continue;
+    int i = c % nx;
+    float hc = h[c], vc = v[c];
+    float grad = 0.0f, lap = 0.0f;
+    if (i < nx - 1 && wet[c + 1]) {
+      float d = h[c + 1] - hc;
+      grad += d * d * inv_dx2;
+      lap += d * inv_dx2;
+    }
+    if (c + nx < n && wet[c + nx]) {
+      float d = h[c + nx] - hc;
+      grad += d * d * inv_dy2;
+      lap += d * inv_dy2;
+    }
+    if (i > 0 && wet[c - 1])
+      lap += (h[c - 1] - hc) * inv_dx2;
+    if (c >= nx && wet[c - nx])
+      lap += (h[c - nx] - hc) * inv_dy2;
+    gr_df_add(&s_hi, &s_lo, hc);
+    gr_df_add(&e_hi, &e_lo, 0.5f * vc * vc + 0.5f * c2 * grad + half_dt_c2 * vc * lap);
+    gr_df_add(&n_hi, &n_lo, 1.0f);
+    hmax = fmax(hmax, fabs(hc));
+  }
+  __local float *mine = gr_reduce_slots(scratch, GR_WATER_SURFACE_SUMS, GR_WATER_SURFACE_MAXES);
+  mine[0] = s_hi;
+  mine[1] = s_lo;
+  mine[2] = e_hi;
+  mine[3] = e_lo;
+  mine[4] = n_hi;
+  mine[5] = n_lo;
+  mine[6] = hmax;
+  gr_reduce_group(scratch, GR_WATER_SURFACE_SUMS, GR_WATER_SURFACE_MAXES, partial);
+}
+
+/* One derivative of the water surface base + h along an axis at a wet point:
+ * central where both neighbours are wet, one-sided where one is, 0 where
+ * none is (the still surface's and the wave's differences are taken apart,
+ * so a small wave on high ground keeps its precision). */
+GR_INLINE float gr_ws_slope(__global const float *restrict base, __global const float *restrict h,
+                            int c, int step, bool lo, bool hi, float inv_d) {
+  if (lo && hi)
+    return ((base[c + step] - base[c - step]) + (h[c + step] - h[c - step])) * (0.5f * inv_d);
+  if (hi)
+    return ((base[c + step] - base[c]) + (h[c + step] - h[c])) * inv_d;
+  if (lo)
+    return ((base[c] - base[c - step]) + (h[c] - h[c - step])) * inv_d;
+  return 0.0f;
+}
+
+/* Fields derived on read: the water surface (base + h on wet points, base on
+ * dry ones), the unit normal of the water surface ((0, 0, 1) on dry points
+ * and wherever the surface is level), the wet mask as 0 / 1, or the wave
+ * height (0 on dry points, which a wave set before any step may not be). */
+__kernel void water_surface_derive(__global const float *restrict h,
+                                   __global const float *restrict base,
+                                   __global const uchar *restrict wet, __global float *restrict out,
+                                   int nx, int ny, float inv_dx, float inv_dy, int what) {
+  int i = get_global_id(0), j = get_global_id(1);
+  if (!gr_inside(i, j, nx, ny))
+    return;
+  int c = gr_idx(i, j, nx);
+  bool w = wet[c] != 0;
+  if (what == GR_WATER_SURFACE_DERIVE_SURFACE) {
+    out[c] = w ? base[c] + h[c] : base[c];
+    return;
+  }
+  if (what == GR_WATER_SURFACE_DERIVE_WET) {
+    out[c] = w ? 1.0f : 0.0f;
+    return;
+  }
+  if (what == GR_WATER_SURFACE_DERIVE_WAVE) {
+    out[c] = w ? h[c] : 0.0f;
+    return;
+  }
+  float gx = 0.0f, gy = 0.0f;
+  if (w) {
+    gx = gr_ws_slope(base, h, c, 1, i > 0 && wet[c - 1], i < nx - 1 && wet[c + 1], inv_dx);
+    gy = gr_ws_slope(base, h, c, nx, j > 0 && wet[c - nx], j < ny - 1 && wet[c + nx], inv_dy);
+  }
+  float g2 = gx * gx + gy * gy;
+  float nxv = 0.0f, nyv = 0.0f, nzv = 1.0f;
+  if (g2 > 0.0f) {
+    float inv_len = 1.0f / sqrt(g2 + 1.0f);
+    nxv = (0.0f - gx) * inv_len;
+    nyv = (0.0f - gy) * inv_len;
+    nzv = inv_len;
+  }
+  out[3 * c] = nxv;
+  out[3 * c + 1] = nyv;
+  out[3 * c + 2] = nzv;
+}
