@@ -317,13 +317,13 @@ __kernel void rain_runoff_reduce(
  * (3 components, m/s, 0 below GR_RAIN_RUNOFF_VELOCITY_DEPTH), 2 discharge |q|
  * (m^2/s, cell-centred average of the faces), 3 infiltrated (cumulative,
  * m). */
-__kernel void rain_runoff_derive(__global const float *restrict h, __global const float *restrict b,
-                                 __global const float *restrict qx,
-                                 __global const float *restrict qy,
-                                 __global const float *restrict limit,
-                                 __global const float *restrict infiltrated,
-                                 __global const float *restrict infiltrated_comp,
-                                 __global float *restrict out, int nx, int ny, int what) {
+__kernel void
+rain_runoff_derive(__global const float *restrict h, __global const float *restrict b,
+                   __global const float *restrict qx, __global const float *restrict qy,
+                   __global const float *restrict limit, __global const float *restrict infiltrated,
+                   __global const float *restrict infiltrated_comp,
+                   __global const float *restrict qu, __global const float *restrict qv,
+                   __global float *restrict out, int nx, int ny, int what, int sw) {
   int i = get_global_id(0), j = get_global_id(1);
   if (!gr_inside(i, j, nx, ny))
     return;
@@ -334,6 +334,19 @@ __kernel void rain_runoff_derive(__global const float *restrict h, __global cons
   }
   if (what == 3) {
     out[c] = infiltrated[c] - infiltrated_comp[c];
+    return;
+  }
+  if (sw) {
+    /* The shallow-water model's discharges are the cells' own. */
+    float u = qu[c], v = qv[c], d = h[c];
+    if (what == 2) {
+      out[c] = sqrt(u * u + v * v);
+      return;
+    }
+    int wet = d >= GR_RAIN_RUNOFF_VELOCITY_DEPTH;
+    out[3 * c] = wet ? u / d : 0.0f;
+    out[3 * c + 1] = wet ? v / d : 0.0f;
+    out[3 * c + 2] = 0.0f;
     return;
   }
   float kc = limit[c];
@@ -353,4 +366,343 @@ __kernel void rain_runoff_derive(__global const float *restrict h, __global cons
   out[3 * c] = wet ? u / d : 0.0f;
   out[3 * c + 1] = wet ? v / d : 0.0f;
   out[3 * c + 2] = 0.0f;
+}
+
+/* ------------------------------------------------- shallow-water model
+ *
+ * FlowModel 0 (graupel/rain_runoff.h): the 2-D shallow-water equations by
+ * finite volumes, cell-centred state (h, qu = h u, qv = h v). Fluxes: HLL
+ * on the hydrostatic reconstruction of Audusse, Bouchut, Bristeau, Klein &
+ * Perthame (2004), second order: minmod slopes of the depth, the surface
+ * (as bed differences plus depth differences, so that large elevations
+ * lose nothing to rounding), and the velocities; Heun's method (SSP-RK2)
+ * in time, in two launches. Each launch is a gather: a cell computes its
+ * four faces itself, and the neighbour that shares a face computes the same
+ * flux from the same inputs by the same expression (FP_CONTRACT off), so
+ * the mass that leaves one cell is the float that arrives in the other.
+ * Every face reads two cells either side of it, so a launch reads two cells
+ * away and a step (two launches) four: a piece's ring is
+ * GR_RAIN_RUNOFF_GHOST_SW cells and the halo is exchanged once per step. */
+
+/* Depth below which a cell's velocity is desingularised (Kurganov & Petrova
+ * 2007): u = 2 h q / (h^2 + max(h^2, eps^2)), which is q / h above it and
+ * falls smoothly to 0 with the depth below it, so films a step leaves
+ * behind at a front do not get huge velocities from rounding. */
+#define GR_RAIN_RUNOFF_SW_EPS 1.0e-5f
+
+GR_INLINE float gr_sw_velocity(float h, float q) {
+  float h2 = h * h;
+  return 2.0f * h * q / (h2 + fmax(h2, GR_RAIN_RUNOFF_SW_EPS * GR_RAIN_RUNOFF_SW_EPS));
+}
+
+GR_INLINE float gr_sw_minmod(float a, float b) {
+  return a > 0.0f && b > 0.0f ? fmin(a, b) : (a < 0.0f && b < 0.0f ? fmax(a, b) : 0.0f);
+}
+
+/* One cell's reconstruction along an axis: its depth h, bed b, normal and
+ * tangential velocities un, ut, and the slopes (full-cell differences) of
+ * the depth, of the bed under the reconstructed surface (surface slope
+ * minus depth slope), and of the velocities. */
+typedef struct gr_sw_cell {
+  float h, b, un, ut, sh, se, sb, sun, sut;
+} gr_sw_cell;
+
+/* Cell k of a 5-cell line (k = 1, 2, 3), its slopes 0 unless both
+ * neighbours exist (lo, hi). */
+GR_INLINE gr_sw_cell gr_sw_recon(const float *h, const float *b, const float *un, const float *ut,
+                                 int k, bool lo, bool hi) {
+  gr_sw_cell c;
+  c.h = h[k];
+  c.b = b[k];
+  c.un = un[k];
+  c.ut = ut[k];
+  c.sh = 0.0f;
+  c.se = 0.0f;
+  c.sb = 0.0f;
+  c.sun = 0.0f;
+  c.sut = 0.0f;
+  if (lo && hi) {
+    float dhm = h[k] - h[k - 1], dhp = h[k + 1] - h[k];
+    float dem = (b[k] - b[k - 1]) + dhm, dep = (b[k + 1] - b[k]) + dhp;
+    c.sh = gr_sw_minmod(dhm, dhp);
+    c.se = gr_sw_minmod(dem, dep);
+    c.sb = c.se - c.sh;
+    /* A dry neighbour's velocity (0) says nothing of the flow: at a front
+     * the wet side's difference alone extrapolates it (else the front's
+     * thin tip lags, its face velocity held to the cell's). */
+    bool dm = h[k - 1] <= 0.0f, dp = h[k + 1] <= 0.0f;
+    float um = un[k] - un[k - 1], up = un[k + 1] - un[k];
+    float tm = ut[k] - ut[k - 1], tp = ut[k + 1] - ut[k];
+    c.sun = dm == dp ? gr_sw_minmod(um, up) : (dm ? up : um);
+    c.sut = dm == dp ? gr_sw_minmod(tm, tp) : (dm ? tp : tm);
+  }
+  return c;
+}
+
+/* HLL flux between two states (depth, normal and tangential velocity) along
+ * the normal: mass, normal momentum; the tangential momentum is carried
+ * upwind with the mass. Dry sides take the dry-front speeds. */
+GR_INLINE void gr_sw_hll(float hL, float uL, float vL, float hR, float uR, float vR, float g,
+                         float *fh, float *fm, float *ft) {
+  if (hL <= 0.0f && hR <= 0.0f) {
+    *fh = 0.0f;
+    *fm = 0.0f;
+    *ft = 0.0f;
+    return;
+  }
+  float cL = sqrt(g * hL), cR = sqrt(g * hR);
+  float sL = hL <= 0.0f ? uR - 2.0f * cR : (hR <= 0.0f ? uL - cL : fmin(uL - cL, uR - cR));
+  float sR = hR <= 0.0f ? uL + 2.0f * cL : (hL <= 0.0f ? uR + cR : fmax(uL + cL, uR + cR));
+  float qL = hL * uL, qR = hR * uR;
+  float mL = qL * uL + 0.5f * g * hL * hL, mR = qR * uR + 0.5f * g * hR * hR;
+  float mass, mom;
+  if (sL >= 0.0f) {
+    mass = qL;
+    mom = mL;
+  } else if (sR <= 0.0f) {
+    mass = qR;
+    mom = mR;
+  } else {
+    /* (sR F_L - sL F_R + sL sR (U_R - U_L)) / (sR - sL), written as F_L
+     * plus a difference so that equal states give F_L exactly (a lake at
+     * rest then balances to the bit). */
+    float w = sL / (sR - sL);
+    mass = qL + w * (sR * (hR - hL) - (qR - qL));
+    mom = mL + w * (sR * (qR - qL) - (mR - mL));
+  }
+  *fh = mass;
+  *fm = mom;
+  *ft = mass * (mass > 0.0f ? vL : vR);
+}
+
+/* The face between reconstructed cells L and R (R on the high side): the
+ * hydrostatic reconstruction at the face's bed max(b_L, b_R) (the
+ * difference db = b_R - b_L of the two sides' face beds, so a flat bed
+ * keeps the depths exactly), the HLL flux, and the normal momentum flux as
+ * seen by L (fmL) and by R (fmR) less the hydrostatic pressure of each
+ * side's own face depth, g h^2 / 2, which gr_sw_axis adds back with the bed
+ * source in one product that vanishes where the surface is flat: a lake at
+ * rest then balances to the bit, not to rounding. */
+GR_INLINE void gr_sw_face(gr_sw_cell L, gr_sw_cell R, float g, float *fh, float *fmL, float *fmR,
+                          float *ft) {
+  float hL = L.h + 0.5f * L.sh, hR = R.h - 0.5f * R.sh;
+  float uL = L.un + 0.5f * L.sun, uR = R.un - 0.5f * R.sun;
+  float vL = L.ut + 0.5f * L.sut, vR = R.ut - 0.5f * R.sut;
+  float db = (R.b - L.b) - 0.5f * (L.sb + R.sb);
+  float hLs = fmax(0.0f, hL - fmax(0.0f, db)), hRs = fmax(0.0f, hR - fmax(0.0f, -db));
+  float fm;
+  gr_sw_hll(hLs, uL, vL, hRs, uR, vR, g, fh, &fm, ft);
+  *fmL = fm - 0.5f * g * hLs * hLs;
+  *fmR = fm - 0.5f * g * hRs * hRs;
+}
+
+/* A face on the grid's edge, with the cell C inside on the high side (low
+ * = 1) or the low side: a wall mirrors C; an open edge leads into a dry
+ * cell at the face's bed and passes outflow only. Returns the momentum flux
+ * seen by C less g h^2 / 2 (as gr_sw_face's); *fh and *ft as
+ * gr_sw_face's, positive toward the high side. */
+GR_INLINE float gr_sw_edge(gr_sw_cell C, bool low, int closed, float g, float *fh, float *ft) {
+  float s = low ? -0.5f : 0.5f;
+  float h = C.h + s * C.sh, u = C.un + s * C.sun, v = C.ut + s * C.sut;
+  float m;
+  if (closed) {
+    gr_sw_hll(h, u, v, h, -u, v, g, fh, &m, ft);
+    *fh = 0.0f;
+    *ft = 0.0f;
+    return m - 0.5f * g * h * h;
+  }
+  if (low)
+    gr_sw_hll(0.0f, 0.0f, 0.0f, h, u, v, g, fh, &m, ft);
+  else
+    gr_sw_hll(h, u, v, 0.0f, 0.0f, 0.0f, g, fh, &m, ft);
+  /* Nothing enters: an edge the flux would cross inward is a still wall. */
+  bool inward = low ? *fh > 0.0f : *fh < 0.0f;
+  if (inward) {
+    *fh = 0.0f;
+    *ft = 0.0f;
+    return 0.0f;
+  }
+  return m - 0.5f * g * h * h;
+}
+
+/* The flux balance of the centre cell (k = 2) of a 5-cell line along one
+ * axis: dh (mass in minus out), dqn and dqt (momentum, with the bed's
+ * source), per unit of the axis' face length; out_lo, out_hi the depth
+ * flux (m^2/s) leaving through the grid's edge faces. i, n: the cell's
+ * index and the line's length. */
+GR_INLINE void gr_sw_axis(const float *h, const float *b, const float *un, const float *ut, int i,
+                          int n, int closed, float g, float *dh, float *dqn, float *dqt,
+                          float *out_lo, float *out_hi) {
+  gr_sw_cell C = gr_sw_recon(h, b, un, ut, 2, i > 0, i < n - 1);
+  float fhw, fmw, ftw, fhe, fme, fte, unused;
+  *out_lo = 0.0f;
+  *out_hi = 0.0f;
+  if (i > 0) {
+    gr_sw_cell W = gr_sw_recon(h, b, un, ut, 1, i > 1, true);
+    gr_sw_face(W, C, g, &fhw, &unused, &fmw, &ftw);
+  } else {
+    fmw = gr_sw_edge(C, true, closed, g, &fhw, &ftw);
+    *out_lo = -fhw;
+  }
+  if (i < n - 1) {
+    gr_sw_cell E = gr_sw_recon(h, b, un, ut, 3, true, i < n - 2);
+    gr_sw_face(C, E, g, &fhe, &fme, &unused, &fte);
+  } else {
+    fme = gr_sw_edge(C, false, closed, g, &fhe, &fte);
+    *out_hi = fhe;
+  }
+  float hw = C.h - 0.5f * C.sh, he = C.h + 0.5f * C.sh;
+  *dh = fhw - fhe;
+  /* (fmw + g hw^2 / 2) - (fme + g he^2 / 2) - g (hw + he) / 2 (bed slope)
+   * = fmw - fme - g (hw + he) / 2 (surface slope). */
+  *dqn = (fmw - fme) - 0.5f * g * (hw + he) * C.se;
+  *dqt = ftw - fte;
+}
+
+/* Rain and infiltration on a cell's water (as the local inertial model
+ * takes them), its momentum scaled with the water infiltration removes. */
+GR_INLINE float gr_sw_wet_q(float h, float q, float r, float dt, float hw) {
+  float h1 = h + r * dt;
+  return h1 > 0.0f ? q * (hw / h1) : 0.0f;
+}
+
+/* One stage of Heun's method for every cell (a 1-D launch over the local
+ * array: it reads and writes per cell):
+ *   stage 1: U1 = Uw + dt L(Uw), Uw the state after rain and infiltration,
+ *            from h, qu, qv (computed for every cell it reads);
+ *   stage 2: U = (Uw + U1 + dt L(U1)) / 2, from h1, qu1, qv1, then Manning
+ *            friction, implicit, on the new discharge:
+ *            |q'| (1 + g dt n^2 |q'| / h^(7/3)) = |q|, in q's direction;
+ *            written over h, qu, qv (each cell reads its own old values
+ *            only), with the infiltration and half of each stage's edge
+ *            outflow booked in Kahan sums. */
+__kernel void rain_runoff_sw_stage(
+    __global float *restrict h, __global float *restrict qu, __global float *restrict qv,
+    __global float *restrict h_comp, __global float *restrict h1, __global float *restrict qu1,
+    __global float *restrict qv1, __global float *restrict dh1, __global const float *restrict b,
+    __global const float *restrict rain, __global const float *restrict perm,
+    __global float *restrict infiltrated, __global float *restrict infiltrated_comp,
+    __global float *restrict outflow, __global float *restrict outflow_comp, int nx, int ny,
+    float dt, float inv_dx, float inv_dy, float g, float n2, int use_rain, float rain_uniform,
+    int use_perm, float perm_uniform, int closed, int stage) {
+  int c = get_global_id(0);
+  if (c >= nx * ny)
+    return;
+  int i = c % nx, j = c / nx;
+  __global const float *sh = stage == 1 ? h : h1;
+  __global const float *su = stage == 1 ? qu : qu1;
+  __global const float *sv = stage == 1 ? qv : qv1;
+  /* The cross of 5 + 5 cells around (i, j); index 2 is the cell itself.
+   * Missing cells (beyond the array) are never used: their slots read the
+   * centre. */
+  float xh[5], xb[5], xu[5], xv[5], yh[5], yb[5], yu[5], yv[5];
+  for (int k = 0; k < 5; ++k) {
+    int ii = i + k - 2, jj = j + k - 2;
+    int cx = ii >= 0 && ii < nx ? c + k - 2 : c;
+    int cy = jj >= 0 && jj < ny ? c + (k - 2) * nx : c;
+    int cc[2] = {cx, cy};
+    for (int a = 0; a < 2; ++a) {
+      int q = cc[a];
+      float hh = sh[q], pu = su[q], pv = sv[q];
+      if (stage == 1) {
+        float r = gr_rain_runoff_input(rain, use_rain, rain_uniform, q);
+        float hw =
+            gr_rain_runoff_wet(hh, r, gr_rain_runoff_input(perm, use_perm, perm_uniform, q), dt);
+        pu = gr_sw_wet_q(hh, pu, r, dt, hw);
+        pv = gr_sw_wet_q(hh, pv, r, dt, hw);
+        hh = hw;
+      }
+      float u = gr_sw_velocity(hh, pu), v = gr_sw_velocity(hh, pv);
+      if (a == 0) {
+        xh[k] = hh;
+        xb[k] = b[q];
+        xu[k] = u;
+        xv[k] = v;
+      } else {
+        yh[k] = hh;
+        yb[k] = b[q];
+        yu[k] = v;
+        yv[k] = u;
+      }
+    }
+  }
+  float dhx, dqx_x, dqy_x, olx, ohx, dhy, dqy_y, dqx_y, oly, ohy;
+  gr_sw_axis(xh, xb, xu, xv, i, nx, closed, g, &dhx, &dqx_x, &dqy_x, &olx, &ohx);
+  gr_sw_axis(yh, yb, yu, yv, j, ny, closed, g, &dhy, &dqy_y, &dqx_y, &oly, &ohy);
+  float dh = dt * (dhx * inv_dx + dhy * inv_dy);
+  float hn = xh[2] + dh;
+  float qun = su[c] + dt * (dqx_x * inv_dx + dqx_y * inv_dy);
+  float qvn = sv[c] + dt * (dqy_x * inv_dx + dqy_y * inv_dy);
+  float out = 0.5f * dt * ((olx + ohx) * inv_dx + (oly + ohy) * inv_dy);
+  if (stage == 1) {
+    /* su, sv are the momenta before rain: take the wet ones. */
+    float r = gr_rain_runoff_input(rain, use_rain, rain_uniform, c);
+    float hw = xh[2];
+    qun = gr_sw_wet_q(h[c], qu[c], r, dt, hw) + dt * (dqx_x * inv_dx + dqx_y * inv_dy);
+    qvn = gr_sw_wet_q(h[c], qv[c], r, dt, hw) + dt * (dqy_x * inv_dx + dqy_y * inv_dy);
+    h1[c] = fmax(hn, 0.0f);
+    dh1[c] = dh;
+    qu1[c] = hn > 0.0f ? qun : 0.0f;
+    qv1[c] = hn > 0.0f ? qvn : 0.0f;
+  } else {
+    float h0 = h[c];
+    float r = gr_rain_runoff_input(rain, use_rain, rain_uniform, c);
+    float k = gr_rain_runoff_input(perm, use_perm, perm_uniform, c);
+    float hw = gr_rain_runoff_wet(h0, r, k, dt);
+    float inf = gr_rain_runoff_infiltration(h0, r, k, dt);
+    /* The new depth h0 + (r dt - i) + (dh1 + dh) / 2, Kahan-summed as the
+     * local inertial model's (h - h_comp is the water): without it the
+     * rounding of the depth would show in the ledger after 10^3 steps. */
+    float delta = (r * dt - inf) + 0.5f * (dh1[c] + dh);
+    float y = delta - h_comp[c];
+    float hf = h0 + y;
+    float comp = (hf - h0) - y;
+    float qx = 0.5f * (gr_sw_wet_q(h0, qu[c], r, dt, hw) + qun);
+    float qy = 0.5f * (gr_sw_wet_q(h0, qv[c], r, dt, hw) + qvn);
+    if (hf > 0.0f && n2 > 0.0f) {
+      float qm = sqrt(qx * qx + qy * qy);
+      float hs = fmax(hf, GR_RAIN_RUNOFF_DRY);
+      float kf = g * dt * n2 * gr_rain_runoff_pow_m73(hs);
+      float scale = qm > 0.0f ? gr_rain_runoff_solve(qm, kf) / qm : 0.0f;
+      qx *= scale;
+      qy *= scale;
+    }
+    h[c] = fmax(hf, 0.0f);
+    h_comp[c] = hf > 0.0f ? comp : 0.0f;
+    qu[c] = hf > 0.0f ? qx : 0.0f;
+    qv[c] = hf > 0.0f ? qy : 0.0f;
+    if (inf != 0.0f)
+      gr_kahan_add(infiltrated, infiltrated_comp, c, inf);
+  }
+  if (out != 0.0f)
+    gr_kahan_add(outflow, outflow_comp, c, out);
+}
+
+/* The stable step's inputs, per work-group: the deepest cell and the
+ * largest |u| + sqrt(g h) and |v| + sqrt(g h) of the owned cells. */
+__kernel void rain_runoff_sw_speed(__global const float *restrict h,
+                                   __global const float *restrict qu,
+                                   __global const float *restrict qv,
+                                   __global float *restrict partial,
+                                   __local float *restrict scratch, int n, int row, int own_x0,
+                                   int own_x1, int own_y0, int own_y1, int masked, float g) {
+  int lid = get_local_id(0), wg = get_local_size(0), start, end;
+  gr_reduce_block(n, &start, &end);
+  float hmax = 0.0f, ax = 0.0f, ay = 0.0f;
+  for (int c = start + lid; c < end; c += wg) {
+    if (masked) {
+      int i = c % row, j = c / row;
+      if (i < own_x0 || i >= own_x1 || j < own_y0 || j >= own_y1)
+        continue;
+    }
+    float d = h[c], a = sqrt(g * d);
+    hmax = fmax(hmax, d);
+    ax = fmax(ax, fabs(gr_sw_velocity(d, qu[c])) + a);
+    ay = fmax(ay, fabs(gr_sw_velocity(d, qv[c])) + a);
+  }
+  __local float *mine = gr_reduce_slots(scratch, 0, 3);
+  mine[0] = hmax;
+  mine[1] = ax;
+  mine[2] = ay;
+  gr_reduce_group(scratch, 0, 3, partial);
 }
