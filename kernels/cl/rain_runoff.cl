@@ -506,7 +506,11 @@ GR_INLINE float gr_sw_edge(gr_sw_cell C, bool low, int closed, float g, float *f
   float h = C.h + s * C.sh, u = C.un + s * C.sun, v = C.ut + s * C.sut;
   float m;
   if (closed) {
-    gr_sw_hll(h, u, v, h, -u, v, g, fh, &m, ft);
+    /* The mirror image is the ghost: on the low side it is the left state. */
+    if (low)
+      gr_sw_hll(h, -u, v, h, u, v, g, fh, &m, ft);
+    else
+      gr_sw_hll(h, u, v, h, -u, v, g, fh, &m, ft);
     *fh = 0.0f;
     *ft = 0.0f;
     return m - 0.5f * g * h * h;
@@ -679,16 +683,17 @@ __kernel void rain_runoff_sw_stage(
 }
 
 /* The stable step's inputs, per work-group: the deepest cell and the
- * largest |u| + sqrt(g h) and |v| + sqrt(g h) of the owned cells. */
-__kernel void rain_runoff_sw_speed(__global const float *restrict h,
-                                   __global const float *restrict qu,
-                                   __global const float *restrict qv,
-                                   __global float *restrict partial,
-                                   __local float *restrict scratch, int n, int row, int own_x0,
-                                   int own_x1, int own_y0, int own_y1, int masked, float g) {
+ * fastest rate (|u| + sqrt(g h)) / dx + (|v| + sqrt(g h)) / dy of the owned
+ * cells (a cell's own sum: what its update needs, and the same maximum
+ * whichever way the domain is split). */
+__kernel void
+rain_runoff_sw_speed(__global const float *restrict h, __global const float *restrict qu,
+                     __global const float *restrict qv, __global float *restrict partial,
+                     __local float *restrict scratch, int n, int row, int own_x0, int own_x1,
+                     int own_y0, int own_y1, int masked, float g, float inv_dx, float inv_dy) {
   int lid = get_local_id(0), wg = get_local_size(0), start, end;
   gr_reduce_block(n, &start, &end);
-  float hmax = 0.0f, ax = 0.0f, ay = 0.0f;
+  float hmax = 0.0f, rate = 0.0f;
   for (int c = start + lid; c < end; c += wg) {
     if (masked) {
       int i = c % row, j = c / row;
@@ -697,12 +702,11 @@ __kernel void rain_runoff_sw_speed(__global const float *restrict h,
     }
     float d = h[c], a = sqrt(g * d);
     hmax = fmax(hmax, d);
-    ax = fmax(ax, fabs(gr_sw_velocity(d, qu[c])) + a);
-    ay = fmax(ay, fabs(gr_sw_velocity(d, qv[c])) + a);
+    rate = fmax(rate, (fabs(gr_sw_velocity(d, qu[c])) + a) * inv_dx +
+                          (fabs(gr_sw_velocity(d, qv[c])) + a) * inv_dy);
   }
-  __local float *mine = gr_reduce_slots(scratch, 0, 3);
+  __local float *mine = gr_reduce_slots(scratch, 0, 2);
   mine[0] = hmax;
-  mine[1] = ax;
-  mine[2] = ay;
-  gr_reduce_group(scratch, 0, 3, partial);
+  mine[1] = rate;
+  gr_reduce_group(scratch, 0, 2, partial);
 }

@@ -101,7 +101,7 @@ struct gr_rain_runoff {
   double initial_volume, rain_volume, time;
   long long steps;
   gr_reduction ledger; /* the reduction behind the ledger and the stable step */
-  gr_reduction speed;  /* shallow water's stable step: deepest cell, max |u| + c, |v| + c */
+  gr_reduction speed;  /* shallow water's stable step: deepest cell, fastest wave rate */
   /* The step kernels' arguments other than the alternating face arrays are
    * set again only when they change: the parameters, the input fields or
    * dt (steps_dt). */
@@ -554,7 +554,7 @@ gr_status gr_rain_runoff_create(gr_context *ctx, const gr_grid *grid,
     st = gr_reduction_init(ctx, s->reduce, cells, GR_RAIN_RUNOFF_SUMS, GR_RAIN_RUNOFF_MAXES,
                            &s->ledger);
   if (st == GR_OK)
-    st = gr_reduction_init(ctx, s->sw_speed, cells, 0, 3, &s->speed);
+    st = gr_reduction_init(ctx, s->sw_speed, cells, 0, 2, &s->speed);
   /* Dry, flat ground; nothing infiltrated or gone. */
   cl_mem *zeroed[] = {&s->h,     &s->h_c, &s->b,   &s->inf, &s->inf_c, &s->out,
                       &s->out_c, &s->h1,  &s->qu1, &s->qv1, &s->dh1,   &s->dummy};
@@ -1135,8 +1135,8 @@ gr_status gr_rain_runoff_step(gr_rain_runoff *s, double dt, int nsteps) {
 }
 
 /* Shallow water: the Courant condition of the explicit finite volumes on the
- * fastest waves, |u| + sqrt(g h) along x and |v| + sqrt(g h) along y,
- *   dt (ax / dx + ay / dy) <= cfl / 2,
+ * fastest waves of any cell, |u| + sqrt(g h) along x and |v| + sqrt(g h)
+ * along y:  dt max(ax / dx + ay / dy) <= cfl / 2,
  * the half keeping the hydrostatic reconstruction's depths positive with the
  * second-order reconstruction (Audusse et al. 2004). */
 static gr_status gr_rain_runoff_sw_stable_dt(gr_rain_runoff *s, double *dt) {
@@ -1145,7 +1145,10 @@ static gr_status gr_rain_runoff_sw_stable_dt(gr_rain_runoff *s, double *dt) {
   cl_int own_y0 = s->ring[2], own_y1 = s->nyl - s->ring[3];
   cl_int masked = gr_rain_runoff_has_ring(s);
   cl_float g = (cl_float)GR_GRAVITY;
+  cl_float inv_dx = (cl_float)(1.0 / s->grid.dx), inv_dy = (cl_float)(1.0 / s->grid.dy);
   const gr_rain_runoff_arg args[] = {
+      {"inv_dx", sizeof(inv_dx), &inv_dx},
+      {"inv_dy", sizeof(inv_dy), &inv_dy},
       {"h", sizeof(cl_mem), &s->h},
       {"qu", sizeof(cl_mem), &s->qu},
       {"qv", sizeof(cl_mem), &s->qv},
@@ -1158,15 +1161,15 @@ static gr_status gr_rain_runoff_sw_stable_dt(gr_rain_runoff *s, double *dt) {
       {"masked", sizeof(masked), &masked},
       {"g", sizeof(g), &g},
   };
-  double maxes[3] = {0.0, 0.0, 0.0};
+  double maxes[2] = {0.0, 0.0};
   gr_status st = GR_RAIN_RUNOFF_ARGS(s, s->sw_speed, args);
   if (st == GR_OK)
     st = gr_reduction_run(s->ctx, &s->speed, s->sw_speed, NULL, maxes);
   if (st == GR_OK && s->allreduce)
-    st = gr_rain_runoff_allreduce(s, maxes, 3, GR_REDUCE_MAX);
+    st = gr_rain_runoff_allreduce(s, maxes, 2, GR_REDUCE_MAX);
   if (st != GR_OK)
     return st;
-  double rate = maxes[1] / s->grid.dx + maxes[2] / s->grid.dy;
+  double rate = maxes[1];
   double stable = rate > 0.0 ? 0.5 * s->params.cfl / rate : s->params.max_dt;
   *dt = stable < s->params.max_dt ? stable : s->params.max_dt;
   return GR_OK;

@@ -80,9 +80,11 @@
  * (gathers: each cell computes its four faces itself, and the cell that
  * shares a face computes the same floats from the same inputs), the
  * checkpoints and the pieces work as for the local inertial model; the
- * stable step is cfl / 2 / max(|u| + sqrt(g h)) / dx + max(|v| + sqrt(g
- * h)) / dy), and a piece's ring is GR_RAIN_RUNOFF_GHOST_SW cells (each
- * stage reads two cells away: one exchange per step covers both stages).
+ * stable step is cfl / 2 / max((|u| + sqrt(g h)) / dx + (|v| + sqrt(g h))
+ * / dy) over the cells (one reduction, as the local inertial model's), and
+ * a piece's ring is GR_RAIN_RUNOFF_GHOST_SW cells (each stage reads two
+ * cells away: one exchange per step covers both stages; the halo strip holds
+ * per cell the depth, qu, qv and the depth's Kahan compensation).
  * VELOCITY (3 components, z ignored; after WATER_DEPTH, which clears the
  * flow) sets the initial discharges h (u, v), and WATER_SURFACE (after
  * ELEVATION) sets the depth max(0, surface - elevation) as WATER_DEPTH
@@ -215,7 +217,8 @@ GR_API gr_status gr_rain_runoff_step(gr_rain_runoff *s, double dt, int nsteps);
  *   cfl * sqrt(theta) / (sqrt(g * max_depth) * sqrt(1/dx^2 + 1/dy^2)),
  * theta = 0.8 (for dx = dy: cfl * 0.632 * dx / sqrt(g h); Bates et al.'s
  * cfl * dx / sqrt(g h) is the 1-D limit and unstable in 2-D above cfl =
- * 0.63), capped at params.max_dt. Reads one reduction back.
+ * 0.63), capped at params.max_dt. Reads one reduction back. (The
+ * shallow-water model's: see "Shallow-water model" above.)
  */
 GR_API gr_status gr_rain_runoff_stable_dt(gr_rain_runoff *s, double *dt);
 
