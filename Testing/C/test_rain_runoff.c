@@ -2620,6 +2620,144 @@ static void test_sw_bump(void) {
   free(vel);
 }
 
+/* Rain on a tilted plane (slope 0.01 toward x = 0, 100 m long, Manning
+ * 0.03, 360 mm/h, open edges) reaches the kinematic-wave equilibrium in
+ * about 300 s: then the outflow equals the rain (over 600 to 800 s, within
+ * 1e-3), and in the middle row (berms keep the water off the sides) the depth a distance x below
+ * the top edge is the kinematic wave's (r x n / sqrt(S))^(3/5), within 5% from 20 to 80 m (the
+ * shallow-water model adds the pressure gradient, which the kinematic wave leaves out). */
+static void test_sw_tilted_plane(void) {
+  gr_grid g = {50, 20, 2.0, 2.0, 0.0, 0.0, 0, 0};
+  const double slope = 0.01, rain = 1e-4, mann = 0.03;
+  float *b = alloc_field(&g, 1);
+  /* Berms 1 m high along the sides and the top keep the plane's water off
+   * the open edges there (their own rain runs off them). */
+  for (int j = 0; j < g.ny; ++j)
+    for (int i = 0; i < g.nx; ++i)
+      b[(size_t)j * g.nx + i] = (float)(slope * (i + 0.5) * g.dx +
+                                        (j == 0 || j == g.ny - 1 || i == g.nx - 1 ? 1.0 : 0.0));
+  gr_rain_runoff_params p = sw_params(mann, GR_BOUNDARY_OPEN);
+  p.rain_rate = rain;
+  gr_rain_runoff *s = make_sim(&g, &p, b, NULL);
+  if (s) {
+    CHECK(gr_rain_runoff_advance(s, 600.0, NULL) == GR_OK);
+    gr_rain_runoff_ledger l0 = ledger(s);
+    CHECK(gr_rain_runoff_advance(s, 200.0, NULL) == GR_OK);
+    gr_rain_runoff_ledger l1 = ledger(s);
+    double ratio = (l1.outflow_volume - l0.outflow_volume) / (l1.rain_volume - l0.rain_volume);
+    float *h = get(s, &g, GR_FIELD_WATER_DEPTH);
+    double worst = 0.0;
+    for (int i = 10; i < 40; ++i) {
+      double from_top = (g.nx - 1 - i - 0.5) * g.dx; /* the rain of that much plane passes */
+      double kin = pow(rain * from_top * mann / sqrt(slope), 0.6);
+      worst = fmax(worst, fabs(h[(size_t)(g.ny / 2) * g.nx + i] - kin) / kin);
+    }
+    printf("SW tilted plane: outflow / rain %.6f over 600 to 800 s; depth vs the kinematic wave "
+           "within %.3g%% from 20 to 80 m; balance %.3g of the rain\n",
+           ratio, 100.0 * worst, l1.balance_error / l1.rain_volume);
+    CHECK_MSG(fabs(ratio - 1.0) < 1e-3, "outflow / rain %.6f", ratio);
+    CHECK_MSG(worst < 0.05, "depth off the kinematic wave by %.3g", worst);
+    CHECK(fabs(l1.balance_error) <= 1e-8 * l1.rain_volume);
+    free(h);
+    gr_rain_runoff_destroy(s);
+  }
+  free(b);
+}
+
+/* The shallow-water model's own inputs: WATER_SURFACE sets the depth
+ * max(0, surface - elevation) exactly as WATER_DEPTH would; VELOCITY the
+ * discharges h (u, v) (read back as the velocity and |q|), which reset
+ * returns to and a new WATER_DEPTH clears; the local inertial model refuses
+ * both with a sentence. */
+static void test_sw_inputs(void) {
+  gr_grid g = {12, 9, 1.0, 2.0, 0.0, 0.0, 0, 0};
+  size_t n = cells_of(&g);
+  float *b = alloc_field(&g, 1), *surf = alloc_field(&g, 1), *d = alloc_field(&g, 1);
+  float *vel = alloc_field(&g, 3);
+  for (size_t c = 0; c < n; ++c) {
+    b[c] = (float)(0.5 * hash01((int)c, 1, 2));
+    surf[c] = 0.3f;
+    d[c] = surf[c] - b[c] > 0.0f ? surf[c] - b[c] : 0.0f;
+    vel[3 * c] = (float)(hash01((int)c, 3, 4) - 0.5);
+    vel[3 * c + 1] = (float)(hash01((int)c, 5, 6) - 0.5);
+    vel[3 * c + 2] = 7.0f; /* ignored */
+  }
+  gr_rain_runoff_params p = sw_params(0.03, GR_BOUNDARY_CLOSED);
+  gr_rain_runoff *s = make_sim(&g, &p, b, NULL);
+  if (s) {
+    CHECK(gr_rain_runoff_set_field(s, GR_FIELD_WATER_SURFACE, surf) == GR_OK);
+    float *h = get(s, &g, GR_FIELD_WATER_DEPTH);
+    CHECK(memcmp(h, d, n * sizeof(float)) == 0);
+    int dry = 0;
+    for (size_t c = 0; c < n; ++c)
+      dry += d[c] == 0.0f;
+    CHECK(dry > 0 && dry < (int)n);
+    CHECK_NEAR(ledger(s).initial_volume, sum_of(d, n) * g.dx * g.dy, 1e-9);
+    CHECK(gr_rain_runoff_set_field(s, GR_FIELD_VELOCITY, vel) == GR_OK);
+    float *v = get(s, &g, GR_FIELD_VELOCITY), *q = get(s, &g, GR_FIELD_DISCHARGE);
+    int off = 0;
+    for (size_t c = 0; c < n; ++c) {
+      int wet = d[c] >= 1e-4f;
+      float qx = d[c] * vel[3 * c], qy = d[c] * vel[3 * c + 1];
+      off += wet && (fabsf(v[3 * c] - qx / d[c]) > 1e-6f * fabsf(vel[3 * c]) + 1e-7f ||
+                     fabsf(v[3 * c + 1] - qy / d[c]) > 1e-6f * fabsf(vel[3 * c + 1]) + 1e-7f);
+      off += !wet && (v[3 * c] != 0.0f || v[3 * c + 1] != 0.0f);
+      off += v[3 * c + 2] != 0.0f;
+      off += fabsf(q[c] - sqrtf(qx * qx + qy * qy)) > 1e-6f * q[c] + 1e-9f;
+    }
+    CHECK_MSG(off == 0, "%d velocities or discharges are not the ones given", off);
+    /* Reset returns to the given water and velocity. */
+    CHECK(gr_rain_runoff_advance(s, 5.0, NULL) == GR_OK);
+    CHECK(gr_rain_runoff_reset(s) == GR_OK);
+    float *v2 = get(s, &g, GR_FIELD_VELOCITY), *h2 = get(s, &g, GR_FIELD_WATER_DEPTH);
+    CHECK(memcmp(v, v2, 3 * n * sizeof(float)) == 0 && memcmp(h2, d, n * sizeof(float)) == 0);
+    /* A new depth is still water. */
+    CHECK(gr_rain_runoff_set_field(s, GR_FIELD_WATER_DEPTH, d) == GR_OK);
+    float *q2 = get(s, &g, GR_FIELD_DISCHARGE);
+    CHECK(sum_of(q2, n) == 0.0);
+    /* Refused values name the field and the cell. */
+    vel[3 * 14 + 1] = NAN;
+    CHECK(gr_rain_runoff_set_field(s, GR_FIELD_VELOCITY, vel) == GR_ERR_INVALID_ARGUMENT);
+    CHECK_MSG(has(gr_rain_runoff_last_error(s), "velocity") &&
+                  has(gr_rain_runoff_last_error(s), "(2, 1)"),
+              "'%s'", gr_rain_runoff_last_error(s));
+    surf[5] = 2e6f;
+    CHECK(gr_rain_runoff_set_field(s, GR_FIELD_WATER_SURFACE, surf) == GR_ERR_INVALID_ARGUMENT);
+    CHECK(has(gr_rain_runoff_last_error(s), "water_surface"));
+    free(h);
+    free(v);
+    free(q);
+    free(v2);
+    free(h2);
+    free(q2);
+    gr_rain_runoff_destroy(s);
+  }
+  /* The local inertial model has neither input. */
+  p.flow_model = GR_FLOW_LOCAL_INERTIAL;
+  s = make_sim(&g, &p, b, NULL);
+  if (s) {
+    CHECK(gr_rain_runoff_set_field(s, GR_FIELD_VELOCITY, vel) == GR_ERR_INVALID_ARGUMENT);
+    CHECK(gr_rain_runoff_set_field(s, GR_FIELD_WATER_SURFACE, d) == GR_ERR_INVALID_ARGUMENT);
+    CHECK_MSG(has(gr_rain_runoff_last_error(s), "FlowModel 0"), "'%s'",
+              gr_rain_runoff_last_error(s));
+    /* Switching the model keeps the water, from rest. */
+    CHECK(gr_rain_runoff_set_field(s, GR_FIELD_WATER_DEPTH, d) == GR_OK);
+    CHECK(gr_rain_runoff_advance(s, 3.0, NULL) == GR_OK);
+    gr_rain_runoff_params sw = p;
+    sw.flow_model = GR_FLOW_SHALLOW_WATER;
+    sw.manning_n = 0.0;
+    CHECK(gr_rain_runoff_set_params(s, &sw) == GR_OK);
+    CHECK(gr_rain_runoff_advance(s, 3.0, NULL) == GR_OK);
+    gr_rain_runoff_ledger l = ledger(s);
+    CHECK_MSG(fabs(l.balance_error) <= 1e-7 * l.initial_volume, "balance %.3g", l.balance_error);
+    gr_rain_runoff_destroy(s);
+  }
+  free(b);
+  free(surf);
+  free(d);
+  free(vel);
+}
+
 /* The pieces tests again with the shallow-water model (ring
  * GR_RAIN_RUNOFF_GHOST_SW, one exchange per step): every owned cell of every
  * field bit for bit the whole grid's. */
@@ -2677,6 +2815,8 @@ static const gr_subtest tests[] = {
     {"sw_determinism", test_sw_determinism, 0},
     {"sw_thacker", test_sw_thacker, 0},
     {"sw_bump", test_sw_bump, 0},
+    {"sw_tilted_plane", test_sw_tilted_plane, 0},
+    {"sw_inputs", test_sw_inputs, 0},
     {"sw_pieces_x", test_sw_pieces_x, 0},
     {"sw_pieces_y", test_sw_pieces_y, 0},
     {"sw_advance_pieces_x", test_sw_advance_pieces_x, 0},

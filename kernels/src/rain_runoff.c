@@ -97,6 +97,7 @@ struct gr_rain_runoff {
   cl_mem dummy;   /* bound in place of a field that was not set */
   int has_rain, has_perm;
   double rain_field_sum; /* sum of the rain-rate field's floats, m/s */
+  double rain_field_max; /* its largest value, m/s (the local array's, ring included) */
   double initial_sum;    /* sum of the initial depth's floats, m */
   double initial_volume, rain_volume, time;
   long long steps;
@@ -694,6 +695,9 @@ static gr_status gr_rain_runoff_set_field_impl(gr_rain_runoff *s, gr_field f, co
     if (st == GR_OK) {
       s->has_rain = 1;
       s->rain_field_sum = sum;
+      s->rain_field_max = 0.0;
+      for (size_t c = 0; c < cells; ++c)
+        s->rain_field_max = host[c] > s->rain_field_max ? host[c] : s->rain_field_max;
     }
     break;
   }
@@ -1161,16 +1165,26 @@ static gr_status gr_rain_runoff_sw_stable_dt(gr_rain_runoff *s, double *dt) {
       {"masked", sizeof(masked), &masked},
       {"g", sizeof(g), &g},
   };
-  double maxes[2] = {0.0, 0.0};
+  /* The deepest cell, the fastest rate, the heaviest rain (m/s). */
+  double maxes[3] = {0.0, 0.0, s->has_rain ? s->rain_field_max : s->params.rain_rate};
   gr_status st = GR_RAIN_RUNOFF_ARGS(s, s->sw_speed, args);
   if (st == GR_OK)
     st = gr_reduction_run(s->ctx, &s->speed, s->sw_speed, NULL, maxes);
   if (st == GR_OK && s->allreduce)
-    st = gr_rain_runoff_allreduce(s, maxes, 2, GR_REDUCE_MAX);
+    st = gr_rain_runoff_allreduce(s, maxes, 3, GR_REDUCE_MAX);
   if (st != GR_OK)
     return st;
   double rate = maxes[1];
   double stable = rate > 0.0 ? 0.5 * s->params.cfl / rate : s->params.max_dt;
+  /* Rain on dry (or still) ground: the step must not outrun the waves of
+   * the water it adds, r dt deep: dt sqrt(g r dt) (1/dx + 1/dy) <= cfl / 2.
+   * Without it a dry grid's first step is MaxTimeStep long. */
+  double r = maxes[2];
+  if (r > 0.0) {
+    double inv = 1.0 / s->grid.dx + 1.0 / s->grid.dy;
+    double wet = pow(0.5 * s->params.cfl / (inv * sqrt(GR_GRAVITY * r)), 2.0 / 3.0);
+    stable = wet < stable ? wet : stable;
+  }
   *dt = stable < s->params.max_dt ? stable : s->params.max_dt;
   return GR_OK;
 }
