@@ -2623,9 +2623,11 @@ static void test_sw_bump(void) {
 /* Rain on a tilted plane (slope 0.01 toward x = 0, 100 m long, Manning
  * 0.03, 360 mm/h, open edges) reaches the kinematic-wave equilibrium in
  * about 300 s: then the outflow equals the rain (over 600 to 800 s, within
- * 1e-3), and in the middle row (berms keep the water off the sides) the depth a distance x below
- * the top edge is the kinematic wave's (r x n / sqrt(S))^(3/5), within 5% from 20 to 80 m (the
- * shallow-water model adds the pressure gradient, which the kinematic wave leaves out). */
+ * 1e-3), and in the middle row (berms keep the water off the sides) the
+ * depth a distance x below the top edge is the kinematic wave's
+ * (r x n / sqrt(S))^(3/5) within 6% from 20 to 80 m: the kinematic wave
+ * leaves out the pressure gradient and the inertia of this flow (Froude
+ * number about 0.5), which make it some 4% deeper. */
 static void test_sw_tilted_plane(void) {
   gr_grid g = {50, 20, 2.0, 2.0, 0.0, 0.0, 0, 0};
   const double slope = 0.01, rain = 1e-4, mann = 0.03;
@@ -2656,7 +2658,7 @@ static void test_sw_tilted_plane(void) {
            "within %.3g%% from 20 to 80 m; balance %.3g of the rain\n",
            ratio, 100.0 * worst, l1.balance_error / l1.rain_volume);
     CHECK_MSG(fabs(ratio - 1.0) < 1e-3, "outflow / rain %.6f", ratio);
-    CHECK_MSG(worst < 0.05, "depth off the kinematic wave by %.3g", worst);
+    CHECK_MSG(worst < 0.06, "depth off the kinematic wave by %.3g", worst);
     CHECK(fabs(l1.balance_error) <= 1e-8 * l1.rain_volume);
     free(h);
     gr_rain_runoff_destroy(s);
@@ -2664,11 +2666,11 @@ static void test_sw_tilted_plane(void) {
   free(b);
 }
 
-/* The shallow-water model's own inputs: WATER_SURFACE sets the depth
- * max(0, surface - elevation) exactly as WATER_DEPTH would; VELOCITY the
- * discharges h (u, v) (read back as the velocity and |q|), which reset
- * returns to and a new WATER_DEPTH clears; the local inertial model refuses
- * both with a sentence. */
+/* The new inputs: WATER_SURFACE sets the depth max(0, surface -
+ * elevation) exactly as WATER_DEPTH would; VELOCITY the discharges h (u, v)
+ * (read back as the velocity and |q|), which reset returns to and a new
+ * WATER_DEPTH clears; the local inertial model refuses a velocity with a
+ * sentence (it starts from rest) and takes a surface. */
 static void test_sw_inputs(void) {
   gr_grid g = {12, 9, 1.0, 2.0, 0.0, 0.0, 0, 0};
   size_t n = cells_of(&g);
@@ -2732,14 +2734,19 @@ static void test_sw_inputs(void) {
     free(q2);
     gr_rain_runoff_destroy(s);
   }
-  /* The local inertial model has neither input. */
+  /* The local inertial model takes no velocity, but a surface. */
   p.flow_model = GR_FLOW_LOCAL_INERTIAL;
+  vel[3 * 14 + 1] = 0.1f;
   s = make_sim(&g, &p, b, NULL);
   if (s) {
     CHECK(gr_rain_runoff_set_field(s, GR_FIELD_VELOCITY, vel) == GR_ERR_INVALID_ARGUMENT);
-    CHECK(gr_rain_runoff_set_field(s, GR_FIELD_WATER_SURFACE, d) == GR_ERR_INVALID_ARGUMENT);
     CHECK_MSG(has(gr_rain_runoff_last_error(s), "FlowModel 0"), "'%s'",
               gr_rain_runoff_last_error(s));
+    surf[5] = 0.3f;
+    CHECK(gr_rain_runoff_set_field(s, GR_FIELD_WATER_SURFACE, surf) == GR_OK);
+    float *h = get(s, &g, GR_FIELD_WATER_DEPTH);
+    CHECK(memcmp(h, d, n * sizeof(float)) == 0);
+    free(h);
     /* Switching the model keeps the water, from rest. */
     CHECK(gr_rain_runoff_set_field(s, GR_FIELD_WATER_DEPTH, d) == GR_OK);
     CHECK(gr_rain_runoff_advance(s, 3.0, NULL) == GR_OK);

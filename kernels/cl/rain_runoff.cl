@@ -563,6 +563,19 @@ GR_INLINE void gr_sw_axis(const float *h, const float *b, const float *un, const
   *dqt = ftw - fte;
 }
 
+/* Manning friction on the discharge (qx, qy) of water h deep over dt,
+ * implicit in the new discharge: |q'| (1 + g dt n^2 |q'| / h^(7/3)) = |q|,
+ * in q's direction (solved exactly, as the local inertial model does). */
+GR_INLINE void gr_sw_friction(float h, float dt, float g, float n2, float *qx, float *qy) {
+  if (!(h > 0.0f && n2 > 0.0f))
+    return;
+  float qm = sqrt(*qx * *qx + *qy * *qy);
+  float kf = g * dt * n2 * gr_rain_runoff_pow_m73(fmax(h, GR_RAIN_RUNOFF_DRY));
+  float scale = qm > 0.0f ? gr_rain_runoff_solve(qm, kf) / qm : 0.0f;
+  *qx *= scale;
+  *qy *= scale;
+}
+
 /* Rain and infiltration on a cell's water (as the local inertial model
  * takes them), its momentum scaled with the water infiltration removes. */
 GR_INLINE float gr_sw_wet_q(float h, float q, float r, float dt, float hw) {
@@ -571,15 +584,14 @@ GR_INLINE float gr_sw_wet_q(float h, float q, float r, float dt, float hw) {
 }
 
 /* One stage of Heun's method for every cell (a 1-D launch over the local
- * array: it reads and writes per cell):
+ * array: it reads and writes per cell), Manning friction implicit in each
+ * stage (gr_sw_friction) on its forward-Euler discharge:
  *   stage 1: U1 = Uw + dt L(Uw), Uw the state after rain and infiltration,
  *            from h, qu, qv (computed for every cell it reads);
- *   stage 2: U = (Uw + U1 + dt L(U1)) / 2, from h1, qu1, qv1, then Manning
- *            friction, implicit, on the new discharge:
- *            |q'| (1 + g dt n^2 |q'| / h^(7/3)) = |q|, in q's direction;
- *            written over h, qu, qv (each cell reads its own old values
- *            only), with the infiltration and half of each stage's edge
- *            outflow booked in Kahan sums. */
+ *   stage 2: U = (Uw + U1 + dt L(U1)) / 2, from h1, qu1, qv1, written over
+ *            h, qu, qv (each cell reads its own old values only), with the
+ *            infiltration and half of each stage's edge outflow booked in
+ *            Kahan sums. */
 __kernel void rain_runoff_sw_stage(
     __global float *restrict h, __global float *restrict qu, __global float *restrict qv,
     __global float *restrict h_comp, __global float *restrict h1, __global float *restrict qu1,
@@ -644,6 +656,10 @@ __kernel void rain_runoff_sw_stage(
     float hw = xh[2];
     qun = gr_sw_wet_q(h[c], qu[c], r, dt, hw) + dt * (dqx_x * inv_dx + dqx_y * inv_dy);
     qvn = gr_sw_wet_q(h[c], qv[c], r, dt, hw) + dt * (dqy_x * inv_dx + dqy_y * inv_dy);
+    /* Friction in each stage: without it a film on a steep slope would
+     * gather g S dt of speed in the first stage and empty its cell in the
+     * second. */
+    gr_sw_friction(hn, dt, g, n2, &qun, &qvn);
     h1[c] = fmax(hn, 0.0f);
     dh1[c] = dh;
     qu1[c] = hn > 0.0f ? qun : 0.0f;
@@ -661,16 +677,9 @@ __kernel void rain_runoff_sw_stage(
     float y = delta - h_comp[c];
     float hf = h0 + y;
     float comp = (hf - h0) - y;
+    gr_sw_friction(hn, dt, g, n2, &qun, &qvn);
     float qx = 0.5f * (gr_sw_wet_q(h0, qu[c], r, dt, hw) + qun);
     float qy = 0.5f * (gr_sw_wet_q(h0, qv[c], r, dt, hw) + qvn);
-    if (hf > 0.0f && n2 > 0.0f) {
-      float qm = sqrt(qx * qx + qy * qy);
-      float hs = fmax(hf, GR_RAIN_RUNOFF_DRY);
-      float kf = g * dt * n2 * gr_rain_runoff_pow_m73(hs);
-      float scale = qm > 0.0f ? gr_rain_runoff_solve(qm, kf) / qm : 0.0f;
-      qx *= scale;
-      qy *= scale;
-    }
     h[c] = fmax(hf, 0.0f);
     h_comp[c] = hf > 0.0f ? comp : 0.0f;
     qu[c] = hf > 0.0f ? qx : 0.0f;

@@ -633,13 +633,12 @@ static gr_status gr_rain_runoff_set_field_impl(gr_rain_runoff *s, gr_field f, co
   size_t values = f == GR_FIELD_VELOCITY ? 3 * cells : cells;
   if (gr_rain_runoff_field_check(f, host, values, (size_t)s->nxl, 1, msg, sizeof(msg)) != GR_OK)
     return gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT, "%s", msg);
-  if ((f == GR_FIELD_VELOCITY || f == GR_FIELD_WATER_SURFACE) &&
-      s->params.flow_model != GR_FLOW_SHALLOW_WATER)
+  if (f == GR_FIELD_VELOCITY && s->params.flow_model != GR_FLOW_SHALLOW_WATER)
     return gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
-                        "The field '%s' is an input of FlowModel 0 (shallow water) only, and this "
-                        "simulation runs FlowModel %d (local inertial): set water_depth instead, "
-                        "or take FlowModel 0.",
-                        gr_rain_runoff_field_label(f), (int)s->params.flow_model);
+                        "The field 'velocity' is an input of FlowModel 0 (shallow water) only, and "
+                        "this simulation runs FlowModel %d (local inertial), which starts from "
+                        "rest: leave it out, or take FlowModel 0.",
+                        (int)s->params.flow_model);
   if (f == GR_FIELD_WATER_SURFACE) {
     /* The depth under the surface, as WATER_DEPTH sets it. */
     float *d = malloc(cells * sizeof(float));

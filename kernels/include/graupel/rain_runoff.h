@@ -70,7 +70,7 @@
  *    differences, so that large elevations lose nothing to rounding), with
  *    the matching centred bed source term;
  *  - second order in time: Heun's method (SSP-RK2), two launches a step;
- *  - Manning friction after the step, implicit in the new discharge:
+ *  - Manning friction in each stage, implicit in the new discharge:
  *    |q'| (1 + g dt n^2 |q'| / h^(7/3)) = |q| (solved exactly, as the local
  *    inertial model does), so thin films on steep slopes stay at their
  *    Manning velocity whatever the step; ManningN = 0 is frictionless.
@@ -88,7 +88,7 @@
  * VELOCITY (3 components, z ignored; after WATER_DEPTH, which clears the
  * flow) sets the initial discharges h (u, v), and WATER_SURFACE (after
  * ELEVATION) sets the depth max(0, surface - elevation) as WATER_DEPTH
- * does; both are inputs of this model only.
+ * does (for either model); VELOCITY is an input of this model only.
  */
 #ifndef GRAUPEL_RAIN_RUNOFF_H
 #define GRAUPEL_RAIN_RUNOFF_H
