@@ -2632,12 +2632,13 @@ static void test_sw_tilted_plane(void) {
   gr_grid g = {50, 20, 2.0, 2.0, 0.0, 0.0, 0, 0};
   const double slope = 0.01, rain = 1e-4, mann = 0.03;
   float *b = alloc_field(&g, 1);
-  /* Berms 1 m high along the sides and the top keep the plane's water off
-   * the open edges there (their own rain runs off them). */
+  /* Berms 10 cm high along the sides and the top keep the plane's water
+   * (3 cm deep at most) off the open edges there (their own rain runs off
+   * them). */
   for (int j = 0; j < g.ny; ++j)
     for (int i = 0; i < g.nx; ++i)
       b[(size_t)j * g.nx + i] = (float)(slope * (i + 0.5) * g.dx +
-                                        (j == 0 || j == g.ny - 1 || i == g.nx - 1 ? 1.0 : 0.0));
+                                        (j == 0 || j == g.ny - 1 || i == g.nx - 1 ? 0.1 : 0.0));
   gr_rain_runoff_params p = sw_params(mann, GR_BOUNDARY_OPEN);
   p.rain_rate = rain;
   gr_rain_runoff *s = make_sim(&g, &p, b, NULL);
@@ -2659,7 +2660,7 @@ static void test_sw_tilted_plane(void) {
            ratio, 100.0 * worst, l1.balance_error / l1.rain_volume);
     CHECK_MSG(fabs(ratio - 1.0) < 1e-3, "outflow / rain %.6f", ratio);
     CHECK_MSG(worst < 0.06, "depth off the kinematic wave by %.3g", worst);
-    CHECK(fabs(l1.balance_error) <= 1e-8 * l1.rain_volume);
+    CHECK(fabs(l1.balance_error) <= 1e-7 * l1.rain_volume);
     free(h);
     gr_rain_runoff_destroy(s);
   }
@@ -2765,6 +2766,49 @@ static void test_sw_inputs(void) {
   free(vel);
 }
 
+/* Thin films on steep, rough slopes: 50 mm/h for 60 s on ridges and
+ * hollows with slopes up to 3, Manning 0.03, 0.005 (the local inertial
+ * model's floor) and frictionless, open edges,
+ * the filter's default MaxTimeStep of 1 s. Friction taken in each stage
+ * keeps the films at their Manning speed; frictionless, the stable step's
+ * bound on the bed's acceleration (g S dt) does. No depth is negative and
+ * the ledger closes to 1e-7 (a cell emptied beyond its water would be
+ * clamped to 0, creating water: 8e-4 of the rain without the bound). */
+static void test_sw_thin_films(void) {
+  gr_grid g = {48, 40, 2.0, 2.0, 0.0, 0.0, 0, 0};
+  size_t n = cells_of(&g);
+  float *b = alloc_field(&g, 1);
+  for (int j = 0; j < g.ny; ++j)
+    for (int i = 0; i < g.nx; ++i)
+      b[(size_t)j * g.nx + i] =
+          (float)(8.0 * sin(0.35 * i) * cos(0.3 * j) + 0.5 * i + 0.4 * hash01(i, j, 31));
+  const double roughness[3] = {0.03, 0.005, 0.0};
+  for (int k = 0; k < 3; ++k) {
+    gr_rain_runoff_params p = sw_params(roughness[k], GR_BOUNDARY_OPEN);
+    p.rain_rate = 50.0 / 3.6e6;
+    p.max_dt = 1.0;
+    gr_rain_runoff *s = make_sim(&g, &p, b, NULL);
+    if (!s)
+      continue;
+    int steps = 0;
+    CHECK(gr_rain_runoff_advance(s, 60.0, &steps) == GR_OK);
+    gr_rain_runoff_ledger l = ledger(s);
+    float *h = get(s, &g, GR_FIELD_WATER_DEPTH), *v = get(s, &g, GR_FIELD_VELOCITY);
+    double rel = fabs(l.balance_error) / l.rain_volume, vmax = 0.0;
+    for (size_t c = 0; c < n; ++c)
+      vmax = fmax(vmax, hypot(v[3 * c], v[3 * c + 1]));
+    printf("SW thin films (ManningN %g): %d steps, deepest %.3g m, fastest %.3g m/s, outflow "
+           "%.3g of the rain, balance %.3g of it\n",
+           roughness[k], steps, l.max_depth, vmax, l.outflow_volume / l.rain_volume, rel);
+    CHECK_MSG(rel <= 1e-7, "balance %.3g of the rain", rel);
+    CHECK(bad_depths(h, n) == 0 && bad_values(v, 3 * n) == 0);
+    free(h);
+    free(v);
+    gr_rain_runoff_destroy(s);
+  }
+  free(b);
+}
+
 /* The pieces tests again with the shallow-water model (ring
  * GR_RAIN_RUNOFF_GHOST_SW, one exchange per step): every owned cell of every
  * field bit for bit the whole grid's. */
@@ -2824,6 +2868,7 @@ static const gr_subtest tests[] = {
     {"sw_bump", test_sw_bump, 0},
     {"sw_tilted_plane", test_sw_tilted_plane, 0},
     {"sw_inputs", test_sw_inputs, 0},
+    {"sw_thin_films", test_sw_thin_films, 0},
     {"sw_pieces_x", test_sw_pieces_x, 0},
     {"sw_pieces_y", test_sw_pieces_y, 0},
     {"sw_advance_pieces_x", test_sw_advance_pieces_x, 0},

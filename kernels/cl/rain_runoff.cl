@@ -427,14 +427,8 @@ GR_INLINE gr_sw_cell gr_sw_recon(const float *h, const float *b, const float *un
     c.sh = gr_sw_minmod(dhm, dhp);
     c.se = gr_sw_minmod(dem, dep);
     c.sb = c.se - c.sh;
-    /* A dry neighbour's velocity (0) says nothing of the flow: at a front
-     * the wet side's difference alone extrapolates it (else the front's
-     * thin tip lags, its face velocity held to the cell's). */
-    bool dm = h[k - 1] <= 0.0f, dp = h[k + 1] <= 0.0f;
-    float um = un[k] - un[k - 1], up = un[k + 1] - un[k];
-    float tm = ut[k] - ut[k - 1], tp = ut[k + 1] - ut[k];
-    c.sun = dm == dp ? gr_sw_minmod(um, up) : (dm ? up : um);
-    c.sut = dm == dp ? gr_sw_minmod(tm, tp) : (dm ? tp : tm);
+    c.sun = gr_sw_minmod(un[k] - un[k - 1], un[k + 1] - un[k]);
+    c.sut = gr_sw_minmod(ut[k] - ut[k - 1], ut[k + 1] - ut[k]);
   }
   return c;
 }

@@ -98,7 +98,10 @@ struct gr_rain_runoff {
   int has_rain, has_perm;
   double rain_field_sum; /* sum of the rain-rate field's floats, m/s */
   double rain_field_max; /* its largest value, m/s (the local array's, ring included) */
-  double initial_sum;    /* sum of the initial depth's floats, m */
+  /* g max(|db/dx| / dx + |db/dy| / dy) over the local array, 1/s^2: the
+   * fastest the bed's slope can speed water up, per cell crossed. */
+  double slope_rate;
+  double initial_sum; /* sum of the initial depth's floats, m */
   double initial_volume, rain_volume, time;
   long long steps;
   gr_reduction ledger; /* the reduction behind the ledger and the stable step */
@@ -680,9 +683,29 @@ static gr_status gr_rain_runoff_set_field_impl(gr_rain_runoff *s, gr_field f, co
   gr_status st = GR_OK;
   s->args_set = 0; /* a field allocated now is bound at the next step */
   switch (f) {
-  case GR_FIELD_ELEVATION:
+  case GR_FIELD_ELEVATION: {
     st = gr_buffer_write(s->ctx, s->b, 0, cells * sizeof(cl_float), host);
+    double worst = 0.0;
+    const int nx = s->nxl, ny = s->nyl;
+    for (int j = 0; j < ny; ++j)
+      for (int i = 0; i < nx; ++i) {
+        const float *z = host + (size_t)j * nx + i;
+        double sx = 0.0, sy = 0.0;
+        if (i > 0)
+          sx = fabs((double)z[0] - z[-1]);
+        if (i < nx - 1)
+          sx = fmax(sx, fabs((double)z[1] - z[0]));
+        if (j > 0)
+          sy = fabs((double)z[0] - z[-nx]);
+        if (j < ny - 1)
+          sy = fmax(sy, fabs((double)z[nx] - z[0]));
+        double rate = sx / (s->grid.dx * s->grid.dx) + sy / (s->grid.dy * s->grid.dy);
+        worst = rate > worst ? rate : worst;
+      }
+    if (st == GR_OK)
+      s->slope_rate = GR_GRAVITY * worst;
     break;
+  }
   case GR_FIELD_PERMEABILITY:
     st = gr_rain_runoff_upload(s, &s->perm, host);
     if (st == GR_OK)
@@ -1164,13 +1187,15 @@ static gr_status gr_rain_runoff_sw_stable_dt(gr_rain_runoff *s, double *dt) {
       {"masked", sizeof(masked), &masked},
       {"g", sizeof(g), &g},
   };
-  /* The deepest cell, the fastest rate, the heaviest rain (m/s). */
-  double maxes[3] = {0.0, 0.0, s->has_rain ? s->rain_field_max : s->params.rain_rate};
+  /* The deepest cell, the fastest rate, the heaviest rain (m/s), the
+   * steepest bed (slope_rate). */
+  double maxes[4] = {0.0, 0.0, s->has_rain ? s->rain_field_max : s->params.rain_rate,
+                     s->slope_rate};
   gr_status st = GR_RAIN_RUNOFF_ARGS(s, s->sw_speed, args);
   if (st == GR_OK)
     st = gr_reduction_run(s->ctx, &s->speed, s->sw_speed, NULL, maxes);
   if (st == GR_OK && s->allreduce)
-    st = gr_rain_runoff_allreduce(s, maxes, 3, GR_REDUCE_MAX);
+    st = gr_rain_runoff_allreduce(s, maxes, 4, GR_REDUCE_MAX);
   if (st != GR_OK)
     return st;
   double rate = maxes[1];
@@ -1183,6 +1208,23 @@ static gr_status gr_rain_runoff_sw_stable_dt(gr_rain_runoff *s, double *dt) {
     double inv = 1.0 / s->grid.dx + 1.0 / s->grid.dy;
     double wet = pow(0.5 * s->params.cfl / (inv * sqrt(GR_GRAVITY * r)), 2.0 / 3.0);
     stable = wet < stable ? wet : stable;
+  }
+  /* Frictionless water on a slope gains g S dt of speed within the step,
+   * before the second stage moves it: a film on a steep bed that starts
+   * still (which the speeds above cannot see) would cross cells in that
+   * stage. So, with ManningN 0, also
+   *   dt^2 g max(|db/dx| / dx + |db/dy| / dy) <= cfl / 8,
+   * a quarter of the budget above (both together: 1.25 cfl / 2 at worst,
+   * below the 1/2 that keeps depths positive), each bound a function of
+   * one maximum, so that pieces taking the smallest of their steps take
+   * the whole grid's. With friction, taken in each stage, a film gains no
+   * more than its Manning speed, and no bound is needed. (sw_thin_films
+   * shows both: frictionless rain on slopes up to 3, with MaxTimeStep 1 s,
+   * emptied cells beyond their water without it.) */
+  double accel = maxes[3];
+  if (accel > 0.0 && s->params.manning_n == 0.0 && (maxes[0] > 0.0 || r > 0.0)) {
+    double steep = sqrt(0.125 * s->params.cfl / accel);
+    stable = steep < stable ? steep : stable;
   }
   *dt = stable < s->params.max_dt ? stable : s->params.max_dt;
   return GR_OK;
