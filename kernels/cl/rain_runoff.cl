@@ -399,37 +399,37 @@ GR_INLINE float gr_sw_minmod(float a, float b) {
   return a > 0.0f && b > 0.0f ? fmin(a, b) : (a < 0.0f && b < 0.0f ? fmax(a, b) : 0.0f);
 }
 
+/* A cell of a line: depth, bed, velocity along and across the line. */
+typedef struct gr_sw_pt {
+  float h, b, un, ut;
+} gr_sw_pt;
+
 /* One cell's reconstruction along an axis: its depth h, bed b, normal and
  * tangential velocities un, ut, and the slopes (full-cell differences) of
- * the depth, of the bed under the reconstructed surface (surface slope
- * minus depth slope), and of the velocities. */
+ * the depth, of the surface (se: bed differences plus depth differences),
+ * of the bed under the reconstructed surface (sb = se - sh), and of the
+ * velocities. */
 typedef struct gr_sw_cell {
   float h, b, un, ut, sh, se, sb, sun, sut;
 } gr_sw_cell;
 
-/* Cell k of a 5-cell line (k = 1, 2, 3), its slopes 0 unless both
- * neighbours exist (lo, hi). */
-GR_INLINE gr_sw_cell gr_sw_recon(const float *h, const float *b, const float *un, const float *ut,
-                                 int k, bool lo, bool hi) {
+/* Cell p between its neighbours m and q along the line, its slopes 0 unless
+ * both neighbours exist (both): computed either way and selected, without
+ * a branch, so that CPU compilers vectorise across work-items. */
+GR_INLINE gr_sw_cell gr_sw_recon(gr_sw_pt m, gr_sw_pt p, gr_sw_pt q, bool both) {
   gr_sw_cell c;
-  c.h = h[k];
-  c.b = b[k];
-  c.un = un[k];
-  c.ut = ut[k];
-  c.sh = 0.0f;
-  c.se = 0.0f;
-  c.sb = 0.0f;
-  c.sun = 0.0f;
-  c.sut = 0.0f;
-  if (lo && hi) {
-    float dhm = h[k] - h[k - 1], dhp = h[k + 1] - h[k];
-    float dem = (b[k] - b[k - 1]) + dhm, dep = (b[k + 1] - b[k]) + dhp;
-    c.sh = gr_sw_minmod(dhm, dhp);
-    c.se = gr_sw_minmod(dem, dep);
-    c.sb = c.se - c.sh;
-    c.sun = gr_sw_minmod(un[k] - un[k - 1], un[k + 1] - un[k]);
-    c.sut = gr_sw_minmod(ut[k] - ut[k - 1], ut[k + 1] - ut[k]);
-  }
+  c.h = p.h;
+  c.b = p.b;
+  c.un = p.un;
+  c.ut = p.ut;
+  float dhm = p.h - m.h, dhp = q.h - p.h;
+  float dem = (p.b - m.b) + dhm, dep = (q.b - p.b) + dhp;
+  float sh = gr_sw_minmod(dhm, dhp), se = gr_sw_minmod(dem, dep);
+  c.sh = both ? sh : 0.0f;
+  c.se = both ? se : 0.0f;
+  c.sb = both ? se - sh : 0.0f;
+  c.sun = both ? gr_sw_minmod(p.un - m.un, q.un - p.un) : 0.0f;
+  c.sut = both ? gr_sw_minmod(p.ut - m.ut, q.ut - p.ut) : 0.0f;
   return c;
 }
 
@@ -438,32 +438,23 @@ GR_INLINE gr_sw_cell gr_sw_recon(const float *h, const float *b, const float *un
  * upwind with the mass. Dry sides take the dry-front speeds. */
 GR_INLINE void gr_sw_hll(float hL, float uL, float vL, float hR, float uR, float vR, float g,
                          float *fh, float *fm, float *ft) {
-  if (hL <= 0.0f && hR <= 0.0f) {
-    *fh = 0.0f;
-    *fm = 0.0f;
-    *ft = 0.0f;
-    return;
-  }
+  /* Every branch computed and the right one selected: CPU compilers then
+   * vectorise across work-items (a dry pair's NaN is never selected). */
+  bool dryL = hL <= 0.0f, dryR = hR <= 0.0f;
   float cL = sqrt(g * hL), cR = sqrt(g * hR);
-  float sL = hL <= 0.0f ? uR - 2.0f * cR : (hR <= 0.0f ? uL - cL : fmin(uL - cL, uR - cR));
-  float sR = hR <= 0.0f ? uL + 2.0f * cL : (hL <= 0.0f ? uR + cR : fmax(uL + cL, uR + cR));
+  float sL = dryL ? uR - 2.0f * cR : (dryR ? uL - cL : fmin(uL - cL, uR - cR));
+  float sR = dryR ? uL + 2.0f * cL : (dryL ? uR + cR : fmax(uL + cL, uR + cR));
   float qL = hL * uL, qR = hR * uR;
   float mL = qL * uL + 0.5f * g * hL * hL, mR = qR * uR + 0.5f * g * hR * hR;
-  float mass, mom;
-  if (sL >= 0.0f) {
-    mass = qL;
-    mom = mL;
-  } else if (sR <= 0.0f) {
-    mass = qR;
-    mom = mR;
-  } else {
-    /* (sR F_L - sL F_R + sL sR (U_R - U_L)) / (sR - sL), written as F_L
-     * plus a difference so that equal states give F_L exactly (a lake at
-     * rest then balances to the bit). */
-    float w = sL / (sR - sL);
-    mass = qL + w * (sR * (hR - hL) - (qR - qL));
-    mom = mL + w * (sR * (qR - qL) - (mR - mL));
-  }
+  /* (sR F_L - sL F_R + sL sR (U_R - U_L)) / (sR - sL), written as F_L plus
+   * a difference so that equal states give F_L exactly (a lake at rest
+   * then balances to the bit). */
+  float w = sL / (sR - sL);
+  float mass = qL + w * (sR * (hR - hL) - (qR - qL));
+  float mom = mL + w * (sR * (qR - qL) - (mR - mL));
+  bool left = sL >= 0.0f, right = sR <= 0.0f, none = dryL && dryR;
+  mass = none ? 0.0f : (left ? qL : (right ? qR : mass));
+  mom = none ? 0.0f : (left ? mL : (right ? mR : mom));
   *fh = mass;
   *fm = mom;
   *ft = mass * (mass > 0.0f ? vL : vR);
@@ -490,65 +481,72 @@ GR_INLINE void gr_sw_face(gr_sw_cell L, gr_sw_cell R, float g, float *fh, float 
   *fmR = fm - 0.5f * g * hRs * hRs;
 }
 
-/* A face on the grid's edge, with the cell C inside on the high side (low
- * = 1) or the low side: a wall mirrors C; an open edge leads into a dry
- * cell at the face's bed and passes outflow only. Returns the momentum flux
- * seen by C less g h^2 / 2 (as gr_sw_face's); *fh and *ft as
- * gr_sw_face's, positive toward the high side. */
-GR_INLINE float gr_sw_edge(gr_sw_cell C, bool low, int closed, float g, float *fh, float *ft) {
+/* The ghost beyond the grid's edge next to cell C, as a reconstructed cell
+ * whose face toward C carries (low: C's west face; else its east face): a
+ * wall's mirror image of C's face values (normal velocity negated), or an
+ * open edge's dry, still cell; at C's face bed either way (db = 0
+ * exactly), so that gr_sw_face gives the wall's or the outfall's flux. */
+GR_INLINE gr_sw_cell gr_sw_ghost(gr_sw_cell C, bool low, int closed) {
   float s = low ? -0.5f : 0.5f;
-  float h = C.h + s * C.sh, u = C.un + s * C.sun, v = C.ut + s * C.sut;
-  float m;
-  if (closed) {
-    /* The mirror image is the ghost: on the low side it is the left state. */
-    if (low)
-      gr_sw_hll(h, -u, v, h, u, v, g, fh, &m, ft);
-    else
-      gr_sw_hll(h, u, v, h, -u, v, g, fh, &m, ft);
-    *fh = 0.0f;
-    *ft = 0.0f;
-    return m - 0.5f * g * h * h;
-  }
-  if (low)
-    gr_sw_hll(0.0f, 0.0f, 0.0f, h, u, v, g, fh, &m, ft);
-  else
-    gr_sw_hll(h, u, v, 0.0f, 0.0f, 0.0f, g, fh, &m, ft);
-  /* Nothing enters: an edge the flux would cross inward is a still wall. */
-  bool inward = low ? *fh > 0.0f : *fh < 0.0f;
-  if (inward) {
-    *fh = 0.0f;
-    *ft = 0.0f;
-    return 0.0f;
-  }
-  return m - 0.5f * g * h * h;
+  gr_sw_cell g;
+  g.h = closed ? C.h + s * C.sh : 0.0f;
+  g.un = closed ? -(C.un + s * C.sun) : 0.0f;
+  g.ut = closed ? C.ut + s * C.sut : 0.0f;
+  g.b = C.b;
+  g.sb = -C.sb;
+  g.se = 0.0f;
+  g.sh = 0.0f;
+  g.sun = 0.0f;
+  g.sut = 0.0f;
+  return g;
 }
 
-/* The flux balance of the centre cell (k = 2) of a 5-cell line along one
+/* a where use, else b, field by field (a conditional on whole structs
+ * compiles to a branch, which keeps CPU compilers from vectorising). */
+GR_INLINE gr_sw_cell gr_sw_pick(bool use, gr_sw_cell a, gr_sw_cell b) {
+  gr_sw_cell c;
+  c.h = use ? a.h : b.h;
+  c.b = use ? a.b : b.b;
+  c.un = use ? a.un : b.un;
+  c.ut = use ? a.ut : b.ut;
+  c.sh = use ? a.sh : b.sh;
+  c.se = use ? a.se : b.se;
+  c.sb = use ? a.sb : b.sb;
+  c.sun = use ? a.sun : b.sun;
+  c.sut = use ? a.sut : b.sut;
+  return c;
+}
+
+/* The flux balance of the centre cell (p2) of a 5-cell line along one
  * axis: dh (mass in minus out), dqn and dqt (momentum, with the bed's
  * source), per unit of the axis' face length; out_lo, out_hi the depth
  * flux (m^2/s) leaving through the grid's edge faces. i, n: the cell's
- * index and the line's length. */
-GR_INLINE void gr_sw_axis(const float *h, const float *b, const float *un, const float *ut, int i,
+ * index and the line's length. The edge faces are faces with a ghost
+ * (gr_sw_ghost): a wall passes no water, an open edge only outflow. */
+GR_INLINE void gr_sw_axis(gr_sw_pt p0, gr_sw_pt p1, gr_sw_pt p2, gr_sw_pt p3, gr_sw_pt p4, int i,
                           int n, int closed, float g, float *dh, float *dqn, float *dqt,
                           float *out_lo, float *out_hi) {
-  gr_sw_cell C = gr_sw_recon(h, b, un, ut, 2, i > 0, i < n - 1);
+  bool lo = i > 0, hi = i < n - 1;
+  gr_sw_cell C = gr_sw_recon(p1, p2, p3, lo && hi);
+  gr_sw_cell W = gr_sw_recon(p0, p1, p2, i > 1);
+  gr_sw_cell E = gr_sw_recon(p2, p3, p4, i < n - 2);
+  gr_sw_cell gw = gr_sw_ghost(C, true, closed), ge = gr_sw_ghost(C, false, closed);
+  W = gr_sw_pick(lo, W, gw);
+  E = gr_sw_pick(hi, E, ge);
   float fhw, fmw, ftw, fhe, fme, fte, unused;
-  *out_lo = 0.0f;
-  *out_hi = 0.0f;
-  if (i > 0) {
-    gr_sw_cell W = gr_sw_recon(h, b, un, ut, 1, i > 1, true);
-    gr_sw_face(W, C, g, &fhw, &unused, &fmw, &ftw);
-  } else {
-    fmw = gr_sw_edge(C, true, closed, g, &fhw, &ftw);
-    *out_lo = -fhw;
-  }
-  if (i < n - 1) {
-    gr_sw_cell E = gr_sw_recon(h, b, un, ut, 3, true, i < n - 2);
-    gr_sw_face(C, E, g, &fhe, &fme, &unused, &fte);
-  } else {
-    fme = gr_sw_edge(C, false, closed, g, &fhe, &fte);
-    *out_hi = fhe;
-  }
+  gr_sw_face(W, C, g, &fhw, &unused, &fmw, &ftw);
+  gr_sw_face(C, E, g, &fhe, &fme, &unused, &fte);
+  /* At the edges: nothing through a wall, nothing in through an open edge
+   * (a still wall then: no momentum either). */
+  bool stop_w = !lo && (closed || fhw > 0.0f), stop_e = !hi && (closed || fhe < 0.0f);
+  fmw = stop_w && !closed ? 0.0f : fmw;
+  fme = stop_e && !closed ? 0.0f : fme;
+  fhw = stop_w ? 0.0f : fhw;
+  fhe = stop_e ? 0.0f : fhe;
+  ftw = stop_w ? 0.0f : ftw;
+  fte = stop_e ? 0.0f : fte;
+  *out_lo = lo ? 0.0f : -fhw;
+  *out_hi = hi ? 0.0f : fhe;
   float hw = C.h - 0.5f * C.sh, he = C.h + 0.5f * C.sh;
   *dh = fhw - fhe;
   /* (fmw + g hw^2 / 2) - (fme + g he^2 / 2) - g (hw + he) / 2 (bed slope)
@@ -577,8 +575,34 @@ GR_INLINE float gr_sw_wet_q(float h, float q, float r, float dt, float hw) {
   return h1 > 0.0f ? q * (hw / h1) : 0.0f;
 }
 
-/* One stage of Heun's method for every cell (a 1-D launch over the local
- * array: it reads and writes per cell), Manning friction implicit in each
+/* One cell of a stage's cross (in: inside the local array; q its index):
+ * its depth (after rain and infiltration in stage 1), bed, and velocities
+ * along (sn) and across (st) the line; 0 where it is outside. */
+GR_INLINE gr_sw_pt gr_sw_load(__global const float *restrict sh, __global const float *restrict sn,
+                              __global const float *restrict st, __global const float *restrict b,
+                              __global const float *restrict rain,
+                              __global const float *restrict perm, bool in, int q, int stage,
+                              float dt, int use_rain, float rain_uniform, int use_perm,
+                              float perm_uniform) {
+  float hh = in ? sh[q] : 0.0f, pn = in ? sn[q] : 0.0f, pt = in ? st[q] : 0.0f;
+  if (stage == 1) {
+    float r = in ? gr_rain_runoff_input(rain, use_rain, rain_uniform, q) : 0.0f;
+    float k = in ? gr_rain_runoff_input(perm, use_perm, perm_uniform, q) : 0.0f;
+    float hw = gr_rain_runoff_wet(hh, r, k, dt);
+    pn = gr_sw_wet_q(hh, pn, r, dt, hw);
+    pt = gr_sw_wet_q(hh, pt, r, dt, hw);
+    hh = hw;
+  }
+  gr_sw_pt p;
+  p.h = hh;
+  p.b = in ? b[q] : 0.0f;
+  p.un = gr_sw_velocity(hh, pn);
+  p.ut = gr_sw_velocity(hh, pt);
+  return p;
+}
+
+/* One stage of Heun's method for every cell (one work-item per cell of the
+ * local array, which reads and writes that cell's values only), Manning friction implicit in each
  * stage (gr_sw_friction) on its forward-Euler discharge:
  *   stage 1: U1 = Uw + dt L(Uw), Uw the state after rain and infiltration,
  *            from h, qu, qv (computed for every cell it reads);
@@ -586,7 +610,7 @@ GR_INLINE float gr_sw_wet_q(float h, float q, float r, float dt, float hw) {
  *            h, qu, qv (each cell reads its own old values only), with the
  *            infiltration and half of each stage's edge outflow booked in
  *            Kahan sums. */
-__kernel void rain_runoff_sw_stage(
+GR_INLINE void gr_sw_stage(
     __global float *restrict h, __global float *restrict qu, __global float *restrict qv,
     __global float *restrict h_comp, __global float *restrict h1, __global float *restrict qu1,
     __global float *restrict qv1, __global float *restrict dh1, __global const float *restrict b,
@@ -594,60 +618,42 @@ __kernel void rain_runoff_sw_stage(
     __global float *restrict infiltrated, __global float *restrict infiltrated_comp,
     __global float *restrict outflow, __global float *restrict outflow_comp, int nx, int ny,
     float dt, float inv_dx, float inv_dy, float g, float n2, int use_rain, float rain_uniform,
-    int use_perm, float perm_uniform, int closed, int stage) {
-  int c = get_global_id(0);
-  if (c >= nx * ny)
+    int use_perm, float perm_uniform, int closed, __global const float *restrict sh,
+    __global const float *restrict su, __global const float *restrict sv, const int stage) {
+  int i = get_global_id(0), j = get_global_id(1);
+  if (!gr_inside(i, j, nx, ny))
     return;
-  int i = c % nx, j = c / nx;
-  __global const float *sh = stage == 1 ? h : h1;
-  __global const float *su = stage == 1 ? qu : qu1;
-  __global const float *sv = stage == 1 ? qv : qv1;
-  /* The cross of 5 + 5 cells around (i, j); index 2 is the cell itself.
-   * Missing cells (beyond the array) are never used: their slots read the
-   * centre. */
-  float xh[5], xb[5], xu[5], xv[5], yh[5], yb[5], yu[5], yv[5];
-  for (int k = 0; k < 5; ++k) {
-    int ii = i + k - 2, jj = j + k - 2;
-    int cx = ii >= 0 && ii < nx ? c + k - 2 : c;
-    int cy = jj >= 0 && jj < ny ? c + (k - 2) * nx : c;
-    int cc[2] = {cx, cy};
-    for (int a = 0; a < 2; ++a) {
-      int q = cc[a];
-      float hh = sh[q], pu = su[q], pv = sv[q];
-      if (stage == 1) {
-        float r = gr_rain_runoff_input(rain, use_rain, rain_uniform, q);
-        float hw =
-            gr_rain_runoff_wet(hh, r, gr_rain_runoff_input(perm, use_perm, perm_uniform, q), dt);
-        pu = gr_sw_wet_q(hh, pu, r, dt, hw);
-        pv = gr_sw_wet_q(hh, pv, r, dt, hw);
-        hh = hw;
-      }
-      float u = gr_sw_velocity(hh, pu), v = gr_sw_velocity(hh, pv);
-      if (a == 0) {
-        xh[k] = hh;
-        xb[k] = b[q];
-        xu[k] = u;
-        xv[k] = v;
-      } else {
-        yh[k] = hh;
-        yb[k] = b[q];
-        yu[k] = v;
-        yv[k] = u;
-      }
-    }
-  }
+  int c = gr_idx(i, j, nx);
+  /* The cross of 5 + 5 cells around (i, j); x2 and y2 are the cell itself.
+   * Cells beyond the array are masked to dry, flat and still, and never
+   * used (the reconstruction's slopes and the edge faces do without them);
+   * indices stay linear so that CPU compilers vectorise the loads. */
+#define GR_SW_LOAD(o, in, q, sn, st)                                                               \
+  gr_sw_load(sh, sn, st, b, rain, perm, (in), (q), stage, dt, use_rain, rain_uniform, use_perm,    \
+             perm_uniform)
+  gr_sw_pt x0 = GR_SW_LOAD(-2, i >= 2, c - 2, su, sv);
+  gr_sw_pt x1 = GR_SW_LOAD(-1, i >= 1, c - 1, su, sv);
+  gr_sw_pt x2 = GR_SW_LOAD(0, true, c, su, sv);
+  gr_sw_pt x3 = GR_SW_LOAD(1, i + 1 < nx, c + 1, su, sv);
+  gr_sw_pt x4 = GR_SW_LOAD(2, i + 2 < nx, c + 2, su, sv);
+  gr_sw_pt y0 = GR_SW_LOAD(-2, j >= 2, c - 2 * nx, sv, su);
+  gr_sw_pt y1 = GR_SW_LOAD(-1, j >= 1, c - nx, sv, su);
+  gr_sw_pt y3 = GR_SW_LOAD(1, j + 1 < ny, c + nx, sv, su);
+  gr_sw_pt y4 = GR_SW_LOAD(2, j + 2 < ny, c + 2 * nx, sv, su);
+#undef GR_SW_LOAD
+  gr_sw_pt y2 = {x2.h, x2.b, x2.ut, x2.un};
   float dhx, dqx_x, dqy_x, olx, ohx, dhy, dqy_y, dqx_y, oly, ohy;
-  gr_sw_axis(xh, xb, xu, xv, i, nx, closed, g, &dhx, &dqx_x, &dqy_x, &olx, &ohx);
-  gr_sw_axis(yh, yb, yu, yv, j, ny, closed, g, &dhy, &dqy_y, &dqx_y, &oly, &ohy);
+  gr_sw_axis(x0, x1, x2, x3, x4, i, nx, closed, g, &dhx, &dqx_x, &dqy_x, &olx, &ohx);
+  gr_sw_axis(y0, y1, y2, y3, y4, j, ny, closed, g, &dhy, &dqy_y, &dqx_y, &oly, &ohy);
   float dh = dt * (dhx * inv_dx + dhy * inv_dy);
-  float hn = xh[2] + dh;
+  float hn = x2.h + dh;
   float qun = su[c] + dt * (dqx_x * inv_dx + dqx_y * inv_dy);
   float qvn = sv[c] + dt * (dqy_x * inv_dx + dqy_y * inv_dy);
   float out = 0.5f * dt * ((olx + ohx) * inv_dx + (oly + ohy) * inv_dy);
   if (stage == 1) {
     /* su, sv are the momenta before rain: take the wet ones. */
     float r = gr_rain_runoff_input(rain, use_rain, rain_uniform, c);
-    float hw = xh[2];
+    float hw = x2.h;
     qun = gr_sw_wet_q(h[c], qu[c], r, dt, hw) + dt * (dqx_x * inv_dx + dqx_y * inv_dy);
     qvn = gr_sw_wet_q(h[c], qv[c], r, dt, hw) + dt * (dqy_x * inv_dx + dqy_y * inv_dy);
     /* Friction in each stage: without it a film on a steep slope would
@@ -683,6 +689,32 @@ __kernel void rain_runoff_sw_stage(
   }
   if (out != 0.0f)
     gr_kahan_add(outflow, outflow_comp, c, out);
+}
+
+/* The two stages as two kernels, each reading one state and writing
+ * another that the compiler can tell apart (a pointer chosen at run time
+ * between them kept PoCL from vectorising across work-items). */
+#define GR_SW_STAGE_ARGS                                                                           \
+  __global float *restrict h, __global float *restrict qu, __global float *restrict qv,            \
+      __global float *restrict h_comp, __global float *restrict h1, __global float *restrict qu1,  \
+      __global float *restrict qv1, __global float *restrict dh1,                                  \
+      __global const float *restrict b, __global const float *restrict rain,                       \
+      __global const float *restrict perm, __global float *restrict infiltrated,                   \
+      __global float *restrict infiltrated_comp, __global float *restrict outflow,                 \
+      __global float *restrict outflow_comp, int nx, int ny, float dt, float inv_dx, float inv_dy, \
+      float g, float n2, int use_rain, float rain_uniform, int use_perm, float perm_uniform,       \
+      int closed
+#define GR_SW_STAGE_PASS                                                                           \
+  h, qu, qv, h_comp, h1, qu1, qv1, dh1, b, rain, perm, infiltrated, infiltrated_comp, outflow,     \
+      outflow_comp, nx, ny, dt, inv_dx, inv_dy, g, n2, use_rain, rain_uniform, use_perm,           \
+      perm_uniform, closed
+
+__kernel void rain_runoff_sw_stage1(GR_SW_STAGE_ARGS) {
+  gr_sw_stage(GR_SW_STAGE_PASS, h, qu, qv, 1);
+}
+
+__kernel void rain_runoff_sw_stage2(GR_SW_STAGE_ARGS) {
+  gr_sw_stage(GR_SW_STAGE_PASS, h1, qu1, qv1, 2);
 }
 
 /* The stable step's inputs, per work-group: the deepest cell and the

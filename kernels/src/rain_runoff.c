@@ -84,7 +84,7 @@ struct gr_rain_runoff {
   int nxl, nyl;
   int ring[4]; /* gr_rain_runoff_side order: west, east, south, north */
   gr_rain_runoff_params params;
-  cl_kernel flux, limit, update, reduce, derive, sw_stage, sw_speed;
+  cl_kernel flux, limit, update, reduce, derive, sw_stage[2], sw_speed;
   cl_mem h, h_c, b, k, inf, inf_c, out, out_c;
   cl_mem qu, qv, h1, qu1, qv1, dh1; /* shallow water: discharges and Heun's stage */
   cl_mem qu0, qv0;                  /* initial discharges, once VELOCITY was set */
@@ -538,7 +538,9 @@ gr_status gr_rain_runoff_create(gr_context *ctx, const gr_grid *grid,
   if (st == GR_OK)
     st = gr_kernel_create(ctx, prog, "rain_runoff_derive", &s->derive);
   if (st == GR_OK)
-    st = gr_kernel_create(ctx, prog, "rain_runoff_sw_stage", &s->sw_stage);
+    st = gr_kernel_create(ctx, prog, "rain_runoff_sw_stage1", &s->sw_stage[0]);
+  if (st == GR_OK)
+    st = gr_kernel_create(ctx, prog, "rain_runoff_sw_stage2", &s->sw_stage[1]);
   if (st == GR_OK)
     st = gr_kernel_create(ctx, prog, "rain_runoff_sw_speed", &s->sw_speed);
   cl_mem *per_cell[] = {&s->h,     &s->h_c, &s->b,  &s->k,  &s->inf, &s->inf_c, &s->out,
@@ -580,8 +582,8 @@ gr_status gr_rain_runoff_create(gr_context *ctx, const gr_grid *grid,
 void gr_rain_runoff_destroy(gr_rain_runoff *s) {
   if (!s)
     return;
-  cl_kernel kernels[] = {s->flux,   s->limit,    s->update,  s->reduce,
-                         s->derive, s->sw_stage, s->sw_speed};
+  cl_kernel kernels[] = {s->flux,   s->limit,       s->update,      s->reduce,
+                         s->derive, s->sw_stage[0], s->sw_stage[1], s->sw_speed};
   for (size_t i = 0; i < sizeof(kernels) / sizeof(kernels[0]); ++i)
     if (kernels[i])
       clReleaseKernel(kernels[i]);
@@ -1013,7 +1015,6 @@ static gr_status gr_rain_runoff_bind(gr_rain_runoff *s, cl_float dt) {
       {"outflow", m, &s->out}, {"outflow_comp", m, &s->out_c},
   };
   if (p->flow_model == GR_FLOW_SHALLOW_WATER) {
-    cl_int stage = 1;
     const gr_rain_runoff_arg sw[] = {
         {"h", m, &s->h},
         {"qu", m, &s->qu},
@@ -1042,9 +1043,10 @@ static gr_status gr_rain_runoff_bind(gr_rain_runoff *s, cl_float dt) {
         {"use_perm", sizeof(use_perm), &use_perm},
         {"perm_uniform", sizeof(perm_uniform), &perm_uniform},
         {"closed", sizeof(closed), &closed},
-        {"stage", sizeof(stage), &stage},
     };
-    gr_status st = GR_RAIN_RUNOFF_ARGS(s, s->sw_stage, sw);
+    gr_status st = GR_RAIN_RUNOFF_ARGS(s, s->sw_stage[0], sw);
+    if (st == GR_OK)
+      st = GR_RAIN_RUNOFF_ARGS(s, s->sw_stage[1], sw);
     s->args_set = st == GR_OK;
     s->args_dt = dt;
     return st;
@@ -1073,14 +1075,10 @@ static gr_status gr_rain_runoff_enqueue(gr_rain_runoff *s, double dt, int nsteps
   gr_status st = gr_rain_runoff_bind(s, dtf);
   int done = 0, exchange = s->halo_exchange && gr_rain_runoff_has_ring(s);
   int sw = s->params.flow_model == GR_FLOW_SHALLOW_WATER;
-  size_t cells = gr_rain_runoff_cells(s);
   while (sw && st == GR_OK && done < nsteps && !*stop) {
-    /* Heun's two stages; the stage argument is the only one that changes. */
-    for (cl_int stage = 1; st == GR_OK && stage <= 2; ++stage) {
-      st = gr_kernel_arg(s->ctx, s->sw_stage, "stage", sizeof(stage), &stage);
-      if (st == GR_OK)
-        st = gr_enqueue_1d(s->ctx, s->sw_stage, cells);
-    }
+    /* Heun's two stages. */
+    for (int stage = 0; st == GR_OK && stage < 2; ++stage)
+      st = gr_enqueue_2d(s->ctx, s->sw_stage[stage], 0, 0, (size_t)s->nxl, (size_t)s->nyl, NULL);
     if (st == GR_OK)
       ++done;
     if (st == GR_OK && exchange)
