@@ -49,6 +49,7 @@ GRAUPEL_TABLE_SETTER(vtkRainRunoffFilter, RainRate, double, gr_rain_runoff_param
 GRAUPEL_TABLE_SETTER(vtkRainRunoffFilter, Permeability, double, gr_rain_runoff_param_bounds)
 GRAUPEL_TABLE_SETTER(vtkRainRunoffFilter, ManningN, double, gr_rain_runoff_param_bounds)
 GRAUPEL_TABLE_SETTER(vtkRainRunoffFilter, Boundary, int, gr_rain_runoff_param_bounds)
+GRAUPEL_TABLE_SETTER(vtkRainRunoffFilter, FlowModel, int, gr_rain_runoff_param_bounds)
 GRAUPEL_TABLE_SETTER(vtkRainRunoffFilter, MaxTimeStep, double, gr_rain_runoff_param_bounds)
 GRAUPEL_TABLE_SETTER(vtkRainRunoffFilter, CourantNumber, double, gr_rain_runoff_param_bounds)
 
@@ -56,9 +57,10 @@ int vtkRainRunoffFilter::CheckParameters() {
   const struct {
     const char *property;
     double value;
-  } values[] = {{"RainRate", this->RainRate},       {"Permeability", this->Permeability},
-                {"ManningN", this->ManningN},       {"Boundary", double(this->Boundary)},
-                {"MaxTimeStep", this->MaxTimeStep}, {"CourantNumber", this->CourantNumber}};
+  } values[] = {{"RainRate", this->RainRate},          {"Permeability", this->Permeability},
+                {"ManningN", this->ManningN},          {"Boundary", double(this->Boundary)},
+                {"MaxTimeStep", this->MaxTimeStep},    {"CourantNumber", this->CourantNumber},
+                {"FlowModel", double(this->FlowModel)}};
   for (const auto &p : values) {
     const gr_param_bound *b = Bound(p.property);
     if (!b) {
@@ -131,8 +133,18 @@ int vtkRainRunoffFilter::SetUpState(vtkInformationVector **inputVector) {
   };
   std::vector<Upload> uploads;
   uploads.push_back({GR_FIELD_ELEVATION, AsFloat(elevationArray), "Input"});
+  // The water: its depth, or its surface (a Rain Runoff output has both:
+  // the depth is the one then).
   if (vtkDataArray *depth = pd->GetArray("water_depth")) {
     uploads.push_back({GR_FIELD_WATER_DEPTH, AsFloat(depth), "Input"});
+  } else if (vtkDataArray *surface = pd->GetArray("water_surface")) {
+    uploads.push_back({GR_FIELD_WATER_SURFACE, AsFloat(surface), "Input"});
+  }
+  // After the water, whose velocity it is; the local inertial model starts
+  // from rest.
+  vtkDataArray *velocity = pd->GetArray("velocity");
+  if (velocity && this->FlowModel == SHALLOW_WATER) {
+    uploads.push_back({GR_FIELD_VELOCITY, AsFloat(velocity), "Input"});
   }
   if (vtkDataArray *rain = pd->GetArray("rain_rate")) {
     uploads.push_back({GR_FIELD_RAIN_RATE, AsFloat(rain), "Input"});
@@ -158,13 +170,15 @@ int vtkRainRunoffFilter::SetUpState(vtkInformationVector **inputVector) {
   const size_t npoints = static_cast<size_t>(dims[0]) * static_cast<size_t>(dims[1]);
   char msg[512];
   for (const Upload &u : uploads) {
-    if (u.values->GetNumberOfComponents() != 1 ||
+    const int comps = gr_field_components(u.field);
+    if (u.values->GetNumberOfComponents() != comps ||
         static_cast<size_t>(u.values->GetNumberOfTuples()) != npoints) {
-      vtkErrorMacro("Rain Runoff's " << u.where << " array '" << gr_field_name(u.field)
-                                     << "' must have one value per point.");
+      vtkErrorMacro("Rain Runoff's "
+                    << u.where << " array '" << gr_field_name(u.field) << "' must have "
+                    << (comps == 1 ? "one value" : "3 components") << " per point.");
       return 0;
     }
-    if (gr_rain_runoff_field_validate(u.field, u.values->GetPointer(0), npoints, msg,
+    if (gr_rain_runoff_field_validate(u.field, u.values->GetPointer(0), npoints * comps, msg,
                                       sizeof(msg)) != GR_OK) {
       vtkErrorMacro("Rain Runoff's " << u.where << ": " << msg);
       return 0;
@@ -179,6 +193,7 @@ int vtkRainRunoffFilter::SetUpState(vtkInformationVector **inputVector) {
   p.cfl = this->CourantNumber;
   p.max_dt = this->MaxTimeStep;
   p.boundary = this->Boundary == CLOSED ? GR_BOUNDARY_CLOSED : GR_BOUNDARY_OPEN;
+  p.flow_model = this->FlowModel == LOCAL_INERTIAL ? GR_FLOW_LOCAL_INERTIAL : GR_FLOW_SHALLOW_WATER;
   if (gr_rain_runoff_params_validate(&p, msg, sizeof(msg)) != GR_OK) {
     vtkErrorMacro("Rain Runoff: " << msg);
     return 0;
@@ -276,6 +291,9 @@ void vtkRainRunoffFilter::PrintSelf(ostream &os, vtkIndent indent) {
   os << indent << "Permeability: " << this->Permeability << " mm/h\n";
   os << indent << "ManningN: " << this->ManningN << "\n";
   os << indent << "Boundary: " << (this->Boundary == CLOSED ? "closed" : "open") << "\n";
+  os << indent
+     << "FlowModel: " << (this->FlowModel == LOCAL_INERTIAL ? "local inertial" : "shallow water")
+     << "\n";
   os << indent << "MaxTimeStep: " << this->MaxTimeStep << " s\n";
   os << indent << "CourantNumber: " << this->CourantNumber << "\n";
 }

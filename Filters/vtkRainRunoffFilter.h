@@ -6,7 +6,12 @@
  * Input 0 (`Input`) is the terrain: a 2-D vtkImageData with the point array
  * `elevation` (m; an input without it is refused: active scalars are not
  * guessed at). Optional point arrays on it: `water_depth` (m, the water present at
- * time 0) and `rain_rate` (m/s, replaces RainRate cell by cell).
+ * time 0) or `water_surface` (m: the depth is max(0, surface - elevation)),
+ * `velocity` (m/s, 3 components, z ignored: the water's velocity at time 0;
+ * the local inertial model starts from rest and leaves it out) and
+ * `rain_rate` (m/s, replaces RainRate cell by cell). With both water_depth
+ * and water_surface (a Rain Runoff output as the input) water_depth is
+ * taken.
  * Input 1 (`PermeabilityMap`, optional) is an image with the same dimensions
  * whose point array `permeability` (m/s) replaces Permeability.
  *
@@ -44,6 +49,7 @@ public:
   void PrintSelf(ostream &os, vtkIndent indent) override;
 
   enum Boundaries { OPEN = 0, CLOSED = 1 };
+  enum FlowModels { SHALLOW_WATER = 0, LOCAL_INERTIAL = 1 };
 
   ///@{
   /** Rain intensity, mm/h (default 10). */
@@ -67,6 +73,12 @@ public:
   /** 0: water leaves through the grid's edge (default); 1: the edge is a wall. */
   virtual void SetBoundary(int value);
   vtkGetMacro(Boundary, int);
+  ///@}
+
+  ///@{
+  /** 0: the shallow-water equations with advection (default); 1: the local inertial scheme. */
+  virtual void SetFlowModel(int value);
+  vtkGetMacro(FlowModel, int);
   ///@}
 
   ///@{
@@ -103,6 +115,7 @@ protected:
   double Permeability = 0.0;
   double ManningN = 0.03;
   int Boundary = OPEN;
+  int FlowModel = SHALLOW_WATER;
   double MaxTimeStep = 1.0;
   double CourantNumber = 0.7;
 

@@ -3,8 +3,9 @@
  *
  * Input layout (missing bytes read as 0): byte 0 picks the mode, byte 1 the
  * length of a small message buffer, byte 2 the field to validate, then:
- *   mode 0  the six parameters from raw bytes (8 per double, 4 for the
- *           boundary enum), so NaN, infinities and huge values appear;
+ *   mode 0  the seven parameters from raw bytes (8 per double, 4 for the
+ *           boundary and flow model enums), so NaN, infinities and huge
+ *           values appear;
  *   mode 1  one byte per parameter picks an edge value: a bound of any row
  *           of the parameter table (gr_rain_runoff_param_bounds) in the
  *           core's unit, one ulp either side, or 0, -0, NaN, infinities;
@@ -13,9 +14,11 @@
  * Checks: the status is GR_OK or GR_ERR_INVALID_ARGUMENT; a failure comes with
  * a non-empty message ending in '.'; parameters are accepted exactly when they
  * lie in the table's ranges (user bounds times to_core; open minimum and
- * whole numbers where a row says so), fields exactly when every value is
+ * whole numbers where a row says so) and, for FlowModel 1 (local inertial),
+ * ManningN is at least 0.005; fields exactly when every value is
  * finite and, for the depth, permeability and rain-rate inputs, within the
- * RainRate and Permeability rows' ranges; outputs-only fields are refused; a short message
+ * RainRate and Permeability rows' ranges (velocities within +-1000 m/s);
+ * outputs-only fields are refused; a short message
  * buffer is never overrun and always terminated. */
 #include "fuzz_common.h"
 #include "graupel/rain_runoff.h"
@@ -44,11 +47,13 @@ static int in_row(const char *property, double v) {
 }
 
 static int params_documented(const gr_rain_runoff_params *p) {
-  int boundary;
+  int boundary, model;
   memcpy(&boundary, &p->boundary, sizeof boundary);
+  memcpy(&model, &p->flow_model, sizeof model);
   return in_row("RainRate", p->rain_rate) && in_row("Permeability", p->permeability) &&
          in_row("ManningN", p->manning_n) && in_row("CourantNumber", p->cfl) &&
-         in_row("MaxTimeStep", p->max_dt) && in_row("Boundary", (double)boundary);
+         in_row("MaxTimeStep", p->max_dt) && in_row("Boundary", (double)boundary) &&
+         in_row("FlowModel", (double)model) && (model != 1 || p->manning_n >= 0.005);
 }
 
 static int field_documented(gr_field f, const float *v, size_t n) {
@@ -62,13 +67,15 @@ static int field_documented(gr_field f, const float *v, size_t n) {
       return 0;
     if (f == GR_FIELD_RAIN_RATE && !in_row("RainRate", x))
       return 0;
+    if (f == GR_FIELD_VELOCITY && !(x >= -1000.0 && x <= 1000.0))
+      return 0;
   }
   return 1;
 }
 
 static int is_input(gr_field f) {
   return f == GR_FIELD_ELEVATION || f == GR_FIELD_WATER_DEPTH || f == GR_FIELD_PERMEABILITY ||
-         f == GR_FIELD_RAIN_RATE;
+         f == GR_FIELD_RAIN_RATE || f == GR_FIELD_WATER_SURFACE || f == GR_FIELD_VELOCITY;
 }
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
@@ -94,9 +101,12 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
   }
   if (mode == 0) {
     take(&r, &p.boundary, sizeof(int));
+    take(&r, &p.flow_model, sizeof(int));
   } else {
     int b = (int)take_byte(&r) % 4 - 1; /* -1, 0, 1, 2 */
     memcpy(&p.boundary, &b, sizeof b);
+    b = (int)take_byte(&r) % 4 - 1;
+    memcpy(&p.flow_model, &b, sizeof b);
   }
 
   msg[0] = '\0';

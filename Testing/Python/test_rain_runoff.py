@@ -88,6 +88,7 @@ T.check(f.GetRainRate() == 10.0 and f.GetPermeability() == 0.0 and f.GetManningN
         "defaults RainRate 10 mm/h, Permeability 0, ManningN 0.03")
 T.check(f.GetBoundary() == 0 and f.GetEndTime() == 600.0 and f.GetOutputInterval() == 10.0,
         "defaults Boundary open, EndTime 600 s, OutputInterval 10 s")
+T.check(f.GetFlowModel() == 0, "default FlowModel 0 (shallow water)")
 
 f = rain(bowl, EndTime=65.0, Boundary=1, RainRate=36.0)
 f.UpdateInformation()
@@ -281,6 +282,52 @@ T.check(ai.GetRestoreCount() == 1 and ai.GetRestartCount() == 1,
         "it restored the 10 s checkpoint (restores %d, restarts %d)"
         % (ai.GetRestoreCount(), ai.GetRestartCount()))
 
+# ---- FlowModel: the two models, and the shallow-water model's inputs ------------
+sw, _ = at(rain(slope + bowl, RainRate=50.0), 30.0)
+li, _ = at(rain(slope + bowl, RainRate=50.0, FlowModel=1), 30.0)
+T.check(sw is not None and li is not None and not np.array_equal(sw, li)
+        and abs(float(sw.sum()) - float(li.sum())) < 0.05 * float(sw.sum()),
+        "the two models differ, with much the same water (%g, %g)"
+        % (float(sw.sum()), float(li.sum())))
+g = rain(bowl, FlowModel=1, ManningN=0.0)
+errs = T.ErrorCatcher(g)
+d, _ = at(g, 10.0)
+T.check(d is None and "ManningN" in errs.text() and "FlowModel" in errs.text(),
+        "frictionless local inertial refused with a sentence: %r" % errs.text()[:200])
+d, _ = at(rain(bowl, ManningN=0.0), 10.0)
+T.check(d is not None and float(d.min()) >= 0.0, "frictionless shallow water runs")
+
+
+def started(arrays, **kw):
+    g = vtkRainRunoffFilter()
+    g.SetInputConnection(producer(image(arrays)).GetOutputPort())
+    g.SetEndTime(20.0)
+    for k, v in kw.items():
+        getattr(g, "Set" + k)(v)
+    return g
+
+
+surface = np.full((NY, NX), 1.0)
+depth = np.maximum(0.0, surface.astype(np.float32) - bowl.astype(np.float32))
+by_depth, _ = at(started({"elevation": bowl, "water_depth": depth}), 20.0)
+by_surface, _ = at(started({"elevation": bowl, "water_surface": surface}), 20.0)
+T.check(by_depth is not None and np.array_equal(by_depth, by_surface),
+        "water_surface sets the depth max(0, surface - elevation), bit for bit")
+vel = np.zeros((NY * NX, 3))
+vel[:, 0] = 0.5
+moving = started({"elevation": bowl, "water_depth": depth}, RainRate=0.0)
+arr = numpy_to_vtk(vel.astype(np.float32), deep=1)
+arr.SetName("velocity")
+moving.GetInputConnection(0, 0).GetProducer().GetOutputDataObject(0).GetPointData().AddArray(arr)
+m0, out0 = at(moving, 0.0)
+v0 = vtk_to_numpy(out0.GetPointData().GetArray("velocity")).reshape(NY, NX, 3)
+wet = depth > 1e-3
+T.check(np.allclose(v0[wet, 0], 0.5, atol=1e-5) and np.all(v0[..., 1] == 0.0),
+        "the velocity array sets the initial velocity (x 0.5 m/s)")
+m20, _ = at(moving, 20.0)
+still, _ = at(started({"elevation": bowl, "water_depth": depth}, RainRate=0.0), 20.0)
+T.check(m20 is not None and not np.array_equal(m20, still), "moving water moves")
+
 # ---- bad input: one sentence, an empty output, the next good update works ------
 bad_elev = bowl.copy()
 bad_elev[3, 7] = np.nan
@@ -327,8 +374,11 @@ T.check(g.GetRainRate() == 0.0, "RainRate -1 clamps to 0 mm/h: %r" % g.GetRainRa
 g.SetRainRate(1e9)
 T.check(0.0 < g.GetRainRate() < 1e9, "RainRate 1e9 clamps to the table's maximum: %r"
         % g.GetRainRate())
-g.SetManningN(0.0)
-T.check(g.GetManningN() > 0.0, "ManningN 0 clamps to the table's minimum: %r" % g.GetManningN())
+g.SetManningN(-1.0)
+T.check(g.GetManningN() == 0.0, "ManningN -1 clamps to the table's minimum 0: %r"
+        % g.GetManningN())
+g.SetFlowModel(5)
+T.check(g.GetFlowModel() == 1, "FlowModel 5 clamps to 1: %r" % g.GetFlowModel())
 g = rain(bowl, RainRate=float("nan"))
 errs = T.ErrorCatcher(g)
 at(g, 10.0)

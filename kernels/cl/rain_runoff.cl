@@ -317,13 +317,13 @@ __kernel void rain_runoff_reduce(
  * (3 components, m/s, 0 below GR_RAIN_RUNOFF_VELOCITY_DEPTH), 2 discharge |q|
  * (m^2/s, cell-centred average of the faces), 3 infiltrated (cumulative,
  * m). */
-__kernel void rain_runoff_derive(__global const float *restrict h, __global const float *restrict b,
-                                 __global const float *restrict qx,
-                                 __global const float *restrict qy,
-                                 __global const float *restrict limit,
-                                 __global const float *restrict infiltrated,
-                                 __global const float *restrict infiltrated_comp,
-                                 __global float *restrict out, int nx, int ny, int what) {
+__kernel void
+rain_runoff_derive(__global const float *restrict h, __global const float *restrict b,
+                   __global const float *restrict qx, __global const float *restrict qy,
+                   __global const float *restrict limit, __global const float *restrict infiltrated,
+                   __global const float *restrict infiltrated_comp,
+                   __global const float *restrict qu, __global const float *restrict qv,
+                   __global float *restrict out, int nx, int ny, int what, int sw) {
   int i = get_global_id(0), j = get_global_id(1);
   if (!gr_inside(i, j, nx, ny))
     return;
@@ -334,6 +334,19 @@ __kernel void rain_runoff_derive(__global const float *restrict h, __global cons
   }
   if (what == 3) {
     out[c] = infiltrated[c] - infiltrated_comp[c];
+    return;
+  }
+  if (sw) {
+    /* The shallow-water model's discharges are the cells' own. */
+    float u = qu[c], v = qv[c], d = h[c];
+    if (what == 2) {
+      out[c] = sqrt(u * u + v * v);
+      return;
+    }
+    int wet = d >= GR_RAIN_RUNOFF_VELOCITY_DEPTH;
+    out[3 * c] = wet ? u / d : 0.0f;
+    out[3 * c + 1] = wet ? v / d : 0.0f;
+    out[3 * c + 2] = 0.0f;
     return;
   }
   float kc = limit[c];
@@ -353,4 +366,382 @@ __kernel void rain_runoff_derive(__global const float *restrict h, __global cons
   out[3 * c] = wet ? u / d : 0.0f;
   out[3 * c + 1] = wet ? v / d : 0.0f;
   out[3 * c + 2] = 0.0f;
+}
+
+/* ------------------------------------------------- shallow-water model
+ *
+ * FlowModel 0 (graupel/rain_runoff.h): the 2-D shallow-water equations by
+ * finite volumes, cell-centred state (h, qu = h u, qv = h v). Fluxes: HLL
+ * on the hydrostatic reconstruction of Audusse, Bouchut, Bristeau, Klein &
+ * Perthame (2004), second order: minmod slopes of the depth, the surface
+ * (as bed differences plus depth differences, so that large elevations
+ * lose nothing to rounding), and the velocities; Heun's method (SSP-RK2)
+ * in time, in two launches. Each launch is a gather: a cell computes its
+ * four faces itself, and the neighbour that shares a face computes the same
+ * flux from the same inputs by the same expression (FP_CONTRACT off), so
+ * the mass that leaves one cell is the float that arrives in the other.
+ * Every face reads two cells either side of it, so a launch reads two cells
+ * away and a step (two launches) four: a piece's ring is
+ * GR_RAIN_RUNOFF_GHOST_SW cells and the halo is exchanged once per step. */
+
+/* Depth below which a cell's velocity is desingularised (Kurganov & Petrova
+ * 2007): u = 2 h q / (h^2 + max(h^2, eps^2)), which is q / h above it and
+ * falls smoothly to 0 with the depth below it, so films a step leaves
+ * behind at a front do not get huge velocities from rounding. */
+#define GR_RAIN_RUNOFF_SW_EPS 1.0e-5f
+
+GR_INLINE float gr_sw_velocity(float h, float q) {
+  float h2 = h * h;
+  return 2.0f * h * q / (h2 + fmax(h2, GR_RAIN_RUNOFF_SW_EPS * GR_RAIN_RUNOFF_SW_EPS));
+}
+
+GR_INLINE float gr_sw_minmod(float a, float b) {
+  return a > 0.0f && b > 0.0f ? fmin(a, b) : (a < 0.0f && b < 0.0f ? fmax(a, b) : 0.0f);
+}
+
+/* A cell of a line: depth, bed, velocity along and across the line. */
+typedef struct gr_sw_pt {
+  float h, b, un, ut;
+} gr_sw_pt;
+
+/* One cell's reconstruction along an axis: its depth h, bed b, normal and
+ * tangential velocities un, ut, and the slopes (full-cell differences) of
+ * the depth, of the surface (se: bed differences plus depth differences),
+ * of the bed under the reconstructed surface (sb = se - sh), and of the
+ * velocities. */
+typedef struct gr_sw_cell {
+  float h, b, un, ut, sh, se, sb, sun, sut;
+} gr_sw_cell;
+
+/* Cell p between its neighbours m and q along the line, its slopes 0 unless
+ * both neighbours exist (both): computed either way and selected, without
+ * a branch, so that CPU compilers vectorise across work-items. */
+GR_INLINE gr_sw_cell gr_sw_recon(gr_sw_pt m, gr_sw_pt p, gr_sw_pt q, bool both) {
+  gr_sw_cell c;
+  c.h = p.h;
+  c.b = p.b;
+  c.un = p.un;
+  c.ut = p.ut;
+  float dhm = p.h - m.h, dhp = q.h - p.h;
+  float dem = (p.b - m.b) + dhm, dep = (q.b - p.b) + dhp;
+  float sh = gr_sw_minmod(dhm, dhp), se = gr_sw_minmod(dem, dep);
+  c.sh = both ? sh : 0.0f;
+  c.se = both ? se : 0.0f;
+  c.sb = both ? se - sh : 0.0f;
+  c.sun = both ? gr_sw_minmod(p.un - m.un, q.un - p.un) : 0.0f;
+  c.sut = both ? gr_sw_minmod(p.ut - m.ut, q.ut - p.ut) : 0.0f;
+  return c;
+}
+
+/* HLL flux between two states (depth, normal and tangential velocity) along
+ * the normal: mass, normal momentum; the tangential momentum is carried
+ * upwind with the mass. Dry sides take the dry-front speeds. */
+GR_INLINE void gr_sw_hll(float hL, float uL, float vL, float hR, float uR, float vR, float g,
+                         float *fh, float *fm, float *ft) {
+  /* Every branch computed and the right one selected: CPU compilers then
+   * vectorise across work-items (a dry pair's NaN is never selected). */
+  bool dryL = hL <= 0.0f, dryR = hR <= 0.0f;
+  float cL = sqrt(g * hL), cR = sqrt(g * hR);
+  float sL = dryL ? uR - 2.0f * cR : (dryR ? uL - cL : fmin(uL - cL, uR - cR));
+  float sR = dryR ? uL + 2.0f * cL : (dryL ? uR + cR : fmax(uL + cL, uR + cR));
+  float qL = hL * uL, qR = hR * uR;
+  float mL = qL * uL + 0.5f * g * hL * hL, mR = qR * uR + 0.5f * g * hR * hR;
+  /* (sR F_L - sL F_R + sL sR (U_R - U_L)) / (sR - sL), written as F_L plus
+   * a difference so that equal states give F_L exactly (a lake at rest
+   * then balances to the bit). */
+  float w = sL / (sR - sL);
+  float mass = qL + w * (sR * (hR - hL) - (qR - qL));
+  float mom = mL + w * (sR * (qR - qL) - (mR - mL));
+  bool left = sL >= 0.0f, right = sR <= 0.0f, none = dryL && dryR;
+  mass = none ? 0.0f : (left ? qL : (right ? qR : mass));
+  mom = none ? 0.0f : (left ? mL : (right ? mR : mom));
+  *fh = mass;
+  *fm = mom;
+  *ft = mass * (mass > 0.0f ? vL : vR);
+}
+
+/* The face between reconstructed cells L and R (R on the high side): the
+ * hydrostatic reconstruction at the face's bed max(b_L, b_R) (the
+ * difference db = b_R - b_L of the two sides' face beds, so a flat bed
+ * keeps the depths exactly), the HLL flux, and the normal momentum flux as
+ * seen by L (fmL) and by R (fmR) less the hydrostatic pressure of each
+ * side's own face depth, g h^2 / 2, which gr_sw_axis adds back with the bed
+ * source in one product that vanishes where the surface is flat: a lake at
+ * rest then balances to the bit, not to rounding. */
+GR_INLINE void gr_sw_face(gr_sw_cell L, gr_sw_cell R, float g, float *fh, float *fmL, float *fmR,
+                          float *ft) {
+  float hL = L.h + 0.5f * L.sh, hR = R.h - 0.5f * R.sh;
+  float uL = L.un + 0.5f * L.sun, uR = R.un - 0.5f * R.sun;
+  float vL = L.ut + 0.5f * L.sut, vR = R.ut - 0.5f * R.sut;
+  float db = (R.b - L.b) - 0.5f * (L.sb + R.sb);
+  float hLs = fmax(0.0f, hL - fmax(0.0f, db)), hRs = fmax(0.0f, hR - fmax(0.0f, -db));
+  float fm;
+  gr_sw_hll(hLs, uL, vL, hRs, uR, vR, g, fh, &fm, ft);
+  *fmL = fm - 0.5f * g * hLs * hLs;
+  *fmR = fm - 0.5f * g * hRs * hRs;
+}
+
+/* The ghost beyond the grid's edge next to cell C, as a reconstructed cell
+ * whose face toward C carries (low: C's west face; else its east face): a
+ * wall's mirror image of C's face values (normal velocity negated), or an
+ * open edge's dry, still cell; at C's face bed either way (db = 0
+ * exactly), so that gr_sw_face gives the wall's or the outfall's flux. */
+GR_INLINE gr_sw_cell gr_sw_ghost(gr_sw_cell C, bool low, int closed) {
+  float s = low ? -0.5f : 0.5f;
+  gr_sw_cell g;
+  g.h = closed ? C.h + s * C.sh : 0.0f;
+  g.un = closed ? -(C.un + s * C.sun) : 0.0f;
+  g.ut = closed ? C.ut + s * C.sut : 0.0f;
+  g.b = C.b;
+  g.sb = -C.sb;
+  g.se = 0.0f;
+  g.sh = 0.0f;
+  g.sun = 0.0f;
+  g.sut = 0.0f;
+  return g;
+}
+
+/* a where use, else b, field by field (a conditional on whole structs
+ * compiles to a branch, which keeps CPU compilers from vectorising). */
+GR_INLINE gr_sw_cell gr_sw_pick(bool use, gr_sw_cell a, gr_sw_cell b) {
+  gr_sw_cell c;
+  c.h = use ? a.h : b.h;
+  c.b = use ? a.b : b.b;
+  c.un = use ? a.un : b.un;
+  c.ut = use ? a.ut : b.ut;
+  c.sh = use ? a.sh : b.sh;
+  c.se = use ? a.se : b.se;
+  c.sb = use ? a.sb : b.sb;
+  c.sun = use ? a.sun : b.sun;
+  c.sut = use ? a.sut : b.sut;
+  return c;
+}
+
+/* The flux balance of the centre cell (p2) of a 5-cell line along one
+ * axis: dh (mass in minus out), dqn and dqt (momentum, with the bed's
+ * source), per unit of the axis' face length; out_lo, out_hi the depth
+ * flux (m^2/s) leaving through the grid's edge faces. i, n: the cell's
+ * index and the line's length. The edge faces are faces with a ghost
+ * (gr_sw_ghost): a wall passes no water, an open edge only outflow. */
+GR_INLINE void gr_sw_axis(gr_sw_pt p0, gr_sw_pt p1, gr_sw_pt p2, gr_sw_pt p3, gr_sw_pt p4, int i,
+                          int n, int closed, float g, float *dh, float *dqn, float *dqt,
+                          float *out_lo, float *out_hi) {
+  bool lo = i > 0, hi = i < n - 1;
+  gr_sw_cell C = gr_sw_recon(p1, p2, p3, lo && hi);
+  gr_sw_cell W = gr_sw_recon(p0, p1, p2, i > 1);
+  gr_sw_cell E = gr_sw_recon(p2, p3, p4, i < n - 2);
+  gr_sw_cell gw = gr_sw_ghost(C, true, closed), ge = gr_sw_ghost(C, false, closed);
+  W = gr_sw_pick(lo, W, gw);
+  E = gr_sw_pick(hi, E, ge);
+  float fhw, fmw, ftw, fhe, fme, fte, unused;
+  gr_sw_face(W, C, g, &fhw, &unused, &fmw, &ftw);
+  gr_sw_face(C, E, g, &fhe, &fme, &unused, &fte);
+  /* At the edges: nothing through a wall, nothing in through an open edge
+   * (a still wall then: no momentum either). */
+  bool stop_w = !lo && (closed || fhw > 0.0f), stop_e = !hi && (closed || fhe < 0.0f);
+  fmw = stop_w && !closed ? 0.0f : fmw;
+  fme = stop_e && !closed ? 0.0f : fme;
+  fhw = stop_w ? 0.0f : fhw;
+  fhe = stop_e ? 0.0f : fhe;
+  ftw = stop_w ? 0.0f : ftw;
+  fte = stop_e ? 0.0f : fte;
+  *out_lo = lo ? 0.0f : -fhw;
+  *out_hi = hi ? 0.0f : fhe;
+  float hw = C.h - 0.5f * C.sh, he = C.h + 0.5f * C.sh;
+  *dh = fhw - fhe;
+  /* (fmw + g hw^2 / 2) - (fme + g he^2 / 2) - g (hw + he) / 2 (bed slope)
+   * = fmw - fme - g (hw + he) / 2 (surface slope). */
+  *dqn = (fmw - fme) - 0.5f * g * (hw + he) * C.se;
+  *dqt = ftw - fte;
+}
+
+/* Manning friction on the discharge (qx, qy) of water h deep over dt,
+ * implicit in the new discharge: |q'| (1 + g dt n^2 |q'| / h^(7/3)) = |q|,
+ * in q's direction (solved exactly, as the local inertial model does). */
+GR_INLINE void gr_sw_friction(float h, float dt, float g, float n2, float *qx, float *qy) {
+  if (!(h > 0.0f && n2 > 0.0f))
+    return;
+  float qm = sqrt(*qx * *qx + *qy * *qy);
+  float kf = g * dt * n2 * gr_rain_runoff_pow_m73(fmax(h, GR_RAIN_RUNOFF_DRY));
+  float scale = qm > 0.0f ? gr_rain_runoff_solve(qm, kf) / qm : 0.0f;
+  *qx *= scale;
+  *qy *= scale;
+}
+
+/* Rain and infiltration on a cell's water (as the local inertial model
+ * takes them), its momentum scaled with the water infiltration removes. */
+GR_INLINE float gr_sw_wet_q(float h, float q, float r, float dt, float hw) {
+  float h1 = h + r * dt;
+  return h1 > 0.0f ? q * (hw / h1) : 0.0f;
+}
+
+/* One cell of a stage's cross (in: inside the local array; q its index):
+ * its depth (after rain and infiltration in stage 1), bed, and velocities
+ * along (sn) and across (st) the line; 0 where it is outside. */
+GR_INLINE gr_sw_pt gr_sw_load(__global const float *restrict sh, __global const float *restrict sn,
+                              __global const float *restrict st, __global const float *restrict b,
+                              __global const float *restrict rain,
+                              __global const float *restrict perm, bool in, int q, int stage,
+                              float dt, int use_rain, float rain_uniform, int use_perm,
+                              float perm_uniform) {
+  float hh = in ? sh[q] : 0.0f, pn = in ? sn[q] : 0.0f, pt = in ? st[q] : 0.0f;
+  if (stage == 1) {
+    float r = in ? gr_rain_runoff_input(rain, use_rain, rain_uniform, q) : 0.0f;
+    float k = in ? gr_rain_runoff_input(perm, use_perm, perm_uniform, q) : 0.0f;
+    float hw = gr_rain_runoff_wet(hh, r, k, dt);
+    pn = gr_sw_wet_q(hh, pn, r, dt, hw);
+    pt = gr_sw_wet_q(hh, pt, r, dt, hw);
+    hh = hw;
+  }
+  gr_sw_pt p;
+  p.h = hh;
+  p.b = in ? b[q] : 0.0f;
+  p.un = gr_sw_velocity(hh, pn);
+  p.ut = gr_sw_velocity(hh, pt);
+  return p;
+}
+
+/* One stage of Heun's method for every cell (one work-item per cell of the
+ * local array, which reads and writes that cell's values only), Manning friction implicit in each
+ * stage (gr_sw_friction) on its forward-Euler discharge:
+ *   stage 1: U1 = Uw + dt L(Uw), Uw the state after rain and infiltration,
+ *            from h, qu, qv (computed for every cell it reads);
+ *   stage 2: U = (Uw + U1 + dt L(U1)) / 2, from h1, qu1, qv1, written over
+ *            h, qu, qv (each cell reads its own old values only), with the
+ *            infiltration and half of each stage's edge outflow booked in
+ *            Kahan sums. */
+GR_INLINE void gr_sw_stage(
+    __global float *restrict h, __global float *restrict qu, __global float *restrict qv,
+    __global float *restrict h_comp, __global float *restrict h1, __global float *restrict qu1,
+    __global float *restrict qv1, __global float *restrict dh1, __global const float *restrict b,
+    __global const float *restrict rain, __global const float *restrict perm,
+    __global float *restrict infiltrated, __global float *restrict infiltrated_comp,
+    __global float *restrict outflow, __global float *restrict outflow_comp, int nx, int ny,
+    float dt, float inv_dx, float inv_dy, float g, float n2, int use_rain, float rain_uniform,
+    int use_perm, float perm_uniform, int closed, __global const float *restrict sh,
+    __global const float *restrict su, __global const float *restrict sv, const int stage) {
+  int i = get_global_id(0), j = get_global_id(1);
+  if (!gr_inside(i, j, nx, ny))
+    return;
+  int c = gr_idx(i, j, nx);
+  /* The cross of 5 + 5 cells around (i, j); x2 and y2 are the cell itself.
+   * Cells beyond the array are masked to dry, flat and still, and never
+   * used (the reconstruction's slopes and the edge faces do without them);
+   * indices stay linear so that CPU compilers vectorise the loads. */
+#define GR_SW_LOAD(o, in, q, sn, st)                                                               \
+  gr_sw_load(sh, sn, st, b, rain, perm, (in), (q), stage, dt, use_rain, rain_uniform, use_perm,    \
+             perm_uniform)
+  gr_sw_pt x0 = GR_SW_LOAD(-2, i >= 2, c - 2, su, sv);
+  gr_sw_pt x1 = GR_SW_LOAD(-1, i >= 1, c - 1, su, sv);
+  gr_sw_pt x2 = GR_SW_LOAD(0, true, c, su, sv);
+  gr_sw_pt x3 = GR_SW_LOAD(1, i + 1 < nx, c + 1, su, sv);
+  gr_sw_pt x4 = GR_SW_LOAD(2, i + 2 < nx, c + 2, su, sv);
+  gr_sw_pt y0 = GR_SW_LOAD(-2, j >= 2, c - 2 * nx, sv, su);
+  gr_sw_pt y1 = GR_SW_LOAD(-1, j >= 1, c - nx, sv, su);
+  gr_sw_pt y3 = GR_SW_LOAD(1, j + 1 < ny, c + nx, sv, su);
+  gr_sw_pt y4 = GR_SW_LOAD(2, j + 2 < ny, c + 2 * nx, sv, su);
+#undef GR_SW_LOAD
+  gr_sw_pt y2 = {x2.h, x2.b, x2.ut, x2.un};
+  float dhx, dqx_x, dqy_x, olx, ohx, dhy, dqy_y, dqx_y, oly, ohy;
+  gr_sw_axis(x0, x1, x2, x3, x4, i, nx, closed, g, &dhx, &dqx_x, &dqy_x, &olx, &ohx);
+  gr_sw_axis(y0, y1, y2, y3, y4, j, ny, closed, g, &dhy, &dqy_y, &dqx_y, &oly, &ohy);
+  float dh = dt * (dhx * inv_dx + dhy * inv_dy);
+  float hn = x2.h + dh;
+  float qun = su[c] + dt * (dqx_x * inv_dx + dqx_y * inv_dy);
+  float qvn = sv[c] + dt * (dqy_x * inv_dx + dqy_y * inv_dy);
+  float out = 0.5f * dt * ((olx + ohx) * inv_dx + (oly + ohy) * inv_dy);
+  if (stage == 1) {
+    /* su, sv are the momenta before rain: take the wet ones. */
+    float r = gr_rain_runoff_input(rain, use_rain, rain_uniform, c);
+    float hw = x2.h;
+    qun = gr_sw_wet_q(h[c], qu[c], r, dt, hw) + dt * (dqx_x * inv_dx + dqx_y * inv_dy);
+    qvn = gr_sw_wet_q(h[c], qv[c], r, dt, hw) + dt * (dqy_x * inv_dx + dqy_y * inv_dy);
+    /* Friction in each stage: without it a film on a steep slope would
+     * gather g S dt of speed in the first stage and empty its cell in the
+     * second. */
+    gr_sw_friction(hn, dt, g, n2, &qun, &qvn);
+    h1[c] = fmax(hn, 0.0f);
+    dh1[c] = dh;
+    qu1[c] = hn > 0.0f ? qun : 0.0f;
+    qv1[c] = hn > 0.0f ? qvn : 0.0f;
+  } else {
+    float h0 = h[c];
+    float r = gr_rain_runoff_input(rain, use_rain, rain_uniform, c);
+    float k = gr_rain_runoff_input(perm, use_perm, perm_uniform, c);
+    float hw = gr_rain_runoff_wet(h0, r, k, dt);
+    float inf = gr_rain_runoff_infiltration(h0, r, k, dt);
+    /* The new depth h0 + (r dt - i) + (dh1 + dh) / 2, Kahan-summed as the
+     * local inertial model's (h - h_comp is the water): without it the
+     * rounding of the depth would show in the ledger after 10^3 steps. */
+    float delta = (r * dt - inf) + 0.5f * (dh1[c] + dh);
+    float y = delta - h_comp[c];
+    float hf = h0 + y;
+    float comp = (hf - h0) - y;
+    gr_sw_friction(hn, dt, g, n2, &qun, &qvn);
+    float qx = 0.5f * (gr_sw_wet_q(h0, qu[c], r, dt, hw) + qun);
+    float qy = 0.5f * (gr_sw_wet_q(h0, qv[c], r, dt, hw) + qvn);
+    h[c] = fmax(hf, 0.0f);
+    h_comp[c] = hf > 0.0f ? comp : 0.0f;
+    qu[c] = hf > 0.0f ? qx : 0.0f;
+    qv[c] = hf > 0.0f ? qy : 0.0f;
+    if (inf != 0.0f)
+      gr_kahan_add(infiltrated, infiltrated_comp, c, inf);
+  }
+  if (out != 0.0f)
+    gr_kahan_add(outflow, outflow_comp, c, out);
+}
+
+/* The two stages as two kernels, each reading one state and writing
+ * another that the compiler can tell apart (a pointer chosen at run time
+ * between them kept PoCL from vectorising across work-items). */
+#define GR_SW_STAGE_ARGS                                                                           \
+  __global float *restrict h, __global float *restrict qu, __global float *restrict qv,            \
+      __global float *restrict h_comp, __global float *restrict h1, __global float *restrict qu1,  \
+      __global float *restrict qv1, __global float *restrict dh1,                                  \
+      __global const float *restrict b, __global const float *restrict rain,                       \
+      __global const float *restrict perm, __global float *restrict infiltrated,                   \
+      __global float *restrict infiltrated_comp, __global float *restrict outflow,                 \
+      __global float *restrict outflow_comp, int nx, int ny, float dt, float inv_dx, float inv_dy, \
+      float g, float n2, int use_rain, float rain_uniform, int use_perm, float perm_uniform,       \
+      int closed
+#define GR_SW_STAGE_PASS                                                                           \
+  h, qu, qv, h_comp, h1, qu1, qv1, dh1, b, rain, perm, infiltrated, infiltrated_comp, outflow,     \
+      outflow_comp, nx, ny, dt, inv_dx, inv_dy, g, n2, use_rain, rain_uniform, use_perm,           \
+      perm_uniform, closed
+
+__kernel void rain_runoff_sw_stage1(GR_SW_STAGE_ARGS) {
+  gr_sw_stage(GR_SW_STAGE_PASS, h, qu, qv, 1);
+}
+
+__kernel void rain_runoff_sw_stage2(GR_SW_STAGE_ARGS) {
+  gr_sw_stage(GR_SW_STAGE_PASS, h1, qu1, qv1, 2);
+}
+
+/* The stable step's inputs, per work-group: the deepest cell and the
+ * fastest rate (|u| + sqrt(g h)) / dx + (|v| + sqrt(g h)) / dy of the owned
+ * cells (a cell's own sum: what its update needs, and the same maximum
+ * whichever way the domain is split). */
+__kernel void
+rain_runoff_sw_speed(__global const float *restrict h, __global const float *restrict qu,
+                     __global const float *restrict qv, __global float *restrict partial,
+                     __local float *restrict scratch, int n, int row, int own_x0, int own_x1,
+                     int own_y0, int own_y1, int masked, float g, float inv_dx, float inv_dy) {
+  int lid = get_local_id(0), wg = get_local_size(0), start, end;
+  gr_reduce_block(n, &start, &end);
+  float hmax = 0.0f, rate = 0.0f;
+  for (int c = start + lid; c < end; c += wg) {
+    if (masked) {
+      int i = c % row, j = c / row;
+      if (i < own_x0 || i >= own_x1 || j < own_y0 || j >= own_y1)
+        continue;
+    }
+    float d = h[c], a = sqrt(g * d);
+    hmax = fmax(hmax, d);
+    rate = fmax(rate, (fabs(gr_sw_velocity(d, qu[c])) + a) * inv_dx +
+                          (fabs(gr_sw_velocity(d, qv[c])) + a) * inv_dy);
+  }
+  __local float *mine = gr_reduce_slots(scratch, 0, 2);
+  mine[0] = hmax;
+  mine[1] = rate;
+  gr_reduce_group(scratch, 0, 2, partial);
 }

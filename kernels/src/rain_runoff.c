@@ -33,10 +33,14 @@
 #define GR_RAIN_RUNOFF_PROGRESS_EVERY 0.1
 /* Checkpoints: "GRR1" and the layout's version. */
 #define GR_RAIN_RUNOFF_STATE_MAGIC 0x31525247u
-#define GR_RAIN_RUNOFF_STATE_VERSION 2u /* 2: the piece's i0, j0 */
-/* Per-cell arrays of a checkpoint: h, h_c, k, inf, inf_c, out, out_c. */
-#define GR_RAIN_RUNOFF_HALO_ARRAYS 4 /* per halo cell: h, k, west and south faces */
-#define GR_RAIN_RUNOFF_STATE_CELL_ARRAYS 7
+#define GR_RAIN_RUNOFF_STATE_VERSION 3u /* 2: the piece's i0, j0; 3: qu, qv */
+/* Per-cell arrays of a checkpoint: h, h_c, k, inf, inf_c, out, out_c, qu, qv. */
+/* Per halo cell: h, k, west and south faces (local inertial); h, qu, qv and
+ * h_c (shallow water). */
+#define GR_RAIN_RUNOFF_HALO_ARRAYS 4
+#define GR_RAIN_RUNOFF_STATE_CELL_ARRAYS 9
+/* The local inertial model's smallest Manning n (shallow water allows 0). */
+#define GR_RAIN_RUNOFF_LI_MIN_N 0.005
 
 /* The parameter table's rows, in gr_rain_runoff_param_bounds' order. */
 enum {
@@ -46,6 +50,7 @@ enum {
   GR_RAIN_RUNOFF_P_MAX_DT,
   GR_RAIN_RUNOFF_P_CFL,
   GR_RAIN_RUNOFF_P_BOUNDARY,
+  GR_RAIN_RUNOFF_P_FLOW_MODEL,
   GR_RAIN_RUNOFF_P_COUNT
 };
 
@@ -54,10 +59,11 @@ enum {
 static const gr_param_bound gr_rain_runoff_bounds[GR_RAIN_RUNOFF_P_COUNT] = {
     {"RainRate", "mm/h", 0.0, 3600.0, 10.0, 1.0 / 3.6e6, 0, 0},
     {"Permeability", "mm/h", 0.0, 36000.0, 0.0, 1.0 / 3.6e6, 0, 0},
-    {"ManningN", "s/m^(1/3)", 0.005, 1.0, 0.03, 1.0, 0, 0},
+    {"ManningN", "s/m^(1/3)", 0.0, 1.0, 0.03, 1.0, 0, 0},
     {"MaxTimeStep", "s", 0.0, 3600.0, 1.0, 1.0, 1, 0},
     {"CourantNumber", "", 0.0, 1.0, 0.7, 1.0, 1, 0},
     {"Boundary", "", 0.0, 1.0, 0.0, 1.0, 0, 1},
+    {"FlowModel", "", 0.0, 1.0, 0.0, 1.0, 0, 1},
 };
 
 /* A row's range in the core's unit: exactly the products a caller gets from
@@ -78,9 +84,11 @@ struct gr_rain_runoff {
   int nxl, nyl;
   int ring[4]; /* gr_rain_runoff_side order: west, east, south, north */
   gr_rain_runoff_params params;
-  cl_kernel flux, limit, update, reduce, derive;
+  cl_kernel flux, limit, update, reduce, derive, sw_stage[2], sw_speed;
   cl_mem h, h_c, b, k, inf, inf_c, out, out_c;
-  cl_mem qx[2], qy[2]; /* discharges; [cur] is the latest, the other the next */
+  cl_mem qu, qv, h1, qu1, qv1, dh1; /* shallow water: discharges and Heun's stage */
+  cl_mem qu0, qv0;                  /* initial discharges, once VELOCITY was set */
+  cl_mem qx[2], qy[2];              /* discharges; [cur] is the latest, the other the next */
   int cur;
   cl_mem h0;      /* initial depth, once WATER_DEPTH was set */
   cl_mem rain;    /* rain-rate field, once set */
@@ -89,10 +97,15 @@ struct gr_rain_runoff {
   cl_mem dummy;   /* bound in place of a field that was not set */
   int has_rain, has_perm;
   double rain_field_sum; /* sum of the rain-rate field's floats, m/s */
-  double initial_sum;    /* sum of the initial depth's floats, m */
+  double rain_field_max; /* its largest value, m/s (the local array's, ring included) */
+  /* g max(|db/dx| / dx + |db/dy| / dy) over the local array, 1/s^2: the
+   * fastest the bed's slope can speed water up, per cell crossed. */
+  double slope_rate;
+  double initial_sum; /* sum of the initial depth's floats, m */
   double initial_volume, rain_volume, time;
   long long steps;
   gr_reduction ledger; /* the reduction behind the ledger and the stable step */
+  gr_reduction speed;  /* shallow water's stable step: deepest cell, fastest wave rate */
   /* The step kernels' arguments other than the alternating face arrays are
    * set again only when they change: the parameters, the input fields or
    * dt (steps_dt). */
@@ -133,6 +146,7 @@ void gr_rain_runoff_params_init(gr_rain_runoff_params *p) {
   p->max_dt = t[GR_RAIN_RUNOFF_P_MAX_DT].default_value;
   p->cfl = t[GR_RAIN_RUNOFF_P_CFL].default_value;
   p->boundary = (gr_boundary)(int)t[GR_RAIN_RUNOFF_P_BOUNDARY].default_value;
+  p->flow_model = (gr_flow_model)(int)t[GR_RAIN_RUNOFF_P_FLOW_MODEL].default_value;
 }
 
 /* The core's value of row `row` in p. */
@@ -148,6 +162,11 @@ static double gr_rain_runoff_param_value(const gr_rain_runoff_params *p, int row
     return p->max_dt;
   case GR_RAIN_RUNOFF_P_CFL:
     return p->cfl;
+  case GR_RAIN_RUNOFF_P_FLOW_MODEL: {
+    int m; /* any bit pattern the enum may hold */
+    memcpy(&m, &p->flow_model, sizeof(m));
+    return (double)m;
+  }
   default: {
     int b; /* any bit pattern the enum may hold */
     memcpy(&b, &p->boundary, sizeof(b));
@@ -171,6 +190,15 @@ gr_status gr_rain_runoff_params_validate(const gr_rain_runoff_params *p, char *m
     gr_param_explain(r, v, "Invalid rain runoff parameters", msg, msg_len);
     return GR_ERR_INVALID_ARGUMENT;
   }
+  if (p->flow_model == GR_FLOW_LOCAL_INERTIAL && p->manning_n < GR_RAIN_RUNOFF_LI_MIN_N) {
+    if (msg && msg_len)
+      snprintf(msg, msg_len,
+               "Invalid rain runoff parameters: ManningN must be at least %g s/m^(1/3) for "
+               "FlowModel 1 (local inertial) (got %g); raise it, or take FlowModel 0 (shallow "
+               "water), which allows 0.",
+               GR_RAIN_RUNOFF_LI_MIN_N, p->manning_n);
+    return GR_ERR_INVALID_ARGUMENT;
+  }
   return GR_OK;
 }
 
@@ -186,6 +214,7 @@ static gr_status gr_rain_runoff_field_check(gr_field f, const float *values, siz
   const char *rule = NULL;
   char rule_text[160];
   double lo = -HUGE_VAL, hi = HUGE_VAL;
+  size_t comps = 1;
   switch (f) {
   case GR_FIELD_ELEVATION:
     rule = strict ? "elevations must be finite and within +-1e6 m" : "elevations must be finite";
@@ -193,6 +222,20 @@ static gr_status gr_rain_runoff_field_check(gr_field f, const float *values, siz
       lo = -GR_RAIN_RUNOFF_MAX_ELEVATION;
       hi = GR_RAIN_RUNOFF_MAX_ELEVATION;
     }
+    break;
+  case GR_FIELD_WATER_SURFACE:
+    rule = strict ? "water surfaces must be finite and within +-1e6 m"
+                  : "water surfaces must be finite";
+    if (strict) {
+      lo = -GR_RAIN_RUNOFF_MAX_ELEVATION;
+      hi = GR_RAIN_RUNOFF_MAX_ELEVATION;
+    }
+    break;
+  case GR_FIELD_VELOCITY:
+    rule = "velocities must be finite and within +-1000 m/s";
+    lo = -1000.0;
+    hi = 1000.0;
+    comps = 3;
     break;
   case GR_FIELD_WATER_DEPTH:
     rule = strict ? "depths must be finite, at least 0 and at most 1e4 m"
@@ -219,7 +262,7 @@ static gr_status gr_rain_runoff_field_check(gr_field f, const float *values, siz
     if (msg && msg_len)
       snprintf(msg, msg_len,
                "The field '%s' is not an input of the rain runoff simulation; its inputs are "
-               "elevation, water_depth, permeability and rain_rate.",
+               "elevation, water_depth, water_surface, velocity, permeability and rain_rate.",
                gr_rain_runoff_field_label(f));
     return GR_ERR_INVALID_ARGUMENT;
   }
@@ -236,7 +279,7 @@ static gr_status gr_rain_runoff_field_check(gr_field f, const float *values, siz
     if (msg && msg_len) {
       if (nx > 0)
         snprintf(msg, msg_len, "The field '%s' has the value %g at cell (%zu, %zu): %s.",
-                 gr_rain_runoff_field_label(f), v, c % nx, c / nx, rule);
+                 gr_rain_runoff_field_label(f), v, c / comps % nx, c / comps / nx, rule);
       else
         snprintf(msg, msg_len,
                  "The field '%s' has the value %g at index %zu (row-major, x fastest): %s.",
@@ -315,6 +358,10 @@ static gr_status gr_rain_runoff_clear_flow(gr_rain_runoff *s) {
   }
   if (st == GR_OK)
     st = gr_rain_runoff_fill(s, s->k, 1.0f, nx * ny * sizeof(float));
+  if (st == GR_OK)
+    st = gr_rain_runoff_fill(s, s->qu, 0.0f, nx * ny * sizeof(float));
+  if (st == GR_OK)
+    st = gr_rain_runoff_fill(s, s->qv, 0.0f, nx * ny * sizeof(float));
   return st;
 }
 
@@ -382,7 +429,9 @@ static gr_status gr_rain_runoff_reduce(gr_rain_runoff *s, double sums[GR_RAIN_RU
 
 /* The piece contract (graupel.h, rain_runoff.h): which sides have a
  * neighbour, and so a ring of GR_RAIN_RUNOFF_GHOST cells. */
-static gr_status gr_rain_runoff_piece(const gr_grid *g, int ring[4], char *msg, size_t len) {
+static gr_status gr_rain_runoff_piece(const gr_grid *g, gr_flow_model model, int ring[4], char *msg,
+                                      size_t len) {
+  const int G = model == GR_FLOW_SHALLOW_WATER ? GR_RAIN_RUNOFF_GHOST_SW : GR_RAIN_RUNOFF_GHOST;
   long long gnx = g->global_nx > 0 ? g->global_nx : g->nx;
   long long gny = g->global_ny > 0 ? g->global_ny : g->ny;
   int whole_x = g->global_nx <= 0, whole_y = g->global_ny <= 0;
@@ -402,27 +451,26 @@ static gr_status gr_rain_runoff_piece(const gr_grid *g, int ring[4], char *msg, 
     return GR_ERR_INVALID_ARGUMENT;
   }
   if (!whole_x) {
-    ring[0] = g->i0 > 0 ? GR_RAIN_RUNOFF_GHOST : 0;
-    ring[1] = (long long)g->i0 + g->nx < gnx ? GR_RAIN_RUNOFF_GHOST : 0;
+    ring[0] = g->i0 > 0 ? G : 0;
+    ring[1] = (long long)g->i0 + g->nx < gnx ? G : 0;
   }
   if (!whole_y) {
-    ring[2] = g->j0 > 0 ? GR_RAIN_RUNOFF_GHOST : 0;
-    ring[3] = (long long)g->j0 + g->ny < gny ? GR_RAIN_RUNOFF_GHOST : 0;
+    ring[2] = g->j0 > 0 ? G : 0;
+    ring[3] = (long long)g->j0 + g->ny < gny ? G : 0;
   }
   int any = ring[0] || ring[1] || ring[2] || ring[3];
-  if (any && g->ghost != GR_RAIN_RUNOFF_GHOST) {
+  if (any && g->ghost != G) {
     snprintf(msg, len,
              "Invalid grid: a rain runoff piece with neighbours needs a ghost ring of %d points "
-             "(got ghost = %d); set grid.ghost to %d.",
-             GR_RAIN_RUNOFF_GHOST, g->ghost, GR_RAIN_RUNOFF_GHOST);
+             "for FlowModel %d (got ghost = %d); set grid.ghost to %d.",
+             G, (int)model, g->ghost, G);
     return GR_ERR_INVALID_ARGUMENT;
   }
-  if (((ring[0] || ring[1]) && g->nx < GR_RAIN_RUNOFF_GHOST) ||
-      ((ring[2] || ring[3]) && g->ny < GR_RAIN_RUNOFF_GHOST)) {
+  if (((ring[0] || ring[1]) && g->nx < G) || ((ring[2] || ring[3]) && g->ny < G)) {
     snprintf(msg, len,
              "Invalid grid: a rain runoff piece of %d x %d points is narrower than its ghost ring "
              "of %d toward a neighbour; split the domain into fewer pieces.",
-             g->nx, g->ny, GR_RAIN_RUNOFF_GHOST);
+             g->nx, g->ny, G);
     return GR_ERR_INVALID_ARGUMENT;
   }
   return GR_OK;
@@ -440,7 +488,7 @@ gr_status gr_rain_runoff_create(gr_context *ctx, const gr_grid *grid,
   if (gr_rain_runoff_params_validate(p, msg, sizeof(msg)) != GR_OK)
     return gr_set_error(ctx, GR_ERR_INVALID_ARGUMENT, "%s", msg);
   int ring[4];
-  if (gr_rain_runoff_piece(grid, ring, msg, sizeof(msg)) != GR_OK)
+  if (gr_rain_runoff_piece(grid, p->flow_model, ring, msg, sizeof(msg)) != GR_OK)
     return gr_set_error(ctx, GR_ERR_INVALID_ARGUMENT, "%s", msg);
 
   size_t nx = (size_t)grid->nx + (size_t)ring[0] + (size_t)ring[1];
@@ -451,13 +499,15 @@ gr_status gr_rain_runoff_create(gr_context *ctx, const gr_grid *grid,
                         "address at most about 2.1e9 faces; split the domain or coarsen it.",
                         nx, ny);
   /* The state that is always there: depth, elevation, limiter, infiltrated
-   * and outflow with their compensations (8 per cell) and two sets of face
-   * arrays. Refuse before allocating when the device cannot hold it. */
+   * and outflow with their compensations, the shallow-water discharges and
+   * stage (14 per cell) and two sets of face arrays. Refuse before allocating when the device
+   * cannot hold it. */
   gr_device_info info;
   gr_status st = gr_context_device_info(ctx, &info);
   if (st != GR_OK)
     return st;
-  double need = 4.0 * (8.0 * (double)cells + 2.0 * ((double)(nx + 1) * ny + (double)nx * (ny + 1)));
+  double need =
+      4.0 * (14.0 * (double)cells + 2.0 * ((double)(nx + 1) * ny + (double)nx * (ny + 1)));
   if (need > (double)info.global_mem_bytes)
     return gr_set_error(ctx, GR_ERR_TOO_LARGE,
                         "The rain runoff state of a %zu x %zu grid needs %.1f MiB but the device "
@@ -487,7 +537,14 @@ gr_status gr_rain_runoff_create(gr_context *ctx, const gr_grid *grid,
     st = gr_kernel_create(ctx, prog, "rain_runoff_reduce", &s->reduce);
   if (st == GR_OK)
     st = gr_kernel_create(ctx, prog, "rain_runoff_derive", &s->derive);
-  cl_mem *per_cell[] = {&s->h, &s->h_c, &s->b, &s->k, &s->inf, &s->inf_c, &s->out, &s->out_c};
+  if (st == GR_OK)
+    st = gr_kernel_create(ctx, prog, "rain_runoff_sw_stage1", &s->sw_stage[0]);
+  if (st == GR_OK)
+    st = gr_kernel_create(ctx, prog, "rain_runoff_sw_stage2", &s->sw_stage[1]);
+  if (st == GR_OK)
+    st = gr_kernel_create(ctx, prog, "rain_runoff_sw_speed", &s->sw_speed);
+  cl_mem *per_cell[] = {&s->h,     &s->h_c, &s->b,  &s->k,  &s->inf, &s->inf_c, &s->out,
+                        &s->out_c, &s->qu,  &s->qv, &s->h1, &s->qu1, &s->qv1,   &s->dh1};
   for (size_t i = 0; st == GR_OK && i < sizeof(per_cell) / sizeof(per_cell[0]); ++i)
     st = gr_buffer_create(ctx, CL_MEM_READ_WRITE, bytes, NULL, per_cell[i]);
   for (int a = 0; a < 2 && st == GR_OK; ++a) {
@@ -502,8 +559,11 @@ gr_status gr_rain_runoff_create(gr_context *ctx, const gr_grid *grid,
   if (st == GR_OK)
     st = gr_reduction_init(ctx, s->reduce, cells, GR_RAIN_RUNOFF_SUMS, GR_RAIN_RUNOFF_MAXES,
                            &s->ledger);
+  if (st == GR_OK)
+    st = gr_reduction_init(ctx, s->sw_speed, cells, 0, 2, &s->speed);
   /* Dry, flat ground; nothing infiltrated or gone. */
-  cl_mem *zeroed[] = {&s->h, &s->h_c, &s->b, &s->inf, &s->inf_c, &s->out, &s->out_c, &s->dummy};
+  cl_mem *zeroed[] = {&s->h,     &s->h_c, &s->b,   &s->inf, &s->inf_c, &s->out,
+                      &s->out_c, &s->h1,  &s->qu1, &s->qv1, &s->dh1,   &s->dummy};
   for (size_t i = 0; st == GR_OK && i < sizeof(zeroed) / sizeof(zeroed[0]); ++i)
     st =
         gr_rain_runoff_fill(s, *zeroed[i], 0.0f, *zeroed[i] == s->dummy ? sizeof(cl_float) : bytes);
@@ -522,16 +582,19 @@ gr_status gr_rain_runoff_create(gr_context *ctx, const gr_grid *grid,
 void gr_rain_runoff_destroy(gr_rain_runoff *s) {
   if (!s)
     return;
-  cl_kernel kernels[] = {s->flux, s->limit, s->update, s->reduce, s->derive};
+  cl_kernel kernels[] = {s->flux,   s->limit,       s->update,      s->reduce,
+                         s->derive, s->sw_stage[0], s->sw_stage[1], s->sw_speed};
   for (size_t i = 0; i < sizeof(kernels) / sizeof(kernels[0]); ++i)
     if (kernels[i])
       clReleaseKernel(kernels[i]);
-  cl_mem *bufs[] = {&s->h,     &s->h_c,  &s->b,    &s->qx[0],   &s->qy[0], &s->qx[1],
-                    &s->qy[1], &s->k,    &s->inf,  &s->inf_c,   &s->out,   &s->out_c,
-                    &s->h0,    &s->rain, &s->perm, &s->scratch, &s->dummy};
+  cl_mem *bufs[] = {&s->h,    &s->h_c,     &s->b,     &s->qx[0], &s->qy[0], &s->qx[1], &s->qy[1],
+                    &s->k,    &s->inf,     &s->inf_c, &s->out,   &s->out_c, &s->h0,    &s->rain,
+                    &s->perm, &s->scratch, &s->dummy, &s->qu,    &s->qv,    &s->h1,    &s->qu1,
+                    &s->qv1,  &s->qu0,     &s->qv0,   &s->dh1};
   for (size_t i = 0; i < sizeof(bufs) / sizeof(bufs[0]); ++i)
     gr_buffer_release(bufs[i]);
   gr_reduction_release(&s->ledger);
+  gr_reduction_release(&s->speed);
   gr_context_release(s->ctx);
   free(s);
 }
@@ -543,6 +606,19 @@ gr_status gr_rain_runoff_set_params(gr_rain_runoff *s, const gr_rain_runoff_para
                         "gr_rain_runoff_set_params needs a simulation.");
   if (gr_rain_runoff_params_validate(p, msg, sizeof(msg)) != GR_OK)
     return GR_RAIN_RUNOFF_KEEP_ERROR(s, gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT, "%s", msg));
+  if (p->flow_model != s->params.flow_model) {
+    /* The models keep their discharges in different places: the water
+     * stays and starts from rest. A piece's ring width is its model's. */
+    if (gr_rain_runoff_has_ring(s))
+      return GR_RAIN_RUNOFF_KEEP_ERROR(
+          s, gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
+                          "A rain runoff piece with neighbours cannot change its FlowModel (from "
+                          "%d to %d): its ghost ring is the model's; create the pieces anew.",
+                          (int)s->params.flow_model, (int)p->flow_model));
+    gr_status st = gr_rain_runoff_clear_flow(s);
+    if (st != GR_OK)
+      return GR_RAIN_RUNOFF_KEEP_ERROR(s, st);
+  }
   s->params = *p;
   s->args_set = 0;
   return GR_OK;
@@ -559,14 +635,79 @@ static gr_status gr_rain_runoff_upload(gr_rain_runoff *s, cl_mem *buf, const flo
 static gr_status gr_rain_runoff_set_field_impl(gr_rain_runoff *s, gr_field f, const float *host) {
   char msg[320];
   size_t cells = gr_rain_runoff_cells(s);
-  if (gr_rain_runoff_field_check(f, host, cells, (size_t)s->nxl, 1, msg, sizeof(msg)) != GR_OK)
+  size_t values = f == GR_FIELD_VELOCITY ? 3 * cells : cells;
+  if (gr_rain_runoff_field_check(f, host, values, (size_t)s->nxl, 1, msg, sizeof(msg)) != GR_OK)
     return gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT, "%s", msg);
+  if (f == GR_FIELD_VELOCITY && s->params.flow_model != GR_FLOW_SHALLOW_WATER)
+    return gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
+                        "The field 'velocity' is an input of FlowModel 0 (shallow water) only, and "
+                        "this simulation runs FlowModel %d (local inertial), which starts from "
+                        "rest: leave it out, or take FlowModel 0.",
+                        (int)s->params.flow_model);
+  if (f == GR_FIELD_WATER_SURFACE) {
+    /* The depth under the surface, as WATER_DEPTH sets it. */
+    float *d = malloc(cells * sizeof(float));
+    if (!d)
+      return gr_set_error(s->ctx, GR_ERR_OUT_OF_MEMORY, "Out of host memory.");
+    gr_status st = gr_buffer_read(s->ctx, s->b, 0, cells * sizeof(cl_float), d);
+    for (size_t c = 0; st == GR_OK && c < cells; ++c) {
+      float depth = host[c] - d[c];
+      d[c] = depth > 0.0f ? depth : 0.0f;
+    }
+    if (st == GR_OK)
+      st = gr_rain_runoff_set_field_impl(s, GR_FIELD_WATER_DEPTH, d);
+    free(d);
+    return st;
+  }
+  if (f == GR_FIELD_VELOCITY) {
+    /* The discharges h (u, v) of the water there now; they are also the
+     * initial ones that reset returns to. */
+    float *q = malloc(3 * cells * sizeof(float));
+    if (!q)
+      return gr_set_error(s->ctx, GR_ERR_OUT_OF_MEMORY, "Out of host memory.");
+    float *qx = q + cells, *qy = q + 2 * cells;
+    gr_status st = gr_buffer_read(s->ctx, s->h, 0, cells * sizeof(cl_float), q);
+    for (size_t c = 0; st == GR_OK && c < cells; ++c) {
+      qx[c] = q[c] * host[3 * c];
+      qy[c] = q[c] * host[3 * c + 1];
+    }
+    if (st == GR_OK)
+      st = gr_rain_runoff_upload(s, &s->qu0, qx);
+    if (st == GR_OK)
+      st = gr_rain_runoff_upload(s, &s->qv0, qy);
+    if (st == GR_OK)
+      st = gr_buffer_write(s->ctx, s->qu, 0, cells * sizeof(cl_float), qx);
+    if (st == GR_OK)
+      st = gr_buffer_write(s->ctx, s->qv, 0, cells * sizeof(cl_float), qy);
+    free(q);
+    return st;
+  }
   gr_status st = GR_OK;
   s->args_set = 0; /* a field allocated now is bound at the next step */
   switch (f) {
-  case GR_FIELD_ELEVATION:
+  case GR_FIELD_ELEVATION: {
     st = gr_buffer_write(s->ctx, s->b, 0, cells * sizeof(cl_float), host);
+    double worst = 0.0;
+    const int nx = s->nxl, ny = s->nyl;
+    for (int j = 0; j < ny; ++j)
+      for (int i = 0; i < nx; ++i) {
+        const float *z = host + (size_t)j * nx + i;
+        double sx = 0.0, sy = 0.0;
+        if (i > 0)
+          sx = fabs((double)z[0] - z[-1]);
+        if (i < nx - 1)
+          sx = fmax(sx, fabs((double)z[1] - z[0]));
+        if (j > 0)
+          sy = fabs((double)z[0] - z[-nx]);
+        if (j < ny - 1)
+          sy = fmax(sy, fabs((double)z[nx] - z[0]));
+        double rate = sx / (s->grid.dx * s->grid.dx) + sy / (s->grid.dy * s->grid.dy);
+        worst = rate > worst ? rate : worst;
+      }
+    if (st == GR_OK)
+      s->slope_rate = GR_GRAVITY * worst;
     break;
+  }
   case GR_FIELD_PERMEABILITY:
     st = gr_rain_runoff_upload(s, &s->perm, host);
     if (st == GR_OK)
@@ -578,6 +719,9 @@ static gr_status gr_rain_runoff_set_field_impl(gr_rain_runoff *s, gr_field f, co
     if (st == GR_OK) {
       s->has_rain = 1;
       s->rain_field_sum = sum;
+      s->rain_field_max = 0.0;
+      for (size_t c = 0; c < cells; ++c)
+        s->rain_field_max = host[c] > s->rain_field_max ? host[c] : s->rain_field_max;
     }
     break;
   }
@@ -594,6 +738,9 @@ static gr_status gr_rain_runoff_set_field_impl(gr_rain_runoff *s, gr_field f, co
       st = gr_rain_runoff_fill(s, s->h_c, 0.0f, cells * sizeof(cl_float));
     if (st == GR_OK)
       st = gr_rain_runoff_clear_flow(s);
+    /* No discharge: the initial velocity, if any, was of other water. */
+    gr_buffer_release(&s->qu0);
+    gr_buffer_release(&s->qv0);
     if (st == GR_OK) {
       s->initial_sum = sum;
       s->initial_volume += (sum - now[0]) * s->grid.dx * s->grid.dy;
@@ -662,8 +809,8 @@ static gr_status gr_rain_runoff_exchange(gr_rain_runoff *s, long long step) {
 static size_t gr_rain_runoff_strip_cells(const gr_rain_runoff *s, int side, size_t *w, size_t *h) {
   if (side < 0 || side > 3 || !s->ring[side])
     return 0;
-  *w = side < 2 ? (size_t)GR_RAIN_RUNOFF_GHOST : (size_t)s->nxl;
-  *h = side < 2 ? (size_t)s->nyl : (size_t)GR_RAIN_RUNOFF_GHOST;
+  *w = side < 2 ? (size_t)s->ring[side] : (size_t)s->nxl;
+  *h = side < 2 ? (size_t)s->nyl : (size_t)s->ring[side];
   return *w * *h;
 }
 
@@ -693,7 +840,7 @@ static gr_status gr_rain_runoff_halo_copy(gr_rain_runoff *s, int side, void *hos
                         "The halo buffer has %zu bytes but side %d's strip has %zu: size it with "
                         "gr_rain_runoff_halo_size.",
                         bytes, side, need);
-  const size_t g = GR_RAIN_RUNOFF_GHOST, nxl = (size_t)s->nxl, nyl = (size_t)s->nyl;
+  const size_t g = (size_t)s->ring[side], nxl = (size_t)s->nxl, nyl = (size_t)s->nyl;
   size_t x0 = 0, y0 = 0;
   switch (side) {
   case 0:
@@ -712,8 +859,11 @@ static gr_status gr_rain_runoff_halo_copy(gr_rain_runoff *s, int side, void *hos
   /* Per cell: depth, limiter, its west x-face and its south y-face (the
    * faces are numbered from the cell's corner: x-face rows are nxl + 1
    * wide, y-faces like cells). */
-  const cl_mem bufs[GR_RAIN_RUNOFF_HALO_ARRAYS] = {s->h, s->k, s->qx[s->cur], s->qy[s->cur]};
-  const size_t pitch[GR_RAIN_RUNOFF_HALO_ARRAYS] = {nxl, nxl, nxl + 1, nxl};
+  int sw = s->params.flow_model == GR_FLOW_SHALLOW_WATER;
+  const cl_mem li_bufs[GR_RAIN_RUNOFF_HALO_ARRAYS] = {s->h, s->k, s->qx[s->cur], s->qy[s->cur]};
+  const cl_mem sw_bufs[GR_RAIN_RUNOFF_HALO_ARRAYS] = {s->h, s->qu, s->qv, s->h_c};
+  const cl_mem *bufs = sw ? sw_bufs : li_bufs;
+  const size_t pitch[GR_RAIN_RUNOFF_HALO_ARRAYS] = {nxl, nxl, sw ? nxl : nxl + 1, nxl};
   unsigned char *at = host;
   gr_status st = GR_OK;
   for (int a = 0; st == GR_OK && a < GR_RAIN_RUNOFF_HALO_ARRAYS; ++a) {
@@ -864,6 +1014,43 @@ static gr_status gr_rain_runoff_bind(gr_rain_runoff *s, cl_float dt) {
       {"h_comp", m, &s->h_c},  {"infiltrated", m, &s->inf},    {"infiltrated_comp", m, &s->inf_c},
       {"outflow", m, &s->out}, {"outflow_comp", m, &s->out_c},
   };
+  if (p->flow_model == GR_FLOW_SHALLOW_WATER) {
+    const gr_rain_runoff_arg sw[] = {
+        {"h", m, &s->h},
+        {"qu", m, &s->qu},
+        {"qv", m, &s->qv},
+        {"h1", m, &s->h1},
+        {"h_comp", m, &s->h_c},
+        {"dh1", m, &s->dh1},
+        {"qu1", m, &s->qu1},
+        {"qv1", m, &s->qv1},
+        {"b", m, &s->b},
+        {"rain", m, &rain},
+        {"perm", m, &perm},
+        {"infiltrated", m, &s->inf},
+        {"infiltrated_comp", m, &s->inf_c},
+        {"outflow", m, &s->out},
+        {"outflow_comp", m, &s->out_c},
+        {"nx", sizeof(nx), &nx},
+        {"ny", sizeof(ny), &ny},
+        {"dt", sizeof(dt), &dt},
+        {"inv_dx", sizeof(inv_dx), &inv_dx},
+        {"inv_dy", sizeof(inv_dy), &inv_dy},
+        {"g", sizeof(g), &g},
+        {"n2", sizeof(n2), &n2},
+        {"use_rain", sizeof(use_rain), &use_rain},
+        {"rain_uniform", sizeof(rain_uniform), &rain_uniform},
+        {"use_perm", sizeof(use_perm), &use_perm},
+        {"perm_uniform", sizeof(perm_uniform), &perm_uniform},
+        {"closed", sizeof(closed), &closed},
+    };
+    gr_status st = GR_RAIN_RUNOFF_ARGS(s, s->sw_stage[0], sw);
+    if (st == GR_OK)
+      st = GR_RAIN_RUNOFF_ARGS(s, s->sw_stage[1], sw);
+    s->args_set = st == GR_OK;
+    s->args_dt = dt;
+    return st;
+  }
   cl_kernel kernels[] = {s->flux, s->limit, s->update};
   gr_status st = GR_OK;
   for (int i = 0; st == GR_OK && i < 3; ++i)
@@ -887,7 +1074,19 @@ static gr_status gr_rain_runoff_enqueue(gr_rain_runoff *s, double dt, int nsteps
   const size_t m = sizeof(cl_mem);
   gr_status st = gr_rain_runoff_bind(s, dtf);
   int done = 0, exchange = s->halo_exchange && gr_rain_runoff_has_ring(s);
-  while (st == GR_OK && done < nsteps && !*stop) {
+  int sw = s->params.flow_model == GR_FLOW_SHALLOW_WATER;
+  while (sw && st == GR_OK && done < nsteps && !*stop) {
+    /* Heun's two stages. */
+    for (int stage = 0; st == GR_OK && stage < 2; ++stage)
+      st = gr_enqueue_2d(s->ctx, s->sw_stage[stage], 0, 0, (size_t)s->nxl, (size_t)s->nyl, NULL);
+    if (st == GR_OK)
+      ++done;
+    if (st == GR_OK && exchange)
+      st = gr_rain_runoff_exchange(s, s->steps + done);
+    if (st == GR_OK && w)
+      st = gr_rain_runoff_watch_step(s, w, s->time + dt * (double)done, stop);
+  }
+  while (!sw && st == GR_OK && done < nsteps && !*stop) {
     int old = s->cur, now = 1 - s->cur;
     const gr_rain_runoff_arg flux[] = {
         {"qx_old", m, &s->qx[old]},
@@ -959,7 +1158,79 @@ gr_status gr_rain_runoff_step(gr_rain_runoff *s, double dt, int nsteps) {
   return GR_RAIN_RUNOFF_KEEP_ERROR(s, gr_rain_runoff_step_impl(s, dt, nsteps));
 }
 
+/* Shallow water: the Courant condition of the explicit finite volumes on the
+ * fastest waves of any cell, |u| + sqrt(g h) along x and |v| + sqrt(g h)
+ * along y:  dt max(ax / dx + ay / dy) <= cfl / 2,
+ * the half keeping the hydrostatic reconstruction's depths positive with the
+ * second-order reconstruction (Audusse et al. 2004). */
+static gr_status gr_rain_runoff_sw_stable_dt(gr_rain_runoff *s, double *dt) {
+  cl_int n = (cl_int)gr_rain_runoff_cells(s);
+  cl_int row = s->nxl, own_x0 = s->ring[0], own_x1 = s->nxl - s->ring[1];
+  cl_int own_y0 = s->ring[2], own_y1 = s->nyl - s->ring[3];
+  cl_int masked = gr_rain_runoff_has_ring(s);
+  cl_float g = (cl_float)GR_GRAVITY;
+  cl_float inv_dx = (cl_float)(1.0 / s->grid.dx), inv_dy = (cl_float)(1.0 / s->grid.dy);
+  const gr_rain_runoff_arg args[] = {
+      {"inv_dx", sizeof(inv_dx), &inv_dx},
+      {"inv_dy", sizeof(inv_dy), &inv_dy},
+      {"h", sizeof(cl_mem), &s->h},
+      {"qu", sizeof(cl_mem), &s->qu},
+      {"qv", sizeof(cl_mem), &s->qv},
+      {"n", sizeof(n), &n},
+      {"row", sizeof(row), &row},
+      {"own_x0", sizeof(own_x0), &own_x0},
+      {"own_x1", sizeof(own_x1), &own_x1},
+      {"own_y0", sizeof(own_y0), &own_y0},
+      {"own_y1", sizeof(own_y1), &own_y1},
+      {"masked", sizeof(masked), &masked},
+      {"g", sizeof(g), &g},
+  };
+  /* The deepest cell, the fastest rate, the heaviest rain (m/s), the
+   * steepest bed (slope_rate). */
+  double maxes[4] = {0.0, 0.0, s->has_rain ? s->rain_field_max : s->params.rain_rate,
+                     s->slope_rate};
+  gr_status st = GR_RAIN_RUNOFF_ARGS(s, s->sw_speed, args);
+  if (st == GR_OK)
+    st = gr_reduction_run(s->ctx, &s->speed, s->sw_speed, NULL, maxes);
+  if (st == GR_OK && s->allreduce)
+    st = gr_rain_runoff_allreduce(s, maxes, 4, GR_REDUCE_MAX);
+  if (st != GR_OK)
+    return st;
+  double rate = maxes[1];
+  double stable = rate > 0.0 ? 0.5 * s->params.cfl / rate : s->params.max_dt;
+  /* Rain on dry (or still) ground: the step must not outrun the waves of
+   * the water it adds, r dt deep: dt sqrt(g r dt) (1/dx + 1/dy) <= cfl / 2.
+   * Without it a dry grid's first step is MaxTimeStep long. */
+  double r = maxes[2];
+  if (r > 0.0) {
+    double inv = 1.0 / s->grid.dx + 1.0 / s->grid.dy;
+    double wet = pow(0.5 * s->params.cfl / (inv * sqrt(GR_GRAVITY * r)), 2.0 / 3.0);
+    stable = wet < stable ? wet : stable;
+  }
+  /* Frictionless water on a slope gains g S dt of speed within the step,
+   * before the second stage moves it: a film on a steep bed that starts
+   * still (which the speeds above cannot see) would cross cells in that
+   * stage. So, with ManningN 0, also
+   *   dt^2 g max(|db/dx| / dx + |db/dy| / dy) <= cfl / 8,
+   * a quarter of the budget above (both together: 1.25 cfl / 2 at worst,
+   * below the 1/2 that keeps depths positive), each bound a function of
+   * one maximum, so that pieces taking the smallest of their steps take
+   * the whole grid's. With friction, taken in each stage, a film gains no
+   * more than its Manning speed, and no bound is needed. (sw_thin_films
+   * shows both: frictionless rain on slopes up to 3, with MaxTimeStep 1 s,
+   * emptied cells beyond their water without it.) */
+  double accel = maxes[3];
+  if (accel > 0.0 && s->params.manning_n == 0.0 && (maxes[0] > 0.0 || r > 0.0)) {
+    double steep = sqrt(0.125 * s->params.cfl / accel);
+    stable = steep < stable ? steep : stable;
+  }
+  *dt = stable < s->params.max_dt ? stable : s->params.max_dt;
+  return GR_OK;
+}
+
 static gr_status gr_rain_runoff_stable_dt_impl(gr_rain_runoff *s, double *dt) {
+  if (s->params.flow_model == GR_FLOW_SHALLOW_WATER)
+    return gr_rain_runoff_sw_stable_dt(s, dt);
   double sums[GR_RAIN_RUNOFF_SUMS], hmax = 0.0;
   gr_status st = gr_rain_runoff_reduce(s, sums, &hmax);
   /* The deepest cell of the whole domain: every piece takes the same step. */
@@ -1095,11 +1366,14 @@ static gr_status gr_rain_runoff_derive(gr_rain_runoff *s, cl_int what, size_t co
   if (!s->scratch)
     st = gr_buffer_create(s->ctx, CL_MEM_READ_WRITE, 3 * cells * sizeof(cl_float), NULL,
                           &s->scratch);
-  cl_int nx = s->nxl, ny = s->nyl;
+  cl_int nx = s->nxl, ny = s->nyl, sw = s->params.flow_model == GR_FLOW_SHALLOW_WATER;
   const size_t m = sizeof(cl_mem);
   const gr_rain_runoff_arg args[] = {
       {"h", m, &s->h},
       {"b", m, &s->b},
+      {"qu", m, &s->qu},
+      {"qv", m, &s->qv},
+      {"sw", sizeof(sw), &sw},
       {"qx", m, &s->qx[s->cur]},
       {"qy", m, &s->qy[s->cur]},
       {"limit", m, &s->k},
@@ -1215,6 +1489,11 @@ static gr_status gr_rain_runoff_reset_impl(gr_rain_runoff *s) {
     st = gr_rain_runoff_fill(s, zeroed[i], 0.0f, bytes);
   if (st == GR_OK)
     st = gr_rain_runoff_clear_flow(s);
+  for (int a = 0; st == GR_OK && s->qu0 && a < 2; ++a)
+    st = gr_cl_check(s->ctx,
+                     clEnqueueCopyBuffer(gr_context_queue(s->ctx), a ? s->qv0 : s->qu0,
+                                         a ? s->qv : s->qu, 0, 0, bytes, 0, NULL, NULL),
+                     "Copying the initial discharges");
   if (st != GR_OK)
     return st;
   s->time = 0.0;
@@ -1266,8 +1545,8 @@ gr_status gr_rain_runoff_state_size(const gr_rain_runoff *s, size_t *bytes) {
 
 /* The state's device arrays in checkpoint order, with their sizes. */
 static int gr_rain_runoff_state_arrays(gr_rain_runoff *s, int cur, cl_mem *bufs, size_t *sizes) {
-  cl_mem cells[GR_RAIN_RUNOFF_STATE_CELL_ARRAYS] = {s->h,     s->h_c, s->k,    s->inf,
-                                                    s->inf_c, s->out, s->out_c};
+  cl_mem cells[GR_RAIN_RUNOFF_STATE_CELL_ARRAYS] = {s->h,   s->h_c,   s->k,  s->inf, s->inf_c,
+                                                    s->out, s->out_c, s->qu, s->qv};
   int n = 0;
   for (int i = 0; i < GR_RAIN_RUNOFF_STATE_CELL_ARRAYS; ++i, ++n) {
     bufs[n] = cells[i];

@@ -54,6 +54,42 @@
  * m) and the inputs (PERMEABILITY and RAIN_RATE as uniform fields of the
  * parameters when none was set).
  */
+/*
+ * Shallow-water model (FlowModel 0, the default): the same steps 1 and 2
+ * (rain, infiltration, as above), then the 2-D shallow-water equations with
+ * advection for the depth h and the discharges (qu, qv) = h (u, v), cell-
+ * centred, by conservative finite volumes:
+ *  - fluxes: HLL on the hydrostatic reconstruction of Audusse, Bouchut,
+ *    Bristeau, Klein & Perthame (2004): at each face the depths are cut to
+ *    the higher of the two sides' beds, and the pressure of what was cut
+ *    goes to the cell it came from, which keeps a lake at rest exactly at
+ *    rest (well-balanced) and no depth negative at wet/dry fronts (at a
+ *    Courant number of at most 1/2, which the stable step keeps);
+ *  - second order in space: minmod-limited slopes of the depth, the water
+ *    surface and the velocities (the surface as bed differences plus depth
+ *    differences, so that large elevations lose nothing to rounding), with
+ *    the matching centred bed source term;
+ *  - second order in time: Heun's method (SSP-RK2), two launches a step;
+ *  - Manning friction in each stage, implicit in the new discharge:
+ *    |q'| (1 + g dt n^2 |q'| / h^(7/3)) = |q| (solved exactly, as the local
+ *    inertial model does), so thin films on steep slopes stay at their
+ *    Manning velocity whatever the step; ManningN = 0 is frictionless.
+ * Velocities are desingularised below 1e-5 m of depth (Kurganov & Petrova
+ * 2007). Edges: a wall mirrors the edge cell; an open edge leads into a dry
+ * cell at the edge's bed and passes outflow only. The ledger, determinism
+ * (gathers: each cell computes its four faces itself, and the cell that
+ * shares a face computes the same floats from the same inputs), the
+ * checkpoints and the pieces work as for the local inertial model; the
+ * stable step is cfl / 2 / max((|u| + sqrt(g h)) / dx + (|v| + sqrt(g h))
+ * / dy) over the cells (one reduction, as the local inertial model's), and
+ * a piece's ring is GR_RAIN_RUNOFF_GHOST_SW cells (each stage reads two
+ * cells away: one exchange per step covers both stages; the halo strip holds
+ * per cell the depth, qu, qv and the depth's Kahan compensation).
+ * VELOCITY (3 components, z ignored; after WATER_DEPTH, which clears the
+ * flow) sets the initial discharges h (u, v), and WATER_SURFACE (after
+ * ELEVATION) sets the depth max(0, surface - elevation) as WATER_DEPTH
+ * does (for either model); VELOCITY is an input of this model only.
+ */
 #ifndef GRAUPEL_RAIN_RUNOFF_H
 #define GRAUPEL_RAIN_RUNOFF_H
 
@@ -62,6 +98,16 @@
 #ifdef __cplusplus
 extern "C" {
 #endif
+
+/** The flow model (row FlowModel). */
+typedef enum gr_flow_model {
+  /** The 2-D shallow-water equations with advection (the default): see
+   *  "Shallow-water model" below. */
+  GR_FLOW_SHALLOW_WATER = 0,
+  /** The local inertial scheme described above (Bates et al. 2010), kept
+   *  bit for bit: cheaper per step, without advection. */
+  GR_FLOW_LOCAL_INERTIAL = 1
+} gr_flow_model;
 
 typedef enum gr_boundary {
   GR_BOUNDARY_OPEN = 0,  /**< water may leave through the grid's edge */
@@ -83,6 +129,10 @@ typedef struct gr_rain_runoff_params {
   double cfl;           /**< Courant number of the adaptive step (row CourantNumber) */
   double max_dt;        /**< longest step, s (row MaxTimeStep) */
   gr_boundary boundary; /**< row Boundary: 0 open, 1 closed */
+  /** row FlowModel: 0 shallow water (the default), 1 local inertial. The
+   *  local inertial model needs manning_n >= 0.005; shallow water allows 0
+   *  (frictionless). */
+  gr_flow_model flow_model;
 } gr_rain_runoff_params;
 
 /** The table's defaults. */
@@ -167,7 +217,8 @@ GR_API gr_status gr_rain_runoff_step(gr_rain_runoff *s, double dt, int nsteps);
  *   cfl * sqrt(theta) / (sqrt(g * max_depth) * sqrt(1/dx^2 + 1/dy^2)),
  * theta = 0.8 (for dx = dy: cfl * 0.632 * dx / sqrt(g h); Bates et al.'s
  * cfl * dx / sqrt(g h) is the 1-D limit and unstable in 2-D above cfl =
- * 0.63), capped at params.max_dt. Reads one reduction back.
+ * 0.63), capped at params.max_dt. Reads one reduction back. (The
+ * shallow-water model's: see "Shallow-water model" above.)
  */
 GR_API gr_status gr_rain_runoff_stable_dt(gr_rain_runoff *s, double *dt);
 
@@ -273,8 +324,12 @@ GR_API gr_status gr_rain_runoff_state_load(gr_rain_runoff *s, const void *host, 
  * @{
  */
 
-/** Ring width of a piece toward each neighbour, cells. */
+/** Ring width of a piece toward each neighbour, cells (local inertial). */
 #define GR_RAIN_RUNOFF_GHOST 3
+/** Ring width for the shallow-water model: its two stages read 2 cells away
+ *  each, so 4 cells make one exchange per step enough. A piece's model
+ *  cannot change (the ring would). */
+#define GR_RAIN_RUNOFF_GHOST_SW 4
 
 /** Sides of a piece, for the halo calls. */
 typedef enum gr_rain_runoff_side {
@@ -316,7 +371,7 @@ GR_API const char *gr_rain_runoff_last_error(const gr_rain_runoff *s);
 
 /**
  * The parameter table (RainRate mm/h, Permeability mm/h, ManningN,
- * MaxTimeStep s, CourantNumber, Boundary) that gr_rain_runoff_params_validate
+ * MaxTimeStep s, CourantNumber, Boundary, FlowModel) that gr_rain_runoff_params_validate
  * follows; *count gets the number of rows.
  */
 GR_API const gr_param_bound *gr_rain_runoff_param_bounds(int *count);
