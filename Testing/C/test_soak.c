@@ -213,6 +213,8 @@ static void random_rain_runoff_params(gr_rain_runoff_params *p) {
   p->cfl = uniform(0.3, 0.9);
   p->max_dt = uniform(0.05, 2.0);
   p->boundary = uniform(0.0, 1.0) < 0.5 ? GR_BOUNDARY_OPEN : GR_BOUNDARY_CLOSED;
+  /* Both flow models, switched between phases on the same water. */
+  p->flow_model = uniform(0.0, 1.0) < 0.5 ? GR_FLOW_SHALLOW_WATER : GR_FLOW_LOCAL_INERTIAL;
 }
 
 static void soak_rain_runoff(long n) {
