@@ -10,6 +10,7 @@
 set(GRAUPEL_CORES
   procedural_terrain
   rain_runoff
+  sky
   snow_accumulation
   snow_deformation
   terrain_analysis
