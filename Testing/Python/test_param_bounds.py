@@ -50,9 +50,12 @@ from paraview import servermanager  # noqa: E402
 from paraview.simple import LoadPlugin  # noqa: E402
 
 # The proxy of a core is named after it (rain_runoff -> RainRunoff, one name
-# through every layer), a source or a filter; CORES maps core -> (proxy group,
-# proxy name, VTK class) and is filled from the plugin below, so a new core
-# needs no line here.
+# through every layer), a source or a filter; a core behind several proxies
+# (sky: Lightning and CloudCover) names itself in each one's hint
+# <GraupelCore name="sky"/>, and each of its rows is checked on every one of
+# them that has the property (at least one must). CORES maps core -> list of
+# (proxy group, proxy name, VTK class) and is filled from the plugin below,
+# so a new core needs no line here.
 CORES = {}
 INT_MIN, INT_MAX = -2 ** 31, 2 ** 31 - 1
 
@@ -82,13 +85,28 @@ def fmt(row):
 CORE_ONLY = set()
 LoadPlugin(a.plugin, ns=globals())
 pxm = servermanager.ProxyManager()
+DECLARED = {}  # core -> [(group, name, class)] from <GraupelCore name=.../> hints
+for group in ("sources", "filters"):
+    it = pxm.GetProxyDefinitionManager().NewSingleGroupIterator(group)
+    it.GoToFirstItem()
+    while not it.IsDoneWithTraversal():
+        proto = pxm.GetPrototypeProxy(group, it.GetProxyName())
+        hints = proto.GetHints() if proto else None
+        declared = hints.FindNestedElementByName("GraupelCore") if hints else None
+        if declared is not None:
+            DECLARED.setdefault(declared.GetAttribute("name"), []).append(
+                (group, it.GetProxyName(), proto.GetVTKClassName()))
+        it.GoToNextItem()
 for core in tables:
     name = "".join(w.capitalize() for w in core.split("_"))
     for group in ("sources", "filters"):
         proto = pxm.GetPrototypeProxy(group, name)
         if proto is not None:
-            CORES[core] = (group, name, proto.GetVTKClassName())
+            CORES[core] = [(group, name, proto.GetVTKClassName())]
             break
+    if core not in CORES and core in DECLARED:
+        CORES[core] = DECLARED[core]
+        name = " or ".join(n for _, n, _ in DECLARED[core])
     if core in CORE_ONLY:
         T.check(core not in CORES, "the core %s has its proxy %s now: take it off CORE_ONLY"
                 % (core, name))
@@ -101,7 +119,7 @@ for core in tables:
 # value. ELEMENT maps (core, row) -> (property, value index); the README row
 # is the property's, its default cell the values in order.
 ELEMENT = {}
-for core, (group, name, _) in CORES.items():
+for core, (group, name, _) in ((c, x) for c, xs in CORES.items() for x in xs):
     proto = pxm.GetPrototypeProxy(group, name)
     it = proto.NewPropertyIterator()
     it.Begin()
@@ -114,8 +132,15 @@ for core, (group, name, _) in CORES.items():
         it.Next()
 
 
-def check_xml(core, row):
-    group, name, _ = CORES[core]
+def proxies_with(core, row):
+    """The core's proxies that have the row's property (or its element)."""
+    p = ELEMENT.get((core, row["property"]), (row["property"], 0))[0]
+    have = [x for x in CORES[core] if pxm.GetPrototypeProxy(x[0], x[1]).GetProperty(p) is not None]
+    return have if len(CORES[core]) > 1 else CORES[core]
+
+
+def check_xml(core, row, proxy):
+    group, name, _ = proxy
     proto = pxm.GetPrototypeProxy(group, name)
     p, index = ELEMENT.get((core, row["property"]), (row["property"], 0))
     prop = proto.GetProperty(p) if proto else None
@@ -171,12 +196,12 @@ def check_xml(core, row):
 
 
 # ---------------------------------------------------------- the VTK classes
-def check_class(core, row):
-    cls = getattr(graupel, CORES[core][2])
+def check_class(core, row, proxy):
+    cls = getattr(graupel, proxy[2])
     obj = cls()
     p = row["property"]
     get, set_ = getattr(obj, "Get" + p), getattr(obj, "Set" + p)
-    where = "%s.Set%s (table %s)" % (CORES[core][2], p, fmt(row))
+    where = "%s.Set%s (table %s)" % (proxy[2], p, fmt(row))
     T.check(same(float(get()), row["default"]), "%s: class default %r" % (where, get()))
     if isinstance(get(), bool) or (row["min"] <= INT_MIN and row["max"] >= INT_MAX):
         return  # a bool or a whole int: no value lies outside
@@ -235,11 +260,11 @@ def parse_range(cell):
 readme = readme_rows(a.readme)
 
 
-def check_readme(core, row):
+def check_readme(core, row, proxy):
     p, index = ELEMENT.get((core, row["property"]), (row["property"], -1))
-    found = readme.get((CORES[core][1], p), [])
+    found = readme.get((proxy[1], p), [])
     T.check(len(found) == 1, "README: one table row for `%s` in the section of %s (found %d)"
-            % (p, CORES[core][1], len(found)))
+            % (p, proxy[1], len(found)))
     if len(found) != 1:
         return
     default_cell, range_cell = found[0]
@@ -272,8 +297,12 @@ for core, rows in sorted(tables.items()):
         T.check(row["min"] <= row["default"] <= row["max"] and
                 not (row["min_open"] and row["default"] == row["min"]),
                 "%s.%s: the default %g lies in %s" % (core, row["property"], row["default"], fmt(row)))
-        check_xml(core, row)
-        check_class(core, row)
-        check_readme(core, row)
+        proxies = proxies_with(core, row)
+        T.check(len(proxies) > 0, "%s.%s: a proxy of the core has the property"
+                % (core, row["property"]))
+        for proxy in proxies:
+            check_xml(core, row, proxy)
+            check_class(core, row, proxy)
+            check_readme(core, row, proxy)
 
 T.finish()
