@@ -4,6 +4,7 @@
 #include "vtkDataArray.h"
 #include "vtkDataSet.h"
 #include "vtkDoubleArray.h"
+#include "vtkFieldData.h"
 #include "vtkFloatArray.h"
 #include "vtkImageData.h"
 #include "vtkInformation.h"
@@ -14,6 +15,7 @@
 #include "vtkPointData.h"
 #include "vtkPoints.h"
 #include "vtkPolyData.h"
+#include "vtkStreamingDemandDrivenPipeline.h"
 
 #include "graupel/sky.h"
 
@@ -28,6 +30,7 @@ vtkStandardNewMacro(vtkLightningSource);
 GRAUPEL_TABLE_SETTER(vtkLightningSource, ControlPoints, int, gr_sky_param_bounds)
 GRAUPEL_TABLE_SETTER(vtkLightningSource, Strands, int, gr_sky_param_bounds)
 GRAUPEL_TABLE_SETTER(vtkLightningSource, Jitter, double, gr_sky_param_bounds)
+GRAUPEL_TABLE_SETTER(vtkLightningSource, FlickerRate, double, gr_sky_param_bounds)
 
 vtkLightningSource::vtkLightningSource() {
   this->SetNumberOfInputPorts(1);
@@ -38,6 +41,7 @@ vtkLightningSource::vtkLightningSource() {
   this->Jitter = p.jitter;
   this->Seed = p.seed;
   this->Variant = p.variant;
+  this->FlickerRate = p.flicker_rate;
   std::copy(p.start, p.start + 3, this->Start);
   std::copy(p.end, p.end + 3, this->End);
 }
@@ -53,10 +57,33 @@ int vtkLightningSource::FillOutputPortInformation(int, vtkInformation *info) {
   return 1;
 }
 
+int vtkLightningSource::RequestInformation(vtkInformation *, vtkInformationVector **,
+                                           vtkInformationVector *outputVector) {
+  vtkInformation *outInfo = outputVector->GetInformationObject(0);
+  // A flickering bolt depends on time: the pipeline re-executes for a new
+  // time only when the source advertises times.
+  outInfo->Remove(vtkStreamingDemandDrivenPipeline::TIME_STEPS());
+  outInfo->Remove(vtkStreamingDemandDrivenPipeline::TIME_RANGE());
+  if (this->FlickerRate > 0.0) {
+    if (!(this->Duration >= 0.0) || !std::isfinite(this->Duration)) {
+      vtkErrorMacro("Lightning: Duration is " << this->Duration
+                                              << " s but must be finite and at least 0.");
+      return 0;
+    }
+    double range[2] = {0.0, this->Duration};
+    outInfo->Set(vtkStreamingDemandDrivenPipeline::TIME_RANGE(), range, 2);
+  }
+  return 1;
+}
+
 int vtkLightningSource::RequestData(vtkInformation *, vtkInformationVector **inputVector,
                                     vtkInformationVector *outputVector) {
-  vtkPolyData *output = vtkPolyData::GetData(outputVector, 0);
+  vtkInformation *outInfo = outputVector->GetInformationObject(0);
+  vtkPolyData *output = vtkPolyData::GetData(outInfo);
   output->Initialize();
+  const double t = outInfo->Has(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP())
+                       ? outInfo->Get(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP())
+                       : 0.0;
   gr_lightning_params p;
   gr_lightning_params_init(&p);
   p.control_points = this->ControlPoints;
@@ -64,6 +91,9 @@ int vtkLightningSource::RequestData(vtkInformation *, vtkInformationVector **inp
   p.jitter = this->Jitter;
   p.seed = this->Seed;
   p.variant = this->Variant;
+  p.flicker_rate = this->FlickerRate;
+  p.time = t;
+  const int shape = gr_lightning_shape(&p);
   std::copy(this->Start, this->Start + 3, p.start);
   std::copy(this->End, this->End + 3, p.end);
 
@@ -99,7 +129,7 @@ int vtkLightningSource::RequestData(vtkInformation *, vtkInformationVector **inp
       bounds[4] += range[0];
       bounds[5] += range[1];
     }
-    gr_lightning_start_over(this->Seed, this->Variant, bounds, p.end, p.start);
+    gr_lightning_start_over(this->Seed, shape, bounds, p.end, p.start);
   }
 
   char msg[256];
@@ -141,6 +171,11 @@ int vtkLightningSource::RequestData(vtkInformation *, vtkInformationVector **inp
   output->SetLines(lines);
   output->GetPointData()->AddArray(strand);
   output->GetPointData()->SetScalars(intensity);
+  vtkNew<vtkIntArray> shapeArray;
+  shapeArray->SetName("shape");
+  shapeArray->InsertNextValue(shape);
+  output->GetFieldData()->AddArray(shapeArray);
+  output->GetInformation()->Set(vtkDataObject::DATA_TIME_STEP(), t);
   return 1;
 }
 
@@ -151,6 +186,8 @@ void vtkLightningSource::PrintSelf(ostream &os, vtkIndent indent) {
   os << indent << "Jitter: " << this->Jitter << "\n";
   os << indent << "Seed: " << this->Seed << "\n";
   os << indent << "Variant: " << this->Variant << "\n";
+  os << indent << "FlickerRate: " << this->FlickerRate << "\n";
+  os << indent << "Duration: " << this->Duration << "\n";
   os << indent << "Start: " << this->Start[0] << " " << this->Start[1] << " " << this->Start[2]
      << "\n";
   os << indent << "End: " << this->End[0] << " " << this->End[1] << " " << this->End[2] << "\n";

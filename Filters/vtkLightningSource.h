@@ -5,13 +5,14 @@
  * A bolt from Start (in the cloud) to End (the strike): a main strand of
  * ControlPoints points, Strands branches grown from it, displaced sideways
  * by Jitter times the bolt's length; the model is in
- * kernels/include/graupel/sky.h. The bolt is a pure function of Seed and
- * Variant (the seed reshapes a visible bolt a few times: Variant numbers the
- * shapes): the same values give the same points bit for bit.
+ * kernels/include/graupel/sky.h. The bolt is a pure function of Seed, Variant
+ * and, with a FlickerRate, the time requested (the seed reshapes a visible
+ * bolt a few times: shape Variant + floor(t FlickerRate)): the same values
+ * give the same points bit for bit.
  *
  * With a terrain on the optional input (any vtkDataSet; an image whose
  * points lie flat with an `elevation` array is read as that surface), End
- * is a point of the terrain's surface chosen by a hash of Seed and Variant,
+ * is a point of the terrain's surface chosen by a hash of Seed and the shape,
  * and Start lies half the terrain's larger extent above its highest point;
  * Start and End are then not used.
  *
@@ -21,7 +22,7 @@
  * is a few hundred sequential points (sky.h says why), so this source has
  * no Device.
  *
- * ControlPoints, Strands, Jitter and Seed follow the sky core's parameter
+ * ControlPoints, Strands, Jitter, Seed and FlickerRate follow the sky core's parameter
  * table (gr_sky_param_bounds): the setters clamp to it, and a ControlPoints
  * below 2 (the table's open end) is refused with a sentence at the update.
  */
@@ -62,9 +63,28 @@ public:
   ///@}
 
   ///@{
-  /** Which reshape of the Seed's bolt (default 0). */
+  /** The first shape of the Seed's bolt (default 0). */
   vtkSetMacro(Variant, int);
   vtkGetMacro(Variant, int);
+  ///@}
+
+  ///@{
+  /**
+   * Reshapes per second (default 0: one shape at every time): at time t the
+   * bolt is shape Variant + floor(t FlickerRate).
+   */
+  virtual void SetFlickerRate(double value);
+  vtkGetMacro(FlickerRate, double);
+  ///@}
+
+  ///@{
+  /**
+   * Seconds: with a FlickerRate, the end of the time range the source
+   * advertises (default 10); without one the bolt does not depend on time
+   * and no range is advertised.
+   */
+  vtkSetMacro(Duration, double);
+  vtkGetMacro(Duration, double);
   ///@}
 
   ///@{
@@ -85,6 +105,8 @@ protected:
 
   int FillInputPortInformation(int port, vtkInformation *info) override;
   int FillOutputPortInformation(int port, vtkInformation *info) override;
+  int RequestInformation(vtkInformation *, vtkInformationVector **,
+                         vtkInformationVector *) override;
   int RequestData(vtkInformation *, vtkInformationVector **, vtkInformationVector *) override;
 
   // The table's properties start at the core's defaults (the constructor).
@@ -93,6 +115,8 @@ protected:
   double Jitter = 0.0;
   int Seed = 0;
   int Variant = 0;
+  double FlickerRate = 0.0;
+  double Duration = 10.0;
   double Start[3] = {0.0, 0.0, 1000.0};
   double End[3] = {0.0, 0.0, 0.0};
 

@@ -4,11 +4,10 @@
  * and End exact, a straight line without jitter, every branch rooted
  * exactly on a main-strand point and leaving it at 20 to 45 degrees, the
  * middle's lateral spread Jitter L / 2 per axis over 4000 seeds, the strike
- * on a terrain. Cloud cover: the clouded fraction within 0.05 of Cover on a
- * large image, exactly 0 and 1 at the ends, monotone in Cover pixel by
- * pixel, determinism (also band by band), the drift an exact shift for
- * whole pixels and within the interpolation error for half a pixel, and the
- * error paths. */
+ * on a terrain, the shape at a time Variant + floor(t FlickerRate). Cloud cover: the clouded
+ * fraction within 0.05 of Cover on a large image, exactly 0 and 1 at the ends, monotone in Cover
+ * pixel by pixel, determinism (also band by band), the drift an exact shift for whole pixels and
+ * within the interpolation error for half a pixel, and the error paths. */
 #include "graupel/sky.h"
 #include "gr_test.h"
 
@@ -262,6 +261,44 @@ static void test_lightning_strike(void) {
   CHECK(hypot(start[0] - end[0], start[1] - end[1]) <= 1000.0 / 3.0 + 1e-9);
 }
 
+static void test_lightning_flicker(void) {
+  /* The shape at time t is Variant + floor(t FlickerRate): at 4 reshapes a
+   * second, t = 0.3 s draws Variant 1's bolt and t = 0.24 s Variant 0's,
+   * bit for bit; FlickerRate 0 draws one shape at every time. */
+  gr_lightning_params p = slanted();
+  p.strands = 3;
+  bolt still, one, later, fixed;
+  make_bolt(&p, &still);
+  p.variant = 1;
+  make_bolt(&p, &one);
+  p.variant = 0;
+  p.flicker_rate = 4.0;
+  static const double times[] = {0.0, 0.1, 0.24, 0.25, 0.3, 0.49, 7.76};
+  static const int shapes[] = {0, 0, 0, 1, 1, 1, 31};
+  for (int k = 0; k < 7; ++k) {
+    p.time = times[k];
+    CHECK_MSG(gr_lightning_shape(&p) == shapes[k], "t %g: shape %d", times[k],
+              gr_lightning_shape(&p));
+  }
+  p.time = 0.3;
+  make_bolt(&p, &later);
+  p.flicker_rate = 0.0;
+  p.time = 1234.5;
+  make_bolt(&p, &fixed);
+  size_t bytes = sizeof(double) * 3 * (size_t)still.n;
+  CHECK(memcmp(later.xyz, one.xyz, bytes) == 0);
+  CHECK(memcmp(later.xyz, still.xyz, bytes) != 0);
+  CHECK(memcmp(fixed.xyz, still.xyz, bytes) == 0);
+  p.time = NAN;
+  char msg[256];
+  CHECK(gr_lightning_params_validate(&p, msg, sizeof(msg)) == GR_ERR_INVALID_ARGUMENT &&
+        strstr(msg, "time"));
+  free_bolt(&still);
+  free_bolt(&one);
+  free_bolt(&later);
+  free_bolt(&fixed);
+}
+
 static void test_lightning_errors(void) {
   char msg[256];
   double xyz[3 * 200];
@@ -284,6 +321,7 @@ static void test_lightning_errors(void) {
   REFUSED(bad.strands = 101, "Strands");
   REFUSED(bad.jitter = NAN, "Jitter");
   REFUSED(bad.jitter = 1.5, "Jitter");
+  REFUSED(bad.flicker_rate = -1.0, "FlickerRate");
   REFUSED(memcpy(bad.end, bad.start, sizeof(bad.start)), "same point");
   REFUSED(bad.start[1] = INFINITY, "finite");
 #undef REFUSED
@@ -557,7 +595,7 @@ static void test_cloud_errors(void) {
 static void test_param_table(void) {
   int count = 0;
   const gr_param_bound *b = gr_sky_param_bounds(&count);
-  CHECK(count == 11);
+  CHECK(count == 12);
   char msg[256];
   gr_lightning_params lp;
   gr_cloud_cover_params cp;
@@ -578,6 +616,8 @@ static void test_param_table(void) {
       lp.jitter = x, is_l = 1;                                                                     \
     else if (!strcmp(q, "Seed"))                                                                   \
       lp.seed = cp.seed = (int)x, is_l = is_c = 1;                                                 \
+    else if (!strcmp(q, "FlickerRate"))                                                            \
+      lp.flicker_rate = x, is_l = 1;                                                               \
     else if (!strcmp(q, "Cover"))                                                                  \
       cp.cover = x, is_c = 1;                                                                      \
     else if (!strcmp(q, "Scale"))                                                                  \
@@ -630,6 +670,7 @@ static const gr_subtest tests[] = {
     {"lightning_branches", test_lightning_branches, 0},
     {"lightning_spread", test_lightning_spread, 0},
     {"lightning_strike", test_lightning_strike, 0},
+    {"lightning_flicker", test_lightning_flicker, 0},
     {"lightning_errors", test_lightning_errors, 0},
     {"cloud_fraction", test_cloud_fraction, 0},
     {"cloud_determinism", test_cloud_determinism, 0},

@@ -15,7 +15,8 @@
  * Checks: the status is GR_OK or GR_ERR_INVALID_ARGUMENT; a failure comes
  * with a non-empty message ending in '.'; parameters are accepted exactly
  * when every table field lies in its row of gr_sky_param_bounds (and, for
- * the lightning, Start and End are finite and apart); an accepted bolt has
+ * the lightning, Start and End are finite and apart and the time finite);
+ * an accepted bolt has
  * ControlPoints + Strands * max(2, ControlPoints / 2) points, a refused one
  * 0, and a small accepted bolt is generated with Start and End exact; a
  * short message buffer is never overrun and is always terminated; the
@@ -41,6 +42,8 @@ static const field lightning_fields[] = {
     {offsetof(gr_lightning_params, jitter), 'd', "Jitter"},
     {offsetof(gr_lightning_params, seed), 'i', "Seed"},
     {offsetof(gr_lightning_params, variant), 'i', NULL},
+    {offsetof(gr_lightning_params, flicker_rate), 'd', "FlickerRate"},
+    {offsetof(gr_lightning_params, time), 'd', NULL},
     {offsetof(gr_lightning_params, start), 'd', NULL},
     {offsetof(gr_lightning_params, start) + sizeof(double), 'd', NULL},
     {offsetof(gr_lightning_params, start) + 2 * sizeof(double), 'd', NULL},
@@ -85,7 +88,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
   char msg[1024];
   int n = 0;
   const gr_param_bound *table = gr_sky_param_bounds(&n);
-  REQUIRE(table != NULL && n == 11);
+  REQUIRE(table != NULL && n == 12);
 
   r.p = data;
   r.n = size;
@@ -130,6 +133,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
       documented &= fuzz_in_row(fuzz_row(table, n, fields[f].row), field_value(p, &fields[f]));
   if (!cloud) {
     double d2 = 0.0;
+    documented &= isfinite(lp.time);
     for (int c = 0; c < 3; ++c) {
       documented &= isfinite(lp.start[c]) && isfinite(lp.end[c]);
       d2 += (lp.end[c] - lp.start[c]) * (lp.end[c] - lp.start[c]);

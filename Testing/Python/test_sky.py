@@ -3,8 +3,8 @@ plugin build, plain python3 on Debian's VTK): the bolt's point count
 ControlPoints + Strands * max(2, ControlPoints / 2) as one polyline per
 strand, Start and End exact, intensity 1 on the main strand and less on the
 branches, every branch rooted on a main-strand point, bit-identical bolts
-for one Seed and different ones for another, a strike on a terrain's
-surface; the clouded fraction within 0.05 of Cover and monotone in it,
+for one Seed and different ones for another, the shape at a time Variant +
+floor(t FlickerRate), a strike on a terrain's surface; the clouded fraction within 0.05 of Cover and monotone in it,
 bit-identical skies, the drift at t + dt the image at t shifted by
 WindSpeed dt; bad input (ControlPoints 1, Start = End, Resolution 0, an
 empty terrain: one sentence, an empty output, then the next good update
@@ -87,6 +87,16 @@ T.check(moved >= a0.GetNumberOfPoints() - 2 - 4, "another Seed moves %d of %d po
         % (moved, a0.GetNumberOfPoints()))
 _, v1 = bolt(Seed=11, Variant=1)
 T.check((points(a0) != points(v1)).any(axis=1).sum() > 100, "another Variant reshapes the bolt")
+
+# Flicker: at 4 reshapes a second, t = 0.3 s shows Variant 1's bolt, t = 0.2 s Variant 0's.
+f = vtkLightningSource()
+f.SetSeed(11)
+f.SetFlickerRate(4.0)
+for t, want in ((0.2, a0), (0.3, v1), (0.1, a0)):
+    f.UpdateTimeStep(t)
+    out = f.GetOutput()
+    T.check(points(out).tobytes() == points(want).tobytes(),
+            "FlickerRate 4 at t = %g s draws shape %d" % (t, out.GetFieldData().GetArray("shape").GetValue(0)))
 
 # A strike on a terrain: End is one of the surface's points, Start far above.
 NX, NY = 40, 30

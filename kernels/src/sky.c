@@ -23,6 +23,7 @@ enum {
   GR_SKY_STRANDS,
   GR_SKY_JITTER,
   GR_SKY_SEED,
+  GR_SKY_FLICKER_RATE,
   GR_SKY_COVER,
   GR_SKY_SCALE,
   GR_SKY_SHARPNESS,
@@ -46,6 +47,7 @@ static const gr_param_bound gr_sky_bounds[GR_SKY_ROWS] = {
     {"Strands", "", 0.0, 100.0, 4.0, 1.0, 0, 1},
     {"Jitter", "", 0.0, 1.0, 0.1, 1.0, 0, 0},
     {"Seed", "", (double)INT_MIN, (double)INT_MAX, 0.0, 1.0, 0, 1},
+    {"FlickerRate", "1/s", 0.0, 100.0, 0.0, 1.0, 0, 0},
     {"Cover", "", 0.0, 1.0, 0.5, 1.0, 0, 0},
     {"Scale", "m", 0.0, 1e7, 2000.0, 1.0, 1, 0},
     {"Sharpness", "", 0.5, 0.999, 0.96, 1.0, 0, 0},
@@ -59,6 +61,7 @@ static const char *const gr_sky_hints[GR_SKY_ROWS] = {
     [GR_SKY_CONTROL_POINTS] = " (points of the main strand)",
     [GR_SKY_STRANDS] = " (branches)",
     [GR_SKY_JITTER] = " (lateral displacement relative to the bolt's length)",
+    [GR_SKY_FLICKER_RATE] = " (reshapes per second)",
     [GR_SKY_COVER] = " (the fraction of the sky clouded)",
     [GR_SKY_SCALE] = " (the clouds' wavelength)",
     [GR_SKY_WIND_DIRECTION] = " (the bearing the clouds move towards)",
@@ -106,6 +109,7 @@ void gr_lightning_params_init(gr_lightning_params *p) {
   p->strands = (int)gr_sky_bounds[GR_SKY_STRANDS].default_value;
   p->jitter = gr_sky_bounds[GR_SKY_JITTER].default_value;
   p->seed = (int)gr_sky_bounds[GR_SKY_SEED].default_value;
+  p->flicker_rate = gr_sky_bounds[GR_SKY_FLICKER_RATE].default_value;
   p->start[2] = 1000.0;
 }
 
@@ -115,13 +119,20 @@ gr_status gr_lightning_params_validate(const gr_lightning_params *p, char *msg, 
       snprintf(msg, msg_len, "Invalid lightning parameters: no parameters were given.");
     return GR_ERR_INVALID_ARGUMENT;
   }
-  const int rows[] = {GR_SKY_CONTROL_POINTS, GR_SKY_STRANDS, GR_SKY_JITTER, GR_SKY_SEED};
-  const double values[] = {p->control_points, p->strands, p->jitter, p->seed};
-  for (int r = 0; r < 4; ++r)
+  const int rows[] = {GR_SKY_CONTROL_POINTS, GR_SKY_STRANDS, GR_SKY_JITTER, GR_SKY_SEED,
+                      GR_SKY_FLICKER_RATE};
+  const double values[] = {p->control_points, p->strands, p->jitter, p->seed, p->flicker_rate};
+  for (int r = 0; r < 5; ++r)
     if (!gr_param_accepts(&gr_sky_bounds[rows[r]], values[r])) {
       gr_sky_explain("lightning", rows[r], values[r], msg, msg_len);
       return GR_ERR_INVALID_ARGUMENT;
     }
+  if (!isfinite(p->time)) {
+    if (msg && msg_len)
+      snprintf(msg, msg_len, "Invalid lightning parameters: the time is %g s but must be finite.",
+               p->time);
+    return GR_ERR_INVALID_ARGUMENT;
+  }
   double len2 = 0.0;
   for (int c = 0; c < 3; ++c) {
     if (!isfinite(p->start[c]) || !isfinite(p->end[c])) {
@@ -146,6 +157,14 @@ gr_status gr_lightning_params_validate(const gr_lightning_params *p, char *msg, 
   return GR_OK;
 }
 
+int gr_lightning_shape(const gr_lightning_params *p) {
+  if (!p)
+    return 0;
+  double k = floor(p->time * p->flicker_rate);
+  double shape = (double)p->variant + (isfinite(k) ? k : 0.0);
+  return shape >= (double)INT_MAX ? INT_MAX : shape <= (double)INT_MIN ? INT_MIN : (int)shape;
+}
+
 int gr_lightning_branch_points(int control_points) {
   return control_points / 2 > 2 ? control_points / 2 : 2;
 }
@@ -156,7 +175,7 @@ long gr_lightning_point_count(const gr_lightning_params *p) {
   return (long)p->control_points + (long)p->strands * gr_lightning_branch_points(p->control_points);
 }
 
-/* The random numbers: hashes of (seed, variant, strand, point, purpose), so
+/* The random numbers: hashes of (seed, shape, strand, point, purpose), so
  * every number is a pure function of where it is used. */
 enum { GR_LH_WALK_X, GR_LH_WALK_Y, GR_LH_ATTACH, GR_LH_ANGLE, GR_LH_AZIMUTH, GR_LH_LENGTH };
 
@@ -181,9 +200,9 @@ static double gr_unit(uint64_t h) {
 }
 
 /* A standard normal pair (Box-Muller) for point k of a strand. */
-static void gr_gauss2(const gr_lightning_params *p, long strand, long k, double g[2]) {
-  double u1 = 1.0 - gr_unit(gr_lhash(p->seed, p->variant, strand, k, GR_LH_WALK_X));
-  double u2 = gr_unit(gr_lhash(p->seed, p->variant, strand, k, GR_LH_WALK_Y));
+static void gr_gauss2(int seed, int shape, long strand, long k, double g[2]) {
+  double u1 = 1.0 - gr_unit(gr_lhash(seed, shape, strand, k, GR_LH_WALK_X));
+  double u2 = gr_unit(gr_lhash(seed, shape, strand, k, GR_LH_WALK_Y));
   double r = sqrt(-2.0 * log(u1));
   g[0] = r * cos(2.0 * GR_SKY_PI * u2);
   g[1] = r * sin(2.0 * GR_SKY_PI * u2);
@@ -217,6 +236,7 @@ gr_status gr_lightning_generate(const gr_lightning_params *p, double *xyz, float
     return GR_ERR_INVALID_ARGUMENT;
   }
   const int n = p->control_points, m = gr_lightning_branch_points(n);
+  const int shape = gr_lightning_shape(p);
   double d[3], u[3], v[3], w[3];
   double len = 0.0;
   for (int c = 0; c < 3; ++c) {
@@ -235,7 +255,7 @@ gr_status gr_lightning_generate(const gr_lightning_params *p, double *xyz, float
   for (int k = 0; k < n; ++k) {
     if (k > 0) {
       double g[2];
-      gr_gauss2(p, 0, k, g);
+      gr_gauss2(p->seed, shape, 0, k, g);
       walk[0] += step * g[0];
       walk[1] += step * g[1];
     }
@@ -263,12 +283,12 @@ gr_status gr_lightning_generate(const gr_lightning_params *p, double *xyz, float
   const int kmax = n - 2 < (int)(0.8 * (n - 1)) ? n - 2 : (int)(0.8 * (n - 1));
   const double bstep = sqrt(1.0 / (m - 1));
   for (int s = 1; s <= p->strands; ++s) {
-    int k = (int)(gr_unit(gr_lhash(p->seed, p->variant, s, 0, GR_LH_ATTACH)) * (kmax + 1));
+    int k = (int)(gr_unit(gr_lhash(p->seed, shape, s, 0, GR_LH_ATTACH)) * (kmax + 1));
     k = k > kmax ? kmax : k;
-    double theta = (20.0 + 25.0 * gr_unit(gr_lhash(p->seed, p->variant, s, 0, GR_LH_ANGLE))) *
-                   GR_SKY_PI / 180.0;
-    double phi = 2.0 * GR_SKY_PI * gr_unit(gr_lhash(p->seed, p->variant, s, 0, GR_LH_AZIMUTH));
-    double blen = (0.15 + 0.25 * gr_unit(gr_lhash(p->seed, p->variant, s, 0, GR_LH_LENGTH))) * len *
+    double theta =
+        (20.0 + 25.0 * gr_unit(gr_lhash(p->seed, shape, s, 0, GR_LH_ANGLE))) * GR_SKY_PI / 180.0;
+    double phi = 2.0 * GR_SKY_PI * gr_unit(gr_lhash(p->seed, shape, s, 0, GR_LH_AZIMUTH));
+    double blen = (0.15 + 0.25 * gr_unit(gr_lhash(p->seed, shape, s, 0, GR_LH_LENGTH))) * len *
                   (1.0 - (double)k / (n - 1));
     double bd[3], bv[3], bw[3];
     for (int c = 0; c < 3; ++c)
@@ -281,7 +301,7 @@ gr_status gr_lightning_generate(const gr_lightning_params *p, double *xyz, float
     for (int j = 0; j < m; ++j) {
       if (j > 0) {
         double g[2];
-        gr_gauss2(p, s, j, g);
+        gr_gauss2(p->seed, shape, s, j, g);
         walk[0] += bstep * g[0];
         walk[1] += bstep * g[1];
       }
@@ -299,20 +319,20 @@ gr_status gr_lightning_generate(const gr_lightning_params *p, double *xyz, float
   return GR_OK;
 }
 
-long gr_lightning_strike_index(int seed, int variant, long npoints) {
+long gr_lightning_strike_index(int seed, int shape, long npoints) {
   if (npoints < 1)
     return -1;
-  long k = (long)(gr_unit(gr_lhash(seed, variant, -1, 0, GR_LH_ATTACH)) * (double)npoints);
+  long k = (long)(gr_unit(gr_lhash(seed, shape, -1, 0, GR_LH_ATTACH)) * (double)npoints);
   return k < npoints ? k : npoints - 1;
 }
 
-void gr_lightning_start_over(int seed, int variant, const double bounds[6], const double end[3],
+void gr_lightning_start_over(int seed, int shape, const double bounds[6], const double end[3],
                              double start[3]) {
   double xr = bounds[1] - bounds[0], yr = bounds[3] - bounds[2];
   double h = 0.5 * (xr > yr ? xr : yr);
   h = h > 100.0 ? h : 100.0;
-  double r = h / 3.0 * gr_unit(gr_lhash(seed, variant, -1, 0, GR_LH_LENGTH));
-  double phi = 2.0 * GR_SKY_PI * gr_unit(gr_lhash(seed, variant, -1, 0, GR_LH_AZIMUTH));
+  double r = h / 3.0 * gr_unit(gr_lhash(seed, shape, -1, 0, GR_LH_LENGTH));
+  double phi = 2.0 * GR_SKY_PI * gr_unit(gr_lhash(seed, shape, -1, 0, GR_LH_AZIMUTH));
   start[0] = end[0] + r * cos(phi);
   start[1] = end[1] + r * sin(phi);
   start[2] = (bounds[5] > end[2] ? bounds[5] : end[2]) + h;

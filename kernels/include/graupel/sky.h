@@ -35,9 +35,11 @@
  * - intensity: 1 on the main strand; on a branch 0.5 at its root fading
  *   linearly to 0.15 at its tip (the seed draws white lines; intensity is
  *   for colouring, glow width or opacity). strand: 0 main, s for branch s.
- * - Timing (a:L185: a bolt is shown briefly and reshaped a few times) is the
- *   caller's: Variant numbers the reshapes; each Variant is another bolt of
- *   the same Seed.
+ * - Timing (a:L185: a bolt is shown briefly and reshaped a few times):
+ *   the shape is Variant + floor(Time * FlickerRate) (gr_lightning_shape),
+ *   each shape another bolt of the same Seed; FlickerRate 0 keeps one shape
+ *   at every time. When a bolt is shown (the seed's random intervals) is
+ *   left to the caller: an animation shows or hides the source.
  *
  * Cloud cover (gr_cloud_cover_*, OpenCL kernels sky_cloud_noise and
  * sky_cloud_shade). After Hugo Elias's "Cloud Cover" as the seed uses it
@@ -78,24 +80,33 @@ extern "C" {
 
 /** A bolt's parameters; Seed is shared with the cloud cover's row. */
 typedef struct gr_lightning_params {
-  int control_points; /**< ControlPoints: points of the main strand, at least 2 */
-  int strands;        /**< Strands: branches besides the main strand */
-  double jitter;      /**< Jitter: lateral displacement relative to the length */
-  int seed;           /**< Seed: any integer */
-  int variant;        /**< which reshape of the Seed's bolt (not a table row) */
-  double start[3];    /**< where the bolt leaves the cloud, m */
-  double end[3];      /**< where it strikes, m; must differ from start */
+  int control_points;  /**< ControlPoints: points of the main strand, at least 2 */
+  int strands;         /**< Strands: branches besides the main strand */
+  double jitter;       /**< Jitter: lateral displacement relative to the length */
+  int seed;            /**< Seed: any integer */
+  int variant;         /**< the first shape of the Seed's bolt (not a table row) */
+  double flicker_rate; /**< FlickerRate: reshapes per second, 0 still */
+  double time;         /**< s: with flicker_rate, picks the shape (not a table row) */
+  double start[3];     /**< where the bolt leaves the cloud, m */
+  double end[3];       /**< where it strikes, m; must differ from start */
 } gr_lightning_params;
 
 /** The table's defaults, Variant 0, Start (0, 0, 1000) and End (0, 0, 0). */
 GR_API void gr_lightning_params_init(gr_lightning_params *p);
 
 /**
- * Checks the table's lightning rows and Start, End (finite, apart); a
- * sentence naming the property, the value and the fix goes to msg.
+ * Checks the table's lightning rows, Start and End (finite, apart) and the
+ * time (finite); a sentence naming the property, the value and the fix goes
+ * to msg.
  */
 GR_API gr_status gr_lightning_params_validate(const gr_lightning_params *p, char *msg,
                                               size_t msg_len);
+
+/**
+ * The shape drawn: variant + floor(time * flicker_rate), saturating at the
+ * int range; variant when flicker_rate is 0.
+ */
+GR_API int gr_lightning_shape(const gr_lightning_params *p);
 
 /** Points of each branch: max(2, control_points / 2). */
 GR_API int gr_lightning_branch_points(int control_points);
@@ -113,9 +124,10 @@ GR_API gr_status gr_lightning_generate(const gr_lightning_params *p, double *xyz
 
 /**
  * A strike on a terrain: the index (0 .. npoints-1) of the point that the
- * bolt of (seed, variant) hits, a hash of them. -1 when npoints < 1.
+ * bolt of (seed, shape) hits, a hash of them (shape: gr_lightning_shape).
+ * -1 when npoints < 1.
  */
-GR_API long gr_lightning_strike_index(int seed, int variant, long npoints);
+GR_API long gr_lightning_strike_index(int seed, int shape, long npoints);
 
 /**
  * The start of a strike at end over a terrain of bounds (xmin, xmax, ymin,
@@ -123,7 +135,7 @@ GR_API long gr_lightning_strike_index(int seed, int variant, long npoints);
  * 100 m) above its highest point, offset sideways by up to a third of that
  * height in a hashed direction, so bolts lean.
  */
-GR_API void gr_lightning_start_over(int seed, int variant, const double bounds[6],
+GR_API void gr_lightning_start_over(int seed, int shape, const double bounds[6],
                                     const double end[3], double start[3]);
 
 /* ----------------------------------------------------------- cloud cover */
@@ -155,7 +167,7 @@ GR_API void gr_cloud_cover_grid(const gr_cloud_cover_params *p, gr_grid *out);
 
 /**
  * The parameter table of the sky core (Lightning: ControlPoints, Strands,
- * Jitter, Seed; Cloud Cover: Cover, Scale, Sharpness, WindSpeed,
+ * Jitter, Seed, FlickerRate; Cloud Cover: Cover, Scale, Sharpness, WindSpeed,
  * WindDirection, Resolution, Size, and Seed, the one row both share);
  * *count gets the rows.
  */
