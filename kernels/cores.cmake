@@ -11,6 +11,7 @@ set(GRAUPEL_CORES
   particles
   procedural_terrain
   rain_runoff
+  sky
   snow_accumulation
   snow_deformation
   terrain_analysis

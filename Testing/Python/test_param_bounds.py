@@ -51,11 +51,11 @@ from paraview.simple import LoadPlugin  # noqa: E402
 
 # The proxy of a core is named after it (rain_runoff -> RainRunoff, one name
 # through every layer), a source or a filter; a core behind several proxies
-# and none of its own name (particles -> RainParticles, SnowfallParticles)
-# has the proxies whose names end in its name. CORES maps core -> [(proxy
-# group, proxy name, VTK class), ...] and is filled from the plugin below, so
-# a new core needs no line here. Each row of a core's table is checked on
-# every one of its proxies that has the property, and must be on one.
+# (sky: Lightning and CloudCover) names itself in each one's hint
+# <GraupelCore name="sky"/>, and each of its rows is checked on every one of
+# them that has the property (at least one must). CORES maps core -> list of
+# (proxy group, proxy name, VTK class) and is filled from the plugin below,
+# so a new core needs no line here.
 CORES = {}
 INT_MIN, INT_MAX = -2 ** 31, 2 ** 31 - 1
 
@@ -85,21 +85,18 @@ def fmt(row):
 CORE_ONLY = set()
 LoadPlugin(a.plugin, ns=globals())
 pxm = servermanager.ProxyManager()
-
-
-def proxies_ending(suffix):
-    """(group, name) of every source and filter whose name ends in suffix."""
-    found = []
-    for group in ("sources", "filters"):
-        it = pxm.GetProxyDefinitionManager().NewSingleGroupIterator(group)
-        it.GoToFirstItem()
-        while not it.IsDoneWithTraversal():
-            if it.GetProxyName().endswith(suffix):
-                found.append((group, it.GetProxyName()))
-            it.GoToNextItem()
-    return found
-
-
+DECLARED = {}  # core -> [(group, name, class)] from <GraupelCore name=.../> hints
+for group in ("sources", "filters"):
+    it = pxm.GetProxyDefinitionManager().NewSingleGroupIterator(group)
+    it.GoToFirstItem()
+    while not it.IsDoneWithTraversal():
+        proto = pxm.GetPrototypeProxy(group, it.GetProxyName())
+        hints = proto.GetHints() if proto else None
+        declared = hints.FindNestedElementByName("GraupelCore") if hints else None
+        if declared is not None:
+            DECLARED.setdefault(declared.GetAttribute("name"), []).append(
+                (group, it.GetProxyName(), proto.GetVTKClassName()))
+        it.GoToNextItem()
 for core in tables:
     name = "".join(w.capitalize() for w in core.split("_"))
     for group in ("sources", "filters"):
@@ -107,11 +104,9 @@ for core in tables:
         if proto is not None:
             CORES[core] = [(group, name, proto.GetVTKClassName())]
             break
-    if core not in CORES:
-        several = [(g, n, pxm.GetPrototypeProxy(g, n).GetVTKClassName())
-                   for g, n in proxies_ending(name) if n != name]
-        if several:
-            CORES[core] = several
+    if core not in CORES and core in DECLARED:
+        CORES[core] = DECLARED[core]
+        name = " or ".join(n for _, n, _ in DECLARED[core])
     if core in CORE_ONLY:
         T.check(core not in CORES, "the core %s has its proxy %s now: take it off CORE_ONLY"
                 % (core, name))
@@ -124,7 +119,7 @@ for core in tables:
 # value. ELEMENT maps (core, row) -> (property, value index); the README row
 # is the property's, its default cell the values in order.
 ELEMENT = {}
-for (group, name, _) in [px for pxs in CORES.values() for px in pxs]:
+for core, (group, name, _) in ((c, x) for c, xs in CORES.items() for x in xs):
     proto = pxm.GetPrototypeProxy(group, name)
     it = proto.NewPropertyIterator()
     it.Begin()
@@ -133,21 +128,21 @@ for (group, name, _) in [px for pxs in CORES.values() for px in pxs]:
         rows = hints.FindNestedElementByName("GraupelTableRows") if hints else None
         if rows is not None:
             for k, r in enumerate(rows.GetAttribute("rows").split()):
-                ELEMENT[(name, r)] = (it.GetKey(), k)
+                ELEMENT[(core, r)] = (it.GetKey(), k)
         it.Next()
 
 
-def has_row(proxy, row):
-    """The proxy has the row's property (itself, or a property of several values)."""
-    group, name, _ = proxy
-    p = ELEMENT.get((name, row["property"]), (row["property"], 0))[0]
-    return pxm.GetPrototypeProxy(group, name).GetProperty(p) is not None
+def proxies_with(core, row):
+    """The core's proxies that have the row's property (or its element)."""
+    p = ELEMENT.get((core, row["property"]), (row["property"], 0))[0]
+    have = [x for x in CORES[core] if pxm.GetPrototypeProxy(x[0], x[1]).GetProperty(p) is not None]
+    return have if len(CORES[core]) > 1 else CORES[core]
 
 
-def check_xml(proxy, row):
+def check_xml(core, row, proxy):
     group, name, _ = proxy
     proto = pxm.GetPrototypeProxy(group, name)
-    p, index = ELEMENT.get((name, row["property"]), (row["property"], 0))
+    p, index = ELEMENT.get((core, row["property"]), (row["property"], 0))
     prop = proto.GetProperty(p) if proto else None
     T.check(prop is not None, "%s has the property %s" % (name, p))
     if prop is None:
@@ -201,7 +196,7 @@ def check_xml(proxy, row):
 
 
 # ---------------------------------------------------------- the VTK classes
-def check_class(proxy, row):
+def check_class(core, row, proxy):
     cls = getattr(graupel, proxy[2])
     obj = cls()
     p = row["property"]
@@ -265,8 +260,8 @@ def parse_range(cell):
 readme = readme_rows(a.readme)
 
 
-def check_readme(proxy, row):
-    p, index = ELEMENT.get((proxy[1], row["property"]), (row["property"], -1))
+def check_readme(core, row, proxy):
+    p, index = ELEMENT.get((core, row["property"]), (row["property"], -1))
     found = readme.get((proxy[1], p), [])
     T.check(len(found) == 1, "README: one table row for `%s` in the section of %s (found %d)"
             % (p, proxy[1], len(found)))
@@ -302,12 +297,12 @@ for core, rows in sorted(tables.items()):
         T.check(row["min"] <= row["default"] <= row["max"] and
                 not (row["min_open"] and row["default"] == row["min"]),
                 "%s.%s: the default %g lies in %s" % (core, row["property"], row["default"], fmt(row)))
-        on = [px for px in CORES[core] if has_row(px, row)]
-        T.check(len(on) > 0, "%s.%s is a property of %s" % (core, row["property"],
-                                                          [px[1] for px in CORES[core]]))
-        for proxy in on:
-            check_xml(proxy, row)
-            check_class(proxy, row)
-            check_readme(proxy, row)
+        proxies = proxies_with(core, row)
+        T.check(len(proxies) > 0, "%s.%s: a proxy of the core has the property"
+                % (core, row["property"]))
+        for proxy in proxies:
+            check_xml(core, row, proxy)
+            check_class(core, row, proxy)
+            check_readme(core, row, proxy)
 
 T.finish()
