@@ -49,27 +49,36 @@ bool IsBuiltin() {
 // progress of a Graupel simulation, once per process, and writes the time of
 // the click (seconds since the epoch) to GRAUPEL_GUI_TEST_ABORT_LOG. The
 // timer fires only if Qt processes events during the update, as the real
-// click needs.
+// click needs. A button still disabled then (on a busy machine the update
+// that reported the progress may have ended and the next not yet begun) is
+// looked at again every 50 ms, for up to 60 s, and clicked once enabled.
+void ClickWhenEnabled(int tries) {
+  for (QWidget *w : QApplication::allWidgets()) {
+    auto *button = qobject_cast<QAbstractButton *>(w);
+    if (button && button->objectName() == QLatin1String("AbortButton")) {
+      if (!button->isEnabled() && tries > 0) {
+        QTimer::singleShot(50, QCoreApplication::instance(),
+                           [tries]() { ClickWhenEnabled(tries - 1); });
+        return;
+      }
+      const QString log = qEnvironmentVariable("GRAUPEL_GUI_TEST_ABORT_LOG");
+      QFile file(log);
+      if (!log.isEmpty() && file.open(QIODevice::WriteOnly)) {
+        file.write(QByteArray::number(QDateTime::currentMSecsSinceEpoch() / 1000.0, 'f', 3) +
+                   (button->isEnabled() ? " enabled\n" : " disabled\n"));
+      }
+      button->click();
+      return;
+    }
+  }
+}
+
 void ArmTestClick() {
   const int ms = qEnvironmentVariableIntValue("GRAUPEL_GUI_TEST_ABORT_MS");
   if (ms <= 0) {
     return;
   }
-  QTimer::singleShot(ms, QCoreApplication::instance(), []() {
-    for (QWidget *w : QApplication::allWidgets()) {
-      auto *button = qobject_cast<QAbstractButton *>(w);
-      if (button && button->objectName() == QLatin1String("AbortButton")) {
-        const QString log = qEnvironmentVariable("GRAUPEL_GUI_TEST_ABORT_LOG");
-        QFile file(log);
-        if (!log.isEmpty() && file.open(QIODevice::WriteOnly)) {
-          file.write(QByteArray::number(QDateTime::currentMSecsSinceEpoch() / 1000.0, 'f', 3) +
-                     (button->isEnabled() ? " enabled\n" : " disabled\n"));
-        }
-        button->click();
-        return;
-      }
-    }
-  });
+  QTimer::singleShot(ms, QCoreApplication::instance(), []() { ClickWhenEnabled(1200); });
 }
 
 bool IsAbortButton(QObject *obj) {
