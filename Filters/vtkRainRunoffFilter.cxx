@@ -12,6 +12,7 @@
 #include "vtkNew.h"
 #include "vtkObjectFactory.h"
 #include "vtkPointData.h"
+#include "vtkPointSet.h"
 #include "vtkSmartPointer.h"
 #include "vtkStreamingDemandDrivenPipeline.h"
 #include "vtkTable.h"
@@ -23,6 +24,7 @@
 
 #include <cmath>
 #include <cstring>
+#include <string>
 #include <vector>
 
 vtkStandardNewMacro(vtkRainRunoffFilter);
@@ -43,7 +45,7 @@ const gr_param_bound *Bound(const char *property) {
 } // namespace
 
 vtkRainRunoffFilter::vtkRainRunoffFilter() {
-  this->SetNumberOfInputPorts(2);
+  this->SetNumberOfInputPorts(3);
   this->SetNumberOfOutputPorts(2);
 }
 
@@ -93,6 +95,10 @@ vtkRainRunoffFilter::~vtkRainRunoffFilter() {
 
 void vtkRainRunoffFilter::SetPermeabilityMapConnection(vtkAlgorithmOutput *output) {
   this->SetInputConnection(1, output);
+}
+
+void vtkRainRunoffFilter::SetGaugesConnection(vtkAlgorithmOutput *output) {
+  this->SetInputConnection(2, output);
 }
 
 int vtkRainRunoffFilter::FillOutputPortInformation(int port, vtkInformation *info) {
@@ -157,8 +163,8 @@ int vtkRainRunoffFilter::RequestData(vtkInformation *request, vtkInformationVect
 }
 
 int vtkRainRunoffFilter::FillInputPortInformation(int port, vtkInformation *info) {
-  info->Set(vtkAlgorithm::INPUT_REQUIRED_DATA_TYPE(), "vtkImageData");
-  if (port == 1) {
+  info->Set(vtkAlgorithm::INPUT_REQUIRED_DATA_TYPE(), port == 2 ? "vtkPointSet" : "vtkImageData");
+  if (port >= 1) {
     info->Set(vtkAlgorithm::INPUT_IS_OPTIONAL(), 1);
   }
   return 1;
@@ -269,6 +275,36 @@ int vtkRainRunoffFilter::SetUpState(vtkInformationVector **inputVector) {
     return 0;
   }
 
+  // Each gauge at its nearest terrain point.
+  this->GaugeCells.clear();
+  vtkPointSet *gauges = inputVector[2]->GetNumberOfInformationObjects()
+                            ? vtkPointSet::GetData(inputVector[2])
+                            : nullptr;
+  if (gauges) {
+    int ext[6];
+    terrain->GetExtent(ext);
+    const double *origin = terrain->GetOrigin();
+    for (vtkIdType k = 0; k < gauges->GetNumberOfPoints(); ++k) {
+      double x[3];
+      gauges->GetPoint(k, x);
+      const double fi = (x[0] - origin[0]) / spacing[0] - ext[0];
+      const double fj = (x[1] - origin[1]) / spacing[1] - ext[2];
+      const bool finite = std::isfinite(fi) && std::isfinite(fj);
+      const long long ci = finite ? std::llround(fi) : -1, cj = finite ? std::llround(fj) : -1;
+      if (ci < 0 || cj < 0 || ci >= dims[0] || cj >= dims[1]) {
+        vtkErrorMacro(
+            "Rain Runoff's Gauges point "
+            << k << " at (" << x[0] << ", " << x[1] << ") lies off the terrain (x "
+            << origin[0] + ext[0] * spacing[0] << " to " << origin[0] + ext[1] * spacing[0]
+            << " m, y " << origin[1] + ext[2] * spacing[1] << " to "
+            << origin[1] + ext[3] * spacing[1] << " m); move it onto the terrain or remove it.");
+        return 0;
+      }
+      this->GaugeCells.push_back(static_cast<int>(ci));
+      this->GaugeCells.push_back(static_cast<int>(cj));
+    }
+  }
+
   gr_grid grid;
   TerrainGrid(terrain, &grid);
   gr_status st = gr_rain_runoff_create(this->GetContext(), &grid, &p, &this->Simulation);
@@ -285,6 +321,7 @@ int vtkRainRunoffFilter::SetUpState(vtkInformationVector **inputVector) {
   // Progress with the simulated time, and an abort inside a long interval.
   gr_rain_runoff_set_progress(this->Simulation, &vtkGraupelSimulation::CoreProgress, this);
   this->Ledgers.clear();
+  this->GaugeRows.clear();
   return this->RecordLedger(0);
 }
 
@@ -301,6 +338,18 @@ int vtkRainRunoffFilter::RecordLedger(int index) {
   this->Ledgers[static_cast<size_t>(index)] = {this->GetOutputTime(index), ledger.rain_volume,
                                                ledger.infiltrated_volume,  ledger.outflow_volume,
                                                ledger.stored_volume,       ledger.balance_error};
+  const int gauges = static_cast<int>(this->GaugeCells.size() / 2);
+  if (this->GaugeRows.size() <= static_cast<size_t>(index)) {
+    this->GaugeRows.resize(static_cast<size_t>(index) + 1);
+  }
+  std::vector<float> &row = this->GaugeRows[static_cast<size_t>(index)];
+  row.assign(3 * static_cast<size_t>(gauges), 0.0f);
+  const gr_status sst =
+      gr_rain_runoff_sample(this->Simulation, this->GaugeCells.data(), gauges, row.data());
+  if (sst != GR_OK) {
+    return this->ReportFailure(sst, "Rain Runoff could not read its gauges",
+                               gr_rain_runoff_last_error(this->Simulation));
+  }
   return 1;
 }
 
@@ -427,7 +476,8 @@ int vtkRainRunoffFilter::FillHydrograph(vtkDataObject *tableObject) {
     return 1; // a pipeline that asked for the image only
   }
   const int rows = this->GetStateIndex() + 1;
-  if (rows < 1 || this->Ledgers.size() < static_cast<size_t>(rows)) {
+  if (rows < 1 || this->Ledgers.size() < static_cast<size_t>(rows) ||
+      this->GaugeRows.size() < static_cast<size_t>(rows)) {
     vtkErrorMacro("Rain Runoff's hydrograph lacks the ledger of an output time before "
                   << this->GetStateTime() << " s; this is a bug: please report it.");
     return 0;
@@ -454,6 +504,21 @@ int vtkRainRunoffFilter::FillHydrograph(vtkDataObject *tableObject) {
   }
   for (int k = 0; k < columns; ++k) {
     table->AddColumn(c[static_cast<size_t>(k)]);
+  }
+  // Three columns per gauge.
+  const int gauges = static_cast<int>(this->GaugeCells.size() / 2);
+  const char *what[] = {"depth", "surface", "discharge"};
+  for (int gk = 0; gk < gauges; ++gk) {
+    for (int w = 0; w < 3; ++w) {
+      vtkNew<vtkFloatArray> a;
+      a->SetName(("gauge" + std::to_string(gk) + "_" + what[w]).c_str());
+      a->SetNumberOfTuples(rows);
+      for (int r = 0; r < rows; ++r) {
+        const std::vector<float> &g = this->GaugeRows[static_cast<size_t>(r)];
+        a->SetValue(r, g[3 * static_cast<size_t>(gk) + static_cast<size_t>(w)]);
+      }
+      table->AddColumn(a);
+    }
   }
   return 1;
 }

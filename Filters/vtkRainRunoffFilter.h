@@ -44,6 +44,14 @@
  * or a restart re-records the same values (the steps are the same), so the
  * table does not depend on the order of requests either.
  *
+ * Input 2 (`Gauges`, optional) is a point set: each point is snapped to the
+ * nearest terrain point (a point beyond the terrain is refused with a
+ * sentence), and the hydrograph gets three columns per gauge k,
+ * `gauge<k>_depth` (m), `gauge<k>_surface` (m) and `gauge<k>_discharge`
+ * (m^2/s, |q|), the output fields' values there at each output time (read
+ * with gr_rain_runoff_sample: a few floats per output, whatever the grid).
+ * Gauges are a static input: moving them sets the simulation up again.
+ *
  * Time is handled by vtkGraupelSimulation: request a time with
  * UpdateTimeStep(t) (ParaView's animation does it). Checkpoints are the
  * core's gr_rain_runoff_state_save/load; an abort is honoured inside an
@@ -132,6 +140,8 @@ public:
 
   /** Connects the optional permeability map (input port 1). */
   void SetPermeabilityMapConnection(vtkAlgorithmOutput *output);
+  /** Connects the optional gauge points (input port 2). */
+  void SetGaugesConnection(vtkAlgorithmOutput *output);
 
 protected:
   vtkRainRunoffFilter();
@@ -182,6 +192,10 @@ private:
   /** The ledger's volumes at each output time passed: time, rain, infiltrated,
    *  outflow, stored, balance error. */
   std::vector<std::array<double, 6>> Ledgers;
+  /** The gauges' grid points, (i, j) pairs, and per output time their depth,
+   *  surface and discharge (3 floats per gauge). */
+  std::vector<int> GaugeCells;
+  std::vector<std::vector<float>> GaugeRows;
   vtkInformationVector *OutputVector = nullptr; // during RequestData only
   bool HydrographFilled = false;
 };

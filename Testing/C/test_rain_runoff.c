@@ -1684,6 +1684,56 @@ static void test_maps_reset(void) {
   gr_rain_runoff_destroy(b);
 }
 
+/* Gauges: gr_rain_runoff_sample gives at each cell the floats that
+ * get_field's depth, surface and discharge hold there (both models, a
+ * flowing state); a cell outside the grid is refused with a sentence. */
+static void test_gauges(void) {
+  for (int model = 0; model < 2; ++model) {
+    gr_grid g = {23, 17, 1.5, 2.0, 0.0, 0.0, 0, 0};
+    size_t n = cells_of(&g);
+    float *b = alloc_field(&g, 1), *d0 = alloc_field(&g, 1);
+    for (size_t c = 0; c < n; ++c) {
+      b[c] = (float)(100.0 + 0.3 * hash01((int)c, 2, 3) + 0.02 * (double)(c % (size_t)g.nx));
+      d0[c] = (c % (size_t)g.nx) < 6 ? 0.8f : 0.0f;
+    }
+    gr_rain_runoff_params p = params_with(20.0 / 3.6e6, 0.0, GR_BOUNDARY_OPEN);
+    p.flow_model = model ? GR_FLOW_LOCAL_INERTIAL : GR_FLOW_SHALLOW_WATER;
+    gr_rain_runoff *s = make_sim(&g, &p, b, d0);
+    if (!s) {
+      free(b);
+      free(d0);
+      return;
+    }
+    CHECK(gr_rain_runoff_advance(s, 15.0, NULL) == GR_OK);
+    const int ij[] = {0, 0, 22, 16, 7, 8, 5, 3, 12, 9};
+    const int k = (int)(sizeof(ij) / sizeof(ij[0]) / 2);
+    float got[3 * 5];
+    CHECK(gr_rain_runoff_sample(s, ij, k, got) == GR_OK);
+    float *h = get(s, &g, GR_FIELD_WATER_DEPTH), *z = get(s, &g, GR_FIELD_WATER_SURFACE);
+    float *q = get(s, &g, GR_FIELD_DISCHARGE);
+    int differ = 0, flowing = 0;
+    for (int m = 0; m < k; ++m) {
+      size_t c = (size_t)ij[2 * m + 1] * (size_t)g.nx + (size_t)ij[2 * m];
+      differ += got[3 * m] != h[c] || got[3 * m + 1] != z[c] || got[3 * m + 2] != q[c];
+      flowing += q[c] > 0.0f;
+    }
+    printf("gauges, FlowModel %d: %d of %d differ from the fields; %d with flow\n", model, differ,
+           k, flowing);
+    CHECK(differ == 0 && flowing > 0);
+    const int outside[] = {3, 4, 23, 0};
+    CHECK(gr_rain_runoff_sample(s, outside, 2, got) == GR_ERR_INVALID_ARGUMENT);
+    CHECK_MSG(strstr(gr_rain_runoff_last_error(s), "(23, 0), outside the 23 x 17 grid") != NULL,
+              "'%s'", gr_rain_runoff_last_error(s));
+    CHECK(gr_rain_runoff_sample(s, NULL, 0, NULL) == GR_OK);
+    free(h);
+    free(z);
+    free(q);
+    free(b);
+    free(d0);
+    gr_rain_runoff_destroy(s);
+  }
+}
+
 /* Checkpoints: save at t1, run to t2, load, run to t2 again: the same bits
  * and ledger; loaded into a second simulation of the same grid and inputs:
  * the same bits again; bad sizes, headers and grids are refused with a
@@ -3263,6 +3313,7 @@ static const gr_subtest tests[] = {
     {"maps_arrival", test_maps_arrival, 0},
     {"maps_hazard", test_maps_hazard, 0},
     {"maps_reset", test_maps_reset, 0},
+    {"gauges", test_gauges, 0},
 };
 
 static int setup(void) {

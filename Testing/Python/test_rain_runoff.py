@@ -17,7 +17,8 @@ import gr_check as T  # noqa: E402
 a = T.args()
 
 from vtkmodules.util.numpy_support import vtk_to_numpy, numpy_to_vtk  # noqa: E402
-from vtkmodules.vtkCommonDataModel import vtkImageData  # noqa: E402
+from vtkmodules.vtkCommonCore import vtkPoints  # noqa: E402
+from vtkmodules.vtkCommonDataModel import vtkImageData, vtkPolyData  # noqa: E402
 from vtkmodules.vtkCommonExecutionModel import (  # noqa: E402
     vtkStreamingDemandDrivenPipeline as SDDP,
     vtkTrivialProducer,
@@ -436,6 +437,61 @@ for props, text in (({"WettingDepth": 0.0}, "WettingDepth must be above 0 m and 
     T.check(d is None and len(errs.messages) == 1 and text in errs.text()
             and hydrograph(g) == {}, "%r refused with one sentence, empty outputs: %r"
             % (props, errs.text()[:200]))
+
+# Gauges: three columns each in the hydrograph, the output's values at the
+# nearest terrain point at every output time, whatever the request order.
+def gauge_points(xy):
+    pts = vtkPoints()
+    for gx, gy in xy:
+        pts.InsertNextPoint(gx, gy, 0.0)
+    poly = vtkPolyData()
+    poly.SetPoints(pts)
+    return poly
+
+
+GAUGE_IJ = ((3, 4), (20, 16), (37, 29))
+# Off the lattice by less than half a spacing: each snaps to its point.
+gxy = [(100.0 + gi * DX + 0.4, -50.0 + gj * DX - 0.3) for gi, gj in GAUGE_IJ]
+
+
+def gauged(**kw):
+    f = rain(slope + bowl, RainRate=80.0, CheckpointInterval=2, DebrisFactor=0.5, **kw)
+    f.SetGaugesConnection(producer(gauge_points(gxy)).GetOutputPort())
+    return f
+
+
+ga = gauged()
+want = {}
+for t in TIMES:
+    d, out = at(ga, t)
+    z = vtk_to_numpy(out.GetPointData().GetArray("water_surface")).reshape(NY, NX)
+    q = vtk_to_numpy(out.GetPointData().GetArray("discharge")).reshape(NY, NX)
+    want[t] = [(d[gj, gi], z[gj, gi], q[gj, gi]) for gi, gj in GAUGE_IJ]
+rows = hydrograph(ga)
+ok = len(rows.get("gauge2_discharge", [])) == len(TIMES)
+for k, t in enumerate(TIMES):
+    for n_, (gi, gj) in enumerate(GAUGE_IJ):
+        got = tuple(rows["gauge%d_%s" % (n_, w)][k] for w in ("depth", "surface", "discharge"))
+        ok = ok and got == tuple(np.float32(v) for v in want[t][n_])
+T.check(ok, "gauge columns: the depth, surface and discharge of the output at each gauge, "
+        "every output time, to the bit")
+T.check(max(rows["gauge1_depth"]) > 0.0 and max(rows["gauge1_discharge"]) > 0.0,
+        "the middle gauge sees water and flow")
+T.check(np.array_equal(rows["outflow_rate"], fwd_hydro[60.0]["outflow_rate"]),
+        "gauges change no other column")
+gb = gauged()
+for t in (40.0, 10.0, 60.0):
+    at(gb, t)
+rows_b = hydrograph(gb)
+T.check(rows_b.keys() == rows.keys() and all(np.array_equal(rows_b[c], rows[c]) for c in rows),
+        "gauge columns the same after requests 40, 10, 60 s")
+off = rain(bowl)
+off.SetGaugesConnection(producer(gauge_points([(0.0, 0.0)])).GetOutputPort())
+errs = T.ErrorCatcher(off)
+d, _ = at(off, 10.0)
+T.check(d is None and len(errs.messages) == 1 and "Gauges point 0" in errs.text()
+        and "off the terrain" in errs.text(), "a gauge off the terrain refused: %r"
+        % errs.text()[:200])
 
 # ---- bad input: one sentence, an empty output, the next good update works ------
 bad_elev = bowl.copy()

@@ -1453,9 +1453,8 @@ void gr_rain_runoff_set_progress(gr_rain_runoff *s, gr_progress_fn fn, void *use
 /* ---------------------------------------------------------------- reading */
 
 /* Runs the derive kernel (what: 0 surface, 1 velocity, 2 discharge, 3
- * infiltrated) into the scratch buffer and reads the owned cells' `comps`
- * floats each back. */
-static gr_status gr_rain_runoff_derive(gr_rain_runoff *s, cl_int what, size_t comps, float *host) {
+ * infiltrated) into the scratch buffer. */
+static gr_status gr_rain_runoff_derive_run(gr_rain_runoff *s, cl_int what) {
   size_t cells = gr_rain_runoff_cells(s);
   gr_status st = GR_OK;
   if (!s->scratch)
@@ -1483,9 +1482,61 @@ static gr_status gr_rain_runoff_derive(gr_rain_runoff *s, cl_int what, size_t co
     st = GR_RAIN_RUNOFF_ARGS(s, s->derive, args);
   if (st == GR_OK)
     st = gr_enqueue_2d(s->ctx, s->derive, 0, 0, (size_t)nx, (size_t)ny, NULL);
+  return st;
+}
+
+/* derive_run, then the owned cells' `comps` floats each back. */
+static gr_status gr_rain_runoff_derive(gr_rain_runoff *s, cl_int what, size_t comps, float *host) {
+  gr_status st = gr_rain_runoff_derive_run(s, what);
   if (st == GR_OK)
     st = gr_rain_runoff_read_own(s, s->scratch, comps, host);
   return st;
+}
+
+static gr_status gr_rain_runoff_sample_impl(gr_rain_runoff *s, const int *ij, int n,
+                                            float *values) {
+  if (n < 0)
+    return gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
+                        "The number of points to sample must be 0 or more (got %d).", n);
+  for (int k = 0; k < n; ++k)
+    if (ij[2 * k] < 0 || ij[2 * k] >= s->grid.nx || ij[2 * k + 1] < 0 ||
+        ij[2 * k + 1] >= s->grid.ny)
+      return gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
+                          "Sample point %d is the cell (%d, %d), outside the %d x %d grid: give "
+                          "cells from (0, 0) to (%d, %d).",
+                          k, ij[2 * k], ij[2 * k + 1], s->grid.nx, s->grid.ny, s->grid.nx - 1,
+                          s->grid.ny - 1);
+  if (n == 0)
+    return GR_OK;
+  gr_status st = gr_rain_runoff_derive_run(s, 2);
+  for (int k = 0; st == GR_OK && k < n; ++k) {
+    /* The cell in the local array (past the ring). */
+    size_t c = ((size_t)ij[2 * k + 1] + (size_t)s->ring[2]) * (size_t)s->nxl + (size_t)ij[2 * k] +
+               (size_t)s->ring[0];
+    float h = 0.0f, b = 0.0f, q = 0.0f;
+    st = gr_buffer_read(s->ctx, s->h, c * sizeof(float), sizeof(float), &h);
+    if (st == GR_OK)
+      st = gr_buffer_read(s->ctx, s->b, c * sizeof(float), sizeof(float), &b);
+    if (st == GR_OK)
+      st = gr_buffer_read(s->ctx, s->scratch, c * sizeof(float), sizeof(float), &q);
+    /* The surface as WATER_SURFACE gives it: the float sum b + h. */
+    values[3 * k] = h;
+    values[3 * k + 1] = b + h;
+    values[3 * k + 2] = q;
+  }
+  return st;
+}
+
+gr_status gr_rain_runoff_sample(gr_rain_runoff *s, const int *ij, int n, float *values) {
+  if (!s)
+    return gr_set_error(NULL, GR_ERR_INVALID_ARGUMENT,
+                        "gr_rain_runoff_sample needs a simulation, the cells and room for values.");
+  if (n > 0 && (!ij || !values))
+    return GR_RAIN_RUNOFF_KEEP_ERROR(
+        s,
+        gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
+                     "gr_rain_runoff_sample needs a simulation, the cells and room for values."));
+  return GR_RAIN_RUNOFF_KEEP_ERROR(s, gr_rain_runoff_sample_impl(s, ij, n, values));
 }
 
 static gr_status gr_rain_runoff_get_field_impl(gr_rain_runoff *s, gr_field f, float *host) {

@@ -244,6 +244,16 @@ GR_API gr_status gr_rain_runoff_advance(gr_rain_runoff *s, double duration, int 
 /** Reads a field back (waits): nx*ny floats, 3*nx*ny for VELOCITY (a piece: its own cells). */
 GR_API gr_status gr_rain_runoff_get_field(gr_rain_runoff *s, gr_field f, float *host);
 
+/**
+ * Gauges: the state at n owned cells, given as (i, j) pairs in ij (2n ints;
+ * for a piece, its own cells from (0, 0)); values gets 3 floats per cell:
+ * the depth (m), the water surface (m) and the discharge |q| (m^2/s), the
+ * very floats get_field's WATER_DEPTH, WATER_SURFACE and DISCHARGE hold
+ * there. Reads a few floats only (waits), so it can follow every output of
+ * a large grid. A cell outside the grid is refused with a sentence.
+ */
+GR_API gr_status gr_rain_runoff_sample(gr_rain_runoff *s, const int *ij, int n, float *values);
+
 /** The ledger now (waits; reduces the volumes on the device). */
 GR_API gr_status gr_rain_runoff_ledger_get(gr_rain_runoff *s, gr_rain_runoff_ledger *out);
 
