@@ -2081,6 +2081,20 @@ static long piece_diff(piece *p, gr_rain_runoff *whole, const domain *dm, gr_fie
   return diff;
 }
 
+/* The same for flood map m. */
+static long piece_map_diff(piece *p, gr_rain_runoff *whole, const domain *dm,
+                           gr_rain_runoff_map m) {
+  float *w = get_map(whole, &dm->g, m), *v = get_map(p->s, &p->g, m);
+  long diff = 0;
+  for (int j = 0; j < p->g.ny; ++j)
+    for (int i = 0; i < p->g.nx; ++i)
+      diff += memcmp(&v[(size_t)j * p->g.nx + i],
+                     &w[(size_t)(p->g.j0 + j) * dm->g.nx + p->g.i0 + i], sizeof(float)) != 0;
+  free(w);
+  free(v);
+  return diff;
+}
+
 static void check_pieces(piece *pc, int n, gr_rain_runoff *whole, const domain *dm,
                          const char *what) {
   const gr_field fields[] = {GR_FIELD_WATER_DEPTH, GR_FIELD_VELOCITY, GR_FIELD_DISCHARGE,
@@ -2093,7 +2107,16 @@ static void check_pieces(piece *pc, int n, gr_rain_runoff *whole, const domain *
                 gr_field_name(fields[f]));
       total += d;
     }
-  printf("%s: %ld cells differ from the whole grid in any bit\n", what, total);
+  /* The flood maps too: each piece folds in its own cells' steps. */
+  for (int k = 0; k < n; ++k)
+    for (int m = 0; m < GR_RAIN_RUNOFF_MAP_COUNT; ++m) {
+      long d = piece_map_diff(&pc[k], whole, dm, (gr_rain_runoff_map)m);
+      CHECK_MSG(d == 0, "%s: piece %d: %ld cells of the map %s differ from the whole grid", what, k,
+                d, gr_rain_runoff_map_name((gr_rain_runoff_map)m));
+      total += d;
+    }
+  printf("%s: %ld cells (fields and flood maps) differ from the whole grid in any bit\n", what,
+         total);
 }
 
 /* Two halves split in x, stepped by one driver that exchanges the halo

@@ -750,8 +750,8 @@ rain_runoff_sw_speed(__global const float *restrict h, __global const float *res
  *
  * The cumulative maps (graupel/rain_runoff.h, "Flood maps"), updated after
  * every step from the state the step left, per cell and in place: each
- * work-item reads and writes its own cell only, so the 1-D launch needs no
- * atomics and gives the same floats whatever the work-group size. The
+ * work-item (i, j) reads and writes its own cell only, so the launch needs
+ * no atomics and gives the same floats whatever the work-group size. The
  * velocity is the one VELOCITY reads (rain_runoff_derive's): the cell's own
  * discharges for shallow water, the mean of its limited faces for the local
  * inertial model, over the depth, 0 below GR_RAIN_RUNOFF_VELOCITY_DEPTH.
@@ -768,15 +768,15 @@ __kernel void rain_runoff_maps(__global const float *restrict h, __global const 
                                __global float *restrict wet_time_comp,
                                __global float *restrict max_hazard, int nx, int ny, int sw,
                                float wetting_depth, float debris_factor, float time, float dt) {
-  int c = get_global_id(0);
-  if (c >= nx * ny)
+  int i = get_global_id(0), j = get_global_id(1);
+  if (!gr_inside(i, j, nx, ny))
     return;
+  int c = gr_idx(i, j, nx);
   float d = h[c], u, v;
   if (sw) {
     u = qu[c];
     v = qv[c];
   } else {
-    int i = c % nx, j = c / nx;
     float kc = limit[c];
     float fw =
         gr_rain_runoff_limited(qx[j * (nx + 1) + i], limit[gr_idx(max(i - 1, 0), j, nx)], kc);

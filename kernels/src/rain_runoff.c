@@ -480,9 +480,10 @@ static gr_status gr_rain_runoff_maps_update(gr_rain_runoff *s, double time, doub
   };
   if (st == GR_OK)
     st = GR_RAIN_RUNOFF_ARGS(s, s->maps, step);
-  /* Read-modify-write per cell: a 1-D launch runs each cell once. */
+  /* Read-modify-write per cell: the kernel takes (i, j) and leaves the
+   * padding of the rounded-up launch alone, so each cell runs once. */
   if (st == GR_OK)
-    st = gr_enqueue_1d(s->ctx, s->maps, gr_rain_runoff_cells(s));
+    st = gr_enqueue_2d(s->ctx, s->maps, 0, 0, (size_t)s->nxl, (size_t)s->nyl, NULL);
   return st;
 }
 
