@@ -24,6 +24,7 @@
 
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -495,9 +496,13 @@ int vtkRainRunoffFilter::FillHydrograph(vtkDataObject *tableObject) {
     const std::array<double, 6> &now = this->Ledgers[static_cast<size_t>(r)];
     const std::array<double, 6> &before = this->Ledgers[static_cast<size_t>(r > 0 ? r - 1 : 0)];
     const double span = now[0] - before[0];
-    // The mean rate over the interval that ends at this row (0 for row 0).
-    auto rate = [&](int i) { return span > 0.0 ? (now[i] - before[i]) / span : 0.0; };
-    const double values[] = {now[0], rate(1), 0.0, rate(2), rate(3), now[4], now[3], now[5]};
+    // The mean rate over the interval that ends at this row; no interval
+    // ends at row 0, whose rates are NaN (a line chart starts at row 1
+    // instead of ramping up from a 0 that never was).
+    const double none = std::numeric_limits<double>::quiet_NaN();
+    auto rate = [&](int i) { return span > 0.0 ? (now[i] - before[i]) / span : none; };
+    const double inflow = span > 0.0 ? 0.0 : none;
+    const double values[] = {now[0], rate(1), inflow, rate(2), rate(3), now[4], now[3], now[5]};
     for (int k = 0; k < columns; ++k) {
       c[static_cast<size_t>(k)]->SetValue(r, values[k]);
     }

@@ -37,7 +37,8 @@
  * `infiltration_rate` and `outflow_rate` (m^3/s over the domain: row k's is
  * the mean over the output interval that ends at its time, the ledger's
  * volume difference over the interval, so rate times interval sums to the
- * ledger's volume exactly; row 0's rates are 0), `stored_volume`,
+ * ledger's volume exactly; row 0's rates are NaN: no interval ends there),
+ * `stored_volume`,
  * `outflow_volume` and `balance_error` (m^3, the ledger at that time).
  * inflow_rate is 0 (the core has no inflows yet). Every row is the ledger
  * recorded when the state passed that output time; a checkpoint restored

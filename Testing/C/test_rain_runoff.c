@@ -1148,6 +1148,11 @@ static void test_memcheck(void) {
                              GR_FIELD_PERMEABILITY, GR_FIELD_RAIN_RATE};
   for (size_t f = 0; f < sizeof(fields) / sizeof(fields[0]); ++f)
     CHECK(gr_rain_runoff_get_field(s, fields[f], out) == GR_OK);
+  /* The flood maps and the gauges' reads. */
+  for (int m = 0; m < GR_RAIN_RUNOFF_MAP_COUNT; ++m)
+    CHECK(gr_rain_runoff_get_map(s, (gr_rain_runoff_map)m, out) == GR_OK);
+  const int gauge_ij[] = {0, 0, 5, 4, 2, 3};
+  CHECK(gr_rain_runoff_sample(s, gauge_ij, 3, out) == GR_OK);
   gr_rain_runoff_ledger l = ledger(s);
   CHECK(fabs(l.balance_error) <= 1e-5 * (l.initial_volume + l.rain_volume));
   CHECK(gr_rain_runoff_reset(s) == GR_OK);
