@@ -1,7 +1,9 @@
 #include "vtkRainRunoffFilter.h"
 
 #include "vtkAlgorithmOutput.h"
+#include "vtkDemandDrivenPipeline.h"
 #include "vtkDoubleArray.h"
+#include "vtkExecutive.h"
 #include "vtkFieldData.h"
 #include "vtkFloatArray.h"
 #include "vtkImageData.h"
@@ -10,8 +12,10 @@
 #include "vtkNew.h"
 #include "vtkObjectFactory.h"
 #include "vtkPointData.h"
+#include "vtkPointSet.h"
 #include "vtkSmartPointer.h"
 #include "vtkStreamingDemandDrivenPipeline.h"
+#include "vtkTable.h"
 
 #include "graupel/rain_runoff.h"
 
@@ -20,6 +24,8 @@
 
 #include <cmath>
 #include <cstring>
+#include <limits>
+#include <string>
 #include <vector>
 
 vtkStandardNewMacro(vtkRainRunoffFilter);
@@ -40,7 +46,8 @@ const gr_param_bound *Bound(const char *property) {
 } // namespace
 
 vtkRainRunoffFilter::vtkRainRunoffFilter() {
-  this->SetNumberOfInputPorts(2);
+  this->SetNumberOfInputPorts(3);
+  this->SetNumberOfOutputPorts(2);
 }
 
 // The core's parameter table clamps every property: the class writes no
@@ -52,15 +59,18 @@ GRAUPEL_TABLE_SETTER(vtkRainRunoffFilter, Boundary, int, gr_rain_runoff_param_bo
 GRAUPEL_TABLE_SETTER(vtkRainRunoffFilter, FlowModel, int, gr_rain_runoff_param_bounds)
 GRAUPEL_TABLE_SETTER(vtkRainRunoffFilter, MaxTimeStep, double, gr_rain_runoff_param_bounds)
 GRAUPEL_TABLE_SETTER(vtkRainRunoffFilter, CourantNumber, double, gr_rain_runoff_param_bounds)
+GRAUPEL_TABLE_SETTER(vtkRainRunoffFilter, WettingDepth, double, gr_rain_runoff_param_bounds)
+GRAUPEL_TABLE_SETTER(vtkRainRunoffFilter, DebrisFactor, double, gr_rain_runoff_param_bounds)
 
 int vtkRainRunoffFilter::CheckParameters() {
   const struct {
     const char *property;
     double value;
-  } values[] = {{"RainRate", this->RainRate},          {"Permeability", this->Permeability},
-                {"ManningN", this->ManningN},          {"Boundary", double(this->Boundary)},
-                {"MaxTimeStep", this->MaxTimeStep},    {"CourantNumber", this->CourantNumber},
-                {"FlowModel", double(this->FlowModel)}};
+  } values[] = {{"RainRate", this->RainRate},           {"Permeability", this->Permeability},
+                {"ManningN", this->ManningN},           {"Boundary", double(this->Boundary)},
+                {"MaxTimeStep", this->MaxTimeStep},     {"CourantNumber", this->CourantNumber},
+                {"FlowModel", double(this->FlowModel)}, {"WettingDepth", this->WettingDepth},
+                {"DebrisFactor", this->DebrisFactor}};
   for (const auto &p : values) {
     const gr_param_bound *b = Bound(p.property);
     if (!b) {
@@ -88,9 +98,74 @@ void vtkRainRunoffFilter::SetPermeabilityMapConnection(vtkAlgorithmOutput *outpu
   this->SetInputConnection(1, output);
 }
 
+void vtkRainRunoffFilter::SetGaugesConnection(vtkAlgorithmOutput *output) {
+  this->SetInputConnection(2, output);
+}
+
+int vtkRainRunoffFilter::FillOutputPortInformation(int port, vtkInformation *info) {
+  info->Set(vtkDataObject::DATA_TYPE_NAME(), port == 0 ? "vtkImageData" : "vtkTable");
+  return 1;
+}
+
+vtkTypeBool vtkRainRunoffFilter::ProcessRequest(vtkInformation *request,
+                                                vtkInformationVector **inInfo,
+                                                vtkInformationVector *outInfo) {
+  // A request from the hydrograph's port asks for the same time of the
+  // simulation, which the base reads from port 0.
+  if ((request->Has(vtkStreamingDemandDrivenPipeline::REQUEST_UPDATE_EXTENT()) ||
+       request->Has(vtkDemandDrivenPipeline::REQUEST_DATA())) &&
+      request->Has(vtkExecutive::FROM_OUTPUT_PORT()) &&
+      request->Get(vtkExecutive::FROM_OUTPUT_PORT()) == 1) {
+    vtkInformation *from = outInfo->GetInformationObject(1);
+    vtkInformation *to = outInfo->GetInformationObject(0);
+    if (from->Has(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP())) {
+      to->Set(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP(),
+              from->Get(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP()));
+    }
+  }
+  return this->Superclass::ProcessRequest(request, inInfo, outInfo);
+}
+
+int vtkRainRunoffFilter::RequestInformation(vtkInformation *request,
+                                            vtkInformationVector **inputVector,
+                                            vtkInformationVector *outputVector) {
+  const int ok = this->Superclass::RequestInformation(request, inputVector, outputVector);
+  // The hydrograph has the simulation's times, not the input's.
+  vtkInformation *image = outputVector->GetInformationObject(0);
+  vtkInformation *table = outputVector->GetInformationObject(1);
+  table->Remove(vtkStreamingDemandDrivenPipeline::TIME_STEPS());
+  table->Remove(vtkStreamingDemandDrivenPipeline::TIME_RANGE());
+  if (image->Has(vtkStreamingDemandDrivenPipeline::TIME_STEPS())) {
+    table->CopyEntry(image, vtkStreamingDemandDrivenPipeline::TIME_STEPS());
+    table->CopyEntry(image, vtkStreamingDemandDrivenPipeline::TIME_RANGE());
+  }
+  return ok;
+}
+
+int vtkRainRunoffFilter::RequestData(vtkInformation *request, vtkInformationVector **inputVector,
+                                     vtkInformationVector *outputVector) {
+  vtkInformation *tableInfo = outputVector->GetInformationObject(1);
+  if (vtkDataObject *table = tableInfo->Get(vtkDataObject::DATA_OBJECT())) {
+    table->Initialize();
+  }
+  this->OutputVector = outputVector;
+  this->HydrographFilled = false;
+  const int ok = this->Superclass::RequestData(request, inputVector, outputVector);
+  this->OutputVector = nullptr;
+  if (ok && this->HydrographFilled) {
+    vtkDataObject *image = outputVector->GetInformationObject(0)->Get(vtkDataObject::DATA_OBJECT());
+    vtkDataObject *table = tableInfo->Get(vtkDataObject::DATA_OBJECT());
+    if (image->GetInformation()->Has(vtkDataObject::DATA_TIME_STEP())) {
+      table->GetInformation()->Set(vtkDataObject::DATA_TIME_STEP(),
+                                   image->GetInformation()->Get(vtkDataObject::DATA_TIME_STEP()));
+    }
+  }
+  return ok;
+}
+
 int vtkRainRunoffFilter::FillInputPortInformation(int port, vtkInformation *info) {
-  info->Set(vtkAlgorithm::INPUT_REQUIRED_DATA_TYPE(), "vtkImageData");
-  if (port == 1) {
+  info->Set(vtkAlgorithm::INPUT_REQUIRED_DATA_TYPE(), port == 2 ? "vtkPointSet" : "vtkImageData");
+  if (port >= 1) {
     info->Set(vtkAlgorithm::INPUT_IS_OPTIONAL(), 1);
   }
   return 1;
@@ -194,9 +269,41 @@ int vtkRainRunoffFilter::SetUpState(vtkInformationVector **inputVector) {
   p.max_dt = this->MaxTimeStep;
   p.boundary = this->Boundary == CLOSED ? GR_BOUNDARY_CLOSED : GR_BOUNDARY_OPEN;
   p.flow_model = this->FlowModel == LOCAL_INERTIAL ? GR_FLOW_LOCAL_INERTIAL : GR_FLOW_SHALLOW_WATER;
+  p.wetting_depth = this->WettingDepth;
+  p.debris_factor = this->DebrisFactor;
   if (gr_rain_runoff_params_validate(&p, msg, sizeof(msg)) != GR_OK) {
     vtkErrorMacro("Rain Runoff: " << msg);
     return 0;
+  }
+
+  // Each gauge at its nearest terrain point.
+  this->GaugeCells.clear();
+  vtkPointSet *gauges = inputVector[2]->GetNumberOfInformationObjects()
+                            ? vtkPointSet::GetData(inputVector[2])
+                            : nullptr;
+  if (gauges) {
+    int ext[6];
+    terrain->GetExtent(ext);
+    const double *origin = terrain->GetOrigin();
+    for (vtkIdType k = 0; k < gauges->GetNumberOfPoints(); ++k) {
+      double x[3];
+      gauges->GetPoint(k, x);
+      const double fi = (x[0] - origin[0]) / spacing[0] - ext[0];
+      const double fj = (x[1] - origin[1]) / spacing[1] - ext[2];
+      const bool finite = std::isfinite(fi) && std::isfinite(fj);
+      const long long ci = finite ? std::llround(fi) : -1, cj = finite ? std::llround(fj) : -1;
+      if (ci < 0 || cj < 0 || ci >= dims[0] || cj >= dims[1]) {
+        vtkErrorMacro(
+            "Rain Runoff's Gauges point "
+            << k << " at (" << x[0] << ", " << x[1] << ") lies off the terrain (x "
+            << origin[0] + ext[0] * spacing[0] << " to " << origin[0] + ext[1] * spacing[0]
+            << " m, y " << origin[1] + ext[2] * spacing[1] << " to "
+            << origin[1] + ext[3] * spacing[1] << " m); move it onto the terrain or remove it.");
+        return 0;
+      }
+      this->GaugeCells.push_back(static_cast<int>(ci));
+      this->GaugeCells.push_back(static_cast<int>(cj));
+    }
   }
 
   gr_grid grid;
@@ -214,12 +321,42 @@ int vtkRainRunoffFilter::SetUpState(vtkInformationVector **inputVector) {
   }
   // Progress with the simulated time, and an abort inside a long interval.
   gr_rain_runoff_set_progress(this->Simulation, &vtkGraupelSimulation::CoreProgress, this);
+  this->Ledgers.clear();
+  this->GaugeRows.clear();
+  return this->RecordLedger(0);
+}
+
+int vtkRainRunoffFilter::RecordLedger(int index) {
+  gr_rain_runoff_ledger ledger;
+  const gr_status st = gr_rain_runoff_ledger_get(this->Simulation, &ledger);
+  if (st != GR_OK) {
+    return this->ReportFailure(st, "Rain Runoff could not read its ledger",
+                               gr_rain_runoff_last_error(this->Simulation));
+  }
+  if (this->Ledgers.size() <= static_cast<size_t>(index)) {
+    this->Ledgers.resize(static_cast<size_t>(index) + 1);
+  }
+  this->Ledgers[static_cast<size_t>(index)] = {this->GetOutputTime(index), ledger.rain_volume,
+                                               ledger.infiltrated_volume,  ledger.outflow_volume,
+                                               ledger.stored_volume,       ledger.balance_error};
+  const int gauges = static_cast<int>(this->GaugeCells.size() / 2);
+  if (this->GaugeRows.size() <= static_cast<size_t>(index)) {
+    this->GaugeRows.resize(static_cast<size_t>(index) + 1);
+  }
+  std::vector<float> &row = this->GaugeRows[static_cast<size_t>(index)];
+  row.assign(3 * static_cast<size_t>(gauges), 0.0f);
+  const gr_status sst =
+      gr_rain_runoff_sample(this->Simulation, this->GaugeCells.data(), gauges, row.data());
+  if (sst != GR_OK) {
+    return this->ReportFailure(sst, "Rain Runoff could not read its gauges",
+                               gr_rain_runoff_last_error(this->Simulation));
+  }
   return 1;
 }
 
 int vtkRainRunoffFilter::ResetState() {
   const gr_status st = gr_rain_runoff_reset(this->Simulation);
-  return st == GR_OK ? 1
+  return st == GR_OK ? this->RecordLedger(0)
                      : this->ReportFailure(st, "Rain Runoff could not restart",
                                            gr_rain_runoff_last_error(this->Simulation));
 }
@@ -229,9 +366,16 @@ int vtkRainRunoffFilter::AdvanceState(double t0, double t1) {
   if (st == GR_ERR_ABORTED) {
     return ADVANCE_ABORTED;
   }
-  return st == GR_OK ? ADVANCE_DONE
-                     : this->ReportFailure(st, "Rain Runoff could not advance",
-                                           gr_rain_runoff_last_error(this->Simulation));
+  if (st != GR_OK) {
+    return this->ReportFailure(st, "Rain Runoff could not advance",
+                               gr_rain_runoff_last_error(this->Simulation));
+  }
+  // At an output time (the base's own test of the knot), the hydrograph's row.
+  const int next = this->GetStateIndex() + 1;
+  if (t1 == this->GetOutputTime(next) && !this->RecordLedger(next)) {
+    return ADVANCE_FAILED;
+  }
+  return ADVANCE_DONE;
 }
 
 int vtkRainRunoffFilter::SaveState(std::vector<unsigned char> &bytes) {
@@ -277,6 +421,110 @@ int vtkRainRunoffFilter::FillOutput(vtkDataObject *outputObject, vtkInformation 
   AddValue(fd, "stored_volume", ledger.stored_volume);
   AddValue(fd, "balance_error", ledger.balance_error);
   AddValue(fd, "max_depth", ledger.max_depth);
+  if (!this->AddMaps(output)) {
+    return 0;
+  }
+  if (this->OutputVector) {
+    vtkDataObject *table =
+        this->OutputVector->GetInformationObject(1)->Get(vtkDataObject::DATA_OBJECT());
+    if (!this->FillHydrograph(table)) {
+      return 0;
+    }
+    this->HydrographFilled = true;
+  }
+  return 1;
+}
+
+int vtkRainRunoffFilter::AddMaps(vtkDataObject *outputObject) {
+  vtkImageData *output = vtkImageData::SafeDownCast(outputObject);
+  vtkImageData *input = vtkImageData::GetData(this->GetInputInformation(0, 0));
+  if (!output || !input) {
+    return 0;
+  }
+  int in[6], out[6], dims[3];
+  input->GetExtent(in);
+  output->GetExtent(out);
+  input->GetDimensions(dims);
+  const size_t n = static_cast<size_t>(dims[0]) * static_cast<size_t>(dims[1]);
+  std::vector<float> whole(n);
+  const vtkIdType w = out[1] - out[0] + 1, h = out[3] - out[2] + 1;
+  for (int m = 0; m < GR_RAIN_RUNOFF_MAP_COUNT; ++m) {
+    const gr_rain_runoff_map map = static_cast<gr_rain_runoff_map>(m);
+    const gr_status st = gr_rain_runoff_get_map(this->Simulation, map, whole.data());
+    if (st != GR_OK) {
+      return this->ReportFailure(st, "Rain Runoff could not read its flood maps",
+                                 gr_rain_runoff_last_error(this->Simulation));
+    }
+    vtkNew<vtkFloatArray> a;
+    a->SetName(gr_rain_runoff_map_name(map));
+    a->SetNumberOfTuples(w > 0 && h > 0 ? w * h : 0);
+    // The output is the requested piece of the whole grid (FillImage's crop).
+    for (vtkIdType j = 0; j < h; ++j) {
+      for (vtkIdType i = 0; i < w; ++i) {
+        const size_t src = static_cast<size_t>(out[2] - in[2] + j) * static_cast<size_t>(dims[0]) +
+                           static_cast<size_t>(out[0] - in[0] + i);
+        a->SetValue(j * w + i, whole[src]);
+      }
+    }
+    output->GetPointData()->AddArray(a);
+  }
+  return 1;
+}
+
+int vtkRainRunoffFilter::FillHydrograph(vtkDataObject *tableObject) {
+  vtkTable *table = vtkTable::SafeDownCast(tableObject);
+  if (!table) {
+    return 1; // a pipeline that asked for the image only
+  }
+  const int rows = this->GetStateIndex() + 1;
+  if (rows < 1 || this->Ledgers.size() < static_cast<size_t>(rows) ||
+      this->GaugeRows.size() < static_cast<size_t>(rows)) {
+    vtkErrorMacro("Rain Runoff's hydrograph lacks the ledger of an output time before "
+                  << this->GetStateTime() << " s; this is a bug: please report it.");
+    return 0;
+  }
+  const char *names[] = {"time",         "rain_rate",     "inflow_rate",    "infiltration_rate",
+                         "outflow_rate", "stored_volume", "outflow_volume", "balance_error"};
+  const int columns = static_cast<int>(sizeof(names) / sizeof(names[0]));
+  std::vector<vtkSmartPointer<vtkDoubleArray>> c(static_cast<size_t>(columns));
+  for (int k = 0; k < columns; ++k) {
+    c[static_cast<size_t>(k)] = vtkSmartPointer<vtkDoubleArray>::New();
+    c[static_cast<size_t>(k)]->SetName(names[k]);
+    c[static_cast<size_t>(k)]->SetNumberOfTuples(rows);
+  }
+  for (int r = 0; r < rows; ++r) {
+    const std::array<double, 6> &now = this->Ledgers[static_cast<size_t>(r)];
+    const std::array<double, 6> &before = this->Ledgers[static_cast<size_t>(r > 0 ? r - 1 : 0)];
+    const double span = now[0] - before[0];
+    // The mean rate over the interval that ends at this row; no interval
+    // ends at row 0, whose rates are NaN (a line chart starts at row 1
+    // instead of ramping up from a 0 that never was).
+    const double none = std::numeric_limits<double>::quiet_NaN();
+    auto rate = [&](int i) { return span > 0.0 ? (now[i] - before[i]) / span : none; };
+    const double inflow = span > 0.0 ? 0.0 : none;
+    const double values[] = {now[0], rate(1), inflow, rate(2), rate(3), now[4], now[3], now[5]};
+    for (int k = 0; k < columns; ++k) {
+      c[static_cast<size_t>(k)]->SetValue(r, values[k]);
+    }
+  }
+  for (int k = 0; k < columns; ++k) {
+    table->AddColumn(c[static_cast<size_t>(k)]);
+  }
+  // Three columns per gauge.
+  const int gauges = static_cast<int>(this->GaugeCells.size() / 2);
+  const char *what[] = {"depth", "surface", "discharge"};
+  for (int gk = 0; gk < gauges; ++gk) {
+    for (int w = 0; w < 3; ++w) {
+      vtkNew<vtkFloatArray> a;
+      a->SetName(("gauge" + std::to_string(gk) + "_" + what[w]).c_str());
+      a->SetNumberOfTuples(rows);
+      for (int r = 0; r < rows; ++r) {
+        const std::vector<float> &g = this->GaugeRows[static_cast<size_t>(r)];
+        a->SetValue(r, g[3 * static_cast<size_t>(gk) + static_cast<size_t>(w)]);
+      }
+      table->AddColumn(a);
+    }
+  }
   return 1;
 }
 
@@ -296,4 +544,6 @@ void vtkRainRunoffFilter::PrintSelf(ostream &os, vtkIndent indent) {
      << "\n";
   os << indent << "MaxTimeStep: " << this->MaxTimeStep << " s\n";
   os << indent << "CourantNumber: " << this->CourantNumber << "\n";
+  os << indent << "WettingDepth: " << this->WettingDepth << " m\n";
+  os << indent << "DebrisFactor: " << this->DebrisFactor << "\n";
 }

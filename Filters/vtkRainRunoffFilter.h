@@ -23,6 +23,36 @@
  * (m^3, double) and `max_depth` (m). The model, its deviation from the seed
  * and its conservation are described in kernels/include/graupel/rain_runoff.h.
  *
+ * Flood maps (point arrays of output 0, cumulative since time 0, the core's
+ * gr_rain_runoff_get_map, documented in rain_runoff.h): `max_depth` (m),
+ * `max_speed` (m/s), `arrival_time` (s, NaN where the depth never exceeded
+ * WettingDepth), `wet_duration` (s), `hazard_rating` (the largest UK
+ * Defra/EA FD2321 rating h (v + 0.5) + DF, DF = DebrisFactor where h > 0.25
+ * m) and `hazard_class` (0 low, 1 moderate, 2 significant, 3 extreme).
+ * They live in the core's checkpointed state, so they are the same
+ * whatever the order in which times are requested.
+ *
+ * Output 1 (`Hydrograph`) is a vtkTable with one row per output time up to
+ * the requested one: `time` (s), `rain_rate`, `inflow_rate`,
+ * `infiltration_rate` and `outflow_rate` (m^3/s over the domain: row k's is
+ * the mean over the output interval that ends at its time, the ledger's
+ * volume difference over the interval, so rate times interval sums to the
+ * ledger's volume exactly; row 0's rates are NaN: no interval ends there),
+ * `stored_volume`,
+ * `outflow_volume` and `balance_error` (m^3, the ledger at that time).
+ * inflow_rate is 0 (the core has no inflows yet). Every row is the ledger
+ * recorded when the state passed that output time; a checkpoint restored
+ * or a restart re-records the same values (the steps are the same), so the
+ * table does not depend on the order of requests either.
+ *
+ * Input 2 (`Gauges`, optional) is a point set: each point is snapped to the
+ * nearest terrain point (a point beyond the terrain is refused with a
+ * sentence), and the hydrograph gets three columns per gauge k,
+ * `gauge<k>_depth` (m), `gauge<k>_surface` (m) and `gauge<k>_discharge`
+ * (m^2/s, |q|), the output fields' values there at each output time (read
+ * with gr_rain_runoff_sample: a few floats per output, whatever the grid).
+ * Gauges are a static input: moving them sets the simulation up again.
+ *
  * Time is handled by vtkGraupelSimulation: request a time with
  * UpdateTimeStep(t) (ParaView's animation does it). Checkpoints are the
  * core's gr_rain_runoff_state_save/load; an abort is honoured inside an
@@ -39,6 +69,9 @@
 
 #include "GraupelFiltersModule.h"
 #include "vtkGraupelSimulation.h"
+
+#include <array>
+#include <vector>
 
 struct gr_rain_runoff;
 
@@ -93,14 +126,35 @@ public:
   vtkGetMacro(CourantNumber, double);
   ///@}
 
+  ///@{
+  /** Depth above which a point is wet for arrival_time and wet_duration, m (default 0.01). */
+  virtual void SetWettingDepth(double value);
+  vtkGetMacro(WettingDepth, double);
+  ///@}
+
+  ///@{
+  /** FD2321's debris factor, added to the hazard rating where the depth exceeds 0.25 m (default 0).
+   */
+  virtual void SetDebrisFactor(double value);
+  vtkGetMacro(DebrisFactor, double);
+  ///@}
+
   /** Connects the optional permeability map (input port 1). */
   void SetPermeabilityMapConnection(vtkAlgorithmOutput *output);
+  /** Connects the optional gauge points (input port 2). */
+  void SetGaugesConnection(vtkAlgorithmOutput *output);
 
 protected:
   vtkRainRunoffFilter();
   ~vtkRainRunoffFilter() override;
 
   int FillInputPortInformation(int port, vtkInformation *info) override;
+  int FillOutputPortInformation(int port, vtkInformation *info) override;
+  vtkTypeBool ProcessRequest(vtkInformation *request, vtkInformationVector **inInfo,
+                             vtkInformationVector *outInfo) override;
+  int RequestInformation(vtkInformation *, vtkInformationVector **,
+                         vtkInformationVector *) override;
+  int RequestData(vtkInformation *, vtkInformationVector **, vtkInformationVector *) override;
 
   int SetUpState(vtkInformationVector **inputVector) override;
   int ResetState() override;
@@ -118,6 +172,8 @@ protected:
   int FlowModel = SHALLOW_WATER;
   double MaxTimeStep = 1.0;
   double CourantNumber = 0.7;
+  double WettingDepth = 0.01;
+  double DebrisFactor = 0.0;
 
 private:
   vtkRainRunoffFilter(const vtkRainRunoffFilter &) = delete;
@@ -126,7 +182,23 @@ private:
   /** 0 with one sentence in the user's unit when a property is out of its range. */
   int CheckParameters();
 
+  /** Records the ledger as the hydrograph's row `index`; 0 with the core's sentence. */
+  int RecordLedger(int index);
+  /** Fills the hydrograph table with rows 0 to the state's output index. */
+  int FillHydrograph(vtkDataObject *table);
+  /** Adds the flood maps to the image output, on its extent. */
+  int AddMaps(vtkDataObject *output);
+
   gr_rain_runoff *Simulation = nullptr;
+  /** The ledger's volumes at each output time passed: time, rain, infiltrated,
+   *  outflow, stored, balance error. */
+  std::vector<std::array<double, 6>> Ledgers;
+  /** The gauges' grid points, (i, j) pairs, and per output time their depth,
+   *  surface and discharge (3 floats per gauge). */
+  std::vector<int> GaugeCells;
+  std::vector<std::vector<float>> GaugeRows;
+  vtkInformationVector *OutputVector = nullptr; // during RequestData only
+  bool HydrographFilled = false;
 };
 
 #endif

@@ -53,7 +53,8 @@ static int params_documented(const gr_rain_runoff_params *p) {
   return in_row("RainRate", p->rain_rate) && in_row("Permeability", p->permeability) &&
          in_row("ManningN", p->manning_n) && in_row("CourantNumber", p->cfl) &&
          in_row("MaxTimeStep", p->max_dt) && in_row("Boundary", (double)boundary) &&
-         in_row("FlowModel", (double)model) && (model != 1 || p->manning_n >= 0.005);
+         in_row("FlowModel", (double)model) && in_row("WettingDepth", p->wetting_depth) &&
+         in_row("DebrisFactor", p->debris_factor) && (model != 1 || p->manning_n >= 0.005);
 }
 
 static int field_documented(gr_field f, const float *v, size_t n) {
@@ -85,7 +86,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
   const int mode = take_byte(&r) % 2;
   const size_t small_len = take_byte(&r) % 96;
   const gr_field f = (gr_field)(take_byte(&r) % (GR_FIELD_COUNT + 1));
-  double *d[5];
+  double *d[7];
 
   memset(&p, 0, sizeof p);
   d[0] = &p.rain_rate;
@@ -93,7 +94,9 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
   d[2] = &p.manning_n;
   d[3] = &p.cfl;
   d[4] = &p.max_dt;
-  for (int k = 0; k < 5; ++k) {
+  d[5] = &p.wetting_depth;
+  d[6] = &p.debris_factor;
+  for (int k = 0; k < 7; ++k) {
     if (mode == 0)
       take(&r, d[k], sizeof(double));
     else

@@ -17,7 +17,8 @@ import gr_check as T  # noqa: E402
 a = T.args()
 
 from vtkmodules.util.numpy_support import vtk_to_numpy, numpy_to_vtk  # noqa: E402
-from vtkmodules.vtkCommonDataModel import vtkImageData  # noqa: E402
+from vtkmodules.vtkCommonCore import vtkPoints  # noqa: E402
+from vtkmodules.vtkCommonDataModel import vtkImageData, vtkPolyData  # noqa: E402
 from vtkmodules.vtkCommonExecutionModel import (  # noqa: E402
     vtkStreamingDemandDrivenPipeline as SDDP,
     vtkTrivialProducer,
@@ -327,6 +328,172 @@ T.check(np.allclose(v0[wet, 0], 0.5, atol=1e-5) and np.all(v0[..., 1] == 0.0),
 m20, _ = at(moving, 20.0)
 still, _ = at(started({"elevation": bowl, "water_depth": depth}, RainRate=0.0), 20.0)
 T.check(m20 is not None and not np.array_equal(m20, still), "moving water moves")
+
+# ---- flood maps and the hydrograph: the same whatever the request order ----------
+MAPS = ("max_depth", "max_speed", "arrival_time", "wet_duration", "hazard_rating", "hazard_class")
+
+
+def maps_of(out):
+    nx, ny, _ = out.GetDimensions()
+    return {m: vtk_to_numpy(out.GetPointData().GetArray(m)).reshape(ny, nx).copy() for m in MAPS}
+
+
+def hydrograph(f):
+    t = f.GetOutputDataObject(1)
+    return {t.GetColumnName(k): vtk_to_numpy(t.GetColumn(k)).copy()
+            for k in range(t.GetNumberOfColumns())}
+
+
+TIMES = (0.0, 10.0, 20.0, 30.0, 40.0, 50.0, 60.0)
+fm = rain(slope + bowl, RainRate=80.0, CheckpointInterval=2, DebrisFactor=0.5)
+fwd_maps, fwd_depth, fwd_hydro, fwd_out = {}, {}, {}, {}
+for t in TIMES:
+    d, out = at(fm, t)
+    fwd_depth[t], fwd_maps[t], fwd_hydro[t] = d, maps_of(out), hydrograph(fm)
+    fwd_out[t] = field(out, "outflow_volume")
+T.check(all(np.all(fwd_maps[t]["max_depth"] >= fwd_depth[t]) for t in TIMES),
+        "max_depth >= the depth at every output time")
+T.check(all(np.all(fwd_maps[b]["max_depth"] >= fwd_maps[a]["max_depth"])
+            for a, b in zip(TIMES, TIMES[1:])), "max_depth never falls")
+m60 = fwd_maps[60.0]
+wet60 = ~np.isnan(m60["arrival_time"])
+T.check(wet60.any() and (~wet60).any() and np.all(m60["arrival_time"][wet60] <= 60.0)
+        and np.all(m60["wet_duration"][~wet60] == 0.0),
+        "arrival_time: NaN where never wet (%d of %d points wet at 60 s)" % (wet60.sum(), wet60.size))
+T.check(np.all(m60["wet_duration"] <= 60.0 + 1.0) and float(m60["wet_duration"].max()) > 0.0,
+        "wet_duration within the run: up to %g s" % float(m60["wet_duration"].max()))
+cls = np.select([m60["hazard_rating"] > 2.0, m60["hazard_rating"] >= 1.25,
+                 m60["hazard_rating"] >= 0.75], [3, 2, 1], 0)
+T.check(np.array_equal(cls, m60["hazard_class"]), "hazard_class is FD2321's class of hazard_rating")
+T.check(np.all(m60["hazard_rating"] >= m60["max_depth"] * 0.5 - 1e-6),
+        "hazard_rating >= h 0.5 at the deepest (v >= 0)")
+T.check(len(fwd_hydro[60.0]["time"]) == 7 and len(fwd_hydro[20.0]["time"]) == 3
+        and list(fwd_hydro[60.0]["time"]) == list(TIMES), "one hydrograph row per output time so far")
+mm = rain(slope + bowl, RainRate=80.0, CheckpointInterval=2, DebrisFactor=0.5)
+order = (60.0, 20.0, 50.0, 0.0, 30.0, 10.0, 40.0, 40.0)
+same_maps, same_rows = True, True
+for t in order:
+    d, out = at(mm, t)
+    got, rows = maps_of(out), hydrograph(mm)
+    same_maps = same_maps and all(np.array_equal(got[m], fwd_maps[t][m], equal_nan=True)
+                                  for m in MAPS)
+    same_rows = same_rows and rows.keys() == fwd_hydro[t].keys() and all(
+        np.array_equal(rows[c], fwd_hydro[t][c], equal_nan=True) for c in rows)
+T.check(same_maps, "the six maps equal the forward run's bit for bit for requests %r" % (order,))
+T.check(same_rows, "the hydrograph equals the forward run's bit for bit for requests %r" % (order,))
+T.check(mm.GetRestoreCount() > 0, "going back restored checkpoints (%d)" % mm.GetRestoreCount())
+
+# The hydrograph: outflow_rate is each interval's mean, so it integrates to
+# the ledger's outflow_volume; the rain likewise.
+h = fwd_hydro[60.0]
+dt_rows = np.diff(h["time"])
+out_int = float(np.sum(h["outflow_rate"][1:] * dt_rows))
+T.check(fwd_out[60.0] > 0.0 and abs(out_int - fwd_out[60.0]) <= 1e-6 * fwd_out[60.0],
+        "outflow_rate integrates to outflow_volume: %.9g vs %.9g m^3" % (out_int, fwd_out[60.0]))
+rain_int = float(np.sum(h["rain_rate"][1:] * dt_rows))
+rain_q = 80.0 * MM_PER_H * NX * NY * DX * DX
+T.check(abs(rain_int - rain_q * 60.0) <= 1e-6 * rain_q * 60.0 and
+        np.allclose(h["rain_rate"][1:], rain_q, rtol=1e-6),
+        "rain_rate %g m^3/s = rate x area, integrating to the rain (%g m^3)" % (h["rain_rate"][1], rain_int))
+T.check(all(np.isnan(h[c][0]) for c in ("rain_rate", "inflow_rate", "infiltration_rate",
+                                          "outflow_rate")) and np.all(h["inflow_rate"][1:] == 0.0),
+        "row 0 ends no interval: its rates are NaN; no inflows yet")
+T.check(np.all(np.abs(h["balance_error"]) <= 1e-5 * rain_q * 60.0)
+        and np.all(np.diff(h["outflow_volume"]) >= 0.0), "balance_error small, outflow_volume grows")
+T.check(abs(h["stored_volume"][-1] - (rain_int - fwd_out[60.0] - h["balance_error"][-1]))
+        <= 1e-6 * rain_int, "stored = rain - outflow - balance error")
+# Asking the hydrograph's port for a time runs the simulation to it.
+hp = rain(slope + bowl, RainRate=80.0, DebrisFactor=0.5)
+hp.UpdateInformation()
+hp.GetOutputInformation(1).Set(SDDP.UPDATE_TIME_STEP(), 40.0)
+hp.Update(1)
+rows = hydrograph(hp)
+T.check(len(rows.get("time", [])) == 5 and np.array_equal(
+    rows["outflow_rate"], fwd_hydro[40.0]["outflow_rate"], equal_nan=True),
+        "the Hydrograph port at 40 s: 5 rows, those of the forward run")
+tab = hp.GetOutputDataObject(1)
+T.check(tab.GetInformation().Get(tab.DATA_TIME_STEP()) == 40.0,
+        "the table carries its time")
+# The local inertial model keeps maps too, and in any order.
+li1 = rain(slope + bowl, RainRate=80.0, FlowModel=1)
+li2 = rain(slope + bowl, RainRate=80.0, FlowModel=1)
+a40 = maps_of(at(li1, 40.0)[1])
+at(li2, 60.0)
+b40 = maps_of(at(li2, 40.0)[1])
+T.check(all(np.array_equal(a40[m], b40[m], equal_nan=True) for m in MAPS)
+        and float(a40["max_depth"].max()) > 0.0, "local inertial: the maps at 40 s, forward = backward")
+
+# WettingDepth and DebrisFactor: the defaults, a clamp, a sentence.
+g = vtkRainRunoffFilter()
+T.check(g.GetWettingDepth() == 0.01 and g.GetDebrisFactor() == 0.0,
+        "defaults WettingDepth 0.01 m, DebrisFactor 0")
+g.SetDebrisFactor(-1.0)
+T.check(g.GetDebrisFactor() == 0.0, "DebrisFactor -1 clamps to 0")
+for props, text in (({"WettingDepth": 0.0}, "WettingDepth must be above 0 m and up to 10 m; it is 0 m"),
+                    ({"WettingDepth": -0.5}, "WettingDepth must be above 0 m"),
+                    ({"DebrisFactor": float("nan")}, "DebrisFactor must be from 0 to 1")):
+    g = rain(bowl, **props)
+    errs = T.ErrorCatcher(g)
+    d, out = at(g, 10.0)
+    T.check(d is None and len(errs.messages) == 1 and text in errs.text()
+            and hydrograph(g) == {}, "%r refused with one sentence, empty outputs: %r"
+            % (props, errs.text()[:200]))
+
+# Gauges: three columns each in the hydrograph, the output's values at the
+# nearest terrain point at every output time, whatever the request order.
+def gauge_points(xy):
+    pts = vtkPoints()
+    for gx, gy in xy:
+        pts.InsertNextPoint(gx, gy, 0.0)
+    poly = vtkPolyData()
+    poly.SetPoints(pts)
+    return poly
+
+
+GAUGE_IJ = ((3, 4), (20, 16), (37, 29))
+# Off the lattice by less than half a spacing: each snaps to its point.
+gxy = [(100.0 + gi * DX + 0.4, -50.0 + gj * DX - 0.3) for gi, gj in GAUGE_IJ]
+
+
+def gauged(**kw):
+    f = rain(slope + bowl, RainRate=80.0, CheckpointInterval=2, DebrisFactor=0.5, **kw)
+    f.SetGaugesConnection(producer(gauge_points(gxy)).GetOutputPort())
+    return f
+
+
+ga = gauged()
+want = {}
+for t in TIMES:
+    d, out = at(ga, t)
+    z = vtk_to_numpy(out.GetPointData().GetArray("water_surface")).reshape(NY, NX)
+    q = vtk_to_numpy(out.GetPointData().GetArray("discharge")).reshape(NY, NX)
+    want[t] = [(d[gj, gi], z[gj, gi], q[gj, gi]) for gi, gj in GAUGE_IJ]
+rows = hydrograph(ga)
+ok = len(rows.get("gauge2_discharge", [])) == len(TIMES)
+for k, t in enumerate(TIMES):
+    for n_, (gi, gj) in enumerate(GAUGE_IJ):
+        got = tuple(rows["gauge%d_%s" % (n_, w)][k] for w in ("depth", "surface", "discharge"))
+        ok = ok and got == tuple(np.float32(v) for v in want[t][n_])
+T.check(ok, "gauge columns: the depth, surface and discharge of the output at each gauge, "
+        "every output time, to the bit")
+T.check(max(rows["gauge1_depth"]) > 0.0 and max(rows["gauge1_discharge"]) > 0.0,
+        "the middle gauge sees water and flow")
+T.check(np.array_equal(rows["outflow_rate"], fwd_hydro[60.0]["outflow_rate"], equal_nan=True),
+        "gauges change no other column")
+gb = gauged()
+for t in (40.0, 10.0, 60.0):
+    at(gb, t)
+rows_b = hydrograph(gb)
+T.check(rows_b.keys() == rows.keys() and all(np.array_equal(rows_b[c], rows[c], equal_nan=True)
+                                             for c in rows),
+        "gauge columns the same after requests 40, 10, 60 s")
+off = rain(bowl)
+off.SetGaugesConnection(producer(gauge_points([(0.0, 0.0)])).GetOutputPort())
+errs = T.ErrorCatcher(off)
+d, _ = at(off, 10.0)
+T.check(d is None and len(errs.messages) == 1 and "Gauges point 0" in errs.text()
+        and "off the terrain" in errs.text(), "a gauge off the terrain refused: %r"
+        % errs.text()[:200])
 
 # ---- bad input: one sentence, an empty output, the next good update works ------
 bad_elev = bowl.copy()

@@ -745,3 +745,69 @@ rain_runoff_sw_speed(__global const float *restrict h, __global const float *res
   mine[1] = rate;
   gr_reduce_group(scratch, 0, 2, partial);
 }
+
+/* ------------------------------------------------------- flood maps
+ *
+ * The cumulative maps (graupel/rain_runoff.h, "Flood maps"), updated after
+ * every step from the state the step left, per cell and in place: each
+ * work-item (i, j) reads and writes its own cell only, so the launch needs
+ * no atomics and gives the same floats whatever the work-group size. The
+ * velocity is the one VELOCITY reads (rain_runoff_derive's): the cell's own
+ * discharges for shallow water, the mean of its limited faces for the local
+ * inertial model, over the depth, 0 below GR_RAIN_RUNOFF_VELOCITY_DEPTH.
+ * arrival < 0 means "never wet" (the host reads it as NaN: a NaN would not
+ * survive a compiler's finite-math assumptions). dt = 0 folds the present
+ * state in without adding time (after a reset or a new initial depth). */
+__kernel void rain_runoff_maps(__global const float *restrict h, __global const float *restrict qu,
+                               __global const float *restrict qv, __global const float *restrict qx,
+                               __global const float *restrict qy,
+                               __global const float *restrict limit,
+                               __global float *restrict max_depth,
+                               __global float *restrict max_speed, __global float *restrict arrival,
+                               __global float *restrict wet_time,
+                               __global float *restrict wet_time_comp,
+                               __global float *restrict max_hazard, int nx, int ny, int sw,
+                               float wetting_depth, float debris_factor, float time, float dt) {
+  int i = get_global_id(0), j = get_global_id(1);
+  if (!gr_inside(i, j, nx, ny))
+    return;
+  int c = gr_idx(i, j, nx);
+  float d = h[c], u, v;
+  if (sw) {
+    u = qu[c];
+    v = qv[c];
+  } else {
+    float kc = limit[c];
+    float fw =
+        gr_rain_runoff_limited(qx[j * (nx + 1) + i], limit[gr_idx(max(i - 1, 0), j, nx)], kc);
+    float fe = gr_rain_runoff_limited(qx[j * (nx + 1) + i + 1], kc,
+                                      limit[gr_idx(min(i + 1, nx - 1), j, nx)]);
+    float fs = gr_rain_runoff_limited(qy[j * nx + i], limit[gr_idx(i, max(j - 1, 0), nx)], kc);
+    float fn =
+        gr_rain_runoff_limited(qy[(j + 1) * nx + i], kc, limit[gr_idx(i, min(j + 1, ny - 1), nx)]);
+    u = 0.5f * (fw + fe);
+    v = 0.5f * (fs + fn);
+  }
+  int moving = d >= GR_RAIN_RUNOFF_VELOCITY_DEPTH;
+  float ux = moving ? u / d : 0.0f, vy = moving ? v / d : 0.0f;
+  float speed = sqrt(ux * ux + vy * vy);
+  /* FD2321's debris factor applies above 0.25 m only (its table gives 0
+   * below that depth for every land use). */
+  float hazard = d * (speed + 0.5f) + (d > GR_RAIN_RUNOFF_DEBRIS_DEPTH ? debris_factor : 0.0f);
+  /* Stores only where a value changes: past the peak most cells write
+   * nothing, which keeps the launch's traffic near its reads. */
+  if (d > max_depth[c])
+    max_depth[c] = d;
+  /* The speed of water above the wetting depth only: q / h of the films a
+   * front leaves behind says nothing of the flow (hundreds of m/s). */
+  if (d > wetting_depth && speed > max_speed[c])
+    max_speed[c] = speed;
+  if (hazard > max_hazard[c])
+    max_hazard[c] = hazard;
+  if (d > wetting_depth) {
+    if (arrival[c] < 0.0f)
+      arrival[c] = time;
+    if (dt > 0.0f)
+      gr_kahan_add(wet_time, wet_time_comp, c, dt);
+  }
+}

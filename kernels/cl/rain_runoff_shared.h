@@ -27,4 +27,9 @@
 #define GR_RAIN_RUNOFF_SUMS 3
 #define GR_RAIN_RUNOFF_MAXES 1
 
+/* The flood-hazard rating's debris factor applies where the depth exceeds
+ * this (m): FD2321/TR2 (HR Wallingford 2006, Table 3.1) gives DF = 0 up to
+ * 0.25 m under every land use. */
+#define GR_RAIN_RUNOFF_DEBRIS_DEPTH 0.25f
+
 #endif

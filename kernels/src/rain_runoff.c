@@ -33,12 +33,14 @@
 #define GR_RAIN_RUNOFF_PROGRESS_EVERY 0.1
 /* Checkpoints: "GRR1" and the layout's version. */
 #define GR_RAIN_RUNOFF_STATE_MAGIC 0x31525247u
-#define GR_RAIN_RUNOFF_STATE_VERSION 3u /* 2: the piece's i0, j0; 3: qu, qv */
-/* Per-cell arrays of a checkpoint: h, h_c, k, inf, inf_c, out, out_c, qu, qv. */
+#define GR_RAIN_RUNOFF_STATE_VERSION 4u /* 2: the piece's i0, j0; 3: qu, qv; 4: the maps */
+/* Per-cell arrays of a checkpoint: h, h_c, k, inf, inf_c, out, out_c, qu, qv,
+ * and the flood maps' max_depth, max_speed, arrival, wet, wet_c, max_hazard. */
 /* Per halo cell: h, k, west and south faces (local inertial); h, qu, qv and
  * h_c (shallow water). */
 #define GR_RAIN_RUNOFF_HALO_ARRAYS 4
-#define GR_RAIN_RUNOFF_STATE_CELL_ARRAYS 9
+#define GR_RAIN_RUNOFF_STATE_CELL_ARRAYS 15
+#define GR_RAIN_RUNOFF_MAP_ARRAYS 6
 /* The local inertial model's smallest Manning n (shallow water allows 0). */
 #define GR_RAIN_RUNOFF_LI_MIN_N 0.005
 
@@ -51,6 +53,8 @@ enum {
   GR_RAIN_RUNOFF_P_CFL,
   GR_RAIN_RUNOFF_P_BOUNDARY,
   GR_RAIN_RUNOFF_P_FLOW_MODEL,
+  GR_RAIN_RUNOFF_P_WETTING_DEPTH,
+  GR_RAIN_RUNOFF_P_DEBRIS_FACTOR,
   GR_RAIN_RUNOFF_P_COUNT
 };
 
@@ -64,6 +68,8 @@ static const gr_param_bound gr_rain_runoff_bounds[GR_RAIN_RUNOFF_P_COUNT] = {
     {"CourantNumber", "", 0.0, 1.0, 0.7, 1.0, 1, 0},
     {"Boundary", "", 0.0, 1.0, 0.0, 1.0, 0, 1},
     {"FlowModel", "", 0.0, 1.0, 0.0, 1.0, 0, 1},
+    {"WettingDepth", "m", 0.0, 10.0, 0.01, 1.0, 1, 0},
+    {"DebrisFactor", "", 0.0, 1.0, 0.0, 1.0, 0, 0},
 };
 
 /* A row's range in the core's unit: exactly the products a caller gets from
@@ -84,11 +90,14 @@ struct gr_rain_runoff {
   int nxl, nyl;
   int ring[4]; /* gr_rain_runoff_side order: west, east, south, north */
   gr_rain_runoff_params params;
-  cl_kernel flux, limit, update, reduce, derive, sw_stage[2], sw_speed;
+  cl_kernel flux, limit, update, reduce, derive, sw_stage[2], sw_speed, maps;
   cl_mem h, h_c, b, k, inf, inf_c, out, out_c;
   cl_mem qu, qv, h1, qu1, qv1, dh1; /* shallow water: discharges and Heun's stage */
   cl_mem qu0, qv0;                  /* initial discharges, once VELOCITY was set */
   cl_mem qx[2], qy[2];              /* discharges; [cur] is the latest, the other the next */
+  /* The flood maps, in gr_rain_runoff_map order but for the class (read
+   * from the rating) and with the wet duration's Kahan compensation last. */
+  cl_mem map[GR_RAIN_RUNOFF_MAP_ARRAYS];
   int cur;
   cl_mem h0;      /* initial depth, once WATER_DEPTH was set */
   cl_mem rain;    /* rain-rate field, once set */
@@ -111,6 +120,7 @@ struct gr_rain_runoff {
    * dt (steps_dt). */
   int args_set;
   cl_float args_dt;
+  int maps_bound; /* the maps kernel's arguments that change only with the parameters */
   gr_progress_fn progress;
   void *progress_user;
   gr_allreduce_fn allreduce; /* NULL: this simulation is the whole domain's only piece */
@@ -147,6 +157,8 @@ void gr_rain_runoff_params_init(gr_rain_runoff_params *p) {
   p->cfl = t[GR_RAIN_RUNOFF_P_CFL].default_value;
   p->boundary = (gr_boundary)(int)t[GR_RAIN_RUNOFF_P_BOUNDARY].default_value;
   p->flow_model = (gr_flow_model)(int)t[GR_RAIN_RUNOFF_P_FLOW_MODEL].default_value;
+  p->wetting_depth = t[GR_RAIN_RUNOFF_P_WETTING_DEPTH].default_value;
+  p->debris_factor = t[GR_RAIN_RUNOFF_P_DEBRIS_FACTOR].default_value;
 }
 
 /* The core's value of row `row` in p. */
@@ -162,6 +174,10 @@ static double gr_rain_runoff_param_value(const gr_rain_runoff_params *p, int row
     return p->max_dt;
   case GR_RAIN_RUNOFF_P_CFL:
     return p->cfl;
+  case GR_RAIN_RUNOFF_P_WETTING_DEPTH:
+    return p->wetting_depth;
+  case GR_RAIN_RUNOFF_P_DEBRIS_FACTOR:
+    return p->debris_factor;
   case GR_RAIN_RUNOFF_P_FLOW_MODEL: {
     int m; /* any bit pattern the enum may hold */
     memcpy(&m, &p->flow_model, sizeof(m));
@@ -425,6 +441,64 @@ static gr_status gr_rain_runoff_reduce(gr_rain_runoff *s, double sums[GR_RAIN_RU
   return st;
 }
 
+/* ------------------------------------------------------------ flood maps */
+
+/* Folds the state now into the flood maps (rain_runoff_maps): `time` is the
+ * state's time (s), dt the step that led to it (0: count no time). */
+static gr_status gr_rain_runoff_maps_update(gr_rain_runoff *s, double time, double dt) {
+  const size_t m = sizeof(cl_mem);
+  gr_status st = GR_OK;
+  if (!s->maps_bound) {
+    cl_int nx = s->nxl, ny = s->nyl, sw = s->params.flow_model == GR_FLOW_SHALLOW_WATER;
+    cl_float wd = (cl_float)s->params.wetting_depth, df = (cl_float)s->params.debris_factor;
+    const gr_rain_runoff_arg args[] = {
+        {"h", m, &s->h},
+        {"qu", m, &s->qu},
+        {"qv", m, &s->qv},
+        {"limit", m, &s->k},
+        {"max_depth", m, &s->map[0]},
+        {"max_speed", m, &s->map[1]},
+        {"arrival", m, &s->map[2]},
+        {"wet_time", m, &s->map[3]},
+        {"max_hazard", m, &s->map[4]},
+        {"wet_time_comp", m, &s->map[5]},
+        {"nx", sizeof(nx), &nx},
+        {"ny", sizeof(ny), &ny},
+        {"sw", sizeof(sw), &sw},
+        {"wetting_depth", sizeof(wd), &wd},
+        {"debris_factor", sizeof(df), &df},
+    };
+    st = GR_RAIN_RUNOFF_ARGS(s, s->maps, args);
+    s->maps_bound = st == GR_OK;
+  }
+  cl_float t = (cl_float)time, dtf = (cl_float)dt;
+  const gr_rain_runoff_arg step[] = {
+      {"qx", m, &s->qx[s->cur]},
+      {"qy", m, &s->qy[s->cur]},
+      {"time", sizeof(t), &t},
+      {"dt", sizeof(dtf), &dtf},
+  };
+  if (st == GR_OK)
+    st = GR_RAIN_RUNOFF_ARGS(s, s->maps, step);
+  /* Read-modify-write per cell: the kernel takes (i, j) and leaves the
+   * padding of the rounded-up launch alone, so each cell runs once. */
+  if (st == GR_OK)
+    st = gr_enqueue_2d(s->ctx, s->maps, 0, 0, (size_t)s->nxl, (size_t)s->nyl, NULL);
+  return st;
+}
+
+/* The maps of the water there now only (create, reset): nothing yet, never
+ * wet (arrival -1), then the present state folded in at the present time. */
+static gr_status gr_rain_runoff_maps_restart(gr_rain_runoff *s) {
+  size_t bytes = gr_rain_runoff_cells(s) * sizeof(cl_float);
+  gr_status st = GR_OK;
+  for (int a = 0; st == GR_OK && a < GR_RAIN_RUNOFF_MAP_ARRAYS; ++a)
+    st = gr_rain_runoff_fill(s, s->map[a], a == 2 ? -1.0f : 0.0f, bytes);
+  if (st == GR_OK)
+    st = gr_rain_runoff_maps_update(s, s->time, 0.0);
+  return st;
+}
+
 /* ------------------------------------------------------------- life cycle */
 
 /* The piece contract (graupel.h, rain_runoff.h): which sides have a
@@ -500,14 +574,14 @@ gr_status gr_rain_runoff_create(gr_context *ctx, const gr_grid *grid,
                         nx, ny);
   /* The state that is always there: depth, elevation, limiter, infiltrated
    * and outflow with their compensations, the shallow-water discharges and
-   * stage (14 per cell) and two sets of face arrays. Refuse before allocating when the device
-   * cannot hold it. */
+   * stage (14 per cell), the flood maps (6) and two sets of face arrays. Refuse before allocating
+   * when the device cannot hold it. */
   gr_device_info info;
   gr_status st = gr_context_device_info(ctx, &info);
   if (st != GR_OK)
     return st;
-  double need =
-      4.0 * (14.0 * (double)cells + 2.0 * ((double)(nx + 1) * ny + (double)nx * (ny + 1)));
+  double need = 4.0 * ((14.0 + GR_RAIN_RUNOFF_MAP_ARRAYS) * (double)cells +
+                       2.0 * ((double)(nx + 1) * ny + (double)nx * (ny + 1)));
   if (need > (double)info.global_mem_bytes)
     return gr_set_error(ctx, GR_ERR_TOO_LARGE,
                         "The rain runoff state of a %zu x %zu grid needs %.1f MiB but the device "
@@ -543,6 +617,10 @@ gr_status gr_rain_runoff_create(gr_context *ctx, const gr_grid *grid,
     st = gr_kernel_create(ctx, prog, "rain_runoff_sw_stage2", &s->sw_stage[1]);
   if (st == GR_OK)
     st = gr_kernel_create(ctx, prog, "rain_runoff_sw_speed", &s->sw_speed);
+  if (st == GR_OK)
+    st = gr_kernel_create(ctx, prog, "rain_runoff_maps", &s->maps);
+  for (int a = 0; st == GR_OK && a < GR_RAIN_RUNOFF_MAP_ARRAYS; ++a)
+    st = gr_buffer_create(ctx, CL_MEM_READ_WRITE, bytes, NULL, &s->map[a]);
   cl_mem *per_cell[] = {&s->h,     &s->h_c, &s->b,  &s->k,  &s->inf, &s->inf_c, &s->out,
                         &s->out_c, &s->qu,  &s->qv, &s->h1, &s->qu1, &s->qv1,   &s->dh1};
   for (size_t i = 0; st == GR_OK && i < sizeof(per_cell) / sizeof(per_cell[0]); ++i)
@@ -570,6 +648,8 @@ gr_status gr_rain_runoff_create(gr_context *ctx, const gr_grid *grid,
   if (st == GR_OK)
     st = gr_rain_runoff_clear_flow(s);
   if (st == GR_OK)
+    st = gr_rain_runoff_maps_restart(s);
+  if (st == GR_OK)
     st = gr_finish(ctx);
   if (st != GR_OK) {
     gr_rain_runoff_destroy(s);
@@ -582,8 +662,8 @@ gr_status gr_rain_runoff_create(gr_context *ctx, const gr_grid *grid,
 void gr_rain_runoff_destroy(gr_rain_runoff *s) {
   if (!s)
     return;
-  cl_kernel kernels[] = {s->flux,   s->limit,       s->update,      s->reduce,
-                         s->derive, s->sw_stage[0], s->sw_stage[1], s->sw_speed};
+  cl_kernel kernels[] = {s->flux,        s->limit,       s->update,   s->reduce, s->derive,
+                         s->sw_stage[0], s->sw_stage[1], s->sw_speed, s->maps};
   for (size_t i = 0; i < sizeof(kernels) / sizeof(kernels[0]); ++i)
     if (kernels[i])
       clReleaseKernel(kernels[i]);
@@ -593,6 +673,8 @@ void gr_rain_runoff_destroy(gr_rain_runoff *s) {
                     &s->qv1,  &s->qu0,     &s->qv0,   &s->dh1};
   for (size_t i = 0; i < sizeof(bufs) / sizeof(bufs[0]); ++i)
     gr_buffer_release(bufs[i]);
+  for (int a = 0; a < GR_RAIN_RUNOFF_MAP_ARRAYS; ++a)
+    gr_buffer_release(&s->map[a]);
   gr_reduction_release(&s->ledger);
   gr_reduction_release(&s->speed);
   gr_context_release(s->ctx);
@@ -621,6 +703,7 @@ gr_status gr_rain_runoff_set_params(gr_rain_runoff *s, const gr_rain_runoff_para
   }
   s->params = *p;
   s->args_set = 0;
+  s->maps_bound = 0;
   return GR_OK;
 }
 
@@ -679,6 +762,9 @@ static gr_status gr_rain_runoff_set_field_impl(gr_rain_runoff *s, gr_field f, co
       st = gr_buffer_write(s->ctx, s->qu, 0, cells * sizeof(cl_float), qx);
     if (st == GR_OK)
       st = gr_buffer_write(s->ctx, s->qv, 0, cells * sizeof(cl_float), qy);
+    /* The maps see the new speeds from now on. */
+    if (st == GR_OK)
+      st = gr_rain_runoff_maps_update(s, s->time, 0.0);
     free(q);
     return st;
   }
@@ -745,6 +831,9 @@ static gr_status gr_rain_runoff_set_field_impl(gr_rain_runoff *s, gr_field f, co
       s->initial_sum = sum;
       s->initial_volume += (sum - now[0]) * s->grid.dx * s->grid.dy;
     }
+    /* The maps count the new water from the time it is set. */
+    if (st == GR_OK)
+      st = gr_rain_runoff_maps_update(s, s->time, 0.0);
     break;
   }
   default:
@@ -1075,10 +1164,15 @@ static gr_status gr_rain_runoff_enqueue(gr_rain_runoff *s, double dt, int nsteps
   gr_status st = gr_rain_runoff_bind(s, dtf);
   int done = 0, exchange = s->halo_exchange && gr_rain_runoff_has_ring(s);
   int sw = s->params.flow_model == GR_FLOW_SHALLOW_WATER;
+  /* The end time of each step, summed as s->time is below (the flood maps'
+   * arrival times). */
+  double t_end = s->time;
   while (sw && st == GR_OK && done < nsteps && !*stop) {
     /* Heun's two stages. */
     for (int stage = 0; st == GR_OK && stage < 2; ++stage)
       st = gr_enqueue_2d(s->ctx, s->sw_stage[stage], 0, 0, (size_t)s->nxl, (size_t)s->nyl, NULL);
+    if (st == GR_OK)
+      st = gr_rain_runoff_maps_update(s, t_end += dt, (double)dtf);
     if (st == GR_OK)
       ++done;
     if (st == GR_OK && exchange)
@@ -1108,6 +1202,8 @@ static gr_status gr_rain_runoff_enqueue(gr_rain_runoff *s, double dt, int nsteps
       st = gr_enqueue_2d(s->ctx, s->limit, 0, 0, (size_t)s->nxl, (size_t)s->nyl, NULL);
     if (st == GR_OK)
       st = gr_enqueue_2d(s->ctx, s->update, 0, 0, (size_t)s->nxl, (size_t)s->nyl, NULL);
+    if (st == GR_OK)
+      st = gr_rain_runoff_maps_update(s, t_end += dt, (double)dtf);
     if (st == GR_OK)
       ++done;
     if (st == GR_OK && exchange)
@@ -1358,9 +1454,8 @@ void gr_rain_runoff_set_progress(gr_rain_runoff *s, gr_progress_fn fn, void *use
 /* ---------------------------------------------------------------- reading */
 
 /* Runs the derive kernel (what: 0 surface, 1 velocity, 2 discharge, 3
- * infiltrated) into the scratch buffer and reads the owned cells' `comps`
- * floats each back. */
-static gr_status gr_rain_runoff_derive(gr_rain_runoff *s, cl_int what, size_t comps, float *host) {
+ * infiltrated) into the scratch buffer. */
+static gr_status gr_rain_runoff_derive_run(gr_rain_runoff *s, cl_int what) {
   size_t cells = gr_rain_runoff_cells(s);
   gr_status st = GR_OK;
   if (!s->scratch)
@@ -1388,9 +1483,61 @@ static gr_status gr_rain_runoff_derive(gr_rain_runoff *s, cl_int what, size_t co
     st = GR_RAIN_RUNOFF_ARGS(s, s->derive, args);
   if (st == GR_OK)
     st = gr_enqueue_2d(s->ctx, s->derive, 0, 0, (size_t)nx, (size_t)ny, NULL);
+  return st;
+}
+
+/* derive_run, then the owned cells' `comps` floats each back. */
+static gr_status gr_rain_runoff_derive(gr_rain_runoff *s, cl_int what, size_t comps, float *host) {
+  gr_status st = gr_rain_runoff_derive_run(s, what);
   if (st == GR_OK)
     st = gr_rain_runoff_read_own(s, s->scratch, comps, host);
   return st;
+}
+
+static gr_status gr_rain_runoff_sample_impl(gr_rain_runoff *s, const int *ij, int n,
+                                            float *values) {
+  if (n < 0)
+    return gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
+                        "The number of points to sample must be 0 or more (got %d).", n);
+  for (int k = 0; k < n; ++k)
+    if (ij[2 * k] < 0 || ij[2 * k] >= s->grid.nx || ij[2 * k + 1] < 0 ||
+        ij[2 * k + 1] >= s->grid.ny)
+      return gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
+                          "Sample point %d is the cell (%d, %d), outside the %d x %d grid: give "
+                          "cells from (0, 0) to (%d, %d).",
+                          k, ij[2 * k], ij[2 * k + 1], s->grid.nx, s->grid.ny, s->grid.nx - 1,
+                          s->grid.ny - 1);
+  if (n == 0)
+    return GR_OK;
+  gr_status st = gr_rain_runoff_derive_run(s, 2);
+  for (int k = 0; st == GR_OK && k < n; ++k) {
+    /* The cell in the local array (past the ring). */
+    size_t c = ((size_t)ij[2 * k + 1] + (size_t)s->ring[2]) * (size_t)s->nxl + (size_t)ij[2 * k] +
+               (size_t)s->ring[0];
+    float h = 0.0f, b = 0.0f, q = 0.0f;
+    st = gr_buffer_read(s->ctx, s->h, c * sizeof(float), sizeof(float), &h);
+    if (st == GR_OK)
+      st = gr_buffer_read(s->ctx, s->b, c * sizeof(float), sizeof(float), &b);
+    if (st == GR_OK)
+      st = gr_buffer_read(s->ctx, s->scratch, c * sizeof(float), sizeof(float), &q);
+    /* The surface as WATER_SURFACE gives it: the float sum b + h. */
+    values[3 * k] = h;
+    values[3 * k + 1] = b + h;
+    values[3 * k + 2] = q;
+  }
+  return st;
+}
+
+gr_status gr_rain_runoff_sample(gr_rain_runoff *s, const int *ij, int n, float *values) {
+  if (!s)
+    return gr_set_error(NULL, GR_ERR_INVALID_ARGUMENT,
+                        "gr_rain_runoff_sample needs a simulation, the cells and room for values.");
+  if (n > 0 && (!ij || !values))
+    return GR_RAIN_RUNOFF_KEEP_ERROR(
+        s,
+        gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
+                     "gr_rain_runoff_sample needs a simulation, the cells and room for values."));
+  return GR_RAIN_RUNOFF_KEEP_ERROR(s, gr_rain_runoff_sample_impl(s, ij, n, values));
 }
 
 static gr_status gr_rain_runoff_get_field_impl(gr_rain_runoff *s, gr_field f, float *host) {
@@ -1500,13 +1647,79 @@ static gr_status gr_rain_runoff_reset_impl(gr_rain_runoff *s) {
   s->steps = 0;
   s->rain_volume = 0.0;
   s->initial_volume = s->initial_sum * s->grid.dx * s->grid.dy;
-  return GR_OK;
+  return gr_rain_runoff_maps_restart(s);
 }
 
 gr_status gr_rain_runoff_reset(gr_rain_runoff *s) {
   if (!s)
     return gr_set_error(NULL, GR_ERR_INVALID_ARGUMENT, "gr_rain_runoff_reset needs a simulation.");
   return GR_RAIN_RUNOFF_KEEP_ERROR(s, gr_rain_runoff_reset_impl(s));
+}
+
+/* ------------------------------------------------------------ flood maps */
+
+static const char *const gr_rain_runoff_map_names[GR_RAIN_RUNOFF_MAP_COUNT] = {
+    "max_depth", "max_speed", "arrival_time", "wet_duration", "hazard_rating", "hazard_class"};
+
+const char *gr_rain_runoff_map_name(gr_rain_runoff_map map) {
+  int m; /* any bit pattern the enum may hold */
+  memcpy(&m, &map, sizeof(m));
+  return m >= 0 && m < GR_RAIN_RUNOFF_MAP_COUNT ? gr_rain_runoff_map_names[m] : NULL;
+}
+
+int gr_rain_runoff_hazard_class(double rating) {
+  /* FD2321/TR2 Table 13.1: the upper ends of "low" and "moderate" belong to
+   * the class above; 2.0 itself is still "significant". */
+  if (rating > 2.0)
+    return 3;
+  if (rating >= 1.25)
+    return 2;
+  if (rating >= 0.75)
+    return 1;
+  return 0;
+}
+
+static gr_status gr_rain_runoff_get_map_impl(gr_rain_runoff *s, gr_rain_runoff_map map,
+                                             float *host) {
+  size_t cells = gr_rain_runoff_own_cells(s);
+  const char *name = gr_rain_runoff_map_name(map);
+  if (!name)
+    return gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
+                        "The rain runoff simulation has no flood map %d; its maps are 0 "
+                        "max_depth to %d hazard_class (gr_rain_runoff_map).",
+                        (int)map, GR_RAIN_RUNOFF_MAP_COUNT - 1);
+  int buf = map == GR_RAIN_RUNOFF_HAZARD_CLASS ? 4 : (int)map;
+  gr_status st = gr_rain_runoff_read_own(s, s->map[buf], 1, host);
+  if (st != GR_OK)
+    return st;
+  if (map == GR_RAIN_RUNOFF_WET_DURATION) {
+    /* The Kahan sum with its compensation taken off. */
+    float *comp = malloc(cells * sizeof(float));
+    if (!comp)
+      return gr_set_error(s->ctx, GR_ERR_OUT_OF_MEMORY, "Out of host memory.");
+    st = gr_rain_runoff_read_own(s, s->map[5], 1, comp);
+    for (size_t c = 0; st == GR_OK && c < cells; ++c)
+      host[c] -= comp[c];
+    free(comp);
+  } else if (map == GR_RAIN_RUNOFF_ARRIVAL_TIME) {
+    for (size_t c = 0; c < cells; ++c)
+      host[c] = host[c] < 0.0f ? NAN : host[c];
+  } else if (map == GR_RAIN_RUNOFF_HAZARD_CLASS) {
+    for (size_t c = 0; c < cells; ++c)
+      host[c] = (float)gr_rain_runoff_hazard_class(host[c]);
+  }
+  return st;
+}
+
+gr_status gr_rain_runoff_get_map(gr_rain_runoff *s, gr_rain_runoff_map map, float *host) {
+  if (!s)
+    return gr_set_error(NULL, GR_ERR_INVALID_ARGUMENT,
+                        "gr_rain_runoff_get_map needs a simulation and room for the map.");
+  if (!host)
+    return GR_RAIN_RUNOFF_KEEP_ERROR(
+        s, gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
+                        "gr_rain_runoff_get_map needs a simulation and room for the map."));
+  return GR_RAIN_RUNOFF_KEEP_ERROR(s, gr_rain_runoff_get_map_impl(s, map, host));
 }
 
 /* ------------------------------------------------------------ checkpoints */
@@ -1545,8 +1758,9 @@ gr_status gr_rain_runoff_state_size(const gr_rain_runoff *s, size_t *bytes) {
 
 /* The state's device arrays in checkpoint order, with their sizes. */
 static int gr_rain_runoff_state_arrays(gr_rain_runoff *s, int cur, cl_mem *bufs, size_t *sizes) {
-  cl_mem cells[GR_RAIN_RUNOFF_STATE_CELL_ARRAYS] = {s->h,   s->h_c,   s->k,  s->inf, s->inf_c,
-                                                    s->out, s->out_c, s->qu, s->qv};
+  cl_mem cells[GR_RAIN_RUNOFF_STATE_CELL_ARRAYS] = {
+      s->h,  s->h_c,    s->k,      s->inf,    s->inf_c,  s->out,    s->out_c, s->qu,
+      s->qv, s->map[0], s->map[1], s->map[2], s->map[3], s->map[4], s->map[5]};
   int n = 0;
   for (int i = 0; i < GR_RAIN_RUNOFF_STATE_CELL_ARRAYS; ++i, ++n) {
     bufs[n] = cells[i];
