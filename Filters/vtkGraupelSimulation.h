@@ -58,10 +58,10 @@
  * LoadState, so it re-steps at most K output intervals; going forward past
  * a snapshot that is ahead of the state uses it too. K = 10 keeps a
  * 60-output run (600 s at 10 s) to six snapshots and a replay to at most ten
- * intervals; a Rain Runoff snapshot is about 36 bytes per grid point, so a
- * 1024 x 1024 grid keeps 28 of them under 1 GiB. Snapshots are dropped when
- * the simulation is set up again. RestartCount counts set-ups and returns to
- * time 0; RestoreCount counts snapshot loads.
+ * intervals; a Rain Runoff snapshot is about 60 bytes per grid point (15 arrays with the flood
+ * maps), so a 1024 x 1024 grid keeps 17 of them under 1 GiB. Snapshots are dropped when the
+ * simulation is set up again. RestartCount counts set-ups and returns to time 0; RestoreCount
+ * counts snapshot loads.
  *
  * **Progress and abort.** Progress text names what happens ("Rain Runoff:
  * t = 420 s of 1800 s", the second time being the requested one) and is
