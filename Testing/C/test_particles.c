@@ -534,12 +534,37 @@ static void teardown(void) {
   gr_context_release(ctx);
 }
 
+/* For valgrind (memcheck.particles): both kinds of particle once, every
+ * output read, a refused change of parameters. */
+static void test_memcheck(void) {
+  for (int kind = 0; kind < 2; ++kind) {
+    gr_particles_params p;
+    gr_particles_params_init(&p);
+    p.kind = kind;
+    p.count = 1024;
+    gr_particles *s = NULL;
+    CHECK(gr_particles_create(ctx, &p, &s) == GR_OK);
+    if (!s)
+      return;
+    float *out = malloc((size_t)gr_particles_count(s) * 3 * sizeof(float));
+    CHECK(gr_particles_compute(s, 1.5) == GR_OK);
+    for (int o = 0; o < GR_PARTICLES_OUTPUT_COUNT; ++o)
+      CHECK(gr_particles_get_output(s, (gr_particles_output)o, out) == GR_OK);
+    p.count = 1;
+    CHECK(gr_particles_set_params(s, &p) != GR_OK);
+    CHECK(gr_particles_last_error(s)[0] != '\0');
+    free(out);
+    gr_particles_destroy(s);
+  }
+}
+
 static const gr_subtest tests[] = {
     {"counts", test_counts, 0},         {"determinism", test_determinism, 0},
     {"drop_sizes", test_drop_sizes, 0}, {"fall_speeds", test_fall_speeds, 0},
     {"drift", test_drift, 0},           {"inside", test_inside, 0},
     {"snowfall", test_snowfall, 0},     {"streaks", test_streaks, 0},
     {"errors", test_errors, 0},         {"param_table", test_param_table, 0},
+    {"memcheck", test_memcheck, 1},
 };
 
 int main(int argc, char **argv) {

@@ -663,6 +663,36 @@ static void teardown(void) {
   gr_context_release(ctx);
 }
 
+/* For valgrind (memcheck.sky): a bolt, a small cloud image whole and by
+ * rows, a refused change of parameters. */
+static void test_memcheck(void) {
+  gr_lightning_params lp;
+  gr_lightning_params_init(&lp);
+  long n = gr_lightning_point_count(&lp);
+  double *xyz = malloc((size_t)n * 3 * sizeof(double));
+  float *intensity = malloc((size_t)n * sizeof(float));
+  int *strand = malloc((size_t)n * sizeof(int));
+  char msg[256];
+  CHECK(gr_lightning_generate(&lp, xyz, intensity, strand, msg, sizeof(msg)) == GR_OK);
+  free(xyz), free(intensity), free(strand);
+  gr_cloud_cover_params cp;
+  gr_cloud_cover_params_init(&cp);
+  cp.resolution = 16;
+  gr_cloud_cover *c = NULL;
+  CHECK(gr_cloud_cover_create(ctx, &cp, &c) == GR_OK);
+  if (!c)
+    return;
+  float cloud[256];
+  unsigned char rgb[3 * 256];
+  CHECK(gr_cloud_cover_compute(c, 2.0) == GR_OK);
+  CHECK(gr_cloud_cover_compute_rows(c, 3.0, 4, 4) == GR_OK);
+  CHECK(gr_cloud_cover_get(c, cloud, rgb) == GR_OK);
+  cp.cover = 2.0;
+  CHECK(gr_cloud_cover_set_params(c, &cp) != GR_OK);
+  CHECK(gr_cloud_cover_last_error(c)[0] != '\0');
+  gr_cloud_cover_destroy(c);
+}
+
 static const gr_subtest tests[] = {
     {"lightning_determinism", test_lightning_determinism, 0},
     {"lightning_counts", test_lightning_counts, 0},
@@ -677,6 +707,7 @@ static const gr_subtest tests[] = {
     {"cloud_drift", test_cloud_drift, 0},
     {"cloud_errors", test_cloud_errors, 0},
     {"param_table", test_param_table, 0},
+    {"memcheck", test_memcheck, 1},
 };
 
 int main(int argc, char **argv) {
