@@ -8,6 +8,7 @@
 #include <math.h>
 #include <stddef.h>
 #include <stdint.h>
+#include <stdlib.h>
 #include <string.h>
 
 /* An invariant that must hold: a violation is a crash libFuzzer records. */
@@ -114,6 +115,94 @@ static inline double fuzz_table_edge(const gr_param_bound *t, int n, const doubl
   default:
     return nextafter(hi, HUGE_VAL);
   }
+}
+
+/* A field of a parameter struct for fuzz_fill: 'd' double or 'i' int, at
+ * its offset (FUZZ_FIELD_D / FUZZ_FIELD_I). */
+typedef struct fuzz_field {
+  char kind;
+  size_t offset;
+} fuzz_field;
+#define FUZZ_FIELD_D(type, member)                                                                 \
+  { 'd', offsetof(type, member) }
+#define FUZZ_FIELD_I(type, member)                                                                 \
+  { 'i', offsetof(type, member) }
+
+static inline double fuzz_field_value(const void *p, const fuzz_field *f) {
+  const char *at = (const char *)p + f->offset;
+  if (f->kind == 'd') {
+    double v;
+    memcpy(&v, at, sizeof v);
+    return v;
+  }
+  int v;
+  memcpy(&v, at, sizeof v);
+  return v;
+}
+
+/* Fills a parameter struct p of nf fields as the parameter harnesses'
+ * input layout says, in mode (0..2): 0 every field from raw bytes (4 per
+ * int, 8 per double), so NaN, infinities, subnormals and huge values
+ * appear; 1 the fields whose bit is set in the next 2 bytes read raw, the
+ * others left as p holds them (the caller's defaults); 2 one byte per
+ * field picks fuzz_table_edge's value (an int takes it when finite and
+ * small, else -1). */
+static inline void fuzz_fill(reader *r, int mode, void *p, const fuzz_field *fields, int nf,
+                             const gr_param_bound *table, int n, const double *fixed,
+                             size_t nfixed) {
+  char *base = (char *)p;
+  if (mode == 1) {
+    uint8_t bits[2];
+    take(r, bits, sizeof bits);
+    for (int f = 0; f < nf && f < 16; ++f)
+      if (bits[f / 8] & (1u << (f % 8)))
+        take(r, base + fields[f].offset, fields[f].kind == 'd' ? sizeof(double) : sizeof(int));
+    return;
+  }
+  for (int f = 0; f < nf; ++f) {
+    char *at = base + fields[f].offset;
+    if (mode == 0) {
+      take(r, at, fields[f].kind == 'd' ? sizeof(double) : sizeof(int));
+      continue;
+    }
+    double v = fuzz_table_edge(table, n, fixed, nfixed, take_byte(r));
+    if (fields[f].kind == 'd') {
+      memcpy(at, &v, sizeof v);
+    } else {
+      int iv = isfinite(v) && fabs(v) < 2e9 ? (int)v : -1;
+      memcpy(at, &iv, sizeof iv);
+    }
+  }
+}
+
+/* A parameter validator behind a harness's wrapper (p NULL included). */
+typedef gr_status (*fuzz_validate_fn)(const void *p, char *msg, size_t len);
+
+/* A validator's answers for p: GR_OK exactly when documented, else a
+ * sentence; the same answer with no buffer, and with a short buffer of
+ * small_len bytes that it never overruns and always terminates; a sentence
+ * for no parameters at all. */
+static inline void fuzz_check_validator(fuzz_validate_fn validate, const void *p, int documented,
+                                        size_t small_len) {
+  char msg[1024];
+  msg[0] = '\0';
+  gr_status sp = validate(p, msg, sizeof msg);
+  check_message(sp, msg);
+  REQUIRE((sp == GR_OK) == documented);
+  REQUIRE(validate(p, NULL, 0) == sp);
+  REQUIRE(validate(p, NULL, 64) == sp);
+  char *small = (char *)malloc(small_len > 0 ? small_len : 1);
+  REQUIRE(small != NULL);
+  if (small_len > 0) {
+    memset(small, 'x', small_len);
+    REQUIRE(validate(p, small, small_len) == sp);
+    if (sp != GR_OK)
+      REQUIRE(memchr(small, '\0', small_len) != NULL);
+  }
+  free(small);
+  msg[0] = '\0';
+  check_message(validate(NULL, msg, sizeof msg), msg);
+  REQUIRE(msg[0] != '\0');
 }
 
 #endif

@@ -22,51 +22,31 @@
 #include "fuzz_common.h"
 #include "graupel/particles.h"
 
-#include <float.h>
 #include <math.h>
+#include <stddef.h>
 #include <stdint.h>
-#include <stdlib.h>
 #include <string.h>
 
-#define NFIELDS 15
-
-/* Field kinds in order: 'i' int, 'd' double. */
-static const char kinds[] = "iiddid"
-                            "ddd"
-                            "dddddd";
-/* The table row of each field; NULL for the fields the table does not hold. */
-static const char *const rows[NFIELDS] = {NULL,           "Count", "RainRate",
-                                          "ExposureTime", "Seed",  "FlutterAmplitude"};
-
-static void *field_ptr(gr_particles_params *p, int f) {
-  switch (f) {
-  case 0:
-    return &p->kind;
-  case 1:
-    return &p->count;
-  case 2:
-    return &p->rain_rate;
-  case 3:
-    return &p->exposure_time;
-  case 4:
-    return &p->seed;
-  case 5:
-    return &p->flutter_amplitude;
-  default:
-    return f < 9 ? (void *)&p->wind[f - 6] : (void *)&p->region[f - 9];
-  }
-}
-
-static double field_value(gr_particles_params *p, int f) {
-  if (kinds[f] == 'd') {
-    double v;
-    memcpy(&v, field_ptr(p, f), sizeof v);
-    return v;
-  }
-  int v;
-  memcpy(&v, field_ptr(p, f), sizeof v);
-  return v;
-}
+/* The fields in declaration order. */
+static const fuzz_field fields[] = {FUZZ_FIELD_I(gr_particles_params, kind),
+                                    FUZZ_FIELD_I(gr_particles_params, count),
+                                    FUZZ_FIELD_D(gr_particles_params, rain_rate),
+                                    FUZZ_FIELD_D(gr_particles_params, exposure_time),
+                                    FUZZ_FIELD_I(gr_particles_params, seed),
+                                    FUZZ_FIELD_D(gr_particles_params, flutter_amplitude),
+                                    FUZZ_FIELD_D(gr_particles_params, wind[0]),
+                                    FUZZ_FIELD_D(gr_particles_params, wind[1]),
+                                    FUZZ_FIELD_D(gr_particles_params, wind[2]),
+                                    FUZZ_FIELD_D(gr_particles_params, region[0]),
+                                    FUZZ_FIELD_D(gr_particles_params, region[1]),
+                                    FUZZ_FIELD_D(gr_particles_params, region[2]),
+                                    FUZZ_FIELD_D(gr_particles_params, region[3]),
+                                    FUZZ_FIELD_D(gr_particles_params, region[4]),
+                                    FUZZ_FIELD_D(gr_particles_params, region[5])};
+#define NFIELDS ((int)(sizeof fields / sizeof fields[0]))
+/* The table row of fields 1..5 (kind, wind and region are checked apart). */
+static const char *const rows[] = {NULL,           "Count", "RainRate",
+                                   "ExposureTime", "Seed",  "FlutterAmplitude"};
 
 /* The harness's own statement of the rules outside the table. */
 static int region_axis_ok(double lo, double hi) {
@@ -74,11 +54,14 @@ static int region_axis_ok(double lo, double hi) {
          fabs(lo) < 1e9 && fabs(hi) < 1e9;
 }
 
+static gr_status validate(const void *p, char *msg, size_t len) {
+  return gr_particles_params_validate((const gr_particles_params *)p, msg, len);
+}
+
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
   static const double fixed[] = {0.0, -0.0, 1.0, -1.0, 0.5, 100.0, -100.0, 1e9, 1e300, 2.0};
   gr_particles_params p;
   reader r;
-  char msg[1024];
   int n = 0;
   const gr_param_bound *table = gr_particles_param_bounds(&n);
   REQUIRE(table != NULL && n == 5);
@@ -88,56 +71,17 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
   int mode = take_byte(&r) % 3;
   size_t small_len = take_byte(&r) % 96;
   memset(&p, 0, sizeof p);
-  if (mode == 1) {
-    uint8_t bits[2];
+  if (mode == 1)
     gr_particles_params_init(&p);
-    take(&r, bits, sizeof bits);
-    for (int f = 0; f < NFIELDS; ++f)
-      if (bits[f / 8] & (1u << (f % 8)))
-        take(&r, field_ptr(&p, f), kinds[f] == 'd' ? sizeof(double) : sizeof(int));
-  } else {
-    for (int f = 0; f < NFIELDS; ++f) {
-      if (mode == 0) {
-        take(&r, field_ptr(&p, f), kinds[f] == 'd' ? sizeof(double) : sizeof(int));
-      } else {
-        double v = fuzz_table_edge(table, n, fixed, sizeof fixed / sizeof fixed[0], take_byte(&r));
-        if (kinds[f] == 'd') {
-          memcpy(field_ptr(&p, f), &v, sizeof v);
-        } else {
-          int iv = isfinite(v) && fabs(v) < 2e9 ? (int)v : -1;
-          memcpy(field_ptr(&p, f), &iv, sizeof iv);
-        }
-      }
-    }
-  }
+  fuzz_fill(&r, mode, &p, fields, NFIELDS, table, n, fixed, sizeof fixed / sizeof fixed[0]);
 
   int documented = p.kind == GR_PARTICLES_RAIN || p.kind == GR_PARTICLES_SNOW;
   for (int f = 1; f < 6; ++f)
-    documented &= fuzz_in_row(fuzz_row(table, n, rows[f]), field_value(&p, f));
+    documented &= fuzz_in_row(fuzz_row(table, n, rows[f]), fuzz_field_value(&p, &fields[f]));
   for (int c = 0; c < 3; ++c) {
     documented &= fabs(p.wind[c]) <= GR_PARTICLES_MAX_WIND;
     documented &= region_axis_ok(p.region[2 * c], p.region[2 * c + 1]);
   }
-
-  msg[0] = '\0';
-  gr_status sp = gr_particles_params_validate(&p, msg, sizeof msg);
-  check_message(sp, msg);
-  REQUIRE((sp == GR_OK) == documented);
-
-  REQUIRE(gr_particles_params_validate(&p, NULL, 0) == sp);
-  REQUIRE(gr_particles_params_validate(&p, NULL, 64) == sp);
-  char *small = (char *)malloc(small_len > 0 ? small_len : 1);
-  REQUIRE(small != NULL);
-  if (small_len > 0) {
-    memset(small, 'x', small_len);
-    REQUIRE(gr_particles_params_validate(&p, small, small_len) == sp);
-    if (sp != GR_OK)
-      REQUIRE(memchr(small, '\0', small_len) != NULL);
-  }
-  free(small);
-
-  msg[0] = '\0';
-  check_message(gr_particles_params_validate(NULL, msg, sizeof msg), msg);
-  REQUIRE(msg[0] != '\0');
+  fuzz_check_validator(validate, &p, documented, small_len);
   return 0;
 }

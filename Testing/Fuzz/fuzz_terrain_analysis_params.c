@@ -20,61 +20,35 @@
 #include "fuzz_common.h"
 #include "graupel/terrain_analysis.h"
 
-#include <float.h>
 #include <math.h>
+#include <stddef.h>
 #include <stdint.h>
-#include <stdlib.h>
 #include <string.h>
 
-#define NFIELDS 9
-
-/* Field kinds in order: 'i' int, 'd' double. */
-static const char kinds[] = "dddiddd"
-                            "id";
+/* The fields in declaration order. */
+static const fuzz_field fields[] = {FUZZ_FIELD_D(gr_terrain_analysis_params, sun_azimuth),
+                                    FUZZ_FIELD_D(gr_terrain_analysis_params, sun_elevation),
+                                    FUZZ_FIELD_D(gr_terrain_analysis_params, snow_exponent),
+                                    FUZZ_FIELD_I(gr_terrain_analysis_params, cover_mode),
+                                    FUZZ_FIELD_D(gr_terrain_analysis_params, snow_cover_limit),
+                                    FUZZ_FIELD_D(gr_terrain_analysis_params, rock_slope),
+                                    FUZZ_FIELD_D(gr_terrain_analysis_params, water_level),
+                                    FUZZ_FIELD_I(gr_terrain_analysis_params, model_shadows),
+                                    FUZZ_FIELD_D(gr_terrain_analysis_params, penumbra_width)};
+#define NFIELDS ((int)(sizeof fields / sizeof fields[0]))
 /* The table row of each field. */
-static const char *const rows[NFIELDS] = {"SunAzimuth", "SunElevation",   "SnowExponent",
-                                          "CoverMode",  "SnowCoverLimit", "RockSlope",
-                                          "WaterLevel", "ModelShadows",   "PenumbraWidth"};
+static const char *const rows[] = {"SunAzimuth", "SunElevation",   "SnowExponent",
+                                   "CoverMode",  "SnowCoverLimit", "RockSlope",
+                                   "WaterLevel", "ModelShadows",   "PenumbraWidth"};
 
-static void *field_ptr(gr_terrain_analysis_params *p, int f) {
-  switch (f) {
-  case 0:
-    return &p->sun_azimuth;
-  case 1:
-    return &p->sun_elevation;
-  case 2:
-    return &p->snow_exponent;
-  case 3:
-    return &p->cover_mode;
-  case 4:
-    return &p->snow_cover_limit;
-  case 5:
-    return &p->rock_slope;
-  case 6:
-    return &p->water_level;
-  case 7:
-    return &p->model_shadows;
-  default:
-    return &p->penumbra_width;
-  }
-}
-
-static double field_value(gr_terrain_analysis_params *p, int f) {
-  if (kinds[f] == 'd') {
-    double v;
-    memcpy(&v, field_ptr(p, f), sizeof v);
-    return v;
-  }
-  int v;
-  memcpy(&v, field_ptr(p, f), sizeof v);
-  return v;
+static gr_status validate(const void *p, char *msg, size_t len) {
+  return gr_terrain_analysis_params_validate((const gr_terrain_analysis_params *)p, msg, len);
 }
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
   static const double fixed[] = {0.0, -0.0, 1.0, -1.0, 0.5, 90.0, 360.0, 1e300, -1e300, 2.0};
   gr_terrain_analysis_params p;
   reader r;
-  char msg[1024];
   int n = 0;
   const gr_param_bound *table = gr_terrain_analysis_param_bounds(&n);
   REQUIRE(table != NULL && n == NFIELDS);
@@ -84,52 +58,13 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
   int mode = take_byte(&r) % 3;
   size_t small_len = take_byte(&r) % 96;
   memset(&p, 0, sizeof p);
-  if (mode == 1) {
-    uint8_t bits[2];
+  if (mode == 1)
     gr_terrain_analysis_params_init(&p);
-    take(&r, bits, sizeof bits);
-    for (int f = 0; f < NFIELDS; ++f)
-      if (bits[f / 8] & (1u << (f % 8)))
-        take(&r, field_ptr(&p, f), kinds[f] == 'd' ? sizeof(double) : sizeof(int));
-  } else {
-    for (int f = 0; f < NFIELDS; ++f) {
-      if (mode == 0) {
-        take(&r, field_ptr(&p, f), kinds[f] == 'd' ? sizeof(double) : sizeof(int));
-      } else {
-        double v = fuzz_table_edge(table, n, fixed, sizeof fixed / sizeof fixed[0], take_byte(&r));
-        if (kinds[f] == 'd') {
-          memcpy(field_ptr(&p, f), &v, sizeof v);
-        } else {
-          int iv = isfinite(v) && fabs(v) < 2e9 ? (int)v : -1;
-          memcpy(field_ptr(&p, f), &iv, sizeof iv);
-        }
-      }
-    }
-  }
+  fuzz_fill(&r, mode, &p, fields, NFIELDS, table, n, fixed, sizeof fixed / sizeof fixed[0]);
 
   int documented = 1;
   for (int f = 0; f < NFIELDS; ++f)
-    documented &= fuzz_in_row(fuzz_row(table, n, rows[f]), field_value(&p, f));
-
-  msg[0] = '\0';
-  gr_status sp = gr_terrain_analysis_params_validate(&p, msg, sizeof msg);
-  check_message(sp, msg);
-  REQUIRE((sp == GR_OK) == documented);
-
-  REQUIRE(gr_terrain_analysis_params_validate(&p, NULL, 0) == sp);
-  REQUIRE(gr_terrain_analysis_params_validate(&p, NULL, 64) == sp);
-  char *small = (char *)malloc(small_len > 0 ? small_len : 1);
-  REQUIRE(small != NULL);
-  if (small_len > 0) {
-    memset(small, 'x', small_len);
-    REQUIRE(gr_terrain_analysis_params_validate(&p, small, small_len) == sp);
-    if (sp != GR_OK)
-      REQUIRE(memchr(small, '\0', small_len) != NULL);
-  }
-  free(small);
-
-  msg[0] = '\0';
-  check_message(gr_terrain_analysis_params_validate(NULL, msg, sizeof msg), msg);
-  REQUIRE(msg[0] != '\0');
+    documented &= fuzz_in_row(fuzz_row(table, n, rows[f]), fuzz_field_value(&p, &fields[f]));
+  fuzz_check_validator(validate, &p, documented, small_len);
   return 0;
 }
