@@ -32,10 +32,11 @@ rain.UpdatePipeline(end)
 for m in ("max_depth", "max_speed", "arrival_time", "hazard_class"):
     print(m, rain.PointData[m].GetRange())
 
-# The maps from above: depth on a sequential blue map (dry ground dark), the
-# hazard classes as categories with their names.
-for name, arr, rng, preset in (("flood_max_depth", "max_depth", [0.0, 2.0], "Blues"),
-                                ("flood_hazard_class", "hazard_class", None, None)):
+# The maps from above: depth on a sequential blue map (dry ground white), the
+# hazard classes as categories with their names; legends with units.
+for name, arr, title, rng, preset in (
+        ("flood_max_depth", "max_depth", "largest depth (m)", [0.0, 2.0], "Blues"),
+        ("flood_hazard_class", "hazard_class", "flood hazard (FD2321)", None, None)):
     view = CreateView("RenderView")
     view.ViewTime = end
     view.OrientationAxesVisibility = 0
@@ -45,12 +46,16 @@ for name, arr, rng, preset in (("flood_max_depth", "max_depth", [0.0, 2.0], "Blu
     lut = GetColorTransferFunction(arr)
     if preset:
         lut.ApplyPreset(preset, True)
+        lut.InvertTransferFunction()  # dry ground near white, deep water dark blue
         lut.RescaleTransferFunction(*rng)
     else:
         lut.InterpretValuesAsCategories = 1
         lut.Annotations = ["0", "low", "1", "moderate", "2", "significant", "3", "extreme"]
         lut.IndexedColors = [0.85, 0.9, 0.85, 1.0, 0.85, 0.2, 1.0, 0.5, 0.0, 0.8, 0.0, 0.0]
     d.SetScalarBarVisibility(view, True)
+    bar = GetScalarBar(lut, view)
+    bar.Title = title
+    bar.ComponentTitle = ""
     view.ResetCamera()
     f = view.CameraFocalPoint
     view.CameraPosition = [f[0], f[1], f[2] + 1e5]
