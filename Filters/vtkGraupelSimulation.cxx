@@ -404,6 +404,30 @@ int vtkGraupelSimulation::CoreProgress(void *user, double time) {
   return static_cast<vtkGraupelSimulation *>(user)->ReportProgress(time);
 }
 
+int vtkGraupelSimulation::CheckTerrain(vtkImageData *terrain) {
+  const char *label = this->GetSimulationLabel();
+  if (!terrain) {
+    vtkErrorMacro(<< label << " needs a terrain image on its Input.");
+    return 0;
+  }
+  int dims[3];
+  terrain->GetDimensions(dims);
+  double spacing[3];
+  terrain->GetSpacing(spacing);
+  if (dims[0] < 2 || dims[1] < 2 || dims[2] != 1) {
+    vtkErrorMacro(<< label << " needs a 2-D terrain of at least 2 x 2 points on its Input; it got "
+                  << dims[0] << " x " << dims[1] << " x " << dims[2]
+                  << ". Slice a volume or resample the terrain first.");
+    return 0;
+  }
+  if (!(spacing[0] > 0.0) || !(spacing[1] > 0.0)) {
+    vtkErrorMacro(<< label << " needs a terrain spacing above 0 m in x and y; the Input has "
+                  << spacing[0] << " x " << spacing[1] << " m. Set the spacing on the source.");
+    return 0;
+  }
+  return 1;
+}
+
 vtkDataArray *vtkGraupelSimulation::GetElevation(vtkImageData *terrain, const char *inputName) {
   vtkDataArray *a = terrain ? terrain->GetPointData()->GetArray("elevation") : nullptr;
   if (!a || a->GetNumberOfComponents() != 1) {

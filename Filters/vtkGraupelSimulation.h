@@ -284,6 +284,13 @@ protected:
    */
   vtkDataArray *GetElevation(vtkImageData *terrain, const char *inputName);
 
+  /**
+   * The terrain on the Input: refuses none, one that is not 2-D with at
+   * least 2 x 2 points, or a spacing not above 0 (one sentence naming the
+   * simulation, what it got and the fix). 0 after the error.
+   */
+  int CheckTerrain(vtkImageData *terrain);
+
   /** Forgets the state, so the next update sets it up again. */
   void InvalidateState();
 

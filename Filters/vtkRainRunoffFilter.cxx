@@ -176,25 +176,13 @@ int vtkRainRunoffFilter::SetUpState(vtkInformationVector **inputVector) {
   vtkImageData *map = inputVector[1]->GetNumberOfInformationObjects()
                           ? vtkImageData::GetData(inputVector[1])
                           : nullptr;
-  if (!terrain) {
-    vtkErrorMacro("Rain Runoff needs a terrain image on its Input.");
+  if (!this->CheckTerrain(terrain)) {
     return 0;
   }
   int dims[3];
   terrain->GetDimensions(dims);
   double spacing[3];
   terrain->GetSpacing(spacing);
-  if (dims[0] < 2 || dims[1] < 2 || dims[2] != 1) {
-    vtkErrorMacro("Rain Runoff needs a 2-D terrain of at least 2 x 2 points on its Input; it got "
-                  << dims[0] << " x " << dims[1] << " x " << dims[2]
-                  << ". Slice a volume or resample the terrain first.");
-    return 0;
-  }
-  if (!(spacing[0] > 0.0) || !(spacing[1] > 0.0)) {
-    vtkErrorMacro("Rain Runoff needs a terrain spacing above 0 m in x and y; the Input has "
-                  << spacing[0] << " x " << spacing[1] << " m. Set the spacing on the source.");
-    return 0;
-  }
   vtkPointData *pd = terrain->GetPointData();
   vtkDataArray *elevationArray = this->GetElevation(terrain, "Input");
   if (!elevationArray || !this->CheckParameters()) {

@@ -533,6 +533,12 @@ errs = T.ErrorCatcher(g)
 g.Update()
 T.check(g.GetOutput().GetNumberOfPoints() == 0 and "2-D" in errs.text(),
         "a 3-D input refused: %r" % errs.text()[:160])
+g = vtkRainRunoffFilter()
+g.SetInputConnection(producer(image({"elevation": bowl}, spacing=0.0)).GetOutputPort())
+errs = T.ErrorCatcher(g)
+g.Update()
+T.check(g.GetOutput().GetNumberOfPoints() == 0 and len(errs.messages) == 1
+        and "spacing above 0 m" in errs.text(), "a zero spacing refused: %r" % errs.text()[:160])
 
 # Setters clamp to the core's parameter table; an error speaks the user's unit.
 g = vtkRainRunoffFilter()
