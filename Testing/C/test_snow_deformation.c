@@ -783,7 +783,7 @@ static void test_two_objects(void) {
 /* The trench of a box dragged along y = 1.2 m from x = 0.6 to x0_end at
  * speed * dt per step (a fraction of its 0.6 m length), then lifted off
  * for one more step: surfaces per column. Returns the surface. */
-static float *drag_with(int steps, double dt, double speed, int *iterations, int blocked,
+static float *drag_with(int steps, double dt, double speed, int *iterations, int blocked, int group,
                         int max_iterations) {
   gr_snow_deformation_params p;
   gr_snow_deformation_params_init(&p);
@@ -795,6 +795,8 @@ static float *drag_with(int steps, double dt, double speed, int *iterations, int
     return NULL;
   if (blocked >= 0)
     gr_snow_deformation_set_blocked(s, blocked);
+  if (group >= 0)
+    gr_snow_deformation_set_group(s, group);
   test_mesh box;
   mesh_box(&box, 0.3, 0.2, 0.25);
   double v[3] = {speed, 0.0, 0.0};
@@ -823,17 +825,18 @@ static float *drag_with(int steps, double dt, double speed, int *iterations, int
 }
 
 static float *drag(int steps, double dt, double speed, int *iterations) {
-  return drag_with(steps, dt, speed, iterations, -1, -1);
+  return drag_with(steps, dt, speed, iterations, -1, -1, -1);
 }
 
 /* The talus in blocks of iterations per launch (the GPU's way) and in two
  * launches per iteration (the CPU's way) give the same bits, converged
- * (the default cap) or cut short every step (8 iterations). */
+ * (the default cap) or cut short every step (8 iterations); without the
+ * one-group tail, which this grid would otherwise run whole. */
 static void test_blocked(void) {
   for (int cap = 0; cap < 2; ++cap) {
     int its[2] = {0, 0}, max = cap ? 8 : -1;
-    float *a = drag_with(30, 1.0 / 60.0, 1.5, &its[0], 0, max);
-    float *b = drag_with(30, 1.0 / 60.0, 1.5, &its[1], 1, max);
+    float *a = drag_with(30, 1.0 / 60.0, 1.5, &its[0], 0, 0, max);
+    float *b = drag_with(30, 1.0 / 60.0, 1.5, &its[1], 1, 0, max);
     if (!a || !b) {
       free(a), free(b);
       return;
@@ -843,6 +846,30 @@ static void test_blocked(void) {
       differ += memcmp(&a[c], &b[c], sizeof(float)) != 0;
     printf("blocked talus (cap %d): %d of %d values differ; up to %d and %d iterations a step\n",
            max, differ, 2 * 64 * 48, its[0], its[1]);
+    CHECK(differ == 0 && its[0] == its[1] && its[0] > 4);
+    free(a), free(b);
+  }
+}
+
+/* The talus' tail in one work-group gives the bits and the iteration
+ * counts of the launches it replaces, after each kind of launch (blocked
+ * or not), converged or cut short every step by a cap that is not a
+ * multiple of the check's stride (7). */
+static void test_group(void) {
+  for (int k = 0; k < 4; ++k) {
+    int blocked = k & 1, max = (k & 2) ? 7 : -1, its[2] = {0, 0};
+    float *a = drag_with(30, 1.0 / 60.0, 1.5, &its[0], blocked, 0, max);
+    float *b = drag_with(30, 1.0 / 60.0, 1.5, &its[1], blocked, 1, max);
+    if (!a || !b) {
+      free(a), free(b);
+      return;
+    }
+    int differ = 0;
+    for (int c = 0; c < 2 * 64 * 48; ++c)
+      differ += memcmp(&a[c], &b[c], sizeof(float)) != 0;
+    printf("one-group tail (blocked %d, cap %d): %d of %d values differ; up to %d and %d "
+           "iterations a step\n",
+           blocked, max, differ, 2 * 64 * 48, its[0], its[1]);
     CHECK(differ == 0 && its[0] == its[1] && its[0] > 4);
     free(a), free(b);
   }
@@ -1657,6 +1684,7 @@ static const gr_subtest tests[] = {
     {"trail", test_trail, 0},
     {"time_step", test_time_step, 0},
     {"blocked", test_blocked, 0},
+    {"group", test_group, 0},
     {"devices_agree", test_devices_agree, 0},
     {"bare_ground", test_bare_ground, 0},
     {"talus_room", test_talus_room, 0},

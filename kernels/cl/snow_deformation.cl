@@ -548,6 +548,111 @@ snow_relax_block(__global const float *restrict ground, __global const float *re
   }
 }
 
+/* The talus' tail in one work-group: once the points still moving fit in
+ * a small window, one launch runs the remaining iterations (at most cap)
+ * instead of a launch or two per iteration and a check read back every few:
+ * the work-group's barriers order the iterations, and it checks every
+ * iteration itself. The same functions as the other launches, the same
+ * window rule (the givers R: at first the host's window, then the box of
+ * the points that could move more than tol grown by one), so the same bits;
+ * it stops where nothing can move more than tol, at the cap, or when the
+ * window's rates (R grown by two) exceed max_area points at an iteration
+ * count (first, the iterations before the launch, plus those run) that is
+ * a multiple of align (so that the launches after it keep their checks on
+ * the same iterations), and leaves
+ * in result the iterations run, whether nothing could move, and R (x0, y0,
+ * x1, y1, inclusive). The state stays in depth/density (the moves go to
+ * depth_tmp/density_tmp and are copied back on their window), so both
+ * buffers of the pair equal each other wherever it wrote. */
+__kernel void snow_relax_group(__global const float *restrict ground, __global float *depth,
+                               __global float *density, __global float *depth_tmp,
+                               __global float *density_tmp,
+                               __global const float *restrict under_min, float clearance, int nx,
+                               int ny, float tx, float ty, float td, float tol, int x0, int y0,
+                               int x1, int y1, int cap, int max_area, int first, int align,
+                               __global float *rate, __global float *rate_in,
+                               __global int *restrict result) {
+  __local int box[5]; /* the largest movable amount's bits, -x0, x1, -y0, y1 */
+  const int lid = get_local_id(0), wg = get_local_size(0);
+  int it = 0, still = 0;
+  for (; it < cap; ++it) {
+    if (x0 > x1 || y0 > y1)
+      break;
+    const int rx0 = max(x0 - 2, 0), ry0 = max(y0 - 2, 0), rx1 = min(x1 + 2, nx - 1),
+              ry1 = min(y1 + 2, ny - 1), rw = rx1 - rx0 + 1, rn = rw * (ry1 - ry0 + 1);
+    if (rn > max_area && (first + it) % align == 0) {
+      still = 1;
+      break;
+    }
+    if (lid == 0) {
+      box[0] = 0;
+      box[1] = box[2] = box[3] = box[4] = INT_MIN;
+    }
+    barrier(CLK_LOCAL_MEM_FENCE);
+    for (int q = lid; q < rn; q += wg) {
+      int i = rx0 + q % rw, j = ry0 + q / rw, c = gr_idx(i, j, nx);
+      float sn[8], gn[8], un[8], k, kin, mv;
+      for (int e = 0; e < 8; ++e) {
+        int m = snow_neighbour(i, j, e, nx, ny);
+        sn[e] = depth[m];
+        gn[e] = ground[m];
+        un[e] = under_min[m] - clearance;
+      }
+      snow_rate_at(depth[c], ground[c], under_min[c] - clearance, sn, gn, un, tx, ty, td,
+                   i >= x0 && i <= x1 && j >= y0 && j <= y1, tol, &k, &kin, &mv);
+      rate[c] = k;
+      rate_in[c] = kin;
+      if (mv > tol) {
+        atomic_max(&box[0], as_int(mv)); /* non-negative floats order as their bits */
+        atomic_max(&box[1], -i);
+        atomic_max(&box[2], i);
+        atomic_max(&box[3], -j);
+        atomic_max(&box[4], j);
+      }
+    }
+    barrier(CLK_GLOBAL_MEM_FENCE | CLK_LOCAL_MEM_FENCE);
+    const int moving = box[0] != 0, bx0 = -box[1], bx1 = box[2], by0 = -box[3], by1 = box[4];
+    if (!moving)
+      break; /* nothing gives: this iteration would change nothing */
+    const int mx0 = max(x0 - 1, 0), my0 = max(y0 - 1, 0), mx1 = min(x1 + 1, nx - 1),
+              my1 = min(y1 + 1, ny - 1), mw = mx1 - mx0 + 1, mn = mw * (my1 - my0 + 1);
+    for (int q = lid; q < mn; q += wg) {
+      int i = mx0 + q % mw, j = my0 + q / mw, c = gr_idx(i, j, nx);
+      float sn[8], gn[8], un[8], rn[8], kon[8], kinn[8], s1, r1;
+      for (int e = 0; e < 8; ++e) {
+        int m = snow_neighbour(i, j, e, nx, ny);
+        sn[e] = depth[m];
+        gn[e] = ground[m];
+        un[e] = under_min[m] - clearance;
+        rn[e] = density[m];
+        kon[e] = rate[m];
+        kinn[e] = rate_in[m];
+      }
+      snow_move_at(depth[c], density[c], ground[c], under_min[c] - clearance, rate[c], rate_in[c],
+                   sn, gn, un, rn, kon, kinn, tx, ty, td, &s1, &r1);
+      depth_tmp[c] = s1;
+      density_tmp[c] = r1;
+    }
+    barrier(CLK_GLOBAL_MEM_FENCE);
+    for (int q = lid; q < mn; q += wg) {
+      int c = gr_idx(mx0 + q % mw, my0 + q / mw, nx);
+      depth[c] = depth_tmp[c];
+      density[c] = density_tmp[c];
+    }
+    barrier(CLK_GLOBAL_MEM_FENCE);
+    x0 = bx0 - 1, x1 = bx1 + 1, y0 = by0 - 1, y1 = by1 + 1;
+    x0 = max(x0, 0), y0 = max(y0, 0), x1 = min(x1, nx - 1), y1 = min(y1, ny - 1);
+  }
+  if (lid == 0) {
+    result[0] = it;
+    result[1] = !still && it < cap; /* stopped because nothing could move */
+    result[2] = x0;
+    result[3] = y0;
+    result[4] = x1;
+    result[5] = y1;
+  }
+}
+
 /* The largest movable amount on the window [x0, x0 + w) x [y0, y0 + h)
  * (n = w h points), and the box of the points that can still move more
  * than tol, as four maxima (-i, i, -j, j; -1e9 when there is none). */

@@ -68,6 +68,14 @@
 #endif
 #define GR_SNOW_CHECK_LAG 2
 
+/* The talus' tail runs in one work-group (snow_relax_group) once the
+ * window it computes (the givers' window grown by two) holds at most this
+ * many points. Measured on the bench sphere at 1024^2: on the H200 (a group
+ * of 1024) the talus took 0.78-0.93 ms a step with 32768, 1.09-1.31 ms
+ * without the tail, 1.39 ms with 65536; on PoCL here (a group of 256 on one
+ * core) 16-17 ms with 32768 or 131072, 24 ms without. */
+#define GR_SNOW_GROUP_AREA 32768
+
 /* The 8 neighbours' offsets, in the order the talus adds them up:
  * row by row from (-1, -1), the point itself left out. */
 #define GR_SNOW_NEIGHBOUR_DI(q) ((q) < 3 ? (q)-1 : (q) < 5 ? 2 * ((q)-3) - 1 : (q)-6)

@@ -78,14 +78,17 @@ struct gr_snow_deformation {
   void *halo_user;
   gr_snow_deformation_params params;
   cl_kernel raster, raster_clear, overlap_k, contour, obj_reduce, apply, relax_rate, relax_move,
-      relax_block, check_reduce, ledger_reduce, surface, reset, added_reduce, quantize;
+      relax_block, relax_group, check_reduce, ledger_reduce, surface, reset, added_reduce, quantize;
   cl_mem depth[2], density[2]; /* [cur] is the state */
   int cur;
   cl_mem ground, depth0, density0, under, overlap, weight, overlap_sum, contact, under_min, rate,
       rate_in, movable, scratch;
   size_t block[2]; /* the blocked talus launch's work-group: its tile of points */
   int blocked;     /* the talus in blocked launches (GPUs) or one launch per iteration */
-  cl_mem tri;      /* world triangles, 9 floats each */
+  int group;       /* the talus' tail in one work-group (snow_relax_group) */
+  size_t group_size;
+  cl_mem group_result; /* snow_relax_group's iterations, end and window */
+  cl_mem tri;          /* world triangles, 9 floats each */
   size_t tri_cap;
   gr_reduction red_check[GR_SNOW_CHECK_LAG + 1];
   gr_reduction_i64 red_obj, red_ledger, red_added;
@@ -224,6 +227,11 @@ static gr_status gr_snow_mark(gr_snow_deformation *s, double *acc) {
 void gr_snow_deformation_set_blocked(gr_snow_deformation *s, int on) {
   if (s)
     s->blocked = on != 0;
+}
+
+void gr_snow_deformation_set_group(gr_snow_deformation *s, int on) {
+  if (s)
+    s->group = on != 0;
 }
 
 void gr_snow_deformation_set_timing(gr_snow_deformation *s, int on) {
@@ -617,6 +625,16 @@ static gr_status gr_snow_block_shape(gr_snow_deformation *s) {
                         (unsigned long long)local_mem, wg);
   s->block[0] = s->block[1] = t;
   s->blocked = (type & CL_DEVICE_TYPE_GPU) != 0;
+  /* The tail's work-group: as large as the device allows on a GPU (one
+   * group holds one multiprocessor), 256 on a CPU (one core runs it). */
+  wg = 0;
+  err = clGetKernelWorkGroupInfo(s->relax_group, dev, CL_KERNEL_WORK_GROUP_SIZE, sizeof(wg), &wg,
+                                 NULL);
+  if (err != CL_SUCCESS)
+    return gr_cl_check(s->ctx, err, "Querying the device for the talus kernel's work-group");
+  size_t g = (type & CL_DEVICE_TYPE_GPU) ? 1024 : 256;
+  s->group_size = g < wg ? g : wg;
+  s->group = s->group_size >= 32;
   return GR_OK;
 }
 
@@ -687,6 +705,7 @@ gr_status gr_snow_deformation_create(gr_context *ctx, const gr_grid *grid,
             {"snow_relax_rate", &s->relax_rate},
             {"snow_relax_move", &s->relax_move},
             {"snow_relax_block", &s->relax_block},
+            {"snow_relax_group", &s->relax_group},
             {"snow_check_reduce", &s->check_reduce},
             {"snow_ledger_reduce", &s->ledger_reduce},
             {"snow_surface", &s->surface},
@@ -703,6 +722,8 @@ gr_status gr_snow_deformation_create(gr_context *ctx, const gr_grid *grid,
     st = gr_buffer_create(ctx, CL_MEM_READ_WRITE, bytes, NULL, bufs[i]);
   if (st == GR_OK)
     st = gr_snow_block_shape(s);
+  if (st == GR_OK)
+    st = gr_buffer_create(ctx, CL_MEM_READ_WRITE, 6 * sizeof(cl_int), NULL, &s->group_result);
   if (st == GR_OK)
     st = gr_reduction_i64_init(ctx, s->obj_reduce, cells, GR_SNOW_OBJ_SUMS, &s->red_obj);
   if (st == GR_OK)
@@ -735,17 +756,17 @@ gr_status gr_snow_deformation_create(gr_context *ctx, const gr_grid *grid,
 void gr_snow_deformation_destroy(gr_snow_deformation *s) {
   if (!s)
     return;
-  cl_kernel ks[] = {s->raster,      s->raster_clear, s->overlap_k,     s->contour,
-                    s->obj_reduce,  s->apply,        s->relax_rate,    s->relax_move,
-                    s->relax_block, s->check_reduce, s->ledger_reduce, s->surface,
-                    s->reset,       s->added_reduce, s->quantize};
+  cl_kernel ks[] = {s->raster,      s->raster_clear, s->overlap_k,    s->contour,
+                    s->obj_reduce,  s->apply,        s->relax_rate,   s->relax_move,
+                    s->relax_block, s->relax_group,  s->check_reduce, s->ledger_reduce,
+                    s->surface,     s->reset,        s->added_reduce, s->quantize};
   for (size_t i = 0; i < sizeof(ks) / sizeof(ks[0]); ++i)
     if (ks[i])
       clReleaseKernel(ks[i]);
-  cl_mem *bufs[] = {&s->depth[0],    &s->depth[1], &s->density[0], &s->density[1], &s->ground,
-                    &s->depth0,      &s->density0, &s->under,      &s->overlap,    &s->weight,
-                    &s->overlap_sum, &s->contact,  &s->under_min,  &s->rate,       &s->rate_in,
-                    &s->movable,     &s->scratch,  &s->tri};
+  cl_mem *bufs[] = {&s->depth[0],    &s->depth[1], &s->density[0], &s->density[1],  &s->ground,
+                    &s->depth0,      &s->density0, &s->under,      &s->overlap,     &s->weight,
+                    &s->overlap_sum, &s->contact,  &s->under_min,  &s->rate,        &s->rate_in,
+                    &s->movable,     &s->scratch,  &s->tri,        &s->group_result};
   for (size_t i = 0; i < sizeof(bufs) / sizeof(bufs[0]); ++i)
     gr_buffer_release(bufs[i]);
   gr_reduction_i64_release(&s->red_obj);
@@ -1527,6 +1548,61 @@ static gr_status gr_snow_relax_blocked(gr_snow_deformation *s, cl_int gx0, cl_in
   return st;
 }
 
+/* The talus' tail in one launch of snow_relax_group from the givers'
+ * window [*x0, *x1] x [*y0, *y1] (inclusive), at most cap iterations: adds
+ * the iterations run to *ran, sets *done when nothing could move any more,
+ * and leaves the window of the next iteration in *x0.. (waits). The count
+ * is the one the checked launches would give: they check every align
+ * iterations, so a relaxation that ends at iteration e counts e rounded up
+ * to align, and one that would not end before the cap counts the cap. */
+static gr_status gr_snow_relax_group(gr_snow_deformation *s, int *x0, int *y0, int *x1, int *y1,
+                                     cl_int cap, cl_int align, float tol, int *ran, int *done) {
+  cl_int nx = s->grid.nx, ny = s->grid.ny, nxt = 1 - s->cur;
+  cl_int max_area = GR_SNOW_GROUP_AREA;
+  cl_int w[4] = {*x0, *y0, *x1, *y1}, first = *ran, left = cap - first;
+  float thr[3];
+  gr_snow_thresholds(s, thr);
+  float clearance = (float)(2.0 * GR_SNOW_DEFORMATION_CONTACT_GAP); /* snow_excess */
+  const gr_snow_arg args[] = {{"ground", sizeof(cl_mem), &s->ground},
+                              {"depth", sizeof(cl_mem), &s->depth[s->cur]},
+                              {"density", sizeof(cl_mem), &s->density[s->cur]},
+                              {"depth_tmp", sizeof(cl_mem), &s->depth[nxt]},
+                              {"density_tmp", sizeof(cl_mem), &s->density[nxt]},
+                              {"under_min", sizeof(cl_mem), &s->under_min},
+                              {"clearance", sizeof(clearance), &clearance},
+                              {"nx", sizeof(nx), &nx},
+                              {"ny", sizeof(ny), &ny},
+                              {"tx", sizeof(float), &thr[0]},
+                              {"ty", sizeof(float), &thr[1]},
+                              {"td", sizeof(float), &thr[2]},
+                              {"tol", sizeof(tol), &tol},
+                              {"x0", sizeof(cl_int), &w[0]},
+                              {"y0", sizeof(cl_int), &w[1]},
+                              {"x1", sizeof(cl_int), &w[2]},
+                              {"y1", sizeof(cl_int), &w[3]},
+                              {"cap", sizeof(left), &left},
+                              {"max_area", sizeof(max_area), &max_area},
+                              {"first", sizeof(first), &first},
+                              {"align", sizeof(align), &align},
+                              {"rate", sizeof(cl_mem), &s->rate},
+                              {"rate_in", sizeof(cl_mem), &s->rate_in},
+                              {"result", sizeof(cl_mem), &s->group_result}};
+  const size_t local[2] = {s->group_size, 1};
+  cl_int res[6];
+  gr_status st = gr_snow_args(s, s->relax_group, args, sizeof(args) / sizeof(args[0]));
+  if (st == GR_OK)
+    st = gr_enqueue_2d(s->ctx, s->relax_group, 0, 0, s->group_size, 1, local);
+  if (st == GR_OK)
+    st = gr_buffer_read(s->ctx, s->group_result, 0, sizeof(res), res);
+  if (st == GR_OK) {
+    int end = first + res[0], counted = (end + align - 1) / align * align;
+    *done = res[1] != 0 && counted < cap;
+    *ran = *done ? counted : (res[1] != 0 ? cap : end);
+    *x0 = res[2], *y0 = res[3], *x1 = res[4], *y1 = res[5];
+  }
+  return st;
+}
+
 /* Talus relaxation on a window that follows the snow that can move.
  *
  * The window: the givers R (at first the objects' boxes grown by the
@@ -1611,7 +1687,25 @@ static gr_status gr_snow_relax(gr_snow_deformation *s) {
   int before[GR_SNOW_CHECK_LAG + 1], empty[GR_SNOW_CHECK_LAG + 1];
   int launched = 0, started = 0, read = 0, it_launched = 0, done = 0;
   while (st == GR_OK && !done) {
-    if (it_launched < cap && started - read <= lag) {
+    /* The tail: once the givers' window grown by two is small, in one
+     * work-group (not on a piece with a ring: it would need an exchange
+     * every iteration), after every check in flight is read. */
+    int gx = (x1 + 2 < nx - 1 ? x1 + 2 : nx - 1) - (x0 - 2 > 0 ? x0 - 2 : 0) + 1,
+        gy = (y1 + 2 < ny - 1 ? y1 + 2 : ny - 1) - (y0 - 2 > 0 ? y0 - 2 : 0) + 1;
+    int tail = s->group && !gr_snow_has_ring(s) && it_launched < cap &&
+               (double)gx * gy <= GR_SNOW_GROUP_AREA;
+    if (tail && read == started) {
+      x0 = x0 > 0 ? x0 : 0;
+      y0 = y0 > 0 ? y0 : 0;
+      x1 = x1 < nx - 1 ? x1 : nx - 1;
+      y1 = y1 < ny - 1 ? y1 : ny - 1;
+      st = gr_snow_relax_group(s, &x0, &y0, &x1, &y1, cap, GR_SNOW_BLOCK_ITERATIONS * every, tol,
+                               &it_launched, &done);
+      if (st == GR_OK)
+        it = it_launched;
+      continue;
+    }
+    if (!tail && it_launched < cap && started - read <= lag) {
       int left = cap - it_launched;
       cl_int iters = left < GR_SNOW_BLOCK_ITERATIONS ? left : GR_SNOW_BLOCK_ITERATIONS;
       x0 = x0 > 0 ? x0 : 0;

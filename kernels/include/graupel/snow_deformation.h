@@ -430,6 +430,14 @@ GR_API void gr_snow_deformation_set_timing(gr_snow_deformation *s, int on);
  */
 GR_API void gr_snow_deformation_set_blocked(gr_snow_deformation *s, int on);
 
+/**
+ * Whether the talus' last iterations, once the snow still moving fits in a
+ * small window, run in one work-group that iterates and checks by itself
+ * (non-zero, the default but on a piece with neighbours) or as the other
+ * iterations do (0). Both give the same bits; only the speed differs.
+ */
+GR_API void gr_snow_deformation_set_group(gr_snow_deformation *s, int on);
+
 /** The sums since timing was switched on (zeros when it never was). */
 GR_API gr_status gr_snow_deformation_timing_get(const gr_snow_deformation *s,
                                                 gr_snow_deformation_timing *out);
