@@ -224,7 +224,8 @@ static const gr_bench_core bench = {
     snow_deformation_step,
     snow_deformation_teardown,
     96.0,
-    snow_deformation_report};
+    snow_deformation_report,
+    NULL};
 
 const gr_bench_core *gr_bench_snow_deformation(void) {
   return &bench;
