@@ -88,6 +88,9 @@ typedef struct split_member {
   /* seconds since the timed steps began */
   double wait_s, halo_s, barrier_s, allreduce_s;
   int allreduce_calls;
+  double step_allreduce_s; /* of allreduce_s: in the timed steps */
+  int step_allreduce_calls;
+  unsigned long step_exchanges;
   double t0, t1; /* the timed steps' start and end */
   gr_status st;
   char error[600];
@@ -229,12 +232,16 @@ static void *member_run(void *arg) {
   /* The set-up's allreduce waited for the slowest program build: count from here. */
   m->wait_s = m->halo_s = m->barrier_s = m->allreduce_s = 0.0;
   m->allreduce_calls = 0;
+  unsigned long exchanges0 = m->exchanges;
   m->t0 = gr_bench_now_s();
   for (int i = 0; st == GR_OK && i < t->steps; ++i)
     st = t->core->step(m->state);
   if (st == GR_OK)
     st = gr_finish(m->ctx);
   m->t1 = gr_bench_now_s();
+  m->step_allreduce_s = m->allreduce_s;
+  m->step_allreduce_calls = m->allreduce_calls;
+  m->step_exchanges = m->exchanges - exchanges0;
   if (st != GR_OK) {
     member_fail(m, st, "steps");
     return NULL;
@@ -332,7 +339,7 @@ int gr_bench_split_run(const char *name, const gr_bench_core *core, int n, int s
   if (!sp) {
     fprintf(stderr,
             "graupel-bench: --devices needs a core that runs as pieces of a split "
-            "domain; '%s' does not: leave --devices out or name rain_runoff.\n",
+            "domain; '%s' does not: leave --devices out, or see --help for the cores marked *.\n",
             name);
     return 2;
   }
@@ -472,8 +479,9 @@ int gr_bench_split_run(const char *name, const gr_bench_core *core, int n, int s
     goto done;
 
   double t0 = m[0].t0, t1 = m[0].t1, halo = 0.0, wait = 0.0, barrier = 0.0;
-  double allreduce = 0.0;
-  int calls = 0;
+  double allreduce = 0.0, step_allreduce = 0.0;
+  int calls = 0, step_calls = 0;
+  unsigned long exchanges = 0;
   size_t halo_bytes = 0;
   for (int r = 0; r < k; ++r) {
     t0 = fmin(t0, m[r].t0);
@@ -481,8 +489,11 @@ int gr_bench_split_run(const char *name, const gr_bench_core *core, int n, int s
     halo = fmax(halo, m[r].halo_s);
     wait = fmax(wait, m[r].wait_s);
     barrier = fmax(barrier, m[r].barrier_s);
-    allreduce = fmax(allreduce, m[r].allreduce_s);
-    calls = m[r].allreduce_calls > calls ? m[r].allreduce_calls : calls;
+    step_allreduce = fmax(step_allreduce, m[r].step_allreduce_s);
+    allreduce = fmax(allreduce, m[r].allreduce_s - m[r].step_allreduce_s);
+    step_calls = m[r].step_allreduce_calls;
+    calls = m[r].allreduce_calls - m[r].step_allreduce_calls;
+    exchanges = m[r].step_exchanges;
     halo_bytes += m[r].halo_bytes[0] + m[r].halo_bytes[1];
   }
   double elapsed = t1 - t0;
@@ -499,10 +510,11 @@ int gr_bench_split_run(const char *name, const gr_bench_core *core, int n, int s
            "%.4f ms/step\n",
            r, m[r].j0, m[r].j0 + m[r].ny - 1, m[r].device, 1e3 * m[r].wait_s / steps,
            1e3 * m[r].halo_s / steps, 1e3 * m[r].barrier_s / steps);
-  printf("%s: halo exchange %.4f ms/step (copies; the slowest piece; %zu bytes a step over all "
-         "pieces, both ways), barrier wait %.4f ms/step; allreduce %.4f ms in %d calls (the "
-         "ledger after the run; the steps make none)\n",
-         name, 1e3 * halo / steps, halo_bytes, 1e3 * barrier / steps, 1e3 * allreduce, calls);
+  printf("%s: halo exchange %.4f ms/step (copies, the slowest piece's; %.4g exchanges a step, "
+         "%zu bytes each over all pieces), barrier wait %.4f ms/step; allreduce %.4f ms/step "
+         "(%.4g calls a step), %.4f ms in %d calls after the steps (the summary)\n",
+         name, 1e3 * halo / steps, (double)exchanges / steps, halo_bytes, 1e3 * barrier / steps,
+         1e3 * step_allreduce / steps, (double)step_calls / steps, 1e3 * allreduce, calls);
   if (t.summary[0])
     printf("%s\n", t.summary);
   rc = 0;
