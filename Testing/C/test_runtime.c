@@ -107,6 +107,33 @@ static void test_devices(void) {
   CHECK(ctx && strcmp(gr_context_device_name(ctx), infos[0].name) == 0);
   gr_context_release(ctx);
 
+  /* ":N" picks the N-th of the devices a request matches: ":0" the first,
+   * one past the last none, with the whole request in the sentence. */
+  char nth[160];
+  snprintf(nth, sizeof(nth), "%s:0", infos[0].name);
+  opt.device = nth;
+  CHECK(gr_context_create(&opt, &ctx) == GR_OK);
+  CHECK(ctx && strcmp(gr_context_device_name(ctx), infos[0].name) == 0);
+  gr_context_release(ctx);
+  int same_name = 0;
+  for (int i = 0; i < count && i < 8; ++i)
+    same_name += strstr(infos[i].name, infos[0].name) != NULL ||
+                 strstr(infos[i].platform, infos[0].name) != NULL;
+  snprintf(nth, sizeof(nth), "%s:%d", infos[0].name, same_name);
+  if (count <= 8) {
+    CHECK(gr_context_create(&opt, &ctx) == GR_ERR_NO_DEVICE);
+    CHECK(ctx == NULL);
+    CHECK_MSG(strstr(gr_last_error(NULL), nth) != NULL, "'%s'", gr_last_error(NULL));
+  }
+  opt.device = "auto:0";
+  CHECK(gr_context_create(&opt, &ctx) == GR_OK);
+  gr_context *first = NULL;
+  opt.device = "auto";
+  CHECK(gr_context_create(&opt, &first) == GR_OK);
+  CHECK(ctx && first && gr_context_device(ctx) == gr_context_device(first));
+  gr_context_release(ctx);
+  gr_context_release(first);
+
   /* The environment variable is honoured when the option is empty. */
   int have_cpu = 0;
   for (int i = 0; i < count && i < 8; ++i)
@@ -120,6 +147,13 @@ static void test_devices(void) {
     CHECK(info.is_cpu);
     CHECK(!gr_context_is_gpu(ctx));
     gr_context_release(ctx);
+    setenv("GRAUPEL_DEVICE", "cpu:0", 1);
+    CHECK(gr_context_create(&opt, &ctx) == GR_OK);
+    CHECK(ctx && gr_context_device_info(ctx, &info) == GR_OK && info.is_cpu);
+    gr_context_release(ctx);
+    setenv("GRAUPEL_DEVICE", "cpu:64", 1);
+    CHECK(gr_context_create(&opt, &ctx) == GR_ERR_NO_DEVICE);
+    CHECK(strstr(gr_last_error(NULL), "'cpu:64' (from GRAUPEL_DEVICE)") != NULL);
     /* ...and the option wins over the variable. */
     setenv("GRAUPEL_DEVICE", "no-such-device-xyzzy", 1);
     opt.device = "cpu";

@@ -50,6 +50,7 @@ static const gr_bench_core bench = {
     particles_step,
     particles_teardown,
     40.0,
+    NULL,
     NULL};
 
 const gr_bench_core *gr_bench_particles(void) {

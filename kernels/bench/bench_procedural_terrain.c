@@ -23,6 +23,7 @@ static const gr_bench_core bench = {
     terrain_step,
     terrain_teardown,
     4.0,
+    NULL,
     NULL};
 
 const gr_bench_core *gr_bench_procedural_terrain(void) {

@@ -13,6 +13,7 @@
 typedef struct rain_runoff_bench {
   gr_rain_runoff *sim;
   double dt;
+  int nx, ny; /* owned cells */
 } rain_runoff_bench;
 
 static void rain_runoff_teardown(void *state) {
@@ -22,17 +23,38 @@ static void rain_runoff_teardown(void *state) {
   free(r);
 }
 
-static gr_status rain_runoff_setup(gr_context *ctx, int n, void **state) {
-  gr_grid g = {.nx = n, .ny = n, .dx = 2.0, .dy = 2.0};
+static gr_flow_model bench_flow_model(void) {
+  const char *model = getenv("GRAUPEL_BENCH_FLOW_MODEL");
+  return model && atoi(model) == 0 ? GR_FLOW_SHALLOW_WATER : GR_FLOW_LOCAL_INERTIAL;
+}
+
+static int rain_runoff_ring(void) {
+  return bench_flow_model() == GR_FLOW_SHALLOW_WATER ? GR_RAIN_RUNOFF_GHOST_SW
+                                                     : GR_RAIN_RUNOFF_GHOST;
+}
+
+/* Rows j0 .. j0 + ny - 1 of the n by n bowl (the whole grid for j0 = 0,
+ * ny = n), with a ring toward each neighbouring strip: every input is a
+ * function of the global (i, j), so the strips hold the whole grid's floats. */
+static gr_status rain_runoff_setup_piece(gr_context *ctx, int n, int j0, int ny,
+                                         const gr_bench_link *link, void **state) {
+  int whole = j0 == 0 && ny == n, ring = whole ? 0 : rain_runoff_ring();
+  int south = j0 > 0 ? ring : 0, north = j0 + ny < n ? ring : 0;
+  gr_grid g = {.nx = n, .ny = ny, .dx = 2.0, .dy = 2.0, .j0 = j0};
+  if (!whole) {
+    g.global_nx = n;
+    g.global_ny = n;
+    g.ghost = ring;
+  }
   gr_rain_runoff_params p;
   gr_rain_runoff_params_init(&p);
   p.rain_rate = 50.0 / 3.6e6;
   p.permeability = 5.0 / 3.6e6;
   p.max_dt = 0.25; /* stays stable while the bowl fills during the run */
-  const char *model = getenv("GRAUPEL_BENCH_FLOW_MODEL");
-  p.flow_model = model && atoi(model) == 0 ? GR_FLOW_SHALLOW_WATER : GR_FLOW_LOCAL_INERTIAL;
+  p.flow_model = bench_flow_model();
   rain_runoff_bench *r = calloc(1, sizeof(*r));
-  size_t cells = (size_t)n * (size_t)n;
+  int rows = ny + south + north;
+  size_t cells = (size_t)n * (size_t)rows;
   float *b = malloc(cells * sizeof(float)), *d = malloc(cells * sizeof(float));
   if (!r || !b || !d) {
     free(r);
@@ -40,18 +62,27 @@ static gr_status rain_runoff_setup(gr_context *ctx, int n, void **state) {
     free(d);
     return gr_set_error(ctx, GR_ERR_OUT_OF_MEMORY, "Out of host memory.");
   }
+  r->nx = n;
+  r->ny = ny;
   double half = 0.5 * (n - 1);
-  for (int j = 0; j < n; ++j)
+  for (int jl = 0; jl < rows; ++jl)
     for (int i = 0; i < n; ++i) {
+      int j = j0 - south + jl;
       double x = (i - half) / (half > 0.0 ? half : 1.0), y = (j - half) / (half > 0.0 ? half : 1.0);
-      b[(size_t)j * n + i] = (float)(5.0 * (x * x + y * y) + 0.01 * i * g.dx);
-      d[(size_t)j * n + i] = 0.05f;
+      b[(size_t)jl * n + i] = (float)(5.0 * (x * x + y * y) + 0.01 * i * g.dx);
+      d[(size_t)jl * n + i] = 0.05f;
     }
   gr_status st = gr_rain_runoff_create(ctx, &g, &p, &r->sim);
+  if (st == GR_OK && !whole && link) {
+    gr_rain_runoff_set_allreduce(r->sim, link->allreduce, link->allreduce_user);
+    gr_rain_runoff_set_halo_exchange(r->sim, link->exchange, link->exchange_user);
+  }
   if (st == GR_OK)
     st = gr_rain_runoff_set_field(r->sim, GR_FIELD_ELEVATION, b);
   if (st == GR_OK)
     st = gr_rain_runoff_set_field(r->sim, GR_FIELD_WATER_DEPTH, d);
+  /* A piece's stable step is the whole grid's: the allreduce takes the
+   * largest depth over every piece. */
   if (st == GR_OK)
     st = gr_rain_runoff_stable_dt(r->sim, &r->dt);
   free(b);
@@ -62,6 +93,10 @@ static gr_status rain_runoff_setup(gr_context *ctx, int n, void **state) {
   }
   *state = r;
   return GR_OK;
+}
+
+static gr_status rain_runoff_setup(gr_context *ctx, int n, void **state) {
+  return rain_runoff_setup_piece(ctx, n, 0, n, NULL, state);
 }
 
 static gr_status rain_runoff_step(void *state) {
@@ -89,6 +124,66 @@ static gr_status rain_runoff_report(void *state, gr_context *ctx) {
   return st;
 }
 
+/* ------------------------------------------------------------ as pieces */
+
+static gr_status rain_runoff_halo_size(void *state, int side, size_t *bytes) {
+  return gr_rain_runoff_halo_size(((rain_runoff_bench *)state)->sim, side, bytes);
+}
+
+static gr_status rain_runoff_halo_get(void *state, int side, void *host, size_t bytes) {
+  return gr_rain_runoff_halo_get(((rain_runoff_bench *)state)->sim, side, host, bytes);
+}
+
+static gr_status rain_runoff_halo_set(void *state, int side, const void *host, size_t bytes) {
+  return gr_rain_runoff_halo_set(((rain_runoff_bench *)state)->sim, side, host, bytes);
+}
+
+_Static_assert((int)GR_RAIN_RUNOFF_SOUTH == (int)GR_BENCH_SOUTH &&
+                   (int)GR_RAIN_RUNOFF_NORTH == (int)GR_BENCH_NORTH,
+               "bench.h's sides are the core's");
+
+/* Every field a reader gets, then every flood map. */
+static const gr_field verify_fields[] = {GR_FIELD_WATER_DEPTH, GR_FIELD_VELOCITY,
+                                         GR_FIELD_DISCHARGE, GR_FIELD_INFILTRATED,
+                                         GR_FIELD_WATER_SURFACE};
+#define VERIFY_FIELDS ((int)(sizeof(verify_fields) / sizeof(verify_fields[0])))
+
+static gr_status rain_runoff_output(void *state, int i, const char **name, int *components,
+                                    float *host) {
+  rain_runoff_bench *r = state;
+  if (i < VERIFY_FIELDS) {
+    *name = gr_field_name(verify_fields[i]);
+    *components = gr_field_components(verify_fields[i]);
+    return host ? gr_rain_runoff_get_field(r->sim, verify_fields[i], host) : GR_OK;
+  }
+  gr_rain_runoff_map m = (gr_rain_runoff_map)(i - VERIFY_FIELDS);
+  *name = gr_rain_runoff_map_name(m);
+  *components = 1;
+  return host ? gr_rain_runoff_get_map(r->sim, m, host) : GR_OK;
+}
+
+static gr_status rain_runoff_summary(void *state, char *line, size_t len) {
+  rain_runoff_bench *r = state;
+  gr_rain_runoff_ledger l;
+  gr_status st = gr_rain_runoff_ledger_get(r->sim, &l);
+  if (st == GR_OK)
+    snprintf(line, len,
+             "rain_runoff: dt %.4g s; after the run %.6g m^3 stored, %.6g m^3 out, balance %.3g "
+             "of the water in",
+             r->dt, l.stored_volume, l.outflow_volume,
+             fabs(l.balance_error) / (l.initial_volume + l.rain_volume));
+  return st;
+}
+
+static const char *rain_runoff_last_error(void *state) {
+  return gr_rain_runoff_last_error(((rain_runoff_bench *)state)->sim);
+}
+
+static const gr_bench_split split = {
+    rain_runoff_setup_piece, rain_runoff_ring,     rain_runoff_halo_size,
+    rain_runoff_halo_get,    rain_runoff_halo_set, VERIFY_FIELDS + GR_RAIN_RUNOFF_MAP_COUNT,
+    rain_runoff_output,      rain_runoff_summary,  rain_runoff_last_error};
+
 /* Per cell and step, each array once per launch (neighbours come from
  * cache): flux reads depth, elevation, the old discharges and the limiter and
  * writes the new discharges (28 B); limit reads depth and discharges and
@@ -102,7 +197,8 @@ static const gr_bench_core bench = {
     rain_runoff_step,
     rain_runoff_teardown,
     88.0,
-    rain_runoff_report};
+    rain_runoff_report,
+    &split};
 
 const gr_bench_core *gr_bench_rain_runoff(void) {
   return &bench;

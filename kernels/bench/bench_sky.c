@@ -45,6 +45,7 @@ static const gr_bench_core bench = {"sky: cloud cover image, 6 octaves of drifti
                                     sky_step,
                                     sky_teardown,
                                     15.0,
+                                    NULL,
                                     NULL};
 
 const gr_bench_core *gr_bench_sky(void) {

@@ -177,7 +177,8 @@ static const gr_bench_core bench = {
     snow_accumulation_step,
     snow_accumulation_teardown,
     96.0,
-    snow_accumulation_report};
+    snow_accumulation_report,
+    NULL};
 
 const gr_bench_core *gr_bench_snow_accumulation(void) {
   return &bench;

@@ -86,9 +86,20 @@ static gr_status snow_deformation_place(snow_deformation_bench *b) {
   return gr_snow_deformation_set_objects(b->sim, &b->mesh, 1, b->v);
 }
 
-static gr_status snow_deformation_setup(gr_context *ctx, int n, void **state) {
+/* Rows j0 .. j0 + ny - 1 of the n by n set-up (the whole grid for j0 = 0,
+ * ny = n), with a ring toward each neighbouring strip: the snow is the
+ * parameters' uniform cover on flat ground, and every piece sets the same
+ * sphere, which ploughs along y = 10 m, across the middle strips' edges. */
+static gr_status snow_deformation_setup_piece(gr_context *ctx, int n, int j0, int ny,
+                                              const gr_bench_link *link, void **state) {
   double d = 20.0 / (n > 1 ? n - 1 : 1);
-  gr_grid g = {.nx = n, .ny = n, .dx = d, .dy = d};
+  int whole = j0 == 0 && ny == n;
+  gr_grid g = {.nx = n, .ny = ny, .dx = d, .dy = d, .j0 = j0};
+  if (!whole) {
+    g.global_nx = n;
+    g.global_ny = n;
+    g.ghost = GR_SNOW_DEFORMATION_GHOST;
+  }
   gr_snow_deformation_params p;
   gr_snow_deformation_params_init(&p);
   snow_deformation_bench *b = calloc(1, sizeof(*b));
@@ -104,6 +115,10 @@ static gr_status snow_deformation_setup(gr_context *ctx, int n, void **state) {
   b->v[0] = 2.0;
   b->dt = 1.0 / 60.0;
   gr_status st = gr_snow_deformation_create(ctx, &g, &p, &b->sim);
+  if (st == GR_OK && !whole && link) {
+    gr_snow_deformation_set_allreduce(b->sim, link->allreduce, link->allreduce_user);
+    gr_snow_deformation_set_halo_exchange(b->sim, link->exchange, link->exchange_user);
+  }
   if (st == GR_OK)
     st = snow_deformation_place(b);
   if (st != GR_OK) {
@@ -112,6 +127,10 @@ static gr_status snow_deformation_setup(gr_context *ctx, int n, void **state) {
   }
   *state = b;
   return GR_OK;
+}
+
+static gr_status snow_deformation_setup(gr_context *ctx, int n, void **state) {
+  return snow_deformation_setup_piece(ctx, n, 0, n, NULL, state);
 }
 
 /* The step waits (its per-object totals are read back): the bench times
@@ -214,6 +233,63 @@ static gr_status snow_deformation_report(void *state, gr_context *ctx) {
   return st;
 }
 
+/* ------------------------------------------------------------ as pieces */
+
+static int snow_deformation_ring(void) {
+  return GR_SNOW_DEFORMATION_GHOST;
+}
+
+static gr_status snow_deformation_halo_size(void *state, int side, size_t *bytes) {
+  return gr_snow_deformation_halo_size(((snow_deformation_bench *)state)->sim, side, bytes);
+}
+
+static gr_status snow_deformation_halo_get(void *state, int side, void *host, size_t bytes) {
+  return gr_snow_deformation_halo_get(((snow_deformation_bench *)state)->sim, side, host, bytes);
+}
+
+static gr_status snow_deformation_halo_set(void *state, int side, const void *host, size_t bytes) {
+  return gr_snow_deformation_halo_set(((snow_deformation_bench *)state)->sim, side, host, bytes);
+}
+
+_Static_assert((int)GR_SNOW_DEFORMATION_SOUTH == (int)GR_BENCH_SOUTH &&
+                   (int)GR_SNOW_DEFORMATION_NORTH == (int)GR_BENCH_NORTH,
+               "bench.h's sides are the core's");
+
+static const gr_field verify_fields[] = {GR_FIELD_SNOW_DEPTH, GR_FIELD_SNOW_DENSITY,
+                                         GR_FIELD_SNOW_SURFACE, GR_FIELD_OVERLAP, GR_FIELD_CONTACT};
+
+static gr_status snow_deformation_output(void *state, int i, const char **name, int *components,
+                                         float *host) {
+  *name = gr_field_name(verify_fields[i]);
+  *components = 1;
+  return host ? gr_snow_deformation_get_field(((snow_deformation_bench *)state)->sim,
+                                              verify_fields[i], host)
+              : GR_OK;
+}
+
+static gr_status snow_deformation_summary(void *state, char *line, size_t len) {
+  snow_deformation_bench *b = state;
+  gr_snow_deformation_ledger l;
+  gr_status st = gr_snow_deformation_ledger_get(b->sim, &l);
+  if (st == GR_OK)
+    snprintf(line, len,
+             "snow_deformation: %lld steps; %.6g m^3 of snow, %.6g m^3 compressed; mass balance "
+             "%.3g of the snow",
+             l.steps, l.snow_volume, l.compressed_volume, fabs(l.balance_error) / l.initial_mass);
+  return st;
+}
+
+static const char *snow_deformation_last_error(void *state) {
+  return gr_snow_deformation_last_error(((snow_deformation_bench *)state)->sim);
+}
+
+static const gr_bench_split split = {
+    snow_deformation_setup_piece, snow_deformation_ring,
+    snow_deformation_halo_size,   snow_deformation_halo_get,
+    snow_deformation_halo_set,    (int)(sizeof(verify_fields) / sizeof(verify_fields[0])),
+    snow_deformation_output,      snow_deformation_summary,
+    snow_deformation_last_error};
+
 /* Per point and step, roughly: raster writes U (4 B), overlap reads 3 and
  * writes 1 array, contour reads D and writes cw, the reduction reads 6, the
  * apply reads 6 and writes 5, and each talus iteration reads 4 and writes 4
@@ -224,7 +300,8 @@ static const gr_bench_core bench = {
     snow_deformation_step,
     snow_deformation_teardown,
     96.0,
-    snow_deformation_report};
+    snow_deformation_report,
+    &split};
 
 const gr_bench_core *gr_bench_snow_deformation(void) {
   return &bench;

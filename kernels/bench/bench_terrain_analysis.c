@@ -50,6 +50,7 @@ static const gr_bench_core bench = {
     analysis_step,
     analysis_teardown,
     37.0,
+    NULL,
     NULL};
 
 const gr_bench_core *gr_bench_terrain_analysis(void) {

@@ -92,7 +92,8 @@ static const gr_bench_core bench = {
     water_step,
     water_teardown,
     26.0,
-    water_report};
+    water_report,
+    NULL};
 
 const gr_bench_core *gr_bench_water_surface(void) {
   return &bench;

@@ -1,6 +1,7 @@
 /* graupel-bench: speed of every Graupel core on one device.
  *
  *   graupel-bench --core NAME [--size N] [--steps K] [--device SPEC] [--list]
+ *                 [--devices D [--verify]]
  *
  * Prints ms per step, million cells per second, and the effective bandwidth
  * as a fraction of a float4 copy kernel measured on the same device in the
@@ -9,7 +10,14 @@
  * The state stays on the device: steps are enqueued back to back and the
  * clock stops after one clFinish. The cores come from the registry
  * (graupel_cores.h, written from kernels/cores.cmake); each core's set-up and
- * step live in its own bench/bench_<core>.c (see bench.h). */
+ * step live in its own bench/bench_<core>.c (see bench.h).
+ *
+ * --devices D splits the grid into D strips along y, one per OpenCL device
+ * (the D devices SPEC or GRAUPEL_DEVICE matches, every GPU by default;
+ * pieces share devices where fewer exist), one host thread each, the halo
+ * exchange and the allreduce on the host (bench_split.c); --verify then
+ * compares every output with one whole grid's after the same steps and
+ * fails on any bit of difference. */
 #include "bench.h"
 
 #include <stdio.h>
@@ -20,7 +28,7 @@
 
 /* Bytes per second of a device-to-device float4 copy of at least 64 MiB
  * (or the grid's size if larger), the best of several timed rounds. */
-static gr_status copy_bandwidth(gr_context *ctx, size_t min_bytes, double *bytes_per_s) {
+gr_status gr_bench_copy_bandwidth(gr_context *ctx, size_t min_bytes, double *bytes_per_s) {
   size_t bytes = (size_t)64 << 20;
   if (min_bytes > bytes)
     bytes = min_bytes;
@@ -94,14 +102,17 @@ static const int ncores = (int)(sizeof(cores) / sizeof(cores[0]));
 
 static void usage(FILE *f) {
   fprintf(f, "usage: graupel-bench --core NAME [--size N] [--steps K] "
-             "[--device gpu|cpu|NAME] [--list]\ncores:\n");
+             "[--device gpu|cpu|NAME[:N]] [--list]\n"
+             "                     [--devices D [--verify]]   (cores marked *: the grid in D "
+             "strips over D devices)\ncores:\n");
   for (int i = 0; i < ncores; ++i)
-    fprintf(f, "  %-16s %s\n", cores[i].name, cores[i].get()->about);
+    fprintf(f, "  %-16s %s%s\n", cores[i].name, cores[i].get()->split ? "* " : "",
+            cores[i].get()->about);
 }
 
 int main(int argc, char **argv) {
   const char *core_name = NULL, *device = NULL;
-  int size = 1024, steps = 50, list = 0;
+  int size = 1024, steps = 50, list = 0, devices = 0, verify = 0;
   for (int i = 1; i < argc; ++i) {
     if (strcmp(argv[i], "--core") == 0 && i + 1 < argc)
       core_name = argv[++i];
@@ -111,6 +122,10 @@ int main(int argc, char **argv) {
       steps = atoi(argv[++i]);
     else if (strcmp(argv[i], "--device") == 0 && i + 1 < argc)
       device = argv[++i];
+    else if (strcmp(argv[i], "--devices") == 0 && i + 1 < argc)
+      devices = atoi(argv[++i]);
+    else if (strcmp(argv[i], "--verify") == 0)
+      verify = 1;
     else if (strcmp(argv[i], "--list") == 0)
       list = 1;
     else if (strcmp(argv[i], "--help") == 0 || strcmp(argv[i], "-h") == 0) {
@@ -146,6 +161,15 @@ int main(int argc, char **argv) {
     usage(stderr);
     return 2;
   }
+  if (devices < 0 || devices > 64 || (verify && devices == 0)) {
+    fprintf(stderr, "graupel-bench: %s.\n",
+            verify && devices == 0 ? "--verify compares --devices D with one whole grid: add "
+                                     "--devices D"
+                                   : "--devices takes 1 to 64");
+    return 2;
+  }
+  if (devices > 0)
+    return gr_bench_split_run(entry->name, core, size, steps, device, devices, verify);
 
   gr_context_options opt;
   gr_context_options_init(&opt);
@@ -159,7 +183,7 @@ int main(int argc, char **argv) {
   double cells = (double)size * (double)size;
   double copy_bps = 0.0;
   void *state = NULL;
-  gr_status st = copy_bandwidth(ctx, (size_t)(cells * 4.0), &copy_bps);
+  gr_status st = gr_bench_copy_bandwidth(ctx, (size_t)(cells * 4.0), &copy_bps);
   if (st == GR_OK)
     st = core->setup(ctx, size, &state);
   /* Warm-up: first launches pay for compilation and first touch. */

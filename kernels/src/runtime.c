@@ -671,9 +671,15 @@ gr_status gr_device_list(gr_device_info *infos, int max, int *count) {
   return st;
 }
 
-/* Device choice: the request is "gpu", "cpu", "auto" or a name substring. */
+/* Device choice: the request is "gpu", "cpu", "auto" or a name substring,
+ * optionally with ":N", the N-th (from 0) device that the request matches in
+ * the order clinfo -l lists them: several identical GPUs have one name, and
+ * a process that drives them all (graupel-bench --devices, one MPI rank per
+ * GPU) needs each by its place. */
 typedef struct gr_pick_state {
   const char *want; /* normalised request */
+  int nth;          /* the ":N" of the request; 0 without one */
+  int gpus, cpus, matches, anys;
   cl_platform_id first_gpu_p, first_cpu_p, first_any_p, match_p;
   cl_device_id first_gpu, first_cpu, first_any, match;
 } gr_pick_state;
@@ -694,24 +700,40 @@ static int gr_pick_visit(void *user, cl_platform_id p, cl_device_id d) {
   gr_pick_state *s = user;
   gr_device_info info;
   gr_fill_device_info(p, d, &info);
-  if (!s->first_any) {
+  if (s->anys++ == s->nth) {
     s->first_any = d;
     s->first_any_p = p;
   }
-  if (info.is_gpu && !s->first_gpu) {
+  if (info.is_gpu && s->gpus++ == s->nth) {
     s->first_gpu = d;
     s->first_gpu_p = p;
   }
-  if (info.is_cpu && !s->first_cpu) {
+  if (info.is_cpu && s->cpus++ == s->nth) {
     s->first_cpu = d;
     s->first_cpu_p = p;
   }
-  if (!s->match && s->want[0] &&
-      (gr_contains_nocase(info.name, s->want) || gr_contains_nocase(info.platform, s->want))) {
+  if (s->want[0] &&
+      (gr_contains_nocase(info.name, s->want) || gr_contains_nocase(info.platform, s->want)) &&
+      s->matches++ == s->nth) {
     s->match = d;
     s->match_p = p;
   }
   return 0;
+}
+
+/* Splits "spec:N" into spec (copied to base) and N; *nth = 0 and base =
+ * the whole request when there is no ":digits" ending. */
+static void gr_split_request(const char *req, char *base, size_t len, int *nth) {
+  *nth = 0;
+  snprintf(base, len, "%s", req);
+  char *colon = strrchr(base, ':');
+  if (!colon || !colon[1] || strlen(colon + 1) > 6)
+    return;
+  for (const char *c = colon + 1; *c; ++c)
+    if (!isdigit((unsigned char)*c))
+      return;
+  *nth = atoi(colon + 1);
+  *colon = '\0';
 }
 
 static const char *gr_effective_request(const gr_context_options *opt) {
@@ -726,13 +748,15 @@ static const char *gr_effective_request(const gr_context_options *opt) {
 
 static gr_status gr_pick_device(const gr_context_options *opt, cl_platform_id *pp,
                                 cl_device_id *pd) {
-  const char *req = gr_effective_request(opt);
+  const char *full = gr_effective_request(opt);
+  char req[256];
   gr_pick_state s;
   memset(&s, 0, sizeof(s));
+  gr_split_request(full, req, sizeof(req), &s.nth);
   s.want = "";
   int want_gpu = strcmp(req, "gpu") == 0 || strcmp(req, "GPU") == 0;
   int want_cpu = strcmp(req, "cpu") == 0 || strcmp(req, "CPU") == 0;
-  int want_auto = strcmp(req, "auto") == 0;
+  int want_auto = strcmp(req, "auto") == 0 || req[0] == '\0';
   if (!want_gpu && !want_cpu && !want_auto)
     s.want = req;
   gr_status st = gr_for_each_device(gr_pick_visit, &s);
@@ -745,8 +769,10 @@ static gr_status gr_pick_device(const gr_context_options *opt, cl_platform_id *p
     *pd = s.first_cpu;
     *pp = s.first_cpu_p;
   } else if (want_auto) {
-    *pd = s.first_gpu ? s.first_gpu : s.first_cpu ? s.first_cpu : s.first_any;
-    *pp = s.first_gpu ? s.first_gpu_p : s.first_cpu ? s.first_cpu_p : s.first_any_p;
+    /* "auto:N": the N-th GPU where there are GPUs, else the N-th CPU device. */
+    int gpus = s.gpus > 0, cpus = !gpus && s.cpus > 0;
+    *pd = gpus ? s.first_gpu : cpus ? s.first_cpu : s.first_any;
+    *pp = gpus ? s.first_gpu_p : cpus ? s.first_cpu_p : s.first_any_p;
   } else {
     *pd = s.match;
     *pp = s.match_p;
@@ -754,8 +780,9 @@ static gr_status gr_pick_device(const gr_context_options *opt, cl_platform_id *p
   if (!*pd)
     return gr_set_error(NULL, GR_ERR_NO_DEVICE,
                         "No OpenCL device matches the request '%s' (from %s): use 'gpu', "
-                        "'cpu', 'auto' or part of a device name that clinfo -l shows.",
-                        req,
+                        "'cpu', 'auto' or part of a device name that clinfo -l shows, with "
+                        "':N' for the N-th such device from 0.",
+                        full,
                         (opt && opt->device && opt->device[0] && strcmp(opt->device, "auto"))
                             ? "the device option"
                             : "GRAUPEL_DEVICE");

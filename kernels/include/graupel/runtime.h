@@ -27,7 +27,11 @@ typedef struct gr_context_options {
    * Which device: "gpu", "cpu", a case-insensitive substring of the device
    * or platform name, or NULL / "" / "auto" for the default. When NULL or
    * "auto", the environment variable GRAUPEL_DEVICE is read; failing that the
-   * first GPU is taken, else the first CPU device, else any device.
+   * first GPU is taken, else the first CPU device, else any device. A
+   * ":N" ending ("gpu:1", "auto:1", "H200:1") takes the N-th (from 0) of the
+   * devices the rest would choose from, in clinfo -l's order: identical
+   * GPUs share a name, so a process that drives several takes each by its
+   * place.
    */
   const char *device;
   gr_log_fn log;
