@@ -11,7 +11,7 @@ into distance fog (ParaView 5.11 has none: see landscape_scene.py).
     xvfb-run -a pvbatch Examples/rain_scene.py --out out
         [--plugin build/lib/paraview-5.11/plugins/Graupel/Graupel.so]
 
-writes out/rain_scene.png (about 20 s on PoCL on two cores). The
+writes out/rain_scene.png (about 11 s on PoCL on two cores). The
 reference-image test (Testing/Python/test_images.py --scene rain_scene) draws
 the same scene at 400 x 300 pixels.
 """

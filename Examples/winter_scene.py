@@ -5,10 +5,10 @@ sun with the terrain's cast shadows (Terrain Shadow), snow falling (Snowfall
 Particles), a cloud sky (Cloud Cover) and a lightning bolt striking the
 terrain (Lightning), in distance haze.
 
-    xvfb-run -a pvbatch Examples/winter_scene.py --out out [--cells 192]
+    xvfb-run -a pvbatch Examples/winter_scene.py --out out [--cells 256]
         [--plugin build/lib/paraview-5.11/plugins/Graupel/Graupel.so]
 
-writes out/winter_scene.png (about 10 s on PoCL on two cores). The
+writes out/winter_scene.png (about 6 s on PoCL on two cores). The
 reference-image test (Testing/Python/test_images.py --scene winter) draws
 the same scene at 400 x 300 pixels.
 """
