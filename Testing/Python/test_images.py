@@ -8,6 +8,10 @@ Testing/Baseline/ by VTK's image comparison.
   --scene accumulation  4 h of wind-driven snow on a hut and trees (Snow
                    Accumulation), then a sledge across it (Snow Deformation):
                    snow_scene.build_accumulation on a 128 x 128 grid, seen whole
+  --scene winter   Examples/winter_scene.py on a 128 x 128 terrain: snow by
+                   slope, cast shadows, snowfall, cloud sky, lightning
+  --scene rain_scene  Examples/rain_scene.py: an hour of rain on the DEM in
+                   Data/ (every second point), rippled water, rain streaks, fog
 Regenerate a baseline only on purpose (--generate-baseline, or
 GRAUPEL_GENERATE_BASELINE=1 in ctest's environment), and look at it."""
 import os
@@ -18,7 +22,8 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import gr_check as T  # noqa: E402
 
 a = T.args(lambda p: p.add_argument("--scene", choices=("terrain", "rain", "snow",
-                                                          "accumulation"),
+                                                          "accumulation", "winter",
+                                                          "rain_scene"),
                                     default="terrain"))
 
 from paraview.simple import *  # noqa: E402,F401,F403
@@ -133,6 +138,38 @@ elif a.scene == "accumulation":
             % (np.median(sunk), sunk.min()))
     view = S.show_accumulation(acc, end, sledge, crossing, size=(400, 300), bar=False,
                                label=False)
+elif a.scene == "winter":
+    import winter_scene as W  # noqa: E402
+
+    parts = W.build(cells=128, spacing=1528.0 / 127, flakes=6000)
+    view, n = W.show(parts, size=(400, 300), scratch=a.scratch, title=False)
+    print("winter scene:", n)
+    # What the picture claims: mostly snow, rock on the steep parts, the low
+    # sun's shadows on part of it, every flake and bolt point drawn.
+    T.check(n["snow_fraction"] > 0.4 and 0.02 < n["rock_fraction"] < 0.4,
+            "snow on %.0f%% of the terrain, rock on %.0f%%"
+            % (100 * n["snow_fraction"], 100 * n["rock_fraction"]))
+    T.check(0.05 < n["shadow_fraction"] < 0.9,
+            "%.0f%% of the terrain in cast shadow" % (100 * n["shadow_fraction"]))
+    T.check(n["flakes"] == 6000, "6000 flakes (%d)" % n["flakes"])
+    T.check(n["bolt_points"] == 50 + 6 * 25, "the bolt's 200 points (%d)" % n["bolt_points"])
+    T.check(abs(n["cloud_fraction"] - 0.65) < 0.05,
+            "clouds on %.2f of the sky (Cover 0.65)" % n["cloud_fraction"])
+elif a.scene == "rain_scene":
+    import rain_scene as R  # noqa: E402
+
+    parts = R.build(a.data, sample=2, drops=8000)
+    view, n = R.show(parts, size=(400, 300), scratch=a.scratch, title=False)
+    print("rain scene:", n)
+    wet = n["wet_points"] / float(n["points"])
+    T.check(n["max_depth"] > 0.5 and 0.05 < wet < 0.6,
+            "water up to %.2f m deep, on %.0f%% of the DEM" % (n["max_depth"], 100 * wet))
+    T.check(abs(n["balance_error"]) < 1e-6 * n["rain_volume"]
+            and n["stored_volume"] > 0.5 * n["rain_volume"],
+            "ledger: %.4g m^3 rained, %.4g m^3 stored, error %.3g m^3"
+            % (n["rain_volume"], n["stored_volume"], n["balance_error"]))
+    T.check(0.0 < n["max_wave"] < 0.5, "ripples up to %.3f m" % n["max_wave"])
+    T.check(n["drops"] == 8000, "8000 rain drops (%d)" % n["drops"])
 else:
     terrain = ProceduralTerrain(Dimensions=[128, 128], Spacing=4.0, Seed=2026, HeightScale=40.0)
     rain = RainRunoff(Input=terrain, RainRate=100.0, EndTime=600.0, OutputInterval=600.0,
