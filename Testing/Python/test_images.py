@@ -1,8 +1,15 @@
 """pvbatch under xvfb-run: a scene rendered and compared with its baseline in
 Testing/Baseline/ by VTK's image comparison.
-  --scene terrain  the procedural terrain, warped by elevation and coloured
-  --scene rain     ten minutes of 100 mm/h on a procedural terrain (Rain
+  --scene terrain  the procedural terrain as Apply shows it (Terrain Surface:
+                   warped by elevation x2, coloured by the Graupel Terrain
+                   map, walls at the edges), with legend and exaggeration
+  --scene rain     half an hour of 100 mm/h on a procedural terrain (Rain
                    Runoff), warped by the water surface, coloured by depth
+                   (log from 1 cm, dry ground sand)
+  --scene analysis Terrain Analysis's cover classes (ground, snow, rock, ice
+                   below a water level) as Apply shows them
+  --scene water    Water Surface on a lake filled to 14 m, 10 s of raindrop ripples,
+                   as Apply shows it (coloured by water depth)
   --scene snow     a wheel rolled along an S through snow (Snow Deformation,
                    Examples/snow_scene.py on a 160 x 160 grid), seen whole
   --scene accumulation  4 h of wind-driven snow on a hut and trees (Snow
@@ -22,8 +29,8 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import gr_check as T  # noqa: E402
 
 a = T.args(lambda p: p.add_argument("--scene", choices=("terrain", "rain", "snow",
-                                                          "accumulation", "winter",
-                                                          "rain_scene"),
+                                                          "accumulation", "analysis",
+                                                          "water", "winter", "rain_scene"),
                                     default="terrain"))
 
 from paraview.simple import *  # noqa: E402,F401,F403
@@ -33,9 +40,40 @@ LoadPlugin(a.plugin, ns=globals())
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "Examples"))
 import graupel_scene  # noqa: E402
 
+
+def apply_look(source, array):
+    """The picture is Apply's look: Terrain Surface's defaults colour by
+    `array`, whose colour map is the plugin's preset."""
+    view, display, surface = graupel_scene.show_surface(source, size=(400, 300))
+    T.check(display.ColorArrayName[1] == array, "Apply colours by %s (%r)"
+            % (array, display.ColorArrayName[1]))
+    T.check(display.Representation == "Surface", "a surface (%s)" % display.Representation)
+    lut = GetColorTransferFunction(array)
+    T.check(lut.UseLogScale == (1 if array == "water_depth_display" else 0),
+            "%s's map log scale %d" % (array, lut.UseLogScale))
+    n = surface.GetDataInformation().GetNumberOfCells()
+    T.check(n > 0, "the surface has %d cells" % n)
+    return view
+
+
 if a.scene == "terrain":
     terrain = ProceduralTerrain(Dimensions=[192, 192], Spacing=4.0, Seed=2026)
-    view = graupel_scene.show_terrain(terrain, size=(400, 300))
+    view = apply_look(terrain, "elevation")
+    lut = GetColorTransferFunction("elevation")
+    # A sequential map: lightness rises from the lowest ground to the peaks.
+    rgb = lut.RGBPoints
+    light = [0.3 * rgb[k + 1] + 0.59 * rgb[k + 2] + 0.11 * rgb[k + 3] for k in range(0, len(rgb), 4)]
+    T.check(light[0] < light[len(light) // 2] < light[-1], "elevation map lightness %s" % light)
+elif a.scene == "analysis":
+    terrain = ProceduralTerrain(Dimensions=[192, 192], Spacing=4.0, Seed=2026)
+    analysis = TerrainAnalysis(Input=terrain, WaterLevel=12.0)
+    view = apply_look(analysis, "cover_class")
+elif a.scene == "water":
+    terrain = ProceduralTerrain(Dimensions=[128, 128], Spacing=4.0, Seed=2026, HeightScale=40.0)
+    water = WaterSurface(Input=terrain, UseLakeLevel=1, LakeLevel=14.0, EndTime=10.0)
+    water.UpdatePipeline(water.EndTime)
+    GetActiveViewOrCreate("RenderView").ViewTime = water.EndTime
+    view = apply_look(water, "water_depth_display")
 elif a.scene == "snow":
     import snow_scene  # noqa: E402
 
@@ -172,10 +210,12 @@ elif a.scene == "rain_scene":
     T.check(n["drops"] == 8000, "8000 rain drops (%d)" % n["drops"])
 else:
     terrain = ProceduralTerrain(Dimensions=[128, 128], Spacing=4.0, Seed=2026, HeightScale=40.0)
-    rain = RainRunoff(Input=terrain, RainRate=100.0, EndTime=600.0, OutputInterval=600.0,
+    # Half an hour: 5 cm of rain, enough to fill the hollows past the 1 cm
+    # wetting depth (ten minutes left films under it: dry in the picture).
+    rain = RainRunoff(Input=terrain, RainRate=100.0, EndTime=1800.0, OutputInterval=1800.0,
                       MaxTimeStep=2.0)
-    rain.UpdatePipeline(600.0)
-    view = graupel_scene.show_water(rain, 600.0, size=(400, 300), deep=0.5)
+    rain.UpdatePipeline(1800.0)
+    view = graupel_scene.show_water(rain, 1800.0, size=(400, 300), deep=0.5)
 shot = os.path.join(a.scratch, a.scene + ".png")
 SaveScreenshot(shot, view, ImageResolution=[400, 300])
 

@@ -1,0 +1,290 @@
+#include "vtkTerrainSurfaceFilter.h"
+
+#include "vtkCellArray.h"
+#include "vtkDataArray.h"
+#include "vtkDoubleArray.h"
+#include "vtkFieldData.h"
+#include "vtkFloatArray.h"
+#include "vtkIdTypeArray.h"
+#include "vtkImageData.h"
+#include "vtkInformation.h"
+#include "vtkInformationVector.h"
+#include "vtkNew.h"
+#include "vtkObjectFactory.h"
+#include "vtkPointData.h"
+#include "vtkPoints.h"
+#include "vtkPolyData.h"
+#include "vtkStreamingDemandDrivenPipeline.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <vector>
+
+vtkStandardNewMacro(vtkTerrainSurfaceFilter);
+
+namespace {
+// The order in which the data choose: the topmost surface the data have
+// (water over snow over ground), and the quantity each filter is about.
+const char *const HeightChoices[] = {"water_surface", "snow_surface", "elevation"};
+const char *const ColorChoices[] = {"water_depth", "snow_depth", "cover_class", "shadow",
+                                    "elevation"};
+
+vtkPointData *InputPointData(vtkDataObject *input) {
+  auto *image = vtkImageData::SafeDownCast(input);
+  return image ? image->GetPointData() : nullptr;
+}
+
+template <size_t N>
+const char *Choose(vtkDataObject *input, const std::string &wanted, const char *const (&list)[N]) {
+  vtkPointData *pd = InputPointData(input);
+  if (!pd) {
+    return nullptr;
+  }
+  if (!wanted.empty()) {
+    vtkDataArray *a = pd->GetArray(wanted.c_str());
+    return a ? a->GetName() : nullptr;
+  }
+  for (const char *name : list) {
+    if (vtkDataArray *a = pd->GetArray(name)) {
+      if (a->GetNumberOfComponents() == 1) {
+        return a->GetName();
+      }
+    }
+  }
+  return nullptr;
+}
+} // namespace
+
+void vtkTerrainSurfaceFilter::SetHeightArray(const char *name) {
+  std::string value = name ? name : "";
+  if (value != this->HeightArray) {
+    this->HeightArray = value;
+    this->Modified();
+  }
+}
+
+void vtkTerrainSurfaceFilter::SetColorArray(const char *name) {
+  std::string value = name ? name : "";
+  if (value != this->ColorArray) {
+    this->ColorArray = value;
+    this->Modified();
+  }
+}
+
+const char *vtkTerrainSurfaceFilter::ChooseHeightArray(vtkDataObject *input,
+                                                       const std::string &wanted) {
+  return Choose(input, wanted, HeightChoices);
+}
+
+const char *vtkTerrainSurfaceFilter::ChooseColorArray(vtkDataObject *input,
+                                                      const std::string &wanted) {
+  return Choose(input, wanted, ColorChoices);
+}
+
+int vtkTerrainSurfaceFilter::FillInputPortInformation(int, vtkInformation *info) {
+  info->Set(vtkAlgorithm::INPUT_REQUIRED_DATA_TYPE(), "vtkImageData");
+  return 1;
+}
+
+int vtkTerrainSurfaceFilter::RequestUpdateExtent(vtkInformation *,
+                                                 vtkInformationVector **inputVector,
+                                                 vtkInformationVector *) {
+  // The whole field: the normals of the edge points need their neighbours.
+  vtkInformation *inInfo = inputVector[0]->GetInformationObject(0);
+  if (inInfo) {
+    inInfo->Set(vtkStreamingDemandDrivenPipeline::UPDATE_PIECE_NUMBER(), 0);
+    inInfo->Set(vtkStreamingDemandDrivenPipeline::UPDATE_NUMBER_OF_PIECES(), 1);
+    inInfo->Set(vtkStreamingDemandDrivenPipeline::UPDATE_NUMBER_OF_GHOST_LEVELS(), 0);
+    if (inInfo->Has(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT())) {
+      inInfo->Set(vtkStreamingDemandDrivenPipeline::UPDATE_EXTENT(),
+                  inInfo->Get(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT()), 6);
+    }
+  }
+  return 1;
+}
+
+int vtkTerrainSurfaceFilter::RequestData(vtkInformation *, vtkInformationVector **inputVector,
+                                         vtkInformationVector *outputVector) {
+  vtkImageData *input = vtkImageData::GetData(inputVector[0]);
+  vtkPolyData *output = vtkPolyData::GetData(outputVector);
+  if (!input || !output) {
+    return 1;
+  }
+  int dims[3];
+  input->GetDimensions(dims);
+  if (input->GetNumberOfPoints() == 0) {
+    return 1; // an empty upstream (its own error already said why)
+  }
+  if (dims[2] != 1 || dims[0] < 2 || dims[1] < 2) {
+    vtkErrorMacro("Terrain Surface: the input image has " << dims[0] << " x " << dims[1] << " x "
+                                                          << dims[2]
+                                                          << " points; it needs a 2-D height "
+                                                             "field of at least 2 x 2 x 1.");
+    return 1;
+  }
+  const char *heightName = ChooseHeightArray(input, this->HeightArray);
+  if (!heightName) {
+    if (this->HeightArray.empty()) {
+      vtkErrorMacro("Terrain Surface: the input has no point array water_surface, snow_surface "
+                    "or elevation; set Height Array to the array of heights.");
+    } else {
+      vtkErrorMacro("Terrain Surface: the input has no point array '"
+                    << this->HeightArray
+                    << "' (Height Array); name one of its point arrays or leave it empty.");
+    }
+    return 1;
+  }
+  vtkDataArray *height = input->GetPointData()->GetArray(heightName);
+  const vtkIdType n = input->GetNumberOfPoints();
+  const int nx = dims[0], ny = dims[1];
+  double lowest = VTK_DOUBLE_MAX;
+  for (vtkIdType id = 0; id < n; ++id) {
+    const double h = height->GetComponent(id, 0);
+    if (!std::isfinite(h)) {
+      vtkErrorMacro("Terrain Surface: the height array " << heightName << " is " << h
+                                                         << " at point " << id
+                                                         << "; fill the holes first.");
+      return 1;
+    }
+    lowest = std::min(lowest, h);
+  }
+
+  const double s = this->VerticalExaggeration;
+  double spacing[3];
+  input->GetSpacing(spacing);
+  const bool skirt = this->Skirt;
+  // Each wall has its own copies of the edge points: a crisp edge between
+  // the lit top and the walls, whose normals point outwards.
+  const vtkIdType wallPoints = skirt ? 4 * (nx + ny) : 0;
+  vtkNew<vtkPoints> points;
+  points->SetDataTypeToDouble();
+  points->SetNumberOfPoints(n + wallPoints);
+  vtkNew<vtkFloatArray> normals;
+  normals->SetName("Normals");
+  normals->SetNumberOfComponents(3);
+  normals->SetNumberOfTuples(n + wallPoints);
+  vtkPointData *inPD = input->GetPointData();
+  vtkPointData *outPD = output->GetPointData();
+  outPD->CopyAllocate(inPD, n + wallPoints);
+
+  auto z = [&](int i, int j) { return s * height->GetComponent(i + j * nx, 0); };
+  double p[3];
+  for (int j = 0; j < ny; ++j) {
+    for (int i = 0; i < nx; ++i) {
+      const vtkIdType id = i + static_cast<vtkIdType>(j) * nx;
+      input->GetPoint(id, p);
+      p[2] += z(i, j);
+      points->SetPoint(id, p);
+      // Central differences inside, one-sided on the edges: a one-sided edge
+      // normal is the slope of the edge cell, not half of it.
+      const int i0 = i > 0 ? i - 1 : i, i1 = i < nx - 1 ? i + 1 : i;
+      const int j0 = j > 0 ? j - 1 : j, j1 = j < ny - 1 ? j + 1 : j;
+      const double gx = (z(i1, j) - z(i0, j)) / ((i1 - i0) * spacing[0]);
+      const double gy = (z(i, j1) - z(i, j0)) / ((j1 - j0) * spacing[1]);
+      const double len = std::sqrt(gx * gx + gy * gy + 1.0);
+      normals->SetTuple3(id, -gx / len, -gy / len, 1.0 / len);
+      outPD->CopyData(inPD, id, id);
+    }
+  }
+
+  const vtkIdType quads =
+      static_cast<vtkIdType>(nx - 1) * (ny - 1) + (skirt ? 2 * (nx + ny - 2) : 0);
+  vtkNew<vtkIdTypeArray> offsets, conn;
+  offsets->SetNumberOfValues(quads + 1);
+  conn->SetNumberOfValues(4 * quads);
+  vtkIdType q = 0;
+  auto quad = [&](vtkIdType a, vtkIdType b, vtkIdType c, vtkIdType d) {
+    offsets->SetValue(q, 4 * q);
+    conn->SetValue(4 * q, a);
+    conn->SetValue(4 * q + 1, b);
+    conn->SetValue(4 * q + 2, c);
+    conn->SetValue(4 * q + 3, d);
+    ++q;
+  };
+  for (int j = 0; j + 1 < ny; ++j) {
+    for (int i = 0; i + 1 < nx; ++i) {
+      const vtkIdType a = i + static_cast<vtkIdType>(j) * nx;
+      quad(a, a + 1, a + 1 + nx, a + nx); // counter-clockwise seen from above
+    }
+  }
+
+  if (skirt) {
+    // The edges walked counter-clockwise seen from above: south, east,
+    // north, west. The outward normal is the walking direction x z.
+    struct Edge {
+      int i0, j0, di, dj, count;
+    };
+    const Edge edges[4] = {{0, 0, 1, 0, nx},
+                           {nx - 1, 0, 0, 1, ny},
+                           {nx - 1, ny - 1, -1, 0, nx},
+                           {0, ny - 1, 0, -1, ny}};
+    input->GetPoint(0, p);
+    const double base = p[2] + s * (lowest - this->SkirtDepth);
+    vtkIdType next = n;
+    for (const Edge &e : edges) {
+      const double nxw = e.dj, nyw = -e.di;
+      for (int k = 0; k < e.count; ++k) {
+        const vtkIdType src = (e.i0 + k * e.di) + static_cast<vtkIdType>(e.j0 + k * e.dj) * nx;
+        const vtkIdType top = next + 2 * k, bottom = top + 1;
+        points->GetPoint(src, p);
+        points->SetPoint(top, p);
+        p[2] = base;
+        points->SetPoint(bottom, p);
+        normals->SetTuple3(top, nxw, nyw, 0.0);
+        normals->SetTuple3(bottom, nxw, nyw, 0.0);
+        outPD->CopyData(inPD, src, top);
+        outPD->CopyData(inPD, src, bottom);
+        if (k > 0) {
+          quad(top - 2, top - 1, bottom, top);
+        }
+      }
+      next += 2 * e.count;
+    }
+  }
+  offsets->SetValue(quads, 4 * quads);
+  vtkNew<vtkCellArray> polys;
+  polys->SetData(offsets, conn);
+
+  output->SetPoints(points);
+  output->SetPolys(polys);
+  outPD->SetNormals(normals);
+  if (const char *colour = ChooseColorArray(input, this->ColorArray)) {
+    const std::string name = colour;
+    if (name == "water_depth" || name == "max_depth") {
+      // A log scale has no place for 0: VTK's texture colouring maps it to
+      // the bottom of the range, painting dry ground as the thinnest water.
+      // Dry points (under the wetting depth) become NaN, drawn in the map's
+      // NaN colour (the ground's); the input's array stays as it was.
+      vtkDataArray *depth = outPD->GetArray(colour);
+      vtkNew<vtkFloatArray> shown;
+      shown->SetName("water_depth_display");
+      shown->SetNumberOfTuples(depth->GetNumberOfTuples());
+      for (vtkIdType id = 0; id < depth->GetNumberOfTuples(); ++id) {
+        const double d = depth->GetComponent(id, 0);
+        shown->SetValue(id, d >= this->WettingDepth ? static_cast<float>(d)
+                                                    : std::numeric_limits<float>::quiet_NaN());
+      }
+      outPD->AddArray(shown);
+      outPD->SetActiveScalars("water_depth_display");
+    } else {
+      outPD->SetActiveScalars(colour);
+    }
+  }
+  output->GetFieldData()->PassData(input->GetFieldData());
+  vtkNew<vtkDoubleArray> factor;
+  factor->SetName("vertical_exaggeration");
+  factor->InsertNextValue(s);
+  output->GetFieldData()->AddArray(factor);
+  return 1;
+}
+
+void vtkTerrainSurfaceFilter::PrintSelf(ostream &os, vtkIndent indent) {
+  this->Superclass::PrintSelf(os, indent);
+  os << indent << "VerticalExaggeration: " << this->VerticalExaggeration << "\n";
+  os << indent << "HeightArray: " << this->HeightArray << "\n";
+  os << indent << "ColorArray: " << this->ColorArray << "\n";
+  os << indent << "Skirt: " << this->Skirt << "\n";
+  os << indent << "SkirtDepth: " << this->SkirtDepth << "\n";
+  os << indent << "WettingDepth: " << this->WettingDepth << "\n";
+}

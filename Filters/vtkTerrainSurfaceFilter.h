@@ -1,0 +1,112 @@
+/**
+ * @class   vtkTerrainSurfaceFilter
+ * @brief   A height field as a lit 3-D surface: the look every Graupel
+ *          terrain output gets in the render view.
+ *
+ * Input: a 2-D vtkImageData (nx x ny x 1 points, x east, y north) with a
+ * one-component point array of heights in metres, as every Graupel terrain
+ * output has (Procedural Terrain, the EXR reader, Rain Runoff, the snow
+ * filters, Terrain Analysis and Shadow, Water Surface).
+ *
+ * Output: a vtkPolyData of (nx - 1)(ny - 1) quads whose point z is the
+ * image's z plus VerticalExaggeration times the height array, with the
+ * input's point arrays, point normals `Normals` of the exaggerated surface
+ * (central differences inside, one-sided on the edges, so the edges shade
+ * like the inside) and, with Skirt on, walls from the edge down to
+ * SkirtDepth below the lowest height, so that a valley cut by the edge reads
+ * as a notch in a solid block, not as a sheet hanging in the air. The field
+ * data `vertical_exaggeration` holds the factor for captions.
+ *
+ * HeightArray and ColorArray empty (the defaults) choose by the data: the
+ * height is water_surface, else snow_surface, else elevation; the colour
+ * (the output's active scalars, which ParaView colours by on Apply) is
+ * water_depth, else snow_depth, else cover_class, else shadow, else
+ * elevation; water_depth and max_depth are shown through
+ * `water_depth_display` (NaN where drier than WettingDepth). The plugin's colour maps
+ * (Plugin/GraupelColorMaps.json) are the defaults for those arrays.
+ *
+ * Bad input (not an image, 3-D, no height array, non-finite heights) gives
+ * one error sentence and an empty output.
+ */
+#ifndef vtkTerrainSurfaceFilter_h
+#define vtkTerrainSurfaceFilter_h
+
+#include "GraupelFiltersModule.h"
+#include "vtkPolyDataAlgorithm.h"
+
+#include <string>
+
+class GRAUPELFILTERS_EXPORT vtkTerrainSurfaceFilter : public vtkPolyDataAlgorithm {
+public:
+  static vtkTerrainSurfaceFilter *New();
+  vtkTypeMacro(vtkTerrainSurfaceFilter, vtkPolyDataAlgorithm);
+  void PrintSelf(ostream &os, vtkIndent indent) override;
+
+  ///@{
+  /** The height's scale factor (default 2); 0 gives the flat image. */
+  vtkSetClampMacro(VerticalExaggeration, double, 0.0, 1000.0);
+  vtkGetMacro(VerticalExaggeration, double);
+  ///@}
+
+  ///@{
+  /** The point array of heights (m); empty: chosen by the data. */
+  virtual void SetHeightArray(const char *name);
+  const char *GetHeightArray() const { return this->HeightArray.c_str(); }
+  ///@}
+
+  ///@{
+  /** The point array made the active scalars; empty: chosen by the data. */
+  virtual void SetColorArray(const char *name);
+  const char *GetColorArray() const { return this->ColorArray.c_str(); }
+  ///@}
+
+  ///@{
+  /** Walls along the edges down to the base (default on). */
+  vtkSetMacro(Skirt, bool);
+  vtkGetMacro(Skirt, bool);
+  vtkBooleanMacro(Skirt, bool);
+  ///@}
+
+  ///@{
+  /** The base of the walls, metres of height below the lowest point (default 0). */
+  vtkSetClampMacro(SkirtDepth, double, 0.0, 1.0e6);
+  vtkGetMacro(SkirtDepth, double);
+  ///@}
+
+  ///@{
+  /**
+   * Water shallower than this (m, default 0.01) is dry ground: coloured by
+   * water_depth or max_depth, the output's active scalars are
+   * `water_depth_display`, the depth where at least this, NaN elsewhere.
+   */
+  vtkSetClampMacro(WettingDepth, double, 0.0, 1.0e3);
+  vtkGetMacro(WettingDepth, double);
+  ///@}
+
+  /** The height array chosen for `input` (HeightArray, or by the data); nullptr if none. */
+  static const char *ChooseHeightArray(vtkDataObject *input, const std::string &wanted);
+  /** The colour array chosen for `input` (ColorArray, or by the data); nullptr if none. */
+  static const char *ChooseColorArray(vtkDataObject *input, const std::string &wanted);
+
+protected:
+  vtkTerrainSurfaceFilter() = default;
+  ~vtkTerrainSurfaceFilter() override = default;
+
+  int FillInputPortInformation(int port, vtkInformation *info) override;
+  int RequestUpdateExtent(vtkInformation *, vtkInformationVector **,
+                          vtkInformationVector *) override;
+  int RequestData(vtkInformation *, vtkInformationVector **, vtkInformationVector *) override;
+
+  double VerticalExaggeration = 2.0;
+  std::string HeightArray;
+  std::string ColorArray;
+  bool Skirt = true;
+  double SkirtDepth = 0.0;
+  double WettingDepth = 0.01;
+
+private:
+  vtkTerrainSurfaceFilter(const vtkTerrainSurfaceFilter &) = delete;
+  void operator=(const vtkTerrainSurfaceFilter &) = delete;
+};
+
+#endif
