@@ -498,6 +498,27 @@ gr_status gr_error_keep(char *dst, size_t len, gr_status st) {
   return st;
 }
 
+gr_status gr_field_check_range(const char *name, const float *values, size_t n, size_t nx,
+                               double lo, double hi, const char *rule, char *msg, size_t msg_len) {
+  if (!values && n > 0) {
+    if (msg && msg_len)
+      snprintf(msg, msg_len, "The field '%s' has no values (got NULL for %zu points); pass them.",
+               name, n);
+    return GR_ERR_INVALID_ARGUMENT;
+  }
+  size_t row = nx > 0 ? nx : (n > 0 ? n : 1);
+  for (size_t c = 0; c < n; ++c) {
+    double v = values[c];
+    if (isfinite(v) && v >= lo && v <= hi)
+      continue;
+    if (msg && msg_len)
+      snprintf(msg, msg_len, "The field '%s' has the value %g at point (%zu, %zu): %s.", name, v,
+               c % row, c / row, rule);
+    return GR_ERR_INVALID_ARGUMENT;
+  }
+  return GR_OK;
+}
+
 const char *gr_last_error(const gr_context *ctx) {
   (void)ctx; /* kept for compatibility: the text is the calling thread's */
   return gr_thread_error;

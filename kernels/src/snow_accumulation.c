@@ -248,23 +248,7 @@ gr_status gr_snow_accumulation_field_validate(gr_field f, const float *values, s
                name);
     return GR_ERR_INVALID_ARGUMENT;
   }
-  if (!values && n > 0) {
-    if (msg && msg_len)
-      snprintf(msg, msg_len, "The field '%s' has no values (got NULL for %zu points); pass them.",
-               name, n);
-    return GR_ERR_INVALID_ARGUMENT;
-  }
-  size_t row = nx > 0 ? nx : (n > 0 ? n : 1);
-  for (size_t c = 0; c < n; ++c) {
-    double v = values[c];
-    if (isfinite(v) && v >= lo && v <= hi)
-      continue;
-    if (msg && msg_len)
-      snprintf(msg, msg_len, "The field '%s' has the value %g at point (%zu, %zu): %s.", name, v,
-               c % row, c / row, rule);
-    return GR_ERR_INVALID_ARGUMENT;
-  }
-  return GR_OK;
+  return gr_field_check_range(name, values, n, nx, lo, hi, rule, msg, msg_len);
 }
 
 static double gr_snac_now_ms(void) {

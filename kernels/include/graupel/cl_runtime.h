@@ -106,6 +106,17 @@ GR_API gr_status gr_kernel_arg(gr_context *ctx, cl_kernel k, const char *name, s
 GR_API gr_status gr_error_keep(char *dst, size_t len, gr_status st);
 
 /**
+ * The check every core's field validator shares: n values (rows of nx) of
+ * the field called name, each finite and within [lo, hi]. On the first
+ * that is not (or values NULL with n > 0) writes one sentence into msg
+ * ("The field 'x' has the value v at point (i, j): rule.") and returns
+ * GR_ERR_INVALID_ARGUMENT; GR_OK otherwise. Records no error itself.
+ */
+GR_API gr_status gr_field_check_range(const char *name, const float *values, size_t n, size_t nx,
+                                      double lo, double hi, const char *rule, char *msg,
+                                      size_t msg_len);
+
+/**
  * Sets a kernel's arguments in order: pairs of (size_t size, const void
  * *value), ended by a size of 0. Reports which argument failed.
  */
