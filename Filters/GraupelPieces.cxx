@@ -34,7 +34,7 @@ bool Pieces::Plan(vtkInformation *outInfo, int ring) {
   this->Size = this->Controller ? this->Controller->GetNumberOfProcesses() : 1;
   this->Rank = this->Controller ? this->Controller->GetLocalProcessId() : 0;
   this->Ring = ring;
-  this->ExchangeSeconds = 0.0;
+  std::fill(this->ExchangeSeconds, this->ExchangeSeconds + 4, 0.0);
   this->ExchangeCalls = 0;
   this->Signature.assign(1, 0);
   using SDDP = vtkStreamingDemandDrivenPipeline;
@@ -172,6 +172,7 @@ gr_status Pieces::Exchange(void *user) {
     return GR_OK;
   }
   const double t0 = Now();
+  double t1 = t0;
   // Strips along y: only south and north neighbours (x sides would come
   // first, as the cores ask). Pairs (even, odd) first, then (odd, even).
   const int order[2] = {self->Rank % 2 == 0 ? NORTH : SOUTH, self->Rank % 2 == 0 ? SOUTH : NORTH};
@@ -191,16 +192,22 @@ gr_status Pieces::Exchange(void *user) {
     if (st != GR_OK) {
       return st;
     }
+    const double t2 = Now();
+    self->ExchangeSeconds[1] += t2 - t1;
     const vtkIdType n = static_cast<vtkIdType>(bytes);
     if (!self->Swap(other, self->SendBuffer.data(), n, self->ReceiveBuffer.data(), n, TagHalo)) {
       return GR_ERR_ABORTED;
     }
+    const double t3 = Now();
+    self->ExchangeSeconds[2] += t3 - t2;
     st = self->HaloSet(side, self->ReceiveBuffer.data(), bytes);
     if (st != GR_OK) {
       return st;
     }
+    t1 = Now();
+    self->ExchangeSeconds[3] += t1 - t3;
   }
-  self->ExchangeSeconds += Now() - t0;
+  self->ExchangeSeconds[0] += Now() - t0;
   ++self->ExchangeCalls;
   return GR_OK;
 }

@@ -106,8 +106,15 @@ public:
   int GetOwnFirstRow() const { return this->OwnLo; }
   int GetOwnRows() const { return this->OwnHi - this->OwnLo + 1; }
 
-  /** Seconds spent in Exchange since the last Plan, and its calls (for timing runs). */
-  double GetExchangeSeconds() const { return this->ExchangeSeconds; }
+  /**
+   * Seconds spent in Exchange since the last Plan (part 0), of which reading
+   * the strips from the device (1: it waits for the step's kernels), the
+   * messages with the waiting for the neighbours (2) and writing the rings
+   * (3); and the calls. For timing runs.
+   */
+  double GetExchangeSeconds(int part = 0) const {
+    return part >= 0 && part < 4 ? this->ExchangeSeconds[part] : 0.0;
+  }
   long GetExchangeCalls() const { return this->ExchangeCalls; }
 
 private:
@@ -128,7 +135,7 @@ private:
   std::function<gr_status(int, void *, size_t)> HaloGet;
   std::function<gr_status(int, const void *, size_t)> HaloSet;
   std::vector<unsigned char> SendBuffer, ReceiveBuffer;
-  double ExchangeSeconds = 0.0;
+  double ExchangeSeconds[4] = {0.0, 0.0, 0.0, 0.0};
   long ExchangeCalls = 0;
 };
 

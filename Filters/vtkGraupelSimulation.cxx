@@ -97,6 +97,14 @@ bool vtkGraupelSimulation::IsInputTemporal(int port) const {
          this->InputTimes[static_cast<size_t>(port)].size() >= 2;
 }
 
+double vtkGraupelSimulation::GetHaloExchangeSeconds(int part) {
+  return this->PieceLayout->GetExchangeSeconds(part);
+}
+
+long vtkGraupelSimulation::GetHaloExchangeCount() const {
+  return this->PieceLayout->GetExchangeCalls();
+}
+
 int vtkGraupelSimulation::SaveState(std::vector<unsigned char> &) {
   return 0;
 }

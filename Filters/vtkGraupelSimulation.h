@@ -212,6 +212,16 @@ public:
   /** Output index of checkpoint i (0 <= i < GetNumberOfCheckpoints()), oldest first. */
   int GetCheckpointIndex(int i) const;
 
+  /**
+   * Seconds the last update spent in halo exchanges of a split run (part 0),
+   * of which reading the strips from the device (1: this waits for the
+   * step's kernels), the messages and the waiting for the neighbours (2) and
+   * writing the rings (3); and how many exchanges. 0 when the run is not
+   * split. For timing runs (Testing/Benchmarks/mpi_scaling.py).
+   */
+  double GetHaloExchangeSeconds(int part);
+  long GetHaloExchangeCount() const;
+
   /** Whether input port is read in time now (policy TEMPORAL and >= 2 time steps). */
   bool IsInputTemporal(int port) const;
 
