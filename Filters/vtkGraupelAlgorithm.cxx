@@ -12,6 +12,8 @@
 
 #include "graupel/runtime.h"
 
+#include "GraupelPieces.h"
+
 #include <cstring>
 #include <string>
 
@@ -67,7 +69,9 @@ gr_context *vtkGraupelAlgorithm::GetContext() {
   if (!this->Context) {
     gr_context_options opt;
     gr_context_options_init(&opt);
-    opt.device = this->Device;
+    // One device per local rank of an MPI run (gpu:N); the Device itself otherwise.
+    const std::string request = graupel::RankDeviceRequest(this->Device);
+    opt.device = request.c_str();
     opt.log = LogFromCore;
     if (gr_context_acquire(&opt, &this->Context) != GR_OK) {
       vtkErrorMacro("No OpenCL device for " << this->GetClassName() << ": "

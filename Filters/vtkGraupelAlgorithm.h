@@ -4,9 +4,10 @@
  *
  * Holds what every such filter shares: the `Device` property (gpu, cpu, auto
  * or part of a device name; GRAUPEL_DEVICE applies when it is empty or
- * "auto"), the process-wide OpenCL context shared by all filters, the
- * translation of core status codes into one vtkErrorMacro sentence, and the
- * `graupel_device` field-data string that says where an output was computed.
+ * "auto"; in an MPI run local rank N takes the N-th device the request
+ * matches, wrapping around, unless the request names one with ":N"), the process-wide OpenCL
+ * context shared by all filters, the translation of core status codes into one vtkErrorMacro
+ * sentence, and the `graupel_device` field-data string that says where an output was computed.
  *
  * It derives from vtkAlgorithm, not vtkImageAlgorithm, so that a simulation
  * whose output is points (vtkPolyData) shares it; it keeps the behaviour of

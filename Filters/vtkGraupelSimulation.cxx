@@ -2,11 +2,15 @@
 
 #include "vtkDataArray.h"
 #include "vtkDataObject.h"
+#include "vtkDoubleArray.h"
 #include "vtkDemandDrivenPipeline.h"
+#include "vtkExtentTranslator.h"
 #include "vtkExecutive.h"
+#include "vtkFieldData.h"
 #include "vtkFloatArray.h"
 #include "vtkImageData.h"
 #include "vtkInformation.h"
+#include "vtkInformationIntegerRequestKey.h"
 #include "vtkInformationExecutivePortKey.h"
 #include "vtkInformationVector.h"
 #include "vtkNew.h"
@@ -14,6 +18,8 @@
 #include "vtkStreamingDemandDrivenPipeline.h"
 
 #include "graupel/graupel.h"
+
+#include "GraupelPieces.h"
 
 #include <algorithm>
 #include <cmath>
@@ -63,9 +69,11 @@ std::string ProgressTimes(double t, double goal) {
 }
 } // namespace
 
-vtkGraupelSimulation::vtkGraupelSimulation() = default;
+vtkGraupelSimulation::vtkGraupelSimulation() : PieceLayout(new graupel::Pieces) {}
 
-vtkGraupelSimulation::~vtkGraupelSimulation() = default;
+vtkGraupelSimulation::~vtkGraupelSimulation() {
+  delete this->PieceLayout;
+}
 
 void vtkGraupelSimulation::SetTimeDefaults(double endTime, double outputInterval) {
   this->EndTime = this->DefaultEndTime = endTime;
@@ -87,6 +95,14 @@ void vtkGraupelSimulation::SetInputPortPolicy(int port, int policy) {
 bool vtkGraupelSimulation::IsInputTemporal(int port) const {
   return port >= 0 && static_cast<size_t>(port) < this->InputTimes.size() &&
          this->InputTimes[static_cast<size_t>(port)].size() >= 2;
+}
+
+double vtkGraupelSimulation::GetHaloExchangeSeconds(int part) {
+  return this->PieceLayout->GetExchangeSeconds(part);
+}
+
+long vtkGraupelSimulation::GetHaloExchangeCount() const {
+  return this->PieceLayout->GetExchangeCalls();
 }
 
 int vtkGraupelSimulation::SaveState(std::vector<unsigned char> &) {
@@ -224,8 +240,12 @@ int vtkGraupelSimulation::RequestInformation(vtkInformation *, vtkInformationVec
   double range[2] = {0.0, times.back()};
   outInfo->Set(vtkStreamingDemandDrivenPipeline::TIME_STEPS(), times.data(), n);
   outInfo->Set(vtkStreamingDemandDrivenPipeline::TIME_RANGE(), range, 2);
-  // Every rank simulates the whole domain and hands out any piece of it.
+  // Any piece can be handed out (a strip's own rows or the whole grid's).
   outInfo->Set(vtkAlgorithm::CAN_PRODUCE_SUB_EXTENT(), 1);
+  if (this->PieceRing > 0) {
+    // Pieces as strips along y: the split graupel::Pieces simulates.
+    outInfo->Set(vtkExtentTranslator::UPDATE_SPLIT_MODE(), vtkExtentTranslator::Y_SLAB_MODE);
+  }
   return 1;
 }
 
@@ -464,10 +484,15 @@ int vtkGraupelSimulation::RequestData(vtkInformation *request, vtkInformationVec
   vtkDataObject *output = outInfo->Get(vtkDataObject::DATA_OBJECT());
   output->Initialize();
 
+  if (!this->Continuing) {
+    // Collective on a parallel request: every rank plans at once.
+    this->PieceLayout->Plan(outInfo, this->PieceRing);
+  }
 #if GRAUPEL_VTK_ABORT_OUTPUT
-  if (!this->Continuing && (this->GetAbortExecute() || this->GetAbortOutput())) {
+  if (!this->Continuing &&
+      this->PieceLayout->AnyRank(this->GetAbortExecute() != 0 || this->GetAbortOutput())) {
     // Aborted before it began (see the class comment): an empty output, no
-    // warning, nothing touched.
+    // warning, nothing touched (on every rank of a split run at once).
     this->AbortExecute = 0;
     this->SetAbortOutput(true);
     return 1;
@@ -487,7 +512,8 @@ int vtkGraupelSimulation::RequestData(vtkInformation *request, vtkInformationVec
       return 0;
     }
     this->Target = this->TargetIndex(outInfo);
-    if (this->StateIndex < 0 || !(key == this->StateKey)) {
+    if (this->StateIndex < 0 || !(key == this->StateKey) ||
+        this->StateLayout != this->PieceLayout->GetSignature()) {
       this->InvalidateState();
       if (!this->GetContext()) {
         this->HasFailed = true;
@@ -503,6 +529,7 @@ int vtkGraupelSimulation::RequestData(vtkInformation *request, vtkInformationVec
       this->StateTime = 0.0;
       this->StateLost = false;
       this->StateKey = key;
+      this->StateLayout = this->PieceLayout->GetSignature();
     }
     if (!this->Rewind(this->Target)) {
       this->InvalidateState();
@@ -569,7 +596,12 @@ int vtkGraupelSimulation::RequestData(vtkInformation *request, vtkInformationVec
       }
       this->ReportProgress(this->StateTime);
     }
-    if (result == ADVANCE_ABORTED || (this->StateTime < goal && this->GetAbortExecute())) {
+    // A split run's ranks agree on an abort between the knots (the cores
+    // agree inside a call): a rank that stopped alone would leave the others
+    // waiting in their next exchange.
+    const bool abortNow =
+        this->PieceLayout->AnyRank(this->StateTime < goal && this->GetAbortExecute());
+    if (result == ADVANCE_ABORTED || abortNow) {
       vtkWarningMacro(<< this->GetSimulationLabel() << ": the update was aborted at t = "
                       << this->StateTime << " s; the output is empty and the next update "
                       << (result == ADVANCE_ABORTED ? "starts again from the last checkpoint."
@@ -650,14 +682,24 @@ int vtkGraupelSimulation::FillImage(vtkDataObject *outputObject, vtkInformation 
   }
   int dims[3];
   input->GetDimensions(dims);
-  const vtkIdType n = static_cast<vtkIdType>(dims[0]) * dims[1];
-  // The whole grid's fields first (on the input's extent, which need not
-  // start at 0), cropped to the requested piece below.
+  const int *inExtent = input->GetExtent();
+  graupel::Pieces &pieces = *this->PieceLayout;
+  // The core's own points: the whole grid, or a split run's own rows.
+  const int ownRows = pieces.IsSplit() ? pieces.GetOwnRows() : dims[1];
+  const vtkIdType n = static_cast<vtkIdType>(dims[0]) * ownRows;
+  // The rows handed out: the whole grid's, or the requested rows (some of
+  // them a neighbouring rank's) of a split run. Cropped to the request below.
+  int rows[2] = {inExtent[2], inExtent[3]};
+  if (pieces.IsSplit()) {
+    rows[0] = extent[2];
+    rows[1] = extent[3];
+  }
   vtkNew<vtkImageData> whole;
-  whole->SetExtent(input->GetExtent());
+  whole->SetExtent(inExtent[0], inExtent[1], rows[0], rows[1], inExtent[4], inExtent[5]);
   whole->SetOrigin(input->GetOrigin());
   whole->SetSpacing(input->GetSpacing());
   const std::string label = this->GetSimulationLabel();
+  std::vector<float> assembled;
   for (int k = 0; k < count; ++k) {
     const gr_field f = static_cast<gr_field>(fields[k]);
     const int components = gr_field_components(f);
@@ -673,11 +715,30 @@ int vtkGraupelSimulation::FillImage(vtkDataObject *outputObject, vtkInformation 
     if (st != GR_OK) {
       return this->ReportFailure(st, (label + " could not read its fields back").c_str(), detail());
     }
+    if (pieces.IsSplit()) {
+      std::string why;
+      if (!pieces.Rows(a->GetPointer(0), dims[0], components, rows[0] - inExtent[2],
+                       rows[1] - inExtent[2], assembled, why)) {
+        vtkErrorMacro(<< label << " could not assemble its piece from the neighbouring ranks: "
+                      << why << ".");
+        return 0;
+      }
+      a->SetNumberOfTuples(static_cast<vtkIdType>(assembled.size()) / components);
+      std::copy(assembled.begin(), assembled.end(), a->GetPointer(0));
+    }
     whole->GetPointData()->AddArray(a);
   }
   whole->GetPointData()->SetActiveScalars(gr_field_name(static_cast<gr_field>(fields[0])));
   output->ShallowCopy(whole);
   output->Crop(extent);
+  if (this->PieceRing > 0) {
+    // What this rank simulated, ring included: the split a user can see.
+    vtkNew<vtkDoubleArray> cells;
+    cells->SetName("piece_cells");
+    cells->InsertNextValue(static_cast<double>(
+        pieces.IsSplit() ? pieces.GetPieceCells() : static_cast<vtkIdType>(dims[0]) * dims[1]));
+    output->GetFieldData()->AddArray(cells);
+  }
   return 1;
 }
 

@@ -93,9 +93,24 @@
  * step gives one sentence and an empty output, and the same request is not
  * tried again (nor its sentence repeated) until a property or input changes.
  *
- * Every rank of an MPI run simulates the whole domain and outputs its piece,
- * so pieces equal the whole. Subclasses implement the hooks below; they
- * translate, they do not compute.
+ * **Distributed runs.** A simulation whose core follows the piece/halo
+ * contract declares its ring (SetPieceRing, the core's ghost width); in an
+ * MPI run whose request is one piece per rank (pvbatch, pvserver) each rank
+ * then simulates only its strip along y with that ring (graupel::Pieces,
+ * Filters/GraupelPieces.h): SetUpState builds the core on GetPieces()'s
+ * grid (PieceGrid) and local arrays (LocalField) and, when IsSplit(), binds
+ * the core's halo calls (BindHalo) and sets Pieces::Exchange and
+ * Pieces::Allreduce on the core, and FillImage outputs the requested extent, taking
+ * the row a strip shares with the next from that rank. Field data
+ * `piece_cells` gives the grid points the rank simulated, ring included.
+ * Aborts between knots are agreed by every rank (the cores agree inside a
+ * call), so no rank waits alone in a collective call; a failure on one rank
+ * (a device error) leaves the others waiting in their next collective call,
+ * as MPI programs do. A simulation without a ring (SetPieceRing(0), the
+ * default), a request that is not one piece per rank, or strips narrower
+ * than the ring: every rank simulates the whole domain and outputs the
+ * requested piece, so pieces equal the whole. Subclasses implement the
+ * hooks below; they translate, they do not compute.
  */
 #ifndef vtkGraupelSimulation_h
 #define vtkGraupelSimulation_h
@@ -118,6 +133,9 @@
 
 class vtkDataArray;
 class vtkImageData;
+namespace graupel {
+class Pieces;
+}
 
 struct gr_grid;
 class GRAUPELFILTERS_EXPORT vtkGraupelSimulation : public vtkGraupelAlgorithm {
@@ -194,6 +212,16 @@ public:
   /** Output index of checkpoint i (0 <= i < GetNumberOfCheckpoints()), oldest first. */
   int GetCheckpointIndex(int i) const;
 
+  /**
+   * Seconds the last update spent in halo exchanges of a split run (part 0),
+   * of which reading the strips from the device (1: this waits for the
+   * step's kernels), the messages and the waiting for the neighbours (2) and
+   * writing the rings (3); and how many exchanges. 0 when the run is not
+   * split. For timing runs (Testing/Benchmarks/mpi_scaling.py).
+   */
+  double GetHaloExchangeSeconds(int part);
+  long GetHaloExchangeCount() const;
+
   /** Whether input port is read in time now (policy TEMPORAL and >= 2 time steps). */
   bool IsInputTemporal(int port) const;
 
@@ -248,6 +276,16 @@ protected:
                 const std::function<const char *()> &detail);
   /** Frees the device state; must accept being called without state. */
   virtual void ReleaseState() = 0;
+
+  /**
+   * The core's ring for a split run, grid points (its GHOST; 0, the
+   * default: the simulation runs whole on every rank). Call in the
+   * constructor, and again when the ring changes with a property.
+   */
+  void SetPieceRing(int ring) { this->PieceRing = ring; }
+  int GetPieceRing() const { return this->PieceRing; }
+  /** This update's layout (see "Distributed runs"); valid from SetUpState on. */
+  graupel::Pieces &GetPieces() { return *this->PieceLayout; }
 
   ///@{
   /**
@@ -366,6 +404,9 @@ private:
   bool HasFailed = false;
   vtkMTimeType WarnedSpacingFor = 0;
   std::deque<Checkpoint> Checkpoints;
+  int PieceRing = 0;
+  graupel::Pieces *PieceLayout = nullptr;
+  std::vector<int> StateLayout; // the layout the state was set up for
 };
 
 #endif

@@ -29,6 +29,7 @@
 #include "GraupelArrays.h"
 #include "GraupelObjects.h"
 #include "GraupelParameterTable.h"
+#include "GraupelPieces.h"
 
 #include <algorithm>
 #include <array>
@@ -94,6 +95,8 @@ vtkSnowDeformationFilter::vtkSnowDeformationFilter() {
   // at 2 m/s would move 20 m between outputs. 10 s of 0.25 s outputs show a
   // crossing of a few metres, 15 steps per output.
   this->SetTimeDefaults(10.0, 0.25);
+  // The core runs as pieces of a split domain (an MPI run's strips).
+  this->SetPieceRing(GR_SNOW_DEFORMATION_GHOST);
   this->MaxRelaxIterations = static_cast<int>(TableDefault("MaxRelaxIterations", 64));
   this->RelaxTolerance = TableDefault("RelaxTolerance", 1e-4);
 }
@@ -654,12 +657,33 @@ int vtkSnowDeformationFilter::SetUpState(vtkInformationVector **inputVector) {
   if (!this->CheckObjectsReachGrid(gridBounds, std::max(grid.dx, grid.dy))) {
     return 0;
   }
+  // A split run's strip: its rows, its ring and the whole domain around it.
+  // Every piece sets every object (the core rasterizes each over its own
+  // arrays) and the core sums what steers a step, the forces included, over
+  // the pieces through the allreduce: every rank's forces and ledger are
+  // the whole grid's.
+  graupel::Pieces &pieces = this->GetPieces();
+  pieces.PieceGrid(&grid);
   gr_status st = gr_snow_deformation_create(this->GetContext(), &grid, &p, &this->Simulation);
   if (st != GR_OK) {
     return this->ReportFailure(st, "Snow Deformation could not set up the simulation");
   }
+  if (pieces.IsSplit()) {
+    gr_snow_deformation *sim = this->Simulation;
+    pieces.BindHalo(
+        [sim](int side, size_t *bytes) { return gr_snow_deformation_halo_size(sim, side, bytes); },
+        [sim](int side, void *host, size_t bytes) {
+          return gr_snow_deformation_halo_get(sim, side, host, bytes);
+        },
+        [sim](int side, const void *host, size_t bytes) {
+          return gr_snow_deformation_halo_set(sim, side, host, bytes);
+        });
+    gr_snow_deformation_set_allreduce(sim, graupel::Pieces::Allreduce, &pieces);
+    gr_snow_deformation_set_halo_exchange(sim, graupel::Pieces::Exchange, &pieces);
+  }
   for (const Upload &u : uploads) {
-    st = gr_snow_deformation_set_field(this->Simulation, u.field, u.values->GetPointer(0));
+    const std::vector<float> local = pieces.LocalField(u.values->GetPointer(0), dims[0], 1);
+    st = gr_snow_deformation_set_field(this->Simulation, u.field, local.data());
     if (st != GR_OK) {
       vtkErrorMacro(
           "Snow Deformation's Input: " << gr_snow_deformation_last_error(this->Simulation));

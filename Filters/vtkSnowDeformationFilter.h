@@ -55,6 +55,12 @@
  * Time defaults (SetTimeDefaults): EndTime 10 s, OutputInterval 0.25 s,
  * the scale of a wheel crossing a few metres of snow in steps of 1/60 s.
  *
+ * MPI (pvbatch, pvserver): each rank simulates its strip of the grid with
+ * the core's ring of GR_SNOW_DEFORMATION_GHOST rows (see vtkGraupelSimulation,
+ * "Distributed runs"); every rank takes every object, the core sums what
+ * steers a step over the ranks, and every rank's ledger and forces are the
+ * whole grid's, bit for bit. Field data `piece_cells` gives the grid points
+ * the rank simulated, ring included.
  * The model is described in kernels/include/graupel/snow_deformation.h; the
  * setters clamp to its parameter table (gr_snow_deformation_param_bounds).
  */
