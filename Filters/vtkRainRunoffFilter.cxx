@@ -55,7 +55,26 @@ vtkRainRunoffFilter::vtkRainRunoffFilter() {
 GRAUPEL_TABLE_SETTER(vtkRainRunoffFilter, RainRate, double, gr_rain_runoff_param_bounds)
 GRAUPEL_TABLE_SETTER(vtkRainRunoffFilter, Permeability, double, gr_rain_runoff_param_bounds)
 GRAUPEL_TABLE_SETTER(vtkRainRunoffFilter, ManningN, double, gr_rain_runoff_param_bounds)
-GRAUPEL_TABLE_SETTER(vtkRainRunoffFilter, Boundary, int, gr_rain_runoff_param_bounds)
+GRAUPEL_TABLE_SETTER(vtkRainRunoffFilter, BoundaryWest, int, gr_rain_runoff_param_bounds)
+GRAUPEL_TABLE_SETTER(vtkRainRunoffFilter, BoundaryEast, int, gr_rain_runoff_param_bounds)
+GRAUPEL_TABLE_SETTER(vtkRainRunoffFilter, BoundarySouth, int, gr_rain_runoff_param_bounds)
+GRAUPEL_TABLE_SETTER(vtkRainRunoffFilter, BoundaryNorth, int, gr_rain_runoff_param_bounds)
+GRAUPEL_TABLE_SETTER(vtkRainRunoffFilter, LevelWest, double, gr_rain_runoff_param_bounds)
+GRAUPEL_TABLE_SETTER(vtkRainRunoffFilter, LevelEast, double, gr_rain_runoff_param_bounds)
+GRAUPEL_TABLE_SETTER(vtkRainRunoffFilter, LevelSouth, double, gr_rain_runoff_param_bounds)
+GRAUPEL_TABLE_SETTER(vtkRainRunoffFilter, LevelNorth, double, gr_rain_runoff_param_bounds)
+
+void vtkRainRunoffFilter::SetBoundary(int value) {
+  this->SetBoundaryWest(value);
+  this->SetBoundaryEast(value);
+  this->SetBoundarySouth(value);
+  this->SetBoundaryNorth(value);
+}
+
+int vtkRainRunoffFilter::GetBoundary() {
+  const int w = this->BoundaryWest;
+  return w == this->BoundaryEast && w == this->BoundarySouth && w == this->BoundaryNorth ? w : -1;
+}
 GRAUPEL_TABLE_SETTER(vtkRainRunoffFilter, FlowModel, int, gr_rain_runoff_param_bounds)
 GRAUPEL_TABLE_SETTER(vtkRainRunoffFilter, MaxTimeStep, double, gr_rain_runoff_param_bounds)
 GRAUPEL_TABLE_SETTER(vtkRainRunoffFilter, CourantNumber, double, gr_rain_runoff_param_bounds)
@@ -66,10 +85,21 @@ int vtkRainRunoffFilter::CheckParameters() {
   const struct {
     const char *property;
     double value;
-  } values[] = {{"RainRate", this->RainRate},           {"Permeability", this->Permeability},
-                {"ManningN", this->ManningN},           {"Boundary", double(this->Boundary)},
-                {"MaxTimeStep", this->MaxTimeStep},     {"CourantNumber", this->CourantNumber},
-                {"FlowModel", double(this->FlowModel)}, {"WettingDepth", this->WettingDepth},
+  } values[] = {{"RainRate", this->RainRate},
+                {"Permeability", this->Permeability},
+                {"ManningN", this->ManningN},
+                {"BoundaryWest", double(this->BoundaryWest)},
+                {"BoundaryEast", double(this->BoundaryEast)},
+                {"BoundarySouth", double(this->BoundarySouth)},
+                {"BoundaryNorth", double(this->BoundaryNorth)},
+                {"LevelWest", this->LevelWest},
+                {"LevelEast", this->LevelEast},
+                {"LevelSouth", this->LevelSouth},
+                {"LevelNorth", this->LevelNorth},
+                {"MaxTimeStep", this->MaxTimeStep},
+                {"CourantNumber", this->CourantNumber},
+                {"FlowModel", double(this->FlowModel)},
+                {"WettingDepth", this->WettingDepth},
                 {"DebrisFactor", this->DebrisFactor}};
   for (const auto &p : values) {
     const gr_param_bound *b = Bound(p.property);
@@ -255,7 +285,13 @@ int vtkRainRunoffFilter::SetUpState(vtkInformationVector **inputVector) {
   p.manning_n = this->ManningN;
   p.cfl = this->CourantNumber;
   p.max_dt = this->MaxTimeStep;
-  p.boundary = this->Boundary == CLOSED ? GR_BOUNDARY_CLOSED : GR_BOUNDARY_OPEN;
+  const int kinds[4] = {this->BoundaryWest, this->BoundaryEast, this->BoundarySouth,
+                        this->BoundaryNorth};
+  const double levels[4] = {this->LevelWest, this->LevelEast, this->LevelSouth, this->LevelNorth};
+  for (int e = 0; e < 4; ++e) {
+    p.boundary[e] = static_cast<gr_boundary>(kinds[e]);
+    p.boundary_level[e] = levels[e];
+  }
   p.flow_model = this->FlowModel == LOCAL_INERTIAL ? GR_FLOW_LOCAL_INERTIAL : GR_FLOW_SHALLOW_WATER;
   p.wetting_depth = this->WettingDepth;
   p.debris_factor = this->DebrisFactor;
@@ -326,7 +362,8 @@ int vtkRainRunoffFilter::RecordLedger(int index) {
   }
   this->Ledgers[static_cast<size_t>(index)] = {this->GetOutputTime(index), ledger.rain_volume,
                                                ledger.infiltrated_volume,  ledger.outflow_volume,
-                                               ledger.stored_volume,       ledger.balance_error};
+                                               ledger.stored_volume,       ledger.balance_error,
+                                               ledger.inflow_volume};
   const int gauges = static_cast<int>(this->GaugeCells.size() / 2);
   if (this->GaugeRows.size() <= static_cast<size_t>(index)) {
     this->GaugeRows.resize(static_cast<size_t>(index) + 1);
@@ -406,6 +443,7 @@ int vtkRainRunoffFilter::FillOutput(vtkDataObject *outputObject, vtkInformation 
   AddValue(fd, "rain_volume", ledger.rain_volume);
   AddValue(fd, "infiltrated_volume", ledger.infiltrated_volume);
   AddValue(fd, "outflow_volume", ledger.outflow_volume);
+  AddValue(fd, "inflow_volume", ledger.inflow_volume);
   AddValue(fd, "stored_volume", ledger.stored_volume);
   AddValue(fd, "balance_error", ledger.balance_error);
   AddValue(fd, "max_depth", ledger.max_depth);
@@ -481,16 +519,15 @@ int vtkRainRunoffFilter::FillHydrograph(vtkDataObject *tableObject) {
     c[static_cast<size_t>(k)]->SetNumberOfTuples(rows);
   }
   for (int r = 0; r < rows; ++r) {
-    const std::array<double, 6> &now = this->Ledgers[static_cast<size_t>(r)];
-    const std::array<double, 6> &before = this->Ledgers[static_cast<size_t>(r > 0 ? r - 1 : 0)];
+    const std::array<double, 7> &now = this->Ledgers[static_cast<size_t>(r)];
+    const std::array<double, 7> &before = this->Ledgers[static_cast<size_t>(r > 0 ? r - 1 : 0)];
     const double span = now[0] - before[0];
     // The mean rate over the interval that ends at this row; no interval
     // ends at row 0, whose rates are NaN (a line chart starts at row 1
     // instead of ramping up from a 0 that never was).
     const double none = std::numeric_limits<double>::quiet_NaN();
     auto rate = [&](int i) { return span > 0.0 ? (now[i] - before[i]) / span : none; };
-    const double inflow = span > 0.0 ? 0.0 : none;
-    const double values[] = {now[0], rate(1), inflow, rate(2), rate(3), now[4], now[3], now[5]};
+    const double values[] = {now[0], rate(1), rate(6), rate(2), rate(3), now[4], now[3], now[5]};
     for (int k = 0; k < columns; ++k) {
       c[static_cast<size_t>(k)]->SetValue(r, values[k]);
     }
@@ -526,7 +563,19 @@ void vtkRainRunoffFilter::PrintSelf(ostream &os, vtkIndent indent) {
   os << indent << "RainRate: " << this->RainRate << " mm/h\n";
   os << indent << "Permeability: " << this->Permeability << " mm/h\n";
   os << indent << "ManningN: " << this->ManningN << "\n";
-  os << indent << "Boundary: " << (this->Boundary == CLOSED ? "closed" : "open") << "\n";
+  const char *kinds[] = {"open", "closed", "transmissive", "level"};
+  const int edges[4] = {this->BoundaryWest, this->BoundaryEast, this->BoundarySouth,
+                        this->BoundaryNorth};
+  const double levels[4] = {this->LevelWest, this->LevelEast, this->LevelSouth, this->LevelNorth};
+  const char *sides[] = {"West", "East", "South", "North"};
+  for (int e = 0; e < 4; ++e) {
+    os << indent << "Boundary" << sides[e] << ": "
+       << (edges[e] >= 0 && edges[e] < 4 ? kinds[edges[e]] : "(invalid)");
+    if (edges[e] == LEVEL) {
+      os << " at " << levels[e] << " m";
+    }
+    os << "\n";
+  }
   os << indent
      << "FlowModel: " << (this->FlowModel == LOCAL_INERTIAL ? "local inertial" : "shallow water")
      << "\n";

@@ -40,7 +40,7 @@
  * ledger's volume exactly; row 0's rates are NaN: no interval ends there),
  * `stored_volume`,
  * `outflow_volume` and `balance_error` (m^3, the ledger at that time).
- * inflow_rate is 0 (the core has no inflows yet). Every row is the ledger
+ * inflow_rate is what enters through the edges (level boundaries). Every row is the ledger
  * recorded when the state passed that output time; a checkpoint restored
  * or a restart re-records the same values (the steps are the same), so the
  * table does not depend on the order of requests either.
@@ -81,7 +81,7 @@ public:
   vtkTypeMacro(vtkRainRunoffFilter, vtkGraupelSimulation);
   void PrintSelf(ostream &os, vtkIndent indent) override;
 
-  enum Boundaries { OPEN = 0, CLOSED = 1 };
+  enum Boundaries { OPEN = 0, CLOSED = 1, TRANSMISSIVE = 2, LEVEL = 3 };
   enum FlowModels { SHALLOW_WATER = 0, LOCAL_INERTIAL = 1 };
 
   ///@{
@@ -103,9 +103,40 @@ public:
   ///@}
 
   ///@{
-  /** 0: water leaves through the grid's edge (default); 1: the edge is a wall. */
-  virtual void SetBoundary(int value);
-  vtkGetMacro(Boundary, int);
+  /**
+   * The kind of each edge of the terrain (west: lowest x, east: highest x,
+   * south: lowest y, north: highest y): 0 open, a free outfall (default);
+   * 1 closed, a wall; 2 transmissive, the edge's depth, velocity and bed
+   * slope continue (uniform flow leaves at its normal depth); 3 level, the
+   * water surface beyond the edge stands at the edge's Level (m).
+   */
+  virtual void SetBoundaryWest(int value);
+  vtkGetMacro(BoundaryWest, int);
+  virtual void SetBoundaryEast(int value);
+  vtkGetMacro(BoundaryEast, int);
+  virtual void SetBoundarySouth(int value);
+  vtkGetMacro(BoundarySouth, int);
+  virtual void SetBoundaryNorth(int value);
+  vtkGetMacro(BoundaryNorth, int);
+  ///@}
+
+  ///@{
+  /** The water level beyond an edge of kind LEVEL, m, as the elevations (default 0). */
+  virtual void SetLevelWest(double value);
+  vtkGetMacro(LevelWest, double);
+  virtual void SetLevelEast(double value);
+  vtkGetMacro(LevelEast, double);
+  virtual void SetLevelSouth(double value);
+  vtkGetMacro(LevelSouth, double);
+  virtual void SetLevelNorth(double value);
+  vtkGetMacro(LevelNorth, double);
+  ///@}
+
+  ///@{
+  /** Every edge the same kind (the single Boundary of earlier versions);
+   *  GetBoundary: the common kind, or -1 when the edges differ. */
+  void SetBoundary(int value);
+  int GetBoundary();
   ///@}
 
   ///@{
@@ -168,7 +199,14 @@ protected:
   double RainRate = 10.0;
   double Permeability = 0.0;
   double ManningN = 0.03;
-  int Boundary = OPEN;
+  int BoundaryWest = OPEN;
+  int BoundaryEast = OPEN;
+  int BoundarySouth = OPEN;
+  int BoundaryNorth = OPEN;
+  double LevelWest = 0.0;
+  double LevelEast = 0.0;
+  double LevelSouth = 0.0;
+  double LevelNorth = 0.0;
   int FlowModel = SHALLOW_WATER;
   double MaxTimeStep = 1.0;
   double CourantNumber = 0.7;
@@ -191,8 +229,8 @@ private:
 
   gr_rain_runoff *Simulation = nullptr;
   /** The ledger's volumes at each output time passed: time, rain, infiltrated,
-   *  outflow, stored, balance error. */
-  std::vector<std::array<double, 6>> Ledgers;
+   *  outflow, stored, balance error, inflow. */
+  std::vector<std::array<double, 7>> Ledgers;
   /** The gauges' grid points, (i, j) pairs, and per output time their depth,
    *  surface and discharge (3 floats per gauge). */
   std::vector<int> GaugeCells;

@@ -397,7 +397,7 @@ T.check(abs(rain_int - rain_q * 60.0) <= 1e-6 * rain_q * 60.0 and
         "rain_rate %g m^3/s = rate x area, integrating to the rain (%g m^3)" % (h["rain_rate"][1], rain_int))
 T.check(all(np.isnan(h[c][0]) for c in ("rain_rate", "inflow_rate", "infiltration_rate",
                                           "outflow_rate")) and np.all(h["inflow_rate"][1:] == 0.0),
-        "row 0 ends no interval: its rates are NaN; no inflows yet")
+        "row 0 ends no interval: its rates are NaN; no inflow through open edges")
 T.check(np.all(np.abs(h["balance_error"]) <= 1e-5 * rain_q * 60.0)
         and np.all(np.diff(h["outflow_volume"]) >= 0.0), "balance_error small, outflow_volume grows")
 T.check(abs(h["stored_volume"][-1] - (rain_int - fwd_out[60.0] - h["balance_error"][-1]))
@@ -432,6 +432,42 @@ T.check(g.GetDebrisFactor() == 0.0, "DebrisFactor -1 clamps to 0")
 for props, text in (({"WettingDepth": 0.0}, "WettingDepth must be above 0 m and up to 10 m; it is 0 m"),
                     ({"WettingDepth": -0.5}, "WettingDepth must be above 0 m"),
                     ({"DebrisFactor": float("nan")}, "DebrisFactor must be from 0 to 1")):
+    g = rain(bowl, **props)
+    errs = T.ErrorCatcher(g)
+    d, out = at(g, 10.0)
+    T.check(d is None and len(errs.messages) == 1 and text in errs.text()
+            and hydrograph(g) == {}, "%r refused with one sentence, empty outputs: %r"
+            % (props, errs.text()[:200]))
+
+# Boundaries per edge: the defaults, the clamps, SetBoundary for all four, a
+# level edge's inflow in the ledger and the hydrograph, a bad level refused.
+g = vtkRainRunoffFilter()
+T.check([g.GetBoundaryWest(), g.GetBoundaryEast(), g.GetBoundarySouth(), g.GetBoundaryNorth()]
+        == [0, 0, 0, 0] and [g.GetLevelWest(), g.GetLevelEast(), g.GetLevelSouth(),
+                             g.GetLevelNorth()] == [0.0] * 4, "defaults: every edge open, levels 0 m")
+g.SetBoundary(1)
+T.check([g.GetBoundaryWest(), g.GetBoundaryEast(), g.GetBoundarySouth(), g.GetBoundaryNorth()]
+        == [1] * 4 and g.GetBoundary() == 1, "SetBoundary(1) makes all four edges walls")
+g.SetBoundaryWest(7)
+g.SetLevelWest(-5e6)
+T.check(g.GetBoundaryWest() == 3 and g.GetBoundary() == -1 and g.GetLevelWest() == -1e6,
+        "BoundaryWest 7 clamps to 3 (Level), LevelWest -5e6 to -1e6 m; GetBoundary -1 when "
+        "the edges differ")
+lv = rain(np.zeros((NY, NX)), RainRate=0.0, Boundary=1, BoundaryWest=3, LevelWest=0.3,
+          EndTime=60.0, OutputInterval=20.0)
+d, out = at(lv, 60.0)
+h = hydrograph(lv)
+inflow = field(out, "inflow_volume") if d is not None else 0.0
+in_int = float(np.sum(h["inflow_rate"][1:] * np.diff(h["time"]))) if h else 0.0
+T.check(d is not None and inflow > 0.0 and abs(field(out, "stored_volume") - (
+    inflow - field(out, "outflow_volume"))) <= 1e-6 * inflow and d[:, 0].min() > 0.1
+    and d[:, -1].max() < d[:, 0].min(),
+    "a level edge (0.3 m, west) fills a flat, walled terrain from the west: inflow %g m^3 = "
+    "stored + outflow" % inflow)
+T.check(abs(in_int - inflow) <= 1e-6 * inflow,
+        "inflow_rate integrates to inflow_volume: %.9g vs %.9g m^3" % (in_int, inflow))
+for props, text in (({"BoundaryWest": 3, "LevelWest": float("nan")},
+                     "LevelWest must be from -1e+06 m to 1e+06 m; it is nan m"),):
     g = rain(bowl, **props)
     errs = T.ErrorCatcher(g)
     d, out = at(g, 10.0)

@@ -113,10 +113,36 @@ GR_INLINE float gr_rain_runoff_smooth(float own, float before, float after, floa
   return edge ? own : smooth;
 }
 
+/* The cell beyond a domain edge of kind `kind` for the local inertial faces
+ * (graupel/rain_runoff.h, "Boundaries"): its depth *hg and bed *bg from the
+ * edge cell's depth hc (after rain and infiltration) and bed bc, and the bed
+ * bi of the edge cell's inner neighbour. A wall's and an outfall's is dry at
+ * bc (as before there were kinds); a transmissive edge continues the depth
+ * over the continued bed slope; a level edge holds water up to its level
+ * over bc (none when the level is below the ground: a free outfall). */
+GR_INLINE void gr_rain_runoff_ghost(int kind, float level, float hc, float bc, float bi, float *hg,
+                                    float *bg) {
+  bool tr = kind == GR_RAIN_RUNOFF_B_TRANSMISSIVE, lv = kind == GR_RAIN_RUNOFF_B_LEVEL;
+  *hg = tr ? hc : (lv ? fmax(level - bc, 0.0f) : 0.0f);
+  *bg = tr ? bc - (bi - bc) : bc;
+}
+
+/* The discharge q through a domain edge's face (positive toward the high
+ * side; low: the west or south edge) as the edge's kind lets it through: a
+ * wall nothing, an outfall and a transmissive edge outflow only (a
+ * zero-gradient inflow would grow with the edge cell's depth and feed a pit
+ * at the edge without end), a level edge both ways. */
+GR_INLINE float gr_rain_runoff_edge_q(int kind, float q, bool low) {
+  float out_only = low ? fmin(q, 0.0f) : fmax(q, 0.0f);
+  return kind == GR_RAIN_RUNOFF_B_CLOSED ? 0.0f : (kind == GR_RAIN_RUNOFF_B_LEVEL ? q : out_only);
+}
+
 /* Work-item (i, j) of an (nx+1) x (ny+1) launch owns the x-face left of cell
  * (i, j) (for j < ny) and the y-face below it (for i < nx). The grid's edge
- * faces are walls when closed; when open they lead into a dry ghost cell at
- * the edge cell's ground height, and only outflow passes. The discharges of
+ * faces lead into the cell beyond the edge (gr_rain_runoff_ghost) and pass
+ * what their kind lets through (gr_rain_runoff_edge_q); bnd and lvl hold the
+ * kinds and levels of the west, east, south and north edges (a piece's
+ * sides with a neighbour come as walls: their ring is refreshed anyway). The discharges of
  * the previous step are read from qx_old, qy_old and the new ones written
  * to qx, qy (the face arrays alternate between steps).
  *
@@ -133,7 +159,7 @@ __kernel void rain_runoff_flux(__global const float *restrict h, __global const 
                                __global float *restrict qy, __global const float *restrict limit,
                                int nx, int ny, float dt, float inv_dx, float inv_dy, float g,
                                float n2, float theta, int use_rain, float rain_uniform,
-                               int use_perm, float perm_uniform, int closed) {
+                               int use_perm, float perm_uniform, int4 bnd, float4 lvl) {
   int i = get_global_id(0), j = get_global_id(1);
   if (!gr_inside(i, j, nx + 1, ny + 1))
     return;
@@ -154,8 +180,11 @@ __kernel void rain_runoff_flux(__global const float *restrict h, __global const 
                    : 0.0f;
     float bw = in_w ? b[w] : 0.0f;
     float kw = in_w ? limit[w] : 1.0f;
-    float hL = i == 0 ? 0.0f : hw, bL = i == 0 ? bc : bw;
-    float hR = i == nx ? 0.0f : hc, bR = i == nx ? bw : bc;
+    float hgw, bgw, hge, bge;
+    gr_rain_runoff_ghost(bnd.x, lvl.x, hc, bc, i == 0 && nx > 1 ? b[c + 1] : bc, &hgw, &bgw);
+    gr_rain_runoff_ghost(bnd.y, lvl.y, hw, bw, i == nx && nx > 1 ? b[c - 2] : bw, &hge, &bge);
+    float hL = i == 0 ? hgw : hw, bL = i == 0 ? bgw : bw;
+    float hR = i == nx ? hge : hc, bR = i == nx ? bge : bc;
     int f = j * (nx + 1) + i;
     float own = gr_rain_runoff_limited(qx_old[f], kw, kc);
     float before =
@@ -164,10 +193,8 @@ __kernel void rain_runoff_flux(__global const float *restrict h, __global const 
         i < nx ? gr_rain_runoff_limited(qx_old[f + 1], kc, i < nx - 1 ? limit[c + 1] : 1.0f) : 0.0f;
     float prev = gr_rain_runoff_smooth(own, before, after, theta, i == 0 || i == nx);
     float q = gr_rain_runoff_face(hL, hR, bL, bR, prev, own, dt, g, n2, inv_dx);
-    if (i == 0)
-      q = closed ? 0.0f : fmin(q, 0.0f);
-    if (i == nx)
-      q = closed ? 0.0f : fmax(q, 0.0f);
+    q = i == 0 ? gr_rain_runoff_edge_q(bnd.x, q, true) : q;
+    q = i == nx ? gr_rain_runoff_edge_q(bnd.y, q, false) : q;
     qx[f] = q;
   }
   if (i < nx) {
@@ -179,8 +206,11 @@ __kernel void rain_runoff_flux(__global const float *restrict h, __global const 
                    : 0.0f;
     float bs = in_s ? b[s] : 0.0f;
     float ks = in_s ? limit[s] : 1.0f;
-    float hL = j == 0 ? 0.0f : hs, bL = j == 0 ? bc : bs;
-    float hR = j == ny ? 0.0f : hc, bR = j == ny ? bs : bc;
+    float hgs, bgs, hgn, bgn;
+    gr_rain_runoff_ghost(bnd.z, lvl.z, hc, bc, j == 0 && ny > 1 ? b[c + nx] : bc, &hgs, &bgs);
+    gr_rain_runoff_ghost(bnd.w, lvl.w, hs, bs, j == ny && ny > 1 ? b[c - 2 * nx] : bs, &hgn, &bgn);
+    float hL = j == 0 ? hgs : hs, bL = j == 0 ? bgs : bs;
+    float hR = j == ny ? hgn : hc, bR = j == ny ? bgn : bc;
     int f = c; /* y-faces are numbered like cells, with one more row */
     float own = gr_rain_runoff_limited(qy_old[f], ks, kc);
     float before =
@@ -190,10 +220,8 @@ __kernel void rain_runoff_flux(__global const float *restrict h, __global const 
                : 0.0f;
     float prev = gr_rain_runoff_smooth(own, before, after, theta, j == 0 || j == ny);
     float q = gr_rain_runoff_face(hL, hR, bL, bR, prev, own, dt, g, n2, inv_dy);
-    if (j == 0)
-      q = closed ? 0.0f : fmin(q, 0.0f);
-    if (j == ny)
-      q = closed ? 0.0f : fmax(q, 0.0f);
+    q = j == 0 ? gr_rain_runoff_edge_q(bnd.z, q, true) : q;
+    q = j == ny ? gr_rain_runoff_edge_q(bnd.w, q, false) : q;
     qy[f] = q;
   }
 }
@@ -220,8 +248,28 @@ __kernel void rain_runoff_limit(__global const float *restrict h,
   limit[c] = out > wet ? wet / out * GR_RAIN_RUNOFF_KEEP : 1.0f;
 }
 
+/* Books a cell's flow through the domain's edges, given per edge face as
+ * what leaves the cell (m^2/s; negative: what enters), times dt over the
+ * face's cell width: outflow and inflow (metres of depth, Kahan sums). */
+GR_INLINE void gr_rain_runoff_book_edges(__global float *restrict outflow,
+                                         __global float *restrict outflow_comp,
+                                         __global float *restrict inflow,
+                                         __global float *restrict inflow_comp, int c, float dt,
+                                         float inv_dx, float inv_dy, float ow, float oe, float os,
+                                         float on) {
+  float out = dt * ((fmax(ow, 0.0f) + fmax(oe, 0.0f)) * inv_dx +
+                    (fmax(os, 0.0f) + fmax(on, 0.0f)) * inv_dy);
+  float in = dt * ((fmax(-ow, 0.0f) + fmax(-oe, 0.0f)) * inv_dx +
+                   (fmax(-os, 0.0f) + fmax(-on, 0.0f)) * inv_dy);
+  if (out != 0.0f)
+    gr_kahan_add(outflow, outflow_comp, c, out);
+  if (in != 0.0f)
+    gr_kahan_add(inflow, inflow_comp, c, in);
+}
+
 /* The new depth from rain, infiltration and the four faces' limited
- * discharges; edge cells of an open grid book what left through the edge.
+ * discharges; edge cells book what left (outflow) and what came in (inflow)
+ * through the domain's edges.
  * The depth is Kahan-summed too (h - h_comp is the water to about twice
  * float precision): its rounding would otherwise be the same in every step
  * where a pond gains the same rain, and 10^5 such steps would show in the
@@ -232,7 +280,8 @@ rain_runoff_update(__global float *restrict h, __global float *restrict h_comp,
                    __global const float *restrict qx, __global const float *restrict qy,
                    __global const float *restrict limit, __global float *restrict infiltrated,
                    __global float *restrict infiltrated_comp, __global float *restrict outflow,
-                   __global float *restrict outflow_comp, int nx, int ny, float dt, float inv_dx,
+                   __global float *restrict outflow_comp, __global float *restrict inflow,
+                   __global float *restrict inflow_comp, int nx, int ny, float dt, float inv_dx,
                    float inv_dy, int use_rain, float rain_uniform, int use_perm,
                    float perm_uniform) {
   int i = get_global_id(0), j = get_global_id(1);
@@ -263,28 +312,29 @@ rain_runoff_update(__global float *restrict h, __global float *restrict h_comp,
   if (inf != 0.0f)
     gr_kahan_add(infiltrated, infiltrated_comp, c, inf);
   if (i == 0 || j == 0 || i == nx - 1 || j == ny - 1) {
-    /* Edge faces carry outflow only (0 when closed). */
+    /* What the edge faces carry out of the cell (negative: in). */
     float ow = i == 0 ? -fw : 0.0f, oe = i == nx - 1 ? fe : 0.0f;
     float os = j == 0 ? -fs : 0.0f, on = j == ny - 1 ? fn : 0.0f;
-    float out = dt * ((ow + oe) * inv_dx + (os + on) * inv_dy);
-    if (out != 0.0f)
-      gr_kahan_add(outflow, outflow_comp, c, out);
+    gr_rain_runoff_book_edges(outflow, outflow_comp, inflow, inflow_comp, c, dt, inv_dx, inv_dy, ow,
+                              oe, os, on);
   }
 }
 
 /* One pass over the grid for the ledger (reduce.h): per work-group the
- * stored, infiltrated and outflow depths (double-float, metres summed over
+ * stored, infiltrated, outflow and inflow depths (double-float, metres summed over
  * cells) and the deepest cell; masked: only the cells [own_x0, own_x1) x
  * [own_y0, own_y1) of the row-wide local array (a piece without its ring). */
 __kernel void rain_runoff_reduce(
     __global const float *restrict h, __global const float *restrict h_comp,
     __global const float *restrict infiltrated, __global const float *restrict infiltrated_comp,
     __global const float *restrict outflow, __global const float *restrict outflow_comp,
+    __global const float *restrict inflow, __global const float *restrict inflow_comp,
     __global float *restrict partial, __local float *restrict scratch, int n, int row, int own_x0,
     int own_x1, int own_y0, int own_y1, int masked) {
   int lid = get_local_id(0), wg = get_local_size(0), start, end;
   gr_reduce_block(n, &start, &end);
   float s_hi = 0.0f, s_lo = 0.0f, i_hi = 0.0f, i_lo = 0.0f, o_hi = 0.0f, o_lo = 0.0f;
+  float n_hi = 0.0f, n_lo = 0.0f;
   float hmax = 0.0f;
   for (int c = start + lid; c < end; c += wg) {
     if (masked) {
@@ -300,6 +350,8 @@ __kernel void rain_runoff_reduce(
     gr_df_add(&i_hi, &i_lo, -infiltrated_comp[c]);
     gr_df_add(&o_hi, &o_lo, outflow[c]);
     gr_df_add(&o_hi, &o_lo, -outflow_comp[c]);
+    gr_df_add(&n_hi, &n_lo, inflow[c]);
+    gr_df_add(&n_hi, &n_lo, -inflow_comp[c]);
     hmax = fmax(hmax, d);
   }
   __local float *mine = gr_reduce_slots(scratch, GR_RAIN_RUNOFF_SUMS, GR_RAIN_RUNOFF_MAXES);
@@ -309,7 +361,9 @@ __kernel void rain_runoff_reduce(
   mine[3] = i_lo;
   mine[4] = o_hi;
   mine[5] = o_lo;
-  mine[6] = hmax;
+  mine[6] = n_hi;
+  mine[7] = n_lo;
+  mine[8] = hmax;
   gr_reduce_group(scratch, GR_RAIN_RUNOFF_SUMS, GR_RAIN_RUNOFF_MAXES, partial);
 }
 
@@ -483,15 +537,19 @@ GR_INLINE void gr_sw_face(gr_sw_cell L, gr_sw_cell R, float g, float *fh, float 
 
 /* The ghost beyond the grid's edge next to cell C, as a reconstructed cell
  * whose face toward C carries (low: C's west face; else its east face): a
- * wall's mirror image of C's face values (normal velocity negated), or an
- * open edge's dry, still cell; at C's face bed either way (db = 0
- * exactly), so that gr_sw_face gives the wall's or the outfall's flux. */
-GR_INLINE gr_sw_cell gr_sw_ghost(gr_sw_cell C, bool low, int closed) {
+ * wall's mirror image of C's face values (normal velocity negated), an
+ * open edge's dry, still cell, or a level edge's water up to `level` with
+ * C's face velocities; at C's face bed in every case (db = 0 exactly), so
+ * that gr_sw_face gives the wall's, the outfall's or the level's flux.
+ * (A transmissive edge needs no ghost: gr_sw_axis continues the line.) */
+GR_INLINE gr_sw_cell gr_sw_ghost(gr_sw_cell C, bool low, int kind, float level) {
   float s = low ? -0.5f : 0.5f;
+  bool wall = kind == GR_RAIN_RUNOFF_B_CLOSED, lv = kind == GR_RAIN_RUNOFF_B_LEVEL;
+  float bed = C.b + s * C.sb;
   gr_sw_cell g;
-  g.h = closed ? C.h + s * C.sh : 0.0f;
-  g.un = closed ? -(C.un + s * C.sun) : 0.0f;
-  g.ut = closed ? C.ut + s * C.sut : 0.0f;
+  g.h = wall ? C.h + s * C.sh : (lv ? fmax(level - bed, 0.0f) : 0.0f);
+  g.un = wall ? -(C.un + s * C.sun) : (lv ? C.un + s * C.sun : 0.0f);
+  g.ut = wall || lv ? C.ut + s * C.sut : 0.0f;
   g.b = C.b;
   g.sb = -C.sb;
   g.se = 0.0f;
@@ -517,36 +575,76 @@ GR_INLINE gr_sw_cell gr_sw_pick(bool use, gr_sw_cell a, gr_sw_cell b) {
   return c;
 }
 
+/* The line continued k cells beyond its edge cell a, away from a's inner
+ * neighbour m (a transmissive edge): a's depth and velocities over the bed
+ * a.b + k (a.b - m.b). Every work-item that needs a continued cell computes
+ * it from the same two cells by this expression, so the faces near the edge
+ * stay the same floats in both cells that share them. */
+GR_INLINE gr_sw_pt gr_sw_extend(gr_sw_pt a, gr_sw_pt m, float k) {
+  gr_sw_pt p = a;
+  p.b = a.b + k * (a.b - m.b);
+  return p;
+}
+
+GR_INLINE gr_sw_pt gr_sw_pick_pt(bool use, gr_sw_pt a, gr_sw_pt b) {
+  gr_sw_pt c;
+  c.h = use ? a.h : b.h;
+  c.b = use ? a.b : b.b;
+  c.un = use ? a.un : b.un;
+  c.ut = use ? a.ut : b.ut;
+  return c;
+}
+
 /* The flux balance of the centre cell (p2) of a 5-cell line along one
  * axis: dh (mass in minus out), dqn and dqt (momentum, with the bed's
  * source), per unit of the axis' face length; out_lo, out_hi the depth
- * flux (m^2/s) leaving through the grid's edge faces. i, n: the cell's
- * index and the line's length. The edge faces are faces with a ghost
- * (gr_sw_ghost): a wall passes no water, an open edge only outflow. */
+ * flux (m^2/s) leaving through the grid's edge faces (negative: entering).
+ * i, n: the cell's index and the line's length; kind_lo, kind_hi, lvl_lo,
+ * lvl_hi: the kinds and levels of the line's low and high edges. A
+ * transmissive edge continues the line (gr_sw_extend) two cells beyond it,
+ * so its face and its edge cells are computed as inner ones; the other
+ * edges' faces have a ghost (gr_sw_ghost): a wall passes no water, an open
+ * edge only outflow, a level edge both ways. */
 GR_INLINE void gr_sw_axis(gr_sw_pt p0, gr_sw_pt p1, gr_sw_pt p2, gr_sw_pt p3, gr_sw_pt p4, int i,
-                          int n, int closed, float g, float *dh, float *dqn, float *dqt,
-                          float *out_lo, float *out_hi) {
-  bool lo = i > 0, hi = i < n - 1;
+                          int n, int kind_lo, int kind_hi, float lvl_lo, float lvl_hi, float g,
+                          float *dh, float *dqn, float *dqt, float *out_lo, float *out_hi) {
+  bool tlo = kind_lo == GR_RAIN_RUNOFF_B_TRANSMISSIVE,
+       thi = kind_hi == GR_RAIN_RUNOFF_B_TRANSMISSIVE;
+  /* The edge cell's inner neighbour, where the edge is this cell's. */
+  gr_sw_pt in_lo = gr_sw_pick_pt(i + 1 < n, p3, p2), in_hi = gr_sw_pick_pt(i > 0, p1, p2);
+  p0 = gr_sw_pick_pt(tlo && i == 0, gr_sw_extend(p2, in_lo, 2.0f),
+                     gr_sw_pick_pt(tlo && i == 1, gr_sw_extend(p1, p2, 1.0f), p0));
+  p1 = gr_sw_pick_pt(tlo && i == 0, gr_sw_extend(p2, in_lo, 1.0f), p1);
+  p4 = gr_sw_pick_pt(thi && i == n - 1, gr_sw_extend(p2, in_hi, 2.0f),
+                     gr_sw_pick_pt(thi && i == n - 2, gr_sw_extend(p3, p2, 1.0f), p4));
+  p3 = gr_sw_pick_pt(thi && i == n - 1, gr_sw_extend(p2, in_hi, 1.0f), p3);
+  bool lo = i > 0 || tlo, hi = i < n - 1 || thi;
   gr_sw_cell C = gr_sw_recon(p1, p2, p3, lo && hi);
-  gr_sw_cell W = gr_sw_recon(p0, p1, p2, i > 1);
-  gr_sw_cell E = gr_sw_recon(p2, p3, p4, i < n - 2);
-  gr_sw_cell gw = gr_sw_ghost(C, true, closed), ge = gr_sw_ghost(C, false, closed);
+  gr_sw_cell W = gr_sw_recon(p0, p1, p2, i > 1 || tlo);
+  gr_sw_cell E = gr_sw_recon(p2, p3, p4, i < n - 2 || thi);
+  gr_sw_cell gw = gr_sw_ghost(C, true, kind_lo, lvl_lo);
+  gr_sw_cell ge = gr_sw_ghost(C, false, kind_hi, lvl_hi);
   W = gr_sw_pick(lo, W, gw);
   E = gr_sw_pick(hi, E, ge);
   float fhw, fmw, ftw, fhe, fme, fte, unused;
   gr_sw_face(W, C, g, &fhw, &unused, &fmw, &ftw);
   gr_sw_face(C, E, g, &fhe, &fme, &unused, &fte);
-  /* At the edges: nothing through a wall, nothing in through an open edge
-   * (a still wall then: no momentum either). */
-  bool stop_w = !lo && (closed || fhw > 0.0f), stop_e = !hi && (closed || fhe < 0.0f);
-  fmw = stop_w && !closed ? 0.0f : fmw;
-  fme = stop_e && !closed ? 0.0f : fme;
+  /* At the edges: nothing through a wall, nothing in through an open or a
+   * transmissive edge (a still wall then: no momentum either; see
+   * gr_rain_runoff_edge_q for why). */
+  bool wall_lo = kind_lo == GR_RAIN_RUNOFF_B_CLOSED, wall_hi = kind_hi == GR_RAIN_RUNOFF_B_CLOSED;
+  bool only_out_lo = kind_lo == GR_RAIN_RUNOFF_B_OPEN || tlo;
+  bool only_out_hi = kind_hi == GR_RAIN_RUNOFF_B_OPEN || thi;
+  bool stop_w = i == 0 && (wall_lo || (only_out_lo && fhw > 0.0f));
+  bool stop_e = i == n - 1 && (wall_hi || (only_out_hi && fhe < 0.0f));
+  fmw = stop_w && !wall_lo ? 0.0f : fmw;
+  fme = stop_e && !wall_hi ? 0.0f : fme;
   fhw = stop_w ? 0.0f : fhw;
   fhe = stop_e ? 0.0f : fhe;
   ftw = stop_w ? 0.0f : ftw;
   fte = stop_e ? 0.0f : fte;
-  *out_lo = lo ? 0.0f : -fhw;
-  *out_hi = hi ? 0.0f : fhe;
+  *out_lo = i > 0 ? 0.0f : -fhw;
+  *out_hi = i < n - 1 ? 0.0f : fhe;
   float hw = C.h - 0.5f * C.sh, he = C.h + 0.5f * C.sh;
   *dh = fhw - fhe;
   /* (fmw + g hw^2 / 2) - (fme + g he^2 / 2) - g (hw + he) / 2 (bed slope)
@@ -616,9 +714,10 @@ GR_INLINE void gr_sw_stage(
     __global float *restrict qv1, __global float *restrict dh1, __global const float *restrict b,
     __global const float *restrict rain, __global const float *restrict perm,
     __global float *restrict infiltrated, __global float *restrict infiltrated_comp,
-    __global float *restrict outflow, __global float *restrict outflow_comp, int nx, int ny,
-    float dt, float inv_dx, float inv_dy, float g, float n2, int use_rain, float rain_uniform,
-    int use_perm, float perm_uniform, int closed, __global const float *restrict sh,
+    __global float *restrict outflow, __global float *restrict outflow_comp,
+    __global float *restrict inflow, __global float *restrict inflow_comp, int nx, int ny, float dt,
+    float inv_dx, float inv_dy, float g, float n2, int use_rain, float rain_uniform, int use_perm,
+    float perm_uniform, int4 bnd, float4 lvl, __global const float *restrict sh,
     __global const float *restrict su, __global const float *restrict sv, const int stage) {
   int i = get_global_id(0), j = get_global_id(1);
   if (!gr_inside(i, j, nx, ny))
@@ -643,13 +742,14 @@ GR_INLINE void gr_sw_stage(
 #undef GR_SW_LOAD
   gr_sw_pt y2 = {x2.h, x2.b, x2.ut, x2.un};
   float dhx, dqx_x, dqy_x, olx, ohx, dhy, dqy_y, dqx_y, oly, ohy;
-  gr_sw_axis(x0, x1, x2, x3, x4, i, nx, closed, g, &dhx, &dqx_x, &dqy_x, &olx, &ohx);
-  gr_sw_axis(y0, y1, y2, y3, y4, j, ny, closed, g, &dhy, &dqy_y, &dqx_y, &oly, &ohy);
+  gr_sw_axis(x0, x1, x2, x3, x4, i, nx, bnd.x, bnd.y, lvl.x, lvl.y, g, &dhx, &dqx_x, &dqy_x, &olx,
+             &ohx);
+  gr_sw_axis(y0, y1, y2, y3, y4, j, ny, bnd.z, bnd.w, lvl.z, lvl.w, g, &dhy, &dqy_y, &dqx_y, &oly,
+             &ohy);
   float dh = dt * (dhx * inv_dx + dhy * inv_dy);
   float hn = x2.h + dh;
   float qun = su[c] + dt * (dqx_x * inv_dx + dqx_y * inv_dy);
   float qvn = sv[c] + dt * (dqy_x * inv_dx + dqy_y * inv_dy);
-  float out = 0.5f * dt * ((olx + ohx) * inv_dx + (oly + ohy) * inv_dy);
   if (stage == 1) {
     /* su, sv are the momenta before rain: take the wet ones. */
     float r = gr_rain_runoff_input(rain, use_rain, rain_uniform, c);
@@ -687,8 +787,9 @@ GR_INLINE void gr_sw_stage(
     if (inf != 0.0f)
       gr_kahan_add(infiltrated, infiltrated_comp, c, inf);
   }
-  if (out != 0.0f)
-    gr_kahan_add(outflow, outflow_comp, c, out);
+  /* Half of each stage's edge flows (Heun's average). */
+  gr_rain_runoff_book_edges(outflow, outflow_comp, inflow, inflow_comp, c, 0.5f * dt, inv_dx,
+                            inv_dy, olx, ohx, oly, ohy);
 }
 
 /* The two stages as two kernels, each reading one state and writing
@@ -701,13 +802,14 @@ GR_INLINE void gr_sw_stage(
       __global const float *restrict b, __global const float *restrict rain,                       \
       __global const float *restrict perm, __global float *restrict infiltrated,                   \
       __global float *restrict infiltrated_comp, __global float *restrict outflow,                 \
-      __global float *restrict outflow_comp, int nx, int ny, float dt, float inv_dx, float inv_dy, \
+      __global float *restrict outflow_comp, __global float *restrict inflow,                      \
+      __global float *restrict inflow_comp, int nx, int ny, float dt, float inv_dx, float inv_dy,  \
       float g, float n2, int use_rain, float rain_uniform, int use_perm, float perm_uniform,       \
-      int closed
+      int4 bnd, float4 lvl
 #define GR_SW_STAGE_PASS                                                                           \
   h, qu, qv, h_comp, h1, qu1, qv1, dh1, b, rain, perm, infiltrated, infiltrated_comp, outflow,     \
-      outflow_comp, nx, ny, dt, inv_dx, inv_dy, g, n2, use_rain, rain_uniform, use_perm,           \
-      perm_uniform, closed
+      outflow_comp, inflow, inflow_comp, nx, ny, dt, inv_dx, inv_dy, g, n2, use_rain,              \
+      rain_uniform, use_perm, perm_uniform, bnd, lvl
 
 __kernel void rain_runoff_sw_stage1(GR_SW_STAGE_ARGS) {
   gr_sw_stage(GR_SW_STAGE_PASS, h, qu, qv, 1);

@@ -33,13 +33,15 @@
 #define GR_RAIN_RUNOFF_PROGRESS_EVERY 0.1
 /* Checkpoints: "GRR1" and the layout's version. */
 #define GR_RAIN_RUNOFF_STATE_MAGIC 0x31525247u
-#define GR_RAIN_RUNOFF_STATE_VERSION 4u /* 2: the piece's i0, j0; 3: qu, qv; 4: the maps */
+/* 2: the piece's i0, j0; 3: qu, qv; 4: the maps; 5: the inflow */
+#define GR_RAIN_RUNOFF_STATE_VERSION 5u
 /* Per-cell arrays of a checkpoint: h, h_c, k, inf, inf_c, out, out_c, qu, qv,
- * and the flood maps' max_depth, max_speed, arrival, wet, wet_c, max_hazard. */
+ * the flood maps' max_depth, max_speed, arrival, wet, wet_c, max_hazard, and
+ * the inflow and its compensation. */
 /* Per halo cell: h, k, west and south faces (local inertial); h, qu, qv and
  * h_c (shallow water). */
 #define GR_RAIN_RUNOFF_HALO_ARRAYS 4
-#define GR_RAIN_RUNOFF_STATE_CELL_ARRAYS 15
+#define GR_RAIN_RUNOFF_STATE_CELL_ARRAYS 17
 #define GR_RAIN_RUNOFF_MAP_ARRAYS 6
 /* The local inertial model's smallest Manning n (shallow water allows 0). */
 #define GR_RAIN_RUNOFF_LI_MIN_N 0.005
@@ -51,8 +53,9 @@ enum {
   GR_RAIN_RUNOFF_P_MANNING_N,
   GR_RAIN_RUNOFF_P_MAX_DT,
   GR_RAIN_RUNOFF_P_CFL,
-  GR_RAIN_RUNOFF_P_BOUNDARY,
-  GR_RAIN_RUNOFF_P_FLOW_MODEL,
+  GR_RAIN_RUNOFF_P_BOUNDARY,                              /* four rows: west, east, south, north */
+  GR_RAIN_RUNOFF_P_LEVEL = GR_RAIN_RUNOFF_P_BOUNDARY + 4, /* four rows, likewise */
+  GR_RAIN_RUNOFF_P_FLOW_MODEL = GR_RAIN_RUNOFF_P_LEVEL + 4,
   GR_RAIN_RUNOFF_P_WETTING_DEPTH,
   GR_RAIN_RUNOFF_P_DEBRIS_FACTOR,
   GR_RAIN_RUNOFF_P_COUNT
@@ -66,7 +69,14 @@ static const gr_param_bound gr_rain_runoff_bounds[GR_RAIN_RUNOFF_P_COUNT] = {
     {"ManningN", "s/m^(1/3)", 0.0, 1.0, 0.03, 1.0, 0, 0},
     {"MaxTimeStep", "s", 0.0, 3600.0, 1.0, 1.0, 1, 0},
     {"CourantNumber", "", 0.0, 1.0, 0.7, 1.0, 1, 0},
-    {"Boundary", "", 0.0, 1.0, 0.0, 1.0, 0, 1},
+    {"BoundaryWest", "", 0.0, 3.0, 0.0, 1.0, 0, 1},
+    {"BoundaryEast", "", 0.0, 3.0, 0.0, 1.0, 0, 1},
+    {"BoundarySouth", "", 0.0, 3.0, 0.0, 1.0, 0, 1},
+    {"BoundaryNorth", "", 0.0, 3.0, 0.0, 1.0, 0, 1},
+    {"LevelWest", "m", -1.0e6, 1.0e6, 0.0, 1.0, 0, 0},
+    {"LevelEast", "m", -1.0e6, 1.0e6, 0.0, 1.0, 0, 0},
+    {"LevelSouth", "m", -1.0e6, 1.0e6, 0.0, 1.0, 0, 0},
+    {"LevelNorth", "m", -1.0e6, 1.0e6, 0.0, 1.0, 0, 0},
     {"FlowModel", "", 0.0, 1.0, 0.0, 1.0, 0, 1},
     {"WettingDepth", "m", 0.0, 10.0, 0.01, 1.0, 1, 0},
     {"DebrisFactor", "", 0.0, 1.0, 0.0, 1.0, 0, 0},
@@ -92,6 +102,7 @@ struct gr_rain_runoff {
   gr_rain_runoff_params params;
   cl_kernel flux, limit, update, reduce, derive, sw_stage[2], sw_speed, maps;
   cl_mem h, h_c, b, k, inf, inf_c, out, out_c;
+  cl_mem in, in_c; /* inflow through the domain's edges, per cell (m), and its compensation */
   cl_mem qu, qv, h1, qu1, qv1, dh1; /* shallow water: discharges and Heun's stage */
   cl_mem qu0, qv0;                  /* initial discharges, once VELOCITY was set */
   cl_mem qx[2], qy[2];              /* discharges; [cur] is the latest, the other the next */
@@ -110,6 +121,10 @@ struct gr_rain_runoff {
   /* g max(|db/dx| / dx + |db/dy| / dy) over the local array, 1/s^2: the
    * fastest the bed's slope can speed water up, per cell crossed. */
   double slope_rate;
+  /* The lowest ground along each of the domain's edges (west, east, south,
+   * north; 0 on a side with a neighbour): a level edge's depth over it is
+   * water the stable step must see. */
+  double edge_bed[4];
   double initial_sum; /* sum of the initial depth's floats, m */
   double initial_volume, rain_volume, time;
   long long steps;
@@ -155,7 +170,10 @@ void gr_rain_runoff_params_init(gr_rain_runoff_params *p) {
   p->manning_n = t[GR_RAIN_RUNOFF_P_MANNING_N].default_value;
   p->max_dt = t[GR_RAIN_RUNOFF_P_MAX_DT].default_value;
   p->cfl = t[GR_RAIN_RUNOFF_P_CFL].default_value;
-  p->boundary = (gr_boundary)(int)t[GR_RAIN_RUNOFF_P_BOUNDARY].default_value;
+  for (int e = 0; e < 4; ++e) {
+    p->boundary[e] = (gr_boundary)(int)t[GR_RAIN_RUNOFF_P_BOUNDARY + e].default_value;
+    p->boundary_level[e] = t[GR_RAIN_RUNOFF_P_LEVEL + e].default_value;
+  }
   p->flow_model = (gr_flow_model)(int)t[GR_RAIN_RUNOFF_P_FLOW_MODEL].default_value;
   p->wetting_depth = t[GR_RAIN_RUNOFF_P_WETTING_DEPTH].default_value;
   p->debris_factor = t[GR_RAIN_RUNOFF_P_DEBRIS_FACTOR].default_value;
@@ -183,11 +201,14 @@ static double gr_rain_runoff_param_value(const gr_rain_runoff_params *p, int row
     memcpy(&m, &p->flow_model, sizeof(m));
     return (double)m;
   }
-  default: {
-    int b; /* any bit pattern the enum may hold */
-    memcpy(&b, &p->boundary, sizeof(b));
-    return (double)b;
-  }
+  default:
+    if (row >= GR_RAIN_RUNOFF_P_LEVEL)
+      return p->boundary_level[row - GR_RAIN_RUNOFF_P_LEVEL];
+    else {
+      int b; /* any bit pattern the enum may hold */
+      memcpy(&b, &p->boundary[row - GR_RAIN_RUNOFF_P_BOUNDARY], sizeof(b));
+      return (double)b;
+    }
   }
 }
 
@@ -408,7 +429,7 @@ static gr_status gr_rain_runoff_read_own(gr_rain_runoff *s, cl_mem buf, size_t c
                              (size_t)s->grid.nx, (size_t)s->grid.ny, host, 0);
 }
 
-/* Sums the stored, infiltrated and outflow depths over the cells (m, so
+/* Sums the stored, infiltrated, outflow and inflow depths over the cells (m, so
  * times dx dy for m^3) and finds the deepest cell. */
 static gr_status gr_rain_runoff_reduce(gr_rain_runoff *s, double sums[GR_RAIN_RUNOFF_SUMS],
                                        double *max_depth) {
@@ -424,6 +445,8 @@ static gr_status gr_rain_runoff_reduce(gr_rain_runoff *s, double sums[GR_RAIN_RU
       {"infiltrated_comp", sizeof(cl_mem), &s->inf_c},
       {"outflow", sizeof(cl_mem), &s->out},
       {"outflow_comp", sizeof(cl_mem), &s->out_c},
+      {"inflow", sizeof(cl_mem), &s->in},
+      {"inflow_comp", sizeof(cl_mem), &s->in_c},
       {"n", sizeof(n), &n},
       {"row", sizeof(row), &row},
       {"own_x0", sizeof(own_x0), &own_x0},
@@ -573,14 +596,14 @@ gr_status gr_rain_runoff_create(gr_context *ctx, const gr_grid *grid,
                         "address at most about 2.1e9 faces; split the domain or coarsen it.",
                         nx, ny);
   /* The state that is always there: depth, elevation, limiter, infiltrated
-   * and outflow with their compensations, the shallow-water discharges and
-   * stage (14 per cell), the flood maps (6) and two sets of face arrays. Refuse before allocating
-   * when the device cannot hold it. */
+   * outflow and inflow with their compensations, the shallow-water discharges
+   * and stage (16 per cell), the flood maps (6) and two sets of face arrays. Refuse before
+   * allocating when the device cannot hold it. */
   gr_device_info info;
   gr_status st = gr_context_device_info(ctx, &info);
   if (st != GR_OK)
     return st;
-  double need = 4.0 * ((14.0 + GR_RAIN_RUNOFF_MAP_ARRAYS) * (double)cells +
+  double need = 4.0 * ((16.0 + GR_RAIN_RUNOFF_MAP_ARRAYS) * (double)cells +
                        2.0 * ((double)(nx + 1) * ny + (double)nx * (ny + 1)));
   if (need > (double)info.global_mem_bytes)
     return gr_set_error(ctx, GR_ERR_TOO_LARGE,
@@ -621,8 +644,8 @@ gr_status gr_rain_runoff_create(gr_context *ctx, const gr_grid *grid,
     st = gr_kernel_create(ctx, prog, "rain_runoff_maps", &s->maps);
   for (int a = 0; st == GR_OK && a < GR_RAIN_RUNOFF_MAP_ARRAYS; ++a)
     st = gr_buffer_create(ctx, CL_MEM_READ_WRITE, bytes, NULL, &s->map[a]);
-  cl_mem *per_cell[] = {&s->h,     &s->h_c, &s->b,  &s->k,  &s->inf, &s->inf_c, &s->out,
-                        &s->out_c, &s->qu,  &s->qv, &s->h1, &s->qu1, &s->qv1,   &s->dh1};
+  cl_mem *per_cell[] = {&s->h,  &s->h_c,  &s->b,  &s->k,  &s->inf, &s->inf_c, &s->out, &s->out_c,
+                        &s->in, &s->in_c, &s->qu, &s->qv, &s->h1,  &s->qu1,   &s->qv1, &s->dh1};
   for (size_t i = 0; st == GR_OK && i < sizeof(per_cell) / sizeof(per_cell[0]); ++i)
     st = gr_buffer_create(ctx, CL_MEM_READ_WRITE, bytes, NULL, per_cell[i]);
   for (int a = 0; a < 2 && st == GR_OK; ++a) {
@@ -640,8 +663,8 @@ gr_status gr_rain_runoff_create(gr_context *ctx, const gr_grid *grid,
   if (st == GR_OK)
     st = gr_reduction_init(ctx, s->sw_speed, cells, 0, 2, &s->speed);
   /* Dry, flat ground; nothing infiltrated or gone. */
-  cl_mem *zeroed[] = {&s->h,     &s->h_c, &s->b,   &s->inf, &s->inf_c, &s->out,
-                      &s->out_c, &s->h1,  &s->qu1, &s->qv1, &s->dh1,   &s->dummy};
+  cl_mem *zeroed[] = {&s->h,  &s->h_c,  &s->b,  &s->inf, &s->inf_c, &s->out, &s->out_c,
+                      &s->in, &s->in_c, &s->h1, &s->qu1, &s->qv1,   &s->dh1, &s->dummy};
   for (size_t i = 0; st == GR_OK && i < sizeof(zeroed) / sizeof(zeroed[0]); ++i)
     st =
         gr_rain_runoff_fill(s, *zeroed[i], 0.0f, *zeroed[i] == s->dummy ? sizeof(cl_float) : bytes);
@@ -670,7 +693,7 @@ void gr_rain_runoff_destroy(gr_rain_runoff *s) {
   cl_mem *bufs[] = {&s->h,    &s->h_c,     &s->b,     &s->qx[0], &s->qy[0], &s->qx[1], &s->qy[1],
                     &s->k,    &s->inf,     &s->inf_c, &s->out,   &s->out_c, &s->h0,    &s->rain,
                     &s->perm, &s->scratch, &s->dummy, &s->qu,    &s->qv,    &s->h1,    &s->qu1,
-                    &s->qv1,  &s->qu0,     &s->qv0,   &s->dh1};
+                    &s->qv1,  &s->qu0,     &s->qv0,   &s->dh1,   &s->in,    &s->in_c};
   for (size_t i = 0; i < sizeof(bufs) / sizeof(bufs[0]); ++i)
     gr_buffer_release(bufs[i]);
   for (int a = 0; a < GR_RAIN_RUNOFF_MAP_ARRAYS; ++a)
@@ -713,6 +736,35 @@ static gr_status gr_rain_runoff_upload(gr_rain_runoff *s, cl_mem *buf, const flo
   if (!*buf)
     return gr_buffer_create(s->ctx, CL_MEM_READ_WRITE, bytes, host, buf);
   return gr_buffer_write(s->ctx, *buf, 0, bytes, host);
+}
+
+/* The lowest ground along each of the domain's edges in the local array
+ * `z` (s->edge_bed; 0 on a side with a neighbour). */
+static void gr_rain_runoff_edge_beds(gr_rain_runoff *s, const float *z) {
+  const int nx = s->nxl, ny = s->nyl;
+  for (int e = 0; e < 4; ++e) {
+    double low = HUGE_VAL;
+    int n = e < 2 ? ny : nx;
+    for (int k = 0; !s->ring[e] && k < n; ++k) {
+      int i = e == 0 ? 0 : (e == 1 ? nx - 1 : k), j = e < 2 ? k : (e == 2 ? 0 : ny - 1);
+      double v = z[(size_t)j * (size_t)nx + (size_t)i];
+      low = v < low ? v : low;
+    }
+    s->edge_bed[e] = s->ring[e] ? 0.0 : low;
+  }
+}
+
+/* The deepest water a level edge holds over its edge's lowest ground (m; 0
+ * without level edges): the stable step counts it as water in the grid. */
+static double gr_rain_runoff_edge_depth(const gr_rain_runoff *s) {
+  double deepest = 0.0;
+  for (int e = 0; e < 4; ++e) {
+    if (s->ring[e] || s->params.boundary[e] != GR_BOUNDARY_LEVEL)
+      continue;
+    double d = s->params.boundary_level[e] - s->edge_bed[e];
+    deepest = d > deepest ? d : deepest;
+  }
+  return deepest;
 }
 
 static gr_status gr_rain_runoff_set_field_impl(gr_rain_runoff *s, gr_field f, const float *host) {
@@ -790,8 +842,10 @@ static gr_status gr_rain_runoff_set_field_impl(gr_rain_runoff *s, gr_field f, co
         double rate = sx / (s->grid.dx * s->grid.dx) + sy / (s->grid.dy * s->grid.dy);
         worst = rate > worst ? rate : worst;
       }
-    if (st == GR_OK)
+    if (st == GR_OK) {
       s->slope_rate = GR_GRAVITY * worst;
+      gr_rain_runoff_edge_beds(s, host);
+    }
     break;
   }
   case GR_FIELD_PERMEABILITY:
@@ -1072,7 +1126,16 @@ static gr_status gr_rain_runoff_bind(gr_rain_runoff *s, cl_float dt) {
   cl_float n2 = (cl_float)(p->manning_n * p->manning_n);
   cl_int use_rain = s->has_rain, use_perm = s->has_perm;
   cl_float rain_uniform = (cl_float)p->rain_rate, perm_uniform = (cl_float)p->permeability;
-  cl_int closed = p->boundary == GR_BOUNDARY_CLOSED;
+  /* The domain's edges' kinds and levels; a side with a neighbour is a
+   * wall (its ring is refreshed from the neighbour after every step). */
+  cl_int4 bnd;
+  cl_float4 lvl;
+  for (int e = 0; e < 4; ++e) {
+    int kind; /* any bit pattern the enum may hold: validated as a whole number 0-3 */
+    memcpy(&kind, &p->boundary[e], sizeof(kind));
+    bnd.s[e] = s->ring[e] ? GR_RAIN_RUNOFF_B_CLOSED : kind;
+    lvl.s[e] = (cl_float)p->boundary_level[e];
+  }
   cl_mem rain = s->has_rain ? s->rain : s->dummy, perm = s->has_perm ? s->perm : s->dummy;
   cl_float theta = (cl_float)GR_RAIN_RUNOFF_THETA;
   const size_t m = sizeof(cl_mem);
@@ -1097,11 +1160,17 @@ static gr_status gr_rain_runoff_bind(gr_rain_runoff *s, cl_float dt) {
       {"g", sizeof(g), &g},
       {"n2", sizeof(n2), &n2},
       {"theta", sizeof(theta), &theta},
-      {"closed", sizeof(closed), &closed},
+      {"bnd", sizeof(bnd), &bnd},
+      {"lvl", sizeof(lvl), &lvl},
   };
   const gr_rain_runoff_arg update[] = {
-      {"h_comp", m, &s->h_c},  {"infiltrated", m, &s->inf},    {"infiltrated_comp", m, &s->inf_c},
-      {"outflow", m, &s->out}, {"outflow_comp", m, &s->out_c},
+      {"h_comp", m, &s->h_c},
+      {"infiltrated", m, &s->inf},
+      {"infiltrated_comp", m, &s->inf_c},
+      {"outflow", m, &s->out},
+      {"outflow_comp", m, &s->out_c},
+      {"inflow", m, &s->in},
+      {"inflow_comp", m, &s->in_c},
   };
   if (p->flow_model == GR_FLOW_SHALLOW_WATER) {
     const gr_rain_runoff_arg sw[] = {
@@ -1131,7 +1200,10 @@ static gr_status gr_rain_runoff_bind(gr_rain_runoff *s, cl_float dt) {
         {"rain_uniform", sizeof(rain_uniform), &rain_uniform},
         {"use_perm", sizeof(use_perm), &use_perm},
         {"perm_uniform", sizeof(perm_uniform), &perm_uniform},
-        {"closed", sizeof(closed), &closed},
+        {"inflow", m, &s->in},
+        {"inflow_comp", m, &s->in_c},
+        {"bnd", sizeof(bnd), &bnd},
+        {"lvl", sizeof(lvl), &lvl},
     };
     gr_status st = GR_RAIN_RUNOFF_ARGS(s, s->sw_stage[0], sw);
     if (st == GR_OK)
@@ -1288,6 +1360,14 @@ static gr_status gr_rain_runoff_sw_stable_dt(gr_rain_runoff *s, double *dt) {
   gr_status st = GR_RAIN_RUNOFF_ARGS(s, s->sw_speed, args);
   if (st == GR_OK)
     st = gr_reduction_run(s->ctx, &s->speed, s->sw_speed, NULL, maxes);
+  /* A level edge's water enters at up to twice its wave speed (a dry
+   * front's, HLL's). */
+  double edge = gr_rain_runoff_edge_depth(s);
+  if (edge > 0.0) {
+    double c2 = 2.0 * sqrt(GR_GRAVITY * edge) * (1.0 / s->grid.dx + 1.0 / s->grid.dy);
+    maxes[0] = edge > maxes[0] ? edge : maxes[0];
+    maxes[1] = c2 > maxes[1] ? c2 : maxes[1];
+  }
   if (st == GR_OK && s->allreduce)
     st = gr_rain_runoff_allreduce(s, maxes, 4, GR_REDUCE_MAX);
   if (st != GR_OK)
@@ -1329,6 +1409,9 @@ static gr_status gr_rain_runoff_stable_dt_impl(gr_rain_runoff *s, double *dt) {
     return gr_rain_runoff_sw_stable_dt(s, dt);
   double sums[GR_RAIN_RUNOFF_SUMS], hmax = 0.0;
   gr_status st = gr_rain_runoff_reduce(s, sums, &hmax);
+  /* A level edge's water counts as the grid's. */
+  double edge = gr_rain_runoff_edge_depth(s);
+  hmax = edge > hmax ? edge : hmax;
   /* The deepest cell of the whole domain: every piece takes the same step. */
   if (st == GR_OK && s->allreduce)
     st = gr_rain_runoff_allreduce(s, &hmax, 1, GR_REDUCE_MAX);
@@ -1615,8 +1698,9 @@ gr_status gr_rain_runoff_ledger_get(gr_rain_runoff *s, gr_rain_runoff_ledger *ou
   out->stored_volume = all[0] * area;
   out->infiltrated_volume = all[1] * area;
   out->outflow_volume = all[2] * area;
-  out->balance_error = out->initial_volume + out->rain_volume - out->infiltrated_volume -
-                       out->outflow_volume - out->stored_volume;
+  out->inflow_volume = all[3] * area;
+  out->balance_error = out->initial_volume + out->rain_volume + out->inflow_volume -
+                       out->infiltrated_volume - out->outflow_volume - out->stored_volume;
   out->max_depth = hmax;
   return GR_OK;
 }
@@ -1631,7 +1715,7 @@ static gr_status gr_rain_runoff_reset_impl(gr_rain_runoff *s) {
         "Copying the initial water depth");
   else
     st = gr_rain_runoff_fill(s, s->h, 0.0f, bytes);
-  cl_mem zeroed[] = {s->h_c, s->inf, s->inf_c, s->out, s->out_c};
+  cl_mem zeroed[] = {s->h_c, s->inf, s->inf_c, s->out, s->out_c, s->in, s->in_c};
   for (size_t i = 0; st == GR_OK && i < sizeof(zeroed) / sizeof(zeroed[0]); ++i)
     st = gr_rain_runoff_fill(s, zeroed[i], 0.0f, bytes);
   if (st == GR_OK)
@@ -1759,8 +1843,8 @@ gr_status gr_rain_runoff_state_size(const gr_rain_runoff *s, size_t *bytes) {
 /* The state's device arrays in checkpoint order, with their sizes. */
 static int gr_rain_runoff_state_arrays(gr_rain_runoff *s, int cur, cl_mem *bufs, size_t *sizes) {
   cl_mem cells[GR_RAIN_RUNOFF_STATE_CELL_ARRAYS] = {
-      s->h,  s->h_c,    s->k,      s->inf,    s->inf_c,  s->out,    s->out_c, s->qu,
-      s->qv, s->map[0], s->map[1], s->map[2], s->map[3], s->map[4], s->map[5]};
+      s->h,      s->h_c,    s->k,      s->inf,    s->inf_c,  s->out,    s->out_c, s->qu,  s->qv,
+      s->map[0], s->map[1], s->map[2], s->map[3], s->map[4], s->map[5], s->in,    s->in_c};
   int n = 0;
   for (int i = 0; i < GR_RAIN_RUNOFF_STATE_CELL_ARRAYS; ++i, ++n) {
     bufs[n] = cells[i];

@@ -39,9 +39,25 @@
  * The flow is gathered, never scattered, so two runs give bit-identical
  * fields, and a terrain symmetric under a mirror gives a mirrored flow.
  *
- * Boundaries: GR_BOUNDARY_CLOSED is a wall (no flow through the grid's edge);
- * GR_BOUNDARY_OPEN lets water leave (free outfall into a dry cell at the
- * edge cell's ground height) and counts it as outflow. Nothing enters.
+ * Boundaries, one per edge of the domain (params.boundary[side], in
+ * gr_rain_runoff_side order: west, east, south, north), for either model:
+ *  - GR_BOUNDARY_CLOSED: a wall, no flow through the edge;
+ *  - GR_BOUNDARY_OPEN: a free outfall into a dry cell at the edge cell's
+ *    ground height; water leaves (outflow), nothing enters;
+ *  - GR_BOUNDARY_TRANSMISSIVE: zero gradient, the edge's water depth and
+ *    velocity continue beyond it over a bed whose slope continues (the edge
+ *    cell's bed minus the step to its inner neighbour): uniform flow on a
+ *    slope leaves at its normal depth, without reflection; nothing enters
+ *    (a zero-gradient inflow would grow with the edge cell's depth and feed
+ *    a pit at the edge without end);
+ *  - GR_BOUNDARY_LEVEL: the water surface beyond the edge stands at
+ *    params.boundary_level[side] (m, as the elevations) over the edge
+ *    cell's ground (with the edge's velocity for shallow water): the edge
+ *    fills or drains the domain toward that level; a level below the ground
+ *    is a free outfall.
+ * What leaves through an edge is outflow, what enters is inflow, both in
+ * the ledger. The stable step counts the levels' depths over the edges'
+ * lowest ground as water in the grid.
  *
  * Fields (gr_field): set ELEVATION (required, m), optionally PERMEABILITY
  * (m/s, replaces params.permeability), RAIN_RATE (m/s, replaces
@@ -109,10 +125,22 @@ typedef enum gr_flow_model {
   GR_FLOW_LOCAL_INERTIAL = 1
 } gr_flow_model;
 
+/** The kind of an edge (rows BoundaryWest, BoundaryEast, BoundarySouth,
+ *  BoundaryNorth); see "Boundaries" above. */
 typedef enum gr_boundary {
-  GR_BOUNDARY_OPEN = 0,  /**< water may leave through the grid's edge */
-  GR_BOUNDARY_CLOSED = 1 /**< the edge is a wall */
+  GR_BOUNDARY_OPEN = 0,         /**< free outfall: water may leave through the edge */
+  GR_BOUNDARY_CLOSED = 1,       /**< the edge is a wall */
+  GR_BOUNDARY_TRANSMISSIVE = 2, /**< zero gradient: depth, velocity and bed slope continue */
+  GR_BOUNDARY_LEVEL = 3         /**< the water surface beyond the edge is boundary_level */
 } gr_boundary;
+
+/** Sides of the domain (boundaries) and of a piece (the halo calls). */
+typedef enum gr_rain_runoff_side {
+  GR_RAIN_RUNOFF_WEST = 0,  /**< toward i0 - 1 */
+  GR_RAIN_RUNOFF_EAST = 1,  /**< toward i0 + nx */
+  GR_RAIN_RUNOFF_SOUTH = 2, /**< toward j0 - 1 */
+  GR_RAIN_RUNOFF_NORTH = 3  /**< toward j0 + ny */
+} gr_rain_runoff_side;
 
 /** Standard gravity, m/s^2. */
 #define GR_GRAVITY 9.80665
@@ -123,12 +151,17 @@ typedef enum gr_boundary {
  * to these), written nowhere else.
  */
 typedef struct gr_rain_runoff_params {
-  double rain_rate;     /**< m/s (row RainRate, mm/h) */
-  double permeability;  /**< infiltration capacity, m/s (row Permeability, mm/h) */
-  double manning_n;     /**< Manning roughness, s/m^(1/3) (row ManningN) */
-  double cfl;           /**< Courant number of the adaptive step (row CourantNumber) */
-  double max_dt;        /**< longest step, s (row MaxTimeStep) */
-  gr_boundary boundary; /**< row Boundary: 0 open, 1 closed */
+  double rain_rate;    /**< m/s (row RainRate, mm/h) */
+  double permeability; /**< infiltration capacity, m/s (row Permeability, mm/h) */
+  double manning_n;    /**< Manning roughness, s/m^(1/3) (row ManningN) */
+  double cfl;          /**< Courant number of the adaptive step (row CourantNumber) */
+  double max_dt;       /**< longest step, s (row MaxTimeStep) */
+  /** rows BoundaryWest, BoundaryEast, BoundarySouth, BoundaryNorth, by
+   *  gr_rain_runoff_side: 0 open, 1 closed, 2 transmissive, 3 level */
+  gr_boundary boundary[4];
+  /** rows LevelWest, LevelEast, LevelSouth, LevelNorth, m: the water
+   *  surface beyond an edge of kind GR_BOUNDARY_LEVEL (unused otherwise) */
+  double boundary_level[4];
   /** row FlowModel: 0 shallow water (the default), 1 local inertial. The
    *  local inertial model needs manning_n >= 0.005; shallow water allows 0
    *  (frictionless). */
@@ -176,8 +209,9 @@ typedef struct gr_rain_runoff_ledger {
   double rain_volume;        /**< rain that fell on the grid */
   double infiltrated_volume; /**< water that went into the ground */
   double outflow_volume;     /**< water that left through the boundary */
+  double inflow_volume;      /**< water that came in through the boundary */
   double stored_volume;      /**< water on the grid now */
-  /** initial + rain - infiltrated - outflow - stored: float rounding only */
+  /** initial + rain + inflow - infiltrated - outflow - stored: float rounding only */
   double balance_error;
   double max_depth; /**< deepest cell now, m */
 } gr_rain_runoff_ledger;
@@ -376,7 +410,7 @@ GR_API gr_status gr_rain_runoff_state_load(gr_rain_runoff *s, const void *host, 
  * gr_rain_runoff_step call (the caller exchanges between calls) and does not
  * advance (both refused with a sentence). The stable step and the ledger are
  * global through the allreduce callback (the deepest cell by GR_REDUCE_MAX;
- * the stored, infiltrated, outflow, rain and initial volumes by
+ * the stored, infiltrated, outflow, inflow, rain and initial volumes by
  * GR_REDUCE_SUM), so every piece takes the same dt and the same steps as the
  * whole grid, which makes every owned cell bit-identical to the whole
  * grid's; advance on a piece with a ring needs both callbacks.
@@ -410,14 +444,6 @@ GR_API gr_status gr_rain_runoff_state_load(gr_rain_runoff *s, const void *host, 
  *  cannot change (the ring would). */
 #define GR_RAIN_RUNOFF_GHOST_SW 4
 
-/** Sides of a piece, for the halo calls. */
-typedef enum gr_rain_runoff_side {
-  GR_RAIN_RUNOFF_WEST = 0,  /**< toward i0 - 1 */
-  GR_RAIN_RUNOFF_EAST = 1,  /**< toward i0 + nx */
-  GR_RAIN_RUNOFF_SOUTH = 2, /**< toward j0 - 1 */
-  GR_RAIN_RUNOFF_NORTH = 3  /**< toward j0 + ny */
-} gr_rain_runoff_side;
-
 /**
  * The global reduction over the pieces (see gr_allreduce_fn); NULL (the
  * default) for a simulation that is the whole domain or the only piece.
@@ -450,7 +476,8 @@ GR_API const char *gr_rain_runoff_last_error(const gr_rain_runoff *s);
 
 /**
  * The parameter table (RainRate mm/h, Permeability mm/h, ManningN,
- * MaxTimeStep s, CourantNumber, Boundary, FlowModel, WettingDepth m, DebrisFactor) that
+ * MaxTimeStep s, CourantNumber, BoundaryWest/East/South/North, LevelWest/East/South/North m,
+ * FlowModel, WettingDepth m, DebrisFactor) that
  * gr_rain_runoff_params_validate
  * follows; *count gets the number of rows.
  */
