@@ -46,7 +46,7 @@ const gr_param_bound *Bound(const char *property) {
 } // namespace
 
 vtkRainRunoffFilter::vtkRainRunoffFilter() {
-  this->SetNumberOfInputPorts(3);
+  this->SetNumberOfInputPorts(4);
   this->SetNumberOfOutputPorts(2);
 }
 
@@ -132,6 +132,41 @@ void vtkRainRunoffFilter::SetGaugesConnection(vtkAlgorithmOutput *output) {
   this->SetInputConnection(2, output);
 }
 
+void vtkRainRunoffFilter::SetInflowsConnection(vtkAlgorithmOutput *output) {
+  this->SetInputConnection(3, output);
+}
+
+void vtkRainRunoffFilter::AddInflow(int side, double time, double discharge) {
+  this->InflowTimes[side].push_back(time);
+  this->InflowDischarges[side].push_back(discharge);
+  this->Modified();
+}
+
+void vtkRainRunoffFilter::RemoveAllInflow(int side) {
+  if (!this->InflowTimes[side].empty()) {
+    this->InflowTimes[side].clear();
+    this->InflowDischarges[side].clear();
+    this->Modified();
+  }
+}
+
+int vtkRainRunoffFilter::GetNumberOfInflowRows(int side) {
+  return side >= 0 && side < 4 ? static_cast<int>(this->InflowTimes[side].size()) : 0;
+}
+
+#define GRAUPEL_RAIN_RUNOFF_INFLOW(Side, index)                                                    \
+  void vtkRainRunoffFilter::AddInflow##Side(double time, double discharge) {                       \
+    this->AddInflow(index, time, discharge);                                                       \
+  }                                                                                                \
+  void vtkRainRunoffFilter::RemoveAllInflow##Side() {                                              \
+    this->RemoveAllInflow(index);                                                                  \
+  }
+GRAUPEL_RAIN_RUNOFF_INFLOW(West, 0)
+GRAUPEL_RAIN_RUNOFF_INFLOW(East, 1)
+GRAUPEL_RAIN_RUNOFF_INFLOW(South, 2)
+GRAUPEL_RAIN_RUNOFF_INFLOW(North, 3)
+#undef GRAUPEL_RAIN_RUNOFF_INFLOW
+
 int vtkRainRunoffFilter::FillOutputPortInformation(int port, vtkInformation *info) {
   info->Set(vtkDataObject::DATA_TYPE_NAME(), port == 0 ? "vtkImageData" : "vtkTable");
   return 1;
@@ -194,7 +229,7 @@ int vtkRainRunoffFilter::RequestData(vtkInformation *request, vtkInformationVect
 }
 
 int vtkRainRunoffFilter::FillInputPortInformation(int port, vtkInformation *info) {
-  info->Set(vtkAlgorithm::INPUT_REQUIRED_DATA_TYPE(), port == 2 ? "vtkPointSet" : "vtkImageData");
+  info->Set(vtkAlgorithm::INPUT_REQUIRED_DATA_TYPE(), port >= 2 ? "vtkPointSet" : "vtkImageData");
   if (port >= 1) {
     info->Set(vtkAlgorithm::INPUT_IS_OPTIONAL(), 1);
   }
@@ -343,11 +378,74 @@ int vtkRainRunoffFilter::SetUpState(vtkInformationVector **inputVector) {
                                  gr_rain_runoff_last_error(this->Simulation));
     }
   }
+  // The inflows: each edge's hydrograph, and the points with a discharge.
+  const char *sides[4] = {"InflowWest", "InflowEast", "InflowSouth", "InflowNorth"};
+  for (int e = 0; e < 4; ++e) {
+    if (gr_rain_runoff_set_edge_inflow(this->Simulation, e, this->InflowTimes[e].data(),
+                                       this->InflowDischarges[e].data(),
+                                       static_cast<int>(this->InflowTimes[e].size())) != GR_OK) {
+      vtkErrorMacro("Rain Runoff's " << sides[e] << ": "
+                                     << gr_rain_runoff_last_error(this->Simulation));
+      return 0;
+    }
+  }
+  if (!this->SetPointInflows(inputVector, terrain)) {
+    return 0;
+  }
   // Progress with the simulated time, and an abort inside a long interval.
   gr_rain_runoff_set_progress(this->Simulation, &vtkGraupelSimulation::CoreProgress, this);
   this->Ledgers.clear();
   this->GaugeRows.clear();
   return this->RecordLedger(0);
+}
+
+int vtkRainRunoffFilter::SetPointInflows(vtkInformationVector **inputVector,
+                                         vtkImageData *terrain) {
+  vtkPointSet *points = inputVector[3]->GetNumberOfInformationObjects()
+                            ? vtkPointSet::GetData(inputVector[3])
+                            : nullptr;
+  if (!points) {
+    return 1;
+  }
+  vtkDataArray *q = points->GetPointData()->GetArray("discharge");
+  const vtkIdType n = points->GetNumberOfPoints();
+  if (n > 0 && (!q || q->GetNumberOfComponents() != 1)) {
+    vtkErrorMacro("Rain Runoff's Inflows need the point array 'discharge' (m^3/s, one value per "
+                  "point); add it, or disconnect the Inflows input.");
+    return 0;
+  }
+  int ext[6], dims[3];
+  terrain->GetExtent(ext);
+  terrain->GetDimensions(dims);
+  const double *origin = terrain->GetOrigin(), *spacing = terrain->GetSpacing();
+  std::vector<int> ij;
+  std::vector<double> discharge;
+  for (vtkIdType k = 0; k < n; ++k) {
+    double x[3];
+    points->GetPoint(k, x);
+    const double fi = (x[0] - origin[0]) / spacing[0] - ext[0];
+    const double fj = (x[1] - origin[1]) / spacing[1] - ext[2];
+    const bool finite = std::isfinite(fi) && std::isfinite(fj);
+    const long long ci = finite ? std::llround(fi) : -1, cj = finite ? std::llround(fj) : -1;
+    if (ci < 0 || cj < 0 || ci >= dims[0] || cj >= dims[1]) {
+      vtkErrorMacro("Rain Runoff's Inflows point "
+                    << k << " at (" << x[0] << ", " << x[1] << ") lies off the terrain (x "
+                    << origin[0] + ext[0] * spacing[0] << " to " << origin[0] + ext[1] * spacing[0]
+                    << " m, y " << origin[1] + ext[2] * spacing[1] << " to "
+                    << origin[1] + ext[3] * spacing[1]
+                    << " m); move it onto the terrain or remove it.");
+      return 0;
+    }
+    ij.push_back(static_cast<int>(ci));
+    ij.push_back(static_cast<int>(cj));
+    discharge.push_back(q->GetComponent(k, 0));
+  }
+  if (gr_rain_runoff_set_point_inflows(this->Simulation, ij.data(), discharge.data(),
+                                       static_cast<int>(n)) != GR_OK) {
+    vtkErrorMacro("Rain Runoff's Inflows: " << gr_rain_runoff_last_error(this->Simulation));
+    return 0;
+  }
+  return 1;
 }
 
 int vtkRainRunoffFilter::RecordLedger(int index) {

@@ -53,6 +53,16 @@
  * with gr_rain_runoff_sample: a few floats per output, whatever the grid).
  * Gauges are a static input: moving them sets the simulation up again.
  *
+ * Inflows: Input 3 (`Inflows`, optional) is a point set with the point
+ * array `discharge` (m^3/s, 0 to 1e6, constant in time): each point is
+ * snapped to the nearest terrain point and lets that much water in there
+ * (a river, a culvert; points on one terrain point add up); a point off the
+ * terrain or a bad discharge is refused with a sentence. And per edge an
+ * inflow hydrograph (InflowWest ... InflowNorth): rows of time (s) and
+ * discharge (m^3/s), times strictly increasing, linear in between, held
+ * before the first and after the last row, spread evenly along the edge.
+ * Both count as the ledger's inflow_volume.
+ *
  * Time is handled by vtkGraupelSimulation: request a time with
  * UpdateTimeStep(t) (ParaView's animation does it). Checkpoints are the
  * core's gr_rain_runoff_state_save/load; an abort is honoured inside an
@@ -174,6 +184,27 @@ public:
   void SetPermeabilityMapConnection(vtkAlgorithmOutput *output);
   /** Connects the optional gauge points (input port 2). */
   void SetGaugesConnection(vtkAlgorithmOutput *output);
+  /** Connects the optional point inflows (input port 3, point array `discharge` in m^3/s). */
+  void SetInflowsConnection(vtkAlgorithmOutput *output);
+
+  ///@{
+  /**
+   * The inflow hydrograph along an edge: Add appends a row (time s,
+   * discharge m^3/s), RemoveAll clears it (no inflow, the default). Times
+   * must increase from row to row and discharges lie between 0 and 1e6
+   * m^3/s, or the next update is refused with a sentence naming the row.
+   */
+  void AddInflowWest(double time, double discharge);
+  void RemoveAllInflowWest();
+  void AddInflowEast(double time, double discharge);
+  void RemoveAllInflowEast();
+  void AddInflowSouth(double time, double discharge);
+  void RemoveAllInflowSouth();
+  void AddInflowNorth(double time, double discharge);
+  void RemoveAllInflowNorth();
+  /** The rows of edge `side` (0 west, 1 east, 2 south, 3 north). */
+  int GetNumberOfInflowRows(int side);
+  ///@}
 
 protected:
   vtkRainRunoffFilter();
@@ -227,7 +258,14 @@ private:
   /** Adds the flood maps to the image output, on its extent. */
   int AddMaps(vtkDataObject *output);
 
+  /** Gives the core the Inflows input's points (snapped to the terrain); 0 with a sentence. */
+  int SetPointInflows(vtkInformationVector **inputVector, vtkImageData *terrain);
+  void AddInflow(int side, double time, double discharge);
+  void RemoveAllInflow(int side);
+
   gr_rain_runoff *Simulation = nullptr;
+  /** Per edge (west, east, south, north) the hydrograph's times and discharges. */
+  std::vector<double> InflowTimes[4], InflowDischarges[4];
   /** The ledger's volumes at each output time passed: time, rain, infiltrated,
    *  outflow, stored, balance error, inflow. */
   std::vector<std::array<double, 7>> Ledgers;

@@ -2055,6 +2055,19 @@ static float *cut(const float *global, int gnx, int x0, int y0, int w, int h) {
   return out;
 }
 
+/* With piece_edges, the inflows too: a hydrograph along the south edge (a
+ * wall there) and two point inflows, one next to the split in x (in the
+ * west half's ring) and one in the north-west. */
+static void piece_inflows(gr_rain_runoff *s) {
+  if (!piece_edges || !s)
+    return;
+  const double t[3] = {0.0, 20.0, 60.0}, q[3] = {0.0, 0.4, 0.1};
+  const int ij[4] = {19, 5, 4, 19};
+  const double pq[2] = {0.05, 0.02};
+  CHECK(gr_rain_runoff_set_edge_inflow(s, GR_RAIN_RUNOFF_SOUTH, t, q, 3) == GR_OK);
+  CHECK(gr_rain_runoff_set_point_inflows(s, ij, pq, 2) == GR_OK);
+}
+
 static int make_piece(piece *p, const domain *dm, const gr_rain_runoff_params *prm, int i0, int j0,
                       int nx, int ny) {
   const int G = piece_ghost();
@@ -2084,11 +2097,14 @@ static int make_piece(piece *p, const domain *dm, const gr_rain_runoff_params *p
     CHECK_MSG(st == GR_OK, "piece field: %s", gr_rain_runoff_last_error(p->s));
     free(local);
   }
+  if (st == GR_OK)
+    piece_inflows(p->s);
   return st == GR_OK;
 }
 
 static gr_rain_runoff *make_whole(const domain *dm, const gr_rain_runoff_params *prm) {
   gr_rain_runoff *s = make_sim(&dm->g, prm, dm->b, dm->d);
+  piece_inflows(s);
   if (s) {
     CHECK(gr_rain_runoff_set_field(s, GR_FIELD_RAIN_RATE, dm->r) == GR_OK);
     CHECK(gr_rain_runoff_set_field(s, GR_FIELD_PERMEABILITY, dm->k) == GR_OK);
@@ -3611,6 +3627,129 @@ static void test_edges_mirror(void) {
   }
 }
 
+/* ----------------------------------------------------------- inflows */
+
+/* A point inflow in a walled, flat basin raises the level by Q t / area:
+ * Q for 600 s (two sources, one of them twice in the same cell), then 1800
+ * s to settle; every cell within 1 mm of Q t / area, the ledger's inflow Q t
+ * to float rounding and the stored water inflow - outflow (0). */
+static void test_inflow_point(void) {
+  gr_grid g = {20, 16, 2.0, 3.0, 0.0, 0.0, 0, 0};
+  size_t n = cells_of(&g);
+  const double area = 40.0 * 48.0, T = 600.0;
+  const int ij[6] = {3, 4, 15, 11, 3, 4};
+  const double q[3] = {0.1, 0.15, 0.05}, Q = 0.3;
+  for (int m = 0; m < 2; ++m) {
+    gr_rain_runoff_params p = edge_params(m);
+    p.manning_n = 0.05;
+    gr_rain_runoff *s = make_sim(&g, &p, NULL, NULL);
+    if (!s)
+      continue;
+    CHECK(gr_rain_runoff_set_point_inflows(s, ij, q, 3) == GR_OK);
+    CHECK(gr_rain_runoff_advance(s, T, NULL) == GR_OK);
+    gr_rain_runoff_ledger l1 = ledger(s);
+    CHECK(gr_rain_runoff_set_point_inflows(s, NULL, NULL, 0) == GR_OK);
+    CHECK(gr_rain_runoff_advance(s, 1800.0, NULL) == GR_OK);
+    gr_rain_runoff_ledger l2 = ledger(s);
+    float *h = get(s, &g, GR_FIELD_WATER_DEPTH);
+    double rise = Q * T / area, worst = 0.0;
+    for (size_t c = 0; c < n; ++c)
+      worst = fmax(worst, fabs(h[c] - rise));
+    CHECK_MSG(fabs(l1.inflow_volume - Q * T) < 1e-6 * Q * T, "%s: inflow %.9g, Q t %.9g",
+              model_names[m], l1.inflow_volume, Q * T);
+    CHECK(l2.inflow_volume == l1.inflow_volume && l2.outflow_volume == 0.0);
+    CHECK_NEAR(l2.stored_volume, l2.inflow_volume, 1e-6 * l2.inflow_volume);
+    CHECK(fabs(l2.balance_error) < 1e-6 * l2.inflow_volume);
+    CHECK_MSG(worst < 1e-3, "%s: a cell is %.2e m off the level Q t / area = %.4f m",
+              model_names[m], worst, rise);
+    printf("%s: point inflows of %g m^3/s for %g s: inflow %.6f m^3 (Q t %.6f), level %.5f m "
+           "(Q t / area %.5f), every cell within %.1e m\n",
+           model_names[m], Q, T, l1.inflow_volume, Q * T, l2.stored_volume / area, rise, worst);
+    free(h);
+    gr_rain_runoff_destroy(s);
+  }
+}
+
+/* An inflow hydrograph along the west edge of a channel whose east edge is
+ * an outfall: the ledger's inflow is the table's integral, whatever the
+ * steps (some straddle its corners), to float rounding; stored = inflow -
+ * outflow; and the same table on a walled basin fills it by that much. */
+static void test_inflow_edge(void) {
+  gr_grid g = {24, 6, 5.0, 4.0, 0.0, 0.0, 0, 0};
+  float *b = alloc_field(&g, 1);
+  for (int j = 0; j < g.ny; ++j)
+    for (int i = 0; i < g.nx; ++i)
+      b[(size_t)j * g.nx + i] = (float)(0.01 * (g.nx - i) + 0.02 * hash01(i, j, 41));
+  const double t[4] = {0.0, 100.0, 300.0, 400.0}, q[4] = {0.0, 0.5, 0.5, 0.0};
+  const double expect = 150.0; /* the trapezoids: 25 + 100 + 25 m^3 */
+  for (int m = 0; m < 2; ++m)
+    for (int walled = 0; walled < 2; ++walled) {
+      gr_rain_runoff_params p = edge_params(m);
+      if (!walled)
+        p.boundary[GR_RAIN_RUNOFF_EAST] = GR_BOUNDARY_OPEN;
+      gr_rain_runoff *s = make_sim(&g, &p, walled ? NULL : b, NULL);
+      if (!s)
+        continue;
+      CHECK(gr_rain_runoff_set_edge_inflow(s, GR_RAIN_RUNOFF_WEST, t, q, 4) == GR_OK);
+      /* Stretches that end off the table's corners. */
+      const double spans[4] = {73.0, 141.5, 200.25, 85.25};
+      for (int k = 0; k < 4; ++k)
+        CHECK(gr_rain_runoff_advance(s, spans[k], NULL) == GR_OK);
+      gr_rain_runoff_ledger l = ledger(s);
+      CHECK_MSG(fabs(l.inflow_volume - expect) < 1e-6 * expect,
+                "%s: inflow %.9g m^3, the hydrograph's integral %.9g", model_names[m],
+                l.inflow_volume, expect);
+      CHECK_NEAR(l.stored_volume, l.inflow_volume - l.outflow_volume, 1e-6 * expect);
+      CHECK(walled ? l.outflow_volume == 0.0 : l.outflow_volume > 0.05 * expect);
+      printf("%s, %s: hydrograph inflow %.7f m^3 (integral %g), outflow %.3f, stored %.3f, "
+             "balance %.1e\n",
+             model_names[m], walled ? "walled basin" : "channel", l.inflow_volume, expect,
+             l.outflow_volume, l.stored_volume, l.balance_error);
+      gr_rain_runoff_destroy(s);
+    }
+  free(b);
+}
+
+/* Bad inflows: one sentence naming the row or source and its value; the
+ * inflows stay as they were. */
+static void test_inflow_errors(void) {
+  gr_grid g = {8, 6, 1.0, 1.0, 0.0, 0.0, 0, 0};
+  gr_rain_runoff_params p = edge_params(0);
+  gr_rain_runoff *s = make_sim(&g, &p, NULL, NULL);
+  if (!s)
+    return;
+  const double t_bad[3] = {0.0, 10.0, 10.0}, t_ok[3] = {0.0, 10.0, 20.0};
+  const double q_ok[3] = {1.0, 2.0, 0.0}, q_neg[3] = {1.0, -2.0, 0.0}, q_nan[3] = {1.0, NAN, 0.0};
+  const char *e;
+  CHECK(gr_rain_runoff_set_edge_inflow(s, GR_RAIN_RUNOFF_EAST, t_bad, q_ok, 3) ==
+        GR_ERR_INVALID_ARGUMENT);
+  e = gr_rain_runoff_last_error(s);
+  CHECK_MSG(has(e, "east edge's inflow hydrograph's times must increase") && has(e, "row 2"),
+            "'%s'", e);
+  CHECK(gr_rain_runoff_set_edge_inflow(s, GR_RAIN_RUNOFF_NORTH, t_ok, q_neg, 3) ==
+        GR_ERR_INVALID_ARGUMENT);
+  e = gr_rain_runoff_last_error(s);
+  CHECK_MSG(has(e, "north edge's") && has(e, "-2 m^3/s in row 1"), "'%s'", e);
+  CHECK(gr_rain_runoff_set_edge_inflow(s, GR_RAIN_RUNOFF_NORTH, t_ok, q_nan, 3) ==
+        GR_ERR_INVALID_ARGUMENT);
+  CHECK(gr_rain_runoff_set_edge_inflow(s, 4, t_ok, q_ok, 3) == GR_ERR_INVALID_ARGUMENT);
+  CHECK(has(gr_rain_runoff_last_error(s), "got 4"));
+  CHECK(gr_rain_runoff_set_edge_inflow(s, 0, NULL, q_ok, 3) == GR_ERR_INVALID_ARGUMENT);
+  const int ij[4] = {2, 2, 8, 1};
+  const double pq[2] = {1.0, 1.0}, pneg[2] = {-1.0, 1.0};
+  CHECK(gr_rain_runoff_set_point_inflows(s, ij, pq, 2) == GR_ERR_INVALID_ARGUMENT);
+  e = gr_rain_runoff_last_error(s);
+  CHECK_MSG(has(e, "Point inflow 1 is the cell (8, 1), outside"), "'%s'", e);
+  CHECK(gr_rain_runoff_set_point_inflows(s, ij, pneg, 1) == GR_ERR_INVALID_ARGUMENT);
+  CHECK_MSG(has(gr_rain_runoff_last_error(s), "Point inflow 0 has the discharge -1 m^3/s"), "'%s'",
+            gr_rain_runoff_last_error(s));
+  CHECK(gr_rain_runoff_set_point_inflows(s, ij, pq, -1) == GR_ERR_INVALID_ARGUMENT);
+  /* Nothing was taken: no inflow. */
+  CHECK(gr_rain_runoff_advance(s, 5.0, NULL) == GR_OK);
+  CHECK(ledger(s).inflow_volume == 0.0);
+  gr_rain_runoff_destroy(s);
+}
+
 static const gr_subtest tests[] = {
     {"rain_gain", test_rain_gain, 0},
     {"infiltration", test_infiltration, 0},
@@ -3668,6 +3807,9 @@ static const gr_subtest tests[] = {
     {"sw_pieces_edges_x", test_sw_pieces_edges_x, 0},
     {"sw_pieces_edges_y", test_sw_pieces_edges_y, 0},
     {"sw_advance_pieces_edges_x", test_sw_advance_pieces_edges_x, 0},
+    {"inflow_point", test_inflow_point, 0},
+    {"inflow_edge", test_inflow_edge, 0},
+    {"inflow_errors", test_inflow_errors, 0},
 };
 
 static int setup(void) {

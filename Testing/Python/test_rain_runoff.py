@@ -475,6 +475,66 @@ for props, text in (({"BoundaryWest": 3, "LevelWest": float("nan")},
             and hydrograph(g) == {}, "%r refused with one sentence, empty outputs: %r"
             % (props, errs.text()[:200]))
 
+# Inflows: a hydrograph along the west edge and point inflows, on a flat,
+# walled terrain: the ledger's inflow is the table's integral plus Q t, and
+# all of it is stored; bad tables and points are refused with a sentence.
+def inflow_points(xy, q, name="discharge"):
+    pts = vtkPoints()
+    for px, py in xy:
+        pts.InsertNextPoint(px, py, 0.0)
+    poly = vtkPolyData()
+    poly.SetPoints(pts)
+    if name:
+        arr = numpy_to_vtk(np.asarray(q, dtype=np.float64), deep=1)
+        arr.SetName(name)
+        poly.GetPointData().AddArray(arr)
+    return poly
+
+
+fl = rain(np.zeros((NY, NX)), RainRate=0.0, Boundary=1, EndTime=60.0, OutputInterval=20.0)
+for t_q in ((0.0, 0.0), (30.0, 1.0), (45.0, 1.0)):
+    fl.AddInflowWest(*t_q)
+fl.SetInflowsConnection(producer(inflow_points(
+    [(100.0 + 10 * DX, -50.0 + 5 * DX), (100.0 + 10 * DX + 0.3, -50.0 + 5 * DX),
+     (100.0 + 30 * DX, -50.0 + 20 * DX)], [0.1, 0.05, 0.2])).GetOutputPort())
+d, out = at(fl, 60.0)
+expect = 0.5 * 30.0 * 1.0 + 30.0 * 1.0 + 0.35 * 60.0  # the table's integral, held after 45 s
+T.check(fl.GetNumberOfInflowRows(0) == 3 and d is not None
+        and abs(field(out, "inflow_volume") - expect) <= 1e-6 * expect
+        and abs(field(out, "stored_volume") - expect) <= 1e-6 * expect
+        and field(out, "outflow_volume") == 0.0,
+        "hydrograph and point inflows: inflow %.7f m^3, stored %.7f m^3 (expected %g)"
+        % (field(out, "inflow_volume") if d is not None else -1,
+           field(out, "stored_volume") if d is not None else -1, expect))
+bad_tables = (
+    ("InflowWest", ((0.0, 1.0), (10.0, 2.0), (10.0, 3.0)), "InflowWest: The west edge's inflow "
+     "hydrograph's times must increase from row to row, but row 2 has 10 s after 10 s"),
+    ("InflowNorth", ((0.0, 1.0), (10.0, -2.0)), "InflowNorth: The north edge's inflow hydrograph "
+     "has the discharge -2 m^3/s in row 1"),
+)
+for prop, rows, text in bad_tables:
+    g = rain(bowl)
+    for row in rows:
+        getattr(g, "Add" + prop)(*row)
+    errs = T.ErrorCatcher(g)
+    d, out = at(g, 10.0)
+    T.check(d is None and len(errs.messages) == 1 and text in errs.text() and hydrograph(g) == {},
+            "%s %r refused with one sentence, empty outputs: %r" % (prop, rows, errs.text()[:240]))
+    getattr(g, "RemoveAll" + prop)()
+    d, out = at(g, 10.0)
+    T.check(d is not None, "%s cleared: the filter works again" % prop)
+for xy, q, name, text in (
+        ([(100.0, -50.0)], [-1.0], "discharge", "Inflows: Point inflow 0 has the discharge -1 m^3/s"),
+        ([(100.0, -50.0)], [float("nan")], "discharge", "Inflows: Point inflow 0 has the discharge nan"),
+        ([(100.0, -50.0)], [1.0], "flow", "Inflows need the point array 'discharge'"),
+        ([(0.0, 0.0)], [1.0], "discharge", "Inflows point 0 at (0, 0) lies off the terrain")):
+    g = rain(bowl)
+    g.SetInflowsConnection(producer(inflow_points(xy, q, name)).GetOutputPort())
+    errs = T.ErrorCatcher(g)
+    d, out = at(g, 10.0)
+    T.check(d is None and len(errs.messages) == 1 and text in errs.text(),
+            "bad point inflows refused with one sentence: %r" % errs.text()[:200])
+
 # Gauges: three columns each in the hydrograph, the output's values at the
 # nearest terrain point at every output time, whatever the request order.
 def gauge_points(xy):

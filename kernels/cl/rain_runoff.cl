@@ -38,17 +38,27 @@ GR_INLINE float gr_rain_runoff_input(__global const float *restrict field, int u
   return use_field ? field[c] : uniform;
 }
 
-/* Depth after rain gain (h + r dt) and infiltration (at most k dt, never more
- * than the water there). */
-GR_INLINE float gr_rain_runoff_wet(float h, float r, float k, float dt) {
-  float h1 = h + r * dt;
+/* Depth after rain and the sources (inflows, m/s of depth): (h + r dt) +
+ * s dt, two products the ledger books apart (the rain on the host, the
+ * sources per cell); with no source the rain's h + r dt to the bit. */
+GR_INLINE float gr_rain_runoff_gain(float h, float r, float s, float dt) {
+  return (h + r * dt) + s * dt;
+}
+
+/* Depth after rain and source gain and infiltration (at most k dt, never
+ * more than the water there). */
+GR_INLINE float gr_rain_runoff_wet(float h, float r, float s, float k, float dt) {
+  float h1 = gr_rain_runoff_gain(h, r, s, dt);
   return h1 - fmin(k * dt, h1);
 }
 
-GR_INLINE float gr_rain_runoff_infiltration(float h, float r, float k, float dt) {
-  float h1 = h + r * dt;
+GR_INLINE float gr_rain_runoff_infiltration(float h, float r, float s, float k, float dt) {
+  float h1 = gr_rain_runoff_gain(h, r, s, dt);
   return fmin(k * dt, h1);
 }
+
+/* A cell's source rate (m/s of depth): the source field's, 0 without one. */
+#define GR_RAIN_RUNOFF_SRC(c) gr_rain_runoff_input(src, use_src, 0.0f, (c))
 
 /* x^(-7/3) for x > 0 (a normal float), the friction's depth factor: x^(-1/3)
  * from an exponent-thirding first guess and three Newton steps (2e-7
@@ -154,6 +164,7 @@ GR_INLINE float gr_rain_runoff_edge_q(int kind, float q, bool low) {
 __kernel void rain_runoff_flux(__global const float *restrict h, __global const float *restrict b,
                                __global const float *restrict rain,
                                __global const float *restrict perm,
+                               __global const float *restrict src, int use_src,
                                __global const float *restrict qx_old,
                                __global const float *restrict qy_old, __global float *restrict qx,
                                __global float *restrict qy, __global const float *restrict limit,
@@ -166,6 +177,7 @@ __kernel void rain_runoff_flux(__global const float *restrict h, __global const 
   int c = gr_idx(i, j, nx);
   bool in_c = i < nx && j < ny;
   float hc = in_c ? gr_rain_runoff_wet(h[c], gr_rain_runoff_input(rain, use_rain, rain_uniform, c),
+                                       GR_RAIN_RUNOFF_SRC(c),
                                        gr_rain_runoff_input(perm, use_perm, perm_uniform, c), dt)
                   : 0.0f;
   float bc = in_c ? b[c] : 0.0f;
@@ -176,6 +188,7 @@ __kernel void rain_runoff_flux(__global const float *restrict h, __global const 
     bool in_w = i > 0;
     float hw = in_w
                    ? gr_rain_runoff_wet(h[w], gr_rain_runoff_input(rain, use_rain, rain_uniform, w),
+                                        GR_RAIN_RUNOFF_SRC(w),
                                         gr_rain_runoff_input(perm, use_perm, perm_uniform, w), dt)
                    : 0.0f;
     float bw = in_w ? b[w] : 0.0f;
@@ -202,6 +215,7 @@ __kernel void rain_runoff_flux(__global const float *restrict h, __global const 
     bool in_s = j > 0;
     float hs = in_s
                    ? gr_rain_runoff_wet(h[s], gr_rain_runoff_input(rain, use_rain, rain_uniform, s),
+                                        GR_RAIN_RUNOFF_SRC(s),
                                         gr_rain_runoff_input(perm, use_perm, perm_uniform, s), dt)
                    : 0.0f;
     float bs = in_s ? b[s] : 0.0f;
@@ -231,6 +245,7 @@ __kernel void rain_runoff_flux(__global const float *restrict h, __global const 
 __kernel void rain_runoff_limit(__global const float *restrict h,
                                 __global const float *restrict rain,
                                 __global const float *restrict perm,
+                                __global const float *restrict src, int use_src,
                                 __global const float *restrict qx,
                                 __global const float *restrict qy, __global float *restrict limit,
                                 int nx, int ny, float dt, float inv_dx, float inv_dy, int use_rain,
@@ -240,6 +255,7 @@ __kernel void rain_runoff_limit(__global const float *restrict h,
     return;
   int c = gr_idx(i, j, nx);
   float wet = gr_rain_runoff_wet(h[c], gr_rain_runoff_input(rain, use_rain, rain_uniform, c),
+                                 GR_RAIN_RUNOFF_SRC(c),
                                  gr_rain_runoff_input(perm, use_perm, perm_uniform, c), dt);
   float qw = qx[j * (nx + 1) + i], qe = qx[j * (nx + 1) + i + 1];
   float qs = qy[j * nx + i], qn = qy[(j + 1) * nx + i];
@@ -277,6 +293,7 @@ GR_INLINE void gr_rain_runoff_book_edges(__global float *restrict outflow,
 __kernel void
 rain_runoff_update(__global float *restrict h, __global float *restrict h_comp,
                    __global const float *restrict rain, __global const float *restrict perm,
+                   __global const float *restrict src, int use_src,
                    __global const float *restrict qx, __global const float *restrict qy,
                    __global const float *restrict limit, __global float *restrict infiltrated,
                    __global float *restrict infiltrated_comp, __global float *restrict outflow,
@@ -290,8 +307,9 @@ rain_runoff_update(__global float *restrict h, __global float *restrict h_comp,
   int c = gr_idx(i, j, nx);
   float r = gr_rain_runoff_input(rain, use_rain, rain_uniform, c);
   float k = gr_rain_runoff_input(perm, use_perm, perm_uniform, c);
+  float sc = GR_RAIN_RUNOFF_SRC(c);
   float h0 = h[c];
-  float inf = gr_rain_runoff_infiltration(h0, r, k, dt);
+  float inf = gr_rain_runoff_infiltration(h0, r, sc, k, dt);
   float kc = limit[c];
   /* Masked, not clamped, neighbours (see rain_runoff_flux): an edge face
    * never uses the limiter beyond the grid. */
@@ -301,7 +319,7 @@ rain_runoff_update(__global float *restrict h, __global float *restrict h_comp,
   float fe = gr_rain_runoff_limited(qx[j * (nx + 1) + i + 1], kc, ke);
   float fs = gr_rain_runoff_limited(qy[j * nx + i], ks, kc);
   float fn = gr_rain_runoff_limited(qy[(j + 1) * nx + i], kc, kn);
-  float delta = (r * dt - inf) + dt * ((fw - fe) * inv_dx + (fs - fn) * inv_dy);
+  float delta = ((r * dt - inf) + sc * dt) + dt * ((fw - fe) * inv_dx + (fs - fn) * inv_dy);
   float y = delta - h_comp[c];
   float t = h0 + y;
   float comp = (t - h0) - y;
@@ -311,6 +329,9 @@ rain_runoff_update(__global float *restrict h, __global float *restrict h_comp,
   h_comp[c] = t > 0.0f ? comp : 0.0f;
   if (inf != 0.0f)
     gr_kahan_add(infiltrated, infiltrated_comp, c, inf);
+  /* The sources' water is inflow, the very float the depth gained. */
+  if (sc != 0.0f)
+    gr_kahan_add(inflow, inflow_comp, c, sc * dt);
   if (i == 0 || j == 0 || i == nx - 1 || j == ny - 1) {
     /* What the edge faces carry out of the cell (negative: in). */
     float ow = i == 0 ? -fw : 0.0f, oe = i == nx - 1 ? fe : 0.0f;
@@ -318,6 +339,24 @@ rain_runoff_update(__global float *restrict h, __global float *restrict h_comp,
     gr_rain_runoff_book_edges(outflow, outflow_comp, inflow, inflow_comp, c, dt, inv_dx, inv_dy, ow,
                               oe, os, on);
   }
+}
+
+/* The sources of the next step, per cell (m/s of depth): the point inflows
+ * field (pts, when use_pts) and the inflow of each domain edge's hydrograph
+ * spread evenly over its cells (edge: west, east, south, north; 0 on a
+ * side without one, or with a neighbour), added in that fixed order. */
+__kernel void rain_runoff_source(__global const float *restrict pts, int use_pts,
+                                 __global float *restrict src, int nx, int ny, float4 edge) {
+  int i = get_global_id(0), j = get_global_id(1);
+  if (!gr_inside(i, j, nx, ny))
+    return;
+  int c = gr_idx(i, j, nx);
+  float s = use_pts ? pts[c] : 0.0f;
+  s += i == 0 ? edge.x : 0.0f;
+  s += i == nx - 1 ? edge.y : 0.0f;
+  s += j == 0 ? edge.z : 0.0f;
+  s += j == ny - 1 ? edge.w : 0.0f;
+  src[c] = s;
 }
 
 /* One pass over the grid for the ledger (reduce.h): per work-group the
@@ -668,8 +707,8 @@ GR_INLINE void gr_sw_friction(float h, float dt, float g, float n2, float *qx, f
 
 /* Rain and infiltration on a cell's water (as the local inertial model
  * takes them), its momentum scaled with the water infiltration removes. */
-GR_INLINE float gr_sw_wet_q(float h, float q, float r, float dt, float hw) {
-  float h1 = h + r * dt;
+GR_INLINE float gr_sw_wet_q(float h, float q, float r, float s, float dt, float hw) {
+  float h1 = gr_rain_runoff_gain(h, r, s, dt);
   return h1 > 0.0f ? q * (hw / h1) : 0.0f;
 }
 
@@ -679,16 +718,18 @@ GR_INLINE float gr_sw_wet_q(float h, float q, float r, float dt, float hw) {
 GR_INLINE gr_sw_pt gr_sw_load(__global const float *restrict sh, __global const float *restrict sn,
                               __global const float *restrict st, __global const float *restrict b,
                               __global const float *restrict rain,
-                              __global const float *restrict perm, bool in, int q, int stage,
-                              float dt, int use_rain, float rain_uniform, int use_perm,
+                              __global const float *restrict perm,
+                              __global const float *restrict src, int use_src, bool in, int q,
+                              int stage, float dt, int use_rain, float rain_uniform, int use_perm,
                               float perm_uniform) {
   float hh = in ? sh[q] : 0.0f, pn = in ? sn[q] : 0.0f, pt = in ? st[q] : 0.0f;
   if (stage == 1) {
     float r = in ? gr_rain_runoff_input(rain, use_rain, rain_uniform, q) : 0.0f;
     float k = in ? gr_rain_runoff_input(perm, use_perm, perm_uniform, q) : 0.0f;
-    float hw = gr_rain_runoff_wet(hh, r, k, dt);
-    pn = gr_sw_wet_q(hh, pn, r, dt, hw);
-    pt = gr_sw_wet_q(hh, pt, r, dt, hw);
+    float sq = in ? GR_RAIN_RUNOFF_SRC(q) : 0.0f;
+    float hw = gr_rain_runoff_wet(hh, r, sq, k, dt);
+    pn = gr_sw_wet_q(hh, pn, r, sq, dt, hw);
+    pt = gr_sw_wet_q(hh, pt, r, sq, dt, hw);
     hh = hw;
   }
   gr_sw_pt p;
@@ -708,17 +749,19 @@ GR_INLINE gr_sw_pt gr_sw_load(__global const float *restrict sh, __global const 
  *            h, qu, qv (each cell reads its own old values only), with the
  *            infiltration and half of each stage's edge outflow booked in
  *            Kahan sums. */
-GR_INLINE void gr_sw_stage(
-    __global float *restrict h, __global float *restrict qu, __global float *restrict qv,
-    __global float *restrict h_comp, __global float *restrict h1, __global float *restrict qu1,
-    __global float *restrict qv1, __global float *restrict dh1, __global const float *restrict b,
-    __global const float *restrict rain, __global const float *restrict perm,
-    __global float *restrict infiltrated, __global float *restrict infiltrated_comp,
-    __global float *restrict outflow, __global float *restrict outflow_comp,
-    __global float *restrict inflow, __global float *restrict inflow_comp, int nx, int ny, float dt,
-    float inv_dx, float inv_dy, float g, float n2, int use_rain, float rain_uniform, int use_perm,
-    float perm_uniform, int4 bnd, float4 lvl, __global const float *restrict sh,
-    __global const float *restrict su, __global const float *restrict sv, const int stage) {
+GR_INLINE void
+gr_sw_stage(__global float *restrict h, __global float *restrict qu, __global float *restrict qv,
+            __global float *restrict h_comp, __global float *restrict h1,
+            __global float *restrict qu1, __global float *restrict qv1,
+            __global float *restrict dh1, __global const float *restrict b,
+            __global const float *restrict rain, __global const float *restrict perm,
+            __global const float *restrict src, int use_src, __global float *restrict infiltrated,
+            __global float *restrict infiltrated_comp, __global float *restrict outflow,
+            __global float *restrict outflow_comp, __global float *restrict inflow,
+            __global float *restrict inflow_comp, int nx, int ny, float dt, float inv_dx,
+            float inv_dy, float g, float n2, int use_rain, float rain_uniform, int use_perm,
+            float perm_uniform, int4 bnd, float4 lvl, __global const float *restrict sh,
+            __global const float *restrict su, __global const float *restrict sv, const int stage) {
   int i = get_global_id(0), j = get_global_id(1);
   if (!gr_inside(i, j, nx, ny))
     return;
@@ -728,8 +771,8 @@ GR_INLINE void gr_sw_stage(
    * used (the reconstruction's slopes and the edge faces do without them);
    * indices stay linear so that CPU compilers vectorise the loads. */
 #define GR_SW_LOAD(o, in, q, sn, st)                                                               \
-  gr_sw_load(sh, sn, st, b, rain, perm, (in), (q), stage, dt, use_rain, rain_uniform, use_perm,    \
-             perm_uniform)
+  gr_sw_load(sh, sn, st, b, rain, perm, src, use_src, (in), (q), stage, dt, use_rain,              \
+             rain_uniform, use_perm, perm_uniform)
   gr_sw_pt x0 = GR_SW_LOAD(-2, i >= 2, c - 2, su, sv);
   gr_sw_pt x1 = GR_SW_LOAD(-1, i >= 1, c - 1, su, sv);
   gr_sw_pt x2 = GR_SW_LOAD(0, true, c, su, sv);
@@ -753,9 +796,10 @@ GR_INLINE void gr_sw_stage(
   if (stage == 1) {
     /* su, sv are the momenta before rain: take the wet ones. */
     float r = gr_rain_runoff_input(rain, use_rain, rain_uniform, c);
+    float sc = GR_RAIN_RUNOFF_SRC(c);
     float hw = x2.h;
-    qun = gr_sw_wet_q(h[c], qu[c], r, dt, hw) + dt * (dqx_x * inv_dx + dqx_y * inv_dy);
-    qvn = gr_sw_wet_q(h[c], qv[c], r, dt, hw) + dt * (dqy_x * inv_dx + dqy_y * inv_dy);
+    qun = gr_sw_wet_q(h[c], qu[c], r, sc, dt, hw) + dt * (dqx_x * inv_dx + dqx_y * inv_dy);
+    qvn = gr_sw_wet_q(h[c], qv[c], r, sc, dt, hw) + dt * (dqy_x * inv_dx + dqy_y * inv_dy);
     /* Friction in each stage: without it a film on a steep slope would
      * gather g S dt of speed in the first stage and empty its cell in the
      * second. */
@@ -768,24 +812,28 @@ GR_INLINE void gr_sw_stage(
     float h0 = h[c];
     float r = gr_rain_runoff_input(rain, use_rain, rain_uniform, c);
     float k = gr_rain_runoff_input(perm, use_perm, perm_uniform, c);
-    float hw = gr_rain_runoff_wet(h0, r, k, dt);
-    float inf = gr_rain_runoff_infiltration(h0, r, k, dt);
+    float sc = GR_RAIN_RUNOFF_SRC(c);
+    float hw = gr_rain_runoff_wet(h0, r, sc, k, dt);
+    float inf = gr_rain_runoff_infiltration(h0, r, sc, k, dt);
     /* The new depth h0 + (r dt - i) + (dh1 + dh) / 2, Kahan-summed as the
      * local inertial model's (h - h_comp is the water): without it the
      * rounding of the depth would show in the ledger after 10^3 steps. */
-    float delta = (r * dt - inf) + 0.5f * (dh1[c] + dh);
+    float delta = ((r * dt - inf) + sc * dt) + 0.5f * (dh1[c] + dh);
     float y = delta - h_comp[c];
     float hf = h0 + y;
     float comp = (hf - h0) - y;
     gr_sw_friction(hn, dt, g, n2, &qun, &qvn);
-    float qx = 0.5f * (gr_sw_wet_q(h0, qu[c], r, dt, hw) + qun);
-    float qy = 0.5f * (gr_sw_wet_q(h0, qv[c], r, dt, hw) + qvn);
+    float qx = 0.5f * (gr_sw_wet_q(h0, qu[c], r, sc, dt, hw) + qun);
+    float qy = 0.5f * (gr_sw_wet_q(h0, qv[c], r, sc, dt, hw) + qvn);
     h[c] = fmax(hf, 0.0f);
     h_comp[c] = hf > 0.0f ? comp : 0.0f;
     qu[c] = hf > 0.0f ? qx : 0.0f;
     qv[c] = hf > 0.0f ? qy : 0.0f;
     if (inf != 0.0f)
       gr_kahan_add(infiltrated, infiltrated_comp, c, inf);
+    /* The sources' water is inflow, the very float the depth gained. */
+    if (sc != 0.0f)
+      gr_kahan_add(inflow, inflow_comp, c, sc * dt);
   }
   /* Half of each stage's edge flows (Heun's average). */
   gr_rain_runoff_book_edges(outflow, outflow_comp, inflow, inflow_comp, c, 0.5f * dt, inv_dx,
@@ -800,16 +848,16 @@ GR_INLINE void gr_sw_stage(
       __global float *restrict h_comp, __global float *restrict h1, __global float *restrict qu1,  \
       __global float *restrict qv1, __global float *restrict dh1,                                  \
       __global const float *restrict b, __global const float *restrict rain,                       \
-      __global const float *restrict perm, __global float *restrict infiltrated,                   \
-      __global float *restrict infiltrated_comp, __global float *restrict outflow,                 \
-      __global float *restrict outflow_comp, __global float *restrict inflow,                      \
-      __global float *restrict inflow_comp, int nx, int ny, float dt, float inv_dx, float inv_dy,  \
-      float g, float n2, int use_rain, float rain_uniform, int use_perm, float perm_uniform,       \
-      int4 bnd, float4 lvl
+      __global const float *restrict perm, __global const float *restrict src, int use_src,        \
+      __global float *restrict infiltrated, __global float *restrict infiltrated_comp,             \
+      __global float *restrict outflow, __global float *restrict outflow_comp,                     \
+      __global float *restrict inflow, __global float *restrict inflow_comp, int nx, int ny,       \
+      float dt, float inv_dx, float inv_dy, float g, float n2, int use_rain, float rain_uniform,   \
+      int use_perm, float perm_uniform, int4 bnd, float4 lvl
 #define GR_SW_STAGE_PASS                                                                           \
-  h, qu, qv, h_comp, h1, qu1, qv1, dh1, b, rain, perm, infiltrated, infiltrated_comp, outflow,     \
-      outflow_comp, inflow, inflow_comp, nx, ny, dt, inv_dx, inv_dy, g, n2, use_rain,              \
-      rain_uniform, use_perm, perm_uniform, bnd, lvl
+  h, qu, qv, h_comp, h1, qu1, qv1, dh1, b, rain, perm, src, use_src, infiltrated,                  \
+      infiltrated_comp, outflow, outflow_comp, inflow, inflow_comp, nx, ny, dt, inv_dx, inv_dy, g, \
+      n2, use_rain, rain_uniform, use_perm, perm_uniform, bnd, lvl
 
 __kernel void rain_runoff_sw_stage1(GR_SW_STAGE_ARGS) {
   gr_sw_stage(GR_SW_STAGE_PASS, h, qu, qv, 1);

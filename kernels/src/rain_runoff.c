@@ -100,9 +100,19 @@ struct gr_rain_runoff {
   int nxl, nyl;
   int ring[4]; /* gr_rain_runoff_side order: west, east, south, north */
   gr_rain_runoff_params params;
-  cl_kernel flux, limit, update, reduce, derive, sw_stage[2], sw_speed, maps;
+  cl_kernel flux, limit, update, reduce, derive, sw_stage[2], sw_speed, maps, source;
   cl_mem h, h_c, b, k, inf, inf_c, out, out_c;
-  cl_mem in, in_c; /* inflow through the domain's edges, per cell (m), and its compensation */
+  cl_mem in, in_c; /* inflow (edges and sources), per cell (m), and its compensation */
+  /* Sources (m/s of depth): the point inflows' field (pts, once set) and
+   * the field the steps read (src: pts plus the edges' hydrographs, made by
+   * rain_runoff_source before every step while a hydrograph is set). */
+  cl_mem pts, src;
+  int has_pts;
+  double pts_max; /* the largest point-inflow rate, m/s */
+  /* The inflow hydrographs per edge (west, east, south, north): n rows of
+   * time (s) and discharge (m^3/s); n 0 where there is none. */
+  int edge_n[4];
+  double *edge_t[4], *edge_q[4];
   cl_mem qu, qv, h1, qu1, qv1, dh1; /* shallow water: discharges and Heun's stage */
   cl_mem qu0, qv0;                  /* initial discharges, once VELOCITY was set */
   cl_mem qx[2], qy[2];              /* discharges; [cur] is the latest, the other the next */
@@ -144,6 +154,10 @@ struct gr_rain_runoff {
   void *halo_user;
   char error[1024]; /* this handle's latest error (gr_error_keep) */
 };
+
+static int gr_rain_runoff_has_sources(const gr_rain_runoff *s);
+static int gr_rain_runoff_has_edge_inflow(const gr_rain_runoff *s);
+static gr_status gr_rain_runoff_sources_update(gr_rain_runoff *s, double t0, double t1);
 
 /* Every failing public entry point with a handle ends here. */
 #define GR_RAIN_RUNOFF_KEEP_ERROR(s, st) gr_error_keep((s)->error, sizeof((s)->error), (st))
@@ -642,6 +656,8 @@ gr_status gr_rain_runoff_create(gr_context *ctx, const gr_grid *grid,
     st = gr_kernel_create(ctx, prog, "rain_runoff_sw_speed", &s->sw_speed);
   if (st == GR_OK)
     st = gr_kernel_create(ctx, prog, "rain_runoff_maps", &s->maps);
+  if (st == GR_OK)
+    st = gr_kernel_create(ctx, prog, "rain_runoff_source", &s->source);
   for (int a = 0; st == GR_OK && a < GR_RAIN_RUNOFF_MAP_ARRAYS; ++a)
     st = gr_buffer_create(ctx, CL_MEM_READ_WRITE, bytes, NULL, &s->map[a]);
   cl_mem *per_cell[] = {&s->h,  &s->h_c,  &s->b,  &s->k,  &s->inf, &s->inf_c, &s->out, &s->out_c,
@@ -686,20 +702,25 @@ void gr_rain_runoff_destroy(gr_rain_runoff *s) {
   if (!s)
     return;
   cl_kernel kernels[] = {s->flux,        s->limit,       s->update,   s->reduce, s->derive,
-                         s->sw_stage[0], s->sw_stage[1], s->sw_speed, s->maps};
+                         s->sw_stage[0], s->sw_stage[1], s->sw_speed, s->maps,   s->source};
   for (size_t i = 0; i < sizeof(kernels) / sizeof(kernels[0]); ++i)
     if (kernels[i])
       clReleaseKernel(kernels[i]);
-  cl_mem *bufs[] = {&s->h,    &s->h_c,     &s->b,     &s->qx[0], &s->qy[0], &s->qx[1], &s->qy[1],
-                    &s->k,    &s->inf,     &s->inf_c, &s->out,   &s->out_c, &s->h0,    &s->rain,
-                    &s->perm, &s->scratch, &s->dummy, &s->qu,    &s->qv,    &s->h1,    &s->qu1,
-                    &s->qv1,  &s->qu0,     &s->qv0,   &s->dh1,   &s->in,    &s->in_c};
+  cl_mem *bufs[] = {&s->h,     &s->h_c,  &s->b,    &s->qx[0],   &s->qy[0], &s->qx[1],
+                    &s->qy[1], &s->k,    &s->inf,  &s->inf_c,   &s->out,   &s->out_c,
+                    &s->h0,    &s->rain, &s->perm, &s->scratch, &s->dummy, &s->qu,
+                    &s->qv,    &s->h1,   &s->qu1,  &s->qv1,     &s->qu0,   &s->qv0,
+                    &s->dh1,   &s->in,   &s->in_c, &s->pts,     &s->src};
   for (size_t i = 0; i < sizeof(bufs) / sizeof(bufs[0]); ++i)
     gr_buffer_release(bufs[i]);
   for (int a = 0; a < GR_RAIN_RUNOFF_MAP_ARRAYS; ++a)
     gr_buffer_release(&s->map[a]);
   gr_reduction_release(&s->ledger);
   gr_reduction_release(&s->speed);
+  for (int e = 0; e < 4; ++e) {
+    free(s->edge_t[e]);
+    free(s->edge_q[e]);
+  }
   gr_context_release(s->ctx);
   free(s);
 }
@@ -905,6 +926,151 @@ gr_status gr_rain_runoff_set_field(gr_rain_runoff *s, gr_field f, const float *h
         s, gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
                         "gr_rain_runoff_set_field needs a simulation and the field's values."));
   return GR_RAIN_RUNOFF_KEEP_ERROR(s, gr_rain_runoff_set_field_impl(s, f, host));
+}
+
+/* ------------------------------------------------------------- inflows */
+
+#define GR_RAIN_RUNOFF_MAX_DISCHARGE 1.0e6
+#define GR_RAIN_RUNOFF_MAX_ROWS 1000000
+
+static const char *const gr_rain_runoff_side_names[4] = {"west", "east", "south", "north"};
+
+/* (Re)allocates the source field the steps read, and fills it for the
+ * sources now when no hydrograph rewrites it before every step. */
+static gr_status gr_rain_runoff_sources_changed(gr_rain_runoff *s) {
+  size_t bytes = gr_rain_runoff_cells(s) * sizeof(cl_float);
+  gr_status st = GR_OK;
+  if (gr_rain_runoff_has_sources(s) && !s->src)
+    st = gr_buffer_create(s->ctx, CL_MEM_READ_WRITE, bytes, NULL, &s->src);
+  if (st == GR_OK && gr_rain_runoff_has_sources(s) && !gr_rain_runoff_has_edge_inflow(s))
+    st = gr_rain_runoff_sources_update(s, s->time, s->time);
+  s->args_set = 0; /* use_src and the buffer are bound at the next step */
+  return st;
+}
+
+static gr_status gr_rain_runoff_set_point_inflows_impl(gr_rain_runoff *s, const int *ij,
+                                                       const double *q, int n) {
+  if (n < 0 || n > GR_RAIN_RUNOFF_MAX_ROWS || (n > 0 && (!ij || !q)))
+    return gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
+                        "The point inflows must be 0 to %d cells with a discharge each (got %d%s).",
+                        GR_RAIN_RUNOFF_MAX_ROWS, n, n > 0 && (!ij || !q) ? " and no values" : "");
+  int gnx = s->grid.global_nx > 0 ? s->grid.global_nx : s->grid.nx;
+  int gny = s->grid.global_ny > 0 ? s->grid.global_ny : s->grid.ny;
+  for (int k = 0; k < n; ++k) {
+    if (!(q[k] >= 0.0 && q[k] <= GR_RAIN_RUNOFF_MAX_DISCHARGE))
+      return gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
+                          "Point inflow %d has the discharge %g m^3/s: discharges must lie between "
+                          "0 and %g m^3/s; give it a discharge in that range.",
+                          k, q[k], GR_RAIN_RUNOFF_MAX_DISCHARGE);
+    if (ij[2 * k] < 0 || ij[2 * k] >= gnx || ij[2 * k + 1] < 0 || ij[2 * k + 1] >= gny)
+      return gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
+                          "Point inflow %d is the cell (%d, %d), outside the domain of %d x %d "
+                          "cells: give cells from (0, 0) to (%d, %d).",
+                          k, ij[2 * k], ij[2 * k + 1], gnx, gny, gnx - 1, gny - 1);
+  }
+  size_t cells = gr_rain_runoff_cells(s);
+  gr_status st = GR_OK;
+  if (n == 0) {
+    s->has_pts = 0;
+    s->pts_max = 0.0;
+  } else {
+    /* Summed in double in the order given, one float per cell: the same
+     * floats in every piece that holds the cell (owned or in its ring). */
+    double *sum = calloc(cells, sizeof(double));
+    float *f = malloc(cells * sizeof(float));
+    if (!sum || !f) {
+      free(sum);
+      free(f);
+      return gr_set_error(s->ctx, GR_ERR_OUT_OF_MEMORY, "Out of host memory.");
+    }
+    const int x0 = s->grid.i0 - s->ring[0], y0 = s->grid.j0 - s->ring[2];
+    for (int k = 0; k < n; ++k) {
+      int i = ij[2 * k] - x0, j = ij[2 * k + 1] - y0;
+      if (i >= 0 && i < s->nxl && j >= 0 && j < s->nyl)
+        sum[(size_t)j * (size_t)s->nxl + (size_t)i] += q[k];
+    }
+    double area = s->grid.dx * s->grid.dy, top = 0.0;
+    for (size_t c = 0; c < cells; ++c) {
+      f[c] = (float)(sum[c] / area);
+      top = f[c] > top ? f[c] : top;
+    }
+    st = gr_rain_runoff_upload(s, &s->pts, f);
+    free(sum);
+    free(f);
+    if (st != GR_OK)
+      return st;
+    s->has_pts = 1;
+    s->pts_max = top;
+  }
+  return gr_rain_runoff_sources_changed(s);
+}
+
+gr_status gr_rain_runoff_set_point_inflows(gr_rain_runoff *s, const int *ij,
+                                           const double *discharge, int n) {
+  if (!s)
+    return gr_set_error(NULL, GR_ERR_INVALID_ARGUMENT,
+                        "gr_rain_runoff_set_point_inflows needs a simulation.");
+  return GR_RAIN_RUNOFF_KEEP_ERROR(s, gr_rain_runoff_set_point_inflows_impl(s, ij, discharge, n));
+}
+
+static gr_status gr_rain_runoff_set_edge_inflow_impl(gr_rain_runoff *s, int side, const double *t,
+                                                     const double *q, int n) {
+  if (side < 0 || side > 3)
+    return gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
+                        "The edge of an inflow hydrograph must be 0 west, 1 east, 2 south or 3 "
+                        "north (got %d).",
+                        side);
+  const char *name = gr_rain_runoff_side_names[side];
+  if (n < 0 || n > GR_RAIN_RUNOFF_MAX_ROWS || (n > 0 && (!t || !q)))
+    return gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
+                        "The %s edge's inflow hydrograph must have 0 to %d rows of time and "
+                        "discharge (got %d%s).",
+                        name, GR_RAIN_RUNOFF_MAX_ROWS, n,
+                        n > 0 && (!t || !q) ? " and no values" : "");
+  for (int k = 0; k < n; ++k) {
+    if (!(t[k] >= -1e12 && t[k] <= 1e12))
+      return gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
+                          "The %s edge's inflow hydrograph has the time %g s in row %d: times must "
+                          "be finite numbers of seconds; correct that row.",
+                          name, t[k], k);
+    if (k > 0 && !(t[k] > t[k - 1]))
+      return gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
+                          "The %s edge's inflow hydrograph's times must increase from row to row, "
+                          "but row %d has %g s after %g s; sort the rows and drop repeated times.",
+                          name, k, t[k], t[k - 1]);
+    if (!(q[k] >= 0.0 && q[k] <= GR_RAIN_RUNOFF_MAX_DISCHARGE))
+      return gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
+                          "The %s edge's inflow hydrograph has the discharge %g m^3/s in row %d: "
+                          "discharges must lie between 0 and %g m^3/s; correct that row.",
+                          name, q[k], k, GR_RAIN_RUNOFF_MAX_DISCHARGE);
+  }
+  double *nt = NULL, *nq = NULL;
+  if (n > 0) {
+    nt = malloc((size_t)n * sizeof(double));
+    nq = malloc((size_t)n * sizeof(double));
+    if (!nt || !nq) {
+      free(nt);
+      free(nq);
+      return gr_set_error(s->ctx, GR_ERR_OUT_OF_MEMORY, "Out of host memory.");
+    }
+    memcpy(nt, t, (size_t)n * sizeof(double));
+    memcpy(nq, q, (size_t)n * sizeof(double));
+  }
+  free(s->edge_t[side]);
+  free(s->edge_q[side]);
+  s->edge_t[side] = nt;
+  s->edge_q[side] = nq;
+  s->edge_n[side] = n;
+  return gr_rain_runoff_sources_changed(s);
+}
+
+gr_status gr_rain_runoff_set_edge_inflow(gr_rain_runoff *s, int side, const double *times,
+                                         const double *discharge, int n) {
+  if (!s)
+    return gr_set_error(NULL, GR_ERR_INVALID_ARGUMENT,
+                        "gr_rain_runoff_set_edge_inflow needs a simulation.");
+  return GR_RAIN_RUNOFF_KEEP_ERROR(
+      s, gr_rain_runoff_set_edge_inflow_impl(s, side, times, discharge, n));
 }
 
 /* ------------------------------------------------------ pieces and halos */
@@ -1113,6 +1279,86 @@ static gr_status gr_rain_runoff_watch_step(gr_rain_runoff *s, gr_rain_runoff_wat
   return GR_OK;
 }
 
+/* ---------------------------------------------------------------- sources */
+
+static int gr_rain_runoff_has_edge_inflow(const gr_rain_runoff *s) {
+  return s->edge_n[0] || s->edge_n[1] || s->edge_n[2] || s->edge_n[3];
+}
+
+static int gr_rain_runoff_has_sources(const gr_rain_runoff *s) {
+  return s->has_pts || gr_rain_runoff_has_edge_inflow(s);
+}
+
+/* The integral over [a, b] of the piecewise-linear function through (t[k],
+ * v[k]), k < n, held at v[0] before t[0] and at v[n-1] after t[n-1]. */
+static double gr_rain_runoff_table_integral(const double *t, const double *v, int n, double a,
+                                            double b) {
+  double sum = 0.0;
+  if (a < t[0])
+    sum += v[0] * ((b < t[0] ? b : t[0]) - a);
+  if (b > t[n - 1])
+    sum += v[n - 1] * (b - (a > t[n - 1] ? a : t[n - 1]));
+  for (int k = 0; k + 1 < n; ++k) {
+    double lo = a > t[k] ? a : t[k], hi = b < t[k + 1] ? b : t[k + 1];
+    if (hi <= lo)
+      continue;
+    double slope = (v[k + 1] - v[k]) / (t[k + 1] - t[k]);
+    double vlo = v[k] + slope * (lo - t[k]), vhi = v[k] + slope * (hi - t[k]);
+    sum += 0.5 * (vlo + vhi) * (hi - lo);
+  }
+  return sum;
+}
+
+/* The cells along each domain edge of the whole domain (a piece's edge is
+ * part of it): the hydrograph's discharge is spread over all of them. */
+static double gr_rain_runoff_edge_cells(const gr_rain_runoff *s, int side) {
+  int gnx = s->grid.global_nx > 0 ? s->grid.global_nx : s->grid.nx;
+  int gny = s->grid.global_ny > 0 ? s->grid.global_ny : s->grid.ny;
+  return side < 2 ? (double)gny : (double)gnx;
+}
+
+/* Writes the sources of the step [t0, t1] into s->src: the point inflows
+ * and each edge's mean discharge over the step (the exact integral of its
+ * table, over t1 - t0), spread over the edge's cells, as m/s of depth. */
+static gr_status gr_rain_runoff_sources_update(gr_rain_runoff *s, double t0, double t1) {
+  cl_float4 edge;
+  for (int e = 0; e < 4; ++e) {
+    double rate = 0.0;
+    if (s->edge_n[e] && !s->ring[e] && t1 > t0)
+      rate = gr_rain_runoff_table_integral(s->edge_t[e], s->edge_q[e], s->edge_n[e], t0, t1) /
+             (t1 - t0) / (gr_rain_runoff_edge_cells(s, e) * s->grid.dx * s->grid.dy);
+    edge.s[e] = (cl_float)rate;
+  }
+  cl_int nx = s->nxl, ny = s->nyl, use_pts = s->has_pts;
+  cl_mem pts = s->has_pts ? s->pts : s->dummy;
+  const size_t m = sizeof(cl_mem);
+  const gr_rain_runoff_arg args[] = {
+      {"pts", m, &pts},        {"use_pts", sizeof(use_pts), &use_pts},
+      {"src", m, &s->src},     {"nx", sizeof(nx), &nx},
+      {"ny", sizeof(ny), &ny}, {"edge", sizeof(edge), &edge},
+  };
+  gr_status st = GR_RAIN_RUNOFF_ARGS(s, s->source, args);
+  if (st == GR_OK)
+    st = gr_enqueue_2d(s->ctx, s->source, 0, 0, (size_t)s->nxl, (size_t)s->nyl, NULL);
+  return st;
+}
+
+/* The largest source rate the sources may reach (m/s of depth): the point
+ * inflows' and every edge's largest discharge over its cells. */
+static double gr_rain_runoff_source_max(const gr_rain_runoff *s) {
+  double edge = 0.0;
+  for (int e = 0; e < 4; ++e) {
+    if (!s->edge_n[e] || s->ring[e])
+      continue;
+    double q = 0.0;
+    for (int k = 0; k < s->edge_n[e]; ++k)
+      q = s->edge_q[e][k] > q ? s->edge_q[e][k] : q;
+    q /= gr_rain_runoff_edge_cells(s, e) * s->grid.dx * s->grid.dy;
+    edge += q; /* a corner cell gets two edges' */
+  }
+  return (s->has_pts ? s->pts_max : 0.0) + edge;
+}
+
 /* Binds every step-kernel argument but the alternating face arrays, when
  * something they hold has changed since the last step. */
 static gr_status gr_rain_runoff_bind(gr_rain_runoff *s, cl_float dt) {
@@ -1137,6 +1383,8 @@ static gr_status gr_rain_runoff_bind(gr_rain_runoff *s, cl_float dt) {
     lvl.s[e] = (cl_float)p->boundary_level[e];
   }
   cl_mem rain = s->has_rain ? s->rain : s->dummy, perm = s->has_perm ? s->perm : s->dummy;
+  cl_int use_src = gr_rain_runoff_has_sources(s);
+  cl_mem src = use_src ? s->src : s->dummy;
   cl_float theta = (cl_float)GR_RAIN_RUNOFF_THETA;
   const size_t m = sizeof(cl_mem);
   /* Arguments the three step kernels share (each takes those it has). */
@@ -1144,6 +1392,8 @@ static gr_status gr_rain_runoff_bind(gr_rain_runoff *s, cl_float dt) {
       {"h", m, &s->h},
       {"rain", m, &rain},
       {"perm", m, &perm},
+      {"src", m, &src},
+      {"use_src", sizeof(use_src), &use_src},
       {"limit", m, &s->k},
       {"nx", sizeof(nx), &nx},
       {"ny", sizeof(ny), &ny},
@@ -1185,6 +1435,8 @@ static gr_status gr_rain_runoff_bind(gr_rain_runoff *s, cl_float dt) {
         {"b", m, &s->b},
         {"rain", m, &rain},
         {"perm", m, &perm},
+        {"src", m, &src},
+        {"use_src", sizeof(use_src), &use_src},
         {"infiltrated", m, &s->inf},
         {"infiltrated_comp", m, &s->inf_c},
         {"outflow", m, &s->out},
@@ -1239,7 +1491,10 @@ static gr_status gr_rain_runoff_enqueue(gr_rain_runoff *s, double dt, int nsteps
   /* The end time of each step, summed as s->time is below (the flood maps'
    * arrival times). */
   double t_end = s->time;
+  int per_step = gr_rain_runoff_has_edge_inflow(s);
   while (sw && st == GR_OK && done < nsteps && !*stop) {
+    if (per_step)
+      st = gr_rain_runoff_sources_update(s, t_end, t_end + dt);
     /* Heun's two stages. */
     for (int stage = 0; st == GR_OK && stage < 2; ++stage)
       st = gr_enqueue_2d(s->ctx, s->sw_stage[stage], 0, 0, (size_t)s->nxl, (size_t)s->nyl, NULL);
@@ -1261,7 +1516,10 @@ static gr_status gr_rain_runoff_enqueue(gr_rain_runoff *s, double dt, int nsteps
         {"qy", m, &s->qy[now]},
     };
     const gr_rain_runoff_arg faces[] = {{"qx", m, &s->qx[now]}, {"qy", m, &s->qy[now]}};
-    st = GR_RAIN_RUNOFF_ARGS(s, s->flux, flux);
+    if (per_step)
+      st = gr_rain_runoff_sources_update(s, t_end, t_end + dt);
+    if (st == GR_OK)
+      st = GR_RAIN_RUNOFF_ARGS(s, s->flux, flux);
     if (st == GR_OK)
       st = GR_RAIN_RUNOFF_ARGS(s, s->limit, faces);
     if (st == GR_OK)
@@ -1355,7 +1613,9 @@ static gr_status gr_rain_runoff_sw_stable_dt(gr_rain_runoff *s, double *dt) {
   };
   /* The deepest cell, the fastest rate, the heaviest rain (m/s), the
    * steepest bed (slope_rate). */
-  double maxes[4] = {0.0, 0.0, s->has_rain ? s->rain_field_max : s->params.rain_rate,
+  double maxes[4] = {0.0, 0.0,
+                     (s->has_rain ? s->rain_field_max : s->params.rain_rate) +
+                         gr_rain_runoff_source_max(s),
                      s->slope_rate};
   gr_status st = GR_RAIN_RUNOFF_ARGS(s, s->sw_speed, args);
   if (st == GR_OK)

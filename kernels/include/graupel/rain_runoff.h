@@ -209,7 +209,7 @@ typedef struct gr_rain_runoff_ledger {
   double rain_volume;        /**< rain that fell on the grid */
   double infiltrated_volume; /**< water that went into the ground */
   double outflow_volume;     /**< water that left through the boundary */
-  double inflow_volume;      /**< water that came in through the boundary */
+  double inflow_volume;      /**< water that came in: level edges, inflows (see "Inflows") */
   double stored_volume;      /**< water on the grid now */
   /** initial + rain + inflow - infiltrated - outflow - stored: float rounding only */
   double balance_error;
@@ -287,6 +287,46 @@ GR_API gr_status gr_rain_runoff_get_field(gr_rain_runoff *s, gr_field f, float *
  * a large grid. A cell outside the grid is refused with a sentence.
  */
 GR_API gr_status gr_rain_runoff_sample(gr_rain_runoff *s, const int *ij, int n, float *values);
+
+/**
+ * @name Inflows
+ *
+ * Water let in as sources (m/s of depth added to cells, like rain, before
+ * infiltration and flow), counted as the ledger's inflow_volume: per cell
+ * the very float the depth gained, in a Kahan sum, so the ledger closes to
+ * float rounding. Both are inputs, not state: a checkpoint does not hold
+ * them, and reset keeps them. The stable step (shallow water) counts them
+ * as rain.
+ * @{
+ */
+
+/**
+ * Point inflows (a river, a culvert): n sources at the domain's cells
+ * ij[2k], ij[2k+1] (the whole domain's indices, also for a piece, which
+ * keeps those in its local array, ring included), discharge[k] m^3/s each
+ * (0 to 1e6), constant in time. Sources in one cell add up (in double, in
+ * the order given). They replace the previous ones; n = 0 removes them. A
+ * refused list (a sentence names the source and its value) leaves the
+ * sources as they were.
+ */
+GR_API gr_status gr_rain_runoff_set_point_inflows(gr_rain_runoff *s, const int *ij,
+                                                  const double *discharge, int n);
+
+/**
+ * An inflow hydrograph along the domain edge `side` (a gr_rain_runoff_side):
+ * n rows of times[k] (s, finite, strictly increasing) and discharge[k]
+ * (m^3/s, 0 to 1e6), linear in between, the first discharge before the
+ * first time and the last after the last time. Each step of [t, t + dt]
+ * takes the table's exact mean over the step (its integral over dt) and
+ * spreads it evenly over the edge's cells (Q / (n_edge dx dy) per cell, m/s
+ * of depth, n_edge the whole domain's cells along the edge), whatever the
+ * edge's kind; a piece applies the edges it shares with the domain. n = 0
+ * removes it. A refused table (times not increasing, a negative discharge:
+ * a sentence names the row) leaves the edge's hydrograph as it was.
+ */
+GR_API gr_status gr_rain_runoff_set_edge_inflow(gr_rain_runoff *s, int side, const double *times,
+                                                const double *discharge, int n);
+/** @} */
 
 /** The ledger now (waits; reduces the volumes on the device). */
 GR_API gr_status gr_rain_runoff_ledger_get(gr_rain_runoff *s, gr_rain_runoff_ledger *out);
