@@ -150,6 +150,24 @@ void vtkRainRunoffFilter::RemoveAllInflow(int side) {
   }
 }
 
+void vtkRainRunoffFilter::AddHyetograph(double time, double rate) {
+  this->HyetographTimes.push_back(time);
+  this->HyetographRates.push_back(rate);
+  this->Modified();
+}
+
+void vtkRainRunoffFilter::RemoveAllHyetograph() {
+  if (!this->HyetographTimes.empty()) {
+    this->HyetographTimes.clear();
+    this->HyetographRates.clear();
+    this->Modified();
+  }
+}
+
+int vtkRainRunoffFilter::GetNumberOfHyetographRows() {
+  return static_cast<int>(this->HyetographTimes.size());
+}
+
 int vtkRainRunoffFilter::GetNumberOfInflowRows(int side) {
   return side >= 0 && side < 4 ? static_cast<int>(this->InflowTimes[side].size()) : 0;
 }
@@ -277,14 +295,23 @@ int vtkRainRunoffFilter::SetUpState(vtkInformationVector **inputVector) {
   if (vtkDataArray *rain = pd->GetArray("rain_rate")) {
     uploads.push_back({GR_FIELD_RAIN_RATE, AsFloat(rain), "Input"});
   }
+  // The Manning map: the terrain's manning_n, or the PermeabilityMap's.
+  vtkDataArray *manning = pd->GetArray("manning_n");
+  const char *manningWhere = "Input";
   if (map) {
     int mdims[3];
     map->GetDimensions(mdims);
     vtkDataArray *k = map->GetPointData()->GetArray("permeability");
-    if (!k) {
-      vtkErrorMacro("Rain Runoff's PermeabilityMap has no point array 'permeability' (m/s); "
-                    "name the map's array so, or disconnect the map to use Permeability.");
+    vtkDataArray *mn = map->GetPointData()->GetArray("manning_n");
+    if (!k && !mn) {
+      vtkErrorMacro("Rain Runoff's PermeabilityMap has no point array 'permeability' (m/s) or "
+                    "'manning_n' (s/m^(1/3)); name the map's array so, or disconnect the map to "
+                    "use Permeability and ManningN.");
       return 0;
+    }
+    if (mn) {
+      manning = mn;
+      manningWhere = "PermeabilityMap";
     }
     if (mdims[0] != dims[0] || mdims[1] != dims[1] || mdims[2] != dims[2]) {
       vtkErrorMacro("Rain Runoff's PermeabilityMap has "
@@ -293,7 +320,9 @@ int vtkRainRunoffFilter::SetUpState(vtkInformationVector **inputVector) {
                     << dims[2] << "; resample the map onto the terrain's grid.");
       return 0;
     }
-    uploads.push_back({GR_FIELD_PERMEABILITY, AsFloat(k), "PermeabilityMap"});
+    if (k) {
+      uploads.push_back({GR_FIELD_PERMEABILITY, AsFloat(k), "PermeabilityMap"});
+    }
   }
   const size_t npoints = static_cast<size_t>(dims[0]) * static_cast<size_t>(dims[1]);
   char msg[512];
@@ -376,6 +405,36 @@ int vtkRainRunoffFilter::SetUpState(vtkInformationVector **inputVector) {
     if (st != GR_OK) {
       return this->ReportFailure(st, "Rain Runoff could not upload its inputs",
                                  gr_rain_runoff_last_error(this->Simulation));
+    }
+  }
+  // The Manning map, in double (n^2 then rounds as ManningN's does).
+  if (manning) {
+    if (manning->GetNumberOfComponents() != 1 ||
+        static_cast<size_t>(manning->GetNumberOfTuples()) != npoints) {
+      vtkErrorMacro("Rain Runoff's " << manningWhere
+                                     << " array 'manning_n' must have one value per point.");
+      return 0;
+    }
+    std::vector<double> n(npoints);
+    for (size_t c = 0; c < npoints; ++c) {
+      n[c] = manning->GetComponent(static_cast<vtkIdType>(c), 0);
+    }
+    if (gr_rain_runoff_set_manning_map(this->Simulation, n.data()) != GR_OK) {
+      vtkErrorMacro("Rain Runoff's " << manningWhere << ": "
+                                     << gr_rain_runoff_last_error(this->Simulation));
+      return 0;
+    }
+  }
+  // The hyetograph, in m/s.
+  if (!this->HyetographTimes.empty()) {
+    std::vector<double> rates(this->HyetographRates);
+    for (double &r : rates) {
+      r *= MillimetresPerHour;
+    }
+    if (gr_rain_runoff_set_hyetograph(this->Simulation, this->HyetographTimes.data(), rates.data(),
+                                      static_cast<int>(this->HyetographTimes.size())) != GR_OK) {
+      vtkErrorMacro("Rain Runoff's Hyetograph: " << gr_rain_runoff_last_error(this->Simulation));
+      return 0;
     }
   }
   // The inflows: each edge's hydrograph, and the points with a discharge.

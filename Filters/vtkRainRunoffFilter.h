@@ -206,6 +206,20 @@ public:
   int GetNumberOfInflowRows(int side);
   ///@}
 
+  ///@{
+  /**
+   * The hyetograph: rain over time, rows of (time s, rain rate mm/h), linear
+   * in between, the first rate before the first time and the last after the
+   * last; while it has rows it rains in place of RainRate (a rain_rate array
+   * on the Input still wins). Times must increase from row to row and rates
+   * lie within RainRate's range, or the next update is refused with a
+   * sentence naming the row.
+   */
+  void AddHyetograph(double time, double rate);
+  void RemoveAllHyetograph();
+  int GetNumberOfHyetographRows();
+  ///@}
+
 protected:
   vtkRainRunoffFilter();
   ~vtkRainRunoffFilter() override;
@@ -266,6 +280,8 @@ private:
   gr_rain_runoff *Simulation = nullptr;
   /** Per edge (west, east, south, north) the hydrograph's times and discharges. */
   std::vector<double> InflowTimes[4], InflowDischarges[4];
+  /** The hyetograph's times (s) and rain rates (mm/h). */
+  std::vector<double> HyetographTimes, HyetographRates;
   /** The ledger's volumes at each output time passed: time, rain, infiltrated,
    *  outflow, stored, balance error, inflow. */
   std::vector<std::array<double, 7>> Ledgers;

@@ -535,6 +535,59 @@ for xy, q, name, text in (
     T.check(d is None and len(errs.messages) == 1 and text in errs.text(),
             "bad point inflows refused with one sentence: %r" % errs.text()[:200])
 
+# The hyetograph rains its table's integral; a manning_n array of ManningN
+# everywhere (in double) is the uniform run bit for bit; bad ones are refused.
+hy = rain(np.zeros((NY, NX)), RainRate=5.0, Boundary=1, EndTime=60.0, OutputInterval=20.0)
+for row in ((0.0, 0.0), (30.0, 72.0), (50.0, 0.0)):
+    hy.AddHyetograph(*row)
+d, out = at(hy, 60.0)
+area = NX * NY * DX * DX
+expect = 0.5 * 50.0 * 72.0 * MM_PER_H * area
+h = hydrograph(hy)
+T.check(hy.GetNumberOfHyetographRows() == 3 and d is not None
+        and abs(field(out, "rain_volume") - expect) <= 1e-6 * expect
+        and abs(float(np.sum(h["rain_rate"][1:] * np.diff(h["time"]))) - expect) <= 1e-6 * expect
+        and np.allclose(d, expect / area, rtol=1e-5),
+        "the hyetograph rains its integral: %.9g m^3 (expected %.9g), every point %.6g m deep"
+        % (field(out, "rain_volume") if d is not None else -1, expect, expect / area))
+g = rain(bowl)
+for row in ((0.0, 10.0), (20.0, 5.0), (20.0, 1.0)):
+    g.AddHyetograph(*row)
+errs = T.ErrorCatcher(g)
+d, out = at(g, 10.0)
+T.check(d is None and len(errs.messages) == 1 and "Rain Runoff's Hyetograph: The hyetograph's "
+        "times must increase from row to row, but row 2 has 20 s after 20 s" in errs.text(),
+        "a hyetograph with a repeated time refused with one sentence: %r" % errs.text()[:200])
+
+
+def with_manning(terrain, n):
+    img = image({"elevation": terrain})
+    arr = numpy_to_vtk(np.ascontiguousarray(n, dtype=np.float64).reshape(-1), deep=1)
+    arr.SetName("manning_n")
+    img.GetPointData().AddArray(arr)
+    return img
+
+
+runs = []
+for n in (None, np.full((NY, NX), 0.03)):
+    g = vtkRainRunoffFilter()
+    src = image({"elevation": slope + bowl}) if n is None else with_manning(slope + bowl, n)
+    g.SetInputConnection(producer(src).GetOutputPort())
+    g.SetRainRate(80.0)
+    g.SetEndTime(30.0)
+    runs.append(at(g, 30.0)[0])
+T.check(runs[0] is not None and runs[1] is not None and np.array_equal(runs[0], runs[1])
+        and runs[0].max() > 0.0, "a manning_n array of ManningN (0.03) everywhere: the same depths "
+        "bit for bit")
+g = vtkRainRunoffFilter()
+g.SetInputConnection(producer(image({"elevation": bowl})).GetOutputPort())
+g.SetPermeabilityMapConnection(producer(with_manning(bowl, np.full((NY, NX), 2.0))).GetOutputPort())
+errs = T.ErrorCatcher(g)
+d, out = at(g, 10.0)
+T.check(d is None and len(errs.messages) == 1 and "Rain Runoff's PermeabilityMap: The Manning map "
+        "has the value 2 s/m^(1/3) at cell (0, 0)" in errs.text(),
+        "a manning_n of 2 on the PermeabilityMap refused with one sentence: %r" % errs.text()[:200])
+
 # Gauges: three columns each in the hydrograph, the output's values at the
 # nearest terrain point at every output time, whatever the request order.
 def gauge_points(xy):

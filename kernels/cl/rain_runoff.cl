@@ -57,6 +57,14 @@ GR_INLINE float gr_rain_runoff_infiltration(float h, float r, float s, float k, 
   return fmin(k * dt, h1);
 }
 
+/* The friction's n^2 at a face between cells a and b: the uniform n2, or
+ * with a Manning map (use_n2) the mean of the two cells' n^2 (the same
+ * float whichever side computes it; n2 itself where both are n2). */
+GR_INLINE float gr_rain_runoff_face_n2(__global const float *restrict n2map, int use_n2, float n2,
+                                       int a, int b) {
+  return use_n2 ? 0.5f * (n2map[a] + n2map[b]) : n2;
+}
+
 /* A cell's source rate (m/s of depth): the source field's, 0 without one. */
 #define GR_RAIN_RUNOFF_SRC(c) gr_rain_runoff_input(src, use_src, 0.0f, (c))
 
@@ -161,16 +169,14 @@ GR_INLINE float gr_rain_runoff_edge_q(int kind, float q, bool low) {
  * (clamped indices became gathers, three times slower). A masked limiter
  * reads as 1 and a masked depth as 0: where that happens, the value is not
  * used (an edge face's discharge only ever leaves its edge cell). */
-__kernel void rain_runoff_flux(__global const float *restrict h, __global const float *restrict b,
-                               __global const float *restrict rain,
-                               __global const float *restrict perm,
-                               __global const float *restrict src, int use_src,
-                               __global const float *restrict qx_old,
-                               __global const float *restrict qy_old, __global float *restrict qx,
-                               __global float *restrict qy, __global const float *restrict limit,
-                               int nx, int ny, float dt, float inv_dx, float inv_dy, float g,
-                               float n2, float theta, int use_rain, float rain_uniform,
-                               int use_perm, float perm_uniform, int4 bnd, float4 lvl) {
+__kernel void rain_runoff_flux(
+    __global const float *restrict h, __global const float *restrict b,
+    __global const float *restrict rain, __global const float *restrict perm,
+    __global const float *restrict src, int use_src, __global const float *restrict qx_old,
+    __global const float *restrict qy_old, __global float *restrict qx, __global float *restrict qy,
+    __global const float *restrict limit, int nx, int ny, float dt, float inv_dx, float inv_dy,
+    float g, float n2, __global const float *restrict n2map, int use_n2, float theta, int use_rain,
+    float rain_uniform, int use_perm, float perm_uniform, int4 bnd, float4 lvl) {
   int i = get_global_id(0), j = get_global_id(1);
   if (!gr_inside(i, j, nx + 1, ny + 1))
     return;
@@ -205,7 +211,9 @@ __kernel void rain_runoff_flux(__global const float *restrict h, __global const 
     float after =
         i < nx ? gr_rain_runoff_limited(qx_old[f + 1], kc, i < nx - 1 ? limit[c + 1] : 1.0f) : 0.0f;
     float prev = gr_rain_runoff_smooth(own, before, after, theta, i == 0 || i == nx);
-    float q = gr_rain_runoff_face(hL, hR, bL, bR, prev, own, dt, g, n2, inv_dx);
+    /* An edge face takes its one cell's roughness. */
+    float n2f = gr_rain_runoff_face_n2(n2map, use_n2, n2, in_w ? w : c, i < nx ? c : w);
+    float q = gr_rain_runoff_face(hL, hR, bL, bR, prev, own, dt, g, n2f, inv_dx);
     q = i == 0 ? gr_rain_runoff_edge_q(bnd.x, q, true) : q;
     q = i == nx ? gr_rain_runoff_edge_q(bnd.y, q, false) : q;
     qx[f] = q;
@@ -233,7 +241,8 @@ __kernel void rain_runoff_flux(__global const float *restrict h, __global const 
         j < ny ? gr_rain_runoff_limited(qy_old[f + nx], kc, j < ny - 1 ? limit[c + nx] : 1.0f)
                : 0.0f;
     float prev = gr_rain_runoff_smooth(own, before, after, theta, j == 0 || j == ny);
-    float q = gr_rain_runoff_face(hL, hR, bL, bR, prev, own, dt, g, n2, inv_dy);
+    float n2f = gr_rain_runoff_face_n2(n2map, use_n2, n2, in_s ? s : c, j < ny ? c : s);
+    float q = gr_rain_runoff_face(hL, hR, bL, bR, prev, own, dt, g, n2f, inv_dy);
     q = j == 0 ? gr_rain_runoff_edge_q(bnd.z, q, true) : q;
     q = j == ny ? gr_rain_runoff_edge_q(bnd.w, q, false) : q;
     qy[f] = q;
@@ -759,13 +768,15 @@ gr_sw_stage(__global float *restrict h, __global float *restrict qu, __global fl
             __global float *restrict infiltrated_comp, __global float *restrict outflow,
             __global float *restrict outflow_comp, __global float *restrict inflow,
             __global float *restrict inflow_comp, int nx, int ny, float dt, float inv_dx,
-            float inv_dy, float g, float n2, int use_rain, float rain_uniform, int use_perm,
-            float perm_uniform, int4 bnd, float4 lvl, __global const float *restrict sh,
-            __global const float *restrict su, __global const float *restrict sv, const int stage) {
+            float inv_dy, float g, float n2, __global const float *restrict n2map, int use_n2,
+            int use_rain, float rain_uniform, int use_perm, float perm_uniform, int4 bnd,
+            float4 lvl, __global const float *restrict sh, __global const float *restrict su,
+            __global const float *restrict sv, const int stage) {
   int i = get_global_id(0), j = get_global_id(1);
   if (!gr_inside(i, j, nx, ny))
     return;
   int c = gr_idx(i, j, nx);
+  float n2c = use_n2 ? n2map[c] : n2; /* the cell's own roughness, n^2 */
   /* The cross of 5 + 5 cells around (i, j); x2 and y2 are the cell itself.
    * Cells beyond the array are masked to dry, flat and still, and never
    * used (the reconstruction's slopes and the edge faces do without them);
@@ -803,7 +814,7 @@ gr_sw_stage(__global float *restrict h, __global float *restrict qu, __global fl
     /* Friction in each stage: without it a film on a steep slope would
      * gather g S dt of speed in the first stage and empty its cell in the
      * second. */
-    gr_sw_friction(hn, dt, g, n2, &qun, &qvn);
+    gr_sw_friction(hn, dt, g, n2c, &qun, &qvn);
     h1[c] = fmax(hn, 0.0f);
     dh1[c] = dh;
     qu1[c] = hn > 0.0f ? qun : 0.0f;
@@ -822,7 +833,7 @@ gr_sw_stage(__global float *restrict h, __global float *restrict qu, __global fl
     float y = delta - h_comp[c];
     float hf = h0 + y;
     float comp = (hf - h0) - y;
-    gr_sw_friction(hn, dt, g, n2, &qun, &qvn);
+    gr_sw_friction(hn, dt, g, n2c, &qun, &qvn);
     float qx = 0.5f * (gr_sw_wet_q(h0, qu[c], r, sc, dt, hw) + qun);
     float qy = 0.5f * (gr_sw_wet_q(h0, qv[c], r, sc, dt, hw) + qvn);
     h[c] = fmax(hf, 0.0f);
@@ -852,12 +863,13 @@ gr_sw_stage(__global float *restrict h, __global float *restrict qu, __global fl
       __global float *restrict infiltrated, __global float *restrict infiltrated_comp,             \
       __global float *restrict outflow, __global float *restrict outflow_comp,                     \
       __global float *restrict inflow, __global float *restrict inflow_comp, int nx, int ny,       \
-      float dt, float inv_dx, float inv_dy, float g, float n2, int use_rain, float rain_uniform,   \
+      float dt, float inv_dx, float inv_dy, float g, float n2,                                     \
+      __global const float *restrict n2map, int use_n2, int use_rain, float rain_uniform,          \
       int use_perm, float perm_uniform, int4 bnd, float4 lvl
 #define GR_SW_STAGE_PASS                                                                           \
   h, qu, qv, h_comp, h1, qu1, qv1, dh1, b, rain, perm, src, use_src, infiltrated,                  \
       infiltrated_comp, outflow, outflow_comp, inflow, inflow_comp, nx, ny, dt, inv_dx, inv_dy, g, \
-      n2, use_rain, rain_uniform, use_perm, perm_uniform, bnd, lvl
+      n2, n2map, use_n2, use_rain, rain_uniform, use_perm, perm_uniform, bnd, lvl
 
 __kernel void rain_runoff_sw_stage1(GR_SW_STAGE_ARGS) {
   gr_sw_stage(GR_SW_STAGE_PASS, h, qu, qv, 1);

@@ -113,6 +113,13 @@ struct gr_rain_runoff {
    * time (s) and discharge (m^3/s); n 0 where there is none. */
   int edge_n[4];
   double *edge_t[4], *edge_q[4];
+  /* The Manning map as n^2 per cell (once set; has_n2), and its smallest n. */
+  cl_mem n2map;
+  int has_n2;
+  double n_min;
+  /* The hyetograph: hy_n rows of time (s) and rain rate (m/s); 0: none. */
+  int hy_n;
+  double *hy_t, *hy_r;
   cl_mem qu, qv, h1, qu1, qv1, dh1; /* shallow water: discharges and Heun's stage */
   cl_mem qu0, qv0;                  /* initial discharges, once VELOCITY was set */
   cl_mem qx[2], qy[2];              /* discharges; [cur] is the latest, the other the next */
@@ -710,7 +717,7 @@ void gr_rain_runoff_destroy(gr_rain_runoff *s) {
                     &s->qy[1], &s->k,    &s->inf,  &s->inf_c,   &s->out,   &s->out_c,
                     &s->h0,    &s->rain, &s->perm, &s->scratch, &s->dummy, &s->qu,
                     &s->qv,    &s->h1,   &s->qu1,  &s->qv1,     &s->qu0,   &s->qv0,
-                    &s->dh1,   &s->in,   &s->in_c, &s->pts,     &s->src};
+                    &s->dh1,   &s->in,   &s->in_c, &s->pts,     &s->src,   &s->n2map};
   for (size_t i = 0; i < sizeof(bufs) / sizeof(bufs[0]); ++i)
     gr_buffer_release(bufs[i]);
   for (int a = 0; a < GR_RAIN_RUNOFF_MAP_ARRAYS; ++a)
@@ -721,6 +728,8 @@ void gr_rain_runoff_destroy(gr_rain_runoff *s) {
     free(s->edge_t[e]);
     free(s->edge_q[e]);
   }
+  free(s->hy_t);
+  free(s->hy_r);
   gr_context_release(s->ctx);
   free(s);
 }
@@ -732,6 +741,13 @@ gr_status gr_rain_runoff_set_params(gr_rain_runoff *s, const gr_rain_runoff_para
                         "gr_rain_runoff_set_params needs a simulation.");
   if (gr_rain_runoff_params_validate(p, msg, sizeof(msg)) != GR_OK)
     return GR_RAIN_RUNOFF_KEEP_ERROR(s, gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT, "%s", msg));
+  if (p->flow_model == GR_FLOW_LOCAL_INERTIAL && s->has_n2 && s->n_min < GR_RAIN_RUNOFF_LI_MIN_N)
+    return GR_RAIN_RUNOFF_KEEP_ERROR(
+        s, gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
+                        "The Manning map's smallest n is %g s/m^(1/3), below the %g that FlowModel "
+                        "1 (local inertial) needs; raise the map's values, or keep FlowModel 0 "
+                        "(shallow water).",
+                        s->n_min, GR_RAIN_RUNOFF_LI_MIN_N));
   if (p->flow_model != s->params.flow_model) {
     /* The models keep their discharges in different places: the water
      * stays and starts from rest. A piece's ring width is its model's. */
@@ -1073,6 +1089,105 @@ gr_status gr_rain_runoff_set_edge_inflow(gr_rain_runoff *s, int side, const doub
       s, gr_rain_runoff_set_edge_inflow_impl(s, side, times, discharge, n));
 }
 
+/* ------------------------------------------------ rain and roughness maps */
+
+static gr_status gr_rain_runoff_set_manning_map_impl(gr_rain_runoff *s, const double *n) {
+  size_t cells = gr_rain_runoff_cells(s);
+  if (!n) {
+    s->has_n2 = 0;
+    s->args_set = 0;
+    return GR_OK;
+  }
+  const gr_param_bound *row = &gr_rain_runoff_bounds[GR_RAIN_RUNOFF_P_MANNING_N];
+  int li = s->params.flow_model == GR_FLOW_LOCAL_INERTIAL;
+  double lo = li ? GR_RAIN_RUNOFF_LI_MIN_N : row->min, low = HUGE_VAL;
+  for (size_t c = 0; c < cells; ++c) {
+    if (!(n[c] >= lo && n[c] <= row->max))
+      return gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
+                          "The Manning map has the value %g s/m^(1/3) at cell (%zu, %zu): values "
+                          "must lie between %g and %g%s, like ManningN; correct the map.",
+                          n[c], c % (size_t)s->nxl, c / (size_t)s->nxl, lo, row->max,
+                          li ? " for FlowModel 1 (local inertial)" : "");
+    low = n[c] < low ? n[c] : low;
+  }
+  float *n2 = malloc(cells * sizeof(float));
+  if (!n2)
+    return gr_set_error(s->ctx, GR_ERR_OUT_OF_MEMORY, "Out of host memory.");
+  /* n^2 as the uniform ManningN's: in double, then one float (the same
+   * float for the same n, so a map of ManningN everywhere is that run). */
+  for (size_t c = 0; c < cells; ++c)
+    n2[c] = (float)(n[c] * n[c]);
+  gr_status st = gr_rain_runoff_upload(s, &s->n2map, n2);
+  free(n2);
+  if (st != GR_OK)
+    return st;
+  s->has_n2 = 1;
+  s->n_min = low;
+  s->args_set = 0;
+  return GR_OK;
+}
+
+gr_status gr_rain_runoff_set_manning_map(gr_rain_runoff *s, const double *n) {
+  if (!s)
+    return gr_set_error(NULL, GR_ERR_INVALID_ARGUMENT,
+                        "gr_rain_runoff_set_manning_map needs a simulation.");
+  return GR_RAIN_RUNOFF_KEEP_ERROR(s, gr_rain_runoff_set_manning_map_impl(s, n));
+}
+
+static gr_status gr_rain_runoff_set_hyetograph_impl(gr_rain_runoff *s, const double *t,
+                                                    const double *r, int n) {
+  const gr_param_bound *row = &gr_rain_runoff_bounds[GR_RAIN_RUNOFF_P_RAIN_RATE];
+  const double hi = gr_rain_runoff_core_max(GR_RAIN_RUNOFF_P_RAIN_RATE);
+  if (n < 0 || n > GR_RAIN_RUNOFF_MAX_ROWS || (n > 0 && (!t || !r)))
+    return gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
+                        "The hyetograph must have 0 to %d rows of time and rain rate (got %d%s).",
+                        GR_RAIN_RUNOFF_MAX_ROWS, n, n > 0 && (!t || !r) ? " and no values" : "");
+  for (int k = 0; k < n; ++k) {
+    if (!(t[k] >= -1e12 && t[k] <= 1e12))
+      return gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
+                          "The hyetograph has the time %g s in row %d: times must be finite "
+                          "numbers of seconds; correct that row.",
+                          t[k], k);
+    if (k > 0 && !(t[k] > t[k - 1]))
+      return gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
+                          "The hyetograph's times must increase from row to row, but row %d has "
+                          "%g s after %g s; sort the rows and drop repeated times.",
+                          k, t[k], t[k - 1]);
+    if (!(r[k] >= 0.0 && r[k] <= hi))
+      return gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
+                          "The hyetograph has the rain rate %g %s in row %d: rates must lie "
+                          "between %g and %g %s, like RainRate; correct that row.",
+                          r[k] / row->to_core, row->unit, k, row->min, row->max, row->unit);
+  }
+  double *nt = NULL, *nr = NULL;
+  if (n > 0) {
+    nt = malloc((size_t)n * sizeof(double));
+    nr = malloc((size_t)n * sizeof(double));
+    if (!nt || !nr) {
+      free(nt);
+      free(nr);
+      return gr_set_error(s->ctx, GR_ERR_OUT_OF_MEMORY, "Out of host memory.");
+    }
+    memcpy(nt, t, (size_t)n * sizeof(double));
+    memcpy(nr, r, (size_t)n * sizeof(double));
+  }
+  free(s->hy_t);
+  free(s->hy_r);
+  s->hy_t = nt;
+  s->hy_r = nr;
+  s->hy_n = n;
+  s->args_set = 0; /* RainRate again at the next bind when it is removed */
+  return GR_OK;
+}
+
+gr_status gr_rain_runoff_set_hyetograph(gr_rain_runoff *s, const double *times, const double *rates,
+                                        int n) {
+  if (!s)
+    return gr_set_error(NULL, GR_ERR_INVALID_ARGUMENT,
+                        "gr_rain_runoff_set_hyetograph needs a simulation.");
+  return GR_RAIN_RUNOFF_KEEP_ERROR(s, gr_rain_runoff_set_hyetograph_impl(s, times, rates, n));
+}
+
 /* ------------------------------------------------------ pieces and halos */
 
 void gr_rain_runoff_set_allreduce(gr_rain_runoff *s, gr_allreduce_fn fn, void *user) {
@@ -1359,6 +1474,36 @@ static double gr_rain_runoff_source_max(const gr_rain_runoff *s) {
   return (s->has_pts ? s->pts_max : 0.0) + edge;
 }
 
+/* The hyetograph's rain for the step [t0, t1]: the table's exact mean over
+ * it, as the float the kernels take in place of RainRate (a rain_rate field
+ * still wins); *sum adds that float for the ledger. */
+static gr_status gr_rain_runoff_hyetograph_step(gr_rain_runoff *s, double t0, double t1,
+                                                double *sum) {
+  cl_float rf =
+      (cl_float)(gr_rain_runoff_table_integral(s->hy_t, s->hy_r, s->hy_n, t0, t1) / (t1 - t0));
+  int sw = s->params.flow_model == GR_FLOW_SHALLOW_WATER;
+  cl_kernel li[3] = {s->flux, s->limit, s->update}, swk[2] = {s->sw_stage[0], s->sw_stage[1]};
+  gr_status st = GR_OK;
+  for (int k = 0; st == GR_OK && k < (sw ? 2 : 3); ++k)
+    st = gr_kernel_arg(s->ctx, sw ? swk[k] : li[k], "rain_uniform", sizeof(rf), &rf);
+  if (st == GR_OK)
+    *sum += (double)rf;
+  return st;
+}
+
+/* The largest uniform rain rate (m/s): the hyetograph's, or RainRate. */
+static double gr_rain_runoff_rain_max(const gr_rain_runoff *s) {
+  double top = s->hy_n ? 0.0 : s->params.rain_rate;
+  for (int k = 0; k < s->hy_n; ++k)
+    top = s->hy_r[k] > top ? s->hy_r[k] : top;
+  return top;
+}
+
+/* The smallest Manning n the friction takes: the map's, or ManningN. */
+static double gr_rain_runoff_min_n(const gr_rain_runoff *s) {
+  return s->has_n2 ? s->n_min : s->params.manning_n;
+}
+
 /* Binds every step-kernel argument but the alternating face arrays, when
  * something they hold has changed since the last step. */
 static gr_status gr_rain_runoff_bind(gr_rain_runoff *s, cl_float dt) {
@@ -1385,6 +1530,8 @@ static gr_status gr_rain_runoff_bind(gr_rain_runoff *s, cl_float dt) {
   cl_mem rain = s->has_rain ? s->rain : s->dummy, perm = s->has_perm ? s->perm : s->dummy;
   cl_int use_src = gr_rain_runoff_has_sources(s);
   cl_mem src = use_src ? s->src : s->dummy;
+  cl_int use_n2 = s->has_n2;
+  cl_mem n2map = use_n2 ? s->n2map : s->dummy;
   cl_float theta = (cl_float)GR_RAIN_RUNOFF_THETA;
   const size_t m = sizeof(cl_mem);
   /* Arguments the three step kernels share (each takes those it has). */
@@ -1409,6 +1556,8 @@ static gr_status gr_rain_runoff_bind(gr_rain_runoff *s, cl_float dt) {
       {"b", m, &s->b},
       {"g", sizeof(g), &g},
       {"n2", sizeof(n2), &n2},
+      {"n2map", m, &n2map},
+      {"use_n2", sizeof(use_n2), &use_n2},
       {"theta", sizeof(theta), &theta},
       {"bnd", sizeof(bnd), &bnd},
       {"lvl", sizeof(lvl), &lvl},
@@ -1448,6 +1597,8 @@ static gr_status gr_rain_runoff_bind(gr_rain_runoff *s, cl_float dt) {
         {"inv_dy", sizeof(inv_dy), &inv_dy},
         {"g", sizeof(g), &g},
         {"n2", sizeof(n2), &n2},
+        {"n2map", m, &n2map},
+        {"use_n2", sizeof(use_n2), &use_n2},
         {"use_rain", sizeof(use_rain), &use_rain},
         {"rain_uniform", sizeof(rain_uniform), &rain_uniform},
         {"use_perm", sizeof(use_perm), &use_perm},
@@ -1492,9 +1643,12 @@ static gr_status gr_rain_runoff_enqueue(gr_rain_runoff *s, double dt, int nsteps
    * arrival times). */
   double t_end = s->time;
   int per_step = gr_rain_runoff_has_edge_inflow(s);
+  double rate_sum = 0.0; /* the hyetograph's rates the steps took (m/s, floats) */
   while (sw && st == GR_OK && done < nsteps && !*stop) {
     if (per_step)
       st = gr_rain_runoff_sources_update(s, t_end, t_end + dt);
+    if (st == GR_OK && s->hy_n)
+      st = gr_rain_runoff_hyetograph_step(s, t_end, t_end + dt, &rate_sum);
     /* Heun's two stages. */
     for (int stage = 0; st == GR_OK && stage < 2; ++stage)
       st = gr_enqueue_2d(s->ctx, s->sw_stage[stage], 0, 0, (size_t)s->nxl, (size_t)s->nyl, NULL);
@@ -1518,6 +1672,8 @@ static gr_status gr_rain_runoff_enqueue(gr_rain_runoff *s, double dt, int nsteps
     const gr_rain_runoff_arg faces[] = {{"qx", m, &s->qx[now]}, {"qy", m, &s->qy[now]}};
     if (per_step)
       st = gr_rain_runoff_sources_update(s, t_end, t_end + dt);
+    if (st == GR_OK && s->hy_n)
+      st = gr_rain_runoff_hyetograph_step(s, t_end, t_end + dt, &rate_sum);
     if (st == GR_OK)
       st = GR_RAIN_RUNOFF_ARGS(s, s->flux, flux);
     if (st == GR_OK)
@@ -1546,7 +1702,11 @@ static gr_status gr_rain_runoff_enqueue(gr_rain_runoff *s, double dt, int nsteps
   double rain_sum =
       s->has_rain ? s->rain_field_sum
                   : (double)gr_rain_runoff_own_cells(s) * (double)(cl_float)s->params.rain_rate;
-  s->rain_volume += rain_sum * gd->dx * gd->dy * (double)dtf * (double)done;
+  if (s->hy_n && !s->has_rain) /* each step its own rate, as the device took it */
+    s->rain_volume +=
+        (double)gr_rain_runoff_own_cells(s) * rate_sum * gd->dx * gd->dy * (double)dtf;
+  else
+    s->rain_volume += rain_sum * gd->dx * gd->dy * (double)dtf * (double)done;
   /* Step by step, not dt * done: a piece that steps one step per call (to
    * exchange its halo) then keeps the same time, to the bit, as the whole
    * grid stepping many per call. */
@@ -1614,7 +1774,7 @@ static gr_status gr_rain_runoff_sw_stable_dt(gr_rain_runoff *s, double *dt) {
   /* The deepest cell, the fastest rate, the heaviest rain (m/s), the
    * steepest bed (slope_rate). */
   double maxes[4] = {0.0, 0.0,
-                     (s->has_rain ? s->rain_field_max : s->params.rain_rate) +
+                     (s->has_rain ? s->rain_field_max : gr_rain_runoff_rain_max(s)) +
                          gr_rain_runoff_source_max(s),
                      s->slope_rate};
   gr_status st = GR_RAIN_RUNOFF_ARGS(s, s->sw_speed, args);
@@ -1656,7 +1816,7 @@ static gr_status gr_rain_runoff_sw_stable_dt(gr_rain_runoff *s, double *dt) {
    * shows both: frictionless rain on slopes up to 3, with MaxTimeStep 1 s,
    * emptied cells beyond their water without it.) */
   double accel = maxes[3];
-  if (accel > 0.0 && s->params.manning_n == 0.0 && (maxes[0] > 0.0 || r > 0.0)) {
+  if (accel > 0.0 && gr_rain_runoff_min_n(s) == 0.0 && (maxes[0] > 0.0 || r > 0.0)) {
     double steep = sqrt(0.125 * s->params.cfl / accel);
     stable = steep < stable ? steep : stable;
   }

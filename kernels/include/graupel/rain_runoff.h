@@ -328,6 +328,37 @@ GR_API gr_status gr_rain_runoff_set_edge_inflow(gr_rain_runoff *s, int side, con
                                                 const double *discharge, int n);
 /** @} */
 
+/**
+ * @name Rain over time and roughness by place
+ * @{
+ */
+
+/**
+ * A hyetograph: n rows of times[k] (s, finite, strictly increasing) and
+ * rates[k] (m/s, within RainRate's range), linear in between, the first rate
+ * before the first time and the last after the last time. Each step of [t,
+ * t + dt] rains the table's exact mean over the step, uniformly, in place of
+ * params.rain_rate (a RAIN_RATE field still wins); the ledger's rain is the
+ * sum of those floats times the area and dt. n = 0 removes it (RainRate
+ * again). An input, not state; a refused table leaves the one before.
+ */
+GR_API gr_status gr_rain_runoff_set_hyetograph(gr_rain_runoff *s, const double *times,
+                                               const double *rates, int n);
+
+/**
+ * A Manning roughness map: one n per cell of the local array (nx * ny
+ * doubles, ring included for a piece), s/m^(1/3), within ManningN's range
+ * (0.005 and more for the local inertial model), used in place of
+ * params.manning_n: shallow water takes each cell's n, the local inertial
+ * model a face's mean of its two cells' n^2. n^2 is computed in double and
+ * rounded once, as for the uniform ManningN, so a map of ManningN everywhere
+ * gives that run bit for bit. NULL removes it. A refused map (a sentence
+ * names the cell and the value) leaves the one before; set_params refuses
+ * FlowModel 1 while the map holds an n below 0.005.
+ */
+GR_API gr_status gr_rain_runoff_set_manning_map(gr_rain_runoff *s, const double *n);
+/** @} */
+
 /** The ledger now (waits; reduces the volumes on the device). */
 GR_API gr_status gr_rain_runoff_ledger_get(gr_rain_runoff *s, gr_rain_runoff_ledger *out);
 
