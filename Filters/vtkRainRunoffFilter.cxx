@@ -63,6 +63,7 @@ GRAUPEL_TABLE_SETTER(vtkRainRunoffFilter, LevelWest, double, gr_rain_runoff_para
 GRAUPEL_TABLE_SETTER(vtkRainRunoffFilter, LevelEast, double, gr_rain_runoff_param_bounds)
 GRAUPEL_TABLE_SETTER(vtkRainRunoffFilter, LevelSouth, double, gr_rain_runoff_param_bounds)
 GRAUPEL_TABLE_SETTER(vtkRainRunoffFilter, LevelNorth, double, gr_rain_runoff_param_bounds)
+GRAUPEL_TABLE_SETTER(vtkRainRunoffFilter, NoDataBoundary, int, gr_rain_runoff_param_bounds)
 
 void vtkRainRunoffFilter::SetBoundary(int value) {
   this->SetBoundaryWest(value);
@@ -100,7 +101,8 @@ int vtkRainRunoffFilter::CheckParameters() {
                 {"CourantNumber", this->CourantNumber},
                 {"FlowModel", double(this->FlowModel)},
                 {"WettingDepth", this->WettingDepth},
-                {"DebrisFactor", this->DebrisFactor}};
+                {"DebrisFactor", this->DebrisFactor},
+                {"NoDataBoundary", double(this->NoDataBoundary)}};
   for (const auto &p : values) {
     const gr_param_bound *b = Bound(p.property);
     if (!b) {
@@ -359,6 +361,7 @@ int vtkRainRunoffFilter::SetUpState(vtkInformationVector **inputVector) {
   p.flow_model = this->FlowModel == LOCAL_INERTIAL ? GR_FLOW_LOCAL_INERTIAL : GR_FLOW_SHALLOW_WATER;
   p.wetting_depth = this->WettingDepth;
   p.debris_factor = this->DebrisFactor;
+  p.no_data = this->NoDataBoundary == OPEN ? GR_BOUNDARY_OPEN : GR_BOUNDARY_CLOSED;
   if (gr_rain_runoff_params_validate(&p, msg, sizeof(msg)) != GR_OK) {
     vtkErrorMacro("Rain Runoff: " << msg);
     return 0;
@@ -740,4 +743,5 @@ void vtkRainRunoffFilter::PrintSelf(ostream &os, vtkIndent indent) {
   os << indent << "CourantNumber: " << this->CourantNumber << "\n";
   os << indent << "WettingDepth: " << this->WettingDepth << " m\n";
   os << indent << "DebrisFactor: " << this->DebrisFactor << "\n";
+  os << indent << "NoDataBoundary: " << (this->NoDataBoundary == OPEN ? "outfall" : "wall") << "\n";
 }

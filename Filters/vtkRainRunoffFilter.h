@@ -143,6 +143,13 @@ public:
   ///@}
 
   ///@{
+  /** What no-data points (NaN elevations) are: 1 closed, walls (default); 0
+   *  open, outfalls that water pours into and leaves by. Their outputs are NaN. */
+  virtual void SetNoDataBoundary(int value);
+  vtkGetMacro(NoDataBoundary, int);
+  ///@}
+
+  ///@{
   /** Every edge the same kind (the single Boundary of earlier versions);
    *  GetBoundary: the common kind, or -1 when the edges differ. */
   void SetBoundary(int value);
@@ -252,6 +259,7 @@ protected:
   double LevelEast = 0.0;
   double LevelSouth = 0.0;
   double LevelNorth = 0.0;
+  int NoDataBoundary = CLOSED;
   int FlowModel = SHALLOW_WATER;
   double MaxTimeStep = 1.0;
   double CourantNumber = 0.7;

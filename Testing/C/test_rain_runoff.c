@@ -964,9 +964,16 @@ static void test_errors(void) {
    * first bad value is named. */
   float vals[6] = {0.0f, 1.0f, 2.0f, NAN, -1.0f, 3.0f};
   CHECK(gr_rain_runoff_field_validate(GR_FIELD_ELEVATION, vals, 3, msg, sizeof(msg)) == GR_OK);
+  /* A NaN elevation is a no-data cell; an infinite one is refused. */
+  CHECK(gr_rain_runoff_field_validate(GR_FIELD_ELEVATION, vals, 6, msg, sizeof(msg)) == GR_OK);
+  vals[3] = -INFINITY;
   CHECK(gr_rain_runoff_field_validate(GR_FIELD_ELEVATION, vals, 6, msg, sizeof(msg)) ==
         GR_ERR_INVALID_ARGUMENT);
-  CHECK_MSG(has(msg, "elevation") && has(msg, "index 3") && has(msg, "nan"), "'%s'", msg);
+  CHECK_MSG(has(msg, "elevation") && has(msg, "index 3") && has(msg, "inf"), "'%s'", msg);
+  vals[3] = NAN;
+  CHECK(gr_rain_runoff_field_validate(GR_FIELD_WATER_DEPTH, vals, 6, msg, sizeof(msg)) ==
+        GR_ERR_INVALID_ARGUMENT);
+  CHECK_MSG(has(msg, "water_depth") && has(msg, "index 3") && has(msg, "nan"), "'%s'", msg);
   vals[3] = 0.5f;
   CHECK(gr_rain_runoff_field_validate(GR_FIELD_ELEVATION, vals, 6, msg, sizeof(msg)) == GR_OK);
   CHECK(gr_rain_runoff_field_validate(GR_FIELD_WATER_DEPTH, vals, 6, msg, sizeof(msg)) ==
@@ -1075,9 +1082,9 @@ static void test_errors(void) {
   CHECK_MSG(has(gr_last_error(ctx), "(5, 2)") && has(gr_last_error(ctx), "-0.25") &&
                 has(gr_last_error(ctx), "water_depth"),
             "'%s'", gr_last_error(ctx));
-  host[2 * 12 + 5] = NAN;
+  host[2 * 12 + 5] = INFINITY;
   CHECK(gr_rain_runoff_set_field(s, GR_FIELD_ELEVATION, host) == GR_ERR_INVALID_ARGUMENT);
-  CHECK(has(gr_last_error(ctx), "elevation") && has(gr_last_error(ctx), "nan"));
+  CHECK(has(gr_last_error(ctx), "elevation") && has(gr_last_error(ctx), "inf"));
   host[2 * 12 + 5] = 1e9f; /* finite, but beyond set_field's 1e6 m */
   CHECK(gr_rain_runoff_set_field(s, GR_FIELD_ELEVATION, host) == GR_ERR_INVALID_ARGUMENT);
   host[2 * 12 + 5] = 0.5f;
@@ -1219,6 +1226,8 @@ static void set_param(gr_rain_runoff_params *p, const char *property, double v) 
     p->wetting_depth = v;
   else if (strcmp(property, "DebrisFactor") == 0)
     p->debris_factor = v;
+  else if (strcmp(property, "NoDataBoundary") == 0)
+    p->no_data = (gr_boundary)(int)v;
   else
     CHECK_MSG(0, "the table has an unknown property '%s'", property);
 }
@@ -1238,9 +1247,10 @@ static void test_param_table(void) {
   const char *names[] = {"RainRate",      "Permeability", "ManningN",     "MaxTimeStep",
                          "CourantNumber", "BoundaryWest", "BoundaryEast", "BoundarySouth",
                          "BoundaryNorth", "LevelWest",    "LevelEast",    "LevelSouth",
-                         "LevelNorth",    "FlowModel",    "WettingDepth", "DebrisFactor"};
-  CHECK(t != NULL && n == 16);
-  if (!t || n != 16)
+                         "LevelNorth",    "FlowModel",    "WettingDepth", "DebrisFactor",
+                         "NoDataBoundary"};
+  CHECK(t != NULL && n == 17);
+  if (!t || n != 17)
     return;
   CHECK(gr_rain_runoff_param_bounds(NULL) == t);
   for (int r = 0; r < n; ++r)
@@ -1268,6 +1278,9 @@ static void test_param_table(void) {
     CHECK((double)p.boundary[e] == t[5 + e].default_value &&
           p.boundary_level[e] == t[9 + e].default_value);
   CHECK(p.wetting_depth == t[14].default_value && p.debris_factor == t[15].default_value);
+  /* No-data cells are walls by default (1 closed, 0 an outfall). */
+  CHECK(t[16].integer && t[16].default_value == 1.0 && t[16].max == 1.0 &&
+        (double)p.no_data == t[16].default_value && p.no_data == GR_BOUNDARY_CLOSED);
   char msg[512], range[160];
   int bounds_checked = 0;
   for (int r = 0; r < n; ++r) {
@@ -1316,7 +1329,7 @@ static void test_param_table(void) {
     }
     bounds_checked += 2;
   }
-  CHECK(bounds_checked == 32);
+  CHECK(bounds_checked == 34);
   /* The maps' parameters' sentences, one each. */
   q = p;
   q.wetting_depth = 0.0;
@@ -3898,6 +3911,121 @@ static void test_manning_map(void) {
   free(nmap);
 }
 
+/* ---------------------------------------------------------- no-data cells */
+
+/* A DEM with a NaN border (2 cells) and a NaN hole (4 x 3 cells): rain on
+ * it, both models, the no-data cells walls (the default) and outfalls.
+ * Walls: nothing leaves, the rain is that of the domain's cells only, the
+ * ledger closes; outfalls: water leaves over the brinks, the ledger closes;
+ * either way every output is NaN on the no-data cells and finite
+ * elsewhere. And a lake at rest around the hole stays at rest. */
+static void test_no_data(void) {
+  gr_grid g = {30, 24, 2.0, 2.0, 0.0, 0.0, 0, 0};
+  size_t n = cells_of(&g);
+  float *b = alloc_field(&g, 1);
+  int holes = 0;
+  for (int j = 0; j < g.ny; ++j)
+    for (int i = 0; i < g.nx; ++i) {
+      size_t c = (size_t)j * g.nx + i;
+      int border = i < 2 || j < 2 || i >= g.nx - 2 || j >= g.ny - 2;
+      int hole = i >= 12 && i < 16 && j >= 10 && j < 13;
+      b[c] = border || hole ? NAN : (float)(0.03 * i + 0.01 * j + 0.1 * hash01(i, j, 61));
+      holes += border || hole;
+    }
+  const double r = 50.0 / 3.6e6, T = 600.0, area = 4.0;
+  const double rain = (double)(n - (size_t)holes) * (double)(float)r * T * area;
+  for (int m = 0; m < 2; ++m)
+    for (int k = 0; k < 2; ++k) {
+      gr_rain_runoff_params p = edge_params(m);
+      set_edges(&p, GR_BOUNDARY_OPEN);
+      p.rain_rate = r;
+      p.no_data = k ? GR_BOUNDARY_OPEN : GR_BOUNDARY_CLOSED;
+      gr_rain_runoff *s = make_sim(&g, &p, b, NULL);
+      if (!s)
+        continue;
+      CHECK(gr_rain_runoff_advance(s, T, NULL) == GR_OK);
+      gr_rain_runoff_ledger l = ledger(s);
+      CHECK_MSG(fabs(l.rain_volume - rain) < 1e-6 * rain,
+                "%s: rain %.9g m^3 on the domain's cells, expected %.9g", model_names[m],
+                l.rain_volume, rain);
+      CHECK_MSG(fabs(l.balance_error) < 1e-6 * rain, "%s, %s: balance %g of %g", model_names[m],
+                k ? "outfalls" : "walls", l.balance_error, rain);
+      if (k == 0)
+        CHECK_MSG(l.outflow_volume == 0.0 && l.stored_volume > 0.99 * rain,
+                  "%s: walls let %g m^3 out", model_names[m], l.outflow_volume);
+      else
+        CHECK_MSG(l.outflow_volume > 0.1 * rain, "%s: outfalls let only %g of %g m^3 out",
+                  model_names[m], l.outflow_volume, rain);
+      const gr_field fields[] = {GR_FIELD_WATER_DEPTH, GR_FIELD_WATER_SURFACE, GR_FIELD_VELOCITY,
+                                 GR_FIELD_DISCHARGE, GR_FIELD_ELEVATION};
+      long wrong = 0;
+      for (size_t f = 0; f < sizeof(fields) / sizeof(fields[0]); ++f) {
+        int comps = gr_field_components(fields[f]);
+        float *v = get(s, &g, fields[f]);
+        for (size_t c = 0; c < n; ++c)
+          for (int q = 0; q < comps; ++q)
+            wrong += isnan(b[c]) != isnan(v[c * (size_t)comps + (size_t)q]);
+        free(v);
+      }
+      for (int map = 0; map < GR_RAIN_RUNOFF_MAP_COUNT; ++map) {
+        if (map == GR_RAIN_RUNOFF_ARRIVAL_TIME)
+          continue; /* NaN also where never wet */
+        float *v = get_map(s, &g, (gr_rain_runoff_map)map);
+        for (size_t c = 0; c < n; ++c)
+          wrong += isnan(b[c]) != isnan(v[c]);
+        free(v);
+      }
+      CHECK_MSG(wrong == 0, "%s: %ld values are NaN off the no-data cells or not NaN on them",
+                model_names[m], wrong);
+      printf("%s, no-data cells as %s: rain %.4f m^3 (domain cells only), outflow %.4f, stored "
+             "%.4f, balance %.1e; NaN exactly on the %d no-data cells\n",
+             model_names[m], k ? "outfalls" : "walls", l.rain_volume, l.outflow_volume,
+             l.stored_volume, l.balance_error, holes);
+      /* Switching the kind later rebuilds the cells: walls again hold it. */
+      if (k == 1) {
+        p.no_data = GR_BOUNDARY_CLOSED;
+        CHECK(gr_rain_runoff_set_params(s, &p) == GR_OK);
+        double out = ledger(s).outflow_volume;
+        CHECK(gr_rain_runoff_advance(s, 60.0, NULL) == GR_OK);
+        CHECK(ledger(s).outflow_volume == out);
+      }
+      gr_rain_runoff_destroy(s);
+    }
+  /* A lake at rest, 1 m deep on a flat bed, around the hole and inside the
+   * border: still after 300 steps, no water goes anywhere. */
+  float *d = alloc_field(&g, 1);
+  for (size_t c = 0; c < n; ++c) {
+    d[c] = 1.0f;
+    if (!isnan(b[c]))
+      b[c] = 0.0f;
+  }
+  for (int m = 0; m < 2; ++m) {
+    gr_rain_runoff_params p = edge_params(m);
+    gr_rain_runoff *s = make_sim(&g, &p, b, d);
+    if (!s)
+      continue;
+    run_stable(s, 6, 50);
+    float *v = get(s, &g, GR_FIELD_VELOCITY), *h = get(s, &g, GR_FIELD_WATER_DEPTH);
+    double vmax = 0.0, hdev = 0.0;
+    for (size_t c = 0; c < n; ++c)
+      if (!isnan(b[c])) {
+        vmax = fmax(vmax, fmax(fabs(v[3 * c]), fabs(v[3 * c + 1])));
+        hdev = fmax(hdev, fabs(h[c] - 1.0));
+      }
+    gr_rain_runoff_ledger l = ledger(s);
+    CHECK_MSG(vmax < 1e-6 && hdev < 1e-6, "%s: the lake moves around the hole (%.2e m/s, %.2e m)",
+              model_names[m], vmax, hdev);
+    CHECK(fabs(l.initial_volume - (double)(n - (size_t)holes) * area) < 1e-9 * l.initial_volume);
+    printf("%s: a lake at rest around the hole: speeds %.1e m/s, depths within %.1e m\n",
+           model_names[m], vmax, hdev);
+    free(v);
+    free(h);
+    gr_rain_runoff_destroy(s);
+  }
+  free(d);
+  free(b);
+}
+
 static const gr_subtest tests[] = {
     {"rain_gain", test_rain_gain, 0},
     {"infiltration", test_infiltration, 0},
@@ -3960,6 +4088,7 @@ static const gr_subtest tests[] = {
     {"inflow_errors", test_inflow_errors, 0},
     {"hyetograph", test_hyetograph, 0},
     {"manning_map", test_manning_map, 0},
+    {"no_data", test_no_data, 0},
 };
 
 static int setup(void) {

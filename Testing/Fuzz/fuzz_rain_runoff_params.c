@@ -4,8 +4,9 @@
  * Input layout (missing bytes read as 0): byte 0 picks the mode, byte 1 the
  * length of a small message buffer, byte 2 the field to validate, then:
  *   mode 0  the parameters from raw bytes (8 per double: the seven and the
- *           four edges' levels; 4 for each of the four edges' kinds and the
- *           flow model), so NaN, infinities and huge values appear;
+ *           four edges' levels; 4 for each of the four edges' kinds, the
+ *           flow model and the no-data kind), so NaN, infinities and huge
+ *           values appear;
  *   mode 1  one byte per parameter picks an edge value: a bound of any row
  *           of the parameter table (gr_rain_runoff_param_bounds) in the
  *           core's unit, one ulp either side, or 0, -0, NaN, infinities;
@@ -16,8 +17,8 @@
  * lie in the table's ranges (user bounds times to_core; open minimum and
  * whole numbers where a row says so) and, for FlowModel 1 (local inertial),
  * ManningN is at least 0.005; fields exactly when every value is
- * finite and, for the depth, permeability and rain-rate inputs, within the
- * RainRate and Permeability rows' ranges (velocities within +-1000 m/s);
+ * finite (or, for elevations, NaN: a no-data cell) and, for the depth, permeability and rain-rate
+ * inputs, within the RainRate and Permeability rows' ranges (velocities within +-1000 m/s);
  * outputs-only fields are refused; a short message
  * buffer is never overrun and always terminated. */
 #include "fuzz_common.h"
@@ -50,8 +51,11 @@ static int params_documented(const gr_rain_runoff_params *p) {
   static const char *const kinds[4] = {"BoundaryWest", "BoundaryEast", "BoundarySouth",
                                        "BoundaryNorth"};
   static const char *const levels[4] = {"LevelWest", "LevelEast", "LevelSouth", "LevelNorth"};
-  int model;
+  int model, no_data;
   memcpy(&model, &p->flow_model, sizeof model);
+  memcpy(&no_data, &p->no_data, sizeof no_data);
+  if (!in_row("NoDataBoundary", (double)no_data))
+    return 0;
   for (int e = 0; e < 4; ++e) {
     int kind;
     memcpy(&kind, &p->boundary[e], sizeof kind);
@@ -68,6 +72,8 @@ static int params_documented(const gr_rain_runoff_params *p) {
 static int field_documented(gr_field f, const float *v, size_t n) {
   for (size_t i = 0; i < n; ++i) {
     const double x = v[i];
+    if (f == GR_FIELD_ELEVATION && isnan(x))
+      continue; /* a no-data cell */
     if (!isfinite(x))
       return 0;
     if (f == GR_FIELD_WATER_DEPTH && !(x >= 0.0))
@@ -116,6 +122,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
     for (int e = 0; e < 4; ++e)
       take(&r, &p.boundary[e], sizeof(int));
     take(&r, &p.flow_model, sizeof(int));
+    take(&r, &p.no_data, sizeof(int));
   } else {
     int b;
     for (int e = 0; e < 4; ++e) {
@@ -124,6 +131,8 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
     }
     b = (int)take_byte(&r) % 4 - 1; /* -1, 0, 1, 2 */
     memcpy(&p.flow_model, &b, sizeof b);
+    b = (int)take_byte(&r) % 4 - 1;
+    memcpy(&p.no_data, &b, sizeof b);
   }
 
   msg[0] = '\0';

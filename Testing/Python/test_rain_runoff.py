@@ -588,6 +588,33 @@ T.check(d is None and len(errs.messages) == 1 and "Rain Runoff's PermeabilityMap
         "has the value 2 s/m^(1/3) at cell (0, 0)" in errs.text(),
         "a manning_n of 2 on the PermeabilityMap refused with one sentence: %r" % errs.text()[:200])
 
+# No-data points: a NaN hole and a NaN border are outside the terrain, walls
+# by default (nothing leaves), outfalls with NoDataBoundary 0; their outputs
+# are NaN, the ledger closes, the rain falls on the terrain's points only.
+nd = slope + bowl
+nd = nd.copy()
+nd[:2, :] = nd[-2:, :] = np.nan
+nd[:, :2] = nd[:, -2:] = np.nan
+nd[12:15, 18:23] = np.nan
+holes = np.isnan(nd)
+for kind in (1, 0):
+    g = rain(nd, RainRate=80.0, EndTime=60.0, NoDataBoundary=kind)
+    d, out = at(g, 60.0)
+    ok = d is not None
+    rain_q = 80.0 * MM_PER_H * float((~holes).sum()) * DX * DX * 60.0
+    if ok:
+        m = maps_of(out)
+        nan_right = (np.array_equal(np.isnan(d), holes)
+                     and np.array_equal(np.isnan(m["max_depth"]), holes))
+        closes = abs(field(out, "balance_error")) <= 1e-6 * rain_q
+        rain_ok = abs(field(out, "rain_volume") - rain_q) <= 1e-6 * rain_q
+        outflow = field(out, "outflow_volume")
+    T.check(ok and nan_right and closes and rain_ok
+            and (outflow == 0.0 if kind == 1 else outflow > 0.0),
+            "no-data points as %s: NaN exactly there, the rain on the other points (%g m^3), "
+            "outflow %g m^3, the ledger closed" % ("walls" if kind == 1 else "outfalls", rain_q,
+                                                  outflow if ok else -1))
+
 # Gauges: three columns each in the hydrograph, the output's values at the
 # nearest terrain point at every output time, whatever the request order.
 def gauge_points(xy):
@@ -646,7 +673,7 @@ T.check(d is None and len(errs.messages) == 1 and "Gauges point 0" in errs.text(
 
 # ---- bad input: one sentence, an empty output, the next good update works ------
 bad_elev = bowl.copy()
-bad_elev[3, 7] = np.nan
+bad_elev[3, 7] = np.inf  # NaN is a no-data point; infinities are refused
 cases = [
     ({"elevation": bad_elev}, {}, "elevation"),
     ({"height": bowl}, {}, "elevation"),  # no elevation, and no active scalars
@@ -754,7 +781,7 @@ T.check(d is not None and np.array_equal(d, ref[10.0]), "works again once the op
 g = rain(bad_elev)
 errs = T.ErrorCatcher(g)
 d, _ = at(g, 10.0)
-T.check(d is None and "elevation" in errs.text(), "NaN elevation refused")
+T.check(d is None and "elevation" in errs.text(), "an infinite elevation refused")
 g.SetInputConnection(producer(image({"elevation": slope + bowl})).GetOutputPort())
 g.SetRainRate(50.0)
 d, _ = at(g, 10.0)

@@ -65,8 +65,26 @@ GR_INLINE float gr_rain_runoff_face_n2(__global const float *restrict n2map, int
   return use_n2 ? 0.5f * (n2map[a] + n2map[b]) : n2;
 }
 
+/* No-data cells (NaN elevations, graupel/rain_runoff.h): nodata[c] is 0 for
+ * a cell of the domain, 1 for a wall, 2 for an outfall (use_nodata: there
+ * are some). Nothing rains, enters or infiltrates there. */
+#define GR_RAIN_RUNOFF_ACTIVE(c) (!use_nodata || nodata[(c)] == 0.0f)
+#define GR_RAIN_RUNOFF_RAIN(c)                                                                     \
+  (GR_RAIN_RUNOFF_ACTIVE(c) ? gr_rain_runoff_input(rain, use_rain, rain_uniform, (c)) : 0.0f)
+#define GR_RAIN_RUNOFF_PERM(c)                                                                     \
+  (GR_RAIN_RUNOFF_ACTIVE(c) ? gr_rain_runoff_input(perm, use_perm, perm_uniform, (c)) : 0.0f)
+
 /* A cell's source rate (m/s of depth): the source field's, 0 without one. */
-#define GR_RAIN_RUNOFF_SRC(c) gr_rain_runoff_input(src, use_src, 0.0f, (c))
+#define GR_RAIN_RUNOFF_SRC(c)                                                                      \
+  (GR_RAIN_RUNOFF_ACTIVE(c) ? gr_rain_runoff_input(src, use_src, 0.0f, (c)) : 0.0f)
+
+/* The water an outfall no-data cell received in a step leaves the domain:
+ * its new depth t (and Kahan compensation comp) go to the outflow, and the
+ * cell ends dry. Returns the water booked (0 for every other cell). */
+GR_INLINE float gr_rain_runoff_drain(__global const float *restrict nodata, int use_nodata, int c,
+                                     float t, float comp) {
+  return use_nodata && nodata[c] == 2.0f && t > 0.0f ? t - comp : 0.0f;
+}
 
 /* x^(-7/3) for x > 0 (a normal float), the friction's depth factor: x^(-1/3)
  * from an exponent-thirding first guess and three Newton steps (2e-7
@@ -172,19 +190,19 @@ GR_INLINE float gr_rain_runoff_edge_q(int kind, float q, bool low) {
 __kernel void rain_runoff_flux(
     __global const float *restrict h, __global const float *restrict b,
     __global const float *restrict rain, __global const float *restrict perm,
-    __global const float *restrict src, int use_src, __global const float *restrict qx_old,
-    __global const float *restrict qy_old, __global float *restrict qx, __global float *restrict qy,
-    __global const float *restrict limit, int nx, int ny, float dt, float inv_dx, float inv_dy,
-    float g, float n2, __global const float *restrict n2map, int use_n2, float theta, int use_rain,
-    float rain_uniform, int use_perm, float perm_uniform, int4 bnd, float4 lvl) {
+    __global const float *restrict src, int use_src, __global const float *restrict nodata,
+    int use_nodata, __global const float *restrict qx_old, __global const float *restrict qy_old,
+    __global float *restrict qx, __global float *restrict qy, __global const float *restrict limit,
+    int nx, int ny, float dt, float inv_dx, float inv_dy, float g, float n2,
+    __global const float *restrict n2map, int use_n2, float theta, int use_rain, float rain_uniform,
+    int use_perm, float perm_uniform, int4 bnd, float4 lvl) {
   int i = get_global_id(0), j = get_global_id(1);
   if (!gr_inside(i, j, nx + 1, ny + 1))
     return;
   int c = gr_idx(i, j, nx);
   bool in_c = i < nx && j < ny;
-  float hc = in_c ? gr_rain_runoff_wet(h[c], gr_rain_runoff_input(rain, use_rain, rain_uniform, c),
-                                       GR_RAIN_RUNOFF_SRC(c),
-                                       gr_rain_runoff_input(perm, use_perm, perm_uniform, c), dt)
+  float hc = in_c ? gr_rain_runoff_wet(h[c], GR_RAIN_RUNOFF_RAIN(c), GR_RAIN_RUNOFF_SRC(c),
+                                       GR_RAIN_RUNOFF_PERM(c), dt)
                   : 0.0f;
   float bc = in_c ? b[c] : 0.0f;
   float kc = in_c ? limit[c] : 1.0f;
@@ -192,11 +210,9 @@ __kernel void rain_runoff_flux(
     /* Cell (i-1, j) is L, cell (i, j) is R; at the edges one is the ghost. */
     int w = c - 1;
     bool in_w = i > 0;
-    float hw = in_w
-                   ? gr_rain_runoff_wet(h[w], gr_rain_runoff_input(rain, use_rain, rain_uniform, w),
-                                        GR_RAIN_RUNOFF_SRC(w),
-                                        gr_rain_runoff_input(perm, use_perm, perm_uniform, w), dt)
-                   : 0.0f;
+    float hw = in_w ? gr_rain_runoff_wet(h[w], GR_RAIN_RUNOFF_RAIN(w), GR_RAIN_RUNOFF_SRC(w),
+                                         GR_RAIN_RUNOFF_PERM(w), dt)
+                    : 0.0f;
     float bw = in_w ? b[w] : 0.0f;
     float kw = in_w ? limit[w] : 1.0f;
     float hgw, bgw, hge, bge;
@@ -221,11 +237,9 @@ __kernel void rain_runoff_flux(
   if (i < nx) {
     int s = c - nx;
     bool in_s = j > 0;
-    float hs = in_s
-                   ? gr_rain_runoff_wet(h[s], gr_rain_runoff_input(rain, use_rain, rain_uniform, s),
-                                        GR_RAIN_RUNOFF_SRC(s),
-                                        gr_rain_runoff_input(perm, use_perm, perm_uniform, s), dt)
-                   : 0.0f;
+    float hs = in_s ? gr_rain_runoff_wet(h[s], GR_RAIN_RUNOFF_RAIN(s), GR_RAIN_RUNOFF_SRC(s),
+                                         GR_RAIN_RUNOFF_PERM(s), dt)
+                    : 0.0f;
     float bs = in_s ? b[s] : 0.0f;
     float ks = in_s ? limit[s] : 1.0f;
     float hgs, bgs, hgn, bgn;
@@ -255,6 +269,7 @@ __kernel void rain_runoff_limit(__global const float *restrict h,
                                 __global const float *restrict rain,
                                 __global const float *restrict perm,
                                 __global const float *restrict src, int use_src,
+                                __global const float *restrict nodata, int use_nodata,
                                 __global const float *restrict qx,
                                 __global const float *restrict qy, __global float *restrict limit,
                                 int nx, int ny, float dt, float inv_dx, float inv_dy, int use_rain,
@@ -263,9 +278,8 @@ __kernel void rain_runoff_limit(__global const float *restrict h,
   if (!gr_inside(i, j, nx, ny))
     return;
   int c = gr_idx(i, j, nx);
-  float wet = gr_rain_runoff_wet(h[c], gr_rain_runoff_input(rain, use_rain, rain_uniform, c),
-                                 GR_RAIN_RUNOFF_SRC(c),
-                                 gr_rain_runoff_input(perm, use_perm, perm_uniform, c), dt);
+  float wet = gr_rain_runoff_wet(h[c], GR_RAIN_RUNOFF_RAIN(c), GR_RAIN_RUNOFF_SRC(c),
+                                 GR_RAIN_RUNOFF_PERM(c), dt);
   float qw = qx[j * (nx + 1) + i], qe = qx[j * (nx + 1) + i + 1];
   float qs = qy[j * nx + i], qn = qy[(j + 1) * nx + i];
   float out = dt * ((fmax(-qw, 0.0f) + fmax(qe, 0.0f)) * inv_dx +
@@ -299,23 +313,22 @@ GR_INLINE void gr_rain_runoff_book_edges(__global float *restrict outflow,
  * float precision): its rounding would otherwise be the same in every step
  * where a pond gains the same rain, and 10^5 such steps would show in the
  * water balance. */
-__kernel void
-rain_runoff_update(__global float *restrict h, __global float *restrict h_comp,
-                   __global const float *restrict rain, __global const float *restrict perm,
-                   __global const float *restrict src, int use_src,
-                   __global const float *restrict qx, __global const float *restrict qy,
-                   __global const float *restrict limit, __global float *restrict infiltrated,
-                   __global float *restrict infiltrated_comp, __global float *restrict outflow,
-                   __global float *restrict outflow_comp, __global float *restrict inflow,
-                   __global float *restrict inflow_comp, int nx, int ny, float dt, float inv_dx,
-                   float inv_dy, int use_rain, float rain_uniform, int use_perm,
-                   float perm_uniform) {
+__kernel void rain_runoff_update(
+    __global float *restrict h, __global float *restrict h_comp,
+    __global const float *restrict rain, __global const float *restrict perm,
+    __global const float *restrict src, int use_src, __global const float *restrict nodata,
+    int use_nodata, __global const float *restrict qx, __global const float *restrict qy,
+    __global const float *restrict limit, __global float *restrict infiltrated,
+    __global float *restrict infiltrated_comp, __global float *restrict outflow,
+    __global float *restrict outflow_comp, __global float *restrict inflow,
+    __global float *restrict inflow_comp, int nx, int ny, float dt, float inv_dx, float inv_dy,
+    int use_rain, float rain_uniform, int use_perm, float perm_uniform) {
   int i = get_global_id(0), j = get_global_id(1);
   if (!gr_inside(i, j, nx, ny))
     return;
   int c = gr_idx(i, j, nx);
-  float r = gr_rain_runoff_input(rain, use_rain, rain_uniform, c);
-  float k = gr_rain_runoff_input(perm, use_perm, perm_uniform, c);
+  float r = GR_RAIN_RUNOFF_RAIN(c);
+  float k = GR_RAIN_RUNOFF_PERM(c);
   float sc = GR_RAIN_RUNOFF_SRC(c);
   float h0 = h[c];
   float inf = gr_rain_runoff_infiltration(h0, r, sc, k, dt);
@@ -333,9 +346,12 @@ rain_runoff_update(__global float *restrict h, __global float *restrict h_comp,
   float t = h0 + y;
   float comp = (t - h0) - y;
   /* The limiter keeps t >= 0 but for rounding; a cell that ends at or
-   * below 0 is dry, with nothing owed. */
-  h[c] = t > 0.0f ? t : 0.0f;
-  h_comp[c] = t > 0.0f ? comp : 0.0f;
+   * below 0 is dry, with nothing owed. An outfall no-data cell drains. */
+  float gone = gr_rain_runoff_drain(nodata, use_nodata, c, t, comp);
+  h[c] = t > 0.0f && gone == 0.0f ? t : 0.0f;
+  h_comp[c] = t > 0.0f && gone == 0.0f ? comp : 0.0f;
+  if (gone != 0.0f)
+    gr_kahan_add(outflow, outflow_comp, c, gone);
   if (inf != 0.0f)
     gr_kahan_add(infiltrated, infiltrated_comp, c, inf);
   /* The sources' water is inflow, the very float the depth gained. */
@@ -728,13 +744,14 @@ GR_INLINE gr_sw_pt gr_sw_load(__global const float *restrict sh, __global const 
                               __global const float *restrict st, __global const float *restrict b,
                               __global const float *restrict rain,
                               __global const float *restrict perm,
-                              __global const float *restrict src, int use_src, bool in, int q,
+                              __global const float *restrict src, int use_src,
+                              __global const float *restrict nodata, int use_nodata, bool in, int q,
                               int stage, float dt, int use_rain, float rain_uniform, int use_perm,
                               float perm_uniform) {
   float hh = in ? sh[q] : 0.0f, pn = in ? sn[q] : 0.0f, pt = in ? st[q] : 0.0f;
   if (stage == 1) {
-    float r = in ? gr_rain_runoff_input(rain, use_rain, rain_uniform, q) : 0.0f;
-    float k = in ? gr_rain_runoff_input(perm, use_perm, perm_uniform, q) : 0.0f;
+    float r = in ? GR_RAIN_RUNOFF_RAIN(q) : 0.0f;
+    float k = in ? GR_RAIN_RUNOFF_PERM(q) : 0.0f;
     float sq = in ? GR_RAIN_RUNOFF_SRC(q) : 0.0f;
     float hw = gr_rain_runoff_wet(hh, r, sq, k, dt);
     pn = gr_sw_wet_q(hh, pn, r, sq, dt, hw);
@@ -758,20 +775,19 @@ GR_INLINE gr_sw_pt gr_sw_load(__global const float *restrict sh, __global const 
  *            h, qu, qv (each cell reads its own old values only), with the
  *            infiltration and half of each stage's edge outflow booked in
  *            Kahan sums. */
-GR_INLINE void
-gr_sw_stage(__global float *restrict h, __global float *restrict qu, __global float *restrict qv,
-            __global float *restrict h_comp, __global float *restrict h1,
-            __global float *restrict qu1, __global float *restrict qv1,
-            __global float *restrict dh1, __global const float *restrict b,
-            __global const float *restrict rain, __global const float *restrict perm,
-            __global const float *restrict src, int use_src, __global float *restrict infiltrated,
-            __global float *restrict infiltrated_comp, __global float *restrict outflow,
-            __global float *restrict outflow_comp, __global float *restrict inflow,
-            __global float *restrict inflow_comp, int nx, int ny, float dt, float inv_dx,
-            float inv_dy, float g, float n2, __global const float *restrict n2map, int use_n2,
-            int use_rain, float rain_uniform, int use_perm, float perm_uniform, int4 bnd,
-            float4 lvl, __global const float *restrict sh, __global const float *restrict su,
-            __global const float *restrict sv, const int stage) {
+GR_INLINE void gr_sw_stage(
+    __global float *restrict h, __global float *restrict qu, __global float *restrict qv,
+    __global float *restrict h_comp, __global float *restrict h1, __global float *restrict qu1,
+    __global float *restrict qv1, __global float *restrict dh1, __global const float *restrict b,
+    __global const float *restrict rain, __global const float *restrict perm,
+    __global const float *restrict src, int use_src, __global const float *restrict nodata,
+    int use_nodata, __global float *restrict infiltrated, __global float *restrict infiltrated_comp,
+    __global float *restrict outflow, __global float *restrict outflow_comp,
+    __global float *restrict inflow, __global float *restrict inflow_comp, int nx, int ny, float dt,
+    float inv_dx, float inv_dy, float g, float n2, __global const float *restrict n2map, int use_n2,
+    int use_rain, float rain_uniform, int use_perm, float perm_uniform, int4 bnd, float4 lvl,
+    __global const float *restrict sh, __global const float *restrict su,
+    __global const float *restrict sv, const int stage) {
   int i = get_global_id(0), j = get_global_id(1);
   if (!gr_inside(i, j, nx, ny))
     return;
@@ -782,8 +798,8 @@ gr_sw_stage(__global float *restrict h, __global float *restrict qu, __global fl
    * used (the reconstruction's slopes and the edge faces do without them);
    * indices stay linear so that CPU compilers vectorise the loads. */
 #define GR_SW_LOAD(o, in, q, sn, st)                                                               \
-  gr_sw_load(sh, sn, st, b, rain, perm, src, use_src, (in), (q), stage, dt, use_rain,              \
-             rain_uniform, use_perm, perm_uniform)
+  gr_sw_load(sh, sn, st, b, rain, perm, src, use_src, nodata, use_nodata, (in), (q), stage, dt,    \
+             use_rain, rain_uniform, use_perm, perm_uniform)
   gr_sw_pt x0 = GR_SW_LOAD(-2, i >= 2, c - 2, su, sv);
   gr_sw_pt x1 = GR_SW_LOAD(-1, i >= 1, c - 1, su, sv);
   gr_sw_pt x2 = GR_SW_LOAD(0, true, c, su, sv);
@@ -806,7 +822,7 @@ gr_sw_stage(__global float *restrict h, __global float *restrict qu, __global fl
   float qvn = sv[c] + dt * (dqy_x * inv_dx + dqy_y * inv_dy);
   if (stage == 1) {
     /* su, sv are the momenta before rain: take the wet ones. */
-    float r = gr_rain_runoff_input(rain, use_rain, rain_uniform, c);
+    float r = GR_RAIN_RUNOFF_RAIN(c);
     float sc = GR_RAIN_RUNOFF_SRC(c);
     float hw = x2.h;
     qun = gr_sw_wet_q(h[c], qu[c], r, sc, dt, hw) + dt * (dqx_x * inv_dx + dqx_y * inv_dy);
@@ -821,8 +837,8 @@ gr_sw_stage(__global float *restrict h, __global float *restrict qu, __global fl
     qv1[c] = hn > 0.0f ? qvn : 0.0f;
   } else {
     float h0 = h[c];
-    float r = gr_rain_runoff_input(rain, use_rain, rain_uniform, c);
-    float k = gr_rain_runoff_input(perm, use_perm, perm_uniform, c);
+    float r = GR_RAIN_RUNOFF_RAIN(c);
+    float k = GR_RAIN_RUNOFF_PERM(c);
     float sc = GR_RAIN_RUNOFF_SRC(c);
     float hw = gr_rain_runoff_wet(h0, r, sc, k, dt);
     float inf = gr_rain_runoff_infiltration(h0, r, sc, k, dt);
@@ -836,10 +852,15 @@ gr_sw_stage(__global float *restrict h, __global float *restrict qu, __global fl
     gr_sw_friction(hn, dt, g, n2c, &qun, &qvn);
     float qx = 0.5f * (gr_sw_wet_q(h0, qu[c], r, sc, dt, hw) + qun);
     float qy = 0.5f * (gr_sw_wet_q(h0, qv[c], r, sc, dt, hw) + qvn);
-    h[c] = fmax(hf, 0.0f);
-    h_comp[c] = hf > 0.0f ? comp : 0.0f;
-    qu[c] = hf > 0.0f ? qx : 0.0f;
-    qv[c] = hf > 0.0f ? qy : 0.0f;
+    /* An outfall no-data cell drains (its water is outflow). */
+    float gone = gr_rain_runoff_drain(nodata, use_nodata, c, hf, comp);
+    bool keep = hf > 0.0f && gone == 0.0f;
+    h[c] = gone == 0.0f ? fmax(hf, 0.0f) : 0.0f;
+    h_comp[c] = keep ? comp : 0.0f;
+    qu[c] = keep ? qx : 0.0f;
+    qv[c] = keep ? qy : 0.0f;
+    if (gone != 0.0f)
+      gr_kahan_add(outflow, outflow_comp, c, gone);
     if (inf != 0.0f)
       gr_kahan_add(infiltrated, infiltrated_comp, c, inf);
     /* The sources' water is inflow, the very float the depth gained. */
@@ -860,16 +881,17 @@ gr_sw_stage(__global float *restrict h, __global float *restrict qu, __global fl
       __global float *restrict qv1, __global float *restrict dh1,                                  \
       __global const float *restrict b, __global const float *restrict rain,                       \
       __global const float *restrict perm, __global const float *restrict src, int use_src,        \
-      __global float *restrict infiltrated, __global float *restrict infiltrated_comp,             \
-      __global float *restrict outflow, __global float *restrict outflow_comp,                     \
-      __global float *restrict inflow, __global float *restrict inflow_comp, int nx, int ny,       \
-      float dt, float inv_dx, float inv_dy, float g, float n2,                                     \
-      __global const float *restrict n2map, int use_n2, int use_rain, float rain_uniform,          \
-      int use_perm, float perm_uniform, int4 bnd, float4 lvl
+      __global const float *restrict nodata, int use_nodata, __global float *restrict infiltrated, \
+      __global float *restrict infiltrated_comp, __global float *restrict outflow,                 \
+      __global float *restrict outflow_comp, __global float *restrict inflow,                      \
+      __global float *restrict inflow_comp, int nx, int ny, float dt, float inv_dx, float inv_dy,  \
+      float g, float n2, __global const float *restrict n2map, int use_n2, int use_rain,           \
+      float rain_uniform, int use_perm, float perm_uniform, int4 bnd, float4 lvl
 #define GR_SW_STAGE_PASS                                                                           \
-  h, qu, qv, h_comp, h1, qu1, qv1, dh1, b, rain, perm, src, use_src, infiltrated,                  \
-      infiltrated_comp, outflow, outflow_comp, inflow, inflow_comp, nx, ny, dt, inv_dx, inv_dy, g, \
-      n2, n2map, use_n2, use_rain, rain_uniform, use_perm, perm_uniform, bnd, lvl
+  h, qu, qv, h_comp, h1, qu1, qv1, dh1, b, rain, perm, src, use_src, nodata, use_nodata,           \
+      infiltrated, infiltrated_comp, outflow, outflow_comp, inflow, inflow_comp, nx, ny, dt,       \
+      inv_dx, inv_dy, g, n2, n2map, use_n2, use_rain, rain_uniform, use_perm, perm_uniform, bnd,   \
+      lvl
 
 __kernel void rain_runoff_sw_stage1(GR_SW_STAGE_ARGS) {
   gr_sw_stage(GR_SW_STAGE_PASS, h, qu, qv, 1);

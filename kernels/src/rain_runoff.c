@@ -58,6 +58,7 @@ enum {
   GR_RAIN_RUNOFF_P_FLOW_MODEL = GR_RAIN_RUNOFF_P_LEVEL + 4,
   GR_RAIN_RUNOFF_P_WETTING_DEPTH,
   GR_RAIN_RUNOFF_P_DEBRIS_FACTOR,
+  GR_RAIN_RUNOFF_P_NO_DATA,
   GR_RAIN_RUNOFF_P_COUNT
 };
 
@@ -80,6 +81,7 @@ static const gr_param_bound gr_rain_runoff_bounds[GR_RAIN_RUNOFF_P_COUNT] = {
     {"FlowModel", "", 0.0, 1.0, 0.0, 1.0, 0, 1},
     {"WettingDepth", "m", 0.0, 10.0, 0.01, 1.0, 1, 0},
     {"DebrisFactor", "", 0.0, 1.0, 0.0, 1.0, 0, 0},
+    {"NoDataBoundary", "", 0.0, 1.0, 1.0, 1.0, 0, 1},
 };
 
 /* A row's range in the core's unit: exactly the products a caller gets from
@@ -117,6 +119,14 @@ struct gr_rain_runoff {
   cl_mem n2map;
   int has_n2;
   double n_min;
+  /* No-data cells (NaN elevations): per cell of the local array 0 (of the
+   * domain), 1 (a wall) or 2 (an outfall), on the device (nodata, once
+   * there are some: has_nodata) and on the host (mask); the owned cells of
+   * the domain (active_own), for the uniform rain. */
+  cl_mem nodata;
+  int has_nodata;
+  unsigned char *mask;
+  double active_own;
   /* The hyetograph: hy_n rows of time (s) and rain rate (m/s); 0: none. */
   int hy_n;
   double *hy_t, *hy_r;
@@ -165,6 +175,7 @@ struct gr_rain_runoff {
 static int gr_rain_runoff_has_sources(const gr_rain_runoff *s);
 static int gr_rain_runoff_has_edge_inflow(const gr_rain_runoff *s);
 static gr_status gr_rain_runoff_sources_update(gr_rain_runoff *s, double t0, double t1);
+static gr_status gr_rain_runoff_set_elevation(gr_rain_runoff *s, const float *host);
 
 /* Every failing public entry point with a handle ends here. */
 #define GR_RAIN_RUNOFF_KEEP_ERROR(s, st) gr_error_keep((s)->error, sizeof((s)->error), (st))
@@ -198,6 +209,7 @@ void gr_rain_runoff_params_init(gr_rain_runoff_params *p) {
   p->flow_model = (gr_flow_model)(int)t[GR_RAIN_RUNOFF_P_FLOW_MODEL].default_value;
   p->wetting_depth = t[GR_RAIN_RUNOFF_P_WETTING_DEPTH].default_value;
   p->debris_factor = t[GR_RAIN_RUNOFF_P_DEBRIS_FACTOR].default_value;
+  p->no_data = (gr_boundary)(int)t[GR_RAIN_RUNOFF_P_NO_DATA].default_value;
 }
 
 /* The core's value of row `row` in p. */
@@ -217,6 +229,11 @@ static double gr_rain_runoff_param_value(const gr_rain_runoff_params *p, int row
     return p->wetting_depth;
   case GR_RAIN_RUNOFF_P_DEBRIS_FACTOR:
     return p->debris_factor;
+  case GR_RAIN_RUNOFF_P_NO_DATA: {
+    int k; /* any bit pattern the enum may hold */
+    memcpy(&k, &p->no_data, sizeof(k));
+    return (double)k;
+  }
   case GR_RAIN_RUNOFF_P_FLOW_MODEL: {
     int m; /* any bit pattern the enum may hold */
     memcpy(&m, &p->flow_model, sizeof(m));
@@ -273,9 +290,13 @@ static gr_status gr_rain_runoff_field_check(gr_field f, const float *values, siz
   char rule_text[160];
   double lo = -HUGE_VAL, hi = HUGE_VAL;
   size_t comps = 1;
+  int nan_ok = 0;
   switch (f) {
   case GR_FIELD_ELEVATION:
-    rule = strict ? "elevations must be finite and within +-1e6 m" : "elevations must be finite";
+    /* NaN marks a no-data cell (outside the domain); infinities are refused. */
+    nan_ok = 1;
+    rule = strict ? "elevations must be within +-1e6 m, or NaN for a no-data cell"
+                  : "elevations must be finite, or NaN for a no-data cell";
     if (strict) {
       lo = -GR_RAIN_RUNOFF_MAX_ELEVATION;
       hi = GR_RAIN_RUNOFF_MAX_ELEVATION;
@@ -332,7 +353,7 @@ static gr_status gr_rain_runoff_field_check(gr_field f, const float *values, siz
   }
   for (size_t c = 0; c < n; ++c) {
     double v = values[c];
-    if (isfinite(v) && v >= lo && v <= hi)
+    if ((isfinite(v) && v >= lo && v <= hi) || (nan_ok && isnan(v)))
       continue;
     if (msg && msg_len) {
       if (nx > 0)
@@ -374,8 +395,11 @@ static int gr_rain_runoff_has_ring(const gr_rain_runoff *s) {
 static double gr_rain_runoff_own_sum(const gr_rain_runoff *s, const float *host) {
   double sum = 0.0;
   for (int j = s->ring[2]; j < s->nyl - s->ring[3]; ++j)
-    for (int i = s->ring[0]; i < s->nxl - s->ring[1]; ++i)
-      sum += host[(size_t)j * (size_t)s->nxl + (size_t)i];
+    for (int i = s->ring[0]; i < s->nxl - s->ring[1]; ++i) {
+      size_t c = (size_t)j * (size_t)s->nxl + (size_t)i;
+      if (!s->has_nodata || !s->mask[c]) /* nothing falls on, or stays in, no-data cells */
+        sum += host[c];
+    }
   return sum;
 }
 
@@ -713,11 +737,11 @@ void gr_rain_runoff_destroy(gr_rain_runoff *s) {
   for (size_t i = 0; i < sizeof(kernels) / sizeof(kernels[0]); ++i)
     if (kernels[i])
       clReleaseKernel(kernels[i]);
-  cl_mem *bufs[] = {&s->h,     &s->h_c,  &s->b,    &s->qx[0],   &s->qy[0], &s->qx[1],
-                    &s->qy[1], &s->k,    &s->inf,  &s->inf_c,   &s->out,   &s->out_c,
-                    &s->h0,    &s->rain, &s->perm, &s->scratch, &s->dummy, &s->qu,
-                    &s->qv,    &s->h1,   &s->qu1,  &s->qv1,     &s->qu0,   &s->qv0,
-                    &s->dh1,   &s->in,   &s->in_c, &s->pts,     &s->src,   &s->n2map};
+  cl_mem *bufs[] = {&s->h,    &s->h_c,     &s->b,     &s->qx[0], &s->qy[0], &s->qx[1], &s->qy[1],
+                    &s->k,    &s->inf,     &s->inf_c, &s->out,   &s->out_c, &s->h0,    &s->rain,
+                    &s->perm, &s->scratch, &s->dummy, &s->qu,    &s->qv,    &s->h1,    &s->qu1,
+                    &s->qv1,  &s->qu0,     &s->qv0,   &s->dh1,   &s->in,    &s->in_c,  &s->pts,
+                    &s->src,  &s->n2map,   &s->nodata};
   for (size_t i = 0; i < sizeof(bufs) / sizeof(bufs[0]); ++i)
     gr_buffer_release(bufs[i]);
   for (int a = 0; a < GR_RAIN_RUNOFF_MAP_ARRAYS; ++a)
@@ -730,6 +754,7 @@ void gr_rain_runoff_destroy(gr_rain_runoff *s) {
   }
   free(s->hy_t);
   free(s->hy_r);
+  free(s->mask);
   gr_context_release(s->ctx);
   free(s);
 }
@@ -761,9 +786,27 @@ gr_status gr_rain_runoff_set_params(gr_rain_runoff *s, const gr_rain_runoff_para
     if (st != GR_OK)
       return GR_RAIN_RUNOFF_KEEP_ERROR(s, st);
   }
+  int rebuild = s->has_nodata && p->no_data != s->params.no_data;
   s->params = *p;
   s->args_set = 0;
   s->maps_bound = 0;
+  if (rebuild) {
+    /* The no-data cells turn from walls to outfalls or back: their bed and
+     * kind, from the elevation on the device and the mask. */
+    size_t cells = gr_rain_runoff_cells(s);
+    float *b = malloc(cells * sizeof(float));
+    if (!b)
+      return GR_RAIN_RUNOFF_KEEP_ERROR(
+          s, gr_set_error(s->ctx, GR_ERR_OUT_OF_MEMORY, "Out of host memory."));
+    gr_status st = gr_buffer_read(s->ctx, s->b, 0, cells * sizeof(cl_float), b);
+    for (size_t c = 0; c < cells; ++c)
+      if (s->mask[c])
+        b[c] = NAN;
+    if (st == GR_OK)
+      st = gr_rain_runoff_set_elevation(s, b);
+    free(b);
+    return GR_RAIN_RUNOFF_KEEP_ERROR(s, st);
+  }
   return GR_OK;
 }
 
@@ -802,6 +845,100 @@ static double gr_rain_runoff_edge_depth(const gr_rain_runoff *s) {
     deepest = d > deepest ? d : deepest;
   }
   return deepest;
+}
+
+static gr_status gr_rain_runoff_rain_sum(gr_rain_runoff *s);
+
+/* The bed the kernels see in a no-data cell: a wall far above any ground
+ * and water (elevations lie within +-1e6 m), or an outfall's cliff far
+ * below it, over which water pours out (the hydrostatic reconstruction and
+ * the local inertial faces then pass what the cell above it sends, and the
+ * cell drains every step). Fixed heights: every piece sees the same. */
+#define GR_RAIN_RUNOFF_NODATA_WALL 2.0e6f
+#define GR_RAIN_RUNOFF_NODATA_CLIFF -2.0e6f
+
+/* Uploads the elevation (NaN: no-data cells, as the params' kind makes
+ * them), the no-data map when there are no-data cells, and the owned
+ * domain cells' count; the rain field's sum follows the new mask. */
+static gr_status gr_rain_runoff_set_elevation(gr_rain_runoff *s, const float *host) {
+  size_t cells = gr_rain_runoff_cells(s);
+  int any = 0;
+  for (size_t c = 0; c < cells && !any; ++c)
+    any = isnan(host[c]);
+  if (!any) {
+    free(s->mask);
+    s->mask = NULL;
+    s->has_nodata = 0;
+    s->args_set = 0;
+    gr_status st = gr_buffer_write(s->ctx, s->b, 0, cells * sizeof(cl_float), host);
+    if (st == GR_OK && s->has_rain)
+      st = gr_rain_runoff_rain_sum(s);
+    return st;
+  }
+  unsigned char *mask = malloc(cells);
+  float *b = malloc(cells * sizeof(float)), *kind = malloc(cells * sizeof(float));
+  if (!mask || !b || !kind) {
+    free(mask);
+    free(b);
+    free(kind);
+    return gr_set_error(s->ctx, GR_ERR_OUT_OF_MEMORY, "Out of host memory.");
+  }
+  int outfall = s->params.no_data == GR_BOUNDARY_OPEN;
+  double active = 0.0;
+  for (size_t c = 0; c < cells; ++c) {
+    mask[c] = isnan(host[c]) ? 1 : 0;
+    b[c] = mask[c] ? (outfall ? GR_RAIN_RUNOFF_NODATA_CLIFF : GR_RAIN_RUNOFF_NODATA_WALL) : host[c];
+    kind[c] = mask[c] ? (outfall ? 2.0f : 1.0f) : 0.0f;
+  }
+  for (int j = s->ring[2]; j < s->nyl - s->ring[3]; ++j)
+    for (int i = s->ring[0]; i < s->nxl - s->ring[1]; ++i)
+      active += !mask[(size_t)j * (size_t)s->nxl + (size_t)i];
+  gr_status st = gr_buffer_write(s->ctx, s->b, 0, cells * sizeof(cl_float), b);
+  if (st == GR_OK)
+    st = gr_rain_runoff_upload(s, &s->nodata, kind);
+  free(b);
+  free(kind);
+  if (st != GR_OK) {
+    free(mask);
+    return st;
+  }
+  free(s->mask);
+  s->mask = mask;
+  s->has_nodata = 1;
+  s->active_own = active;
+  s->args_set = 0;
+  return s->has_rain ? gr_rain_runoff_rain_sum(s) : GR_OK;
+}
+
+/* The rain field's sum over the owned domain cells and its largest value,
+ * read back from the device (after the no-data cells changed). */
+static gr_status gr_rain_runoff_rain_sum(gr_rain_runoff *s) {
+  size_t cells = gr_rain_runoff_cells(s);
+  float *r = malloc(cells * sizeof(float));
+  if (!r)
+    return gr_set_error(s->ctx, GR_ERR_OUT_OF_MEMORY, "Out of host memory.");
+  gr_status st = gr_buffer_read(s->ctx, s->rain, 0, cells * sizeof(cl_float), r);
+  if (st == GR_OK) {
+    s->rain_field_sum = gr_rain_runoff_own_sum(s, r);
+    s->rain_field_max = 0.0;
+    for (size_t c = 0; c < cells; ++c)
+      if ((!s->has_nodata || !s->mask[c]) && r[c] > s->rain_field_max)
+        s->rain_field_max = r[c];
+  }
+  free(r);
+  return st;
+}
+
+/* After a read of the owned cells (comps floats each): NaN in no-data cells. */
+static void gr_rain_runoff_blank(const gr_rain_runoff *s, float *host, size_t comps) {
+  if (!s->has_nodata)
+    return;
+  size_t k = 0;
+  for (int j = s->ring[2]; j < s->nyl - s->ring[3]; ++j)
+    for (int i = s->ring[0]; i < s->nxl - s->ring[1]; ++i, ++k)
+      if (s->mask[(size_t)j * (size_t)s->nxl + (size_t)i])
+        for (size_t q = 0; q < comps; ++q)
+          host[k * comps + q] = NAN;
 }
 
 static gr_status gr_rain_runoff_set_field_impl(gr_rain_runoff *s, gr_field f, const float *host) {
@@ -861,7 +998,7 @@ static gr_status gr_rain_runoff_set_field_impl(gr_rain_runoff *s, gr_field f, co
   s->args_set = 0; /* a field allocated now is bound at the next step */
   switch (f) {
   case GR_FIELD_ELEVATION: {
-    st = gr_buffer_write(s->ctx, s->b, 0, cells * sizeof(cl_float), host);
+    st = gr_rain_runoff_set_elevation(s, host);
     double worst = 0.0;
     const int nx = s->nxl, ny = s->nyl;
     for (int j = 0; j < ny; ++j)
@@ -898,13 +1035,24 @@ static gr_status gr_rain_runoff_set_field_impl(gr_rain_runoff *s, gr_field f, co
       s->rain_field_sum = sum;
       s->rain_field_max = 0.0;
       for (size_t c = 0; c < cells; ++c)
-        s->rain_field_max = host[c] > s->rain_field_max ? host[c] : s->rain_field_max;
+        if (!s->has_nodata || !s->mask[c])
+          s->rain_field_max = host[c] > s->rain_field_max ? host[c] : s->rain_field_max;
     }
     break;
   }
   case GR_FIELD_WATER_DEPTH: {
     /* The new water replaces what is there now: the ledger counts the
-     * difference as initial water, so the balance still closes. */
+     * difference as initial water, so the balance still closes. No-data
+     * cells hold none. */
+    float *dry = NULL;
+    if (s->has_nodata) {
+      dry = malloc(cells * sizeof(float));
+      if (!dry)
+        return gr_set_error(s->ctx, GR_ERR_OUT_OF_MEMORY, "Out of host memory.");
+      for (size_t c = 0; c < cells; ++c)
+        dry[c] = s->mask[c] ? 0.0f : host[c];
+      host = dry;
+    }
     double now[GR_RAIN_RUNOFF_SUMS], sum = gr_rain_runoff_own_sum(s, host);
     st = gr_rain_runoff_reduce(s, now, NULL);
     if (st == GR_OK)
@@ -925,6 +1073,7 @@ static gr_status gr_rain_runoff_set_field_impl(gr_rain_runoff *s, gr_field f, co
     /* The maps count the new water from the time it is set. */
     if (st == GR_OK)
       st = gr_rain_runoff_maps_update(s, s->time, 0.0);
+    free(dry);
     break;
   }
   default:
@@ -1532,6 +1681,8 @@ static gr_status gr_rain_runoff_bind(gr_rain_runoff *s, cl_float dt) {
   cl_mem src = use_src ? s->src : s->dummy;
   cl_int use_n2 = s->has_n2;
   cl_mem n2map = use_n2 ? s->n2map : s->dummy;
+  cl_int use_nodata = s->has_nodata;
+  cl_mem nodata = use_nodata ? s->nodata : s->dummy;
   cl_float theta = (cl_float)GR_RAIN_RUNOFF_THETA;
   const size_t m = sizeof(cl_mem);
   /* Arguments the three step kernels share (each takes those it has). */
@@ -1541,6 +1692,8 @@ static gr_status gr_rain_runoff_bind(gr_rain_runoff *s, cl_float dt) {
       {"perm", m, &perm},
       {"src", m, &src},
       {"use_src", sizeof(use_src), &use_src},
+      {"nodata", m, &nodata},
+      {"use_nodata", sizeof(use_nodata), &use_nodata},
       {"limit", m, &s->k},
       {"nx", sizeof(nx), &nx},
       {"ny", sizeof(ny), &ny},
@@ -1586,6 +1739,8 @@ static gr_status gr_rain_runoff_bind(gr_rain_runoff *s, cl_float dt) {
         {"perm", m, &perm},
         {"src", m, &src},
         {"use_src", sizeof(use_src), &use_src},
+        {"nodata", m, &nodata},
+        {"use_nodata", sizeof(use_nodata), &use_nodata},
         {"infiltrated", m, &s->inf},
         {"infiltrated_comp", m, &s->inf_c},
         {"outflow", m, &s->out},
@@ -1699,12 +1854,12 @@ static gr_status gr_rain_runoff_enqueue(gr_rain_runoff *s, double dt, int nsteps
   }
   /* The ledger counts the steps whose launches were all enqueued, with the
    * rain the device added: the float dt it was given. */
+  /* The owned cells of the domain: no rain falls on no-data cells. */
+  double active = s->has_nodata ? s->active_own : (double)gr_rain_runoff_own_cells(s);
   double rain_sum =
-      s->has_rain ? s->rain_field_sum
-                  : (double)gr_rain_runoff_own_cells(s) * (double)(cl_float)s->params.rain_rate;
+      s->has_rain ? s->rain_field_sum : active * (double)(cl_float)s->params.rain_rate;
   if (s->hy_n && !s->has_rain) /* each step its own rate, as the device took it */
-    s->rain_volume +=
-        (double)gr_rain_runoff_own_cells(s) * rate_sum * gd->dx * gd->dy * (double)dtf;
+    s->rain_volume += active * rate_sum * gd->dx * gd->dy * (double)dtf;
   else
     s->rain_volume += rain_sum * gd->dx * gd->dy * (double)dtf * (double)done;
   /* Step by step, not dt * done: a piece that steps one step per call (to
@@ -2024,9 +2179,10 @@ static gr_status gr_rain_runoff_sample_impl(gr_rain_runoff *s, const int *ij, in
     if (st == GR_OK)
       st = gr_buffer_read(s->ctx, s->scratch, c * sizeof(float), sizeof(float), &q);
     /* The surface as WATER_SURFACE gives it: the float sum b + h. */
-    values[3 * k] = h;
-    values[3 * k + 1] = b + h;
-    values[3 * k + 2] = q;
+    int off = s->has_nodata && s->mask[c];
+    values[3 * k] = off ? NAN : h;
+    values[3 * k + 1] = off ? NAN : b + h;
+    values[3 * k + 2] = off ? NAN : q;
   }
   return st;
 }
@@ -2043,7 +2199,16 @@ gr_status gr_rain_runoff_sample(gr_rain_runoff *s, const int *ij, int n, float *
   return GR_RAIN_RUNOFF_KEEP_ERROR(s, gr_rain_runoff_sample_impl(s, ij, n, values));
 }
 
+static gr_status gr_rain_runoff_get_field_raw(gr_rain_runoff *s, gr_field f, float *host);
+
 static gr_status gr_rain_runoff_get_field_impl(gr_rain_runoff *s, gr_field f, float *host) {
+  gr_status st = gr_rain_runoff_get_field_raw(s, f, host);
+  if (st == GR_OK)
+    gr_rain_runoff_blank(s, host, f == GR_FIELD_VELOCITY ? 3 : 1);
+  return st;
+}
+
+static gr_status gr_rain_runoff_get_field_raw(gr_rain_runoff *s, gr_field f, float *host) {
   size_t cells = gr_rain_runoff_own_cells(s);
   switch (f) {
   case GR_FIELD_WATER_DEPTH:
@@ -2212,6 +2377,8 @@ static gr_status gr_rain_runoff_get_map_impl(gr_rain_runoff *s, gr_rain_runoff_m
     for (size_t c = 0; c < cells; ++c)
       host[c] = (float)gr_rain_runoff_hazard_class(host[c]);
   }
+  if (st == GR_OK)
+    gr_rain_runoff_blank(s, host, 1);
   return st;
 }
 

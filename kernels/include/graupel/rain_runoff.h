@@ -56,8 +56,17 @@
  *    fills or drains the domain toward that level; a level below the ground
  *    is a free outfall.
  * What leaves through an edge is outflow, what enters is inflow, both in
- * the ledger. The stable step counts the levels' depths over the edges'
- * lowest ground as water in the grid.
+ * the ledger.
+ *
+ * No-data cells: a NaN elevation (as real DEMs mark missing ground) puts its
+ * cell outside the domain, for either model: nothing rains, enters or is
+ * counted there, and get_field, get_map and sample give NaN there. By
+ * params.no_data it is a wall (GR_BOUNDARY_CLOSED, the default: its bed far
+ * above any ground, so no face to it carries water) or an outfall
+ * (GR_BOUNDARY_OPEN: its bed far below, so water pours over the brink as over
+ * a cliff, and what reaches the cell leaves the domain at the end of the step
+ * as outflow). Infinite elevations are still refused. The stable step counts the levels' depths
+ * over the edges' lowest ground as water in the grid.
  *
  * Fields (gr_field): set ELEVATION (required, m), optionally PERMEABILITY
  * (m/s, replaces params.permeability), RAIN_RATE (m/s, replaces
@@ -172,6 +181,10 @@ typedef struct gr_rain_runoff_params {
   /** row DebrisFactor (default 0): FD2321's DF, added to the hazard rating
    *  where the depth exceeds 0.25 m. 0 to 1. */
   double debris_factor;
+  /** row NoDataBoundary (default 1): what no-data cells (NaN elevations) are,
+   *  GR_BOUNDARY_CLOSED a wall or GR_BOUNDARY_OPEN an outfall; see "No-data
+   *  cells". */
+  gr_boundary no_data;
 } gr_rain_runoff_params;
 
 /** The table's defaults. */
