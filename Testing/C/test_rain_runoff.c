@@ -1999,7 +1999,8 @@ static void test_shared_context(void) {
 static gr_flow_model piece_model = GR_FLOW_LOCAL_INERTIAL;
 /* 1: the pieces tests with every kind of edge (the *_edges tests): a level
  * edge west (above the ground there), a transmissive one east, a wall south
- * and an outfall north; 0: every edge an outfall. */
+ * and an outfall north, inflows (piece_inflows) and two no-data holes
+ * across the splits, outfalls; 0: every edge an outfall. */
 static int piece_edges = 0;
 
 static gr_rain_runoff_params piece_params(void) {
@@ -2010,6 +2011,7 @@ static gr_rain_runoff_params piece_params(void) {
     p.boundary_level[GR_RAIN_RUNOFF_WEST] = 0.7;
     p.boundary[GR_RAIN_RUNOFF_EAST] = GR_BOUNDARY_TRANSMISSIVE;
     p.boundary[GR_RAIN_RUNOFF_SOUTH] = GR_BOUNDARY_CLOSED;
+    p.no_data = GR_BOUNDARY_OPEN; /* the no-data holes of make_domain drain */
   }
   return p;
 }
@@ -2042,6 +2044,11 @@ static domain make_domain(int nx, int ny) {
       dm.r[c] = (float)(3e-5 * hash01(i, j, 12));
       dm.k[c] = hash01(i, j, 13) < 0.5 ? 0.0f : (float)(4e-6 * hash01(i, j, 14));
       dm.d[c] = (float)(0.05 * hash01(i, j, 15));
+      /* With every kind of edge, no-data holes too, across the splits. */
+      int hole_a = i >= nx / 2 - 2 && i < nx / 2 + 2 && j >= ny / 3 && j < ny / 3 + 3;
+      int hole_b = i >= 3 && i < 6 && j >= ny / 2 - 2 && j < ny / 2 + 2;
+      if (piece_edges && (hole_a || hole_b))
+        dm.b[c] = NAN;
     }
   return dm;
 }
