@@ -175,10 +175,10 @@ GR_INLINE float gr_rain_runoff_edge_q(int kind, float q, bool low) {
 
 /* Work-item (i, j) of an (nx+1) x (ny+1) launch owns the x-face left of cell
  * (i, j) (for j < ny) and the y-face below it (for i < nx). The grid's edge
- * faces lead into the cell beyond the edge (gr_rain_runoff_ghost) and pass
- * what their kind lets through (gr_rain_runoff_edge_q); bnd and lvl hold the
- * kinds and levels of the west, east, south and north edges (a piece's
- * sides with a neighbour come as walls: their ring is refreshed anyway). The discharges of
+ * faces are those of an open edge here: they lead into a dry ghost cell at
+ * the edge cell's ground height, and only outflow passes; the edges of
+ * other kinds are rewritten by rain_runoff_flux_edges after this launch
+ * (kinds known only at run time cost this kernel half its speed on PoCL). The discharges of
  * the previous step are read from qx_old, qy_old and the new ones written
  * to qx, qy (the face arrays alternate between steps).
  *
@@ -187,15 +187,16 @@ GR_INLINE float gr_rain_runoff_edge_q(int kind, float q, bool low) {
  * (clamped indices became gathers, three times slower). A masked limiter
  * reads as 1 and a masked depth as 0: where that happens, the value is not
  * used (an edge face's discharge only ever leaves its edge cell). */
-__kernel void rain_runoff_flux(
-    __global const float *restrict h, __global const float *restrict b,
-    __global const float *restrict rain, __global const float *restrict perm,
-    __global const float *restrict src, int use_src, __global const float *restrict nodata,
-    int use_nodata, __global const float *restrict qx_old, __global const float *restrict qy_old,
-    __global float *restrict qx, __global float *restrict qy, __global const float *restrict limit,
-    int nx, int ny, float dt, float inv_dx, float inv_dy, float g, float n2,
-    __global const float *restrict n2map, int use_n2, float theta, int use_rain, float rain_uniform,
-    int use_perm, float perm_uniform, int4 bnd, float4 lvl) {
+__kernel void
+rain_runoff_flux(__global const float *restrict h, __global const float *restrict b,
+                 __global const float *restrict rain, __global const float *restrict perm,
+                 __global const float *restrict src, int use_src,
+                 __global const float *restrict nodata, int use_nodata,
+                 __global const float *restrict qx_old, __global const float *restrict qy_old,
+                 __global float *restrict qx, __global float *restrict qy,
+                 __global const float *restrict limit, int nx, int ny, float dt, float inv_dx,
+                 float inv_dy, float g, float n2, __global const float *restrict n2map, int use_n2,
+                 float theta, int use_rain, float rain_uniform, int use_perm, float perm_uniform) {
   int i = get_global_id(0), j = get_global_id(1);
   if (!gr_inside(i, j, nx + 1, ny + 1))
     return;
@@ -215,11 +216,8 @@ __kernel void rain_runoff_flux(
                     : 0.0f;
     float bw = in_w ? b[w] : 0.0f;
     float kw = in_w ? limit[w] : 1.0f;
-    float hgw, bgw, hge, bge;
-    gr_rain_runoff_ghost(bnd.x, lvl.x, hc, bc, i == 0 && nx > 1 ? b[c + 1] : bc, &hgw, &bgw);
-    gr_rain_runoff_ghost(bnd.y, lvl.y, hw, bw, i == nx && nx > 1 ? b[c - 2] : bw, &hge, &bge);
-    float hL = i == 0 ? hgw : hw, bL = i == 0 ? bgw : bw;
-    float hR = i == nx ? hge : hc, bR = i == nx ? bge : bc;
+    float hL = i == 0 ? 0.0f : hw, bL = i == 0 ? bc : bw;
+    float hR = i == nx ? 0.0f : hc, bR = i == nx ? bw : bc;
     int f = j * (nx + 1) + i;
     float own = gr_rain_runoff_limited(qx_old[f], kw, kc);
     float before =
@@ -230,8 +228,10 @@ __kernel void rain_runoff_flux(
     /* An edge face takes its one cell's roughness. */
     float n2f = gr_rain_runoff_face_n2(n2map, use_n2, n2, in_w ? w : c, i < nx ? c : w);
     float q = gr_rain_runoff_face(hL, hR, bL, bR, prev, own, dt, g, n2f, inv_dx);
-    q = i == 0 ? gr_rain_runoff_edge_q(bnd.x, q, true) : q;
-    q = i == nx ? gr_rain_runoff_edge_q(bnd.y, q, false) : q;
+    if (i == 0)
+      q = fmin(q, 0.0f);
+    if (i == nx)
+      q = fmax(q, 0.0f);
     qx[f] = q;
   }
   if (i < nx) {
@@ -242,11 +242,8 @@ __kernel void rain_runoff_flux(
                     : 0.0f;
     float bs = in_s ? b[s] : 0.0f;
     float ks = in_s ? limit[s] : 1.0f;
-    float hgs, bgs, hgn, bgn;
-    gr_rain_runoff_ghost(bnd.z, lvl.z, hc, bc, j == 0 && ny > 1 ? b[c + nx] : bc, &hgs, &bgs);
-    gr_rain_runoff_ghost(bnd.w, lvl.w, hs, bs, j == ny && ny > 1 ? b[c - 2 * nx] : bs, &hgn, &bgn);
-    float hL = j == 0 ? hgs : hs, bL = j == 0 ? bgs : bs;
-    float hR = j == ny ? hgn : hc, bR = j == ny ? bgn : bc;
+    float hL = j == 0 ? 0.0f : hs, bL = j == 0 ? bc : bs;
+    float hR = j == ny ? 0.0f : hc, bR = j == ny ? bs : bc;
     int f = c; /* y-faces are numbered like cells, with one more row */
     float own = gr_rain_runoff_limited(qy_old[f], ks, kc);
     float before =
@@ -257,10 +254,62 @@ __kernel void rain_runoff_flux(
     float prev = gr_rain_runoff_smooth(own, before, after, theta, j == 0 || j == ny);
     float n2f = gr_rain_runoff_face_n2(n2map, use_n2, n2, in_s ? s : c, j < ny ? c : s);
     float q = gr_rain_runoff_face(hL, hR, bL, bR, prev, own, dt, g, n2f, inv_dy);
-    q = j == 0 ? gr_rain_runoff_edge_q(bnd.z, q, true) : q;
-    q = j == ny ? gr_rain_runoff_edge_q(bnd.w, q, false) : q;
+    if (j == 0)
+      q = fmin(q, 0.0f);
+    if (j == ny)
+      q = fmax(q, 0.0f);
     qy[f] = q;
   }
+}
+
+/* The faces of the domain's edges whose kind is not open (those the flux
+ * kernel leaves as open), one work-item per edge face: west faces (ny), east
+ * (ny), south (nx), north (nx). Each is the flux kernel's face expression
+ * with the cell beyond the edge of its kind (gr_rain_runoff_ghost) and its
+ * own previous discharge (edges are not smoothed), passed as the kind lets
+ * it (gr_rain_runoff_edge_q): a mirrored edge gives the negated discharge. */
+__kernel void rain_runoff_flux_edges(
+    __global const float *restrict h, __global const float *restrict b,
+    __global const float *restrict rain, __global const float *restrict perm,
+    __global const float *restrict src, int use_src, __global const float *restrict nodata,
+    int use_nodata, __global const float *restrict qx_old, __global const float *restrict qy_old,
+    __global float *restrict qx, __global float *restrict qy, __global const float *restrict limit,
+    int nx, int ny, float dt, float inv_dx, float inv_dy, float g, float n2,
+    __global const float *restrict n2map, int use_n2, int use_rain, float rain_uniform,
+    int use_perm, float perm_uniform, int bnd_w, int bnd_e, int bnd_s, int bnd_n, float lvl_w,
+    float lvl_e, float lvl_s, float lvl_n) {
+  int k = get_global_id(0);
+  if (k >= 2 * (nx + ny))
+    return;
+  int side = k < ny ? 0 : (k < 2 * ny ? 1 : (k < 2 * ny + nx ? 2 : 3));
+  int t = side == 0 ? k : (side == 1 ? k - ny : (side == 2 ? k - 2 * ny : k - 2 * ny - nx));
+  int kind = side == 0 ? bnd_w : (side == 1 ? bnd_e : (side == 2 ? bnd_s : bnd_n));
+  float level = side == 0 ? lvl_w : (side == 1 ? lvl_e : (side == 2 ? lvl_s : lvl_n));
+  if (kind == GR_RAIN_RUNOFF_B_OPEN)
+    return;
+  bool xs = side < 2, low = side == 0 || side == 2;
+  int len = xs ? nx : ny, stride = xs ? 1 : nx;
+  /* The edge cell, its inner neighbour (for a transmissive edge's slope)
+   * and the face (x-face rows are nx + 1 wide; y-faces numbered like cells). */
+  int c = xs ? t * nx + (low ? 0 : nx - 1) : (low ? 0 : ny - 1) * nx + t;
+  int inner = len > 1 ? (low ? c + stride : c - stride) : c;
+  int f = xs ? t * (nx + 1) + (low ? 0 : nx) : (low ? 0 : ny) * nx + t;
+  float hc = gr_rain_runoff_wet(h[c], GR_RAIN_RUNOFF_RAIN(c), GR_RAIN_RUNOFF_SRC(c),
+                                GR_RAIN_RUNOFF_PERM(c), dt);
+  float bc = b[c], kc = limit[c];
+  float hg, bg;
+  gr_rain_runoff_ghost(kind, level, hc, bc, b[inner], &hg, &bg);
+  float old = xs ? qx_old[f] : qy_old[f];
+  float own = low ? gr_rain_runoff_limited(old, 1.0f, kc) : gr_rain_runoff_limited(old, kc, 1.0f);
+  float n2f = gr_rain_runoff_face_n2(n2map, use_n2, n2, c, c);
+  float inv_d = xs ? inv_dx : inv_dy;
+  float q = low ? gr_rain_runoff_face(hg, hc, bg, bc, own, own, dt, g, n2f, inv_d)
+                : gr_rain_runoff_face(hc, hg, bc, bg, own, own, dt, g, n2f, inv_d);
+  q = gr_rain_runoff_edge_q(kind, q, low);
+  if (xs)
+    qx[f] = q;
+  else
+    qy[f] = q;
 }
 
 /* K = min(1, depth / outgoing depth in dt), a little less when limiting (see
@@ -368,19 +417,20 @@ __kernel void rain_runoff_update(
 
 /* The sources of the next step, per cell (m/s of depth): the point inflows
  * field (pts, when use_pts) and the inflow of each domain edge's hydrograph
- * spread evenly over its cells (edge: west, east, south, north; 0 on a
+ * spread evenly over its cells (edge_*: west, east, south, north; 0 on a
  * side without one, or with a neighbour), added in that fixed order. */
 __kernel void rain_runoff_source(__global const float *restrict pts, int use_pts,
-                                 __global float *restrict src, int nx, int ny, float4 edge) {
+                                 __global float *restrict src, int nx, int ny, float edge_w,
+                                 float edge_e, float edge_s, float edge_n) {
   int i = get_global_id(0), j = get_global_id(1);
   if (!gr_inside(i, j, nx, ny))
     return;
   int c = gr_idx(i, j, nx);
   float s = use_pts ? pts[c] : 0.0f;
-  s += i == 0 ? edge.x : 0.0f;
-  s += i == nx - 1 ? edge.y : 0.0f;
-  s += j == 0 ? edge.z : 0.0f;
-  s += j == ny - 1 ? edge.w : 0.0f;
+  s += i == 0 ? edge_w : 0.0f;
+  s += i == nx - 1 ? edge_e : 0.0f;
+  s += j == 0 ? edge_s : 0.0f;
+  s += j == ny - 1 ? edge_n : 0.0f;
   src[c] = s;
 }
 
@@ -785,7 +835,8 @@ GR_INLINE void gr_sw_stage(
     __global float *restrict outflow, __global float *restrict outflow_comp,
     __global float *restrict inflow, __global float *restrict inflow_comp, int nx, int ny, float dt,
     float inv_dx, float inv_dy, float g, float n2, __global const float *restrict n2map, int use_n2,
-    int use_rain, float rain_uniform, int use_perm, float perm_uniform, int4 bnd, float4 lvl,
+    int use_rain, float rain_uniform, int use_perm, float perm_uniform, int bnd_w, int bnd_e,
+    int bnd_s, int bnd_n, float lvl_w, float lvl_e, float lvl_s, float lvl_n,
     __global const float *restrict sh, __global const float *restrict su,
     __global const float *restrict sv, const int stage) {
   int i = get_global_id(0), j = get_global_id(1);
@@ -812,9 +863,9 @@ GR_INLINE void gr_sw_stage(
 #undef GR_SW_LOAD
   gr_sw_pt y2 = {x2.h, x2.b, x2.ut, x2.un};
   float dhx, dqx_x, dqy_x, olx, ohx, dhy, dqy_y, dqx_y, oly, ohy;
-  gr_sw_axis(x0, x1, x2, x3, x4, i, nx, bnd.x, bnd.y, lvl.x, lvl.y, g, &dhx, &dqx_x, &dqy_x, &olx,
+  gr_sw_axis(x0, x1, x2, x3, x4, i, nx, bnd_w, bnd_e, lvl_w, lvl_e, g, &dhx, &dqx_x, &dqy_x, &olx,
              &ohx);
-  gr_sw_axis(y0, y1, y2, y3, y4, j, ny, bnd.z, bnd.w, lvl.z, lvl.w, g, &dhy, &dqy_y, &dqx_y, &oly,
+  gr_sw_axis(y0, y1, y2, y3, y4, j, ny, bnd_s, bnd_n, lvl_s, lvl_n, g, &dhy, &dqy_y, &dqx_y, &oly,
              &ohy);
   float dh = dt * (dhx * inv_dx + dhy * inv_dy);
   float hn = x2.h + dh;
@@ -886,12 +937,13 @@ GR_INLINE void gr_sw_stage(
       __global float *restrict outflow_comp, __global float *restrict inflow,                      \
       __global float *restrict inflow_comp, int nx, int ny, float dt, float inv_dx, float inv_dy,  \
       float g, float n2, __global const float *restrict n2map, int use_n2, int use_rain,           \
-      float rain_uniform, int use_perm, float perm_uniform, int4 bnd, float4 lvl
+      float rain_uniform, int use_perm, float perm_uniform, int bnd_w, int bnd_e, int bnd_s,       \
+      int bnd_n, float lvl_w, float lvl_e, float lvl_s, float lvl_n
 #define GR_SW_STAGE_PASS                                                                           \
   h, qu, qv, h_comp, h1, qu1, qv1, dh1, b, rain, perm, src, use_src, nodata, use_nodata,           \
       infiltrated, infiltrated_comp, outflow, outflow_comp, inflow, inflow_comp, nx, ny, dt,       \
-      inv_dx, inv_dy, g, n2, n2map, use_n2, use_rain, rain_uniform, use_perm, perm_uniform, bnd,   \
-      lvl
+      inv_dx, inv_dy, g, n2, n2map, use_n2, use_rain, rain_uniform, use_perm, perm_uniform, bnd_w, \
+      bnd_e, bnd_s, bnd_n, lvl_w, lvl_e, lvl_s, lvl_n
 
 __kernel void rain_runoff_sw_stage1(GR_SW_STAGE_ARGS) {
   gr_sw_stage(GR_SW_STAGE_PASS, h, qu, qv, 1);

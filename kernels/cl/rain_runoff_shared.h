@@ -27,7 +27,8 @@
 #define GR_RAIN_RUNOFF_SUMS 4
 
 /* Edge kinds, the values of gr_boundary (graupel/rain_runoff.h), as the
- * kernels get them (int4 bnd: west, east, south, north). */
+ * kernels get them (bnd_w, bnd_e, bnd_s, bnd_n: scalar arguments; int4 ones
+ * kept PoCL from vectorising the local inertial flux kernel, 2x slower). */
 #define GR_RAIN_RUNOFF_B_OPEN 0
 #define GR_RAIN_RUNOFF_B_CLOSED 1
 #define GR_RAIN_RUNOFF_B_TRANSMISSIVE 2

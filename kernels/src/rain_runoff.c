@@ -102,7 +102,7 @@ struct gr_rain_runoff {
   int nxl, nyl;
   int ring[4]; /* gr_rain_runoff_side order: west, east, south, north */
   gr_rain_runoff_params params;
-  cl_kernel flux, limit, update, reduce, derive, sw_stage[2], sw_speed, maps, source;
+  cl_kernel flux, flux_edges, limit, update, reduce, derive, sw_stage[2], sw_speed, maps, source;
   cl_mem h, h_c, b, k, inf, inf_c, out, out_c;
   cl_mem in, in_c; /* inflow (edges and sources), per cell (m), and its compensation */
   /* Sources (m/s of depth): the point inflows' field (pts, once set) and
@@ -672,6 +672,8 @@ gr_status gr_rain_runoff_create(gr_context *ctx, const gr_grid *grid,
   if (st == GR_OK)
     st = gr_kernel_create(ctx, prog, "rain_runoff_flux", &s->flux);
   if (st == GR_OK)
+    st = gr_kernel_create(ctx, prog, "rain_runoff_flux_edges", &s->flux_edges);
+  if (st == GR_OK)
     st = gr_kernel_create(ctx, prog, "rain_runoff_limit", &s->limit);
   if (st == GR_OK)
     st = gr_kernel_create(ctx, prog, "rain_runoff_update", &s->update);
@@ -732,8 +734,9 @@ gr_status gr_rain_runoff_create(gr_context *ctx, const gr_grid *grid,
 void gr_rain_runoff_destroy(gr_rain_runoff *s) {
   if (!s)
     return;
-  cl_kernel kernels[] = {s->flux,        s->limit,       s->update,   s->reduce, s->derive,
-                         s->sw_stage[0], s->sw_stage[1], s->sw_speed, s->maps,   s->source};
+  cl_kernel kernels[] = {s->flux,   s->limit,       s->update,      s->reduce,
+                         s->derive, s->sw_stage[0], s->sw_stage[1], s->sw_speed,
+                         s->maps,   s->source,      s->flux_edges};
   for (size_t i = 0; i < sizeof(kernels) / sizeof(kernels[0]); ++i)
     if (kernels[i])
       clReleaseKernel(kernels[i]);
@@ -1585,21 +1588,27 @@ static double gr_rain_runoff_edge_cells(const gr_rain_runoff *s, int side) {
  * and each edge's mean discharge over the step (the exact integral of its
  * table, over t1 - t0), spread over the edge's cells, as m/s of depth. */
 static gr_status gr_rain_runoff_sources_update(gr_rain_runoff *s, double t0, double t1) {
-  cl_float4 edge;
+  cl_float edge[4];
   for (int e = 0; e < 4; ++e) {
     double rate = 0.0;
     if (s->edge_n[e] && !s->ring[e] && t1 > t0)
       rate = gr_rain_runoff_table_integral(s->edge_t[e], s->edge_q[e], s->edge_n[e], t0, t1) /
              (t1 - t0) / (gr_rain_runoff_edge_cells(s, e) * s->grid.dx * s->grid.dy);
-    edge.s[e] = (cl_float)rate;
+    edge[e] = (cl_float)rate;
   }
   cl_int nx = s->nxl, ny = s->nyl, use_pts = s->has_pts;
   cl_mem pts = s->has_pts ? s->pts : s->dummy;
   const size_t m = sizeof(cl_mem);
   const gr_rain_runoff_arg args[] = {
-      {"pts", m, &pts},        {"use_pts", sizeof(use_pts), &use_pts},
-      {"src", m, &s->src},     {"nx", sizeof(nx), &nx},
-      {"ny", sizeof(ny), &ny}, {"edge", sizeof(edge), &edge},
+      {"pts", m, &pts},
+      {"use_pts", sizeof(use_pts), &use_pts},
+      {"src", m, &s->src},
+      {"nx", sizeof(nx), &nx},
+      {"ny", sizeof(ny), &ny},
+      {"edge_w", sizeof(cl_float), &edge[0]},
+      {"edge_e", sizeof(cl_float), &edge[1]},
+      {"edge_s", sizeof(cl_float), &edge[2]},
+      {"edge_n", sizeof(cl_float), &edge[3]},
   };
   gr_status st = GR_RAIN_RUNOFF_ARGS(s, s->source, args);
   if (st == GR_OK)
@@ -1631,9 +1640,10 @@ static gr_status gr_rain_runoff_hyetograph_step(gr_rain_runoff *s, double t0, do
   cl_float rf =
       (cl_float)(gr_rain_runoff_table_integral(s->hy_t, s->hy_r, s->hy_n, t0, t1) / (t1 - t0));
   int sw = s->params.flow_model == GR_FLOW_SHALLOW_WATER;
-  cl_kernel li[3] = {s->flux, s->limit, s->update}, swk[2] = {s->sw_stage[0], s->sw_stage[1]};
+  cl_kernel li[4] = {s->flux, s->flux_edges, s->limit, s->update};
+  cl_kernel swk[2] = {s->sw_stage[0], s->sw_stage[1]};
   gr_status st = GR_OK;
-  for (int k = 0; st == GR_OK && k < (sw ? 2 : 3); ++k)
+  for (int k = 0; st == GR_OK && k < (sw ? 2 : 4); ++k)
     st = gr_kernel_arg(s->ctx, sw ? swk[k] : li[k], "rain_uniform", sizeof(rf), &rf);
   if (st == GR_OK)
     *sum += (double)rf;
@@ -1666,15 +1676,15 @@ static gr_status gr_rain_runoff_bind(gr_rain_runoff *s, cl_float dt) {
   cl_float n2 = (cl_float)(p->manning_n * p->manning_n);
   cl_int use_rain = s->has_rain, use_perm = s->has_perm;
   cl_float rain_uniform = (cl_float)p->rain_rate, perm_uniform = (cl_float)p->permeability;
-  /* The domain's edges' kinds and levels; a side with a neighbour is a
-   * wall (its ring is refreshed from the neighbour after every step). */
-  cl_int4 bnd;
-  cl_float4 lvl;
+  /* The domain's edges' kinds and levels; a side with a neighbour is open
+   * (its ring is refreshed from the neighbour after every step). */
+  cl_int bnd[4];
+  cl_float lvl[4];
   for (int e = 0; e < 4; ++e) {
     int kind; /* any bit pattern the enum may hold: validated as a whole number 0-3 */
     memcpy(&kind, &p->boundary[e], sizeof(kind));
-    bnd.s[e] = s->ring[e] ? GR_RAIN_RUNOFF_B_CLOSED : kind;
-    lvl.s[e] = (cl_float)p->boundary_level[e];
+    bnd[e] = s->ring[e] ? GR_RAIN_RUNOFF_B_OPEN : kind;
+    lvl[e] = (cl_float)p->boundary_level[e];
   }
   cl_mem rain = s->has_rain ? s->rain : s->dummy, perm = s->has_perm ? s->perm : s->dummy;
   cl_int use_src = gr_rain_runoff_has_sources(s);
@@ -1711,9 +1721,12 @@ static gr_status gr_rain_runoff_bind(gr_rain_runoff *s, cl_float dt) {
       {"n2", sizeof(n2), &n2},
       {"n2map", m, &n2map},
       {"use_n2", sizeof(use_n2), &use_n2},
-      {"theta", sizeof(theta), &theta},
-      {"bnd", sizeof(bnd), &bnd},
-      {"lvl", sizeof(lvl), &lvl},
+  };
+  const gr_rain_runoff_arg edges[] = {
+      {"bnd_w", sizeof(cl_int), &bnd[0]},   {"bnd_e", sizeof(cl_int), &bnd[1]},
+      {"bnd_s", sizeof(cl_int), &bnd[2]},   {"bnd_n", sizeof(cl_int), &bnd[3]},
+      {"lvl_w", sizeof(cl_float), &lvl[0]}, {"lvl_e", sizeof(cl_float), &lvl[1]},
+      {"lvl_s", sizeof(cl_float), &lvl[2]}, {"lvl_n", sizeof(cl_float), &lvl[3]},
   };
   const gr_rain_runoff_arg update[] = {
       {"h_comp", m, &s->h_c},
@@ -1760,8 +1773,14 @@ static gr_status gr_rain_runoff_bind(gr_rain_runoff *s, cl_float dt) {
         {"perm_uniform", sizeof(perm_uniform), &perm_uniform},
         {"inflow", m, &s->in},
         {"inflow_comp", m, &s->in_c},
-        {"bnd", sizeof(bnd), &bnd},
-        {"lvl", sizeof(lvl), &lvl},
+        {"bnd_w", sizeof(cl_int), &bnd[0]},
+        {"bnd_e", sizeof(cl_int), &bnd[1]},
+        {"bnd_s", sizeof(cl_int), &bnd[2]},
+        {"bnd_n", sizeof(cl_int), &bnd[3]},
+        {"lvl_w", sizeof(cl_float), &lvl[0]},
+        {"lvl_e", sizeof(cl_float), &lvl[1]},
+        {"lvl_s", sizeof(cl_float), &lvl[2]},
+        {"lvl_n", sizeof(cl_float), &lvl[3]},
     };
     gr_status st = GR_RAIN_RUNOFF_ARGS(s, s->sw_stage[0], sw);
     if (st == GR_OK)
@@ -1770,12 +1789,18 @@ static gr_status gr_rain_runoff_bind(gr_rain_runoff *s, cl_float dt) {
     s->args_dt = dt;
     return st;
   }
-  cl_kernel kernels[] = {s->flux, s->limit, s->update};
+  cl_kernel kernels[] = {s->flux, s->flux_edges, s->limit, s->update};
   gr_status st = GR_OK;
-  for (int i = 0; st == GR_OK && i < 3; ++i)
+  for (int i = 0; st == GR_OK && i < 4; ++i)
     st = GR_RAIN_RUNOFF_ARGS(s, kernels[i], common);
   if (st == GR_OK)
     st = GR_RAIN_RUNOFF_ARGS(s, s->flux, flux);
+  if (st == GR_OK)
+    st = GR_RAIN_RUNOFF_ARGS(s, s->flux_edges, flux);
+  if (st == GR_OK)
+    st = gr_kernel_arg(s->ctx, s->flux, "theta", sizeof(theta), &theta);
+  if (st == GR_OK)
+    st = GR_RAIN_RUNOFF_ARGS(s, s->flux_edges, edges);
   if (st == GR_OK)
     st = GR_RAIN_RUNOFF_ARGS(s, s->update, update);
   s->args_set = st == GR_OK;
@@ -1798,6 +1823,10 @@ static gr_status gr_rain_runoff_enqueue(gr_rain_runoff *s, double dt, int nsteps
    * arrival times). */
   double t_end = s->time;
   int per_step = gr_rain_runoff_has_edge_inflow(s);
+  /* Any of the domain's edges not open: rain_runoff_flux_edges rewrites it. */
+  int edges = 0;
+  for (int e = 0; e < 4; ++e)
+    edges |= !s->ring[e] && s->params.boundary[e] != GR_BOUNDARY_OPEN;
   double rate_sum = 0.0; /* the hyetograph's rates the steps took (m/s, floats) */
   while (sw && st == GR_OK && done < nsteps && !*stop) {
     if (per_step)
@@ -1831,12 +1860,17 @@ static gr_status gr_rain_runoff_enqueue(gr_rain_runoff *s, double dt, int nsteps
       st = gr_rain_runoff_hyetograph_step(s, t_end, t_end + dt, &rate_sum);
     if (st == GR_OK)
       st = GR_RAIN_RUNOFF_ARGS(s, s->flux, flux);
+    if (st == GR_OK && edges)
+      st = GR_RAIN_RUNOFF_ARGS(s, s->flux_edges, flux);
     if (st == GR_OK)
       st = GR_RAIN_RUNOFF_ARGS(s, s->limit, faces);
     if (st == GR_OK)
       st = GR_RAIN_RUNOFF_ARGS(s, s->update, faces);
     if (st == GR_OK)
       st = gr_enqueue_2d(s->ctx, s->flux, 0, 0, (size_t)s->nxl + 1, (size_t)s->nyl + 1, NULL);
+    /* The edges that are not open, after the flux kernel wrote them so. */
+    if (st == GR_OK && edges)
+      st = gr_enqueue_1d(s->ctx, s->flux_edges, 2 * ((size_t)s->nxl + (size_t)s->nyl));
     if (st == GR_OK)
       s->cur = now; /* the flux kernel is enqueued: the new faces are current */
     if (st == GR_OK)
