@@ -726,12 +726,16 @@ GR_INLINE void gr_sw_axis(gr_sw_pt p0, gr_sw_pt p1, gr_sw_pt p2, gr_sw_pt p3, gr
        thi = kind_hi == GR_RAIN_RUNOFF_B_TRANSMISSIVE;
   /* The edge cell's inner neighbour, where the edge is this cell's. */
   gr_sw_pt in_lo = gr_sw_pick_pt(i + 1 < n, p3, p2), in_hi = gr_sw_pick_pt(i > 0, p1, p2);
-  p0 = gr_sw_pick_pt(tlo && i == 0, gr_sw_extend(p2, in_lo, 2.0f),
-                     gr_sw_pick_pt(tlo && i == 1, gr_sw_extend(p1, p2, 1.0f), p0));
-  p1 = gr_sw_pick_pt(tlo && i == 0, gr_sw_extend(p2, in_lo, 1.0f), p1);
-  p4 = gr_sw_pick_pt(thi && i == n - 1, gr_sw_extend(p2, in_hi, 2.0f),
-                     gr_sw_pick_pt(thi && i == n - 2, gr_sw_extend(p3, p2, 1.0f), p4));
-  p3 = gr_sw_pick_pt(thi && i == n - 1, gr_sw_extend(p2, in_hi, 1.0f), p3);
+  /* A branch on the arguments alone (the same for every work-item): a grid
+   * without transmissive edges pays nothing for them. */
+  if (tlo || thi) {
+    p0 = gr_sw_pick_pt(tlo && i == 0, gr_sw_extend(p2, in_lo, 2.0f),
+                       gr_sw_pick_pt(tlo && i == 1, gr_sw_extend(p1, p2, 1.0f), p0));
+    p1 = gr_sw_pick_pt(tlo && i == 0, gr_sw_extend(p2, in_lo, 1.0f), p1);
+    p4 = gr_sw_pick_pt(thi && i == n - 1, gr_sw_extend(p2, in_hi, 2.0f),
+                       gr_sw_pick_pt(thi && i == n - 2, gr_sw_extend(p3, p2, 1.0f), p4));
+    p3 = gr_sw_pick_pt(thi && i == n - 1, gr_sw_extend(p2, in_hi, 1.0f), p3);
+  }
   bool lo = i > 0 || tlo, hi = i < n - 1 || thi;
   gr_sw_cell C = gr_sw_recon(p1, p2, p3, lo && hi);
   gr_sw_cell W = gr_sw_recon(p0, p1, p2, i > 1 || tlo);
