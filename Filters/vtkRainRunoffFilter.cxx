@@ -46,7 +46,7 @@ const gr_param_bound *Bound(const char *property) {
 } // namespace
 
 vtkRainRunoffFilter::vtkRainRunoffFilter() {
-  this->SetNumberOfInputPorts(3);
+  this->SetNumberOfInputPorts(4);
   this->SetNumberOfOutputPorts(2);
 }
 
@@ -55,7 +55,27 @@ vtkRainRunoffFilter::vtkRainRunoffFilter() {
 GRAUPEL_TABLE_SETTER(vtkRainRunoffFilter, RainRate, double, gr_rain_runoff_param_bounds)
 GRAUPEL_TABLE_SETTER(vtkRainRunoffFilter, Permeability, double, gr_rain_runoff_param_bounds)
 GRAUPEL_TABLE_SETTER(vtkRainRunoffFilter, ManningN, double, gr_rain_runoff_param_bounds)
-GRAUPEL_TABLE_SETTER(vtkRainRunoffFilter, Boundary, int, gr_rain_runoff_param_bounds)
+GRAUPEL_TABLE_SETTER(vtkRainRunoffFilter, BoundaryWest, int, gr_rain_runoff_param_bounds)
+GRAUPEL_TABLE_SETTER(vtkRainRunoffFilter, BoundaryEast, int, gr_rain_runoff_param_bounds)
+GRAUPEL_TABLE_SETTER(vtkRainRunoffFilter, BoundarySouth, int, gr_rain_runoff_param_bounds)
+GRAUPEL_TABLE_SETTER(vtkRainRunoffFilter, BoundaryNorth, int, gr_rain_runoff_param_bounds)
+GRAUPEL_TABLE_SETTER(vtkRainRunoffFilter, LevelWest, double, gr_rain_runoff_param_bounds)
+GRAUPEL_TABLE_SETTER(vtkRainRunoffFilter, LevelEast, double, gr_rain_runoff_param_bounds)
+GRAUPEL_TABLE_SETTER(vtkRainRunoffFilter, LevelSouth, double, gr_rain_runoff_param_bounds)
+GRAUPEL_TABLE_SETTER(vtkRainRunoffFilter, LevelNorth, double, gr_rain_runoff_param_bounds)
+GRAUPEL_TABLE_SETTER(vtkRainRunoffFilter, NoDataBoundary, int, gr_rain_runoff_param_bounds)
+
+void vtkRainRunoffFilter::SetBoundary(int value) {
+  this->SetBoundaryWest(value);
+  this->SetBoundaryEast(value);
+  this->SetBoundarySouth(value);
+  this->SetBoundaryNorth(value);
+}
+
+int vtkRainRunoffFilter::GetBoundary() {
+  const int w = this->BoundaryWest;
+  return w == this->BoundaryEast && w == this->BoundarySouth && w == this->BoundaryNorth ? w : -1;
+}
 GRAUPEL_TABLE_SETTER(vtkRainRunoffFilter, FlowModel, int, gr_rain_runoff_param_bounds)
 GRAUPEL_TABLE_SETTER(vtkRainRunoffFilter, MaxTimeStep, double, gr_rain_runoff_param_bounds)
 GRAUPEL_TABLE_SETTER(vtkRainRunoffFilter, CourantNumber, double, gr_rain_runoff_param_bounds)
@@ -66,11 +86,23 @@ int vtkRainRunoffFilter::CheckParameters() {
   const struct {
     const char *property;
     double value;
-  } values[] = {{"RainRate", this->RainRate},           {"Permeability", this->Permeability},
-                {"ManningN", this->ManningN},           {"Boundary", double(this->Boundary)},
-                {"MaxTimeStep", this->MaxTimeStep},     {"CourantNumber", this->CourantNumber},
-                {"FlowModel", double(this->FlowModel)}, {"WettingDepth", this->WettingDepth},
-                {"DebrisFactor", this->DebrisFactor}};
+  } values[] = {{"RainRate", this->RainRate},
+                {"Permeability", this->Permeability},
+                {"ManningN", this->ManningN},
+                {"BoundaryWest", double(this->BoundaryWest)},
+                {"BoundaryEast", double(this->BoundaryEast)},
+                {"BoundarySouth", double(this->BoundarySouth)},
+                {"BoundaryNorth", double(this->BoundaryNorth)},
+                {"LevelWest", this->LevelWest},
+                {"LevelEast", this->LevelEast},
+                {"LevelSouth", this->LevelSouth},
+                {"LevelNorth", this->LevelNorth},
+                {"MaxTimeStep", this->MaxTimeStep},
+                {"CourantNumber", this->CourantNumber},
+                {"FlowModel", double(this->FlowModel)},
+                {"WettingDepth", this->WettingDepth},
+                {"DebrisFactor", this->DebrisFactor},
+                {"NoDataBoundary", double(this->NoDataBoundary)}};
   for (const auto &p : values) {
     const gr_param_bound *b = Bound(p.property);
     if (!b) {
@@ -101,6 +133,59 @@ void vtkRainRunoffFilter::SetPermeabilityMapConnection(vtkAlgorithmOutput *outpu
 void vtkRainRunoffFilter::SetGaugesConnection(vtkAlgorithmOutput *output) {
   this->SetInputConnection(2, output);
 }
+
+void vtkRainRunoffFilter::SetInflowsConnection(vtkAlgorithmOutput *output) {
+  this->SetInputConnection(3, output);
+}
+
+void vtkRainRunoffFilter::AddInflow(int side, double time, double discharge) {
+  this->InflowTimes[side].push_back(time);
+  this->InflowDischarges[side].push_back(discharge);
+  this->Modified();
+}
+
+void vtkRainRunoffFilter::RemoveAllInflow(int side) {
+  if (!this->InflowTimes[side].empty()) {
+    this->InflowTimes[side].clear();
+    this->InflowDischarges[side].clear();
+    this->Modified();
+  }
+}
+
+void vtkRainRunoffFilter::AddHyetograph(double time, double rate) {
+  this->HyetographTimes.push_back(time);
+  this->HyetographRates.push_back(rate);
+  this->Modified();
+}
+
+void vtkRainRunoffFilter::RemoveAllHyetograph() {
+  if (!this->HyetographTimes.empty()) {
+    this->HyetographTimes.clear();
+    this->HyetographRates.clear();
+    this->Modified();
+  }
+}
+
+int vtkRainRunoffFilter::GetNumberOfHyetographRows() {
+  return static_cast<int>(this->HyetographTimes.size());
+}
+
+int vtkRainRunoffFilter::GetNumberOfInflowRows(int side) {
+  return side >= 0 && side < 4 ? static_cast<int>(this->InflowTimes[side].size()) : 0;
+}
+
+#define GRAUPEL_RAIN_RUNOFF_INFLOW(Side, index)                                                    \
+  void vtkRainRunoffFilter::AddInflow##Side(double time, double discharge) {                       \
+    this->AddInflow(index, time, discharge);                                                       \
+  }                                                                                                \
+  void vtkRainRunoffFilter::RemoveAllInflow##Side() {                                              \
+    this->RemoveAllInflow(index);                                                                  \
+  }
+GRAUPEL_RAIN_RUNOFF_INFLOW(West, 0)
+GRAUPEL_RAIN_RUNOFF_INFLOW(East, 1)
+GRAUPEL_RAIN_RUNOFF_INFLOW(South, 2)
+GRAUPEL_RAIN_RUNOFF_INFLOW(North, 3)
+#undef GRAUPEL_RAIN_RUNOFF_INFLOW
 
 int vtkRainRunoffFilter::FillOutputPortInformation(int port, vtkInformation *info) {
   info->Set(vtkDataObject::DATA_TYPE_NAME(), port == 0 ? "vtkImageData" : "vtkTable");
@@ -164,7 +249,7 @@ int vtkRainRunoffFilter::RequestData(vtkInformation *request, vtkInformationVect
 }
 
 int vtkRainRunoffFilter::FillInputPortInformation(int port, vtkInformation *info) {
-  info->Set(vtkAlgorithm::INPUT_REQUIRED_DATA_TYPE(), port == 2 ? "vtkPointSet" : "vtkImageData");
+  info->Set(vtkAlgorithm::INPUT_REQUIRED_DATA_TYPE(), port >= 2 ? "vtkPointSet" : "vtkImageData");
   if (port >= 1) {
     info->Set(vtkAlgorithm::INPUT_IS_OPTIONAL(), 1);
   }
@@ -212,14 +297,23 @@ int vtkRainRunoffFilter::SetUpState(vtkInformationVector **inputVector) {
   if (vtkDataArray *rain = pd->GetArray("rain_rate")) {
     uploads.push_back({GR_FIELD_RAIN_RATE, AsFloat(rain), "Input"});
   }
+  // The Manning map: the terrain's manning_n, or the PermeabilityMap's.
+  vtkDataArray *manning = pd->GetArray("manning_n");
+  const char *manningWhere = "Input";
   if (map) {
     int mdims[3];
     map->GetDimensions(mdims);
     vtkDataArray *k = map->GetPointData()->GetArray("permeability");
-    if (!k) {
-      vtkErrorMacro("Rain Runoff's PermeabilityMap has no point array 'permeability' (m/s); "
-                    "name the map's array so, or disconnect the map to use Permeability.");
+    vtkDataArray *mn = map->GetPointData()->GetArray("manning_n");
+    if (!k && !mn) {
+      vtkErrorMacro("Rain Runoff's PermeabilityMap has no point array 'permeability' (m/s) or "
+                    "'manning_n' (s/m^(1/3)); name the map's array so, or disconnect the map to "
+                    "use Permeability and ManningN.");
       return 0;
+    }
+    if (mn) {
+      manning = mn;
+      manningWhere = "PermeabilityMap";
     }
     if (mdims[0] != dims[0] || mdims[1] != dims[1] || mdims[2] != dims[2]) {
       vtkErrorMacro("Rain Runoff's PermeabilityMap has "
@@ -228,7 +322,9 @@ int vtkRainRunoffFilter::SetUpState(vtkInformationVector **inputVector) {
                     << dims[2] << "; resample the map onto the terrain's grid.");
       return 0;
     }
-    uploads.push_back({GR_FIELD_PERMEABILITY, AsFloat(k), "PermeabilityMap"});
+    if (k) {
+      uploads.push_back({GR_FIELD_PERMEABILITY, AsFloat(k), "PermeabilityMap"});
+    }
   }
   const size_t npoints = static_cast<size_t>(dims[0]) * static_cast<size_t>(dims[1]);
   char msg[512];
@@ -255,10 +351,17 @@ int vtkRainRunoffFilter::SetUpState(vtkInformationVector **inputVector) {
   p.manning_n = this->ManningN;
   p.cfl = this->CourantNumber;
   p.max_dt = this->MaxTimeStep;
-  p.boundary = this->Boundary == CLOSED ? GR_BOUNDARY_CLOSED : GR_BOUNDARY_OPEN;
+  const int kinds[4] = {this->BoundaryWest, this->BoundaryEast, this->BoundarySouth,
+                        this->BoundaryNorth};
+  const double levels[4] = {this->LevelWest, this->LevelEast, this->LevelSouth, this->LevelNorth};
+  for (int e = 0; e < 4; ++e) {
+    p.boundary[e] = static_cast<gr_boundary>(kinds[e]);
+    p.boundary_level[e] = levels[e];
+  }
   p.flow_model = this->FlowModel == LOCAL_INERTIAL ? GR_FLOW_LOCAL_INERTIAL : GR_FLOW_SHALLOW_WATER;
   p.wetting_depth = this->WettingDepth;
   p.debris_factor = this->DebrisFactor;
+  p.no_data = this->NoDataBoundary == OPEN ? GR_BOUNDARY_OPEN : GR_BOUNDARY_CLOSED;
   if (gr_rain_runoff_params_validate(&p, msg, sizeof(msg)) != GR_OK) {
     vtkErrorMacro("Rain Runoff: " << msg);
     return 0;
@@ -307,11 +410,104 @@ int vtkRainRunoffFilter::SetUpState(vtkInformationVector **inputVector) {
                                  gr_rain_runoff_last_error(this->Simulation));
     }
   }
+  // The Manning map, in double (n^2 then rounds as ManningN's does).
+  if (manning) {
+    if (manning->GetNumberOfComponents() != 1 ||
+        static_cast<size_t>(manning->GetNumberOfTuples()) != npoints) {
+      vtkErrorMacro("Rain Runoff's " << manningWhere
+                                     << " array 'manning_n' must have one value per point.");
+      return 0;
+    }
+    std::vector<double> n(npoints);
+    for (size_t c = 0; c < npoints; ++c) {
+      n[c] = manning->GetComponent(static_cast<vtkIdType>(c), 0);
+    }
+    if (gr_rain_runoff_set_manning_map(this->Simulation, n.data()) != GR_OK) {
+      vtkErrorMacro("Rain Runoff's " << manningWhere << ": "
+                                     << gr_rain_runoff_last_error(this->Simulation));
+      return 0;
+    }
+  }
+  // The hyetograph, in m/s.
+  if (!this->HyetographTimes.empty()) {
+    std::vector<double> rates(this->HyetographRates);
+    for (double &r : rates) {
+      r *= MillimetresPerHour;
+    }
+    if (gr_rain_runoff_set_hyetograph(this->Simulation, this->HyetographTimes.data(), rates.data(),
+                                      static_cast<int>(this->HyetographTimes.size())) != GR_OK) {
+      vtkErrorMacro("Rain Runoff's Hyetograph: " << gr_rain_runoff_last_error(this->Simulation));
+      return 0;
+    }
+  }
+  // The inflows: each edge's hydrograph, and the points with a discharge.
+  const char *sides[4] = {"InflowWest", "InflowEast", "InflowSouth", "InflowNorth"};
+  for (int e = 0; e < 4; ++e) {
+    if (gr_rain_runoff_set_edge_inflow(this->Simulation, e, this->InflowTimes[e].data(),
+                                       this->InflowDischarges[e].data(),
+                                       static_cast<int>(this->InflowTimes[e].size())) != GR_OK) {
+      vtkErrorMacro("Rain Runoff's " << sides[e] << ": "
+                                     << gr_rain_runoff_last_error(this->Simulation));
+      return 0;
+    }
+  }
+  if (!this->SetPointInflows(inputVector, terrain)) {
+    return 0;
+  }
   // Progress with the simulated time, and an abort inside a long interval.
   gr_rain_runoff_set_progress(this->Simulation, &vtkGraupelSimulation::CoreProgress, this);
   this->Ledgers.clear();
   this->GaugeRows.clear();
   return this->RecordLedger(0);
+}
+
+int vtkRainRunoffFilter::SetPointInflows(vtkInformationVector **inputVector,
+                                         vtkImageData *terrain) {
+  vtkPointSet *points = inputVector[3]->GetNumberOfInformationObjects()
+                            ? vtkPointSet::GetData(inputVector[3])
+                            : nullptr;
+  if (!points) {
+    return 1;
+  }
+  vtkDataArray *q = points->GetPointData()->GetArray("discharge");
+  const vtkIdType n = points->GetNumberOfPoints();
+  if (n > 0 && (!q || q->GetNumberOfComponents() != 1)) {
+    vtkErrorMacro("Rain Runoff's Inflows need the point array 'discharge' (m^3/s, one value per "
+                  "point); add it, or disconnect the Inflows input.");
+    return 0;
+  }
+  int ext[6], dims[3];
+  terrain->GetExtent(ext);
+  terrain->GetDimensions(dims);
+  const double *origin = terrain->GetOrigin(), *spacing = terrain->GetSpacing();
+  std::vector<int> ij;
+  std::vector<double> discharge;
+  for (vtkIdType k = 0; k < n; ++k) {
+    double x[3];
+    points->GetPoint(k, x);
+    const double fi = (x[0] - origin[0]) / spacing[0] - ext[0];
+    const double fj = (x[1] - origin[1]) / spacing[1] - ext[2];
+    const bool finite = std::isfinite(fi) && std::isfinite(fj);
+    const long long ci = finite ? std::llround(fi) : -1, cj = finite ? std::llround(fj) : -1;
+    if (ci < 0 || cj < 0 || ci >= dims[0] || cj >= dims[1]) {
+      vtkErrorMacro("Rain Runoff's Inflows point "
+                    << k << " at (" << x[0] << ", " << x[1] << ") lies off the terrain (x "
+                    << origin[0] + ext[0] * spacing[0] << " to " << origin[0] + ext[1] * spacing[0]
+                    << " m, y " << origin[1] + ext[2] * spacing[1] << " to "
+                    << origin[1] + ext[3] * spacing[1]
+                    << " m); move it onto the terrain or remove it.");
+      return 0;
+    }
+    ij.push_back(static_cast<int>(ci));
+    ij.push_back(static_cast<int>(cj));
+    discharge.push_back(q->GetComponent(k, 0));
+  }
+  if (gr_rain_runoff_set_point_inflows(this->Simulation, ij.data(), discharge.data(),
+                                       static_cast<int>(n)) != GR_OK) {
+    vtkErrorMacro("Rain Runoff's Inflows: " << gr_rain_runoff_last_error(this->Simulation));
+    return 0;
+  }
+  return 1;
 }
 
 int vtkRainRunoffFilter::RecordLedger(int index) {
@@ -326,7 +522,8 @@ int vtkRainRunoffFilter::RecordLedger(int index) {
   }
   this->Ledgers[static_cast<size_t>(index)] = {this->GetOutputTime(index), ledger.rain_volume,
                                                ledger.infiltrated_volume,  ledger.outflow_volume,
-                                               ledger.stored_volume,       ledger.balance_error};
+                                               ledger.stored_volume,       ledger.balance_error,
+                                               ledger.inflow_volume};
   const int gauges = static_cast<int>(this->GaugeCells.size() / 2);
   if (this->GaugeRows.size() <= static_cast<size_t>(index)) {
     this->GaugeRows.resize(static_cast<size_t>(index) + 1);
@@ -406,6 +603,7 @@ int vtkRainRunoffFilter::FillOutput(vtkDataObject *outputObject, vtkInformation 
   AddValue(fd, "rain_volume", ledger.rain_volume);
   AddValue(fd, "infiltrated_volume", ledger.infiltrated_volume);
   AddValue(fd, "outflow_volume", ledger.outflow_volume);
+  AddValue(fd, "inflow_volume", ledger.inflow_volume);
   AddValue(fd, "stored_volume", ledger.stored_volume);
   AddValue(fd, "balance_error", ledger.balance_error);
   AddValue(fd, "max_depth", ledger.max_depth);
@@ -481,16 +679,15 @@ int vtkRainRunoffFilter::FillHydrograph(vtkDataObject *tableObject) {
     c[static_cast<size_t>(k)]->SetNumberOfTuples(rows);
   }
   for (int r = 0; r < rows; ++r) {
-    const std::array<double, 6> &now = this->Ledgers[static_cast<size_t>(r)];
-    const std::array<double, 6> &before = this->Ledgers[static_cast<size_t>(r > 0 ? r - 1 : 0)];
+    const std::array<double, 7> &now = this->Ledgers[static_cast<size_t>(r)];
+    const std::array<double, 7> &before = this->Ledgers[static_cast<size_t>(r > 0 ? r - 1 : 0)];
     const double span = now[0] - before[0];
     // The mean rate over the interval that ends at this row; no interval
     // ends at row 0, whose rates are NaN (a line chart starts at row 1
     // instead of ramping up from a 0 that never was).
     const double none = std::numeric_limits<double>::quiet_NaN();
     auto rate = [&](int i) { return span > 0.0 ? (now[i] - before[i]) / span : none; };
-    const double inflow = span > 0.0 ? 0.0 : none;
-    const double values[] = {now[0], rate(1), inflow, rate(2), rate(3), now[4], now[3], now[5]};
+    const double values[] = {now[0], rate(1), rate(6), rate(2), rate(3), now[4], now[3], now[5]};
     for (int k = 0; k < columns; ++k) {
       c[static_cast<size_t>(k)]->SetValue(r, values[k]);
     }
@@ -526,7 +723,19 @@ void vtkRainRunoffFilter::PrintSelf(ostream &os, vtkIndent indent) {
   os << indent << "RainRate: " << this->RainRate << " mm/h\n";
   os << indent << "Permeability: " << this->Permeability << " mm/h\n";
   os << indent << "ManningN: " << this->ManningN << "\n";
-  os << indent << "Boundary: " << (this->Boundary == CLOSED ? "closed" : "open") << "\n";
+  const char *kinds[] = {"open", "closed", "transmissive", "level"};
+  const int edges[4] = {this->BoundaryWest, this->BoundaryEast, this->BoundarySouth,
+                        this->BoundaryNorth};
+  const double levels[4] = {this->LevelWest, this->LevelEast, this->LevelSouth, this->LevelNorth};
+  const char *sides[] = {"West", "East", "South", "North"};
+  for (int e = 0; e < 4; ++e) {
+    os << indent << "Boundary" << sides[e] << ": "
+       << (edges[e] >= 0 && edges[e] < 4 ? kinds[edges[e]] : "(invalid)");
+    if (edges[e] == LEVEL) {
+      os << " at " << levels[e] << " m";
+    }
+    os << "\n";
+  }
   os << indent
      << "FlowModel: " << (this->FlowModel == LOCAL_INERTIAL ? "local inertial" : "shallow water")
      << "\n";
@@ -534,4 +743,5 @@ void vtkRainRunoffFilter::PrintSelf(ostream &os, vtkIndent indent) {
   os << indent << "CourantNumber: " << this->CourantNumber << "\n";
   os << indent << "WettingDepth: " << this->WettingDepth << " m\n";
   os << indent << "DebrisFactor: " << this->DebrisFactor << "\n";
+  os << indent << "NoDataBoundary: " << (this->NoDataBoundary == OPEN ? "outfall" : "wall") << "\n";
 }

@@ -40,7 +40,7 @@
  * ledger's volume exactly; row 0's rates are NaN: no interval ends there),
  * `stored_volume`,
  * `outflow_volume` and `balance_error` (m^3, the ledger at that time).
- * inflow_rate is 0 (the core has no inflows yet). Every row is the ledger
+ * inflow_rate is what enters through the edges (level boundaries). Every row is the ledger
  * recorded when the state passed that output time; a checkpoint restored
  * or a restart re-records the same values (the steps are the same), so the
  * table does not depend on the order of requests either.
@@ -52,6 +52,16 @@
  * (m^2/s, |q|), the output fields' values there at each output time (read
  * with gr_rain_runoff_sample: a few floats per output, whatever the grid).
  * Gauges are a static input: moving them sets the simulation up again.
+ *
+ * Inflows: Input 3 (`Inflows`, optional) is a point set with the point
+ * array `discharge` (m^3/s, 0 to 1e6, constant in time): each point is
+ * snapped to the nearest terrain point and lets that much water in there
+ * (a river, a culvert; points on one terrain point add up); a point off the
+ * terrain or a bad discharge is refused with a sentence. And per edge an
+ * inflow hydrograph (InflowWest ... InflowNorth): rows of time (s) and
+ * discharge (m^3/s), times strictly increasing, linear in between, held
+ * before the first and after the last row, spread evenly along the edge.
+ * Both count as the ledger's inflow_volume.
  *
  * Time is handled by vtkGraupelSimulation: request a time with
  * UpdateTimeStep(t) (ParaView's animation does it). Checkpoints are the
@@ -81,7 +91,7 @@ public:
   vtkTypeMacro(vtkRainRunoffFilter, vtkGraupelSimulation);
   void PrintSelf(ostream &os, vtkIndent indent) override;
 
-  enum Boundaries { OPEN = 0, CLOSED = 1 };
+  enum Boundaries { OPEN = 0, CLOSED = 1, TRANSMISSIVE = 2, LEVEL = 3 };
   enum FlowModels { SHALLOW_WATER = 0, LOCAL_INERTIAL = 1 };
 
   ///@{
@@ -103,9 +113,47 @@ public:
   ///@}
 
   ///@{
-  /** 0: water leaves through the grid's edge (default); 1: the edge is a wall. */
-  virtual void SetBoundary(int value);
-  vtkGetMacro(Boundary, int);
+  /**
+   * The kind of each edge of the terrain (west: lowest x, east: highest x,
+   * south: lowest y, north: highest y): 0 open, a free outfall (default);
+   * 1 closed, a wall; 2 transmissive, the edge's depth, velocity and bed
+   * slope continue (uniform flow leaves at its normal depth); 3 level, the
+   * water surface beyond the edge stands at the edge's Level (m).
+   */
+  virtual void SetBoundaryWest(int value);
+  vtkGetMacro(BoundaryWest, int);
+  virtual void SetBoundaryEast(int value);
+  vtkGetMacro(BoundaryEast, int);
+  virtual void SetBoundarySouth(int value);
+  vtkGetMacro(BoundarySouth, int);
+  virtual void SetBoundaryNorth(int value);
+  vtkGetMacro(BoundaryNorth, int);
+  ///@}
+
+  ///@{
+  /** The water level beyond an edge of kind LEVEL, m, as the elevations (default 0). */
+  virtual void SetLevelWest(double value);
+  vtkGetMacro(LevelWest, double);
+  virtual void SetLevelEast(double value);
+  vtkGetMacro(LevelEast, double);
+  virtual void SetLevelSouth(double value);
+  vtkGetMacro(LevelSouth, double);
+  virtual void SetLevelNorth(double value);
+  vtkGetMacro(LevelNorth, double);
+  ///@}
+
+  ///@{
+  /** What no-data points (NaN elevations) are: 1 closed, walls (default); 0
+   *  open, outfalls that water pours into and leaves by. Their outputs are NaN. */
+  virtual void SetNoDataBoundary(int value);
+  vtkGetMacro(NoDataBoundary, int);
+  ///@}
+
+  ///@{
+  /** Every edge the same kind (the single Boundary of earlier versions);
+   *  GetBoundary: the common kind, or -1 when the edges differ. */
+  void SetBoundary(int value);
+  int GetBoundary();
   ///@}
 
   ///@{
@@ -143,6 +191,41 @@ public:
   void SetPermeabilityMapConnection(vtkAlgorithmOutput *output);
   /** Connects the optional gauge points (input port 2). */
   void SetGaugesConnection(vtkAlgorithmOutput *output);
+  /** Connects the optional point inflows (input port 3, point array `discharge` in m^3/s). */
+  void SetInflowsConnection(vtkAlgorithmOutput *output);
+
+  ///@{
+  /**
+   * The inflow hydrograph along an edge: Add appends a row (time s,
+   * discharge m^3/s), RemoveAll clears it (no inflow, the default). Times
+   * must increase from row to row and discharges lie between 0 and 1e6
+   * m^3/s, or the next update is refused with a sentence naming the row.
+   */
+  void AddInflowWest(double time, double discharge);
+  void RemoveAllInflowWest();
+  void AddInflowEast(double time, double discharge);
+  void RemoveAllInflowEast();
+  void AddInflowSouth(double time, double discharge);
+  void RemoveAllInflowSouth();
+  void AddInflowNorth(double time, double discharge);
+  void RemoveAllInflowNorth();
+  /** The rows of edge `side` (0 west, 1 east, 2 south, 3 north). */
+  int GetNumberOfInflowRows(int side);
+  ///@}
+
+  ///@{
+  /**
+   * The hyetograph: rain over time, rows of (time s, rain rate mm/h), linear
+   * in between, the first rate before the first time and the last after the
+   * last; while it has rows it rains in place of RainRate (a rain_rate array
+   * on the Input still wins). Times must increase from row to row and rates
+   * lie within RainRate's range, or the next update is refused with a
+   * sentence naming the row.
+   */
+  void AddHyetograph(double time, double rate);
+  void RemoveAllHyetograph();
+  int GetNumberOfHyetographRows();
+  ///@}
 
 protected:
   vtkRainRunoffFilter();
@@ -168,7 +251,15 @@ protected:
   double RainRate = 10.0;
   double Permeability = 0.0;
   double ManningN = 0.03;
-  int Boundary = OPEN;
+  int BoundaryWest = OPEN;
+  int BoundaryEast = OPEN;
+  int BoundarySouth = OPEN;
+  int BoundaryNorth = OPEN;
+  double LevelWest = 0.0;
+  double LevelEast = 0.0;
+  double LevelSouth = 0.0;
+  double LevelNorth = 0.0;
+  int NoDataBoundary = CLOSED;
   int FlowModel = SHALLOW_WATER;
   double MaxTimeStep = 1.0;
   double CourantNumber = 0.7;
@@ -189,10 +280,19 @@ private:
   /** Adds the flood maps to the image output, on its extent. */
   int AddMaps(vtkDataObject *output);
 
+  /** Gives the core the Inflows input's points (snapped to the terrain); 0 with a sentence. */
+  int SetPointInflows(vtkInformationVector **inputVector, vtkImageData *terrain);
+  void AddInflow(int side, double time, double discharge);
+  void RemoveAllInflow(int side);
+
   gr_rain_runoff *Simulation = nullptr;
+  /** Per edge (west, east, south, north) the hydrograph's times and discharges. */
+  std::vector<double> InflowTimes[4], InflowDischarges[4];
+  /** The hyetograph's times (s) and rain rates (mm/h). */
+  std::vector<double> HyetographTimes, HyetographRates;
   /** The ledger's volumes at each output time passed: time, rain, infiltrated,
-   *  outflow, stored, balance error. */
-  std::vector<std::array<double, 6>> Ledgers;
+   *  outflow, stored, balance error, inflow. */
+  std::vector<std::array<double, 7>> Ledgers;
   /** The gauges' grid points, (i, j) pairs, and per output time their depth,
    *  surface and discharge (3 floats per gauge). */
   std::vector<int> GaugeCells;

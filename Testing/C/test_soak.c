@@ -213,7 +213,15 @@ static void random_rain_runoff_params(gr_rain_runoff_params *p) {
   p->manning_n = uniform(0.01, 0.2);
   p->cfl = uniform(0.3, 0.9);
   p->max_dt = uniform(0.05, 2.0);
-  p->boundary = uniform(0.0, 1.0) < 0.5 ? GR_BOUNDARY_OPEN : GR_BOUNDARY_CLOSED;
+  /* Every kind of edge, each edge its own (levels may lie below the ground:
+   * an outfall then), all from one draw, so that the later draws stay
+   * those of the runs before there were kinds. */
+  double u = uniform(0.0, 1.0);
+  for (int e = 0; e < 4; ++e) {
+    double digits = u * pow(4.0, e + 1);
+    p->boundary[e] = (gr_boundary)((long)digits % 4);
+    p->boundary_level[e] = -1.0 + 3.0 * (digits - floor(digits));
+  }
   /* Both flow models, switched between phases on the same water. */
   p->flow_model = uniform(0.0, 1.0) < 0.5 ? GR_FLOW_SHALLOW_WATER : GR_FLOW_LOCAL_INERTIAL;
 }
@@ -274,7 +282,7 @@ static void soak_rain_runoff(long n) {
     for (size_t i = 0; i < 3 * cells; ++i)
       bad += !(v[i] > -1e30f && v[i] < 1e30f);
     CHECK_MSG(bad == 0, "step %ld: %d depth or velocity values not finite or negative", done, bad);
-    const double in = led.initial_volume + led.rain_volume;
+    const double in = led.initial_volume + led.rain_volume + led.inflow_volume;
     const double rel = in > 0.0 ? fabs(led.balance_error) / in : fabs(led.balance_error);
     worst = rel > worst ? rel : worst;
     CHECK_MSG(rel <= 1e-4, "step %ld: balance error %g of %g m^3 came in", done, led.balance_error,

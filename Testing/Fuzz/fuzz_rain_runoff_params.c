@@ -3,8 +3,9 @@
  *
  * Input layout (missing bytes read as 0): byte 0 picks the mode, byte 1 the
  * length of a small message buffer, byte 2 the field to validate, then:
- *   mode 0  the seven parameters from raw bytes (8 per double, 4 for the
- *           boundary and flow model enums), so NaN, infinities and huge
+ *   mode 0  the parameters from raw bytes (8 per double: the seven and the
+ *           four edges' levels; 4 for each of the four edges' kinds, the
+ *           flow model and the no-data kind), so NaN, infinities and huge
  *           values appear;
  *   mode 1  one byte per parameter picks an edge value: a bound of any row
  *           of the parameter table (gr_rain_runoff_param_bounds) in the
@@ -16,8 +17,8 @@
  * lie in the table's ranges (user bounds times to_core; open minimum and
  * whole numbers where a row says so) and, for FlowModel 1 (local inertial),
  * ManningN is at least 0.005; fields exactly when every value is
- * finite and, for the depth, permeability and rain-rate inputs, within the
- * RainRate and Permeability rows' ranges (velocities within +-1000 m/s);
+ * finite (or, for elevations, NaN: a no-data cell) and, for the depth, permeability and rain-rate
+ * inputs, within the RainRate and Permeability rows' ranges (velocities within +-1000 m/s);
  * outputs-only fields are refused; a short message
  * buffer is never overrun and always terminated. */
 #include "fuzz_common.h"
@@ -47,19 +48,32 @@ static int in_row(const char *property, double v) {
 }
 
 static int params_documented(const gr_rain_runoff_params *p) {
-  int boundary, model;
-  memcpy(&boundary, &p->boundary, sizeof boundary);
+  static const char *const kinds[4] = {"BoundaryWest", "BoundaryEast", "BoundarySouth",
+                                       "BoundaryNorth"};
+  static const char *const levels[4] = {"LevelWest", "LevelEast", "LevelSouth", "LevelNorth"};
+  int model, no_data;
   memcpy(&model, &p->flow_model, sizeof model);
+  memcpy(&no_data, &p->no_data, sizeof no_data);
+  if (!in_row("NoDataBoundary", (double)no_data))
+    return 0;
+  for (int e = 0; e < 4; ++e) {
+    int kind;
+    memcpy(&kind, &p->boundary[e], sizeof kind);
+    if (!in_row(kinds[e], (double)kind) || !in_row(levels[e], p->boundary_level[e]))
+      return 0;
+  }
   return in_row("RainRate", p->rain_rate) && in_row("Permeability", p->permeability) &&
          in_row("ManningN", p->manning_n) && in_row("CourantNumber", p->cfl) &&
-         in_row("MaxTimeStep", p->max_dt) && in_row("Boundary", (double)boundary) &&
-         in_row("FlowModel", (double)model) && in_row("WettingDepth", p->wetting_depth) &&
-         in_row("DebrisFactor", p->debris_factor) && (model != 1 || p->manning_n >= 0.005);
+         in_row("MaxTimeStep", p->max_dt) && in_row("FlowModel", (double)model) &&
+         in_row("WettingDepth", p->wetting_depth) && in_row("DebrisFactor", p->debris_factor) &&
+         (model != 1 || p->manning_n >= 0.005);
 }
 
 static int field_documented(gr_field f, const float *v, size_t n) {
   for (size_t i = 0; i < n; ++i) {
     const double x = v[i];
+    if (f == GR_FIELD_ELEVATION && isnan(x))
+      continue; /* a no-data cell */
     if (!isfinite(x))
       return 0;
     if (f == GR_FIELD_WATER_DEPTH && !(x >= 0.0))
@@ -86,7 +100,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
   const int mode = take_byte(&r) % 2;
   const size_t small_len = take_byte(&r) % 96;
   const gr_field f = (gr_field)(take_byte(&r) % (GR_FIELD_COUNT + 1));
-  double *d[7];
+  double *d[11];
 
   memset(&p, 0, sizeof p);
   d[0] = &p.rain_rate;
@@ -96,20 +110,29 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
   d[4] = &p.max_dt;
   d[5] = &p.wetting_depth;
   d[6] = &p.debris_factor;
-  for (int k = 0; k < 7; ++k) {
+  for (int e = 0; e < 4; ++e)
+    d[7 + e] = &p.boundary_level[e];
+  for (int k = 0; k < 11; ++k) {
     if (mode == 0)
       take(&r, d[k], sizeof(double));
     else
       *d[k] = edge_double(take_byte(&r));
   }
   if (mode == 0) {
-    take(&r, &p.boundary, sizeof(int));
+    for (int e = 0; e < 4; ++e)
+      take(&r, &p.boundary[e], sizeof(int));
     take(&r, &p.flow_model, sizeof(int));
+    take(&r, &p.no_data, sizeof(int));
   } else {
-    int b = (int)take_byte(&r) % 4 - 1; /* -1, 0, 1, 2 */
-    memcpy(&p.boundary, &b, sizeof b);
-    b = (int)take_byte(&r) % 4 - 1;
+    int b;
+    for (int e = 0; e < 4; ++e) {
+      b = (int)take_byte(&r) % 6 - 1; /* -1 to 4 */
+      memcpy(&p.boundary[e], &b, sizeof b);
+    }
+    b = (int)take_byte(&r) % 4 - 1; /* -1, 0, 1, 2 */
     memcpy(&p.flow_model, &b, sizeof b);
+    b = (int)take_byte(&r) % 4 - 1;
+    memcpy(&p.no_data, &b, sizeof b);
   }
 
   msg[0] = '\0';

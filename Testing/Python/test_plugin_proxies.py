@@ -119,7 +119,8 @@ T.check(dem.PointData["elevation"].GetRange() == (236.0, 1076.0), "real DEM rang
 # Rain Runoff on the DEM: a time source whose times the animation scene sees.
 rr = RainRunoff(Input=dem)
 T.check(rr.RainRate == 10.0 and rr.Permeability == 0.0 and rr.ManningN == 0.03
-        and rr.Boundary == "Open", "Rain Runoff defaults")
+        and rr.BoundaryWest == "Open" and rr.BoundaryNorth == "Open" and rr.LevelEast == 0.0,
+        "Rain Runoff defaults")
 rr.EndTime = 40.0
 rr.OutputInterval = 20.0
 rr.UpdatePipelineInformation()

@@ -397,7 +397,7 @@ T.check(abs(rain_int - rain_q * 60.0) <= 1e-6 * rain_q * 60.0 and
         "rain_rate %g m^3/s = rate x area, integrating to the rain (%g m^3)" % (h["rain_rate"][1], rain_int))
 T.check(all(np.isnan(h[c][0]) for c in ("rain_rate", "inflow_rate", "infiltration_rate",
                                           "outflow_rate")) and np.all(h["inflow_rate"][1:] == 0.0),
-        "row 0 ends no interval: its rates are NaN; no inflows yet")
+        "row 0 ends no interval: its rates are NaN; no inflow through open edges")
 T.check(np.all(np.abs(h["balance_error"]) <= 1e-5 * rain_q * 60.0)
         and np.all(np.diff(h["outflow_volume"]) >= 0.0), "balance_error small, outflow_volume grows")
 T.check(abs(h["stored_volume"][-1] - (rain_int - fwd_out[60.0] - h["balance_error"][-1]))
@@ -438,6 +438,182 @@ for props, text in (({"WettingDepth": 0.0}, "WettingDepth must be above 0 m and 
     T.check(d is None and len(errs.messages) == 1 and text in errs.text()
             and hydrograph(g) == {}, "%r refused with one sentence, empty outputs: %r"
             % (props, errs.text()[:200]))
+
+# Boundaries per edge: the defaults, the clamps, SetBoundary for all four, a
+# level edge's inflow in the ledger and the hydrograph, a bad level refused.
+g = vtkRainRunoffFilter()
+T.check([g.GetBoundaryWest(), g.GetBoundaryEast(), g.GetBoundarySouth(), g.GetBoundaryNorth()]
+        == [0, 0, 0, 0] and [g.GetLevelWest(), g.GetLevelEast(), g.GetLevelSouth(),
+                             g.GetLevelNorth()] == [0.0] * 4, "defaults: every edge open, levels 0 m")
+g.SetBoundary(1)
+T.check([g.GetBoundaryWest(), g.GetBoundaryEast(), g.GetBoundarySouth(), g.GetBoundaryNorth()]
+        == [1] * 4 and g.GetBoundary() == 1, "SetBoundary(1) makes all four edges walls")
+g.SetBoundaryWest(7)
+g.SetLevelWest(-5e6)
+T.check(g.GetBoundaryWest() == 3 and g.GetBoundary() == -1 and g.GetLevelWest() == -1e6,
+        "BoundaryWest 7 clamps to 3 (Level), LevelWest -5e6 to -1e6 m; GetBoundary -1 when "
+        "the edges differ")
+lv = rain(np.zeros((NY, NX)), RainRate=0.0, Boundary=1, BoundaryWest=3, LevelWest=0.3,
+          EndTime=60.0, OutputInterval=20.0)
+d, out = at(lv, 60.0)
+h = hydrograph(lv)
+inflow = field(out, "inflow_volume") if d is not None else 0.0
+in_int = float(np.sum(h["inflow_rate"][1:] * np.diff(h["time"]))) if h else 0.0
+T.check(d is not None and inflow > 0.0 and abs(field(out, "stored_volume") - (
+    inflow - field(out, "outflow_volume"))) <= 1e-6 * inflow and d[:, 0].min() > 0.1
+    and d[:, -1].max() < d[:, 0].min(),
+    "a level edge (0.3 m, west) fills a flat, walled terrain from the west: inflow %g m^3 = "
+    "stored + outflow" % inflow)
+T.check(abs(in_int - inflow) <= 1e-6 * inflow,
+        "inflow_rate integrates to inflow_volume: %.9g vs %.9g m^3" % (in_int, inflow))
+for props, text in (({"BoundaryWest": 3, "LevelWest": float("nan")},
+                     "LevelWest must be from -1e+06 m to 1e+06 m; it is nan m"),):
+    g = rain(bowl, **props)
+    errs = T.ErrorCatcher(g)
+    d, out = at(g, 10.0)
+    T.check(d is None and len(errs.messages) == 1 and text in errs.text()
+            and hydrograph(g) == {}, "%r refused with one sentence, empty outputs: %r"
+            % (props, errs.text()[:200]))
+
+# Inflows: a hydrograph along the west edge and point inflows, on a flat,
+# walled terrain: the ledger's inflow is the table's integral plus Q t, and
+# all of it is stored; bad tables and points are refused with a sentence.
+def inflow_points(xy, q, name="discharge"):
+    pts = vtkPoints()
+    for px, py in xy:
+        pts.InsertNextPoint(px, py, 0.0)
+    poly = vtkPolyData()
+    poly.SetPoints(pts)
+    if name:
+        arr = numpy_to_vtk(np.asarray(q, dtype=np.float64), deep=1)
+        arr.SetName(name)
+        poly.GetPointData().AddArray(arr)
+    return poly
+
+
+fl = rain(np.zeros((NY, NX)), RainRate=0.0, Boundary=1, EndTime=60.0, OutputInterval=20.0)
+for t_q in ((0.0, 0.0), (30.0, 1.0), (45.0, 1.0)):
+    fl.AddInflowWest(*t_q)
+fl.SetInflowsConnection(producer(inflow_points(
+    [(100.0 + 10 * DX, -50.0 + 5 * DX), (100.0 + 10 * DX + 0.3, -50.0 + 5 * DX),
+     (100.0 + 30 * DX, -50.0 + 20 * DX)], [0.1, 0.05, 0.2])).GetOutputPort())
+d, out = at(fl, 60.0)
+expect = 0.5 * 30.0 * 1.0 + 30.0 * 1.0 + 0.35 * 60.0  # the table's integral, held after 45 s
+T.check(fl.GetNumberOfInflowRows(0) == 3 and d is not None
+        and abs(field(out, "inflow_volume") - expect) <= 1e-6 * expect
+        and abs(field(out, "stored_volume") - expect) <= 1e-6 * expect
+        and field(out, "outflow_volume") == 0.0,
+        "hydrograph and point inflows: inflow %.7f m^3, stored %.7f m^3 (expected %g)"
+        % (field(out, "inflow_volume") if d is not None else -1,
+           field(out, "stored_volume") if d is not None else -1, expect))
+bad_tables = (
+    ("InflowWest", ((0.0, 1.0), (10.0, 2.0), (10.0, 3.0)), "InflowWest: The west edge's inflow "
+     "hydrograph's times must increase from row to row, but row 2 has 10 s after 10 s"),
+    ("InflowNorth", ((0.0, 1.0), (10.0, -2.0)), "InflowNorth: The north edge's inflow hydrograph "
+     "has the discharge -2 m^3/s in row 1"),
+)
+for prop, rows, text in bad_tables:
+    g = rain(bowl)
+    for row in rows:
+        getattr(g, "Add" + prop)(*row)
+    errs = T.ErrorCatcher(g)
+    d, out = at(g, 10.0)
+    T.check(d is None and len(errs.messages) == 1 and text in errs.text() and hydrograph(g) == {},
+            "%s %r refused with one sentence, empty outputs: %r" % (prop, rows, errs.text()[:240]))
+    getattr(g, "RemoveAll" + prop)()
+    d, out = at(g, 10.0)
+    T.check(d is not None, "%s cleared: the filter works again" % prop)
+for xy, q, name, text in (
+        ([(100.0, -50.0)], [-1.0], "discharge", "Inflows: Point inflow 0 has the discharge -1 m^3/s"),
+        ([(100.0, -50.0)], [float("nan")], "discharge", "Inflows: Point inflow 0 has the discharge nan"),
+        ([(100.0, -50.0)], [1.0], "flow", "Inflows need the point array 'discharge'"),
+        ([(0.0, 0.0)], [1.0], "discharge", "Inflows point 0 at (0, 0) lies off the terrain")):
+    g = rain(bowl)
+    g.SetInflowsConnection(producer(inflow_points(xy, q, name)).GetOutputPort())
+    errs = T.ErrorCatcher(g)
+    d, out = at(g, 10.0)
+    T.check(d is None and len(errs.messages) == 1 and text in errs.text(),
+            "bad point inflows refused with one sentence: %r" % errs.text()[:200])
+
+# The hyetograph rains its table's integral; a manning_n array of ManningN
+# everywhere (in double) is the uniform run bit for bit; bad ones are refused.
+hy = rain(np.zeros((NY, NX)), RainRate=5.0, Boundary=1, EndTime=60.0, OutputInterval=20.0)
+for row in ((0.0, 0.0), (30.0, 72.0), (50.0, 0.0)):
+    hy.AddHyetograph(*row)
+d, out = at(hy, 60.0)
+area = NX * NY * DX * DX
+expect = 0.5 * 50.0 * 72.0 * MM_PER_H * area
+h = hydrograph(hy)
+T.check(hy.GetNumberOfHyetographRows() == 3 and d is not None
+        and abs(field(out, "rain_volume") - expect) <= 1e-6 * expect
+        and abs(float(np.sum(h["rain_rate"][1:] * np.diff(h["time"]))) - expect) <= 1e-6 * expect
+        and np.allclose(d, expect / area, rtol=1e-5),
+        "the hyetograph rains its integral: %.9g m^3 (expected %.9g), every point %.6g m deep"
+        % (field(out, "rain_volume") if d is not None else -1, expect, expect / area))
+g = rain(bowl)
+for row in ((0.0, 10.0), (20.0, 5.0), (20.0, 1.0)):
+    g.AddHyetograph(*row)
+errs = T.ErrorCatcher(g)
+d, out = at(g, 10.0)
+T.check(d is None and len(errs.messages) == 1 and "Rain Runoff's Hyetograph: The hyetograph's "
+        "times must increase from row to row, but row 2 has 20 s after 20 s" in errs.text(),
+        "a hyetograph with a repeated time refused with one sentence: %r" % errs.text()[:200])
+
+
+def with_manning(terrain, n):
+    img = image({"elevation": terrain})
+    arr = numpy_to_vtk(np.ascontiguousarray(n, dtype=np.float64).reshape(-1), deep=1)
+    arr.SetName("manning_n")
+    img.GetPointData().AddArray(arr)
+    return img
+
+
+runs = []
+for n in (None, np.full((NY, NX), 0.03)):
+    g = vtkRainRunoffFilter()
+    src = image({"elevation": slope + bowl}) if n is None else with_manning(slope + bowl, n)
+    g.SetInputConnection(producer(src).GetOutputPort())
+    g.SetRainRate(80.0)
+    g.SetEndTime(30.0)
+    runs.append(at(g, 30.0)[0])
+T.check(runs[0] is not None and runs[1] is not None and np.array_equal(runs[0], runs[1])
+        and runs[0].max() > 0.0, "a manning_n array of ManningN (0.03) everywhere: the same depths "
+        "bit for bit")
+g = vtkRainRunoffFilter()
+g.SetInputConnection(producer(image({"elevation": bowl})).GetOutputPort())
+g.SetPermeabilityMapConnection(producer(with_manning(bowl, np.full((NY, NX), 2.0))).GetOutputPort())
+errs = T.ErrorCatcher(g)
+d, out = at(g, 10.0)
+T.check(d is None and len(errs.messages) == 1 and "Rain Runoff's PermeabilityMap: The Manning map "
+        "has the value 2 s/m^(1/3) at cell (0, 0)" in errs.text(),
+        "a manning_n of 2 on the PermeabilityMap refused with one sentence: %r" % errs.text()[:200])
+
+# No-data points: a NaN hole and a NaN border are outside the terrain, walls
+# by default (nothing leaves), outfalls with NoDataBoundary 0; their outputs
+# are NaN, the ledger closes, the rain falls on the terrain's points only.
+nd = slope + bowl
+nd = nd.copy()
+nd[:2, :] = nd[-2:, :] = np.nan
+nd[:, :2] = nd[:, -2:] = np.nan
+nd[12:15, 18:23] = np.nan
+holes = np.isnan(nd)
+for kind in (1, 0):
+    g = rain(nd, RainRate=80.0, EndTime=60.0, NoDataBoundary=kind)
+    d, out = at(g, 60.0)
+    ok = d is not None
+    rain_q = 80.0 * MM_PER_H * float((~holes).sum()) * DX * DX * 60.0
+    if ok:
+        m = maps_of(out)
+        nan_right = (np.array_equal(np.isnan(d), holes)
+                     and np.array_equal(np.isnan(m["max_depth"]), holes))
+        closes = abs(field(out, "balance_error")) <= 1e-6 * rain_q
+        rain_ok = abs(field(out, "rain_volume") - rain_q) <= 1e-6 * rain_q
+        outflow = field(out, "outflow_volume")
+    T.check(ok and nan_right and closes and rain_ok
+            and (outflow == 0.0 if kind == 1 else outflow > 0.0),
+            "no-data points as %s: NaN exactly there, the rain on the other points (%g m^3), "
+            "outflow %g m^3, the ledger closed" % ("walls" if kind == 1 else "outfalls", rain_q,
+                                                  outflow if ok else -1))
 
 # Gauges: three columns each in the hydrograph, the output's values at the
 # nearest terrain point at every output time, whatever the request order.
@@ -497,7 +673,7 @@ T.check(d is None and len(errs.messages) == 1 and "Gauges point 0" in errs.text(
 
 # ---- bad input: one sentence, an empty output, the next good update works ------
 bad_elev = bowl.copy()
-bad_elev[3, 7] = np.nan
+bad_elev[3, 7] = np.inf  # NaN is a no-data point; infinities are refused
 cases = [
     ({"elevation": bad_elev}, {}, "elevation"),
     ({"height": bowl}, {}, "elevation"),  # no elevation, and no active scalars
@@ -605,7 +781,7 @@ T.check(d is not None and np.array_equal(d, ref[10.0]), "works again once the op
 g = rain(bad_elev)
 errs = T.ErrorCatcher(g)
 d, _ = at(g, 10.0)
-T.check(d is None and "elevation" in errs.text(), "NaN elevation refused")
+T.check(d is None and "elevation" in errs.text(), "an infinite elevation refused")
 g.SetInputConnection(producer(image({"elevation": slope + bowl})).GetOutputPort())
 g.SetRainRate(50.0)
 d, _ = at(g, 10.0)

@@ -38,16 +38,52 @@ GR_INLINE float gr_rain_runoff_input(__global const float *restrict field, int u
   return use_field ? field[c] : uniform;
 }
 
-/* Depth after rain gain (h + r dt) and infiltration (at most k dt, never more
- * than the water there). */
-GR_INLINE float gr_rain_runoff_wet(float h, float r, float k, float dt) {
-  float h1 = h + r * dt;
+/* Depth after rain and the sources (inflows, m/s of depth): (h + r dt) +
+ * s dt, two products the ledger books apart (the rain on the host, the
+ * sources per cell); with no source the rain's h + r dt to the bit. */
+GR_INLINE float gr_rain_runoff_gain(float h, float r, float s, float dt) {
+  return (h + r * dt) + s * dt;
+}
+
+/* Depth after rain and source gain and infiltration (at most k dt, never
+ * more than the water there). */
+GR_INLINE float gr_rain_runoff_wet(float h, float r, float s, float k, float dt) {
+  float h1 = gr_rain_runoff_gain(h, r, s, dt);
   return h1 - fmin(k * dt, h1);
 }
 
-GR_INLINE float gr_rain_runoff_infiltration(float h, float r, float k, float dt) {
-  float h1 = h + r * dt;
+GR_INLINE float gr_rain_runoff_infiltration(float h, float r, float s, float k, float dt) {
+  float h1 = gr_rain_runoff_gain(h, r, s, dt);
   return fmin(k * dt, h1);
+}
+
+/* The friction's n^2 at a face between cells a and b: the uniform n2, or
+ * with a Manning map (use_n2) the mean of the two cells' n^2 (the same
+ * float whichever side computes it; n2 itself where both are n2). */
+GR_INLINE float gr_rain_runoff_face_n2(__global const float *restrict n2map, int use_n2, float n2,
+                                       int a, int b) {
+  return use_n2 ? 0.5f * (n2map[a] + n2map[b]) : n2;
+}
+
+/* No-data cells (NaN elevations, graupel/rain_runoff.h): nodata[c] is 0 for
+ * a cell of the domain, 1 for a wall, 2 for an outfall (use_nodata: there
+ * are some). Nothing rains, enters or infiltrates there. */
+#define GR_RAIN_RUNOFF_ACTIVE(c) (!use_nodata || nodata[(c)] == 0.0f)
+#define GR_RAIN_RUNOFF_RAIN(c)                                                                     \
+  (GR_RAIN_RUNOFF_ACTIVE(c) ? gr_rain_runoff_input(rain, use_rain, rain_uniform, (c)) : 0.0f)
+#define GR_RAIN_RUNOFF_PERM(c)                                                                     \
+  (GR_RAIN_RUNOFF_ACTIVE(c) ? gr_rain_runoff_input(perm, use_perm, perm_uniform, (c)) : 0.0f)
+
+/* A cell's source rate (m/s of depth): the source field's, 0 without one. */
+#define GR_RAIN_RUNOFF_SRC(c)                                                                      \
+  (GR_RAIN_RUNOFF_ACTIVE(c) ? gr_rain_runoff_input(src, use_src, 0.0f, (c)) : 0.0f)
+
+/* The water an outfall no-data cell received in a step leaves the domain:
+ * its new depth t (and Kahan compensation comp) go to the outflow, and the
+ * cell ends dry. Returns the water booked (0 for every other cell). */
+GR_INLINE float gr_rain_runoff_drain(__global const float *restrict nodata, int use_nodata, int c,
+                                     float t, float comp) {
+  return use_nodata && nodata[c] == 2.0f && t > 0.0f ? t - comp : 0.0f;
 }
 
 /* x^(-7/3) for x > 0 (a normal float), the friction's depth factor: x^(-1/3)
@@ -113,10 +149,36 @@ GR_INLINE float gr_rain_runoff_smooth(float own, float before, float after, floa
   return edge ? own : smooth;
 }
 
+/* The cell beyond a domain edge of kind `kind` for the local inertial faces
+ * (graupel/rain_runoff.h, "Boundaries"): its depth *hg and bed *bg from the
+ * edge cell's depth hc (after rain and infiltration) and bed bc, and the bed
+ * bi of the edge cell's inner neighbour. A wall's and an outfall's is dry at
+ * bc (as before there were kinds); a transmissive edge continues the depth
+ * over the continued bed slope; a level edge holds water up to its level
+ * over bc (none when the level is below the ground: a free outfall). */
+GR_INLINE void gr_rain_runoff_ghost(int kind, float level, float hc, float bc, float bi, float *hg,
+                                    float *bg) {
+  bool tr = kind == GR_RAIN_RUNOFF_B_TRANSMISSIVE, lv = kind == GR_RAIN_RUNOFF_B_LEVEL;
+  *hg = tr ? hc : (lv ? fmax(level - bc, 0.0f) : 0.0f);
+  *bg = tr ? bc - (bi - bc) : bc;
+}
+
+/* The discharge q through a domain edge's face (positive toward the high
+ * side; low: the west or south edge) as the edge's kind lets it through: a
+ * wall nothing, an outfall and a transmissive edge outflow only (a
+ * zero-gradient inflow would grow with the edge cell's depth and feed a pit
+ * at the edge without end), a level edge both ways. */
+GR_INLINE float gr_rain_runoff_edge_q(int kind, float q, bool low) {
+  float out_only = low ? fmin(q, 0.0f) : fmax(q, 0.0f);
+  return kind == GR_RAIN_RUNOFF_B_CLOSED ? 0.0f : (kind == GR_RAIN_RUNOFF_B_LEVEL ? q : out_only);
+}
+
 /* Work-item (i, j) of an (nx+1) x (ny+1) launch owns the x-face left of cell
  * (i, j) (for j < ny) and the y-face below it (for i < nx). The grid's edge
- * faces are walls when closed; when open they lead into a dry ghost cell at
- * the edge cell's ground height, and only outflow passes. The discharges of
+ * faces are those of an open edge here: they lead into a dry ghost cell at
+ * the edge cell's ground height, and only outflow passes; the edges of
+ * other kinds are rewritten by rain_runoff_flux_edges after this launch
+ * (kinds known only at run time cost this kernel half its speed on PoCL). The discharges of
  * the previous step are read from qx_old, qy_old and the new ones written
  * to qx, qy (the face arrays alternate between steps).
  *
@@ -125,22 +187,23 @@ GR_INLINE float gr_rain_runoff_smooth(float own, float before, float after, floa
  * (clamped indices became gathers, three times slower). A masked limiter
  * reads as 1 and a masked depth as 0: where that happens, the value is not
  * used (an edge face's discharge only ever leaves its edge cell). */
-__kernel void rain_runoff_flux(__global const float *restrict h, __global const float *restrict b,
-                               __global const float *restrict rain,
-                               __global const float *restrict perm,
-                               __global const float *restrict qx_old,
-                               __global const float *restrict qy_old, __global float *restrict qx,
-                               __global float *restrict qy, __global const float *restrict limit,
-                               int nx, int ny, float dt, float inv_dx, float inv_dy, float g,
-                               float n2, float theta, int use_rain, float rain_uniform,
-                               int use_perm, float perm_uniform, int closed) {
+__kernel void
+rain_runoff_flux(__global const float *restrict h, __global const float *restrict b,
+                 __global const float *restrict rain, __global const float *restrict perm,
+                 __global const float *restrict src, int use_src,
+                 __global const float *restrict nodata, int use_nodata,
+                 __global const float *restrict qx_old, __global const float *restrict qy_old,
+                 __global float *restrict qx, __global float *restrict qy,
+                 __global const float *restrict limit, int nx, int ny, float dt, float inv_dx,
+                 float inv_dy, float g, float n2, __global const float *restrict n2map, int use_n2,
+                 float theta, int use_rain, float rain_uniform, int use_perm, float perm_uniform) {
   int i = get_global_id(0), j = get_global_id(1);
   if (!gr_inside(i, j, nx + 1, ny + 1))
     return;
   int c = gr_idx(i, j, nx);
   bool in_c = i < nx && j < ny;
-  float hc = in_c ? gr_rain_runoff_wet(h[c], gr_rain_runoff_input(rain, use_rain, rain_uniform, c),
-                                       gr_rain_runoff_input(perm, use_perm, perm_uniform, c), dt)
+  float hc = in_c ? gr_rain_runoff_wet(h[c], GR_RAIN_RUNOFF_RAIN(c), GR_RAIN_RUNOFF_SRC(c),
+                                       GR_RAIN_RUNOFF_PERM(c), dt)
                   : 0.0f;
   float bc = in_c ? b[c] : 0.0f;
   float kc = in_c ? limit[c] : 1.0f;
@@ -148,10 +211,9 @@ __kernel void rain_runoff_flux(__global const float *restrict h, __global const 
     /* Cell (i-1, j) is L, cell (i, j) is R; at the edges one is the ghost. */
     int w = c - 1;
     bool in_w = i > 0;
-    float hw = in_w
-                   ? gr_rain_runoff_wet(h[w], gr_rain_runoff_input(rain, use_rain, rain_uniform, w),
-                                        gr_rain_runoff_input(perm, use_perm, perm_uniform, w), dt)
-                   : 0.0f;
+    float hw = in_w ? gr_rain_runoff_wet(h[w], GR_RAIN_RUNOFF_RAIN(w), GR_RAIN_RUNOFF_SRC(w),
+                                         GR_RAIN_RUNOFF_PERM(w), dt)
+                    : 0.0f;
     float bw = in_w ? b[w] : 0.0f;
     float kw = in_w ? limit[w] : 1.0f;
     float hL = i == 0 ? 0.0f : hw, bL = i == 0 ? bc : bw;
@@ -163,20 +225,21 @@ __kernel void rain_runoff_flux(__global const float *restrict h, __global const 
     float after =
         i < nx ? gr_rain_runoff_limited(qx_old[f + 1], kc, i < nx - 1 ? limit[c + 1] : 1.0f) : 0.0f;
     float prev = gr_rain_runoff_smooth(own, before, after, theta, i == 0 || i == nx);
-    float q = gr_rain_runoff_face(hL, hR, bL, bR, prev, own, dt, g, n2, inv_dx);
+    /* An edge face takes its one cell's roughness. */
+    float n2f = gr_rain_runoff_face_n2(n2map, use_n2, n2, in_w ? w : c, i < nx ? c : w);
+    float q = gr_rain_runoff_face(hL, hR, bL, bR, prev, own, dt, g, n2f, inv_dx);
     if (i == 0)
-      q = closed ? 0.0f : fmin(q, 0.0f);
+      q = fmin(q, 0.0f);
     if (i == nx)
-      q = closed ? 0.0f : fmax(q, 0.0f);
+      q = fmax(q, 0.0f);
     qx[f] = q;
   }
   if (i < nx) {
     int s = c - nx;
     bool in_s = j > 0;
-    float hs = in_s
-                   ? gr_rain_runoff_wet(h[s], gr_rain_runoff_input(rain, use_rain, rain_uniform, s),
-                                        gr_rain_runoff_input(perm, use_perm, perm_uniform, s), dt)
-                   : 0.0f;
+    float hs = in_s ? gr_rain_runoff_wet(h[s], GR_RAIN_RUNOFF_RAIN(s), GR_RAIN_RUNOFF_SRC(s),
+                                         GR_RAIN_RUNOFF_PERM(s), dt)
+                    : 0.0f;
     float bs = in_s ? b[s] : 0.0f;
     float ks = in_s ? limit[s] : 1.0f;
     float hL = j == 0 ? 0.0f : hs, bL = j == 0 ? bc : bs;
@@ -189,13 +252,64 @@ __kernel void rain_runoff_flux(__global const float *restrict h, __global const 
         j < ny ? gr_rain_runoff_limited(qy_old[f + nx], kc, j < ny - 1 ? limit[c + nx] : 1.0f)
                : 0.0f;
     float prev = gr_rain_runoff_smooth(own, before, after, theta, j == 0 || j == ny);
-    float q = gr_rain_runoff_face(hL, hR, bL, bR, prev, own, dt, g, n2, inv_dy);
+    float n2f = gr_rain_runoff_face_n2(n2map, use_n2, n2, in_s ? s : c, j < ny ? c : s);
+    float q = gr_rain_runoff_face(hL, hR, bL, bR, prev, own, dt, g, n2f, inv_dy);
     if (j == 0)
-      q = closed ? 0.0f : fmin(q, 0.0f);
+      q = fmin(q, 0.0f);
     if (j == ny)
-      q = closed ? 0.0f : fmax(q, 0.0f);
+      q = fmax(q, 0.0f);
     qy[f] = q;
   }
+}
+
+/* The faces of the domain's edges whose kind is not open (those the flux
+ * kernel leaves as open), one work-item per edge face: west faces (ny), east
+ * (ny), south (nx), north (nx). Each is the flux kernel's face expression
+ * with the cell beyond the edge of its kind (gr_rain_runoff_ghost) and its
+ * own previous discharge (edges are not smoothed), passed as the kind lets
+ * it (gr_rain_runoff_edge_q): a mirrored edge gives the negated discharge. */
+__kernel void rain_runoff_flux_edges(
+    __global const float *restrict h, __global const float *restrict b,
+    __global const float *restrict rain, __global const float *restrict perm,
+    __global const float *restrict src, int use_src, __global const float *restrict nodata,
+    int use_nodata, __global const float *restrict qx_old, __global const float *restrict qy_old,
+    __global float *restrict qx, __global float *restrict qy, __global const float *restrict limit,
+    int nx, int ny, float dt, float inv_dx, float inv_dy, float g, float n2,
+    __global const float *restrict n2map, int use_n2, int use_rain, float rain_uniform,
+    int use_perm, float perm_uniform, int bnd_w, int bnd_e, int bnd_s, int bnd_n, float lvl_w,
+    float lvl_e, float lvl_s, float lvl_n) {
+  int k = get_global_id(0);
+  if (k >= 2 * (nx + ny))
+    return;
+  int side = k < ny ? 0 : (k < 2 * ny ? 1 : (k < 2 * ny + nx ? 2 : 3));
+  int t = side == 0 ? k : (side == 1 ? k - ny : (side == 2 ? k - 2 * ny : k - 2 * ny - nx));
+  int kind = side == 0 ? bnd_w : (side == 1 ? bnd_e : (side == 2 ? bnd_s : bnd_n));
+  float level = side == 0 ? lvl_w : (side == 1 ? lvl_e : (side == 2 ? lvl_s : lvl_n));
+  if (kind == GR_RAIN_RUNOFF_B_OPEN)
+    return;
+  bool xs = side < 2, low = side == 0 || side == 2;
+  int len = xs ? nx : ny, stride = xs ? 1 : nx;
+  /* The edge cell, its inner neighbour (for a transmissive edge's slope)
+   * and the face (x-face rows are nx + 1 wide; y-faces numbered like cells). */
+  int c = xs ? t * nx + (low ? 0 : nx - 1) : (low ? 0 : ny - 1) * nx + t;
+  int inner = len > 1 ? (low ? c + stride : c - stride) : c;
+  int f = xs ? t * (nx + 1) + (low ? 0 : nx) : (low ? 0 : ny) * nx + t;
+  float hc = gr_rain_runoff_wet(h[c], GR_RAIN_RUNOFF_RAIN(c), GR_RAIN_RUNOFF_SRC(c),
+                                GR_RAIN_RUNOFF_PERM(c), dt);
+  float bc = b[c], kc = limit[c];
+  float hg, bg;
+  gr_rain_runoff_ghost(kind, level, hc, bc, b[inner], &hg, &bg);
+  float old = xs ? qx_old[f] : qy_old[f];
+  float own = low ? gr_rain_runoff_limited(old, 1.0f, kc) : gr_rain_runoff_limited(old, kc, 1.0f);
+  float n2f = gr_rain_runoff_face_n2(n2map, use_n2, n2, c, c);
+  float inv_d = xs ? inv_dx : inv_dy;
+  float q = low ? gr_rain_runoff_face(hg, hc, bg, bc, own, own, dt, g, n2f, inv_d)
+                : gr_rain_runoff_face(hc, hg, bc, bg, own, own, dt, g, n2f, inv_d);
+  q = gr_rain_runoff_edge_q(kind, q, low);
+  if (xs)
+    qx[f] = q;
+  else
+    qy[f] = q;
 }
 
 /* K = min(1, depth / outgoing depth in dt), a little less when limiting (see
@@ -203,6 +317,8 @@ __kernel void rain_runoff_flux(__global const float *restrict h, __global const 
 __kernel void rain_runoff_limit(__global const float *restrict h,
                                 __global const float *restrict rain,
                                 __global const float *restrict perm,
+                                __global const float *restrict src, int use_src,
+                                __global const float *restrict nodata, int use_nodata,
                                 __global const float *restrict qx,
                                 __global const float *restrict qy, __global float *restrict limit,
                                 int nx, int ny, float dt, float inv_dx, float inv_dy, int use_rain,
@@ -211,8 +327,8 @@ __kernel void rain_runoff_limit(__global const float *restrict h,
   if (!gr_inside(i, j, nx, ny))
     return;
   int c = gr_idx(i, j, nx);
-  float wet = gr_rain_runoff_wet(h[c], gr_rain_runoff_input(rain, use_rain, rain_uniform, c),
-                                 gr_rain_runoff_input(perm, use_perm, perm_uniform, c), dt);
+  float wet = gr_rain_runoff_wet(h[c], GR_RAIN_RUNOFF_RAIN(c), GR_RAIN_RUNOFF_SRC(c),
+                                 GR_RAIN_RUNOFF_PERM(c), dt);
   float qw = qx[j * (nx + 1) + i], qe = qx[j * (nx + 1) + i + 1];
   float qs = qy[j * nx + i], qn = qy[(j + 1) * nx + i];
   float out = dt * ((fmax(-qw, 0.0f) + fmax(qe, 0.0f)) * inv_dx +
@@ -220,29 +336,51 @@ __kernel void rain_runoff_limit(__global const float *restrict h,
   limit[c] = out > wet ? wet / out * GR_RAIN_RUNOFF_KEEP : 1.0f;
 }
 
+/* Books a cell's flow through the domain's edges, given per edge face as
+ * what leaves the cell (m^2/s; negative: what enters), times dt over the
+ * face's cell width: outflow and inflow (metres of depth, Kahan sums). */
+GR_INLINE void gr_rain_runoff_book_edges(__global float *restrict outflow,
+                                         __global float *restrict outflow_comp,
+                                         __global float *restrict inflow,
+                                         __global float *restrict inflow_comp, int c, float dt,
+                                         float inv_dx, float inv_dy, float ow, float oe, float os,
+                                         float on) {
+  float out = dt * ((fmax(ow, 0.0f) + fmax(oe, 0.0f)) * inv_dx +
+                    (fmax(os, 0.0f) + fmax(on, 0.0f)) * inv_dy);
+  float in = dt * ((fmax(-ow, 0.0f) + fmax(-oe, 0.0f)) * inv_dx +
+                   (fmax(-os, 0.0f) + fmax(-on, 0.0f)) * inv_dy);
+  if (out != 0.0f)
+    gr_kahan_add(outflow, outflow_comp, c, out);
+  if (in != 0.0f)
+    gr_kahan_add(inflow, inflow_comp, c, in);
+}
+
 /* The new depth from rain, infiltration and the four faces' limited
- * discharges; edge cells of an open grid book what left through the edge.
+ * discharges; edge cells book what left (outflow) and what came in (inflow)
+ * through the domain's edges.
  * The depth is Kahan-summed too (h - h_comp is the water to about twice
  * float precision): its rounding would otherwise be the same in every step
  * where a pond gains the same rain, and 10^5 such steps would show in the
  * water balance. */
-__kernel void
-rain_runoff_update(__global float *restrict h, __global float *restrict h_comp,
-                   __global const float *restrict rain, __global const float *restrict perm,
-                   __global const float *restrict qx, __global const float *restrict qy,
-                   __global const float *restrict limit, __global float *restrict infiltrated,
-                   __global float *restrict infiltrated_comp, __global float *restrict outflow,
-                   __global float *restrict outflow_comp, int nx, int ny, float dt, float inv_dx,
-                   float inv_dy, int use_rain, float rain_uniform, int use_perm,
-                   float perm_uniform) {
+__kernel void rain_runoff_update(
+    __global float *restrict h, __global float *restrict h_comp,
+    __global const float *restrict rain, __global const float *restrict perm,
+    __global const float *restrict src, int use_src, __global const float *restrict nodata,
+    int use_nodata, __global const float *restrict qx, __global const float *restrict qy,
+    __global const float *restrict limit, __global float *restrict infiltrated,
+    __global float *restrict infiltrated_comp, __global float *restrict outflow,
+    __global float *restrict outflow_comp, __global float *restrict inflow,
+    __global float *restrict inflow_comp, int nx, int ny, float dt, float inv_dx, float inv_dy,
+    int use_rain, float rain_uniform, int use_perm, float perm_uniform) {
   int i = get_global_id(0), j = get_global_id(1);
   if (!gr_inside(i, j, nx, ny))
     return;
   int c = gr_idx(i, j, nx);
-  float r = gr_rain_runoff_input(rain, use_rain, rain_uniform, c);
-  float k = gr_rain_runoff_input(perm, use_perm, perm_uniform, c);
+  float r = GR_RAIN_RUNOFF_RAIN(c);
+  float k = GR_RAIN_RUNOFF_PERM(c);
+  float sc = GR_RAIN_RUNOFF_SRC(c);
   float h0 = h[c];
-  float inf = gr_rain_runoff_infiltration(h0, r, k, dt);
+  float inf = gr_rain_runoff_infiltration(h0, r, sc, k, dt);
   float kc = limit[c];
   /* Masked, not clamped, neighbours (see rain_runoff_flux): an edge face
    * never uses the limiter beyond the grid. */
@@ -252,39 +390,65 @@ rain_runoff_update(__global float *restrict h, __global float *restrict h_comp,
   float fe = gr_rain_runoff_limited(qx[j * (nx + 1) + i + 1], kc, ke);
   float fs = gr_rain_runoff_limited(qy[j * nx + i], ks, kc);
   float fn = gr_rain_runoff_limited(qy[(j + 1) * nx + i], kc, kn);
-  float delta = (r * dt - inf) + dt * ((fw - fe) * inv_dx + (fs - fn) * inv_dy);
+  float delta = ((r * dt - inf) + sc * dt) + dt * ((fw - fe) * inv_dx + (fs - fn) * inv_dy);
   float y = delta - h_comp[c];
   float t = h0 + y;
   float comp = (t - h0) - y;
   /* The limiter keeps t >= 0 but for rounding; a cell that ends at or
-   * below 0 is dry, with nothing owed. */
-  h[c] = t > 0.0f ? t : 0.0f;
-  h_comp[c] = t > 0.0f ? comp : 0.0f;
+   * below 0 is dry, with nothing owed. An outfall no-data cell drains. */
+  float gone = gr_rain_runoff_drain(nodata, use_nodata, c, t, comp);
+  h[c] = t > 0.0f && gone == 0.0f ? t : 0.0f;
+  h_comp[c] = t > 0.0f && gone == 0.0f ? comp : 0.0f;
+  if (gone != 0.0f)
+    gr_kahan_add(outflow, outflow_comp, c, gone);
   if (inf != 0.0f)
     gr_kahan_add(infiltrated, infiltrated_comp, c, inf);
+  /* The sources' water is inflow, the very float the depth gained. */
+  if (sc != 0.0f)
+    gr_kahan_add(inflow, inflow_comp, c, sc * dt);
   if (i == 0 || j == 0 || i == nx - 1 || j == ny - 1) {
-    /* Edge faces carry outflow only (0 when closed). */
+    /* What the edge faces carry out of the cell (negative: in). */
     float ow = i == 0 ? -fw : 0.0f, oe = i == nx - 1 ? fe : 0.0f;
     float os = j == 0 ? -fs : 0.0f, on = j == ny - 1 ? fn : 0.0f;
-    float out = dt * ((ow + oe) * inv_dx + (os + on) * inv_dy);
-    if (out != 0.0f)
-      gr_kahan_add(outflow, outflow_comp, c, out);
+    gr_rain_runoff_book_edges(outflow, outflow_comp, inflow, inflow_comp, c, dt, inv_dx, inv_dy, ow,
+                              oe, os, on);
   }
 }
 
+/* The sources of the next step, per cell (m/s of depth): the point inflows
+ * field (pts, when use_pts) and the inflow of each domain edge's hydrograph
+ * spread evenly over its cells (edge_*: west, east, south, north; 0 on a
+ * side without one, or with a neighbour), added in that fixed order. */
+__kernel void rain_runoff_source(__global const float *restrict pts, int use_pts,
+                                 __global float *restrict src, int nx, int ny, float edge_w,
+                                 float edge_e, float edge_s, float edge_n) {
+  int i = get_global_id(0), j = get_global_id(1);
+  if (!gr_inside(i, j, nx, ny))
+    return;
+  int c = gr_idx(i, j, nx);
+  float s = use_pts ? pts[c] : 0.0f;
+  s += i == 0 ? edge_w : 0.0f;
+  s += i == nx - 1 ? edge_e : 0.0f;
+  s += j == 0 ? edge_s : 0.0f;
+  s += j == ny - 1 ? edge_n : 0.0f;
+  src[c] = s;
+}
+
 /* One pass over the grid for the ledger (reduce.h): per work-group the
- * stored, infiltrated and outflow depths (double-float, metres summed over
+ * stored, infiltrated, outflow and inflow depths (double-float, metres summed over
  * cells) and the deepest cell; masked: only the cells [own_x0, own_x1) x
  * [own_y0, own_y1) of the row-wide local array (a piece without its ring). */
 __kernel void rain_runoff_reduce(
     __global const float *restrict h, __global const float *restrict h_comp,
     __global const float *restrict infiltrated, __global const float *restrict infiltrated_comp,
     __global const float *restrict outflow, __global const float *restrict outflow_comp,
+    __global const float *restrict inflow, __global const float *restrict inflow_comp,
     __global float *restrict partial, __local float *restrict scratch, int n, int row, int own_x0,
     int own_x1, int own_y0, int own_y1, int masked) {
   int lid = get_local_id(0), wg = get_local_size(0), start, end;
   gr_reduce_block(n, &start, &end);
   float s_hi = 0.0f, s_lo = 0.0f, i_hi = 0.0f, i_lo = 0.0f, o_hi = 0.0f, o_lo = 0.0f;
+  float n_hi = 0.0f, n_lo = 0.0f;
   float hmax = 0.0f;
   for (int c = start + lid; c < end; c += wg) {
     if (masked) {
@@ -300,6 +464,8 @@ __kernel void rain_runoff_reduce(
     gr_df_add(&i_hi, &i_lo, -infiltrated_comp[c]);
     gr_df_add(&o_hi, &o_lo, outflow[c]);
     gr_df_add(&o_hi, &o_lo, -outflow_comp[c]);
+    gr_df_add(&n_hi, &n_lo, inflow[c]);
+    gr_df_add(&n_hi, &n_lo, -inflow_comp[c]);
     hmax = fmax(hmax, d);
   }
   __local float *mine = gr_reduce_slots(scratch, GR_RAIN_RUNOFF_SUMS, GR_RAIN_RUNOFF_MAXES);
@@ -309,7 +475,9 @@ __kernel void rain_runoff_reduce(
   mine[3] = i_lo;
   mine[4] = o_hi;
   mine[5] = o_lo;
-  mine[6] = hmax;
+  mine[6] = n_hi;
+  mine[7] = n_lo;
+  mine[8] = hmax;
   gr_reduce_group(scratch, GR_RAIN_RUNOFF_SUMS, GR_RAIN_RUNOFF_MAXES, partial);
 }
 
@@ -483,15 +651,19 @@ GR_INLINE void gr_sw_face(gr_sw_cell L, gr_sw_cell R, float g, float *fh, float 
 
 /* The ghost beyond the grid's edge next to cell C, as a reconstructed cell
  * whose face toward C carries (low: C's west face; else its east face): a
- * wall's mirror image of C's face values (normal velocity negated), or an
- * open edge's dry, still cell; at C's face bed either way (db = 0
- * exactly), so that gr_sw_face gives the wall's or the outfall's flux. */
-GR_INLINE gr_sw_cell gr_sw_ghost(gr_sw_cell C, bool low, int closed) {
+ * wall's mirror image of C's face values (normal velocity negated), an
+ * open edge's dry, still cell, or a level edge's water up to `level` with
+ * C's face velocities; at C's face bed in every case (db = 0 exactly), so
+ * that gr_sw_face gives the wall's, the outfall's or the level's flux.
+ * (A transmissive edge needs no ghost: gr_sw_axis continues the line.) */
+GR_INLINE gr_sw_cell gr_sw_ghost(gr_sw_cell C, bool low, int kind, float level) {
   float s = low ? -0.5f : 0.5f;
+  bool wall = kind == GR_RAIN_RUNOFF_B_CLOSED, lv = kind == GR_RAIN_RUNOFF_B_LEVEL;
+  float bed = C.b + s * C.sb;
   gr_sw_cell g;
-  g.h = closed ? C.h + s * C.sh : 0.0f;
-  g.un = closed ? -(C.un + s * C.sun) : 0.0f;
-  g.ut = closed ? C.ut + s * C.sut : 0.0f;
+  g.h = wall ? C.h + s * C.sh : (lv ? fmax(level - bed, 0.0f) : 0.0f);
+  g.un = wall ? -(C.un + s * C.sun) : (lv ? C.un + s * C.sun : 0.0f);
+  g.ut = wall || lv ? C.ut + s * C.sut : 0.0f;
   g.b = C.b;
   g.sb = -C.sb;
   g.se = 0.0f;
@@ -517,36 +689,80 @@ GR_INLINE gr_sw_cell gr_sw_pick(bool use, gr_sw_cell a, gr_sw_cell b) {
   return c;
 }
 
+/* The line continued k cells beyond its edge cell a, away from a's inner
+ * neighbour m (a transmissive edge): a's depth and velocities over the bed
+ * a.b + k (a.b - m.b). Every work-item that needs a continued cell computes
+ * it from the same two cells by this expression, so the faces near the edge
+ * stay the same floats in both cells that share them. */
+GR_INLINE gr_sw_pt gr_sw_extend(gr_sw_pt a, gr_sw_pt m, float k) {
+  gr_sw_pt p = a;
+  p.b = a.b + k * (a.b - m.b);
+  return p;
+}
+
+GR_INLINE gr_sw_pt gr_sw_pick_pt(bool use, gr_sw_pt a, gr_sw_pt b) {
+  gr_sw_pt c;
+  c.h = use ? a.h : b.h;
+  c.b = use ? a.b : b.b;
+  c.un = use ? a.un : b.un;
+  c.ut = use ? a.ut : b.ut;
+  return c;
+}
+
 /* The flux balance of the centre cell (p2) of a 5-cell line along one
  * axis: dh (mass in minus out), dqn and dqt (momentum, with the bed's
  * source), per unit of the axis' face length; out_lo, out_hi the depth
- * flux (m^2/s) leaving through the grid's edge faces. i, n: the cell's
- * index and the line's length. The edge faces are faces with a ghost
- * (gr_sw_ghost): a wall passes no water, an open edge only outflow. */
+ * flux (m^2/s) leaving through the grid's edge faces (negative: entering).
+ * i, n: the cell's index and the line's length; kind_lo, kind_hi, lvl_lo,
+ * lvl_hi: the kinds and levels of the line's low and high edges. A
+ * transmissive edge continues the line (gr_sw_extend) two cells beyond it,
+ * so its face and its edge cells are computed as inner ones; the other
+ * edges' faces have a ghost (gr_sw_ghost): a wall passes no water, an open
+ * edge only outflow, a level edge both ways. */
 GR_INLINE void gr_sw_axis(gr_sw_pt p0, gr_sw_pt p1, gr_sw_pt p2, gr_sw_pt p3, gr_sw_pt p4, int i,
-                          int n, int closed, float g, float *dh, float *dqn, float *dqt,
-                          float *out_lo, float *out_hi) {
-  bool lo = i > 0, hi = i < n - 1;
+                          int n, int kind_lo, int kind_hi, float lvl_lo, float lvl_hi, float g,
+                          float *dh, float *dqn, float *dqt, float *out_lo, float *out_hi) {
+  bool tlo = kind_lo == GR_RAIN_RUNOFF_B_TRANSMISSIVE,
+       thi = kind_hi == GR_RAIN_RUNOFF_B_TRANSMISSIVE;
+  /* The edge cell's inner neighbour, where the edge is this cell's. */
+  gr_sw_pt in_lo = gr_sw_pick_pt(i + 1 < n, p3, p2), in_hi = gr_sw_pick_pt(i > 0, p1, p2);
+  /* A branch on the arguments alone (the same for every work-item): a grid
+   * without transmissive edges pays nothing for them. */
+  if (tlo || thi) {
+    p0 = gr_sw_pick_pt(tlo && i == 0, gr_sw_extend(p2, in_lo, 2.0f),
+                       gr_sw_pick_pt(tlo && i == 1, gr_sw_extend(p1, p2, 1.0f), p0));
+    p1 = gr_sw_pick_pt(tlo && i == 0, gr_sw_extend(p2, in_lo, 1.0f), p1);
+    p4 = gr_sw_pick_pt(thi && i == n - 1, gr_sw_extend(p2, in_hi, 2.0f),
+                       gr_sw_pick_pt(thi && i == n - 2, gr_sw_extend(p3, p2, 1.0f), p4));
+    p3 = gr_sw_pick_pt(thi && i == n - 1, gr_sw_extend(p2, in_hi, 1.0f), p3);
+  }
+  bool lo = i > 0 || tlo, hi = i < n - 1 || thi;
   gr_sw_cell C = gr_sw_recon(p1, p2, p3, lo && hi);
-  gr_sw_cell W = gr_sw_recon(p0, p1, p2, i > 1);
-  gr_sw_cell E = gr_sw_recon(p2, p3, p4, i < n - 2);
-  gr_sw_cell gw = gr_sw_ghost(C, true, closed), ge = gr_sw_ghost(C, false, closed);
+  gr_sw_cell W = gr_sw_recon(p0, p1, p2, i > 1 || tlo);
+  gr_sw_cell E = gr_sw_recon(p2, p3, p4, i < n - 2 || thi);
+  gr_sw_cell gw = gr_sw_ghost(C, true, kind_lo, lvl_lo);
+  gr_sw_cell ge = gr_sw_ghost(C, false, kind_hi, lvl_hi);
   W = gr_sw_pick(lo, W, gw);
   E = gr_sw_pick(hi, E, ge);
   float fhw, fmw, ftw, fhe, fme, fte, unused;
   gr_sw_face(W, C, g, &fhw, &unused, &fmw, &ftw);
   gr_sw_face(C, E, g, &fhe, &fme, &unused, &fte);
-  /* At the edges: nothing through a wall, nothing in through an open edge
-   * (a still wall then: no momentum either). */
-  bool stop_w = !lo && (closed || fhw > 0.0f), stop_e = !hi && (closed || fhe < 0.0f);
-  fmw = stop_w && !closed ? 0.0f : fmw;
-  fme = stop_e && !closed ? 0.0f : fme;
+  /* At the edges: nothing through a wall, nothing in through an open or a
+   * transmissive edge (a still wall then: no momentum either; see
+   * gr_rain_runoff_edge_q for why). */
+  bool wall_lo = kind_lo == GR_RAIN_RUNOFF_B_CLOSED, wall_hi = kind_hi == GR_RAIN_RUNOFF_B_CLOSED;
+  bool only_out_lo = kind_lo == GR_RAIN_RUNOFF_B_OPEN || tlo;
+  bool only_out_hi = kind_hi == GR_RAIN_RUNOFF_B_OPEN || thi;
+  bool stop_w = i == 0 && (wall_lo || (only_out_lo && fhw > 0.0f));
+  bool stop_e = i == n - 1 && (wall_hi || (only_out_hi && fhe < 0.0f));
+  fmw = stop_w && !wall_lo ? 0.0f : fmw;
+  fme = stop_e && !wall_hi ? 0.0f : fme;
   fhw = stop_w ? 0.0f : fhw;
   fhe = stop_e ? 0.0f : fhe;
   ftw = stop_w ? 0.0f : ftw;
   fte = stop_e ? 0.0f : fte;
-  *out_lo = lo ? 0.0f : -fhw;
-  *out_hi = hi ? 0.0f : fhe;
+  *out_lo = i > 0 ? 0.0f : -fhw;
+  *out_hi = i < n - 1 ? 0.0f : fhe;
   float hw = C.h - 0.5f * C.sh, he = C.h + 0.5f * C.sh;
   *dh = fhw - fhe;
   /* (fmw + g hw^2 / 2) - (fme + g he^2 / 2) - g (hw + he) / 2 (bed slope)
@@ -570,8 +786,8 @@ GR_INLINE void gr_sw_friction(float h, float dt, float g, float n2, float *qx, f
 
 /* Rain and infiltration on a cell's water (as the local inertial model
  * takes them), its momentum scaled with the water infiltration removes. */
-GR_INLINE float gr_sw_wet_q(float h, float q, float r, float dt, float hw) {
-  float h1 = h + r * dt;
+GR_INLINE float gr_sw_wet_q(float h, float q, float r, float s, float dt, float hw) {
+  float h1 = gr_rain_runoff_gain(h, r, s, dt);
   return h1 > 0.0f ? q * (hw / h1) : 0.0f;
 }
 
@@ -581,16 +797,19 @@ GR_INLINE float gr_sw_wet_q(float h, float q, float r, float dt, float hw) {
 GR_INLINE gr_sw_pt gr_sw_load(__global const float *restrict sh, __global const float *restrict sn,
                               __global const float *restrict st, __global const float *restrict b,
                               __global const float *restrict rain,
-                              __global const float *restrict perm, bool in, int q, int stage,
-                              float dt, int use_rain, float rain_uniform, int use_perm,
+                              __global const float *restrict perm,
+                              __global const float *restrict src, int use_src,
+                              __global const float *restrict nodata, int use_nodata, bool in, int q,
+                              int stage, float dt, int use_rain, float rain_uniform, int use_perm,
                               float perm_uniform) {
   float hh = in ? sh[q] : 0.0f, pn = in ? sn[q] : 0.0f, pt = in ? st[q] : 0.0f;
   if (stage == 1) {
-    float r = in ? gr_rain_runoff_input(rain, use_rain, rain_uniform, q) : 0.0f;
-    float k = in ? gr_rain_runoff_input(perm, use_perm, perm_uniform, q) : 0.0f;
-    float hw = gr_rain_runoff_wet(hh, r, k, dt);
-    pn = gr_sw_wet_q(hh, pn, r, dt, hw);
-    pt = gr_sw_wet_q(hh, pt, r, dt, hw);
+    float r = in ? GR_RAIN_RUNOFF_RAIN(q) : 0.0f;
+    float k = in ? GR_RAIN_RUNOFF_PERM(q) : 0.0f;
+    float sq = in ? GR_RAIN_RUNOFF_SRC(q) : 0.0f;
+    float hw = gr_rain_runoff_wet(hh, r, sq, k, dt);
+    pn = gr_sw_wet_q(hh, pn, r, sq, dt, hw);
+    pt = gr_sw_wet_q(hh, pt, r, sq, dt, hw);
     hh = hw;
   }
   gr_sw_pt p;
@@ -615,22 +834,27 @@ GR_INLINE void gr_sw_stage(
     __global float *restrict h_comp, __global float *restrict h1, __global float *restrict qu1,
     __global float *restrict qv1, __global float *restrict dh1, __global const float *restrict b,
     __global const float *restrict rain, __global const float *restrict perm,
-    __global float *restrict infiltrated, __global float *restrict infiltrated_comp,
-    __global float *restrict outflow, __global float *restrict outflow_comp, int nx, int ny,
-    float dt, float inv_dx, float inv_dy, float g, float n2, int use_rain, float rain_uniform,
-    int use_perm, float perm_uniform, int closed, __global const float *restrict sh,
-    __global const float *restrict su, __global const float *restrict sv, const int stage) {
+    __global const float *restrict src, int use_src, __global const float *restrict nodata,
+    int use_nodata, __global float *restrict infiltrated, __global float *restrict infiltrated_comp,
+    __global float *restrict outflow, __global float *restrict outflow_comp,
+    __global float *restrict inflow, __global float *restrict inflow_comp, int nx, int ny, float dt,
+    float inv_dx, float inv_dy, float g, float n2, __global const float *restrict n2map, int use_n2,
+    int use_rain, float rain_uniform, int use_perm, float perm_uniform, int bnd_w, int bnd_e,
+    int bnd_s, int bnd_n, float lvl_w, float lvl_e, float lvl_s, float lvl_n,
+    __global const float *restrict sh, __global const float *restrict su,
+    __global const float *restrict sv, const int stage) {
   int i = get_global_id(0), j = get_global_id(1);
   if (!gr_inside(i, j, nx, ny))
     return;
   int c = gr_idx(i, j, nx);
+  float n2c = use_n2 ? n2map[c] : n2; /* the cell's own roughness, n^2 */
   /* The cross of 5 + 5 cells around (i, j); x2 and y2 are the cell itself.
    * Cells beyond the array are masked to dry, flat and still, and never
    * used (the reconstruction's slopes and the edge faces do without them);
    * indices stay linear so that CPU compilers vectorise the loads. */
 #define GR_SW_LOAD(o, in, q, sn, st)                                                               \
-  gr_sw_load(sh, sn, st, b, rain, perm, (in), (q), stage, dt, use_rain, rain_uniform, use_perm,    \
-             perm_uniform)
+  gr_sw_load(sh, sn, st, b, rain, perm, src, use_src, nodata, use_nodata, (in), (q), stage, dt,    \
+             use_rain, rain_uniform, use_perm, perm_uniform)
   gr_sw_pt x0 = GR_SW_LOAD(-2, i >= 2, c - 2, su, sv);
   gr_sw_pt x1 = GR_SW_LOAD(-1, i >= 1, c - 1, su, sv);
   gr_sw_pt x2 = GR_SW_LOAD(0, true, c, su, sv);
@@ -643,52 +867,64 @@ GR_INLINE void gr_sw_stage(
 #undef GR_SW_LOAD
   gr_sw_pt y2 = {x2.h, x2.b, x2.ut, x2.un};
   float dhx, dqx_x, dqy_x, olx, ohx, dhy, dqy_y, dqx_y, oly, ohy;
-  gr_sw_axis(x0, x1, x2, x3, x4, i, nx, closed, g, &dhx, &dqx_x, &dqy_x, &olx, &ohx);
-  gr_sw_axis(y0, y1, y2, y3, y4, j, ny, closed, g, &dhy, &dqy_y, &dqx_y, &oly, &ohy);
+  gr_sw_axis(x0, x1, x2, x3, x4, i, nx, bnd_w, bnd_e, lvl_w, lvl_e, g, &dhx, &dqx_x, &dqy_x, &olx,
+             &ohx);
+  gr_sw_axis(y0, y1, y2, y3, y4, j, ny, bnd_s, bnd_n, lvl_s, lvl_n, g, &dhy, &dqy_y, &dqx_y, &oly,
+             &ohy);
   float dh = dt * (dhx * inv_dx + dhy * inv_dy);
   float hn = x2.h + dh;
   float qun = su[c] + dt * (dqx_x * inv_dx + dqx_y * inv_dy);
   float qvn = sv[c] + dt * (dqy_x * inv_dx + dqy_y * inv_dy);
-  float out = 0.5f * dt * ((olx + ohx) * inv_dx + (oly + ohy) * inv_dy);
   if (stage == 1) {
     /* su, sv are the momenta before rain: take the wet ones. */
-    float r = gr_rain_runoff_input(rain, use_rain, rain_uniform, c);
+    float r = GR_RAIN_RUNOFF_RAIN(c);
+    float sc = GR_RAIN_RUNOFF_SRC(c);
     float hw = x2.h;
-    qun = gr_sw_wet_q(h[c], qu[c], r, dt, hw) + dt * (dqx_x * inv_dx + dqx_y * inv_dy);
-    qvn = gr_sw_wet_q(h[c], qv[c], r, dt, hw) + dt * (dqy_x * inv_dx + dqy_y * inv_dy);
+    qun = gr_sw_wet_q(h[c], qu[c], r, sc, dt, hw) + dt * (dqx_x * inv_dx + dqx_y * inv_dy);
+    qvn = gr_sw_wet_q(h[c], qv[c], r, sc, dt, hw) + dt * (dqy_x * inv_dx + dqy_y * inv_dy);
     /* Friction in each stage: without it a film on a steep slope would
      * gather g S dt of speed in the first stage and empty its cell in the
      * second. */
-    gr_sw_friction(hn, dt, g, n2, &qun, &qvn);
+    gr_sw_friction(hn, dt, g, n2c, &qun, &qvn);
     h1[c] = fmax(hn, 0.0f);
     dh1[c] = dh;
     qu1[c] = hn > 0.0f ? qun : 0.0f;
     qv1[c] = hn > 0.0f ? qvn : 0.0f;
   } else {
     float h0 = h[c];
-    float r = gr_rain_runoff_input(rain, use_rain, rain_uniform, c);
-    float k = gr_rain_runoff_input(perm, use_perm, perm_uniform, c);
-    float hw = gr_rain_runoff_wet(h0, r, k, dt);
-    float inf = gr_rain_runoff_infiltration(h0, r, k, dt);
+    float r = GR_RAIN_RUNOFF_RAIN(c);
+    float k = GR_RAIN_RUNOFF_PERM(c);
+    float sc = GR_RAIN_RUNOFF_SRC(c);
+    float hw = gr_rain_runoff_wet(h0, r, sc, k, dt);
+    float inf = gr_rain_runoff_infiltration(h0, r, sc, k, dt);
     /* The new depth h0 + (r dt - i) + (dh1 + dh) / 2, Kahan-summed as the
      * local inertial model's (h - h_comp is the water): without it the
      * rounding of the depth would show in the ledger after 10^3 steps. */
-    float delta = (r * dt - inf) + 0.5f * (dh1[c] + dh);
+    float delta = ((r * dt - inf) + sc * dt) + 0.5f * (dh1[c] + dh);
     float y = delta - h_comp[c];
     float hf = h0 + y;
     float comp = (hf - h0) - y;
-    gr_sw_friction(hn, dt, g, n2, &qun, &qvn);
-    float qx = 0.5f * (gr_sw_wet_q(h0, qu[c], r, dt, hw) + qun);
-    float qy = 0.5f * (gr_sw_wet_q(h0, qv[c], r, dt, hw) + qvn);
-    h[c] = fmax(hf, 0.0f);
-    h_comp[c] = hf > 0.0f ? comp : 0.0f;
-    qu[c] = hf > 0.0f ? qx : 0.0f;
-    qv[c] = hf > 0.0f ? qy : 0.0f;
+    gr_sw_friction(hn, dt, g, n2c, &qun, &qvn);
+    float qx = 0.5f * (gr_sw_wet_q(h0, qu[c], r, sc, dt, hw) + qun);
+    float qy = 0.5f * (gr_sw_wet_q(h0, qv[c], r, sc, dt, hw) + qvn);
+    /* An outfall no-data cell drains (its water is outflow). */
+    float gone = gr_rain_runoff_drain(nodata, use_nodata, c, hf, comp);
+    bool keep = hf > 0.0f && gone == 0.0f;
+    h[c] = gone == 0.0f ? fmax(hf, 0.0f) : 0.0f;
+    h_comp[c] = keep ? comp : 0.0f;
+    qu[c] = keep ? qx : 0.0f;
+    qv[c] = keep ? qy : 0.0f;
+    if (gone != 0.0f)
+      gr_kahan_add(outflow, outflow_comp, c, gone);
     if (inf != 0.0f)
       gr_kahan_add(infiltrated, infiltrated_comp, c, inf);
+    /* The sources' water is inflow, the very float the depth gained. */
+    if (sc != 0.0f)
+      gr_kahan_add(inflow, inflow_comp, c, sc * dt);
   }
-  if (out != 0.0f)
-    gr_kahan_add(outflow, outflow_comp, c, out);
+  /* Half of each stage's edge flows (Heun's average). */
+  gr_rain_runoff_book_edges(outflow, outflow_comp, inflow, inflow_comp, c, 0.5f * dt, inv_dx,
+                            inv_dy, olx, ohx, oly, ohy);
 }
 
 /* The two stages as two kernels, each reading one state and writing
@@ -699,15 +935,19 @@ GR_INLINE void gr_sw_stage(
       __global float *restrict h_comp, __global float *restrict h1, __global float *restrict qu1,  \
       __global float *restrict qv1, __global float *restrict dh1,                                  \
       __global const float *restrict b, __global const float *restrict rain,                       \
-      __global const float *restrict perm, __global float *restrict infiltrated,                   \
+      __global const float *restrict perm, __global const float *restrict src, int use_src,        \
+      __global const float *restrict nodata, int use_nodata, __global float *restrict infiltrated, \
       __global float *restrict infiltrated_comp, __global float *restrict outflow,                 \
-      __global float *restrict outflow_comp, int nx, int ny, float dt, float inv_dx, float inv_dy, \
-      float g, float n2, int use_rain, float rain_uniform, int use_perm, float perm_uniform,       \
-      int closed
+      __global float *restrict outflow_comp, __global float *restrict inflow,                      \
+      __global float *restrict inflow_comp, int nx, int ny, float dt, float inv_dx, float inv_dy,  \
+      float g, float n2, __global const float *restrict n2map, int use_n2, int use_rain,           \
+      float rain_uniform, int use_perm, float perm_uniform, int bnd_w, int bnd_e, int bnd_s,       \
+      int bnd_n, float lvl_w, float lvl_e, float lvl_s, float lvl_n
 #define GR_SW_STAGE_PASS                                                                           \
-  h, qu, qv, h_comp, h1, qu1, qv1, dh1, b, rain, perm, infiltrated, infiltrated_comp, outflow,     \
-      outflow_comp, nx, ny, dt, inv_dx, inv_dy, g, n2, use_rain, rain_uniform, use_perm,           \
-      perm_uniform, closed
+  h, qu, qv, h_comp, h1, qu1, qv1, dh1, b, rain, perm, src, use_src, nodata, use_nodata,           \
+      infiltrated, infiltrated_comp, outflow, outflow_comp, inflow, inflow_comp, nx, ny, dt,       \
+      inv_dx, inv_dy, g, n2, n2map, use_n2, use_rain, rain_uniform, use_perm, perm_uniform, bnd_w, \
+      bnd_e, bnd_s, bnd_n, lvl_w, lvl_e, lvl_s, lvl_n
 
 __kernel void rain_runoff_sw_stage1(GR_SW_STAGE_ARGS) {
   gr_sw_stage(GR_SW_STAGE_PASS, h, qu, qv, 1);

@@ -21,10 +21,18 @@
  * rounding of the depth update can never take it below zero. */
 #define GR_RAIN_RUNOFF_KEEP 0.999999f
 
-/* The ledger's reduction (reduce.h): three double-float sums (stored,
- * infiltrated, outflow, in metres of depth over cells) and one maximum (the
- * deepest cell) per work-group. */
-#define GR_RAIN_RUNOFF_SUMS 3
+/* The ledger's reduction (reduce.h): four double-float sums (stored,
+ * infiltrated, outflow, inflow, in metres of depth over cells) and one
+ * maximum (the deepest cell) per work-group. */
+#define GR_RAIN_RUNOFF_SUMS 4
+
+/* Edge kinds, the values of gr_boundary (graupel/rain_runoff.h), as the
+ * kernels get them (bnd_w, bnd_e, bnd_s, bnd_n: scalar arguments; int4 ones
+ * kept PoCL from vectorising the local inertial flux kernel, 2x slower). */
+#define GR_RAIN_RUNOFF_B_OPEN 0
+#define GR_RAIN_RUNOFF_B_CLOSED 1
+#define GR_RAIN_RUNOFF_B_TRANSMISSIVE 2
+#define GR_RAIN_RUNOFF_B_LEVEL 3
 #define GR_RAIN_RUNOFF_MAXES 1
 
 /* The flood-hazard rating's debris factor applies where the depth exceeds

@@ -33,13 +33,15 @@
 #define GR_RAIN_RUNOFF_PROGRESS_EVERY 0.1
 /* Checkpoints: "GRR1" and the layout's version. */
 #define GR_RAIN_RUNOFF_STATE_MAGIC 0x31525247u
-#define GR_RAIN_RUNOFF_STATE_VERSION 4u /* 2: the piece's i0, j0; 3: qu, qv; 4: the maps */
+/* 2: the piece's i0, j0; 3: qu, qv; 4: the maps; 5: the inflow */
+#define GR_RAIN_RUNOFF_STATE_VERSION 5u
 /* Per-cell arrays of a checkpoint: h, h_c, k, inf, inf_c, out, out_c, qu, qv,
- * and the flood maps' max_depth, max_speed, arrival, wet, wet_c, max_hazard. */
+ * the flood maps' max_depth, max_speed, arrival, wet, wet_c, max_hazard, and
+ * the inflow and its compensation. */
 /* Per halo cell: h, k, west and south faces (local inertial); h, qu, qv and
  * h_c (shallow water). */
 #define GR_RAIN_RUNOFF_HALO_ARRAYS 4
-#define GR_RAIN_RUNOFF_STATE_CELL_ARRAYS 15
+#define GR_RAIN_RUNOFF_STATE_CELL_ARRAYS 17
 #define GR_RAIN_RUNOFF_MAP_ARRAYS 6
 /* The local inertial model's smallest Manning n (shallow water allows 0). */
 #define GR_RAIN_RUNOFF_LI_MIN_N 0.005
@@ -51,10 +53,12 @@ enum {
   GR_RAIN_RUNOFF_P_MANNING_N,
   GR_RAIN_RUNOFF_P_MAX_DT,
   GR_RAIN_RUNOFF_P_CFL,
-  GR_RAIN_RUNOFF_P_BOUNDARY,
-  GR_RAIN_RUNOFF_P_FLOW_MODEL,
+  GR_RAIN_RUNOFF_P_BOUNDARY,                              /* four rows: west, east, south, north */
+  GR_RAIN_RUNOFF_P_LEVEL = GR_RAIN_RUNOFF_P_BOUNDARY + 4, /* four rows, likewise */
+  GR_RAIN_RUNOFF_P_FLOW_MODEL = GR_RAIN_RUNOFF_P_LEVEL + 4,
   GR_RAIN_RUNOFF_P_WETTING_DEPTH,
   GR_RAIN_RUNOFF_P_DEBRIS_FACTOR,
+  GR_RAIN_RUNOFF_P_NO_DATA,
   GR_RAIN_RUNOFF_P_COUNT
 };
 
@@ -66,10 +70,18 @@ static const gr_param_bound gr_rain_runoff_bounds[GR_RAIN_RUNOFF_P_COUNT] = {
     {"ManningN", "s/m^(1/3)", 0.0, 1.0, 0.03, 1.0, 0, 0},
     {"MaxTimeStep", "s", 0.0, 3600.0, 1.0, 1.0, 1, 0},
     {"CourantNumber", "", 0.0, 1.0, 0.7, 1.0, 1, 0},
-    {"Boundary", "", 0.0, 1.0, 0.0, 1.0, 0, 1},
+    {"BoundaryWest", "", 0.0, 3.0, 0.0, 1.0, 0, 1},
+    {"BoundaryEast", "", 0.0, 3.0, 0.0, 1.0, 0, 1},
+    {"BoundarySouth", "", 0.0, 3.0, 0.0, 1.0, 0, 1},
+    {"BoundaryNorth", "", 0.0, 3.0, 0.0, 1.0, 0, 1},
+    {"LevelWest", "m", -1.0e6, 1.0e6, 0.0, 1.0, 0, 0},
+    {"LevelEast", "m", -1.0e6, 1.0e6, 0.0, 1.0, 0, 0},
+    {"LevelSouth", "m", -1.0e6, 1.0e6, 0.0, 1.0, 0, 0},
+    {"LevelNorth", "m", -1.0e6, 1.0e6, 0.0, 1.0, 0, 0},
     {"FlowModel", "", 0.0, 1.0, 0.0, 1.0, 0, 1},
     {"WettingDepth", "m", 0.0, 10.0, 0.01, 1.0, 1, 0},
     {"DebrisFactor", "", 0.0, 1.0, 0.0, 1.0, 0, 0},
+    {"NoDataBoundary", "", 0.0, 1.0, 1.0, 1.0, 0, 1},
 };
 
 /* A row's range in the core's unit: exactly the products a caller gets from
@@ -90,8 +102,34 @@ struct gr_rain_runoff {
   int nxl, nyl;
   int ring[4]; /* gr_rain_runoff_side order: west, east, south, north */
   gr_rain_runoff_params params;
-  cl_kernel flux, limit, update, reduce, derive, sw_stage[2], sw_speed, maps;
+  cl_kernel flux, flux_edges, limit, update, reduce, derive, sw_stage[2], sw_speed, maps, source;
   cl_mem h, h_c, b, k, inf, inf_c, out, out_c;
+  cl_mem in, in_c; /* inflow (edges and sources), per cell (m), and its compensation */
+  /* Sources (m/s of depth): the point inflows' field (pts, once set) and
+   * the field the steps read (src: pts plus the edges' hydrographs, made by
+   * rain_runoff_source before every step while a hydrograph is set). */
+  cl_mem pts, src;
+  int has_pts;
+  double pts_max; /* the largest point-inflow rate, m/s */
+  /* The inflow hydrographs per edge (west, east, south, north): n rows of
+   * time (s) and discharge (m^3/s); n 0 where there is none. */
+  int edge_n[4];
+  double *edge_t[4], *edge_q[4];
+  /* The Manning map as n^2 per cell (once set; has_n2), and its smallest n. */
+  cl_mem n2map;
+  int has_n2;
+  double n_min;
+  /* No-data cells (NaN elevations): per cell of the local array 0 (of the
+   * domain), 1 (a wall) or 2 (an outfall), on the device (nodata, once
+   * there are some: has_nodata) and on the host (mask); the owned cells of
+   * the domain (active_own), for the uniform rain. */
+  cl_mem nodata;
+  int has_nodata;
+  unsigned char *mask;
+  double active_own;
+  /* The hyetograph: hy_n rows of time (s) and rain rate (m/s); 0: none. */
+  int hy_n;
+  double *hy_t, *hy_r;
   cl_mem qu, qv, h1, qu1, qv1, dh1; /* shallow water: discharges and Heun's stage */
   cl_mem qu0, qv0;                  /* initial discharges, once VELOCITY was set */
   cl_mem qx[2], qy[2];              /* discharges; [cur] is the latest, the other the next */
@@ -110,6 +148,10 @@ struct gr_rain_runoff {
   /* g max(|db/dx| / dx + |db/dy| / dy) over the local array, 1/s^2: the
    * fastest the bed's slope can speed water up, per cell crossed. */
   double slope_rate;
+  /* The lowest ground along each of the domain's edges (west, east, south,
+   * north; 0 on a side with a neighbour): a level edge's depth over it is
+   * water the stable step must see. */
+  double edge_bed[4];
   double initial_sum; /* sum of the initial depth's floats, m */
   double initial_volume, rain_volume, time;
   long long steps;
@@ -129,6 +171,11 @@ struct gr_rain_runoff {
   void *halo_user;
   char error[1024]; /* this handle's latest error (gr_error_keep) */
 };
+
+static int gr_rain_runoff_has_sources(const gr_rain_runoff *s);
+static int gr_rain_runoff_has_edge_inflow(const gr_rain_runoff *s);
+static gr_status gr_rain_runoff_sources_update(gr_rain_runoff *s, double t0, double t1);
+static gr_status gr_rain_runoff_set_elevation(gr_rain_runoff *s, const float *host);
 
 /* Every failing public entry point with a handle ends here. */
 #define GR_RAIN_RUNOFF_KEEP_ERROR(s, st) gr_error_keep((s)->error, sizeof((s)->error), (st))
@@ -155,10 +202,14 @@ void gr_rain_runoff_params_init(gr_rain_runoff_params *p) {
   p->manning_n = t[GR_RAIN_RUNOFF_P_MANNING_N].default_value;
   p->max_dt = t[GR_RAIN_RUNOFF_P_MAX_DT].default_value;
   p->cfl = t[GR_RAIN_RUNOFF_P_CFL].default_value;
-  p->boundary = (gr_boundary)(int)t[GR_RAIN_RUNOFF_P_BOUNDARY].default_value;
+  for (int e = 0; e < 4; ++e) {
+    p->boundary[e] = (gr_boundary)(int)t[GR_RAIN_RUNOFF_P_BOUNDARY + e].default_value;
+    p->boundary_level[e] = t[GR_RAIN_RUNOFF_P_LEVEL + e].default_value;
+  }
   p->flow_model = (gr_flow_model)(int)t[GR_RAIN_RUNOFF_P_FLOW_MODEL].default_value;
   p->wetting_depth = t[GR_RAIN_RUNOFF_P_WETTING_DEPTH].default_value;
   p->debris_factor = t[GR_RAIN_RUNOFF_P_DEBRIS_FACTOR].default_value;
+  p->no_data = (gr_boundary)(int)t[GR_RAIN_RUNOFF_P_NO_DATA].default_value;
 }
 
 /* The core's value of row `row` in p. */
@@ -178,16 +229,24 @@ static double gr_rain_runoff_param_value(const gr_rain_runoff_params *p, int row
     return p->wetting_depth;
   case GR_RAIN_RUNOFF_P_DEBRIS_FACTOR:
     return p->debris_factor;
+  case GR_RAIN_RUNOFF_P_NO_DATA: {
+    int k; /* any bit pattern the enum may hold */
+    memcpy(&k, &p->no_data, sizeof(k));
+    return (double)k;
+  }
   case GR_RAIN_RUNOFF_P_FLOW_MODEL: {
     int m; /* any bit pattern the enum may hold */
     memcpy(&m, &p->flow_model, sizeof(m));
     return (double)m;
   }
-  default: {
-    int b; /* any bit pattern the enum may hold */
-    memcpy(&b, &p->boundary, sizeof(b));
-    return (double)b;
-  }
+  default:
+    if (row >= GR_RAIN_RUNOFF_P_LEVEL)
+      return p->boundary_level[row - GR_RAIN_RUNOFF_P_LEVEL];
+    else {
+      int b; /* any bit pattern the enum may hold */
+      memcpy(&b, &p->boundary[row - GR_RAIN_RUNOFF_P_BOUNDARY], sizeof(b));
+      return (double)b;
+    }
   }
 }
 
@@ -231,9 +290,13 @@ static gr_status gr_rain_runoff_field_check(gr_field f, const float *values, siz
   char rule_text[160];
   double lo = -HUGE_VAL, hi = HUGE_VAL;
   size_t comps = 1;
+  int nan_ok = 0;
   switch (f) {
   case GR_FIELD_ELEVATION:
-    rule = strict ? "elevations must be finite and within +-1e6 m" : "elevations must be finite";
+    /* NaN marks a no-data cell (outside the domain); infinities are refused. */
+    nan_ok = 1;
+    rule = strict ? "elevations must be within +-1e6 m, or NaN for a no-data cell"
+                  : "elevations must be finite, or NaN for a no-data cell";
     if (strict) {
       lo = -GR_RAIN_RUNOFF_MAX_ELEVATION;
       hi = GR_RAIN_RUNOFF_MAX_ELEVATION;
@@ -290,7 +353,7 @@ static gr_status gr_rain_runoff_field_check(gr_field f, const float *values, siz
   }
   for (size_t c = 0; c < n; ++c) {
     double v = values[c];
-    if (isfinite(v) && v >= lo && v <= hi)
+    if ((isfinite(v) && v >= lo && v <= hi) || (nan_ok && isnan(v)))
       continue;
     if (msg && msg_len) {
       if (nx > 0)
@@ -332,8 +395,11 @@ static int gr_rain_runoff_has_ring(const gr_rain_runoff *s) {
 static double gr_rain_runoff_own_sum(const gr_rain_runoff *s, const float *host) {
   double sum = 0.0;
   for (int j = s->ring[2]; j < s->nyl - s->ring[3]; ++j)
-    for (int i = s->ring[0]; i < s->nxl - s->ring[1]; ++i)
-      sum += host[(size_t)j * (size_t)s->nxl + (size_t)i];
+    for (int i = s->ring[0]; i < s->nxl - s->ring[1]; ++i) {
+      size_t c = (size_t)j * (size_t)s->nxl + (size_t)i;
+      if (!s->has_nodata || !s->mask[c]) /* nothing falls on, or stays in, no-data cells */
+        sum += host[c];
+    }
   return sum;
 }
 
@@ -408,7 +474,7 @@ static gr_status gr_rain_runoff_read_own(gr_rain_runoff *s, cl_mem buf, size_t c
                              (size_t)s->grid.nx, (size_t)s->grid.ny, host, 0);
 }
 
-/* Sums the stored, infiltrated and outflow depths over the cells (m, so
+/* Sums the stored, infiltrated, outflow and inflow depths over the cells (m, so
  * times dx dy for m^3) and finds the deepest cell. */
 static gr_status gr_rain_runoff_reduce(gr_rain_runoff *s, double sums[GR_RAIN_RUNOFF_SUMS],
                                        double *max_depth) {
@@ -424,6 +490,8 @@ static gr_status gr_rain_runoff_reduce(gr_rain_runoff *s, double sums[GR_RAIN_RU
       {"infiltrated_comp", sizeof(cl_mem), &s->inf_c},
       {"outflow", sizeof(cl_mem), &s->out},
       {"outflow_comp", sizeof(cl_mem), &s->out_c},
+      {"inflow", sizeof(cl_mem), &s->in},
+      {"inflow_comp", sizeof(cl_mem), &s->in_c},
       {"n", sizeof(n), &n},
       {"row", sizeof(row), &row},
       {"own_x0", sizeof(own_x0), &own_x0},
@@ -573,14 +641,14 @@ gr_status gr_rain_runoff_create(gr_context *ctx, const gr_grid *grid,
                         "address at most about 2.1e9 faces; split the domain or coarsen it.",
                         nx, ny);
   /* The state that is always there: depth, elevation, limiter, infiltrated
-   * and outflow with their compensations, the shallow-water discharges and
-   * stage (14 per cell), the flood maps (6) and two sets of face arrays. Refuse before allocating
-   * when the device cannot hold it. */
+   * outflow and inflow with their compensations, the shallow-water discharges
+   * and stage (16 per cell), the flood maps (6) and two sets of face arrays. Refuse before
+   * allocating when the device cannot hold it. */
   gr_device_info info;
   gr_status st = gr_context_device_info(ctx, &info);
   if (st != GR_OK)
     return st;
-  double need = 4.0 * ((14.0 + GR_RAIN_RUNOFF_MAP_ARRAYS) * (double)cells +
+  double need = 4.0 * ((16.0 + GR_RAIN_RUNOFF_MAP_ARRAYS) * (double)cells +
                        2.0 * ((double)(nx + 1) * ny + (double)nx * (ny + 1)));
   if (need > (double)info.global_mem_bytes)
     return gr_set_error(ctx, GR_ERR_TOO_LARGE,
@@ -604,6 +672,8 @@ gr_status gr_rain_runoff_create(gr_context *ctx, const gr_grid *grid,
   if (st == GR_OK)
     st = gr_kernel_create(ctx, prog, "rain_runoff_flux", &s->flux);
   if (st == GR_OK)
+    st = gr_kernel_create(ctx, prog, "rain_runoff_flux_edges", &s->flux_edges);
+  if (st == GR_OK)
     st = gr_kernel_create(ctx, prog, "rain_runoff_limit", &s->limit);
   if (st == GR_OK)
     st = gr_kernel_create(ctx, prog, "rain_runoff_update", &s->update);
@@ -619,10 +689,12 @@ gr_status gr_rain_runoff_create(gr_context *ctx, const gr_grid *grid,
     st = gr_kernel_create(ctx, prog, "rain_runoff_sw_speed", &s->sw_speed);
   if (st == GR_OK)
     st = gr_kernel_create(ctx, prog, "rain_runoff_maps", &s->maps);
+  if (st == GR_OK)
+    st = gr_kernel_create(ctx, prog, "rain_runoff_source", &s->source);
   for (int a = 0; st == GR_OK && a < GR_RAIN_RUNOFF_MAP_ARRAYS; ++a)
     st = gr_buffer_create(ctx, CL_MEM_READ_WRITE, bytes, NULL, &s->map[a]);
-  cl_mem *per_cell[] = {&s->h,     &s->h_c, &s->b,  &s->k,  &s->inf, &s->inf_c, &s->out,
-                        &s->out_c, &s->qu,  &s->qv, &s->h1, &s->qu1, &s->qv1,   &s->dh1};
+  cl_mem *per_cell[] = {&s->h,  &s->h_c,  &s->b,  &s->k,  &s->inf, &s->inf_c, &s->out, &s->out_c,
+                        &s->in, &s->in_c, &s->qu, &s->qv, &s->h1,  &s->qu1,   &s->qv1, &s->dh1};
   for (size_t i = 0; st == GR_OK && i < sizeof(per_cell) / sizeof(per_cell[0]); ++i)
     st = gr_buffer_create(ctx, CL_MEM_READ_WRITE, bytes, NULL, per_cell[i]);
   for (int a = 0; a < 2 && st == GR_OK; ++a) {
@@ -640,8 +712,8 @@ gr_status gr_rain_runoff_create(gr_context *ctx, const gr_grid *grid,
   if (st == GR_OK)
     st = gr_reduction_init(ctx, s->sw_speed, cells, 0, 2, &s->speed);
   /* Dry, flat ground; nothing infiltrated or gone. */
-  cl_mem *zeroed[] = {&s->h,     &s->h_c, &s->b,   &s->inf, &s->inf_c, &s->out,
-                      &s->out_c, &s->h1,  &s->qu1, &s->qv1, &s->dh1,   &s->dummy};
+  cl_mem *zeroed[] = {&s->h,  &s->h_c,  &s->b,  &s->inf, &s->inf_c, &s->out, &s->out_c,
+                      &s->in, &s->in_c, &s->h1, &s->qu1, &s->qv1,   &s->dh1, &s->dummy};
   for (size_t i = 0; st == GR_OK && i < sizeof(zeroed) / sizeof(zeroed[0]); ++i)
     st =
         gr_rain_runoff_fill(s, *zeroed[i], 0.0f, *zeroed[i] == s->dummy ? sizeof(cl_float) : bytes);
@@ -662,21 +734,30 @@ gr_status gr_rain_runoff_create(gr_context *ctx, const gr_grid *grid,
 void gr_rain_runoff_destroy(gr_rain_runoff *s) {
   if (!s)
     return;
-  cl_kernel kernels[] = {s->flux,        s->limit,       s->update,   s->reduce, s->derive,
-                         s->sw_stage[0], s->sw_stage[1], s->sw_speed, s->maps};
+  cl_kernel kernels[] = {s->flux,   s->limit,       s->update,      s->reduce,
+                         s->derive, s->sw_stage[0], s->sw_stage[1], s->sw_speed,
+                         s->maps,   s->source,      s->flux_edges};
   for (size_t i = 0; i < sizeof(kernels) / sizeof(kernels[0]); ++i)
     if (kernels[i])
       clReleaseKernel(kernels[i]);
   cl_mem *bufs[] = {&s->h,    &s->h_c,     &s->b,     &s->qx[0], &s->qy[0], &s->qx[1], &s->qy[1],
                     &s->k,    &s->inf,     &s->inf_c, &s->out,   &s->out_c, &s->h0,    &s->rain,
                     &s->perm, &s->scratch, &s->dummy, &s->qu,    &s->qv,    &s->h1,    &s->qu1,
-                    &s->qv1,  &s->qu0,     &s->qv0,   &s->dh1};
+                    &s->qv1,  &s->qu0,     &s->qv0,   &s->dh1,   &s->in,    &s->in_c,  &s->pts,
+                    &s->src,  &s->n2map,   &s->nodata};
   for (size_t i = 0; i < sizeof(bufs) / sizeof(bufs[0]); ++i)
     gr_buffer_release(bufs[i]);
   for (int a = 0; a < GR_RAIN_RUNOFF_MAP_ARRAYS; ++a)
     gr_buffer_release(&s->map[a]);
   gr_reduction_release(&s->ledger);
   gr_reduction_release(&s->speed);
+  for (int e = 0; e < 4; ++e) {
+    free(s->edge_t[e]);
+    free(s->edge_q[e]);
+  }
+  free(s->hy_t);
+  free(s->hy_r);
+  free(s->mask);
   gr_context_release(s->ctx);
   free(s);
 }
@@ -688,6 +769,13 @@ gr_status gr_rain_runoff_set_params(gr_rain_runoff *s, const gr_rain_runoff_para
                         "gr_rain_runoff_set_params needs a simulation.");
   if (gr_rain_runoff_params_validate(p, msg, sizeof(msg)) != GR_OK)
     return GR_RAIN_RUNOFF_KEEP_ERROR(s, gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT, "%s", msg));
+  if (p->flow_model == GR_FLOW_LOCAL_INERTIAL && s->has_n2 && s->n_min < GR_RAIN_RUNOFF_LI_MIN_N)
+    return GR_RAIN_RUNOFF_KEEP_ERROR(
+        s, gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
+                        "The Manning map's smallest n is %g s/m^(1/3), below the %g that FlowModel "
+                        "1 (local inertial) needs; raise the map's values, or keep FlowModel 0 "
+                        "(shallow water).",
+                        s->n_min, GR_RAIN_RUNOFF_LI_MIN_N));
   if (p->flow_model != s->params.flow_model) {
     /* The models keep their discharges in different places: the water
      * stays and starts from rest. A piece's ring width is its model's. */
@@ -701,9 +789,27 @@ gr_status gr_rain_runoff_set_params(gr_rain_runoff *s, const gr_rain_runoff_para
     if (st != GR_OK)
       return GR_RAIN_RUNOFF_KEEP_ERROR(s, st);
   }
+  int rebuild = s->has_nodata && p->no_data != s->params.no_data;
   s->params = *p;
   s->args_set = 0;
   s->maps_bound = 0;
+  if (rebuild) {
+    /* The no-data cells turn from walls to outfalls or back: their bed and
+     * kind, from the elevation on the device and the mask. */
+    size_t cells = gr_rain_runoff_cells(s);
+    float *b = malloc(cells * sizeof(float));
+    if (!b)
+      return GR_RAIN_RUNOFF_KEEP_ERROR(
+          s, gr_set_error(s->ctx, GR_ERR_OUT_OF_MEMORY, "Out of host memory."));
+    gr_status st = gr_buffer_read(s->ctx, s->b, 0, cells * sizeof(cl_float), b);
+    for (size_t c = 0; c < cells; ++c)
+      if (s->mask[c])
+        b[c] = NAN;
+    if (st == GR_OK)
+      st = gr_rain_runoff_set_elevation(s, b);
+    free(b);
+    return GR_RAIN_RUNOFF_KEEP_ERROR(s, st);
+  }
   return GR_OK;
 }
 
@@ -713,6 +819,129 @@ static gr_status gr_rain_runoff_upload(gr_rain_runoff *s, cl_mem *buf, const flo
   if (!*buf)
     return gr_buffer_create(s->ctx, CL_MEM_READ_WRITE, bytes, host, buf);
   return gr_buffer_write(s->ctx, *buf, 0, bytes, host);
+}
+
+/* The lowest ground along each of the domain's edges in the local array
+ * `z` (s->edge_bed; 0 on a side with a neighbour). */
+static void gr_rain_runoff_edge_beds(gr_rain_runoff *s, const float *z) {
+  const int nx = s->nxl, ny = s->nyl;
+  for (int e = 0; e < 4; ++e) {
+    double low = HUGE_VAL;
+    int n = e < 2 ? ny : nx;
+    for (int k = 0; !s->ring[e] && k < n; ++k) {
+      int i = e == 0 ? 0 : (e == 1 ? nx - 1 : k), j = e < 2 ? k : (e == 2 ? 0 : ny - 1);
+      double v = z[(size_t)j * (size_t)nx + (size_t)i];
+      low = v < low ? v : low;
+    }
+    s->edge_bed[e] = s->ring[e] ? 0.0 : low;
+  }
+}
+
+/* The deepest water a level edge holds over its edge's lowest ground (m; 0
+ * without level edges): the stable step counts it as water in the grid. */
+static double gr_rain_runoff_edge_depth(const gr_rain_runoff *s) {
+  double deepest = 0.0;
+  for (int e = 0; e < 4; ++e) {
+    if (s->ring[e] || s->params.boundary[e] != GR_BOUNDARY_LEVEL)
+      continue;
+    double d = s->params.boundary_level[e] - s->edge_bed[e];
+    deepest = d > deepest ? d : deepest;
+  }
+  return deepest;
+}
+
+static gr_status gr_rain_runoff_rain_sum(gr_rain_runoff *s);
+
+/* The bed the kernels see in a no-data cell: a wall far above any ground
+ * and water (elevations lie within +-1e6 m), or an outfall's cliff far
+ * below it, over which water pours out (the hydrostatic reconstruction and
+ * the local inertial faces then pass what the cell above it sends, and the
+ * cell drains every step). Fixed heights: every piece sees the same. */
+#define GR_RAIN_RUNOFF_NODATA_WALL 2.0e6f
+#define GR_RAIN_RUNOFF_NODATA_CLIFF -2.0e6f
+
+/* Uploads the elevation (NaN: no-data cells, as the params' kind makes
+ * them), the no-data map when there are no-data cells, and the owned
+ * domain cells' count; the rain field's sum follows the new mask. */
+static gr_status gr_rain_runoff_set_elevation(gr_rain_runoff *s, const float *host) {
+  size_t cells = gr_rain_runoff_cells(s);
+  int any = 0;
+  for (size_t c = 0; c < cells && !any; ++c)
+    any = isnan(host[c]);
+  if (!any) {
+    free(s->mask);
+    s->mask = NULL;
+    s->has_nodata = 0;
+    s->args_set = 0;
+    gr_status st = gr_buffer_write(s->ctx, s->b, 0, cells * sizeof(cl_float), host);
+    if (st == GR_OK && s->has_rain)
+      st = gr_rain_runoff_rain_sum(s);
+    return st;
+  }
+  unsigned char *mask = malloc(cells);
+  float *b = malloc(cells * sizeof(float)), *kind = malloc(cells * sizeof(float));
+  if (!mask || !b || !kind) {
+    free(mask);
+    free(b);
+    free(kind);
+    return gr_set_error(s->ctx, GR_ERR_OUT_OF_MEMORY, "Out of host memory.");
+  }
+  int outfall = s->params.no_data == GR_BOUNDARY_OPEN;
+  double active = 0.0;
+  for (size_t c = 0; c < cells; ++c) {
+    mask[c] = isnan(host[c]) ? 1 : 0;
+    b[c] = mask[c] ? (outfall ? GR_RAIN_RUNOFF_NODATA_CLIFF : GR_RAIN_RUNOFF_NODATA_WALL) : host[c];
+    kind[c] = mask[c] ? (outfall ? 2.0f : 1.0f) : 0.0f;
+  }
+  for (int j = s->ring[2]; j < s->nyl - s->ring[3]; ++j)
+    for (int i = s->ring[0]; i < s->nxl - s->ring[1]; ++i)
+      active += !mask[(size_t)j * (size_t)s->nxl + (size_t)i];
+  gr_status st = gr_buffer_write(s->ctx, s->b, 0, cells * sizeof(cl_float), b);
+  if (st == GR_OK)
+    st = gr_rain_runoff_upload(s, &s->nodata, kind);
+  free(b);
+  free(kind);
+  if (st != GR_OK) {
+    free(mask);
+    return st;
+  }
+  free(s->mask);
+  s->mask = mask;
+  s->has_nodata = 1;
+  s->active_own = active;
+  s->args_set = 0;
+  return s->has_rain ? gr_rain_runoff_rain_sum(s) : GR_OK;
+}
+
+/* The rain field's sum over the owned domain cells and its largest value,
+ * read back from the device (after the no-data cells changed). */
+static gr_status gr_rain_runoff_rain_sum(gr_rain_runoff *s) {
+  size_t cells = gr_rain_runoff_cells(s);
+  float *r = malloc(cells * sizeof(float));
+  if (!r)
+    return gr_set_error(s->ctx, GR_ERR_OUT_OF_MEMORY, "Out of host memory.");
+  gr_status st = gr_buffer_read(s->ctx, s->rain, 0, cells * sizeof(cl_float), r);
+  if (st == GR_OK) {
+    s->rain_field_sum = gr_rain_runoff_own_sum(s, r);
+    s->rain_field_max = 0.0;
+    for (size_t c = 0; c < cells; ++c)
+      if ((!s->has_nodata || !s->mask[c]) && r[c] > s->rain_field_max)
+        s->rain_field_max = r[c];
+  }
+  free(r);
+  return st;
+}
+
+/* After a read of the owned cells (comps floats each): NaN in no-data cells. */
+static void gr_rain_runoff_blank(const gr_rain_runoff *s, float *host, size_t comps) {
+  if (!s->has_nodata)
+    return;
+  size_t k = 0;
+  for (int j = s->ring[2]; j < s->nyl - s->ring[3]; ++j)
+    for (int i = s->ring[0]; i < s->nxl - s->ring[1]; ++i, ++k)
+      if (s->mask[(size_t)j * (size_t)s->nxl + (size_t)i])
+        for (size_t q = 0; q < comps; ++q)
+          host[k * comps + q] = NAN;
 }
 
 static gr_status gr_rain_runoff_set_field_impl(gr_rain_runoff *s, gr_field f, const float *host) {
@@ -772,7 +1001,7 @@ static gr_status gr_rain_runoff_set_field_impl(gr_rain_runoff *s, gr_field f, co
   s->args_set = 0; /* a field allocated now is bound at the next step */
   switch (f) {
   case GR_FIELD_ELEVATION: {
-    st = gr_buffer_write(s->ctx, s->b, 0, cells * sizeof(cl_float), host);
+    st = gr_rain_runoff_set_elevation(s, host);
     double worst = 0.0;
     const int nx = s->nxl, ny = s->nyl;
     for (int j = 0; j < ny; ++j)
@@ -790,8 +1019,10 @@ static gr_status gr_rain_runoff_set_field_impl(gr_rain_runoff *s, gr_field f, co
         double rate = sx / (s->grid.dx * s->grid.dx) + sy / (s->grid.dy * s->grid.dy);
         worst = rate > worst ? rate : worst;
       }
-    if (st == GR_OK)
+    if (st == GR_OK) {
       s->slope_rate = GR_GRAVITY * worst;
+      gr_rain_runoff_edge_beds(s, host);
+    }
     break;
   }
   case GR_FIELD_PERMEABILITY:
@@ -807,13 +1038,24 @@ static gr_status gr_rain_runoff_set_field_impl(gr_rain_runoff *s, gr_field f, co
       s->rain_field_sum = sum;
       s->rain_field_max = 0.0;
       for (size_t c = 0; c < cells; ++c)
-        s->rain_field_max = host[c] > s->rain_field_max ? host[c] : s->rain_field_max;
+        if (!s->has_nodata || !s->mask[c])
+          s->rain_field_max = host[c] > s->rain_field_max ? host[c] : s->rain_field_max;
     }
     break;
   }
   case GR_FIELD_WATER_DEPTH: {
     /* The new water replaces what is there now: the ledger counts the
-     * difference as initial water, so the balance still closes. */
+     * difference as initial water, so the balance still closes. No-data
+     * cells hold none. */
+    float *dry = NULL;
+    if (s->has_nodata) {
+      dry = malloc(cells * sizeof(float));
+      if (!dry)
+        return gr_set_error(s->ctx, GR_ERR_OUT_OF_MEMORY, "Out of host memory.");
+      for (size_t c = 0; c < cells; ++c)
+        dry[c] = s->mask[c] ? 0.0f : host[c];
+      host = dry;
+    }
     double now[GR_RAIN_RUNOFF_SUMS], sum = gr_rain_runoff_own_sum(s, host);
     st = gr_rain_runoff_reduce(s, now, NULL);
     if (st == GR_OK)
@@ -834,6 +1076,7 @@ static gr_status gr_rain_runoff_set_field_impl(gr_rain_runoff *s, gr_field f, co
     /* The maps count the new water from the time it is set. */
     if (st == GR_OK)
       st = gr_rain_runoff_maps_update(s, s->time, 0.0);
+    free(dry);
     break;
   }
   default:
@@ -851,6 +1094,250 @@ gr_status gr_rain_runoff_set_field(gr_rain_runoff *s, gr_field f, const float *h
         s, gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
                         "gr_rain_runoff_set_field needs a simulation and the field's values."));
   return GR_RAIN_RUNOFF_KEEP_ERROR(s, gr_rain_runoff_set_field_impl(s, f, host));
+}
+
+/* ------------------------------------------------------------- inflows */
+
+#define GR_RAIN_RUNOFF_MAX_DISCHARGE 1.0e6
+#define GR_RAIN_RUNOFF_MAX_ROWS 1000000
+
+static const char *const gr_rain_runoff_side_names[4] = {"west", "east", "south", "north"};
+
+/* (Re)allocates the source field the steps read, and fills it for the
+ * sources now when no hydrograph rewrites it before every step. */
+static gr_status gr_rain_runoff_sources_changed(gr_rain_runoff *s) {
+  size_t bytes = gr_rain_runoff_cells(s) * sizeof(cl_float);
+  gr_status st = GR_OK;
+  if (gr_rain_runoff_has_sources(s) && !s->src)
+    st = gr_buffer_create(s->ctx, CL_MEM_READ_WRITE, bytes, NULL, &s->src);
+  if (st == GR_OK && gr_rain_runoff_has_sources(s) && !gr_rain_runoff_has_edge_inflow(s))
+    st = gr_rain_runoff_sources_update(s, s->time, s->time);
+  s->args_set = 0; /* use_src and the buffer are bound at the next step */
+  return st;
+}
+
+static gr_status gr_rain_runoff_set_point_inflows_impl(gr_rain_runoff *s, const int *ij,
+                                                       const double *q, int n) {
+  if (n < 0 || n > GR_RAIN_RUNOFF_MAX_ROWS || (n > 0 && (!ij || !q)))
+    return gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
+                        "The point inflows must be 0 to %d cells with a discharge each (got %d%s).",
+                        GR_RAIN_RUNOFF_MAX_ROWS, n, n > 0 && (!ij || !q) ? " and no values" : "");
+  int gnx = s->grid.global_nx > 0 ? s->grid.global_nx : s->grid.nx;
+  int gny = s->grid.global_ny > 0 ? s->grid.global_ny : s->grid.ny;
+  for (int k = 0; k < n; ++k) {
+    if (!(q[k] >= 0.0 && q[k] <= GR_RAIN_RUNOFF_MAX_DISCHARGE))
+      return gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
+                          "Point inflow %d has the discharge %g m^3/s: discharges must lie between "
+                          "0 and %g m^3/s; give it a discharge in that range.",
+                          k, q[k], GR_RAIN_RUNOFF_MAX_DISCHARGE);
+    if (ij[2 * k] < 0 || ij[2 * k] >= gnx || ij[2 * k + 1] < 0 || ij[2 * k + 1] >= gny)
+      return gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
+                          "Point inflow %d is the cell (%d, %d), outside the domain of %d x %d "
+                          "cells: give cells from (0, 0) to (%d, %d).",
+                          k, ij[2 * k], ij[2 * k + 1], gnx, gny, gnx - 1, gny - 1);
+  }
+  size_t cells = gr_rain_runoff_cells(s);
+  gr_status st = GR_OK;
+  if (n == 0) {
+    s->has_pts = 0;
+    s->pts_max = 0.0;
+  } else {
+    /* Summed in double in the order given, one float per cell: the same
+     * floats in every piece that holds the cell (owned or in its ring). */
+    double *sum = calloc(cells, sizeof(double));
+    float *f = malloc(cells * sizeof(float));
+    if (!sum || !f) {
+      free(sum);
+      free(f);
+      return gr_set_error(s->ctx, GR_ERR_OUT_OF_MEMORY, "Out of host memory.");
+    }
+    const int x0 = s->grid.i0 - s->ring[0], y0 = s->grid.j0 - s->ring[2];
+    for (int k = 0; k < n; ++k) {
+      int i = ij[2 * k] - x0, j = ij[2 * k + 1] - y0;
+      if (i >= 0 && i < s->nxl && j >= 0 && j < s->nyl)
+        sum[(size_t)j * (size_t)s->nxl + (size_t)i] += q[k];
+    }
+    double area = s->grid.dx * s->grid.dy, top = 0.0;
+    for (size_t c = 0; c < cells; ++c) {
+      f[c] = (float)(sum[c] / area);
+      top = f[c] > top ? f[c] : top;
+    }
+    st = gr_rain_runoff_upload(s, &s->pts, f);
+    free(sum);
+    free(f);
+    if (st != GR_OK)
+      return st;
+    s->has_pts = 1;
+    s->pts_max = top;
+  }
+  return gr_rain_runoff_sources_changed(s);
+}
+
+gr_status gr_rain_runoff_set_point_inflows(gr_rain_runoff *s, const int *ij,
+                                           const double *discharge, int n) {
+  if (!s)
+    return gr_set_error(NULL, GR_ERR_INVALID_ARGUMENT,
+                        "gr_rain_runoff_set_point_inflows needs a simulation.");
+  return GR_RAIN_RUNOFF_KEEP_ERROR(s, gr_rain_runoff_set_point_inflows_impl(s, ij, discharge, n));
+}
+
+static gr_status gr_rain_runoff_set_edge_inflow_impl(gr_rain_runoff *s, int side, const double *t,
+                                                     const double *q, int n) {
+  if (side < 0 || side > 3)
+    return gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
+                        "The edge of an inflow hydrograph must be 0 west, 1 east, 2 south or 3 "
+                        "north (got %d).",
+                        side);
+  const char *name = gr_rain_runoff_side_names[side];
+  if (n < 0 || n > GR_RAIN_RUNOFF_MAX_ROWS || (n > 0 && (!t || !q)))
+    return gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
+                        "The %s edge's inflow hydrograph must have 0 to %d rows of time and "
+                        "discharge (got %d%s).",
+                        name, GR_RAIN_RUNOFF_MAX_ROWS, n,
+                        n > 0 && (!t || !q) ? " and no values" : "");
+  for (int k = 0; k < n; ++k) {
+    if (!(t[k] >= -1e12 && t[k] <= 1e12))
+      return gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
+                          "The %s edge's inflow hydrograph has the time %g s in row %d: times must "
+                          "be finite numbers of seconds; correct that row.",
+                          name, t[k], k);
+    if (k > 0 && !(t[k] > t[k - 1]))
+      return gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
+                          "The %s edge's inflow hydrograph's times must increase from row to row, "
+                          "but row %d has %g s after %g s; sort the rows and drop repeated times.",
+                          name, k, t[k], t[k - 1]);
+    if (!(q[k] >= 0.0 && q[k] <= GR_RAIN_RUNOFF_MAX_DISCHARGE))
+      return gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
+                          "The %s edge's inflow hydrograph has the discharge %g m^3/s in row %d: "
+                          "discharges must lie between 0 and %g m^3/s; correct that row.",
+                          name, q[k], k, GR_RAIN_RUNOFF_MAX_DISCHARGE);
+  }
+  double *nt = NULL, *nq = NULL;
+  if (n > 0) {
+    nt = malloc((size_t)n * sizeof(double));
+    nq = malloc((size_t)n * sizeof(double));
+    if (!nt || !nq) {
+      free(nt);
+      free(nq);
+      return gr_set_error(s->ctx, GR_ERR_OUT_OF_MEMORY, "Out of host memory.");
+    }
+    memcpy(nt, t, (size_t)n * sizeof(double));
+    memcpy(nq, q, (size_t)n * sizeof(double));
+  }
+  free(s->edge_t[side]);
+  free(s->edge_q[side]);
+  s->edge_t[side] = nt;
+  s->edge_q[side] = nq;
+  s->edge_n[side] = n;
+  return gr_rain_runoff_sources_changed(s);
+}
+
+gr_status gr_rain_runoff_set_edge_inflow(gr_rain_runoff *s, int side, const double *times,
+                                         const double *discharge, int n) {
+  if (!s)
+    return gr_set_error(NULL, GR_ERR_INVALID_ARGUMENT,
+                        "gr_rain_runoff_set_edge_inflow needs a simulation.");
+  return GR_RAIN_RUNOFF_KEEP_ERROR(
+      s, gr_rain_runoff_set_edge_inflow_impl(s, side, times, discharge, n));
+}
+
+/* ------------------------------------------------ rain and roughness maps */
+
+static gr_status gr_rain_runoff_set_manning_map_impl(gr_rain_runoff *s, const double *n) {
+  size_t cells = gr_rain_runoff_cells(s);
+  if (!n) {
+    s->has_n2 = 0;
+    s->args_set = 0;
+    return GR_OK;
+  }
+  const gr_param_bound *row = &gr_rain_runoff_bounds[GR_RAIN_RUNOFF_P_MANNING_N];
+  int li = s->params.flow_model == GR_FLOW_LOCAL_INERTIAL;
+  double lo = li ? GR_RAIN_RUNOFF_LI_MIN_N : row->min, low = HUGE_VAL;
+  for (size_t c = 0; c < cells; ++c) {
+    if (!(n[c] >= lo && n[c] <= row->max))
+      return gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
+                          "The Manning map has the value %g s/m^(1/3) at cell (%zu, %zu): values "
+                          "must lie between %g and %g%s, like ManningN; correct the map.",
+                          n[c], c % (size_t)s->nxl, c / (size_t)s->nxl, lo, row->max,
+                          li ? " for FlowModel 1 (local inertial)" : "");
+    low = n[c] < low ? n[c] : low;
+  }
+  float *n2 = malloc(cells * sizeof(float));
+  if (!n2)
+    return gr_set_error(s->ctx, GR_ERR_OUT_OF_MEMORY, "Out of host memory.");
+  /* n^2 as the uniform ManningN's: in double, then one float (the same
+   * float for the same n, so a map of ManningN everywhere is that run). */
+  for (size_t c = 0; c < cells; ++c)
+    n2[c] = (float)(n[c] * n[c]);
+  gr_status st = gr_rain_runoff_upload(s, &s->n2map, n2);
+  free(n2);
+  if (st != GR_OK)
+    return st;
+  s->has_n2 = 1;
+  s->n_min = low;
+  s->args_set = 0;
+  return GR_OK;
+}
+
+gr_status gr_rain_runoff_set_manning_map(gr_rain_runoff *s, const double *n) {
+  if (!s)
+    return gr_set_error(NULL, GR_ERR_INVALID_ARGUMENT,
+                        "gr_rain_runoff_set_manning_map needs a simulation.");
+  return GR_RAIN_RUNOFF_KEEP_ERROR(s, gr_rain_runoff_set_manning_map_impl(s, n));
+}
+
+static gr_status gr_rain_runoff_set_hyetograph_impl(gr_rain_runoff *s, const double *t,
+                                                    const double *r, int n) {
+  const gr_param_bound *row = &gr_rain_runoff_bounds[GR_RAIN_RUNOFF_P_RAIN_RATE];
+  const double hi = gr_rain_runoff_core_max(GR_RAIN_RUNOFF_P_RAIN_RATE);
+  if (n < 0 || n > GR_RAIN_RUNOFF_MAX_ROWS || (n > 0 && (!t || !r)))
+    return gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
+                        "The hyetograph must have 0 to %d rows of time and rain rate (got %d%s).",
+                        GR_RAIN_RUNOFF_MAX_ROWS, n, n > 0 && (!t || !r) ? " and no values" : "");
+  for (int k = 0; k < n; ++k) {
+    if (!(t[k] >= -1e12 && t[k] <= 1e12))
+      return gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
+                          "The hyetograph has the time %g s in row %d: times must be finite "
+                          "numbers of seconds; correct that row.",
+                          t[k], k);
+    if (k > 0 && !(t[k] > t[k - 1]))
+      return gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
+                          "The hyetograph's times must increase from row to row, but row %d has "
+                          "%g s after %g s; sort the rows and drop repeated times.",
+                          k, t[k], t[k - 1]);
+    if (!(r[k] >= 0.0 && r[k] <= hi))
+      return gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
+                          "The hyetograph has the rain rate %g %s in row %d: rates must lie "
+                          "between %g and %g %s, like RainRate; correct that row.",
+                          r[k] / row->to_core, row->unit, k, row->min, row->max, row->unit);
+  }
+  double *nt = NULL, *nr = NULL;
+  if (n > 0) {
+    nt = malloc((size_t)n * sizeof(double));
+    nr = malloc((size_t)n * sizeof(double));
+    if (!nt || !nr) {
+      free(nt);
+      free(nr);
+      return gr_set_error(s->ctx, GR_ERR_OUT_OF_MEMORY, "Out of host memory.");
+    }
+    memcpy(nt, t, (size_t)n * sizeof(double));
+    memcpy(nr, r, (size_t)n * sizeof(double));
+  }
+  free(s->hy_t);
+  free(s->hy_r);
+  s->hy_t = nt;
+  s->hy_r = nr;
+  s->hy_n = n;
+  s->args_set = 0; /* RainRate again at the next bind when it is removed */
+  return GR_OK;
+}
+
+gr_status gr_rain_runoff_set_hyetograph(gr_rain_runoff *s, const double *times, const double *rates,
+                                        int n) {
+  if (!s)
+    return gr_set_error(NULL, GR_ERR_INVALID_ARGUMENT,
+                        "gr_rain_runoff_set_hyetograph needs a simulation.");
+  return GR_RAIN_RUNOFF_KEEP_ERROR(s, gr_rain_runoff_set_hyetograph_impl(s, times, rates, n));
 }
 
 /* ------------------------------------------------------ pieces and halos */
@@ -1059,6 +1546,123 @@ static gr_status gr_rain_runoff_watch_step(gr_rain_runoff *s, gr_rain_runoff_wat
   return GR_OK;
 }
 
+/* ---------------------------------------------------------------- sources */
+
+static int gr_rain_runoff_has_edge_inflow(const gr_rain_runoff *s) {
+  return s->edge_n[0] || s->edge_n[1] || s->edge_n[2] || s->edge_n[3];
+}
+
+static int gr_rain_runoff_has_sources(const gr_rain_runoff *s) {
+  return s->has_pts || gr_rain_runoff_has_edge_inflow(s);
+}
+
+/* The integral over [a, b] of the piecewise-linear function through (t[k],
+ * v[k]), k < n, held at v[0] before t[0] and at v[n-1] after t[n-1]. */
+static double gr_rain_runoff_table_integral(const double *t, const double *v, int n, double a,
+                                            double b) {
+  double sum = 0.0;
+  if (a < t[0])
+    sum += v[0] * ((b < t[0] ? b : t[0]) - a);
+  if (b > t[n - 1])
+    sum += v[n - 1] * (b - (a > t[n - 1] ? a : t[n - 1]));
+  for (int k = 0; k + 1 < n; ++k) {
+    double lo = a > t[k] ? a : t[k], hi = b < t[k + 1] ? b : t[k + 1];
+    if (hi <= lo)
+      continue;
+    double slope = (v[k + 1] - v[k]) / (t[k + 1] - t[k]);
+    double vlo = v[k] + slope * (lo - t[k]), vhi = v[k] + slope * (hi - t[k]);
+    sum += 0.5 * (vlo + vhi) * (hi - lo);
+  }
+  return sum;
+}
+
+/* The cells along each domain edge of the whole domain (a piece's edge is
+ * part of it): the hydrograph's discharge is spread over all of them. */
+static double gr_rain_runoff_edge_cells(const gr_rain_runoff *s, int side) {
+  int gnx = s->grid.global_nx > 0 ? s->grid.global_nx : s->grid.nx;
+  int gny = s->grid.global_ny > 0 ? s->grid.global_ny : s->grid.ny;
+  return side < 2 ? (double)gny : (double)gnx;
+}
+
+/* Writes the sources of the step [t0, t1] into s->src: the point inflows
+ * and each edge's mean discharge over the step (the exact integral of its
+ * table, over t1 - t0), spread over the edge's cells, as m/s of depth. */
+static gr_status gr_rain_runoff_sources_update(gr_rain_runoff *s, double t0, double t1) {
+  cl_float edge[4];
+  for (int e = 0; e < 4; ++e) {
+    double rate = 0.0;
+    if (s->edge_n[e] && !s->ring[e] && t1 > t0)
+      rate = gr_rain_runoff_table_integral(s->edge_t[e], s->edge_q[e], s->edge_n[e], t0, t1) /
+             (t1 - t0) / (gr_rain_runoff_edge_cells(s, e) * s->grid.dx * s->grid.dy);
+    edge[e] = (cl_float)rate;
+  }
+  cl_int nx = s->nxl, ny = s->nyl, use_pts = s->has_pts;
+  cl_mem pts = s->has_pts ? s->pts : s->dummy;
+  const size_t m = sizeof(cl_mem);
+  const gr_rain_runoff_arg args[] = {
+      {"pts", m, &pts},
+      {"use_pts", sizeof(use_pts), &use_pts},
+      {"src", m, &s->src},
+      {"nx", sizeof(nx), &nx},
+      {"ny", sizeof(ny), &ny},
+      {"edge_w", sizeof(cl_float), &edge[0]},
+      {"edge_e", sizeof(cl_float), &edge[1]},
+      {"edge_s", sizeof(cl_float), &edge[2]},
+      {"edge_n", sizeof(cl_float), &edge[3]},
+  };
+  gr_status st = GR_RAIN_RUNOFF_ARGS(s, s->source, args);
+  if (st == GR_OK)
+    st = gr_enqueue_2d(s->ctx, s->source, 0, 0, (size_t)s->nxl, (size_t)s->nyl, NULL);
+  return st;
+}
+
+/* The largest source rate the sources may reach (m/s of depth): the point
+ * inflows' and every edge's largest discharge over its cells. */
+static double gr_rain_runoff_source_max(const gr_rain_runoff *s) {
+  double edge = 0.0;
+  for (int e = 0; e < 4; ++e) {
+    if (!s->edge_n[e] || s->ring[e])
+      continue;
+    double q = 0.0;
+    for (int k = 0; k < s->edge_n[e]; ++k)
+      q = s->edge_q[e][k] > q ? s->edge_q[e][k] : q;
+    q /= gr_rain_runoff_edge_cells(s, e) * s->grid.dx * s->grid.dy;
+    edge += q; /* a corner cell gets two edges' */
+  }
+  return (s->has_pts ? s->pts_max : 0.0) + edge;
+}
+
+/* The hyetograph's rain for the step [t0, t1]: the table's exact mean over
+ * it, as the float the kernels take in place of RainRate (a rain_rate field
+ * still wins); *sum adds that float for the ledger. */
+static gr_status gr_rain_runoff_hyetograph_step(gr_rain_runoff *s, double t0, double t1,
+                                                double *sum) {
+  cl_float rf =
+      (cl_float)(gr_rain_runoff_table_integral(s->hy_t, s->hy_r, s->hy_n, t0, t1) / (t1 - t0));
+  int sw = s->params.flow_model == GR_FLOW_SHALLOW_WATER;
+  cl_kernel li[4] = {s->flux, s->flux_edges, s->limit, s->update};
+  cl_kernel swk[2] = {s->sw_stage[0], s->sw_stage[1]};
+  gr_status st = GR_OK;
+  for (int k = 0; st == GR_OK && k < (sw ? 2 : 4); ++k)
+    st = gr_kernel_arg(s->ctx, sw ? swk[k] : li[k], "rain_uniform", sizeof(rf), &rf);
+  if (st == GR_OK)
+    *sum += (double)rf;
+  return st;
+}
+
+/* The largest uniform rain rate (m/s): the hyetograph's, or RainRate. */
+static double gr_rain_runoff_rain_max(const gr_rain_runoff *s) {
+  double top = s->hy_n ? 0.0 : s->params.rain_rate;
+  for (int k = 0; k < s->hy_n; ++k)
+    top = s->hy_r[k] > top ? s->hy_r[k] : top;
+  return top;
+}
+
+/* The smallest Manning n the friction takes: the map's, or ManningN. */
+static double gr_rain_runoff_min_n(const gr_rain_runoff *s) {
+  return s->has_n2 ? s->n_min : s->params.manning_n;
+}
+
 /* Binds every step-kernel argument but the alternating face arrays, when
  * something they hold has changed since the last step. */
 static gr_status gr_rain_runoff_bind(gr_rain_runoff *s, cl_float dt) {
@@ -1072,8 +1676,23 @@ static gr_status gr_rain_runoff_bind(gr_rain_runoff *s, cl_float dt) {
   cl_float n2 = (cl_float)(p->manning_n * p->manning_n);
   cl_int use_rain = s->has_rain, use_perm = s->has_perm;
   cl_float rain_uniform = (cl_float)p->rain_rate, perm_uniform = (cl_float)p->permeability;
-  cl_int closed = p->boundary == GR_BOUNDARY_CLOSED;
+  /* The domain's edges' kinds and levels; a side with a neighbour is open
+   * (its ring is refreshed from the neighbour after every step). */
+  cl_int bnd[4];
+  cl_float lvl[4];
+  for (int e = 0; e < 4; ++e) {
+    int kind; /* any bit pattern the enum may hold: validated as a whole number 0-3 */
+    memcpy(&kind, &p->boundary[e], sizeof(kind));
+    bnd[e] = s->ring[e] ? GR_RAIN_RUNOFF_B_OPEN : kind;
+    lvl[e] = (cl_float)p->boundary_level[e];
+  }
   cl_mem rain = s->has_rain ? s->rain : s->dummy, perm = s->has_perm ? s->perm : s->dummy;
+  cl_int use_src = gr_rain_runoff_has_sources(s);
+  cl_mem src = use_src ? s->src : s->dummy;
+  cl_int use_n2 = s->has_n2;
+  cl_mem n2map = use_n2 ? s->n2map : s->dummy;
+  cl_int use_nodata = s->has_nodata;
+  cl_mem nodata = use_nodata ? s->nodata : s->dummy;
   cl_float theta = (cl_float)GR_RAIN_RUNOFF_THETA;
   const size_t m = sizeof(cl_mem);
   /* Arguments the three step kernels share (each takes those it has). */
@@ -1081,6 +1700,10 @@ static gr_status gr_rain_runoff_bind(gr_rain_runoff *s, cl_float dt) {
       {"h", m, &s->h},
       {"rain", m, &rain},
       {"perm", m, &perm},
+      {"src", m, &src},
+      {"use_src", sizeof(use_src), &use_src},
+      {"nodata", m, &nodata},
+      {"use_nodata", sizeof(use_nodata), &use_nodata},
       {"limit", m, &s->k},
       {"nx", sizeof(nx), &nx},
       {"ny", sizeof(ny), &ny},
@@ -1096,12 +1719,23 @@ static gr_status gr_rain_runoff_bind(gr_rain_runoff *s, cl_float dt) {
       {"b", m, &s->b},
       {"g", sizeof(g), &g},
       {"n2", sizeof(n2), &n2},
-      {"theta", sizeof(theta), &theta},
-      {"closed", sizeof(closed), &closed},
+      {"n2map", m, &n2map},
+      {"use_n2", sizeof(use_n2), &use_n2},
+  };
+  const gr_rain_runoff_arg edges[] = {
+      {"bnd_w", sizeof(cl_int), &bnd[0]},   {"bnd_e", sizeof(cl_int), &bnd[1]},
+      {"bnd_s", sizeof(cl_int), &bnd[2]},   {"bnd_n", sizeof(cl_int), &bnd[3]},
+      {"lvl_w", sizeof(cl_float), &lvl[0]}, {"lvl_e", sizeof(cl_float), &lvl[1]},
+      {"lvl_s", sizeof(cl_float), &lvl[2]}, {"lvl_n", sizeof(cl_float), &lvl[3]},
   };
   const gr_rain_runoff_arg update[] = {
-      {"h_comp", m, &s->h_c},  {"infiltrated", m, &s->inf},    {"infiltrated_comp", m, &s->inf_c},
-      {"outflow", m, &s->out}, {"outflow_comp", m, &s->out_c},
+      {"h_comp", m, &s->h_c},
+      {"infiltrated", m, &s->inf},
+      {"infiltrated_comp", m, &s->inf_c},
+      {"outflow", m, &s->out},
+      {"outflow_comp", m, &s->out_c},
+      {"inflow", m, &s->in},
+      {"inflow_comp", m, &s->in_c},
   };
   if (p->flow_model == GR_FLOW_SHALLOW_WATER) {
     const gr_rain_runoff_arg sw[] = {
@@ -1116,6 +1750,10 @@ static gr_status gr_rain_runoff_bind(gr_rain_runoff *s, cl_float dt) {
         {"b", m, &s->b},
         {"rain", m, &rain},
         {"perm", m, &perm},
+        {"src", m, &src},
+        {"use_src", sizeof(use_src), &use_src},
+        {"nodata", m, &nodata},
+        {"use_nodata", sizeof(use_nodata), &use_nodata},
         {"infiltrated", m, &s->inf},
         {"infiltrated_comp", m, &s->inf_c},
         {"outflow", m, &s->out},
@@ -1127,11 +1765,22 @@ static gr_status gr_rain_runoff_bind(gr_rain_runoff *s, cl_float dt) {
         {"inv_dy", sizeof(inv_dy), &inv_dy},
         {"g", sizeof(g), &g},
         {"n2", sizeof(n2), &n2},
+        {"n2map", m, &n2map},
+        {"use_n2", sizeof(use_n2), &use_n2},
         {"use_rain", sizeof(use_rain), &use_rain},
         {"rain_uniform", sizeof(rain_uniform), &rain_uniform},
         {"use_perm", sizeof(use_perm), &use_perm},
         {"perm_uniform", sizeof(perm_uniform), &perm_uniform},
-        {"closed", sizeof(closed), &closed},
+        {"inflow", m, &s->in},
+        {"inflow_comp", m, &s->in_c},
+        {"bnd_w", sizeof(cl_int), &bnd[0]},
+        {"bnd_e", sizeof(cl_int), &bnd[1]},
+        {"bnd_s", sizeof(cl_int), &bnd[2]},
+        {"bnd_n", sizeof(cl_int), &bnd[3]},
+        {"lvl_w", sizeof(cl_float), &lvl[0]},
+        {"lvl_e", sizeof(cl_float), &lvl[1]},
+        {"lvl_s", sizeof(cl_float), &lvl[2]},
+        {"lvl_n", sizeof(cl_float), &lvl[3]},
     };
     gr_status st = GR_RAIN_RUNOFF_ARGS(s, s->sw_stage[0], sw);
     if (st == GR_OK)
@@ -1140,12 +1789,18 @@ static gr_status gr_rain_runoff_bind(gr_rain_runoff *s, cl_float dt) {
     s->args_dt = dt;
     return st;
   }
-  cl_kernel kernels[] = {s->flux, s->limit, s->update};
+  cl_kernel kernels[] = {s->flux, s->flux_edges, s->limit, s->update};
   gr_status st = GR_OK;
-  for (int i = 0; st == GR_OK && i < 3; ++i)
+  for (int i = 0; st == GR_OK && i < 4; ++i)
     st = GR_RAIN_RUNOFF_ARGS(s, kernels[i], common);
   if (st == GR_OK)
     st = GR_RAIN_RUNOFF_ARGS(s, s->flux, flux);
+  if (st == GR_OK)
+    st = GR_RAIN_RUNOFF_ARGS(s, s->flux_edges, flux);
+  if (st == GR_OK)
+    st = gr_kernel_arg(s->ctx, s->flux, "theta", sizeof(theta), &theta);
+  if (st == GR_OK)
+    st = GR_RAIN_RUNOFF_ARGS(s, s->flux_edges, edges);
   if (st == GR_OK)
     st = GR_RAIN_RUNOFF_ARGS(s, s->update, update);
   s->args_set = st == GR_OK;
@@ -1167,7 +1822,17 @@ static gr_status gr_rain_runoff_enqueue(gr_rain_runoff *s, double dt, int nsteps
   /* The end time of each step, summed as s->time is below (the flood maps'
    * arrival times). */
   double t_end = s->time;
+  int per_step = gr_rain_runoff_has_edge_inflow(s);
+  /* Any of the domain's edges not open: rain_runoff_flux_edges rewrites it. */
+  int edges = 0;
+  for (int e = 0; e < 4; ++e)
+    edges |= !s->ring[e] && s->params.boundary[e] != GR_BOUNDARY_OPEN;
+  double rate_sum = 0.0; /* the hyetograph's rates the steps took (m/s, floats) */
   while (sw && st == GR_OK && done < nsteps && !*stop) {
+    if (per_step)
+      st = gr_rain_runoff_sources_update(s, t_end, t_end + dt);
+    if (st == GR_OK && s->hy_n)
+      st = gr_rain_runoff_hyetograph_step(s, t_end, t_end + dt, &rate_sum);
     /* Heun's two stages. */
     for (int stage = 0; st == GR_OK && stage < 2; ++stage)
       st = gr_enqueue_2d(s->ctx, s->sw_stage[stage], 0, 0, (size_t)s->nxl, (size_t)s->nyl, NULL);
@@ -1189,13 +1854,23 @@ static gr_status gr_rain_runoff_enqueue(gr_rain_runoff *s, double dt, int nsteps
         {"qy", m, &s->qy[now]},
     };
     const gr_rain_runoff_arg faces[] = {{"qx", m, &s->qx[now]}, {"qy", m, &s->qy[now]}};
-    st = GR_RAIN_RUNOFF_ARGS(s, s->flux, flux);
+    if (per_step)
+      st = gr_rain_runoff_sources_update(s, t_end, t_end + dt);
+    if (st == GR_OK && s->hy_n)
+      st = gr_rain_runoff_hyetograph_step(s, t_end, t_end + dt, &rate_sum);
+    if (st == GR_OK)
+      st = GR_RAIN_RUNOFF_ARGS(s, s->flux, flux);
+    if (st == GR_OK && edges)
+      st = GR_RAIN_RUNOFF_ARGS(s, s->flux_edges, flux);
     if (st == GR_OK)
       st = GR_RAIN_RUNOFF_ARGS(s, s->limit, faces);
     if (st == GR_OK)
       st = GR_RAIN_RUNOFF_ARGS(s, s->update, faces);
     if (st == GR_OK)
       st = gr_enqueue_2d(s->ctx, s->flux, 0, 0, (size_t)s->nxl + 1, (size_t)s->nyl + 1, NULL);
+    /* The edges that are not open, after the flux kernel wrote them so. */
+    if (st == GR_OK && edges)
+      st = gr_enqueue_1d(s->ctx, s->flux_edges, 2 * ((size_t)s->nxl + (size_t)s->nyl));
     if (st == GR_OK)
       s->cur = now; /* the flux kernel is enqueued: the new faces are current */
     if (st == GR_OK)
@@ -1213,10 +1888,14 @@ static gr_status gr_rain_runoff_enqueue(gr_rain_runoff *s, double dt, int nsteps
   }
   /* The ledger counts the steps whose launches were all enqueued, with the
    * rain the device added: the float dt it was given. */
+  /* The owned cells of the domain: no rain falls on no-data cells. */
+  double active = s->has_nodata ? s->active_own : (double)gr_rain_runoff_own_cells(s);
   double rain_sum =
-      s->has_rain ? s->rain_field_sum
-                  : (double)gr_rain_runoff_own_cells(s) * (double)(cl_float)s->params.rain_rate;
-  s->rain_volume += rain_sum * gd->dx * gd->dy * (double)dtf * (double)done;
+      s->has_rain ? s->rain_field_sum : active * (double)(cl_float)s->params.rain_rate;
+  if (s->hy_n && !s->has_rain) /* each step its own rate, as the device took it */
+    s->rain_volume += active * rate_sum * gd->dx * gd->dy * (double)dtf;
+  else
+    s->rain_volume += rain_sum * gd->dx * gd->dy * (double)dtf * (double)done;
   /* Step by step, not dt * done: a piece that steps one step per call (to
    * exchange its halo) then keeps the same time, to the bit, as the whole
    * grid stepping many per call. */
@@ -1283,11 +1962,21 @@ static gr_status gr_rain_runoff_sw_stable_dt(gr_rain_runoff *s, double *dt) {
   };
   /* The deepest cell, the fastest rate, the heaviest rain (m/s), the
    * steepest bed (slope_rate). */
-  double maxes[4] = {0.0, 0.0, s->has_rain ? s->rain_field_max : s->params.rain_rate,
+  double maxes[4] = {0.0, 0.0,
+                     (s->has_rain ? s->rain_field_max : gr_rain_runoff_rain_max(s)) +
+                         gr_rain_runoff_source_max(s),
                      s->slope_rate};
   gr_status st = GR_RAIN_RUNOFF_ARGS(s, s->sw_speed, args);
   if (st == GR_OK)
     st = gr_reduction_run(s->ctx, &s->speed, s->sw_speed, NULL, maxes);
+  /* A level edge's water enters at up to twice its wave speed (a dry
+   * front's, HLL's). */
+  double edge = gr_rain_runoff_edge_depth(s);
+  if (edge > 0.0) {
+    double c2 = 2.0 * sqrt(GR_GRAVITY * edge) * (1.0 / s->grid.dx + 1.0 / s->grid.dy);
+    maxes[0] = edge > maxes[0] ? edge : maxes[0];
+    maxes[1] = c2 > maxes[1] ? c2 : maxes[1];
+  }
   if (st == GR_OK && s->allreduce)
     st = gr_rain_runoff_allreduce(s, maxes, 4, GR_REDUCE_MAX);
   if (st != GR_OK)
@@ -1316,7 +2005,7 @@ static gr_status gr_rain_runoff_sw_stable_dt(gr_rain_runoff *s, double *dt) {
    * shows both: frictionless rain on slopes up to 3, with MaxTimeStep 1 s,
    * emptied cells beyond their water without it.) */
   double accel = maxes[3];
-  if (accel > 0.0 && s->params.manning_n == 0.0 && (maxes[0] > 0.0 || r > 0.0)) {
+  if (accel > 0.0 && gr_rain_runoff_min_n(s) == 0.0 && (maxes[0] > 0.0 || r > 0.0)) {
     double steep = sqrt(0.125 * s->params.cfl / accel);
     stable = steep < stable ? steep : stable;
   }
@@ -1329,6 +2018,9 @@ static gr_status gr_rain_runoff_stable_dt_impl(gr_rain_runoff *s, double *dt) {
     return gr_rain_runoff_sw_stable_dt(s, dt);
   double sums[GR_RAIN_RUNOFF_SUMS], hmax = 0.0;
   gr_status st = gr_rain_runoff_reduce(s, sums, &hmax);
+  /* A level edge's water counts as the grid's. */
+  double edge = gr_rain_runoff_edge_depth(s);
+  hmax = edge > hmax ? edge : hmax;
   /* The deepest cell of the whole domain: every piece takes the same step. */
   if (st == GR_OK && s->allreduce)
     st = gr_rain_runoff_allreduce(s, &hmax, 1, GR_REDUCE_MAX);
@@ -1521,9 +2213,10 @@ static gr_status gr_rain_runoff_sample_impl(gr_rain_runoff *s, const int *ij, in
     if (st == GR_OK)
       st = gr_buffer_read(s->ctx, s->scratch, c * sizeof(float), sizeof(float), &q);
     /* The surface as WATER_SURFACE gives it: the float sum b + h. */
-    values[3 * k] = h;
-    values[3 * k + 1] = b + h;
-    values[3 * k + 2] = q;
+    int off = s->has_nodata && s->mask[c];
+    values[3 * k] = off ? NAN : h;
+    values[3 * k + 1] = off ? NAN : b + h;
+    values[3 * k + 2] = off ? NAN : q;
   }
   return st;
 }
@@ -1540,7 +2233,16 @@ gr_status gr_rain_runoff_sample(gr_rain_runoff *s, const int *ij, int n, float *
   return GR_RAIN_RUNOFF_KEEP_ERROR(s, gr_rain_runoff_sample_impl(s, ij, n, values));
 }
 
+static gr_status gr_rain_runoff_get_field_raw(gr_rain_runoff *s, gr_field f, float *host);
+
 static gr_status gr_rain_runoff_get_field_impl(gr_rain_runoff *s, gr_field f, float *host) {
+  gr_status st = gr_rain_runoff_get_field_raw(s, f, host);
+  if (st == GR_OK)
+    gr_rain_runoff_blank(s, host, f == GR_FIELD_VELOCITY ? 3 : 1);
+  return st;
+}
+
+static gr_status gr_rain_runoff_get_field_raw(gr_rain_runoff *s, gr_field f, float *host) {
   size_t cells = gr_rain_runoff_own_cells(s);
   switch (f) {
   case GR_FIELD_WATER_DEPTH:
@@ -1615,8 +2317,9 @@ gr_status gr_rain_runoff_ledger_get(gr_rain_runoff *s, gr_rain_runoff_ledger *ou
   out->stored_volume = all[0] * area;
   out->infiltrated_volume = all[1] * area;
   out->outflow_volume = all[2] * area;
-  out->balance_error = out->initial_volume + out->rain_volume - out->infiltrated_volume -
-                       out->outflow_volume - out->stored_volume;
+  out->inflow_volume = all[3] * area;
+  out->balance_error = out->initial_volume + out->rain_volume + out->inflow_volume -
+                       out->infiltrated_volume - out->outflow_volume - out->stored_volume;
   out->max_depth = hmax;
   return GR_OK;
 }
@@ -1631,7 +2334,7 @@ static gr_status gr_rain_runoff_reset_impl(gr_rain_runoff *s) {
         "Copying the initial water depth");
   else
     st = gr_rain_runoff_fill(s, s->h, 0.0f, bytes);
-  cl_mem zeroed[] = {s->h_c, s->inf, s->inf_c, s->out, s->out_c};
+  cl_mem zeroed[] = {s->h_c, s->inf, s->inf_c, s->out, s->out_c, s->in, s->in_c};
   for (size_t i = 0; st == GR_OK && i < sizeof(zeroed) / sizeof(zeroed[0]); ++i)
     st = gr_rain_runoff_fill(s, zeroed[i], 0.0f, bytes);
   if (st == GR_OK)
@@ -1708,6 +2411,8 @@ static gr_status gr_rain_runoff_get_map_impl(gr_rain_runoff *s, gr_rain_runoff_m
     for (size_t c = 0; c < cells; ++c)
       host[c] = (float)gr_rain_runoff_hazard_class(host[c]);
   }
+  if (st == GR_OK)
+    gr_rain_runoff_blank(s, host, 1);
   return st;
 }
 
@@ -1759,8 +2464,8 @@ gr_status gr_rain_runoff_state_size(const gr_rain_runoff *s, size_t *bytes) {
 /* The state's device arrays in checkpoint order, with their sizes. */
 static int gr_rain_runoff_state_arrays(gr_rain_runoff *s, int cur, cl_mem *bufs, size_t *sizes) {
   cl_mem cells[GR_RAIN_RUNOFF_STATE_CELL_ARRAYS] = {
-      s->h,  s->h_c,    s->k,      s->inf,    s->inf_c,  s->out,    s->out_c, s->qu,
-      s->qv, s->map[0], s->map[1], s->map[2], s->map[3], s->map[4], s->map[5]};
+      s->h,      s->h_c,    s->k,      s->inf,    s->inf_c,  s->out,    s->out_c, s->qu,  s->qv,
+      s->map[0], s->map[1], s->map[2], s->map[3], s->map[4], s->map[5], s->in,    s->in_c};
   int n = 0;
   for (int i = 0; i < GR_RAIN_RUNOFF_STATE_CELL_ARRAYS; ++i, ++n) {
     bufs[n] = cells[i];

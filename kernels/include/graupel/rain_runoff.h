@@ -39,9 +39,34 @@
  * The flow is gathered, never scattered, so two runs give bit-identical
  * fields, and a terrain symmetric under a mirror gives a mirrored flow.
  *
- * Boundaries: GR_BOUNDARY_CLOSED is a wall (no flow through the grid's edge);
- * GR_BOUNDARY_OPEN lets water leave (free outfall into a dry cell at the
- * edge cell's ground height) and counts it as outflow. Nothing enters.
+ * Boundaries, one per edge of the domain (params.boundary[side], in
+ * gr_rain_runoff_side order: west, east, south, north), for either model:
+ *  - GR_BOUNDARY_CLOSED: a wall, no flow through the edge;
+ *  - GR_BOUNDARY_OPEN: a free outfall into a dry cell at the edge cell's
+ *    ground height; water leaves (outflow), nothing enters;
+ *  - GR_BOUNDARY_TRANSMISSIVE: zero gradient, the edge's water depth and
+ *    velocity continue beyond it over a bed whose slope continues (the edge
+ *    cell's bed minus the step to its inner neighbour): uniform flow on a
+ *    slope leaves at its normal depth, without reflection; nothing enters
+ *    (a zero-gradient inflow would grow with the edge cell's depth and feed
+ *    a pit at the edge without end);
+ *  - GR_BOUNDARY_LEVEL: the water surface beyond the edge stands at
+ *    params.boundary_level[side] (m, as the elevations) over the edge
+ *    cell's ground (with the edge's velocity for shallow water): the edge
+ *    fills or drains the domain toward that level; a level below the ground
+ *    is a free outfall.
+ * What leaves through an edge is outflow, what enters is inflow, both in
+ * the ledger.
+ *
+ * No-data cells: a NaN elevation (as real DEMs mark missing ground) puts its
+ * cell outside the domain, for either model: nothing rains, enters or is
+ * counted there, and get_field, get_map and sample give NaN there. By
+ * params.no_data it is a wall (GR_BOUNDARY_CLOSED, the default: its bed far
+ * above any ground, so no face to it carries water) or an outfall
+ * (GR_BOUNDARY_OPEN: its bed far below, so water pours over the brink as over
+ * a cliff, and what reaches the cell leaves the domain at the end of the step
+ * as outflow). Infinite elevations are still refused. The stable step counts the levels' depths
+ * over the edges' lowest ground as water in the grid.
  *
  * Fields (gr_field): set ELEVATION (required, m), optionally PERMEABILITY
  * (m/s, replaces params.permeability), RAIN_RATE (m/s, replaces
@@ -109,10 +134,22 @@ typedef enum gr_flow_model {
   GR_FLOW_LOCAL_INERTIAL = 1
 } gr_flow_model;
 
+/** The kind of an edge (rows BoundaryWest, BoundaryEast, BoundarySouth,
+ *  BoundaryNorth); see "Boundaries" above. */
 typedef enum gr_boundary {
-  GR_BOUNDARY_OPEN = 0,  /**< water may leave through the grid's edge */
-  GR_BOUNDARY_CLOSED = 1 /**< the edge is a wall */
+  GR_BOUNDARY_OPEN = 0,         /**< free outfall: water may leave through the edge */
+  GR_BOUNDARY_CLOSED = 1,       /**< the edge is a wall */
+  GR_BOUNDARY_TRANSMISSIVE = 2, /**< zero gradient: depth, velocity and bed slope continue */
+  GR_BOUNDARY_LEVEL = 3         /**< the water surface beyond the edge is boundary_level */
 } gr_boundary;
+
+/** Sides of the domain (boundaries) and of a piece (the halo calls). */
+typedef enum gr_rain_runoff_side {
+  GR_RAIN_RUNOFF_WEST = 0,  /**< toward i0 - 1 */
+  GR_RAIN_RUNOFF_EAST = 1,  /**< toward i0 + nx */
+  GR_RAIN_RUNOFF_SOUTH = 2, /**< toward j0 - 1 */
+  GR_RAIN_RUNOFF_NORTH = 3  /**< toward j0 + ny */
+} gr_rain_runoff_side;
 
 /** Standard gravity, m/s^2. */
 #define GR_GRAVITY 9.80665
@@ -123,12 +160,17 @@ typedef enum gr_boundary {
  * to these), written nowhere else.
  */
 typedef struct gr_rain_runoff_params {
-  double rain_rate;     /**< m/s (row RainRate, mm/h) */
-  double permeability;  /**< infiltration capacity, m/s (row Permeability, mm/h) */
-  double manning_n;     /**< Manning roughness, s/m^(1/3) (row ManningN) */
-  double cfl;           /**< Courant number of the adaptive step (row CourantNumber) */
-  double max_dt;        /**< longest step, s (row MaxTimeStep) */
-  gr_boundary boundary; /**< row Boundary: 0 open, 1 closed */
+  double rain_rate;    /**< m/s (row RainRate, mm/h) */
+  double permeability; /**< infiltration capacity, m/s (row Permeability, mm/h) */
+  double manning_n;    /**< Manning roughness, s/m^(1/3) (row ManningN) */
+  double cfl;          /**< Courant number of the adaptive step (row CourantNumber) */
+  double max_dt;       /**< longest step, s (row MaxTimeStep) */
+  /** rows BoundaryWest, BoundaryEast, BoundarySouth, BoundaryNorth, by
+   *  gr_rain_runoff_side: 0 open, 1 closed, 2 transmissive, 3 level */
+  gr_boundary boundary[4];
+  /** rows LevelWest, LevelEast, LevelSouth, LevelNorth, m: the water
+   *  surface beyond an edge of kind GR_BOUNDARY_LEVEL (unused otherwise) */
+  double boundary_level[4];
   /** row FlowModel: 0 shallow water (the default), 1 local inertial. The
    *  local inertial model needs manning_n >= 0.005; shallow water allows 0
    *  (frictionless). */
@@ -139,6 +181,10 @@ typedef struct gr_rain_runoff_params {
   /** row DebrisFactor (default 0): FD2321's DF, added to the hazard rating
    *  where the depth exceeds 0.25 m. 0 to 1. */
   double debris_factor;
+  /** row NoDataBoundary (default 1): what no-data cells (NaN elevations) are,
+   *  GR_BOUNDARY_CLOSED a wall or GR_BOUNDARY_OPEN an outfall; see "No-data
+   *  cells". */
+  gr_boundary no_data;
 } gr_rain_runoff_params;
 
 /** The table's defaults. */
@@ -176,8 +222,9 @@ typedef struct gr_rain_runoff_ledger {
   double rain_volume;        /**< rain that fell on the grid */
   double infiltrated_volume; /**< water that went into the ground */
   double outflow_volume;     /**< water that left through the boundary */
+  double inflow_volume;      /**< water that came in: level edges, inflows (see "Inflows") */
   double stored_volume;      /**< water on the grid now */
-  /** initial + rain - infiltrated - outflow - stored: float rounding only */
+  /** initial + rain + inflow - infiltrated - outflow - stored: float rounding only */
   double balance_error;
   double max_depth; /**< deepest cell now, m */
 } gr_rain_runoff_ledger;
@@ -253,6 +300,77 @@ GR_API gr_status gr_rain_runoff_get_field(gr_rain_runoff *s, gr_field f, float *
  * a large grid. A cell outside the grid is refused with a sentence.
  */
 GR_API gr_status gr_rain_runoff_sample(gr_rain_runoff *s, const int *ij, int n, float *values);
+
+/**
+ * @name Inflows
+ *
+ * Water let in as sources (m/s of depth added to cells, like rain, before
+ * infiltration and flow), counted as the ledger's inflow_volume: per cell
+ * the very float the depth gained, in a Kahan sum, so the ledger closes to
+ * float rounding. Both are inputs, not state: a checkpoint does not hold
+ * them, and reset keeps them. The stable step (shallow water) counts them
+ * as rain.
+ * @{
+ */
+
+/**
+ * Point inflows (a river, a culvert): n sources at the domain's cells
+ * ij[2k], ij[2k+1] (the whole domain's indices, also for a piece, which
+ * keeps those in its local array, ring included), discharge[k] m^3/s each
+ * (0 to 1e6), constant in time. Sources in one cell add up (in double, in
+ * the order given). They replace the previous ones; n = 0 removes them. A
+ * refused list (a sentence names the source and its value) leaves the
+ * sources as they were.
+ */
+GR_API gr_status gr_rain_runoff_set_point_inflows(gr_rain_runoff *s, const int *ij,
+                                                  const double *discharge, int n);
+
+/**
+ * An inflow hydrograph along the domain edge `side` (a gr_rain_runoff_side):
+ * n rows of times[k] (s, finite, strictly increasing) and discharge[k]
+ * (m^3/s, 0 to 1e6), linear in between, the first discharge before the
+ * first time and the last after the last time. Each step of [t, t + dt]
+ * takes the table's exact mean over the step (its integral over dt) and
+ * spreads it evenly over the edge's cells (Q / (n_edge dx dy) per cell, m/s
+ * of depth, n_edge the whole domain's cells along the edge), whatever the
+ * edge's kind; a piece applies the edges it shares with the domain. n = 0
+ * removes it. A refused table (times not increasing, a negative discharge:
+ * a sentence names the row) leaves the edge's hydrograph as it was.
+ */
+GR_API gr_status gr_rain_runoff_set_edge_inflow(gr_rain_runoff *s, int side, const double *times,
+                                                const double *discharge, int n);
+/** @} */
+
+/**
+ * @name Rain over time and roughness by place
+ * @{
+ */
+
+/**
+ * A hyetograph: n rows of times[k] (s, finite, strictly increasing) and
+ * rates[k] (m/s, within RainRate's range), linear in between, the first rate
+ * before the first time and the last after the last time. Each step of [t,
+ * t + dt] rains the table's exact mean over the step, uniformly, in place of
+ * params.rain_rate (a RAIN_RATE field still wins); the ledger's rain is the
+ * sum of those floats times the area and dt. n = 0 removes it (RainRate
+ * again). An input, not state; a refused table leaves the one before.
+ */
+GR_API gr_status gr_rain_runoff_set_hyetograph(gr_rain_runoff *s, const double *times,
+                                               const double *rates, int n);
+
+/**
+ * A Manning roughness map: one n per cell of the local array (nx * ny
+ * doubles, ring included for a piece), s/m^(1/3), within ManningN's range
+ * (0.005 and more for the local inertial model), used in place of
+ * params.manning_n: shallow water takes each cell's n, the local inertial
+ * model a face's mean of its two cells' n^2. n^2 is computed in double and
+ * rounded once, as for the uniform ManningN, so a map of ManningN everywhere
+ * gives that run bit for bit. NULL removes it. A refused map (a sentence
+ * names the cell and the value) leaves the one before; set_params refuses
+ * FlowModel 1 while the map holds an n below 0.005.
+ */
+GR_API gr_status gr_rain_runoff_set_manning_map(gr_rain_runoff *s, const double *n);
+/** @} */
 
 /** The ledger now (waits; reduces the volumes on the device). */
 GR_API gr_status gr_rain_runoff_ledger_get(gr_rain_runoff *s, gr_rain_runoff_ledger *out);
@@ -376,7 +494,7 @@ GR_API gr_status gr_rain_runoff_state_load(gr_rain_runoff *s, const void *host, 
  * gr_rain_runoff_step call (the caller exchanges between calls) and does not
  * advance (both refused with a sentence). The stable step and the ledger are
  * global through the allreduce callback (the deepest cell by GR_REDUCE_MAX;
- * the stored, infiltrated, outflow, rain and initial volumes by
+ * the stored, infiltrated, outflow, inflow, rain and initial volumes by
  * GR_REDUCE_SUM), so every piece takes the same dt and the same steps as the
  * whole grid, which makes every owned cell bit-identical to the whole
  * grid's; advance on a piece with a ring needs both callbacks.
@@ -410,14 +528,6 @@ GR_API gr_status gr_rain_runoff_state_load(gr_rain_runoff *s, const void *host, 
  *  cannot change (the ring would). */
 #define GR_RAIN_RUNOFF_GHOST_SW 4
 
-/** Sides of a piece, for the halo calls. */
-typedef enum gr_rain_runoff_side {
-  GR_RAIN_RUNOFF_WEST = 0,  /**< toward i0 - 1 */
-  GR_RAIN_RUNOFF_EAST = 1,  /**< toward i0 + nx */
-  GR_RAIN_RUNOFF_SOUTH = 2, /**< toward j0 - 1 */
-  GR_RAIN_RUNOFF_NORTH = 3  /**< toward j0 + ny */
-} gr_rain_runoff_side;
-
 /**
  * The global reduction over the pieces (see gr_allreduce_fn); NULL (the
  * default) for a simulation that is the whole domain or the only piece.
@@ -450,7 +560,8 @@ GR_API const char *gr_rain_runoff_last_error(const gr_rain_runoff *s);
 
 /**
  * The parameter table (RainRate mm/h, Permeability mm/h, ManningN,
- * MaxTimeStep s, CourantNumber, Boundary, FlowModel, WettingDepth m, DebrisFactor) that
+ * MaxTimeStep s, CourantNumber, BoundaryWest/East/South/North, LevelWest/East/South/North m,
+ * FlowModel, WettingDepth m, DebrisFactor) that
  * gr_rain_runoff_params_validate
  * follows; *count gets the number of rows.
  */
