@@ -241,8 +241,10 @@ int vtkEXRHeightFieldReader::RequestData(vtkInformation *, vtkInformationVector 
   if (nonFinite > 0) {
     vtkWarningMacro("EXR Height Field Reader: '" << this->FileName << "' has " << nonFinite
                                                  << " elevation values that are NaN or infinite"
-                                                    " (no-data cells); simulations will refuse"
-                                                    " them.");
+                                                    " (no-data cells); Rain Runoff treats NaN"
+                                                    " points as outside its domain (its"
+                                                    " NoDataBoundary), the other simulations"
+                                                    " refuse them.");
   }
   return 1;
 }
