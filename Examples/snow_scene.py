@@ -94,6 +94,29 @@ def build(cells=320, spacing=0.04, time_step=0.016, frames=3):
     return snow, times
 
 
+def _legend(sb, title, fmt, x=0.30, length=0.40):
+    """A horizontal legend titled with units, at the bottom from `x` (a
+    fraction of the width) `length` long."""
+    sb.Title = title
+    sb.ComponentTitle = ""
+    sb.TitleColor = sb.LabelColor = [1.0, 1.0, 1.0]
+    sb.TitleFontSize = sb.LabelFontSize = 14
+    sb.WindowLocation = "Any Location"
+    sb.Orientation = "Horizontal"
+    sb.Position = [x, 0.03]
+    sb.ScalarBarLength = length
+    sb.RangeLabelFormat = sb.LabelFormat = fmt
+
+
+def _note(view, exaggeration):
+    """The vertical exaggeration, written in the upper right as on the
+    terrain pictures (Examples/graupel_scene.py)."""
+    text = Show(Text(Text="vertical exaggeration \u00d7%g" % exaggeration), view)
+    text.WindowLocation = "Upper Right Corner"
+    text.FontSize = 14
+    text.Color = [1.0, 1.0, 1.0]
+
+
 def show(snow, time, size=(1024, 768), bar=True, label=True, close=False):
     """Renders `snow` (a Snow Deformation proxy) at `time` (s): the snow
     surface lit and coloured by snow_density, the objects at their pose:
@@ -112,26 +135,18 @@ def show(snow, time, size=(1024, 768), bar=True, label=True, close=False):
     display = Show(surface, view)
     display.Representation = "Surface"
     ColorBy(display, ("POINTS", "snow_density"))
+    # The plugin's snow density map from the untouched snow's density
+    # (white) to 400 kg/m^3 (deep blue, the default top of the density
+    # range): on its own range (50-500) untouched snow would be pale blue
+    # and the ruts' contrast halved.
     lut = GetColorTransferFunction("snow_density")
-    # Untouched snow white, pressed snow through pale blue to deep blue at
-    # 400 kg/m^3 (the default top of the density range).
-    lut.RGBPoints = [DENSITY, 0.97, 0.97, 0.97, 250.0, 0.62, 0.78, 0.95,
-                     320.0, 0.20, 0.45, 0.85, 400.0, 0.05, 0.15, 0.50]
-    lut.ColorSpace = "RGB"
+    lut.ApplyPreset("Graupel Snow Density", False)
     lut.AutomaticRescaleRangeMode = "Never"
     lut.RescaleTransferFunction(DENSITY, 400.0)
     display.SetScalarBarVisibility(view, bar)
     if bar:
-        sb = GetScalarBar(lut, view)
-        sb.Title = "snow density (kg/m\u00b3)"
-        sb.ComponentTitle = ""
-        sb.TitleColor = sb.LabelColor = [1.0, 1.0, 1.0]
-        sb.WindowLocation = "Any Location"
-        sb.Orientation = "Horizontal"
-        sb.Position = [0.33, 0.04]
-        sb.ScalarBarLength = 0.34
-        sb.RangeLabelFormat = "%.0f"
-        sb.LabelFormat = "%.0f"
+        _legend(GetScalarBar(lut, view), "snow density (kg/m\u00b3)", "%.0f")
+    _note(view, 1.0)
     if label:
         text = Show(Text(Text="Snow Deformation: a wheel (radius %.2f m) at %.1f m/s through "
                               "%.1f m of snow, t = %.1f s" % (RADIUS, SPEED, DEPTH, time)), view)
@@ -208,8 +223,9 @@ TREES = ((2.0, 11.0, 4.6, 1.3), (3.6, 13.0, 3.6, 1.0), (12.0, 12.4, 4.2, 1.2),
 # bevelled up) pulled at 3 m/s, riding 0.12 m into the fresh snow.
 SLEDGE_LENGTH, SLEDGE_WIDTH, SLEDGE_HEIGHT = 1.5, 0.6, 0.3
 SLEDGE_SINK, SLEDGE_SPEED = 0.12, 3.0
-# The pictures draw less snow than this (m) as bare ground.
-BARE = 0.004
+# The pictures draw less snow than this (m) as bare ground: the lowest
+# value of the plugin's Graupel Snow Depth map.
+BARE = 0.005
 
 
 def _closed(faces):
@@ -375,8 +391,9 @@ def build_accumulation(cells=288, spacing=0.05, time_step=300.0, resolution=768,
     the defaults) with half a metre of relief, the hut and trees, HOURS of
     wind-driven snow in steps of `time_step` seconds, then the sledge along
     a curve south and east of the hut (Snow Deformation on Snow
-    Accumulation's port 0 as it is). Returns (accumulation, deformation,
-    the deformation's end time, the path's points)."""
+    Accumulation's port 0 at the end of the snowfall). Returns
+    (accumulation, deformation, the deformation's end time, the path's
+    points)."""
     size = (cells - 1) * spacing
     terrain = _constructor("ProceduralTerrain")(
         Dimensions=[cells, cells], Spacing=spacing, Seed=11, NoiseType="fBm", Octaves=3,
@@ -415,7 +432,10 @@ def build_accumulation(cells=288, spacing=0.05, time_step=300.0, resolution=768,
     length = float(np.sum(np.hypot(np.hypot(np.diff(x), np.diff(y)), np.diff(z))))
 
     crossing = round(0.95 * length / SLEDGE_SPEED, 2)
-    snow = _constructor("SnowDeformation")(Input=acc, Objects=_producer(_sledge()), Path=path)
+    # The snow as it lies at the end of the snowfall, whatever time the
+    # sledge's own seconds ask it for (a state loaded at the crossing's time).
+    fallen = pvs.ForceTime(Input=acc, IgnorePipelineTime=1, ForcedTime=end)
+    snow = _constructor("SnowDeformation")(Input=fallen, Objects=_producer(_sledge()), Path=path)
     snow.TimeStep = sledge_step
     snow.EndTime = crossing
     snow.OutputInterval = crossing
@@ -460,33 +480,22 @@ def show_accumulation(acc, end, snow=None, crossing=None, size=(1024, 768), bar=
     display = Show(surface, view)
     display.Representation = "Surface"
     ColorBy(display, ("POINTS", "snow_depth"))
-    full = RATE * 0.01 * HOURS
+    # The plugin's snow depth map on its own range: a 5 mm dusting grey-blue,
+    # 30 cm and more white; bare ground (under 5 mm, below the range) brown.
     lut = GetColorTransferFunction("snow_depth")
-    # A dusting grey-blue, a full fall white; bare ground (under 4 mm, below
-    # the range) brown.
-    lut.RGBPoints = [BARE, 0.30, 0.42, 0.66, 0.4 * full, 0.55, 0.70, 0.90,
-                     0.8 * full, 0.86, 0.92, 0.99, 1.25 * full, 1.0, 1.0, 1.0]
-    lut.ColorSpace = "RGB"
-    lut.UseBelowRangeColor = 1
-    lut.BelowRangeColor = [0.42, 0.30, 0.20]
+    lut.ApplyPreset("Graupel Snow Depth", False)
     lut.AutomaticRescaleRangeMode = "Never"
+    lut.UseBelowRangeColor = 1
+    lut.BelowRangeColor = [0.42, 0.31, 0.21]
     display.SetScalarBarVisibility(view, bar)
     if bar:
-        sb = GetScalarBar(lut, view)
-        sb.Title = "snow depth (m)"
-        sb.ComponentTitle = ""
-        sb.TitleColor = sb.LabelColor = [1.0, 1.0, 1.0]
-        sb.WindowLocation = "Any Location"
-        sb.Orientation = "Horizontal"
-        sb.Position = [0.33, 0.04]
-        sb.ScalarBarLength = 0.34
-        sb.RangeLabelFormat = "%.2f"
-        sb.LabelFormat = "%.2f"
-        # ParaView 5.11's bar has no swatch for below the range: say it.
-        key = Show(Text(Text="brown: bare ground (under the roof, in the lee)"), view)
+        _legend(GetScalarBar(lut, view), "snow depth (m)", "%.3g", x=0.45, length=0.45)
+        # What the bar's below-range swatch stands for.
+        key = Show(Text(Text="brown: bare ground"), view)
         key.WindowLocation = "Lower Left Corner"
         key.FontSize = 14
         key.Color = [1.0, 0.84, 0.66]
+    _note(view, 1.0)
     if label:
         words = ("Snow Accumulation: %g h of %g cm/h snow, driven by a west wind %g\u00b0 off "
                  "vertical" % (HOURS, RATE, TILT)) if snow is None else (
@@ -510,12 +519,13 @@ def show_accumulation(acc, end, snow=None, crossing=None, size=(1024, 768), bar=
                            0.10, 0.30, 0.14]
     plain.SetScalarBarVisibility(view, False)
     caps = pvs.Threshold(Input=pvs.WarpByVector(Input=objects, Vectors=["POINTS", "snow_offset"]),
-                         Scalars=["POINTS", "snow_depth"], LowerThreshold=0.005,
+                         Scalars=["POINTS", "snow_depth"], LowerThreshold=BARE,
                          UpperThreshold=100.0, AllScalars=1)
     cap = Show(caps, view)
     cap.Representation = "Surface"
     ColorBy(cap, ("POINTS", "snow_depth"))
-    lut.RescaleTransferFunction(BARE, 1.25 * full)
+    # The preset's own range (colouring the caps may have moved it).
+    lut.RescaleTransferFunction(BARE, 0.3)
     if snow is not None:
         sledge = Show(OutputPort(snow, 1), view)
         sledge.Representation = "Surface"

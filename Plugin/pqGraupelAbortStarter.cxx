@@ -1,4 +1,5 @@
 #include "pqGraupelAbortStarter.h"
+#include "pqGraupelApplyLook.h"
 
 #include "pqApplicationCore.h"
 #include "pqPipelineSource.h"
@@ -109,6 +110,8 @@ void graupel_gui_start() {
   }
   started = new pqGraupelAbortStarter(core);
   started->onStartup();
+  // The look on Apply (pqGraupelApplyLook.h): owned by the core as well.
+  (new pqGraupelApplyLook(core))->onStartup();
 }
 
 pqGraupelAbortStarter::pqGraupelAbortStarter(QObject *p) : Superclass(p) {}

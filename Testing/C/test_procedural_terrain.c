@@ -54,7 +54,10 @@ static double ref_elevation(const gr_procedural_terrain_params *p, double x, dou
   double f = p->frequency / 1000.0, m = 1.0, amp = 1.0, w = 1.0;
   double sum = 0, norm = 0;
   for (int o = 0; o < p->octaves; ++o) {
-    double g = ref_gradient(x * f * m, y * f * m, (uint32_t)p->seed + (uint32_t)o);
+    /* The octave's shift off the world axes (graupel/procedural_terrain.h). */
+    double sx = 0.25 + 0.6180339887498949 * o, sy = 0.25 + 0.4142135623730951 * o;
+    double g = ref_gradient(x * f * m + (sx - floor(sx)), y * f * m + (sy - floor(sy)),
+                            (uint32_t)p->seed + (uint32_t)o);
     if (p->type == GR_NOISE_RIDGED) {
       double s = p->offset - fabs(g);
       s = s * s * w;
@@ -164,6 +167,41 @@ static void test_determinism_and_seeds(void) {
   free(a);
   free(b);
   free(c);
+}
+
+/* No seam on the world axes: every octave's lattice used to have a line at
+ * x = 0 and y = 0, where gradient noise has half its spread, so all octaves
+ * dipped together there (edge rows of a terrain at the origin averaged 36 m
+ * against 52 m inside). Averaged over 64 seeds, the rows on the axes must be
+ * as high as the interior's, within 5% (seed sets differ by up to 4%). */
+static void test_no_axis_seam(void) {
+  gr_grid g = {192, 192, 4.0, 4.0, 0.0, 0.0};
+  gr_procedural_terrain_params p;
+  gr_procedural_terrain_params_init(&p);
+  double axes = 0, inside = 0;
+  long n_axes = 0, n_inside = 0;
+  for (int seed = 0; seed < 64; ++seed) {
+    p.seed = 100 + seed;
+    float *h = make(&g, &p);
+    if (!h)
+      return;
+    for (int j = 0; j < g.ny; ++j)
+      for (int i = 0; i < g.nx; ++i) {
+        double v = h[j * g.nx + i];
+        if (i == 0 || j == 0) {
+          axes += v;
+          ++n_axes;
+        } else if (i >= 16 && j >= 16 && i < g.nx - 16 && j < g.ny - 16) {
+          inside += v;
+          ++n_inside;
+        }
+      }
+    free(h);
+  }
+  axes /= (double)n_axes;
+  inside /= (double)n_inside;
+  printf("mean over 64 seeds: %.2f m on the axes x = 0, y = 0; %.2f m inside\n", axes, inside);
+  CHECK_MSG(fabs(axes - inside) < 0.05 * inside, "axes %.2f m, inside %.2f m", axes, inside);
 }
 
 static void test_octaves_energy(void) {
@@ -758,6 +796,7 @@ static const gr_subtest tests[] = {
     {"reference", test_reference, 0},
     {"determinism_and_seeds", test_determinism_and_seeds, 0},
     {"octaves_energy", test_octaves_energy, 0},
+    {"no_axis_seam", test_no_axis_seam, 0},
     {"height_scale_and_bounds", test_height_scale_and_bounds, 0},
     {"tiling_and_inversion", test_tiling_and_inversion, 0},
     {"devices_agree", test_devices_agree, 0},

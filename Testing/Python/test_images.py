@@ -11,10 +11,14 @@ Testing/Baseline/ by VTK's image comparison.
   --scene water    Water Surface on a lake filled to 14 m, 10 s of raindrop ripples,
                    as Apply shows it (coloured by water depth)
   --scene snow     a wheel rolled along an S through snow (Snow Deformation,
-                   Examples/snow_scene.py on a 160 x 160 grid), seen whole
+                   Examples/snow_scene.py on a 160 x 160 grid), seen whole,
+                   coloured by the Graupel Snow Density map, with legend and
+                   exaggeration
   --scene accumulation  4 h of wind-driven snow on a hut and trees (Snow
                    Accumulation), then a sledge across it (Snow Deformation):
-                   snow_scene.build_accumulation on a 128 x 128 grid, seen whole
+                   snow_scene.build_accumulation on a 128 x 128 grid, seen whole,
+                   coloured by the Graupel Snow Depth map, with legend and
+                   exaggeration
   --scene winter   Examples/winter_scene.py on a 128 x 128 terrain: snow by
                    slope, cast shadows, snowfall, cloud sky, lightning
   --scene rain_scene  Examples/rain_scene.py: an hour of rain on the DEM in
@@ -97,7 +101,7 @@ elif a.scene == "snow":
     fd = out.GetFieldData()
     mass = fd.GetArray("snow_mass").GetValue(0)
     T.check(abs(fd.GetArray("balance_error").GetValue(0)) < 1e-6 * mass, "snow mass kept")
-    view = snow_scene.show(snow, times[-1], size=(400, 300), bar=False, label=False)
+    view = snow_scene.show(snow, times[-1], size=(400, 300), label=False)
 elif a.scene == "accumulation":
     import numpy as np  # noqa: E402
     import snow_scene as S  # noqa: E402
@@ -174,8 +178,7 @@ elif a.scene == "accumulation":
     T.check(np.median(sunk) > 0.5 * S.SLEDGE_SINK and sunk.min() > 0.0,
             "the trail lies %.3f m (median; least %.3f m) below the accumulated snow"
             % (np.median(sunk), sunk.min()))
-    view = S.show_accumulation(acc, end, sledge, crossing, size=(400, 300), bar=False,
-                               label=False)
+    view = S.show_accumulation(acc, end, sledge, crossing, size=(400, 300), label=False)
 elif a.scene == "winter":
     import winter_scene as W  # noqa: E402
 

@@ -175,7 +175,10 @@ static gr_status gr_procedural_terrain_upload(gr_procedural_terrain *t) {
   double ridged_step = pow(p->lacunarity, -p->h);
   double m = 1.0, a = 1.0;
   for (int o = 0; o < p->octaves; ++o) {
-    double X = g->x0 * f * m, Y = g->y0 * f * m;
+    /* The octave's shift (procedural_terrain_shared.h): no lattice line
+     * shared by every octave on the world axes. */
+    double sx = 0.25 + GR_PT_SHIFT_STEP_X * o, sy = 0.25 + GR_PT_SHIFT_STEP_Y * o;
+    double X = g->x0 * f * m + (sx - floor(sx)), Y = g->y0 * f * m + (sy - floor(sy));
     double ext_x = fabs(X) + ((double)g->i0 + g->nx) * g->dx * f * m;
     double ext_y = fabs(Y) + ((double)g->j0 + g->ny) * g->dy * f * m;
     if (ext_x > GR_LATTICE_LIMIT || ext_y > GR_LATTICE_LIMIT)

@@ -18,6 +18,10 @@
  *   inverted (seed 001's choice: rounded hills and river valleys instead of
  *   sharp crests) n = 1 - r, else n = r.
  * elevation = height_scale * n, in metres.
+ * Octave o samples g_o at (x, y) * f * lacunarity^o + (frac(0.25 + 0.618034 o),
+ * frac(0.25 + 0.414214 o)) lattice units (f the frequency in cycles per metre):
+ * unshifted, every octave's lattice had lines on x = 0 and y = 0, where
+ * gradient noise has half its spread, and the terrain dipped along both axes.
  */
 #ifndef GRAUPEL_PROCEDURAL_TERRAIN_H
 #define GRAUPEL_PROCEDURAL_TERRAIN_H

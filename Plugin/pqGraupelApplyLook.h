@@ -1,0 +1,62 @@
+/**
+ * @class   pqGraupelApplyLook
+ * @brief   On the first Apply of a Graupel terrain output in the GUI, shows it as a Terrain
+ * Surface.
+ *
+ * A Graupel terrain output (a proxy whose XML hints hold <GraupelSurface/>:
+ * Procedural Terrain, the EXR reader, Rain Runoff, Snow Deformation, Snow
+ * Accumulation, Terrain Analysis, Terrain Shadow, Water Surface) is a flat
+ * 2-D image. When the user applies one for the first time and ParaView has
+ * shown that image in a render view, this component adds a Terrain Surface
+ * below it and shows that instead: the flat image is hidden, as are the
+ * Terrain Surfaces this starter added below the new output's inputs (as
+ * ParaView hides a filter's input), the surface is coloured by its active
+ * scalars with the plugin's colour maps, a legend titled with units
+ * ("water depth (m)") is shown, and when the surface is all the view shows,
+ * the camera looks at it from the south-east and above.
+ *
+ * Only the GUI's Apply path triggers it: ParaView's pqObjectBuilder marks a
+ * source made from a menu UNINITIALIZED until its first Apply
+ * (pqApplyBehavior sets it UNMODIFIED after showing it). Sources made by
+ * Python (the GUI's shell, pvpython, pvbatch) or by loading a state file
+ * never are, so scripts and states keep exactly what they build. The work
+ * is done once the Apply has returned (a zero-time timer), so the image
+ * ParaView showed exists; a timer that fires inside an update (the abort
+ * button lets Qt process events there, pqGraupelAbortStarter) waits for it
+ * to end.
+ *
+ * Lives in the module GraupelGui, started by graupel_gui_start().
+ */
+#ifndef pqGraupelApplyLook_h
+#define pqGraupelApplyLook_h
+
+#include <QObject>
+#include <QPointer>
+#include <QSet>
+
+class pqPipelineSource;
+
+class pqGraupelApplyLook : public QObject {
+  typedef QObject Superclass;
+
+public:
+  pqGraupelApplyLook(QObject *p = nullptr);
+  ~pqGraupelApplyLook() override = default;
+
+  void onStartup();
+
+  /** The legend title of a colour array: "water depth (m)"; the name itself when unknown. */
+  static const char *legendTitle(const char *array);
+
+private:
+  void onSourceAdded(pqPipelineSource *source);
+  void onModifiedStateChanged(pqPipelineSource *source);
+  void showSurfaceLater(QPointer<pqPipelineSource> source, int tries);
+  void showSurface(pqPipelineSource *source);
+
+  Q_DISABLE_COPY(pqGraupelApplyLook)
+  QSet<pqPipelineSource *> Pending; // made from a menu, not applied yet
+  bool Updating = false;            // between progress start and end
+};
+
+#endif
