@@ -6,7 +6,8 @@ with RestartFile set to it, asked for output 2k, starts from output k (its
 RestartIndex) and gives, on every rank, the fields, the ledger (and Rain
 Runoff's hydrograph) of an uninterrupted run to 2k bit for bit. A manifest
 that says another number of ranks, one of another simulation, or one whose
-piece is gone is refused with one sentence and an empty output."""
+piece is gone, and a CheckpointFile that cannot be written, are refused
+with one sentence and an empty output."""
 import builtins
 import json
 import os
@@ -198,4 +199,12 @@ with open(missing, "w") as f:
 refused("a missing piece", rain_runoff, missing, 80.0, ["RestartFile", "could not be opened"])
 refused("no manifest", rain_runoff, os.path.join(folder, "nothing.json"), 80.0,
         ["RestartFile", "could not be opened"])
+# A CheckpointFile in a folder that is not there: one sentence, an empty output.
+nowhere = rain_runoff(CheckpointFile=os.path.join(folder, "no_such_folder", "x.json"))
+errs = T.ErrorCatcher(nowhere.GetClientSideObject())
+n = points(nowhere, 20.0)
+T.check(n == 0 and "could not write its CheckpointFile" in errs.text() and
+        len(errs.messages) == 1,
+        "an unwritable CheckpointFile: one sentence and an empty output (%d points): %r"
+        % (n, errs.text()[:300]))
 T.finish()
