@@ -63,6 +63,23 @@
  * simulation is set up again. RestartCount counts set-ups and returns to time 0; RestoreCount
  * counts snapshot loads.
  *
+ * **Checkpoint files.** With CheckpointFile set (a path ending in .json),
+ * every update also writes the state it outputs: each rank writes
+ * `<stem>.<rank>.vti` beside the manifest, its output (the requested piece,
+ * every array, viewable as it is) with the core's state as SaveState gives
+ * it, byte for byte, in the field array `graupel_state` (an unsigned char
+ * array; the .vti is written raw and zlib-compressed, which is lossless);
+ * then rank 0 writes the manifest `<stem>.json`: the format, the
+ * simulation's label, the output index, time and interval, the grid, the
+ * number of ranks and whether they split the grid, and per rank its own
+ * rows, its file and its state's bytes (plus `steps` where the output has
+ * it). RestartFile names such a manifest: after the set-up each rank checks
+ * it against this run (simulation, grid, ranks, its own rows, the output
+ * time), reads its piece and loads the state (LoadState), so the run goes on
+ * from that output time; the loaded state is also kept as a checkpoint, so
+ * later times come from it and earlier ones from time 0. Every rank takes
+ * the same decision (a piece that fails on one rank fails them all).
+ *
  * **Progress and abort.** Progress text names what happens ("Rain Runoff:
  * t = 420 s of 1800 s", the second time being the requested one) and is
  * updated after every AdvanceState and, through CoreProgress, from inside a
@@ -129,6 +146,7 @@
 
 #include <deque>
 #include <functional>
+#include <string>
 #include <vector>
 
 class vtkDataArray;
@@ -187,6 +205,37 @@ public:
   vtkSetClampMacro(CheckpointMemoryLimit, double, 0.0, 1.0e9);
   vtkGetMacro(CheckpointMemoryLimit, double);
   ///@}
+
+  ///@{
+  /**
+   * A checkpoint on disk (see "Checkpoint files" in the class comment): while
+   * set, every update writes the state it outputs to this manifest (JSON)
+   * and one .vti per rank beside it, replacing what was there. Setting it
+   * does not set the simulation up again. Empty (the default): nothing is
+   * written.
+   */
+  virtual void SetCheckpointFile(const char *path);
+  vtkGetStringMacro(CheckpointFile);
+  ///@}
+
+  ///@{
+  /**
+   * A manifest written through CheckpointFile to start from: the next set-up
+   * loads each rank's piece of it and goes on from its time, bit for bit as
+   * the run that wrote it went on. Needs the same inputs, properties, output
+   * times and number of ranks as that run; a manifest that does not fit is
+   * refused with a sentence and an empty output. Empty (the default): start
+   * at time 0.
+   */
+  vtkSetStringMacro(RestartFile);
+  vtkGetStringMacro(RestartFile);
+  ///@}
+
+  /** How many checkpoints this rank wrote to CheckpointFile (its piece, and the manifest on rank
+   * 0). */
+  vtkGetMacro(CheckpointFileCount, int);
+  /** The output index the state was loaded at from RestartFile at the last set-up; -1 if none. */
+  vtkGetMacro(RestartIndex, int);
 
   /** The limit in force, bytes: CheckpointMemoryLimit capped by physical memory. */
   vtkTypeInt64 GetCheckpointMemoryLimitBytes() const;
@@ -385,6 +434,10 @@ private:
   void KeepCheckpoint();
   /** Ends a request: no further pass. */
   void Finish(vtkInformation *request);
+  /** Writes the state at the output index StateIndex to CheckpointFile; 0 after an error. */
+  int WriteCheckpointFile(vtkDataObject *output);
+  /** Puts the state of RestartFile in place after a set-up; 0 after an error. */
+  int ReadRestartFile();
 
   std::vector<int> Policies;
   std::vector<std::vector<double>> InputTimes; // per port; empty when static
@@ -407,6 +460,12 @@ private:
   int PieceRing = 0;
   graupel::Pieces *PieceLayout = nullptr;
   std::vector<int> StateLayout; // the layout the state was set up for
+  char *CheckpointFile = nullptr;
+  char *RestartFile = nullptr;
+  int CheckpointFileCount = 0;
+  int RestartIndex = -1;
+  int WrittenIndex = -1; // output index last written to WrittenFile since the set-up
+  std::string WrittenFile;
 };
 
 #endif

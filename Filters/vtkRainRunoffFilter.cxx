@@ -21,6 +21,7 @@
 
 #include "GraupelArrays.h"
 #include "GraupelParameterTable.h"
+#include "GraupelPieces.h"
 
 #include <cmath>
 #include <cstring>
@@ -48,6 +49,9 @@ const gr_param_bound *Bound(const char *property) {
 vtkRainRunoffFilter::vtkRainRunoffFilter() {
   this->SetNumberOfInputPorts(4);
   this->SetNumberOfOutputPorts(2);
+  // The core runs as pieces of a split domain (an MPI run's strips), its
+  // ring as wide as the flow model's stencil.
+  this->SetPieceRing(GR_RAIN_RUNOFF_GHOST_SW);
 }
 
 // The core's parameter table clamps every property: the class writes no
@@ -214,6 +218,10 @@ vtkTypeBool vtkRainRunoffFilter::ProcessRequest(vtkInformation *request,
 int vtkRainRunoffFilter::RequestInformation(vtkInformation *request,
                                             vtkInformationVector **inputVector,
                                             vtkInformationVector *outputVector) {
+  // The ring follows the flow model (a property change comes through here
+  // before the next RequestData plans the pieces).
+  this->SetPieceRing(this->FlowModel == LOCAL_INERTIAL ? GR_RAIN_RUNOFF_GHOST
+                                                       : GR_RAIN_RUNOFF_GHOST_SW);
   const int ok = this->Superclass::RequestInformation(request, inputVector, outputVector);
   // The hydrograph has the simulation's times, not the input's.
   vtkInformation *image = outputVector->GetInformationObject(0);
@@ -397,14 +405,36 @@ int vtkRainRunoffFilter::SetUpState(vtkInformationVector **inputVector) {
     }
   }
 
+  // A split run's strip: its rows, its ring and the whole domain around it.
+  // Every input field goes up as the local array (own rows and ring); point
+  // inflows stay in the whole domain's indices (the core keeps those in its
+  // local array); the core reduces the stable step and the ledger over the
+  // pieces, so every rank's ledger is the whole grid's.
+  graupel::Pieces &pieces = this->GetPieces();
   gr_grid grid;
   TerrainGrid(terrain, &grid);
+  pieces.PieceGrid(&grid);
   gr_status st = gr_rain_runoff_create(this->GetContext(), &grid, &p, &this->Simulation);
   if (st != GR_OK) {
     return this->ReportFailure(st, "Rain Runoff could not set up the simulation");
   }
+  if (pieces.IsSplit()) {
+    gr_rain_runoff *sim = this->Simulation;
+    pieces.BindHalo(
+        [sim](int side, size_t *bytes) { return gr_rain_runoff_halo_size(sim, side, bytes); },
+        [sim](int side, void *host, size_t bytes) {
+          return gr_rain_runoff_halo_get(sim, side, host, bytes);
+        },
+        [sim](int side, const void *host, size_t bytes) {
+          return gr_rain_runoff_halo_set(sim, side, host, bytes);
+        });
+    gr_rain_runoff_set_allreduce(sim, graupel::Pieces::Allreduce, &pieces);
+    gr_rain_runoff_set_halo_exchange(sim, graupel::Pieces::Exchange, &pieces);
+  }
   for (const Upload &u : uploads) {
-    st = gr_rain_runoff_set_field(this->Simulation, u.field, u.values->GetPointer(0));
+    const std::vector<float> local =
+        pieces.LocalField(u.values->GetPointer(0), dims[0], gr_field_components(u.field));
+    st = gr_rain_runoff_set_field(this->Simulation, u.field, local.data());
     if (st != GR_OK) {
       return this->ReportFailure(st, "Rain Runoff could not upload its inputs",
                                  gr_rain_runoff_last_error(this->Simulation));
@@ -418,9 +448,11 @@ int vtkRainRunoffFilter::SetUpState(vtkInformationVector **inputVector) {
                                      << " array 'manning_n' must have one value per point.");
       return 0;
     }
-    std::vector<double> n(npoints);
-    for (size_t c = 0; c < npoints; ++c) {
-      n[c] = manning->GetComponent(static_cast<vtkIdType>(c), 0);
+    // The local array's rows (own rows and ring; the whole grid unsplit).
+    const size_t first = static_cast<size_t>(pieces.GetLocalFirstRow()) * dims[0];
+    std::vector<double> n(static_cast<size_t>(pieces.GetLocalRows()) * dims[0]);
+    for (size_t c = 0; c < n.size(); ++c) {
+      n[c] = manning->GetComponent(static_cast<vtkIdType>(first + c), 0);
     }
     if (gr_rain_runoff_set_manning_map(this->Simulation, n.data()) != GR_OK) {
       vtkErrorMacro("Rain Runoff's " << manningWhere << ": "
@@ -530,11 +562,54 @@ int vtkRainRunoffFilter::RecordLedger(int index) {
   }
   std::vector<float> &row = this->GaugeRows[static_cast<size_t>(index)];
   row.assign(3 * static_cast<size_t>(gauges), 0.0f);
-  const gr_status sst =
-      gr_rain_runoff_sample(this->Simulation, this->GaugeCells.data(), gauges, row.data());
+  graupel::Pieces &pieces = this->GetPieces();
+  if (!pieces.IsSplit()) {
+    const gr_status sst =
+        gr_rain_runoff_sample(this->Simulation, this->GaugeCells.data(), gauges, row.data());
+    if (sst != GR_OK) {
+      return this->ReportFailure(sst, "Rain Runoff could not read its gauges",
+                                 gr_rain_runoff_last_error(this->Simulation));
+    }
+    return 1;
+  }
+  // A split run: each rank samples the gauges on its own rows (the core's
+  // own cells from row 0); the others add -0.0, which leaves every float,
+  // -0.0 and NaN included, as it is, so every rank's table holds the owner's bits.
+  std::vector<int> mine;
+  std::vector<int> which;
+  for (int g = 0; g < gauges; ++g) {
+    const int j = this->GaugeCells[2 * static_cast<size_t>(g) + 1] - pieces.GetOwnFirstRow();
+    if (j >= 0 && j < pieces.GetOwnRows()) {
+      mine.push_back(this->GaugeCells[2 * static_cast<size_t>(g)]);
+      mine.push_back(j);
+      which.push_back(g);
+    }
+  }
+  std::vector<float> sampled(3 * which.size());
+  gr_status sst = gr_rain_runoff_sample(this->Simulation, mine.data(),
+                                        static_cast<int>(which.size()), sampled.data());
+  std::vector<double> sum(3 * static_cast<size_t>(gauges), -0.0);
+  for (size_t k = 0; k < which.size(); ++k) {
+    for (size_t w = 0; w < 3; ++w) {
+      sum[3 * static_cast<size_t>(which[k]) + w] = sampled[3 * k + w];
+    }
+  }
+  // Collective whatever this rank's read gave: no rank waits alone.
+  const bool failed = pieces.AnyRank(sst != GR_OK);
+  if (sst == GR_OK && !failed && gauges > 0) {
+    sst = graupel::Pieces::Allreduce(&pieces, sum.data(), static_cast<int>(sum.size()),
+                                     GR_REDUCE_SUM);
+  }
   if (sst != GR_OK) {
     return this->ReportFailure(sst, "Rain Runoff could not read its gauges",
                                gr_rain_runoff_last_error(this->Simulation));
+  }
+  if (failed) {
+    vtkErrorMacro("Rain Runoff could not read its gauges: another rank failed to read its own.");
+    return 0;
+  }
+  for (size_t k = 0; k < row.size(); ++k) {
+    row[k] = static_cast<float>(sum[k]);
   }
   return 1;
 }
@@ -563,17 +638,91 @@ int vtkRainRunoffFilter::AdvanceState(double t0, double t1) {
   return ADVANCE_DONE;
 }
 
+namespace {
+// A checkpoint's layout: the core's bytes, then the hydrograph's rows up to
+// the state's output time (a restart from a file has no other record of
+// them): rows, gauges, the ledgers' doubles, the gauges' floats, and last
+// the core's byte count.
+template <typename T>
+void Put(std::vector<unsigned char> &bytes, const T *values, size_t n) {
+  const unsigned char *p = reinterpret_cast<const unsigned char *>(values);
+  bytes.insert(bytes.end(), p, p + n * sizeof(T));
+}
+template <typename T>
+bool Take(const std::vector<unsigned char> &bytes, size_t &at, T *values, size_t n) {
+  if (n > (bytes.size() - at) / sizeof(T)) {
+    return false;
+  }
+  std::memcpy(values, bytes.data() + at, n * sizeof(T));
+  at += n * sizeof(T);
+  return true;
+}
+} // namespace
+
 int vtkRainRunoffFilter::SaveState(std::vector<unsigned char> &bytes) {
   size_t size = 0;
   if (gr_rain_runoff_state_size(this->Simulation, &size) != GR_OK) {
     return 0;
   }
   bytes.resize(size);
-  return gr_rain_runoff_state_save(this->Simulation, bytes.data(), size) == GR_OK;
+  if (gr_rain_runoff_state_save(this->Simulation, bytes.data(), size) != GR_OK) {
+    return 0;
+  }
+  const vtkTypeInt64 rows = this->GetStateIndex() + 1;
+  const vtkTypeInt64 gauges = static_cast<vtkTypeInt64>(this->GaugeCells.size() / 2);
+  if (rows < 1 || this->Ledgers.size() < static_cast<size_t>(rows) ||
+      this->GaugeRows.size() < static_cast<size_t>(rows)) {
+    return 0;
+  }
+  Put(bytes, &rows, 1);
+  Put(bytes, &gauges, 1);
+  for (vtkTypeInt64 r = 0; r < rows; ++r) {
+    Put(bytes, this->Ledgers[static_cast<size_t>(r)].data(), 7);
+    const std::vector<float> &g = this->GaugeRows[static_cast<size_t>(r)];
+    if (g.size() != 3 * static_cast<size_t>(gauges)) {
+      return 0;
+    }
+    Put(bytes, g.data(), g.size());
+  }
+  const vtkTypeInt64 core = static_cast<vtkTypeInt64>(size);
+  Put(bytes, &core, 1);
+  return 1;
 }
 
 int vtkRainRunoffFilter::LoadState(const std::vector<unsigned char> &bytes) {
-  return gr_rain_runoff_state_load(this->Simulation, bytes.data(), bytes.size()) == GR_OK;
+  vtkTypeInt64 core = 0, rows = 0, gauges = 0;
+  size_t at = bytes.size() >= sizeof(core) ? bytes.size() - sizeof(core) : 0;
+  if (!Take(bytes, at, &core, 1) || core < 0 || static_cast<size_t>(core) > bytes.size()) {
+    return 0;
+  }
+  at = static_cast<size_t>(core);
+  if (!Take(bytes, at, &rows, 1) || !Take(bytes, at, &gauges, 1) || rows < 1 ||
+      gauges != static_cast<vtkTypeInt64>(this->GaugeCells.size() / 2) ||
+      static_cast<size_t>(rows) > bytes.size()) {
+    return 0;
+  }
+  std::vector<std::array<double, 7>> ledgers(static_cast<size_t>(rows));
+  std::vector<std::vector<float>> gaugeRows(static_cast<size_t>(rows));
+  for (size_t r = 0; r < ledgers.size(); ++r) {
+    gaugeRows[r].resize(3 * static_cast<size_t>(gauges));
+    if (!Take(bytes, at, ledgers[r].data(), 7) ||
+        !Take(bytes, at, gaugeRows[r].data(), gaugeRows[r].size())) {
+      return 0;
+    }
+  }
+  if (at != bytes.size() - sizeof(core) ||
+      gr_rain_runoff_state_load(this->Simulation, bytes.data(), static_cast<size_t>(core)) !=
+          GR_OK) {
+    return 0;
+  }
+  // The rows up to the checkpoint's time; later ones are recorded again.
+  if (this->Ledgers.size() < ledgers.size()) {
+    this->Ledgers.resize(ledgers.size());
+    this->GaugeRows.resize(ledgers.size());
+  }
+  std::copy(ledgers.begin(), ledgers.end(), this->Ledgers.begin());
+  std::copy(gaugeRows.begin(), gaugeRows.end(), this->GaugeRows.begin());
+  return 1;
 }
 
 int vtkRainRunoffFilter::FillOutput(vtkDataObject *outputObject, vtkInformation *outInfo) {
@@ -631,15 +780,25 @@ int vtkRainRunoffFilter::AddMaps(vtkDataObject *outputObject) {
   input->GetExtent(in);
   output->GetExtent(out);
   input->GetDimensions(dims);
-  const size_t n = static_cast<size_t>(dims[0]) * static_cast<size_t>(dims[1]);
-  std::vector<float> whole(n);
+  graupel::Pieces &pieces = this->GetPieces();
+  // The core's own rows (a split run's strip, or the whole grid), then the
+  // output's rows, some of them a neighbouring rank's (as FillImage does).
+  const int ownRows = pieces.IsSplit() ? pieces.GetOwnRows() : dims[1];
+  std::vector<float> own(static_cast<size_t>(dims[0]) * static_cast<size_t>(ownRows));
+  std::vector<float> rows;
   const vtkIdType w = out[1] - out[0] + 1, h = out[3] - out[2] + 1;
   for (int m = 0; m < GR_RAIN_RUNOFF_MAP_COUNT; ++m) {
     const gr_rain_runoff_map map = static_cast<gr_rain_runoff_map>(m);
-    const gr_status st = gr_rain_runoff_get_map(this->Simulation, map, whole.data());
+    const gr_status st = gr_rain_runoff_get_map(this->Simulation, map, own.data());
     if (st != GR_OK) {
       return this->ReportFailure(st, "Rain Runoff could not read its flood maps",
                                  gr_rain_runoff_last_error(this->Simulation));
+    }
+    std::string why;
+    if (!pieces.Rows(own.data(), dims[0], 1, out[2] - in[2], out[3] - in[2], rows, why)) {
+      vtkErrorMacro("Rain Runoff could not assemble its flood maps from the neighbouring ranks: "
+                    << why << ".");
+      return 0;
     }
     vtkNew<vtkFloatArray> a;
     a->SetName(gr_rain_runoff_map_name(map));
@@ -647,9 +806,9 @@ int vtkRainRunoffFilter::AddMaps(vtkDataObject *outputObject) {
     // The output is the requested piece of the whole grid (FillImage's crop).
     for (vtkIdType j = 0; j < h; ++j) {
       for (vtkIdType i = 0; i < w; ++i) {
-        const size_t src = static_cast<size_t>(out[2] - in[2] + j) * static_cast<size_t>(dims[0]) +
+        const size_t src = static_cast<size_t>(j) * static_cast<size_t>(dims[0]) +
                            static_cast<size_t>(out[0] - in[0] + i);
-        a->SetValue(j * w + i, whole[src]);
+        a->SetValue(j * w + i, rows[src]);
       }
     }
     output->GetPointData()->AddArray(a);

@@ -63,6 +63,17 @@
  * before the first and after the last row, spread evenly along the edge.
  * Both count as the ledger's inflow_volume.
  *
+ * MPI (pvbatch, pvserver): each rank simulates its strip of the grid with
+ * the core's ring (GR_RAIN_RUNOFF_GHOST rows for the local inertial model,
+ * GR_RAIN_RUNOFF_GHOST_SW for shallow water; see vtkGraupelSimulation,
+ * "Distributed runs"): every input array goes up as the strip's rows and
+ * ring, point inflows and gauges keep the whole grid's points (a gauge is
+ * read by the rank that owns its row and shared with the others), the core
+ * reduces the stable step and the ledger over the ranks, so every rank's
+ * field data and hydrograph are the whole grid's, bit for bit, and the flood
+ * maps come per piece like the fields. Field data `piece_cells` gives the
+ * grid points the rank simulated, ring included.
+ *
  * Time is handled by vtkGraupelSimulation: request a time with
  * UpdateTimeStep(t) (ParaView's animation does it). Checkpoints are the
  * core's gr_rain_runoff_state_save/load; an abort is honoured inside an

@@ -1,7 +1,8 @@
 """mpiexec -n 2 pvbatch: each rank computes its own piece of the terrain;
 together they make exactly the terrain one process computes. Rain Runoff on
-that distributed terrain: every rank simulates the whole grid and keeps its
-piece, which equals that part of a one-process run."""
+that distributed terrain: every rank reads the whole terrain and simulates
+its strip of it (test_mpi_rain_runoff.py checks the split in detail); its
+piece equals that part of a one-process run."""
 import os
 import sys
 
