@@ -332,8 +332,14 @@ __kernel void rain_runoff_limit(__global const float *restrict h,
                                  GR_RAIN_RUNOFF_PERM(c), dt);
   float qw = qx[j * (nx + 1) + i], qe = qx[j * (nx + 1) + i + 1];
   float qs = qy[j * nx + i], qn = qy[(j + 1) * nx + i];
-  float out = dt * ((fmax(-qw, 0.0f) + fmax(qe, 0.0f)) * inv_dx +
-                    (fmax(-qs, 0.0f) + fmax(qn, 0.0f)) * inv_dy);
+  /* The x and y sums written differently (-min(qw, 0) is max(-qw, 0) but
+   * for the sign of a zero, which adding a value >= +0 drops) and the y sum
+   * waiting for the x sum (+ 0 ox: ox is finite and >= 0), so that CPU
+   * compilers do not pair them into <2 x float> values, which kept PoCL
+   * from vectorising this kernel; the same floats. */
+  float ox = -fmin(qw, 0.0f) + fmax(qe, 0.0f);
+  float oy = (fmax(-qs, 0.0f) + fmax(qn, 0.0f)) + 0.0f * ox;
+  float out = dt * (ox * inv_dx + oy * inv_dy);
   limit[c] = out > wet ? wet / out * GR_RAIN_RUNOFF_KEEP : 1.0f;
 }
 
