@@ -19,7 +19,8 @@
  *   rain_runoff_limit   per cell: K = the share of its outgoing q* it can
  *                       afford without going below zero;
  *   rain_runoff_update  per cell: rain, infiltration and the four faces'
- *                       limited discharges q* K(upwind) into the new depth.
+ *                       limited discharges q* K(upwind) into the new depth,
+ *                       and the new state into the flood maps.
  * The face arrays keep q* and the cell array K: the discharge that flows is
  * q* K(upwind cell), the same float from the same two inputs in both cells
  * that share the face, so what leaves one cell arrives in the other. Rain
@@ -331,8 +332,14 @@ __kernel void rain_runoff_limit(__global const float *restrict h,
                                  GR_RAIN_RUNOFF_PERM(c), dt);
   float qw = qx[j * (nx + 1) + i], qe = qx[j * (nx + 1) + i + 1];
   float qs = qy[j * nx + i], qn = qy[(j + 1) * nx + i];
-  float out = dt * ((fmax(-qw, 0.0f) + fmax(qe, 0.0f)) * inv_dx +
-                    (fmax(-qs, 0.0f) + fmax(qn, 0.0f)) * inv_dy);
+  /* The x and y sums written differently (-min(qw, 0) is max(-qw, 0) but
+   * for the sign of a zero, which adding a value >= +0 drops) and the y sum
+   * waiting for the x sum (+ 0 ox: ox is finite and >= 0), so that CPU
+   * compilers do not pair them into <2 x float> values, which kept PoCL
+   * from vectorising this kernel; the same floats. */
+  float ox = -fmin(qw, 0.0f) + fmax(qe, 0.0f);
+  float oy = (fmax(-qs, 0.0f) + fmax(qn, 0.0f)) + 0.0f * ox;
+  float out = dt * (ox * inv_dx + oy * inv_dy);
   limit[c] = out > wet ? wet / out * GR_RAIN_RUNOFF_KEEP : 1.0f;
 }
 
@@ -355,6 +362,43 @@ GR_INLINE void gr_rain_runoff_book_edges(__global float *restrict outflow,
     gr_kahan_add(inflow, inflow_comp, c, in);
 }
 
+/* The flood maps' arguments (graupel/rain_runoff.h, "Flood maps"; see
+ * rain_runoff_maps), also taken by each model's last step kernel, which
+ * folds the state it leaves into the maps (map_time: the step's end). */
+#define GR_RAIN_RUNOFF_MAP_ARGS                                                                    \
+  __global float *restrict max_depth, __global float *restrict max_speed,                          \
+      __global float *restrict arrival, __global float *restrict wet_time,                         \
+      __global float *restrict wet_time_comp, __global float *restrict max_hazard,                 \
+      float wetting_depth, float debris_factor
+
+/* Folds cell c's depth d and discharges (u, v) (m^2/s) at `time` into the
+ * flood maps, after a step of dt (0: count no time). */
+GR_INLINE void gr_rain_runoff_map_cell(int c, float d, float u, float v, GR_RAIN_RUNOFF_MAP_ARGS,
+                                       float time, float dt) {
+  int moving = d >= GR_RAIN_RUNOFF_VELOCITY_DEPTH;
+  float ux = moving ? u / d : 0.0f, vy = moving ? v / d : 0.0f;
+  float speed = sqrt(ux * ux + vy * vy);
+  /* FD2321's debris factor applies above 0.25 m only (its table gives 0
+   * below that depth for every land use). */
+  float hazard = d * (speed + 0.5f) + (d > GR_RAIN_RUNOFF_DEBRIS_DEPTH ? debris_factor : 0.0f);
+  /* Stores only where a value changes: past the peak most cells write
+   * nothing, which keeps the launch's traffic near its reads. */
+  if (d > max_depth[c])
+    max_depth[c] = d;
+  /* The speed of water above the wetting depth only: q / h of the films a
+   * front leaves behind says nothing of the flow (hundreds of m/s). */
+  if (d > wetting_depth && speed > max_speed[c])
+    max_speed[c] = speed;
+  if (hazard > max_hazard[c])
+    max_hazard[c] = hazard;
+  if (d > wetting_depth) {
+    if (arrival[c] < 0.0f)
+      arrival[c] = time;
+    if (dt > 0.0f)
+      gr_kahan_add(wet_time, wet_time_comp, c, dt);
+  }
+}
+
 /* The new depth from rain, infiltration and the four faces' limited
  * discharges; edge cells book what left (outflow) and what came in (inflow)
  * through the domain's edges.
@@ -362,16 +406,18 @@ GR_INLINE void gr_rain_runoff_book_edges(__global float *restrict outflow,
  * float precision): its rounding would otherwise be the same in every step
  * where a pond gains the same rain, and 10^5 such steps would show in the
  * water balance. */
-__kernel void rain_runoff_update(
-    __global float *restrict h, __global float *restrict h_comp,
-    __global const float *restrict rain, __global const float *restrict perm,
-    __global const float *restrict src, int use_src, __global const float *restrict nodata,
-    int use_nodata, __global const float *restrict qx, __global const float *restrict qy,
-    __global const float *restrict limit, __global float *restrict infiltrated,
-    __global float *restrict infiltrated_comp, __global float *restrict outflow,
-    __global float *restrict outflow_comp, __global float *restrict inflow,
-    __global float *restrict inflow_comp, int nx, int ny, float dt, float inv_dx, float inv_dy,
-    int use_rain, float rain_uniform, int use_perm, float perm_uniform) {
+__kernel void
+rain_runoff_update(__global float *restrict h, __global float *restrict h_comp,
+                   __global const float *restrict rain, __global const float *restrict perm,
+                   __global const float *restrict src, int use_src,
+                   __global const float *restrict nodata, int use_nodata,
+                   __global const float *restrict qx, __global const float *restrict qy,
+                   __global const float *restrict limit, __global float *restrict infiltrated,
+                   __global float *restrict infiltrated_comp, __global float *restrict outflow,
+                   __global float *restrict outflow_comp, __global float *restrict inflow,
+                   __global float *restrict inflow_comp, int nx, int ny, float dt, float inv_dx,
+                   float inv_dy, int use_rain, float rain_uniform, int use_perm, float perm_uniform,
+                   GR_RAIN_RUNOFF_MAP_ARGS, float map_time) {
   int i = get_global_id(0), j = get_global_id(1);
   if (!gr_inside(i, j, nx, ny))
     return;
@@ -386,10 +432,12 @@ __kernel void rain_runoff_update(
    * never uses the limiter beyond the grid. */
   float kw = i > 0 ? limit[c - 1] : 1.0f, ke = i < nx - 1 ? limit[c + 1] : 1.0f;
   float ks = j > 0 ? limit[c - nx] : 1.0f, kn = j < ny - 1 ? limit[c + nx] : 1.0f;
-  float fw = gr_rain_runoff_limited(qx[j * (nx + 1) + i], kw, kc);
-  float fe = gr_rain_runoff_limited(qx[j * (nx + 1) + i + 1], kc, ke);
-  float fs = gr_rain_runoff_limited(qy[j * nx + i], ks, kc);
-  float fn = gr_rain_runoff_limited(qy[(j + 1) * nx + i], kc, kn);
+  float qw = qx[j * (nx + 1) + i], qe = qx[j * (nx + 1) + i + 1];
+  float qs = qy[j * nx + i], qn = qy[(j + 1) * nx + i];
+  float fw = gr_rain_runoff_limited(qw, kw, kc);
+  float fe = gr_rain_runoff_limited(qe, kc, ke);
+  float fs = gr_rain_runoff_limited(qs, ks, kc);
+  float fn = gr_rain_runoff_limited(qn, kc, kn);
   float delta = ((r * dt - inf) + sc * dt) + dt * ((fw - fe) * inv_dx + (fs - fn) * inv_dy);
   float y = delta - h_comp[c];
   float t = h0 + y;
@@ -397,8 +445,18 @@ __kernel void rain_runoff_update(
   /* The limiter keeps t >= 0 but for rounding; a cell that ends at or
    * below 0 is dry, with nothing owed. An outfall no-data cell drains. */
   float gone = gr_rain_runoff_drain(nodata, use_nodata, c, t, comp);
-  h[c] = t > 0.0f && gone == 0.0f ? t : 0.0f;
+  float d = t > 0.0f && gone == 0.0f ? t : 0.0f;
+  h[c] = d;
   h_comp[c] = t > 0.0f && gone == 0.0f ? comp : 0.0f;
+  /* The flood maps from the new state, with the velocity VELOCITY reads
+   * (rain_runoff_derive's: an edge face limited by its own cell's K). */
+  float mw = i > 0 ? fw : gr_rain_runoff_limited(qw, kc, kc);
+  float me = i < nx - 1 ? fe : gr_rain_runoff_limited(qe, kc, kc);
+  float ms = j > 0 ? fs : gr_rain_runoff_limited(qs, kc, kc);
+  float mn = j < ny - 1 ? fn : gr_rain_runoff_limited(qn, kc, kc);
+  gr_rain_runoff_map_cell(c, d, 0.5f * (mw + me), 0.5f * (ms + mn), max_depth, max_speed, arrival,
+                          wet_time, wet_time_comp, max_hazard, wetting_depth, debris_factor,
+                          map_time, dt);
   if (gone != 0.0f)
     gr_kahan_add(outflow, outflow_comp, c, gone);
   if (inf != 0.0f)
@@ -544,13 +602,19 @@ rain_runoff_derive(__global const float *restrict h, __global const float *restr
  * Perthame (2004), second order: minmod slopes of the depth, the surface
  * (as bed differences plus depth differences, so that large elevations
  * lose nothing to rounding), and the velocities; Heun's method (SSP-RK2)
- * in time, in two launches. Each launch is a gather: a cell computes its
- * four faces itself, and the neighbour that shares a face computes the same
- * flux from the same inputs by the same expression (FP_CONTRACT off), so
- * the mass that leaves one cell is the float that arrives in the other.
- * Every face reads two cells either side of it, so a launch reads two cells
- * away and a step (two launches) four: a piece's ring is
- * GR_RAIN_RUNOFF_GHOST_SW cells and the halo is exchanged once per step. */
+ * in time. A step is seven launches, each a gather that writes only what
+ * its own work-item owns: rain_runoff_sw_prep (stage 1's points: the depth
+ * after rain and infiltration, the velocities), then per stage
+ * rain_runoff_sw_faces* (every face once, stored: the two cells that share
+ * it read the same floats, so the mass that leaves one cell is the float
+ * that arrives in the other), rain_runoff_sw_update* (every cell from its
+ * four faces; stage 2 also folds the new state into the flood maps) and
+ * rain_runoff_sw_edges (the rim's cells book the stage's edge flows).
+ * Every face reads two cells either side of it, so a stage reads two cells
+ * away and a step four: a piece's ring is GR_RAIN_RUNOFF_GHOST_SW cells and
+ * the halo is exchanged once per step. Computing each face once instead of
+ * in both its cells, and keeping <2 x float> values out of the kernels (see
+ * gr_sw_pt, gr_sw_hll), made the step 4-6x faster on PoCL, the same floats. */
 
 /* Depth below which a cell's velocity is desingularised (Kurganov & Petrova
  * 2007): u = 2 h q / (h^2 + max(h^2, eps^2)), which is q / h above it and
@@ -567,9 +631,13 @@ GR_INLINE float gr_sw_minmod(float a, float b) {
   return a > 0.0f && b > 0.0f ? fmin(a, b) : (a < 0.0f && b < 0.0f ? fmax(a, b) : 0.0f);
 }
 
-/* A cell of a line: depth, bed, velocity along and across the line. */
+/* A cell of a line: depth, bed, velocity along and across the line. The
+ * fifth float is never read: a struct of four floats is passed and returned
+ * as two <2 x float> registers under the x86-64 ABI, and such vector values
+ * kept PoCL's vectoriser off every kernel that used one (a step 5x slower);
+ * one of five floats is passed in memory, which inlining then removes. */
 typedef struct gr_sw_pt {
-  float h, b, un, ut;
+  float h, b, un, ut, abi;
 } gr_sw_pt;
 
 /* One cell's reconstruction along an axis: its depth h, bed b, normal and
@@ -609,7 +677,11 @@ GR_INLINE void gr_sw_hll(float hL, float uL, float vL, float hR, float uR, float
   /* Every branch computed and the right one selected: CPU compilers then
    * vectorise across work-items (a dry pair's NaN is never selected). */
   bool dryL = hL <= 0.0f, dryR = hR <= 0.0f;
-  float cL = sqrt(g * hL), cR = sqrt(g * hR);
+  /* cR waits for cL (0 cL is +0: cL is finite and >= 0; g hR + 0 is g hR
+   * but for the sign of a zero, and cR is never read where hR is 0), so
+   * that CPU compilers do not pair the two square roots into a <2 x float>
+   * before vectorising across work-items, which such values prevent. */
+  float cL = sqrt(g * hL), cR = sqrt(g * hR + 0.0f * cL);
   float sL = dryL ? uR - 2.0f * cR : (dryR ? uL - cL : fmin(uL - cL, uR - cR));
   float sR = dryR ? uL + 2.0f * cL : (dryL ? uR + cR : fmax(uL + cL, uR + cR));
   float qL = hL * uL, qR = hR * uR;
@@ -633,7 +705,7 @@ GR_INLINE void gr_sw_hll(float hL, float uL, float vL, float hR, float uR, float
  * difference db = b_R - b_L of the two sides' face beds, so a flat bed
  * keeps the depths exactly), the HLL flux, and the normal momentum flux as
  * seen by L (fmL) and by R (fmR) less the hydrostatic pressure of each
- * side's own face depth, g h^2 / 2, which gr_sw_axis adds back with the bed
+ * side's own face depth, g h^2 / 2, which gr_sw_balance adds back with the bed
  * source in one product that vanishes where the surface is flat: a lake at
  * rest then balances to the bit, not to rounding. */
 GR_INLINE void gr_sw_face(gr_sw_cell L, gr_sw_cell R, float g, float *fh, float *fmL, float *fmR,
@@ -655,7 +727,7 @@ GR_INLINE void gr_sw_face(gr_sw_cell L, gr_sw_cell R, float g, float *fh, float 
  * open edge's dry, still cell, or a level edge's water up to `level` with
  * C's face velocities; at C's face bed in every case (db = 0 exactly), so
  * that gr_sw_face gives the wall's, the outfall's or the level's flux.
- * (A transmissive edge needs no ghost: gr_sw_axis continues the line.) */
+ * (A transmissive edge needs no ghost: gr_sw_continue continues the line.) */
 GR_INLINE gr_sw_cell gr_sw_ghost(gr_sw_cell C, bool low, int kind, float level) {
   float s = low ? -0.5f : 0.5f;
   bool wall = kind == GR_RAIN_RUNOFF_B_CLOSED, lv = kind == GR_RAIN_RUNOFF_B_LEVEL;
@@ -706,71 +778,105 @@ GR_INLINE gr_sw_pt gr_sw_pick_pt(bool use, gr_sw_pt a, gr_sw_pt b) {
   c.b = use ? a.b : b.b;
   c.un = use ? a.un : b.un;
   c.ut = use ? a.ut : b.ut;
+  c.abi = 0.0f;
   return c;
 }
 
-/* The flux balance of the centre cell (p2) of a 5-cell line along one
- * axis: dh (mass in minus out), dqn and dqt (momentum, with the bed's
- * source), per unit of the axis' face length; out_lo, out_hi the depth
- * flux (m^2/s) leaving through the grid's edge faces (negative: entering).
- * i, n: the cell's index and the line's length; kind_lo, kind_hi, lvl_lo,
- * lvl_hi: the kinds and levels of the line's low and high edges. A
- * transmissive edge continues the line (gr_sw_extend) two cells beyond it,
- * so its face and its edge cells are computed as inner ones; the other
- * edges' faces have a ghost (gr_sw_ghost): a wall passes no water, an open
- * edge only outflow, a level edge both ways. */
-GR_INLINE void gr_sw_axis(gr_sw_pt p0, gr_sw_pt p1, gr_sw_pt p2, gr_sw_pt p3, gr_sw_pt p4, int i,
-                          int n, int kind_lo, int kind_hi, float lvl_lo, float lvl_hi, float g,
-                          float *dh, float *dqn, float *dqt, float *out_lo, float *out_hi) {
-  bool tlo = kind_lo == GR_RAIN_RUNOFF_B_TRANSMISSIVE,
-       thi = kind_hi == GR_RAIN_RUNOFF_B_TRANSMISSIVE;
-  /* The edge cell's inner neighbour, where the edge is this cell's. */
-  gr_sw_pt in_lo = gr_sw_pick_pt(i + 1 < n, p3, p2), in_hi = gr_sw_pick_pt(i > 0, p1, p2);
+/* The cells k - 2 .. k + 1 (q0 .. q3, masked to dry, flat and still beyond
+ * the array) of a line of n cells, those beyond a transmissive edge (tlo,
+ * thi) continued (gr_sw_extend) from the edge cell away from its inner
+ * neighbour (itself on a line of one cell). Every work-item continues the
+ * line from the same two cells by the same expression, so a face near the
+ * edge is the same float whichever work-item computes it. */
+GR_INLINE void gr_sw_continue(gr_sw_pt *q0, gr_sw_pt *q1, gr_sw_pt *q2, gr_sw_pt *q3, int k, int n,
+                              bool tlo, bool thi) {
   /* A branch on the arguments alone (the same for every work-item): a grid
    * without transmissive edges pays nothing for them. */
-  if (tlo || thi) {
-    p0 = gr_sw_pick_pt(tlo && i == 0, gr_sw_extend(p2, in_lo, 2.0f),
-                       gr_sw_pick_pt(tlo && i == 1, gr_sw_extend(p1, p2, 1.0f), p0));
-    p1 = gr_sw_pick_pt(tlo && i == 0, gr_sw_extend(p2, in_lo, 1.0f), p1);
-    p4 = gr_sw_pick_pt(thi && i == n - 1, gr_sw_extend(p2, in_hi, 2.0f),
-                       gr_sw_pick_pt(thi && i == n - 2, gr_sw_extend(p3, p2, 1.0f), p4));
-    p3 = gr_sw_pick_pt(thi && i == n - 1, gr_sw_extend(p2, in_hi, 1.0f), p3);
-  }
-  bool lo = i > 0 || tlo, hi = i < n - 1 || thi;
-  gr_sw_cell C = gr_sw_recon(p1, p2, p3, lo && hi);
-  gr_sw_cell W = gr_sw_recon(p0, p1, p2, i > 1 || tlo);
-  gr_sw_cell E = gr_sw_recon(p2, p3, p4, i < n - 2 || thi);
-  gr_sw_cell gw = gr_sw_ghost(C, true, kind_lo, lvl_lo);
-  gr_sw_cell ge = gr_sw_ghost(C, false, kind_hi, lvl_hi);
-  W = gr_sw_pick(lo, W, gw);
-  E = gr_sw_pick(hi, E, ge);
-  float fhw, fmw, ftw, fhe, fme, fte, unused;
-  gr_sw_face(W, C, g, &fhw, &unused, &fmw, &ftw);
-  gr_sw_face(C, E, g, &fhe, &fme, &unused, &fte);
+  if (!(tlo || thi))
+    return;
+  gr_sw_pt a0 = gr_sw_pick_pt(k == 0, *q2, *q1), a1 = gr_sw_pick_pt(k == 0, *q3, *q2);
+  gr_sw_pt in_lo = gr_sw_pick_pt(n > 1, a1, a0); /* cell 0 and its inner neighbour */
+  gr_sw_pt z0 = gr_sw_pick_pt(k == n, *q1, *q2), z1 = gr_sw_pick_pt(k == n, *q0, *q1);
+  gr_sw_pt in_hi = gr_sw_pick_pt(n > 1, z1, z0); /* cell n - 1 and its inner neighbour */
+  *q0 = gr_sw_pick_pt(tlo && k == 0, gr_sw_extend(a0, in_lo, 2.0f),
+                      gr_sw_pick_pt(tlo && k == 1, gr_sw_extend(a0, in_lo, 1.0f), *q0));
+  *q1 = gr_sw_pick_pt(tlo && k == 0, gr_sw_extend(a0, in_lo, 1.0f), *q1);
+  *q3 = gr_sw_pick_pt(thi && k == n, gr_sw_extend(z0, in_hi, 2.0f),
+                      gr_sw_pick_pt(thi && k == n - 1, gr_sw_extend(z0, in_hi, 1.0f), *q3));
+  *q2 = gr_sw_pick_pt(thi && k == n, gr_sw_extend(z0, in_hi, 1.0f), *q2);
+}
+
+/* Face k of a line of n cells (between cells k - 1 and k; 0 and n are the
+ * grid's edge faces), from the cells k - 2 .. k + 1: the depth flux fh,
+ * the normal momentum flux as seen by the low cell (fmL) and by the high
+ * cell (fmR) (gr_sw_face), and the tangential flux ft, written to out[f]
+ * and the three planes after it (plane floats apart). kind_lo, kind_hi, lvl_lo, lvl_hi: the kinds
+ * and levels of the line's low and high edges. A transmissive edge continues the line
+ * (gr_sw_continue), so its face is computed as an inner one; the other
+ * edges' faces have a ghost (gr_sw_ghost): a wall passes no water, an open
+ * edge only outflow, a level edge both ways. Each face is computed once per
+ * stage and read by the two cells that share it (rain_runoff_sw_update*). */
+GR_INLINE void gr_sw_line_face(gr_sw_pt q0, gr_sw_pt q1, gr_sw_pt q2, gr_sw_pt q3, int k, int n,
+                               int kind_lo, int kind_hi, float lvl_lo, float lvl_hi, float g,
+                               __global float *restrict out, int f, int plane) {
+  bool tlo = kind_lo == GR_RAIN_RUNOFF_B_TRANSMISSIVE,
+       thi = kind_hi == GR_RAIN_RUNOFF_B_TRANSMISSIVE;
+  gr_sw_continue(&q0, &q1, &q2, &q3, k, n, tlo, thi);
+  /* Each side's slopes where that cell has (or continues to) both
+   * neighbours. */
+  gr_sw_cell L = gr_sw_recon(q0, q1, q2, (k > 1 || tlo) && (k < n || thi));
+  gr_sw_cell R = gr_sw_recon(q1, q2, q3, (k > 0 || tlo) && (k < n - 1 || thi));
+  gr_sw_cell gl = gr_sw_ghost(R, true, kind_lo, lvl_lo);
+  gr_sw_cell gh = gr_sw_ghost(L, false, kind_hi, lvl_hi);
+  L = gr_sw_pick(k == 0 && !tlo, gl, L);
+  R = gr_sw_pick(k == n && !thi, gh, R);
+  float fh, fmL, fmR, ft;
+  gr_sw_face(L, R, g, &fh, &fmL, &fmR, &ft);
   /* At the edges: nothing through a wall, nothing in through an open or a
    * transmissive edge (a still wall then: no momentum either; see
    * gr_rain_runoff_edge_q for why). */
   bool wall_lo = kind_lo == GR_RAIN_RUNOFF_B_CLOSED, wall_hi = kind_hi == GR_RAIN_RUNOFF_B_CLOSED;
   bool only_out_lo = kind_lo == GR_RAIN_RUNOFF_B_OPEN || tlo;
   bool only_out_hi = kind_hi == GR_RAIN_RUNOFF_B_OPEN || thi;
-  bool stop_w = i == 0 && (wall_lo || (only_out_lo && fhw > 0.0f));
-  bool stop_e = i == n - 1 && (wall_hi || (only_out_hi && fhe < 0.0f));
-  fmw = stop_w && !wall_lo ? 0.0f : fmw;
-  fme = stop_e && !wall_hi ? 0.0f : fme;
-  fhw = stop_w ? 0.0f : fhw;
-  fhe = stop_e ? 0.0f : fhe;
-  ftw = stop_w ? 0.0f : ftw;
-  fte = stop_e ? 0.0f : fte;
-  *out_lo = i > 0 ? 0.0f : -fhw;
-  *out_hi = i < n - 1 ? 0.0f : fhe;
-  float hw = C.h - 0.5f * C.sh, he = C.h + 0.5f * C.sh;
-  *dh = fhw - fhe;
-  /* (fmw + g hw^2 / 2) - (fme + g he^2 / 2) - g (hw + he) / 2 (bed slope)
-   * = fmw - fme - g (hw + he) / 2 (surface slope). */
-  *dqn = (fmw - fme) - 0.5f * g * (hw + he) * C.se;
-  *dqt = ftw - fte;
+  bool stop_lo = k == 0 && (wall_lo || (only_out_lo && fh > 0.0f));
+  bool stop_hi = k == n && (wall_hi || (only_out_hi && fh < 0.0f));
+  fmR = stop_lo && !wall_lo ? 0.0f : fmR;
+  fmL = stop_hi && !wall_hi ? 0.0f : fmL;
+  bool stop = stop_lo || stop_hi;
+  fh = stop ? 0.0f : fh;
+  ft = stop ? 0.0f : ft;
+  out[f] = fh;
+  out[f + plane] = fmL;
+  out[f + 2 * plane] = fmR;
+  out[f + 3 * plane] = ft;
 }
 
+/* The flux balance of cell i (p2, between p1 and p3) of a line of n cells
+ * along one axis, from its low face lo and high face hi in f (planes of
+ * gr_sw_line_face, plane floats apart):
+ * dh (mass in minus out), dqn and dqt (momentum, with the bed's source),
+ * per unit of the axis' face length. */
+GR_INLINE void gr_sw_balance(gr_sw_pt p1, gr_sw_pt p2, gr_sw_pt p3,
+                             __global const float *restrict f, int lo, int hi, int plane, int i,
+                             int n, int kind_lo, int kind_hi, float g, float *dh, float *dqn,
+                             float *dqt) {
+  bool tlo = kind_lo == GR_RAIN_RUNOFF_B_TRANSMISSIVE,
+       thi = kind_hi == GR_RAIN_RUNOFF_B_TRANSMISSIVE;
+  if (tlo || thi) {
+    /* The edge cell's inner neighbour, where the edge is this cell's. */
+    gr_sw_pt in_lo = gr_sw_pick_pt(i + 1 < n, p3, p2), in_hi = gr_sw_pick_pt(i > 0, p1, p2);
+    p1 = gr_sw_pick_pt(tlo && i == 0, gr_sw_extend(p2, in_lo, 1.0f), p1);
+    p3 = gr_sw_pick_pt(thi && i == n - 1, gr_sw_extend(p2, in_hi, 1.0f), p3);
+  }
+  gr_sw_cell C = gr_sw_recon(p1, p2, p3, (i > 0 || tlo) && (i < n - 1 || thi));
+  float fh_lo = f[lo], fh_hi = f[hi];
+  float hw = C.h - 0.5f * C.sh, he = C.h + 0.5f * C.sh;
+  *dh = fh_lo - fh_hi;
+  /* (fmw + g hw^2 / 2) - (fme + g he^2 / 2) - g (hw + he) / 2 (bed slope)
+   * = fmw - fme - g (hw + he) / 2 (surface slope). */
+  *dqn = (f[lo + 2 * plane] - f[hi + plane]) - 0.5f * g * (hw + he) * C.se;
+  *dqt = f[lo + 3 * plane] - f[hi + 3 * plane];
+}
 /* Manning friction on the discharge (qx, qy) of water h deep over dt,
  * implicit in the new discharge: |q'| (1 + g dt n^2 |q'| / h^(7/3)) = |q|,
  * in q's direction (solved exactly, as the local inertial model does). */
@@ -791,48 +897,119 @@ GR_INLINE float gr_sw_wet_q(float h, float q, float r, float s, float dt, float 
   return h1 > 0.0f ? q * (hw / h1) : 0.0f;
 }
 
-/* One cell of a stage's cross (in: inside the local array; q its index):
- * its depth (after rain and infiltration in stage 1), bed, and velocities
- * along (sn) and across (st) the line; 0 where it is outside. */
-GR_INLINE gr_sw_pt gr_sw_load(__global const float *restrict sh, __global const float *restrict sn,
-                              __global const float *restrict st, __global const float *restrict b,
-                              __global const float *restrict rain,
-                              __global const float *restrict perm,
-                              __global const float *restrict src, int use_src,
-                              __global const float *restrict nodata, int use_nodata, bool in, int q,
-                              int stage, float dt, int use_rain, float rain_uniform, int use_perm,
-                              float perm_uniform) {
-  float hh = in ? sh[q] : 0.0f, pn = in ? sn[q] : 0.0f, pt = in ? st[q] : 0.0f;
-  if (stage == 1) {
-    float r = in ? GR_RAIN_RUNOFF_RAIN(q) : 0.0f;
-    float k = in ? GR_RAIN_RUNOFF_PERM(q) : 0.0f;
-    float sq = in ? GR_RAIN_RUNOFF_SRC(q) : 0.0f;
-    float hw = gr_rain_runoff_wet(hh, r, sq, k, dt);
-    pn = gr_sw_wet_q(hh, pn, r, sq, dt, hw);
-    pt = gr_sw_wet_q(hh, pt, r, sq, dt, hw);
-    hh = hw;
-  }
+/* The arguments every shallow-water step kernel takes (each uses those it
+ * needs): the state (h, qu, qv, h_comp), Heun's stage (h1, qu1, qv1, dh1),
+ * the points the faces read (stage 1: wh, wu, wv, the depth after rain and
+ * infiltration and the velocities; stage 2: h1, u1, v1), the faces (fx:
+ * (nx+1) x ny x-faces, row stride nx+1; fy: nx x (ny+1) y-faces, numbered
+ * like cells with one more row; four planes each, fh, fmL, fmR and ft of
+ * gr_sw_line_face: separate planes, not float4s, which CPU compilers do
+ * not vectorise across work-items), the inputs and the ledger's per-cell sums. */
+#define GR_SW_STEP_ARGS                                                                            \
+  __global float *restrict h, __global float *restrict qu, __global float *restrict qv,            \
+      __global float *restrict h_comp, __global float *restrict h1, __global float *restrict qu1,  \
+      __global float *restrict qv1, __global float *restrict dh1, __global float *restrict wh,     \
+      __global float *restrict wu, __global float *restrict wv, __global float *restrict u1,       \
+      __global float *restrict v1, __global float *restrict fx, __global float *restrict fy,       \
+      __global const float *restrict b, __global const float *restrict rain,                       \
+      __global const float *restrict perm, __global const float *restrict src, int use_src,        \
+      __global const float *restrict nodata, int use_nodata, __global float *restrict infiltrated, \
+      __global float *restrict infiltrated_comp, __global float *restrict outflow,                 \
+      __global float *restrict outflow_comp, __global float *restrict inflow,                      \
+      __global float *restrict inflow_comp, int nx, int ny, float dt, float inv_dx, float inv_dy,  \
+      float g, float n2, __global const float *restrict n2map, int use_n2, int use_rain,           \
+      float rain_uniform, int use_perm, float perm_uniform, int bnd_w, int bnd_e, int bnd_s,       \
+      int bnd_n, float lvl_w, float lvl_e, float lvl_s, float lvl_n, GR_RAIN_RUNOFF_MAP_ARGS,      \
+      float map_time
+
+/* Stage 1's points, once per cell: the depth after rain and infiltration
+ * (as the local inertial model takes them) and the velocities of the
+ * momentum scaled with the water infiltration removed. */
+__kernel void rain_runoff_sw_prep(GR_SW_STEP_ARGS) {
+  int i = get_global_id(0), j = get_global_id(1);
+  if (!gr_inside(i, j, nx, ny))
+    return;
+  int c = gr_idx(i, j, nx);
+  float h0 = h[c], r = GR_RAIN_RUNOFF_RAIN(c), k = GR_RAIN_RUNOFF_PERM(c);
+  float sc = GR_RAIN_RUNOFF_SRC(c);
+  float hw = gr_rain_runoff_wet(h0, r, sc, k, dt);
+  wh[c] = hw;
+  wu[c] = gr_sw_velocity(hw, gr_sw_wet_q(h0, qu[c], r, sc, dt, hw));
+  wv[c] = gr_sw_velocity(hw, gr_sw_wet_q(h0, qv[c], r, sc, dt, hw));
+}
+
+/* One point of a line (in: inside the local array; q its index): depth,
+ * bed, velocities along (pn) and across (pt) the line; 0 where outside. */
+GR_INLINE gr_sw_pt gr_sw_point(__global const float *restrict ph, __global const float *restrict pn,
+                               __global const float *restrict pt, __global const float *restrict b,
+                               bool in, int q) {
   gr_sw_pt p;
-  p.h = hh;
+  p.h = in ? ph[q] : 0.0f;
   p.b = in ? b[q] : 0.0f;
-  p.un = gr_sw_velocity(hh, pn);
-  p.ut = gr_sw_velocity(hh, pt);
+  p.un = in ? pn[q] : 0.0f;
+  p.ut = in ? pt[q] : 0.0f;
+  p.abi = 0.0f;
   return p;
 }
 
+/* Every face of a stage, once: work-item (i, j) of an (nx+1) x (ny+1)
+ * launch owns the x-face left of cell (i, j) (for j < ny) and the y-face
+ * below it (for i < nx), from the points (ph, pu, pv) two cells either
+ * side. Indices stay linear and loads beyond the array masked, so that CPU
+ * compilers vectorise the loads. */
+GR_INLINE void gr_sw_faces(__global const float *restrict ph, __global const float *restrict pu,
+                           __global const float *restrict pv, __global const float *restrict b,
+                           __global float *restrict fx, __global float *restrict fy, int nx, int ny,
+                           float g, int bnd_w, int bnd_e, int bnd_s, int bnd_n, float lvl_w,
+                           float lvl_e, float lvl_s, float lvl_n) {
+  int i = get_global_id(0), j = get_global_id(1);
+  if (!gr_inside(i, j, nx + 1, ny + 1))
+    return;
+  int c = j * nx + i;
+  if (j < ny) {
+    gr_sw_pt q0 = gr_sw_point(ph, pu, pv, b, i >= 2, c - 2);
+    gr_sw_pt q1 = gr_sw_point(ph, pu, pv, b, i >= 1, c - 1);
+    gr_sw_pt q2 = gr_sw_point(ph, pu, pv, b, i < nx, c);
+    gr_sw_pt q3 = gr_sw_point(ph, pu, pv, b, i + 1 < nx, c + 1);
+    gr_sw_line_face(q0, q1, q2, q3, i, nx, bnd_w, bnd_e, lvl_w, lvl_e, g, fx, j * (nx + 1) + i,
+                    (nx + 1) * ny);
+  }
+  if (i < nx) {
+    gr_sw_pt q0 = gr_sw_point(ph, pv, pu, b, j >= 2, c - 2 * nx);
+    gr_sw_pt q1 = gr_sw_point(ph, pv, pu, b, j >= 1, c - nx);
+    gr_sw_pt q2 = gr_sw_point(ph, pv, pu, b, j < ny, c);
+    gr_sw_pt q3 = gr_sw_point(ph, pv, pu, b, j + 1 < ny, c + nx);
+    gr_sw_line_face(q0, q1, q2, q3, j, ny, bnd_s, bnd_n, lvl_s, lvl_n, g, fy, c, nx * (ny + 1));
+  }
+}
+
+__kernel void rain_runoff_sw_faces1(GR_SW_STEP_ARGS) {
+  gr_sw_faces(wh, wu, wv, b, fx, fy, nx, ny, g, bnd_w, bnd_e, bnd_s, bnd_n, lvl_w, lvl_e, lvl_s,
+              lvl_n);
+}
+
+__kernel void rain_runoff_sw_faces2(GR_SW_STEP_ARGS) {
+  gr_sw_faces(h1, u1, v1, b, fx, fy, nx, ny, g, bnd_w, bnd_e, bnd_s, bnd_n, lvl_w, lvl_e, lvl_s,
+              lvl_n);
+}
+
 /* One stage of Heun's method for every cell (one work-item per cell of the
- * local array, which reads and writes that cell's values only), Manning friction implicit in each
- * stage (gr_sw_friction) on its forward-Euler discharge:
+ * local array, which reads and writes that cell's values only) from its
+ * four faces, Manning friction implicit in each stage (gr_sw_friction) on
+ * its forward-Euler discharge:
  *   stage 1: U1 = Uw + dt L(Uw), Uw the state after rain and infiltration,
- *            from h, qu, qv (computed for every cell it reads);
+ *            from h, qu, qv (and the points wh, wu, wv); also the
+ *            velocities u1, v1 of U1, stage 2's points;
  *   stage 2: U = (Uw + U1 + dt L(U1)) / 2, from h1, qu1, qv1, written over
  *            h, qu, qv (each cell reads its own old values only), with the
  *            infiltration and half of each stage's edge outflow booked in
  *            Kahan sums. */
-GR_INLINE void gr_sw_stage(
+GR_INLINE void gr_sw_update(
     __global float *restrict h, __global float *restrict qu, __global float *restrict qv,
     __global float *restrict h_comp, __global float *restrict h1, __global float *restrict qu1,
-    __global float *restrict qv1, __global float *restrict dh1, __global const float *restrict b,
+    __global float *restrict qv1, __global float *restrict dh1, __global float *restrict u1,
+    __global float *restrict v1, __global const float *restrict fx,
+    __global const float *restrict fy, __global const float *restrict b,
     __global const float *restrict rain, __global const float *restrict perm,
     __global const float *restrict src, int use_src, __global const float *restrict nodata,
     int use_nodata, __global float *restrict infiltrated, __global float *restrict infiltrated_comp,
@@ -840,37 +1017,27 @@ GR_INLINE void gr_sw_stage(
     __global float *restrict inflow, __global float *restrict inflow_comp, int nx, int ny, float dt,
     float inv_dx, float inv_dy, float g, float n2, __global const float *restrict n2map, int use_n2,
     int use_rain, float rain_uniform, int use_perm, float perm_uniform, int bnd_w, int bnd_e,
-    int bnd_s, int bnd_n, float lvl_w, float lvl_e, float lvl_s, float lvl_n,
-    __global const float *restrict sh, __global const float *restrict su,
+    int bnd_s, int bnd_n, GR_RAIN_RUNOFF_MAP_ARGS, float map_time,
+    __global const float *restrict ph, __global const float *restrict pu,
+    __global const float *restrict pv, __global const float *restrict su,
     __global const float *restrict sv, const int stage) {
   int i = get_global_id(0), j = get_global_id(1);
   if (!gr_inside(i, j, nx, ny))
     return;
   int c = gr_idx(i, j, nx);
   float n2c = use_n2 ? n2map[c] : n2; /* the cell's own roughness, n^2 */
-  /* The cross of 5 + 5 cells around (i, j); x2 and y2 are the cell itself.
-   * Cells beyond the array are masked to dry, flat and still, and never
-   * used (the reconstruction's slopes and the edge faces do without them);
-   * indices stay linear so that CPU compilers vectorise the loads. */
-#define GR_SW_LOAD(o, in, q, sn, st)                                                               \
-  gr_sw_load(sh, sn, st, b, rain, perm, src, use_src, nodata, use_nodata, (in), (q), stage, dt,    \
-             use_rain, rain_uniform, use_perm, perm_uniform)
-  gr_sw_pt x0 = GR_SW_LOAD(-2, i >= 2, c - 2, su, sv);
-  gr_sw_pt x1 = GR_SW_LOAD(-1, i >= 1, c - 1, su, sv);
-  gr_sw_pt x2 = GR_SW_LOAD(0, true, c, su, sv);
-  gr_sw_pt x3 = GR_SW_LOAD(1, i + 1 < nx, c + 1, su, sv);
-  gr_sw_pt x4 = GR_SW_LOAD(2, i + 2 < nx, c + 2, su, sv);
-  gr_sw_pt y0 = GR_SW_LOAD(-2, j >= 2, c - 2 * nx, sv, su);
-  gr_sw_pt y1 = GR_SW_LOAD(-1, j >= 1, c - nx, sv, su);
-  gr_sw_pt y3 = GR_SW_LOAD(1, j + 1 < ny, c + nx, sv, su);
-  gr_sw_pt y4 = GR_SW_LOAD(2, j + 2 < ny, c + 2 * nx, sv, su);
-#undef GR_SW_LOAD
-  gr_sw_pt y2 = {x2.h, x2.b, x2.ut, x2.un};
-  float dhx, dqx_x, dqy_x, olx, ohx, dhy, dqy_y, dqx_y, oly, ohy;
-  gr_sw_axis(x0, x1, x2, x3, x4, i, nx, bnd_w, bnd_e, lvl_w, lvl_e, g, &dhx, &dqx_x, &dqy_x, &olx,
-             &ohx);
-  gr_sw_axis(y0, y1, y2, y3, y4, j, ny, bnd_s, bnd_n, lvl_s, lvl_n, g, &dhy, &dqy_y, &dqx_y, &oly,
-             &ohy);
+  gr_sw_pt x1 = gr_sw_point(ph, pu, pv, b, i >= 1, c - 1);
+  gr_sw_pt x2 = gr_sw_point(ph, pu, pv, b, true, c);
+  gr_sw_pt x3 = gr_sw_point(ph, pu, pv, b, i + 1 < nx, c + 1);
+  gr_sw_pt y1 = gr_sw_point(ph, pv, pu, b, j >= 1, c - nx);
+  gr_sw_pt y3 = gr_sw_point(ph, pv, pu, b, j + 1 < ny, c + nx);
+  gr_sw_pt y2 = {x2.h, x2.b, x2.ut, x2.un, 0.0f};
+  float dhx, dqx_x, dqy_x, dhy, dqy_y, dqx_y;
+  int f = j * (nx + 1) + i;
+  gr_sw_balance(x1, x2, x3, fx, f, f + 1, (nx + 1) * ny, i, nx, bnd_w, bnd_e, g, &dhx, &dqx_x,
+                &dqy_x);
+  gr_sw_balance(y1, y2, y3, fy, c, c + nx, nx * (ny + 1), j, ny, bnd_s, bnd_n, g, &dhy, &dqy_y,
+                &dqx_y);
   float dh = dt * (dhx * inv_dx + dhy * inv_dy);
   float hn = x2.h + dh;
   float qun = su[c] + dt * (dqx_x * inv_dx + dqx_y * inv_dy);
@@ -886,10 +1053,13 @@ GR_INLINE void gr_sw_stage(
      * gather g S dt of speed in the first stage and empty its cell in the
      * second. */
     gr_sw_friction(hn, dt, g, n2c, &qun, &qvn);
-    h1[c] = fmax(hn, 0.0f);
+    float hs = fmax(hn, 0.0f), qus = hn > 0.0f ? qun : 0.0f, qvs = hn > 0.0f ? qvn : 0.0f;
+    h1[c] = hs;
     dh1[c] = dh;
-    qu1[c] = hn > 0.0f ? qun : 0.0f;
-    qv1[c] = hn > 0.0f ? qvn : 0.0f;
+    qu1[c] = qus;
+    qv1[c] = qvs;
+    u1[c] = gr_sw_velocity(hs, qus);
+    v1[c] = gr_sw_velocity(hs, qvs);
   } else {
     float h0 = h[c];
     float r = GR_RAIN_RUNOFF_RAIN(c);
@@ -910,10 +1080,14 @@ GR_INLINE void gr_sw_stage(
     /* An outfall no-data cell drains (its water is outflow). */
     float gone = gr_rain_runoff_drain(nodata, use_nodata, c, hf, comp);
     bool keep = hf > 0.0f && gone == 0.0f;
-    h[c] = gone == 0.0f ? fmax(hf, 0.0f) : 0.0f;
+    float d = gone == 0.0f ? fmax(hf, 0.0f) : 0.0f, u = keep ? qx : 0.0f, v = keep ? qy : 0.0f;
+    h[c] = d;
     h_comp[c] = keep ? comp : 0.0f;
-    qu[c] = keep ? qx : 0.0f;
-    qv[c] = keep ? qy : 0.0f;
+    qu[c] = u;
+    qv[c] = v;
+    /* The flood maps from the new state. */
+    gr_rain_runoff_map_cell(c, d, u, v, max_depth, max_speed, arrival, wet_time, wet_time_comp,
+                            max_hazard, wetting_depth, debris_factor, map_time, dt);
     if (gone != 0.0f)
       gr_kahan_add(outflow, outflow_comp, c, gone);
     if (inf != 0.0f)
@@ -922,41 +1096,54 @@ GR_INLINE void gr_sw_stage(
     if (sc != 0.0f)
       gr_kahan_add(inflow, inflow_comp, c, sc * dt);
   }
-  /* Half of each stage's edge flows (Heun's average). */
+  /* Half of each stage's edge flows (Heun's average) are booked by
+   * rain_runoff_sw_edges after this launch: here, their sums paired into
+   * <2 x float> values kept CPU compilers from vectorising the update. */
+}
+
+/* The two stages' updates as two kernels, each reading one state and
+ * writing another that the compiler can tell apart (a pointer chosen at
+ * run time between them kept PoCL from vectorising across work-items). */
+#define GR_SW_UPDATE_PASS                                                                          \
+  h, qu, qv, h_comp, h1, qu1, qv1, dh1, u1, v1, fx, fy, b, rain, perm, src, use_src, nodata,       \
+      use_nodata, infiltrated, infiltrated_comp, outflow, outflow_comp, inflow, inflow_comp, nx,   \
+      ny, dt, inv_dx, inv_dy, g, n2, n2map, use_n2, use_rain, rain_uniform, use_perm,              \
+      perm_uniform, bnd_w, bnd_e, bnd_s, bnd_n, max_depth, max_speed, arrival, wet_time,           \
+      wet_time_comp, max_hazard, wetting_depth, debris_factor, map_time
+
+__kernel void rain_runoff_sw_update1(GR_SW_STEP_ARGS) {
+  gr_sw_update(GR_SW_UPDATE_PASS, wh, wu, wv, qu, qv, 1);
+}
+
+__kernel void rain_runoff_sw_update2(GR_SW_STEP_ARGS) {
+  gr_sw_update(GR_SW_UPDATE_PASS, h1, u1, v1, qu1, qv1, 2);
+}
+
+/* Half of a stage's flows through the domain's edges (Heun's average),
+ * booked after the stage's update (rain_runoff_sw_update*, which books
+ * the rest of a cell's ledger first): one work-item per cell on the grid's
+ * rim (the rows j = 0 and ny - 1, then the columns i = 0 and nx - 1 in
+ * between), each from its edge faces, all four sides at once. */
+__kernel void rain_runoff_sw_edges(GR_SW_STEP_ARGS) {
+  int k = get_global_id(0);
+  int cols = nx > 1 ? 2 : 1, rows = ny > 1 ? 2 : 1;
+  if (k >= rows * nx + (ny - rows) * cols)
+    return;
+  int i, j;
+  if (k < rows * nx) {
+    i = k % nx;
+    j = k < nx ? 0 : ny - 1;
+  } else {
+    int t = k - rows * nx;
+    j = 1 + t / cols;
+    i = t % cols == 0 ? 0 : nx - 1;
+  }
+  int c = gr_idx(i, j, nx), f = j * (nx + 1) + i;
+  float olx = i > 0 ? 0.0f : -fx[f], ohx = i < nx - 1 ? 0.0f : fx[f + 1];
+  float oly = j > 0 ? 0.0f : -fy[c], ohy = j < ny - 1 ? 0.0f : fy[c + nx];
   gr_rain_runoff_book_edges(outflow, outflow_comp, inflow, inflow_comp, c, 0.5f * dt, inv_dx,
                             inv_dy, olx, ohx, oly, ohy);
 }
-
-/* The two stages as two kernels, each reading one state and writing
- * another that the compiler can tell apart (a pointer chosen at run time
- * between them kept PoCL from vectorising across work-items). */
-#define GR_SW_STAGE_ARGS                                                                           \
-  __global float *restrict h, __global float *restrict qu, __global float *restrict qv,            \
-      __global float *restrict h_comp, __global float *restrict h1, __global float *restrict qu1,  \
-      __global float *restrict qv1, __global float *restrict dh1,                                  \
-      __global const float *restrict b, __global const float *restrict rain,                       \
-      __global const float *restrict perm, __global const float *restrict src, int use_src,        \
-      __global const float *restrict nodata, int use_nodata, __global float *restrict infiltrated, \
-      __global float *restrict infiltrated_comp, __global float *restrict outflow,                 \
-      __global float *restrict outflow_comp, __global float *restrict inflow,                      \
-      __global float *restrict inflow_comp, int nx, int ny, float dt, float inv_dx, float inv_dy,  \
-      float g, float n2, __global const float *restrict n2map, int use_n2, int use_rain,           \
-      float rain_uniform, int use_perm, float perm_uniform, int bnd_w, int bnd_e, int bnd_s,       \
-      int bnd_n, float lvl_w, float lvl_e, float lvl_s, float lvl_n
-#define GR_SW_STAGE_PASS                                                                           \
-  h, qu, qv, h_comp, h1, qu1, qv1, dh1, b, rain, perm, src, use_src, nodata, use_nodata,           \
-      infiltrated, infiltrated_comp, outflow, outflow_comp, inflow, inflow_comp, nx, ny, dt,       \
-      inv_dx, inv_dy, g, n2, n2map, use_n2, use_rain, rain_uniform, use_perm, perm_uniform, bnd_w, \
-      bnd_e, bnd_s, bnd_n, lvl_w, lvl_e, lvl_s, lvl_n
-
-__kernel void rain_runoff_sw_stage1(GR_SW_STAGE_ARGS) {
-  gr_sw_stage(GR_SW_STAGE_PASS, h, qu, qv, 1);
-}
-
-__kernel void rain_runoff_sw_stage2(GR_SW_STAGE_ARGS) {
-  gr_sw_stage(GR_SW_STAGE_PASS, h1, qu1, qv1, 2);
-}
-
 /* The stable step's inputs, per work-group: the deepest cell and the
  * fastest rate (|u| + sqrt(g h)) / dx + (|v| + sqrt(g h)) / dy of the owned
  * cells (a cell's own sum: what its update needs, and the same maximum
@@ -988,8 +1175,10 @@ rain_runoff_sw_speed(__global const float *restrict h, __global const float *res
 
 /* ------------------------------------------------------- flood maps
  *
- * The cumulative maps (graupel/rain_runoff.h, "Flood maps"), updated after
- * every step from the state the step left, per cell and in place: each
+ * The cumulative maps (graupel/rain_runoff.h, "Flood maps"), updated from
+ * the state a step left by the step's last kernel (rain_runoff_update,
+ * rain_runoff_sw_update2: gr_rain_runoff_map_cell) and by this kernel when
+ * no step did (a reset, a new initial depth), per cell and in place: each
  * work-item (i, j) reads and writes its own cell only, so the launch needs
  * no atomics and gives the same floats whatever the work-group size. The
  * velocity is the one VELOCITY reads (rain_runoff_derive's): the cell's own
@@ -1001,13 +1190,8 @@ rain_runoff_sw_speed(__global const float *restrict h, __global const float *res
 __kernel void rain_runoff_maps(__global const float *restrict h, __global const float *restrict qu,
                                __global const float *restrict qv, __global const float *restrict qx,
                                __global const float *restrict qy,
-                               __global const float *restrict limit,
-                               __global float *restrict max_depth,
-                               __global float *restrict max_speed, __global float *restrict arrival,
-                               __global float *restrict wet_time,
-                               __global float *restrict wet_time_comp,
-                               __global float *restrict max_hazard, int nx, int ny, int sw,
-                               float wetting_depth, float debris_factor, float time, float dt) {
+                               __global const float *restrict limit, GR_RAIN_RUNOFF_MAP_ARGS,
+                               int nx, int ny, int sw, float time, float dt) {
   int i = get_global_id(0), j = get_global_id(1);
   if (!gr_inside(i, j, nx, ny))
     return;
@@ -1028,26 +1212,6 @@ __kernel void rain_runoff_maps(__global const float *restrict h, __global const 
     u = 0.5f * (fw + fe);
     v = 0.5f * (fs + fn);
   }
-  int moving = d >= GR_RAIN_RUNOFF_VELOCITY_DEPTH;
-  float ux = moving ? u / d : 0.0f, vy = moving ? v / d : 0.0f;
-  float speed = sqrt(ux * ux + vy * vy);
-  /* FD2321's debris factor applies above 0.25 m only (its table gives 0
-   * below that depth for every land use). */
-  float hazard = d * (speed + 0.5f) + (d > GR_RAIN_RUNOFF_DEBRIS_DEPTH ? debris_factor : 0.0f);
-  /* Stores only where a value changes: past the peak most cells write
-   * nothing, which keeps the launch's traffic near its reads. */
-  if (d > max_depth[c])
-    max_depth[c] = d;
-  /* The speed of water above the wetting depth only: q / h of the films a
-   * front leaves behind says nothing of the flow (hundreds of m/s). */
-  if (d > wetting_depth && speed > max_speed[c])
-    max_speed[c] = speed;
-  if (hazard > max_hazard[c])
-    max_hazard[c] = hazard;
-  if (d > wetting_depth) {
-    if (arrival[c] < 0.0f)
-      arrival[c] = time;
-    if (dt > 0.0f)
-      gr_kahan_add(wet_time, wet_time_comp, c, dt);
-  }
+  gr_rain_runoff_map_cell(c, d, u, v, max_depth, max_speed, arrival, wet_time, wet_time_comp,
+                          max_hazard, wetting_depth, debris_factor, time, dt);
 }

@@ -102,7 +102,10 @@ struct gr_rain_runoff {
   int nxl, nyl;
   int ring[4]; /* gr_rain_runoff_side order: west, east, south, north */
   gr_rain_runoff_params params;
-  cl_kernel flux, flux_edges, limit, update, reduce, derive, sw_stage[2], sw_speed, maps, source;
+  cl_kernel flux, flux_edges, limit, update, reduce, derive, sw_speed, maps, source;
+  /* Shallow water's step: the points of stage 1, then per stage the faces
+   * and the cells' update. */
+  cl_kernel sw_prep, sw_faces[2], sw_update[2], sw_edges;
   cl_mem h, h_c, b, k, inf, inf_c, out, out_c;
   cl_mem in, in_c; /* inflow (edges and sources), per cell (m), and its compensation */
   /* Sources (m/s of depth): the point inflows' field (pts, once set) and
@@ -131,8 +134,12 @@ struct gr_rain_runoff {
   int hy_n;
   double *hy_t, *hy_r;
   cl_mem qu, qv, h1, qu1, qv1, dh1; /* shallow water: discharges and Heun's stage */
-  cl_mem qu0, qv0;                  /* initial discharges, once VELOCITY was set */
-  cl_mem qx[2], qy[2];              /* discharges; [cur] is the latest, the other the next */
+  /* Shallow water within a step: stage 1's points (the depth after rain and
+   * infiltration, velocities), stage 2's velocities, and the faces' fluxes
+   * (4 floats per face). */
+  cl_mem wh, wu, wv, u1, v1, fx, fy;
+  cl_mem qu0, qv0;     /* initial discharges, once VELOCITY was set */
+  cl_mem qx[2], qy[2]; /* discharges; [cur] is the latest, the other the next */
   /* The flood maps, in gr_rain_runoff_map order but for the class (read
    * from the rating) and with the wet duration's Kahan compensation last. */
   cl_mem map[GR_RAIN_RUNOFF_MAP_ARRAYS];
@@ -641,15 +648,16 @@ gr_status gr_rain_runoff_create(gr_context *ctx, const gr_grid *grid,
                         "address at most about 2.1e9 faces; split the domain or coarsen it.",
                         nx, ny);
   /* The state that is always there: depth, elevation, limiter, infiltrated
-   * outflow and inflow with their compensations, the shallow-water discharges
-   * and stage (16 per cell), the flood maps (6) and two sets of face arrays. Refuse before
+   * outflow and inflow with their compensations, the shallow-water discharges,
+   * stage and points (21 per cell), the flood maps (6), two sets of face arrays
+   * and the shallow-water faces (4 floats each). Refuse before
    * allocating when the device cannot hold it. */
   gr_device_info info;
   gr_status st = gr_context_device_info(ctx, &info);
   if (st != GR_OK)
     return st;
-  double need = 4.0 * ((16.0 + GR_RAIN_RUNOFF_MAP_ARRAYS) * (double)cells +
-                       2.0 * ((double)(nx + 1) * ny + (double)nx * (ny + 1)));
+  double need = 4.0 * ((21.0 + GR_RAIN_RUNOFF_MAP_ARRAYS) * (double)cells +
+                       6.0 * ((double)(nx + 1) * ny + (double)nx * (ny + 1)));
   if (need > (double)info.global_mem_bytes)
     return gr_set_error(ctx, GR_ERR_TOO_LARGE,
                         "The rain runoff state of a %zu x %zu grid needs %.1f MiB but the device "
@@ -682,9 +690,17 @@ gr_status gr_rain_runoff_create(gr_context *ctx, const gr_grid *grid,
   if (st == GR_OK)
     st = gr_kernel_create(ctx, prog, "rain_runoff_derive", &s->derive);
   if (st == GR_OK)
-    st = gr_kernel_create(ctx, prog, "rain_runoff_sw_stage1", &s->sw_stage[0]);
+    st = gr_kernel_create(ctx, prog, "rain_runoff_sw_prep", &s->sw_prep);
   if (st == GR_OK)
-    st = gr_kernel_create(ctx, prog, "rain_runoff_sw_stage2", &s->sw_stage[1]);
+    st = gr_kernel_create(ctx, prog, "rain_runoff_sw_faces1", &s->sw_faces[0]);
+  if (st == GR_OK)
+    st = gr_kernel_create(ctx, prog, "rain_runoff_sw_faces2", &s->sw_faces[1]);
+  if (st == GR_OK)
+    st = gr_kernel_create(ctx, prog, "rain_runoff_sw_update1", &s->sw_update[0]);
+  if (st == GR_OK)
+    st = gr_kernel_create(ctx, prog, "rain_runoff_sw_update2", &s->sw_update[1]);
+  if (st == GR_OK)
+    st = gr_kernel_create(ctx, prog, "rain_runoff_sw_edges", &s->sw_edges);
   if (st == GR_OK)
     st = gr_kernel_create(ctx, prog, "rain_runoff_sw_speed", &s->sw_speed);
   if (st == GR_OK)
@@ -693,8 +709,9 @@ gr_status gr_rain_runoff_create(gr_context *ctx, const gr_grid *grid,
     st = gr_kernel_create(ctx, prog, "rain_runoff_source", &s->source);
   for (int a = 0; st == GR_OK && a < GR_RAIN_RUNOFF_MAP_ARRAYS; ++a)
     st = gr_buffer_create(ctx, CL_MEM_READ_WRITE, bytes, NULL, &s->map[a]);
-  cl_mem *per_cell[] = {&s->h,  &s->h_c,  &s->b,  &s->k,  &s->inf, &s->inf_c, &s->out, &s->out_c,
-                        &s->in, &s->in_c, &s->qu, &s->qv, &s->h1,  &s->qu1,   &s->qv1, &s->dh1};
+  cl_mem *per_cell[] = {&s->h,     &s->h_c, &s->b,    &s->k,  &s->inf, &s->inf_c, &s->out,
+                        &s->out_c, &s->in,  &s->in_c, &s->qu, &s->qv,  &s->h1,    &s->qu1,
+                        &s->qv1,   &s->dh1, &s->wh,   &s->wu, &s->wv,  &s->u1,    &s->v1};
   for (size_t i = 0; st == GR_OK && i < sizeof(per_cell) / sizeof(per_cell[0]); ++i)
     st = gr_buffer_create(ctx, CL_MEM_READ_WRITE, bytes, NULL, per_cell[i]);
   for (int a = 0; a < 2 && st == GR_OK; ++a) {
@@ -704,6 +721,12 @@ gr_status gr_rain_runoff_create(gr_context *ctx, const gr_grid *grid,
       st = gr_buffer_create(ctx, CL_MEM_READ_WRITE, nx * (ny + 1) * sizeof(cl_float), NULL,
                             &s->qy[a]);
   }
+  if (st == GR_OK)
+    st = gr_buffer_create(ctx, CL_MEM_READ_WRITE, (nx + 1) * ny * 4 * sizeof(cl_float), NULL,
+                          &s->fx);
+  if (st == GR_OK)
+    st = gr_buffer_create(ctx, CL_MEM_READ_WRITE, nx * (ny + 1) * 4 * sizeof(cl_float), NULL,
+                          &s->fy);
   if (st == GR_OK)
     st = gr_buffer_create(ctx, CL_MEM_READ_ONLY, sizeof(cl_float), NULL, &s->dummy);
   if (st == GR_OK)
@@ -734,17 +757,19 @@ gr_status gr_rain_runoff_create(gr_context *ctx, const gr_grid *grid,
 void gr_rain_runoff_destroy(gr_rain_runoff *s) {
   if (!s)
     return;
-  cl_kernel kernels[] = {s->flux,   s->limit,       s->update,      s->reduce,
-                         s->derive, s->sw_stage[0], s->sw_stage[1], s->sw_speed,
-                         s->maps,   s->source,      s->flux_edges};
+  cl_kernel kernels[] = {s->flux,         s->limit,        s->update,      s->reduce,
+                         s->derive,       s->sw_prep,      s->sw_faces[0], s->sw_faces[1],
+                         s->sw_update[0], s->sw_update[1], s->sw_speed,    s->maps,
+                         s->source,       s->flux_edges,   s->sw_edges};
   for (size_t i = 0; i < sizeof(kernels) / sizeof(kernels[0]); ++i)
     if (kernels[i])
       clReleaseKernel(kernels[i]);
-  cl_mem *bufs[] = {&s->h,    &s->h_c,     &s->b,     &s->qx[0], &s->qy[0], &s->qx[1], &s->qy[1],
-                    &s->k,    &s->inf,     &s->inf_c, &s->out,   &s->out_c, &s->h0,    &s->rain,
-                    &s->perm, &s->scratch, &s->dummy, &s->qu,    &s->qv,    &s->h1,    &s->qu1,
-                    &s->qv1,  &s->qu0,     &s->qv0,   &s->dh1,   &s->in,    &s->in_c,  &s->pts,
-                    &s->src,  &s->n2map,   &s->nodata};
+  cl_mem *bufs[] = {&s->h,    &s->h_c,     &s->b,      &s->qx[0], &s->qy[0], &s->qx[1], &s->qy[1],
+                    &s->k,    &s->inf,     &s->inf_c,  &s->out,   &s->out_c, &s->h0,    &s->rain,
+                    &s->perm, &s->scratch, &s->dummy,  &s->qu,    &s->qv,    &s->h1,    &s->qu1,
+                    &s->qv1,  &s->qu0,     &s->qv0,    &s->dh1,   &s->in,    &s->in_c,  &s->pts,
+                    &s->src,  &s->n2map,   &s->nodata, &s->wh,    &s->wu,    &s->wv,    &s->u1,
+                    &s->v1,   &s->fx,      &s->fy};
   for (size_t i = 0; i < sizeof(bufs) / sizeof(bufs[0]); ++i)
     gr_buffer_release(bufs[i]);
   for (int a = 0; a < GR_RAIN_RUNOFF_MAP_ARRAYS; ++a)
@@ -1641,9 +1666,9 @@ static gr_status gr_rain_runoff_hyetograph_step(gr_rain_runoff *s, double t0, do
       (cl_float)(gr_rain_runoff_table_integral(s->hy_t, s->hy_r, s->hy_n, t0, t1) / (t1 - t0));
   int sw = s->params.flow_model == GR_FLOW_SHALLOW_WATER;
   cl_kernel li[4] = {s->flux, s->flux_edges, s->limit, s->update};
-  cl_kernel swk[2] = {s->sw_stage[0], s->sw_stage[1]};
+  cl_kernel swk[5] = {s->sw_prep, s->sw_faces[0], s->sw_update[0], s->sw_faces[1], s->sw_update[1]};
   gr_status st = GR_OK;
-  for (int k = 0; st == GR_OK && k < (sw ? 2 : 4); ++k)
+  for (int k = 0; st == GR_OK && k < (sw ? 5 : 4); ++k)
     st = gr_kernel_arg(s->ctx, sw ? swk[k] : li[k], "rain_uniform", sizeof(rf), &rf);
   if (st == GR_OK)
     *sum += (double)rf;
@@ -1694,7 +1719,17 @@ static gr_status gr_rain_runoff_bind(gr_rain_runoff *s, cl_float dt) {
   cl_int use_nodata = s->has_nodata;
   cl_mem nodata = use_nodata ? s->nodata : s->dummy;
   cl_float theta = (cl_float)GR_RAIN_RUNOFF_THETA;
+  cl_float wd = (cl_float)p->wetting_depth, df = (cl_float)p->debris_factor, t0 = 0.0f;
   const size_t m = sizeof(cl_mem);
+  /* The flood maps, which the last kernel of a step folds its state into
+   * (map_time is set before every launch). */
+  const gr_rain_runoff_arg maps[] = {
+      {"max_depth", m, &s->map[0]},       {"max_speed", m, &s->map[1]},
+      {"arrival", m, &s->map[2]},         {"wet_time", m, &s->map[3]},
+      {"max_hazard", m, &s->map[4]},      {"wet_time_comp", m, &s->map[5]},
+      {"wetting_depth", sizeof(wd), &wd}, {"debris_factor", sizeof(df), &df},
+      {"map_time", sizeof(t0), &t0},
+  };
   /* Arguments the three step kernels share (each takes those it has). */
   const gr_rain_runoff_arg common[] = {
       {"h", m, &s->h},
@@ -1743,6 +1778,13 @@ static gr_status gr_rain_runoff_bind(gr_rain_runoff *s, cl_float dt) {
         {"qu", m, &s->qu},
         {"qv", m, &s->qv},
         {"h1", m, &s->h1},
+        {"wh", m, &s->wh},
+        {"wu", m, &s->wu},
+        {"wv", m, &s->wv},
+        {"u1", m, &s->u1},
+        {"v1", m, &s->v1},
+        {"fx", m, &s->fx},
+        {"fy", m, &s->fy},
         {"h_comp", m, &s->h_c},
         {"dh1", m, &s->dh1},
         {"qu1", m, &s->qu1},
@@ -1782,9 +1824,13 @@ static gr_status gr_rain_runoff_bind(gr_rain_runoff *s, cl_float dt) {
         {"lvl_s", sizeof(cl_float), &lvl[2]},
         {"lvl_n", sizeof(cl_float), &lvl[3]},
     };
-    gr_status st = GR_RAIN_RUNOFF_ARGS(s, s->sw_stage[0], sw);
-    if (st == GR_OK)
-      st = GR_RAIN_RUNOFF_ARGS(s, s->sw_stage[1], sw);
+    cl_kernel swk[6] = {s->sw_prep,     s->sw_faces[0],  s->sw_update[0],
+                        s->sw_faces[1], s->sw_update[1], s->sw_edges};
+    gr_status st = GR_OK;
+    for (int k = 0; st == GR_OK && k < 6; ++k)
+      st = GR_RAIN_RUNOFF_ARGS(s, swk[k], sw);
+    for (int k = 0; st == GR_OK && k < 6; ++k)
+      st = GR_RAIN_RUNOFF_ARGS(s, swk[k], maps);
     s->args_set = st == GR_OK;
     s->args_dt = dt;
     return st;
@@ -1803,6 +1849,8 @@ static gr_status gr_rain_runoff_bind(gr_rain_runoff *s, cl_float dt) {
     st = GR_RAIN_RUNOFF_ARGS(s, s->flux_edges, edges);
   if (st == GR_OK)
     st = GR_RAIN_RUNOFF_ARGS(s, s->update, update);
+  if (st == GR_OK)
+    st = GR_RAIN_RUNOFF_ARGS(s, s->update, maps);
   s->args_set = st == GR_OK;
   s->args_dt = dt;
   return st;
@@ -1833,11 +1881,24 @@ static gr_status gr_rain_runoff_enqueue(gr_rain_runoff *s, double dt, int nsteps
       st = gr_rain_runoff_sources_update(s, t_end, t_end + dt);
     if (st == GR_OK && s->hy_n)
       st = gr_rain_runoff_hyetograph_step(s, t_end, t_end + dt, &rate_sum);
-    /* Heun's two stages. */
-    for (int stage = 0; st == GR_OK && stage < 2; ++stage)
-      st = gr_enqueue_2d(s->ctx, s->sw_stage[stage], 0, 0, (size_t)s->nxl, (size_t)s->nyl, NULL);
+    /* Stage 1's points, then Heun's two stages: every face once, then every
+     * cell from its four faces. */
     if (st == GR_OK)
-      st = gr_rain_runoff_maps_update(s, t_end += dt, (double)dtf);
+      st = gr_enqueue_2d(s->ctx, s->sw_prep, 0, 0, (size_t)s->nxl, (size_t)s->nyl, NULL);
+    /* Stage 2's update folds the new state into the flood maps at the
+     * step's end. */
+    cl_float map_time = (cl_float)(t_end += dt);
+    if (st == GR_OK)
+      st = gr_kernel_arg(s->ctx, s->sw_update[1], "map_time", sizeof(map_time), &map_time);
+    for (int stage = 0; st == GR_OK && stage < 2; ++stage) {
+      st = gr_enqueue_2d(s->ctx, s->sw_faces[stage], 0, 0, (size_t)s->nxl + 1, (size_t)s->nyl + 1,
+                         NULL);
+      if (st == GR_OK)
+        st = gr_enqueue_2d(s->ctx, s->sw_update[stage], 0, 0, (size_t)s->nxl, (size_t)s->nyl, NULL);
+      /* The rim's cells book the stage's edge flows (after their update). */
+      if (st == GR_OK)
+        st = gr_enqueue_1d(s->ctx, s->sw_edges, 2 * ((size_t)s->nxl + (size_t)s->nyl));
+    }
     if (st == GR_OK)
       ++done;
     if (st == GR_OK && exchange)
@@ -1866,6 +1927,10 @@ static gr_status gr_rain_runoff_enqueue(gr_rain_runoff *s, double dt, int nsteps
       st = GR_RAIN_RUNOFF_ARGS(s, s->limit, faces);
     if (st == GR_OK)
       st = GR_RAIN_RUNOFF_ARGS(s, s->update, faces);
+    /* The update folds the new state into the flood maps at the step's end. */
+    cl_float map_time = (cl_float)(t_end += dt);
+    if (st == GR_OK)
+      st = gr_kernel_arg(s->ctx, s->update, "map_time", sizeof(map_time), &map_time);
     if (st == GR_OK)
       st = gr_enqueue_2d(s->ctx, s->flux, 0, 0, (size_t)s->nxl + 1, (size_t)s->nyl + 1, NULL);
     /* The edges that are not open, after the flux kernel wrote them so. */
@@ -1877,8 +1942,6 @@ static gr_status gr_rain_runoff_enqueue(gr_rain_runoff *s, double dt, int nsteps
       st = gr_enqueue_2d(s->ctx, s->limit, 0, 0, (size_t)s->nxl, (size_t)s->nyl, NULL);
     if (st == GR_OK)
       st = gr_enqueue_2d(s->ctx, s->update, 0, 0, (size_t)s->nxl, (size_t)s->nyl, NULL);
-    if (st == GR_OK)
-      st = gr_rain_runoff_maps_update(s, t_end += dt, (double)dtf);
     if (st == GR_OK)
       ++done;
     if (st == GR_OK && exchange)

@@ -102,8 +102,8 @@
  * Velocities are desingularised below 1e-5 m of depth (Kurganov & Petrova
  * 2007). Edges: a wall mirrors the edge cell; an open edge leads into a dry
  * cell at the edge's bed and passes outflow only. The ledger, determinism
- * (gathers: each cell computes its four faces itself, and the cell that
- * shares a face computes the same floats from the same inputs), the
+ * (gathers: each face is computed once per stage and read by the two cells
+ * that share it), the
  * checkpoints and the pieces work as for the local inertial model; the
  * stable step is cfl / 2 / max((|u| + sqrt(g h)) / dx + (|v| + sqrt(g h))
  * / dy) over the cells (one reduction, as the local inertial model's), and
@@ -409,12 +409,10 @@ GR_API gr_status gr_rain_runoff_ledger_get(gr_rain_runoff *s, gr_rain_runoff_led
  *    0 low (HR < 0.75, "caution"), 1 moderate (0.75 <= HR < 1.25, "danger
  *    for some"), 2 significant (1.25 <= HR <= 2.0, "danger for most"), 3
  *    extreme (HR > 2.0, "danger for all"); see gr_rain_runoff_hazard_class.
- * The maps cost one more launch per step that reads the depth and the
- * discharges (the local inertial model: its faces and limiters, as
- * VELOCITY does) and writes only the cells whose values change: on PoCL
- * at 512^2 (graupel-bench) 2.9 instead of 2.0 ms per local inertial step
- * and 35.4 instead of 34.5 ms per shallow-water step; folding it into the
- * steps' last launch would save most of that.
+ * Each step's last launch folds the state it leaves into the maps (the
+ * velocity as VELOCITY reads it) and writes only the cells whose values
+ * change: no launch of its own, no second read of the depth and the
+ * discharges.
  * @{
  */
 typedef enum gr_rain_runoff_map {
