@@ -70,11 +70,14 @@
 
 /* The talus' tail runs in one work-group (snow_relax_group) once the
  * window it computes (the givers' window grown by two) holds at most this
- * many points. Measured on the bench sphere at 1024^2: on the H200 (a group
- * of 1024) the talus took 0.78-0.93 ms a step with 32768, 1.09-1.31 ms
- * without the tail, 1.39 ms with 65536; on PoCL here (a group of 256 on one
- * core) 16-17 ms with 32768 or 131072, 24 ms without. */
-#define GR_SNOW_GROUP_AREA 32768
+ * many points: on GPUs, where the group is one multiprocessor's, and on
+ * CPUs, where it is one core's. Measured on the bench sphere at 1024^2, a
+ * group of 256: on the H200 the talus took 0.79-0.84 ms a step with 8192,
+ * 1.09-1.51 ms with 4096 or without the tail, 1.39 ms with 16384 or 32768;
+ * on PoCL here 16-17 ms with 32768 or 131072, 22 ms with 8192, 24 ms
+ * without. */
+#define GR_SNOW_GROUP_AREA_GPU 8192
+#define GR_SNOW_GROUP_AREA_CPU 32768
 
 /* The 8 neighbours' offsets, in the order the talus adds them up:
  * row by row from (-1, -1), the point itself left out. */

@@ -87,6 +87,7 @@ struct gr_snow_deformation {
   int blocked;     /* the talus in blocked launches (GPUs) or one launch per iteration */
   int group;       /* the talus' tail in one work-group (snow_relax_group) */
   size_t group_size;
+  int group_area;      /* the largest window the tail's group computes */
   cl_mem group_result; /* snow_relax_group's iterations, end and window */
   cl_mem tri;          /* world triangles, 9 floats each */
   size_t tri_cap;
@@ -635,6 +636,7 @@ static gr_status gr_snow_block_shape(gr_snow_deformation *s) {
   size_t g = (type & CL_DEVICE_TYPE_GPU) ? 1024 : 256;
   s->group_size = g < wg ? g : wg;
   s->group = s->group_size >= 32;
+  s->group_area = (type & CL_DEVICE_TYPE_GPU) ? GR_SNOW_GROUP_AREA_GPU : GR_SNOW_GROUP_AREA_CPU;
   return GR_OK;
 }
 
@@ -1542,7 +1544,7 @@ static gr_status gr_snow_relax_blocked(gr_snow_deformation *s, cl_int gx0, cl_in
 static gr_status gr_snow_relax_group(gr_snow_deformation *s, int *x0, int *y0, int *x1, int *y1,
                                      cl_int cap, cl_int align, float tol, int *ran, int *done) {
   cl_int nx = s->grid.nx, ny = s->grid.ny, nxt = 1 - s->cur;
-  cl_int max_area = GR_SNOW_GROUP_AREA;
+  cl_int max_area = s->group_area;
   cl_int w[4] = {*x0, *y0, *x1, *y1}, first = *ran, left = cap - first;
   float thr[3];
   gr_snow_thresholds(s, thr);
@@ -1677,7 +1679,7 @@ static gr_status gr_snow_relax(gr_snow_deformation *s) {
     int gx = (x1 + 2 < nx - 1 ? x1 + 2 : nx - 1) - (x0 - 2 > 0 ? x0 - 2 : 0) + 1,
         gy = (y1 + 2 < ny - 1 ? y1 + 2 : ny - 1) - (y0 - 2 > 0 ? y0 - 2 : 0) + 1;
     int tail = s->group && !gr_snow_has_ring(s) && it_launched < cap &&
-               (double)gx * gy <= GR_SNOW_GROUP_AREA;
+               (double)gx * gy <= (double)s->group_area;
     if (tail && read == started) {
       x0 = x0 > 0 ? x0 : 0;
       y0 = y0 > 0 ? y0 : 0;
