@@ -185,11 +185,14 @@ elif a.scene == "winter":
     parts = W.build(cells=128, spacing=1528.0 / 127, flakes=6000)
     view, n = W.show(parts, size=(400, 300), scratch=a.scratch, title=False)
     print("winter scene:", n)
-    # What the picture claims: mostly snow, rock on the steep parts, the low
-    # sun's shadows on part of it, every flake and bolt point drawn.
+    # What the picture claims: mostly snow (Snow Accumulation's, its ledger
+    # closed), bare rock where the wind did not reach, the low sun's shadows
+    # on part of it, every flake and bolt point drawn.
     T.check(n["snow_fraction"] > 0.4 and 0.02 < n["rock_fraction"] < 0.4,
-            "snow on %.0f%% of the terrain, rock on %.0f%%"
+            "snow over 20 cm on %.0f%% of the terrain, under 4 cm on %.0f%%"
             % (100 * n["snow_fraction"], 100 * n["rock_fraction"]))
+    T.check(abs(n["acc_balance"]) < 1e-3, "the snowfall's ledger closes (%.3g m^3)"
+            % n["acc_balance"])
     T.check(0.05 < n["shadow_fraction"] < 0.9,
             "%.0f%% of the terrain in cast shadow" % (100 * n["shadow_fraction"]))
     T.check(n["flakes"] == 6000, "6000 flakes (%d)" % n["flakes"])
