@@ -5,6 +5,8 @@ plugin's colour maps (the defaults of elevation, water_depth, snow_depth,
 ..., see Plugin/GraupelColorMaps.json), with a legend in units and the
 vertical exaggeration written on the picture, seen from the south-east.
 Used by the demo, the state files and the reference-image tests."""
+import math
+
 import paraview.simple as pvs
 from paraview.simple import (GetActiveViewOrCreate, GetColorTransferFunction, GetScalarBar,
                              Render, Show, Text)
@@ -56,7 +58,7 @@ def show_surface(source, size=(1024, 768), exaggeration=2.0, color="", height=""
         lut = GetColorTransferFunction(array)
         display.SetScalarBarVisibility(view, bar)
         if bar:
-            _legend(GetScalarBar(lut, view), array)
+            _legend(GetScalarBar(lut, view), array, lut)
     if note:
         text = Show(Text(Text="vertical exaggeration \u00d7%g" % exaggeration), view)
         text.WindowLocation = "Upper Right Corner"
@@ -67,7 +69,7 @@ def show_surface(source, size=(1024, 768), exaggeration=2.0, color="", height=""
     return view, display, surface
 
 
-def _legend(sb, array):
+def _legend(sb, array, lut=None):
     sb.Title = TITLES.get(array, array)
     sb.ComponentTitle = ""
     sb.TitleColor = sb.LabelColor = [1.0, 1.0, 1.0]
@@ -81,6 +83,22 @@ def _legend(sb, array):
         sb.RangeLabelFormat = sb.LabelFormat = fmt
     else:
         sb.Position = [0.30, 0.10]
+    if lut is not None and lut.UseLogScale:
+        # On a log scale the automatic ticks crowd each decade's end: label
+        # the ends, then whole decades, then 2s and 5s, each at least 0.45
+        # of a decade from every label taken.
+        lo, hi = lut.RGBPoints[0], lut.RGBPoints[-4]
+        taken = [math.log10(lo), math.log10(hi)]
+        labels = []
+        for m in (1.0, 2.0, 5.0):
+            for e in range(-6, 7):
+                t = m * 10.0 ** e
+                if lo < t < hi and all(abs(math.log10(t) - x) >= 0.45 for x in taken):
+                    labels.append(t)
+                    taken.append(math.log10(t))
+        sb.UseCustomLabels = 1
+        sb.CustomLabels = sorted(labels)
+        sb.AddRangeLabels = 1
 
 
 def _camera(view, surface):
@@ -113,5 +131,6 @@ def show_water(source, time, size=(1024, 768), exaggeration=2.0, deep=2.0, bar=T
     lut = GetColorTransferFunction("water_depth_display")
     lut.ApplyPreset("Graupel Water Depth", False)
     lut.RescaleTransferFunction(0.01, deep)
+    lut.UseLogScale = 1  # the preset's scale; applying it by name leaves it linear
     return show_surface(source, size, exaggeration, color="water_depth", time=time, bar=bar,
                         note=note)[0]
