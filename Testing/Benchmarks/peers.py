@@ -13,23 +13,26 @@ the depth recorded every 30 min.
   run (UpdateTimeStep(end): the steps, the ledger at each output time and the
   output's read-back) and the steps taken. Once with PoCL's kernel cache
   emptied (the first run on a machine) and then warm.
-- GRASS GIS r.sim.water (Debian's grass-core) in a temporary XY location with
+- GRASS GIS r.sim.water (Debian's grass-core) in a temporary UTM 16N location with
   the DEM's rows, columns and resolutions; dx and dy from r.slope.aspect
   (timed apart), rain_value 50, infil_value 0, man_value 0.03, niterations
   180, output_step 30 with -t, a fixed random_seed, nprocs = the cores.
 - Landlab's OverlandFlow (de Almeida et al. 2012, the scheme of FlowModel 1)
   on a RasterModelGrid with the DEM's own spacings (xy_spacing=(74.5, 92.1):
-  Landlab's raster grid allows rectangular cells; its step uses dx, the
-  shorter), steep_slopes on, its own adaptive step.
+  Landlab's raster grid allows rectangular cells; its step uses the shorter;
+  --square takes the mean spacing instead), steep_slopes on, its own adaptive
+  step through run_one_step(output interval).
 
-Agreement: Pearson's r of the final depth fields against Graupel's
-shallow-water run (on the common grid, all points, and the points wet in
-either), and the stored and outflow volumes (outflow = rain - stored where a
-peer keeps no ledger).
+Agreement: Pearson's r of the final depth fields against each Graupel run
+(on the common grid: all points, and the points wet in either), and the
+stored and outflow volumes (outflow = rain - stored where a peer keeps no
+ledger). Times: each run's wall clock and the CPU seconds of its process and
+all it waited for (on a shared machine they move less with the load).
 
-    python3 Testing/Benchmarks/peers.py --install            # as root: grass-core, landlab
-    python3 Testing/Benchmarks/peers.py --build build-vtk    # the `vtk` preset's tree
-    python3 Testing/Benchmarks/peers.py --build /tmp/b --out /tmp/peers  # + the depth fields
+    python3 Testing/Benchmarks/peers.py --install --build build-vtk  # as root
+    python3 Testing/Benchmarks/peers.py --build build-vtk            # the `vtk` preset's tree
+    python3 Testing/Benchmarks/peers.py --build build-vtk --out /tmp/peers  # + depth fields
+    python3 Testing/Benchmarks/peers.py --build build-vtk --profile  # where Graupel's time goes
 
 `--only graupel,grass,landlab` picks runs; `--hours`, `--rain`, `--manning`,
 `--max-time-step` change the scenario (MaxTimeStep is Graupel's; 1 s is its
@@ -71,9 +74,11 @@ def install(venv):
     py = os.path.join(venv, "bin", "python3")
     if not os.path.exists(py):
         subprocess.check_call([sys.executable, "-m", "venv", venv])
-    # landlab 2.10 on needs requireit, written for Python 3.12 (PEP 695).
-    spec = "landlab" if sys.version_info >= (3, 12) else "landlab<2.10"
-    subprocess.check_call([py, "-m", "pip", "install", "-q", spec])
+    # landlab 2.10 on needs requireit, written for Python 3.12 (PEP 695). 2.9
+    # calls np.intersect1d on the links every step, which numpy 2.3's hashed
+    # unique makes 10 times slower (0.9 of 1.1 s a step here): numpy 2.2.
+    spec = ["landlab"] if sys.version_info >= (3, 12) else ["landlab<2.10", "numpy<2.3"]
+    subprocess.check_call([py, "-m", "pip", "install", "-q"] + spec)
 
 
 # ---------------------------------------------------------------- workers
@@ -311,7 +316,7 @@ def main():
                     "(default: BUILD/deps/root, as graupel.sh lays them)")
     ap.add_argument("--python", default="/usr/bin/python3",
                     help="interpreter for Graupel (python3 with the vtk build, pvpython)")
-    ap.add_argument("--venv", help="venv holding landlab (default: BUILD/../peers-venv)")
+    ap.add_argument("--venv", help="venv holding landlab (default: BUILD/peers-venv)")
     ap.add_argument("--only", default="graupel,grass,landlab")
     ap.add_argument("--models", default="0,1", help="Graupel FlowModels to run")
     ap.add_argument("--hours", type=float, default=3.0)
@@ -348,11 +353,10 @@ def main():
          "grass": worker_grass}[a.worker](a)
         return
 
-    venv = a.venv or (os.path.join(os.path.dirname(os.path.abspath(a.build)), "peers-venv")
-                      if a.build else None)
+    venv = a.venv or (os.path.join(os.path.abspath(a.build), "peers-venv") if a.build else None)
     if a.install:
         if not venv:
-            sys.exit("--install needs --venv or --build (the venv goes beside the build)")
+            sys.exit("--install needs --venv or --build (the venv goes into the build tree)")
         install(venv)
         if not a.build:
             return
@@ -511,15 +515,16 @@ def profile(a, deps):
 
 
 def report(rows, a):
-    ref = next((r for l, r, _ in rows if l == "Graupel shallow water"), None)
-    if ref is None:
-        ref = next((r for l, r, _ in rows if l.startswith("Graupel") and "cold" not in l), None)
+    refs = [(name, next((r for l, r, _ in rows if l == "Graupel " + name), None))
+            for name in ("shallow water", "local inertial")]
+    refs = [(name, r) for name, r in refs if r is not None]
     load_avg = os.getloadavg()
     print("\n%g h of %g mm/h on %s, Manning n %g, open edges; load average %.1f %.1f %.1f on %d "
           "cores" % (a.hours, a.rain, os.path.basename(DEM), a.manning, *load_avg,
                      os.cpu_count()))
     hdr = ("| run | process s | process CPU s | solver s | set-up s | steps | stored m³ | "
-           "outflow m³ | r (all) | r (wet) |")
+           "outflow m³ | " + "".join("r vs %s (all; wet > 1 cm) | " % n for n, _ in refs))
+    hdr = hdr.rstrip()
     print(hdr)
     print("|" + "---|" * (hdr.count("|") - 1))
     solver = {}
@@ -528,11 +533,11 @@ def report(rows, a):
         # program build, upload) and run; GRASS's r.sim.water; Landlab's loop.
         s = r["t_run"] + r.get("t_setup", 0.0)
         solver[label] = (s, wall, cpu)
-        rr = corr(ref["depth"], r["depth"]) if ref is not None else (float("nan"),) * 2
-        print("| %s | %.2f | %.2f | %.2f | %s | %s | %.4g | %.4g | %.4f | %.4f |"
+        rs = "".join(" %.4f; %.4f |" % corr(ref["depth"], r["depth"]) for _, ref in refs)
+        print("| %s | %.2f | %.2f | %.2f | %s | %s | %.4g | %.4g |%s"
               % (label, wall, cpu, s, "%.2f" % r["t_setup"] if "t_setup" in r else
                  "%.2f (dx, dy)" % r["t_prep"] if "t_prep" in r else "—",
-                 r.get("steps", "—"), r["stored_volume"], r["outflow_volume"], rr[0], rr[1]))
+                 r.get("steps", "—"), r["stored_volume"], r["outflow_volume"], rs))
     peers = [(l, v) for l, v in solver.items() if not l.startswith("Graupel")]
     gr = [(l, v) for l, v in solver.items() if l.startswith("Graupel") and "cold" not in l]
     if peers and gr:
