@@ -1130,6 +1130,29 @@ static const char *const gr_rain_runoff_side_names[4] = {"west", "east", "south"
 
 /* (Re)allocates the source field the steps read, and fills it for the
  * sources now when no hydrograph rewrites it before every step. */
+/* Keeps a copy of a validated table of n rows (times t, values v) in
+ * *keep_t, *keep_v, freeing the one before; n = 0 keeps none. */
+static gr_status gr_rain_runoff_table_keep(gr_rain_runoff *s, const double *t, const double *v,
+                                           int n, double **keep_t, double **keep_v) {
+  double *nt = NULL, *nv = NULL;
+  if (n > 0) {
+    nt = malloc((size_t)n * sizeof(double));
+    nv = malloc((size_t)n * sizeof(double));
+    if (!nt || !nv) {
+      free(nt);
+      free(nv);
+      return gr_set_error(s->ctx, GR_ERR_OUT_OF_MEMORY, "Out of host memory.");
+    }
+    memcpy(nt, t, (size_t)n * sizeof(double));
+    memcpy(nv, v, (size_t)n * sizeof(double));
+  }
+  free(*keep_t);
+  free(*keep_v);
+  *keep_t = nt;
+  *keep_v = nv;
+  return GR_OK;
+}
+
 static gr_status gr_rain_runoff_sources_changed(gr_rain_runoff *s) {
   size_t bytes = gr_rain_runoff_cells(s) * sizeof(cl_float);
   gr_status st = GR_OK;
@@ -1237,22 +1260,9 @@ static gr_status gr_rain_runoff_set_edge_inflow_impl(gr_rain_runoff *s, int side
                           "discharges must lie between 0 and %g m^3/s; correct that row.",
                           name, q[k], k, GR_RAIN_RUNOFF_MAX_DISCHARGE);
   }
-  double *nt = NULL, *nq = NULL;
-  if (n > 0) {
-    nt = malloc((size_t)n * sizeof(double));
-    nq = malloc((size_t)n * sizeof(double));
-    if (!nt || !nq) {
-      free(nt);
-      free(nq);
-      return gr_set_error(s->ctx, GR_ERR_OUT_OF_MEMORY, "Out of host memory.");
-    }
-    memcpy(nt, t, (size_t)n * sizeof(double));
-    memcpy(nq, q, (size_t)n * sizeof(double));
-  }
-  free(s->edge_t[side]);
-  free(s->edge_q[side]);
-  s->edge_t[side] = nt;
-  s->edge_q[side] = nq;
+  gr_status st = gr_rain_runoff_table_keep(s, t, q, n, &s->edge_t[side], &s->edge_q[side]);
+  if (st != GR_OK)
+    return st;
   s->edge_n[side] = n;
   return gr_rain_runoff_sources_changed(s);
 }
@@ -1336,22 +1346,9 @@ static gr_status gr_rain_runoff_set_hyetograph_impl(gr_rain_runoff *s, const dou
                           "between %g and %g %s, like RainRate; correct that row.",
                           r[k] / row->to_core, row->unit, k, row->min, row->max, row->unit);
   }
-  double *nt = NULL, *nr = NULL;
-  if (n > 0) {
-    nt = malloc((size_t)n * sizeof(double));
-    nr = malloc((size_t)n * sizeof(double));
-    if (!nt || !nr) {
-      free(nt);
-      free(nr);
-      return gr_set_error(s->ctx, GR_ERR_OUT_OF_MEMORY, "Out of host memory.");
-    }
-    memcpy(nt, t, (size_t)n * sizeof(double));
-    memcpy(nr, r, (size_t)n * sizeof(double));
-  }
-  free(s->hy_t);
-  free(s->hy_r);
-  s->hy_t = nt;
-  s->hy_r = nr;
+  gr_status st = gr_rain_runoff_table_keep(s, t, r, n, &s->hy_t, &s->hy_r);
+  if (st != GR_OK)
+    return st;
   s->hy_n = n;
   s->args_set = 0; /* RainRate again at the next bind when it is removed */
   return GR_OK;

@@ -1425,30 +1425,37 @@ static void gr_snow_thresholds(const gr_snow_deformation *s, float thr[3]) {
   thr[2] = (float)(slope * sqrt(dx * dx + dy * dy));
 }
 
-/* Iteration t of a launch whose givers' window at t = 0 is [gx0, gx_end) x
- * [gy0, gy_end), in two launches: the rates on the window grown by t + 2,
- * the moves on it grown by t + 1; the state flips buffers. */
-static gr_status gr_snow_relax_once(gr_snow_deformation *s, cl_int gx0, cl_int gy0, cl_int gx_end,
-                                    cl_int gy_end, cl_int t, float tol) {
-  cl_int nx = s->grid.nx, ny = s->grid.ny, nxt = 1 - s->cur;
+/* The arguments every talus kernel shares: the ground, the lowest
+ * underside and its clearance (snow_excess), the grid and the thresholds. */
+static gr_status gr_snow_talus_args(gr_snow_deformation *s, cl_kernel k) {
+  cl_int nx = s->grid.nx, ny = s->grid.ny;
   float thr[3];
   gr_snow_thresholds(s, thr);
-  cl_int rx0 = gx0 - t - 2 > 0 ? gx0 - t - 2 : 0, ry0 = gy0 - t - 2 > 0 ? gy0 - t - 2 : 0;
-  cl_int rx_end = gx_end + t + 2 < nx ? gx_end + t + 2 : nx,
-         ry_end = gy_end + t + 2 < ny ? gy_end + t + 2 : ny;
-  cl_int mx0 = gx0 - t - 1 > 0 ? gx0 - t - 1 : 0, my0 = gy0 - t - 1 > 0 ? gy0 - t - 1 : 0;
-  cl_int mx_end = gx_end + t + 1 < nx ? gx_end + t + 1 : nx,
-         my_end = gy_end + t + 1 < ny ? gy_end + t + 1 : ny;
-  float clearance = (float)(2.0 * GR_SNOW_DEFORMATION_CONTACT_GAP); /* snow_excess */
-  const gr_snow_arg rate[] = {{"ground", sizeof(cl_mem), &s->ground},
-                              {"depth", sizeof(cl_mem), &s->depth[s->cur]},
+  float clearance = (float)(2.0 * GR_SNOW_DEFORMATION_CONTACT_GAP);
+  const gr_snow_arg args[] = {{"ground", sizeof(cl_mem), &s->ground},
                               {"under_min", sizeof(cl_mem), &s->under_min},
                               {"clearance", sizeof(clearance), &clearance},
                               {"nx", sizeof(nx), &nx},
                               {"ny", sizeof(ny), &ny},
                               {"tx", sizeof(float), &thr[0]},
                               {"ty", sizeof(float), &thr[1]},
-                              {"td", sizeof(float), &thr[2]},
+                              {"td", sizeof(float), &thr[2]}};
+  return gr_snow_args(s, k, args, sizeof(args) / sizeof(args[0]));
+}
+
+/* Iteration t of a launch whose givers' window at t = 0 is [gx0, gx_end) x
+ * [gy0, gy_end), in two launches: the rates on the window grown by t + 2,
+ * the moves on it grown by t + 1; the state flips buffers. */
+static gr_status gr_snow_relax_once(gr_snow_deformation *s, cl_int gx0, cl_int gy0, cl_int gx_end,
+                                    cl_int gy_end, cl_int t, float tol) {
+  cl_int nx = s->grid.nx, ny = s->grid.ny, nxt = 1 - s->cur;
+  cl_int rx0 = gx0 - t - 2 > 0 ? gx0 - t - 2 : 0, ry0 = gy0 - t - 2 > 0 ? gy0 - t - 2 : 0;
+  cl_int rx_end = gx_end + t + 2 < nx ? gx_end + t + 2 : nx,
+         ry_end = gy_end + t + 2 < ny ? gy_end + t + 2 : ny;
+  cl_int mx0 = gx0 - t - 1 > 0 ? gx0 - t - 1 : 0, my0 = gy0 - t - 1 > 0 ? gy0 - t - 1 : 0;
+  cl_int mx_end = gx_end + t + 1 < nx ? gx_end + t + 1 : nx,
+         my_end = gy_end + t + 1 < ny ? gy_end + t + 1 : ny;
+  const gr_snow_arg rate[] = {{"depth", sizeof(cl_mem), &s->depth[s->cur]},
                               {"tol", sizeof(tol), &tol},
                               {"gx0", sizeof(gx0), &gx0},
                               {"gy0", sizeof(gy0), &gy0},
@@ -1460,26 +1467,22 @@ static gr_status gr_snow_relax_once(gr_snow_deformation *s, cl_int gx0, cl_int g
                               {"rate", sizeof(cl_mem), &s->rate},
                               {"rate_in", sizeof(cl_mem), &s->rate_in},
                               {"movable", sizeof(cl_mem), &s->movable}};
-  gr_status st = gr_snow_args(s, s->relax_rate, rate, sizeof(rate) / sizeof(rate[0]));
+  gr_status st = gr_snow_talus_args(s, s->relax_rate);
+  if (st == GR_OK)
+    st = gr_snow_args(s, s->relax_rate, rate, sizeof(rate) / sizeof(rate[0]));
   if (st == GR_OK && rx_end > rx0 && ry_end > ry0) /* a piece's cut may be empty */
     st = gr_enqueue_2d(s->ctx, s->relax_rate, (size_t)rx0, (size_t)ry0, (size_t)(rx_end - rx0),
                        (size_t)(ry_end - ry0), NULL);
-  const gr_snow_arg move[] = {{"ground", sizeof(cl_mem), &s->ground},
-                              {"depth", sizeof(cl_mem), &s->depth[s->cur]},
+  const gr_snow_arg move[] = {{"depth", sizeof(cl_mem), &s->depth[s->cur]},
                               {"density", sizeof(cl_mem), &s->density[s->cur]},
-                              {"under_min", sizeof(cl_mem), &s->under_min},
-                              {"clearance", sizeof(clearance), &clearance},
                               {"rate", sizeof(cl_mem), &s->rate},
                               {"rate_in", sizeof(cl_mem), &s->rate_in},
-                              {"nx", sizeof(nx), &nx},
-                              {"ny", sizeof(ny), &ny},
-                              {"tx", sizeof(float), &thr[0]},
-                              {"ty", sizeof(float), &thr[1]},
-                              {"td", sizeof(float), &thr[2]},
                               {"x_end", sizeof(mx_end), &mx_end},
                               {"y_end", sizeof(my_end), &my_end},
                               {"depth_out", sizeof(cl_mem), &s->depth[nxt]},
                               {"density_out", sizeof(cl_mem), &s->density[nxt]}};
+  if (st == GR_OK)
+    st = gr_snow_talus_args(s, s->relax_move);
   if (st == GR_OK)
     st = gr_snow_args(s, s->relax_move, move, sizeof(move) / sizeof(move[0]));
   if (st == GR_OK && mx_end > mx0 && my_end > my0)
@@ -1495,23 +1498,12 @@ static gr_status gr_snow_relax_once(gr_snow_deformation *s, cl_int gx0, cl_int g
 static gr_status gr_snow_relax_blocked(gr_snow_deformation *s, cl_int gx0, cl_int gy0,
                                        cl_int gx_end, cl_int gy_end, cl_int mx0, cl_int my0,
                                        cl_int mx_end, cl_int my_end, cl_int iters, float tol) {
-  cl_int nx = s->grid.nx, ny = s->grid.ny, nxt = 1 - s->cur;
-  float thr[3];
-  gr_snow_thresholds(s, thr);
+  cl_int nxt = 1 - s->cur;
   size_t bw = s->block[0], bh = s->block[1];
-  float clearance = (float)(2.0 * GR_SNOW_DEFORMATION_CONTACT_GAP); /* snow_excess */
   size_t lbytes = 8 * (bw + 4 * GR_SNOW_BLOCK_ITERATIONS) * (bh + 4 * GR_SNOW_BLOCK_ITERATIONS) *
                   sizeof(cl_float);
-  const gr_snow_arg args[] = {{"ground", sizeof(cl_mem), &s->ground},
-                              {"depth", sizeof(cl_mem), &s->depth[s->cur]},
+  const gr_snow_arg args[] = {{"depth", sizeof(cl_mem), &s->depth[s->cur]},
                               {"density", sizeof(cl_mem), &s->density[s->cur]},
-                              {"under_min", sizeof(cl_mem), &s->under_min},
-                              {"clearance", sizeof(clearance), &clearance},
-                              {"nx", sizeof(nx), &nx},
-                              {"ny", sizeof(ny), &ny},
-                              {"tx", sizeof(float), &thr[0]},
-                              {"ty", sizeof(float), &thr[1]},
-                              {"td", sizeof(float), &thr[2]},
                               {"tol", sizeof(tol), &tol},
                               {"gx0", sizeof(gx0), &gx0},
                               {"gy0", sizeof(gy0), &gy0},
@@ -1525,7 +1517,9 @@ static gr_status gr_snow_relax_blocked(gr_snow_deformation *s, cl_int gx0, cl_in
                               {"movable", sizeof(cl_mem), &s->movable},
                               {"lmem", lbytes, NULL}};
   const size_t local[2] = {bw, bh};
-  gr_status st = gr_snow_args(s, s->relax_block, args, sizeof(args) / sizeof(args[0]));
+  gr_status st = gr_snow_talus_args(s, s->relax_block);
+  if (st == GR_OK)
+    st = gr_snow_args(s, s->relax_block, args, sizeof(args) / sizeof(args[0]));
   if (st == GR_OK && mx_end > mx0 && my_end > my0) /* a piece's cut may be empty */
     st = gr_enqueue_2d(s->ctx, s->relax_block, (size_t)mx0, (size_t)my0, (size_t)(mx_end - mx0),
                        (size_t)(my_end - my0), local);
@@ -1543,24 +1537,13 @@ static gr_status gr_snow_relax_blocked(gr_snow_deformation *s, cl_int gx0, cl_in
  * to align, and one that would not end before the cap counts the cap. */
 static gr_status gr_snow_relax_group(gr_snow_deformation *s, int *x0, int *y0, int *x1, int *y1,
                                      cl_int cap, cl_int align, float tol, int *ran, int *done) {
-  cl_int nx = s->grid.nx, ny = s->grid.ny, nxt = 1 - s->cur;
+  cl_int nxt = 1 - s->cur;
   cl_int max_area = s->group_area;
   cl_int w[4] = {*x0, *y0, *x1, *y1}, first = *ran, left = cap - first;
-  float thr[3];
-  gr_snow_thresholds(s, thr);
-  float clearance = (float)(2.0 * GR_SNOW_DEFORMATION_CONTACT_GAP); /* snow_excess */
-  const gr_snow_arg args[] = {{"ground", sizeof(cl_mem), &s->ground},
-                              {"depth", sizeof(cl_mem), &s->depth[s->cur]},
+  const gr_snow_arg args[] = {{"depth", sizeof(cl_mem), &s->depth[s->cur]},
                               {"density", sizeof(cl_mem), &s->density[s->cur]},
                               {"depth_tmp", sizeof(cl_mem), &s->depth[nxt]},
                               {"density_tmp", sizeof(cl_mem), &s->density[nxt]},
-                              {"under_min", sizeof(cl_mem), &s->under_min},
-                              {"clearance", sizeof(clearance), &clearance},
-                              {"nx", sizeof(nx), &nx},
-                              {"ny", sizeof(ny), &ny},
-                              {"tx", sizeof(float), &thr[0]},
-                              {"ty", sizeof(float), &thr[1]},
-                              {"td", sizeof(float), &thr[2]},
                               {"tol", sizeof(tol), &tol},
                               {"x0", sizeof(cl_int), &w[0]},
                               {"y0", sizeof(cl_int), &w[1]},
@@ -1575,7 +1558,9 @@ static gr_status gr_snow_relax_group(gr_snow_deformation *s, int *x0, int *y0, i
                               {"result", sizeof(cl_mem), &s->group_result}};
   const size_t local[2] = {s->group_size, 1};
   cl_int res[6];
-  gr_status st = gr_snow_args(s, s->relax_group, args, sizeof(args) / sizeof(args[0]));
+  gr_status st = gr_snow_talus_args(s, s->relax_group);
+  if (st == GR_OK)
+    st = gr_snow_args(s, s->relax_group, args, sizeof(args) / sizeof(args[0]));
   if (st == GR_OK)
     st = gr_enqueue_2d(s->ctx, s->relax_group, 0, 0, s->group_size, 1, local);
   if (st == GR_OK)
