@@ -455,6 +455,42 @@ static gr_mesh cube(float *v, int *t) {
   return m;
 }
 
+/* gr_mesh_check: the answers of gr_mesh_validate, with a memo of the last
+ * mesh that passed. The same arrays under a new transform pass on the memo
+ * (and a singular transform is still refused); a mesh changed in place, the
+ * same pointers, is checked again and refused when broken; an open mesh
+ * remembered as such is checked again when asked for a closed one. */
+static void test_mesh_memo(void) {
+  float v[27];
+  int t[39];
+  char msg[512];
+  gr_mesh_memo memo;
+  memset(&memo, 0, sizeof(memo));
+  gr_mesh m = cube(v, t);
+  CHECK_MSG(gr_mesh_check(&memo, &m, 1, msg, sizeof(msg)) == GR_OK, "%s", msg);
+  CHECK(memo.vertices && memo.ntriangles == 12 && memo.closed == 1);
+  m.transform[12] = 20.0; /* moved */
+  CHECK(gr_mesh_check(&memo, &m, 1, msg, sizeof(msg)) == GR_OK);
+  m.transform[10] = 0.0;
+  CHECK(gr_mesh_check(&memo, &m, 1, msg, sizeof(msg)) == GR_ERR_INVALID_ARGUMENT &&
+        strstr(msg, "singular"));
+  m.transform[10] = 1.0;
+  t[1] = 1, t[2] = 2; /* triangle 0 flipped in place */
+  CHECK(gr_mesh_check(&memo, &m, 1, msg, sizeof(msg)) == GR_ERR_INVALID_ARGUMENT &&
+        strstr(msg, "winding"));
+  CHECK(memo.vertices == NULL); /* a refused mesh is not remembered */
+  CHECK(gr_mesh_check(&memo, &m, 0, msg, sizeof(msg)) == GR_OK && memo.closed == 0);
+  CHECK(gr_mesh_check(&memo, &m, 1, msg, sizeof(msg)) == GR_ERR_INVALID_ARGUMENT);
+  m = cube(v, t);
+  CHECK(gr_mesh_check(&memo, &m, 1, msg, sizeof(msg)) == GR_OK);
+  v[3 * 3 + 1] = NAN; /* a vertex broken in place */
+  CHECK(gr_mesh_check(&memo, &m, 1, msg, sizeof(msg)) == GR_ERR_INVALID_ARGUMENT &&
+        strstr(msg, "vertex 3"));
+  CHECK(gr_mesh_check(NULL, &m, 1, msg, sizeof(msg)) == GR_ERR_INVALID_ARGUMENT);
+  gr_mesh_memo_free(&memo);
+  CHECK(memo.vertices == NULL && memo.triangles == NULL);
+}
+
 static void test_mesh(void) {
   float v[27];
   int t[39];
@@ -780,6 +816,7 @@ static const gr_subtest tests[] = {
     {"enqueue_1d", test_enqueue_1d, 0},
     {"errors_per_thread", test_errors_per_thread, 0},
     {"mesh", test_mesh, 0},
+    {"mesh_memo", test_mesh_memo, 0},
     {"points", test_points, 0},
     {"memcheck", test_memcheck, 1}, /* what valgrind runs */
 };

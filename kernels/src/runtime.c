@@ -245,6 +245,60 @@ static int gr_edge_cmp(const void *pa, const void *pb) {
   return (a->triangle > b->triangle) - (a->triangle < b->triangle);
 }
 
+/* The transform's part of gr_mesh_validate. */
+static gr_status gr_mesh_transform_check(const double *T, char *msg, size_t msg_len) {
+  for (int k = 0; k < 16; ++k)
+    if (!isfinite(T[k]))
+      return gr_invalid(msg, msg_len,
+                        "Invalid mesh: transform element %d (column %d, row %d) is %g; the "
+                        "transform must be finite.",
+                        k, k / 4, k % 4, T[k]);
+  double bound = 0.0, det = gr_det4(T, &bound);
+  if (!(det > 1e-12 * bound))
+    return gr_invalid(msg, msg_len,
+                      "Invalid mesh: the transform is singular (determinant %g); it must map the "
+                      "object's frame to the world invertibly (no zero scale).",
+                      det);
+  return GR_OK;
+}
+
+void gr_mesh_memo_free(gr_mesh_memo *memo) {
+  if (!memo)
+    return;
+  free(memo->vertices);
+  free(memo->triangles);
+  memset(memo, 0, sizeof(*memo));
+}
+
+gr_status gr_mesh_check(gr_mesh_memo *memo, const gr_mesh *m, int closed, char *msg,
+                        size_t msg_len) {
+  if (!memo)
+    return gr_mesh_validate(m, closed, msg, msg_len);
+  if (m && m->vertices && m->triangles && memo->vertices && memo->nvertices == m->nvertices &&
+      memo->ntriangles == m->ntriangles && memo->closed >= (closed != 0) &&
+      memcmp(memo->vertices, m->vertices, (size_t)m->nvertices * 3 * sizeof(float)) == 0 &&
+      memcmp(memo->triangles, m->triangles, (size_t)m->ntriangles * 3 * sizeof(int)) == 0)
+    return gr_mesh_transform_check(m->transform, msg, msg_len);
+  gr_mesh_memo_free(memo);
+  gr_status st = gr_mesh_validate(m, closed, msg, msg_len);
+  if (st != GR_OK)
+    return st;
+  size_t vb = (size_t)m->nvertices * 3 * sizeof(float),
+         tb = (size_t)m->ntriangles * 3 * sizeof(int);
+  memo->vertices = malloc(vb);
+  memo->triangles = malloc(tb);
+  if (!memo->vertices || !memo->triangles) {
+    gr_mesh_memo_free(memo); /* no memo: the next call checks in full */
+    return GR_OK;
+  }
+  memcpy(memo->vertices, m->vertices, vb);
+  memcpy(memo->triangles, m->triangles, tb);
+  memo->nvertices = m->nvertices;
+  memo->ntriangles = m->ntriangles;
+  memo->closed = closed != 0;
+  return GR_OK;
+}
+
 gr_status gr_mesh_validate(const gr_mesh *m, int closed, char *msg, size_t msg_len) {
   if (!m)
     return gr_invalid(msg, msg_len, "Invalid mesh: no mesh was given.");
@@ -290,18 +344,9 @@ gr_status gr_mesh_validate(const gr_mesh *m, int closed, char *msg, size_t msg_l
                         "it or move its corners apart.",
                         t, tri[0], tri[1], tri[2]);
   }
-  for (int k = 0; k < 16; ++k)
-    if (!isfinite(m->transform[k]))
-      return gr_invalid(msg, msg_len,
-                        "Invalid mesh: transform element %d (column %d, row %d) is %g; the "
-                        "transform must be finite.",
-                        k, k / 4, k % 4, m->transform[k]);
-  double bound = 0.0, det = gr_det4(m->transform, &bound);
-  if (!(det > 1e-12 * bound))
-    return gr_invalid(msg, msg_len,
-                      "Invalid mesh: the transform is singular (determinant %g); it must map the "
-                      "object's frame to the world invertibly (no zero scale).",
-                      det);
+  gr_status st = gr_mesh_transform_check(m->transform, msg, msg_len);
+  if (st != GR_OK)
+    return st;
   if (!closed)
     return GR_OK;
 
@@ -353,7 +398,7 @@ gr_status gr_mesh_validate(const gr_mesh *m, int closed, char *msg, size_t msg_l
     i += n;
   }
   free(start);
-  gr_status st = GR_OK;
+  st = GR_OK;
   for (size_t i = 0; i < ne && st == GR_OK;) {
     size_t n = 1;
     while (i + n < ne && edges[i + n].lo == edges[i].lo && edges[i + n].hi == edges[i].hi)

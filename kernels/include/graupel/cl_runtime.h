@@ -21,6 +21,31 @@
 extern "C" {
 #endif
 
+/**
+ * The last mesh an object passed gr_mesh_validate with: a copy of its
+ * vertices and triangles. A simulation checks its objects every step, but
+ * a moving object is the same mesh under a new transform; gr_mesh_check
+ * then compares the arrays (a memcmp) and checks the transform alone
+ * instead of every triangle and edge again. Zeroed to start; free with
+ * gr_mesh_memo_free.
+ */
+typedef struct gr_mesh_memo {
+  float *vertices;
+  int *triangles;
+  int nvertices, ntriangles, closed;
+} gr_mesh_memo;
+
+/**
+ * gr_mesh_validate(m, closed, ..), the same answer and sentence, at the cost
+ * of a comparison when m's vertices and triangles equal the memo's (and it
+ * was checked at least as strictly); a mesh that passes becomes the memo
+ * (when its copy cannot be allocated the memo is only emptied).
+ */
+GR_API gr_status gr_mesh_check(gr_mesh_memo *memo, const gr_mesh *m, int closed, char *msg,
+                               size_t msg_len);
+
+GR_API void gr_mesh_memo_free(gr_mesh_memo *memo);
+
 /** Name of an OpenCL error code, e.g. "CL_OUT_OF_RESOURCES". */
 GR_API const char *gr_cl_error_name(cl_int err);
 
