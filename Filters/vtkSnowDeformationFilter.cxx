@@ -99,6 +99,7 @@ vtkSnowDeformationFilter::vtkSnowDeformationFilter() {
   this->SetPieceRing(GR_SNOW_DEFORMATION_GHOST);
   this->MaxRelaxIterations = static_cast<int>(TableDefault("MaxRelaxIterations", 64));
   this->RelaxTolerance = TableDefault("RelaxTolerance", 1e-4);
+  this->SlumpSpeed = TableDefault("SlumpSpeed", 2.0);
 }
 
 vtkSnowDeformationFilter::~vtkSnowDeformationFilter() {
@@ -120,6 +121,7 @@ GRAUPEL_TABLE_SETTER(vtkSnowDeformationFilter, MaxRelaxIterations, int,
                      gr_snow_deformation_param_bounds)
 GRAUPEL_TABLE_SETTER(vtkSnowDeformationFilter, RelaxTolerance, double,
                      gr_snow_deformation_param_bounds)
+GRAUPEL_TABLE_SETTER(vtkSnowDeformationFilter, SlumpSpeed, double, gr_snow_deformation_param_bounds)
 
 void vtkSnowDeformationFilter::SetDensityRange(double minimum, double maximum) {
   this->SetMinDensity(minimum);
@@ -274,7 +276,8 @@ int vtkSnowDeformationFilter::CheckParameters() {
                 {"MaxSlope", "MaxSlope", this->MaxSlope},
                 {"DirectionFalloff", "DirectionFalloff", this->DirectionFalloff},
                 {"MaxRelaxIterations", "MaxRelaxIterations", double(this->MaxRelaxIterations)},
-                {"RelaxTolerance", "RelaxTolerance", this->RelaxTolerance}};
+                {"RelaxTolerance", "RelaxTolerance", this->RelaxTolerance},
+                {"SlumpSpeed", "SlumpSpeed", this->SlumpSpeed}};
   for (const auto &p : values) {
     const gr_param_bound *b = Bound(p.property);
     if (!b || gr_param_accepts(b, p.value * b->to_core)) {
@@ -643,6 +646,7 @@ int vtkSnowDeformationFilter::SetUpState(vtkInformationVector **inputVector) {
   p.direction_falloff = this->DirectionFalloff;
   p.max_relax_iterations = this->MaxRelaxIterations;
   p.relax_tolerance = this->RelaxTolerance;
+  p.slump_speed = this->SlumpSpeed;
   char msg[512];
   if (gr_snow_deformation_params_validate(&p, msg, sizeof(msg)) != GR_OK) {
     vtkErrorMacro("Snow Deformation: " << msg);
@@ -878,6 +882,7 @@ void vtkSnowDeformationFilter::PrintSelf(ostream &os, vtkIndent indent) {
   os << indent << "DirectionFalloff: " << this->DirectionFalloff << "\n";
   os << indent << "MaxRelaxIterations: " << this->MaxRelaxIterations << "\n";
   os << indent << "RelaxTolerance: " << this->RelaxTolerance << " m\n";
+  os << indent << "SlumpSpeed: " << this->SlumpSpeed << " m/s\n";
   os << indent << "ObjectVelocity: " << this->ObjectVelocity[0] << " " << this->ObjectVelocity[1]
      << " " << this->ObjectVelocity[2] << " m/s\n";
   os << indent << "ObjectAngularVelocity: " << this->ObjectAngularVelocity << " deg/s\n";

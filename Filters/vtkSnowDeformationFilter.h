@@ -187,6 +187,18 @@ public:
   ///@}
 
   ///@{
+  /**
+   * How fast snow slides down a slope steeper than MaxSlope, m/s (default
+   * 2, about sqrt(g H) for a pile H = 0.4 m high; 0: instantly, every step
+   * relaxes to the end). A step of dt runs at most ceil(SlumpSpeed dt /
+   * spacing) talus iterations, the rest goes on in the next steps, so a
+   * collapse takes the same time on every grid.
+   */
+  virtual void SetSlumpSpeed(double value);
+  vtkGetMacro(SlumpSpeed, double);
+  ///@}
+
+  ///@{
   /** Velocity of the objects' centres, m/s (default 0 0 0); along a Path its length is the speed.
    */
   vtkSetVector3Macro(ObjectVelocity, double);
@@ -245,6 +257,7 @@ protected:
   double DirectionFalloff = 8.0;
   int MaxRelaxIterations = 0; // the table's default, set in the constructor
   double RelaxTolerance = 0.0;
+  double SlumpSpeed = 0.0; // the table's default, set in the constructor
   double ObjectVelocity[3] = {0.0, 0.0, 0.0};
   double ObjectAngularVelocity = 0.0;
   double RotationAxis[3] = {0.0, 1.0, 0.0};

@@ -78,11 +78,12 @@ static float *get(gr_snow_deformation *s, gr_field f, int n) {
 static void test_param_table(void) {
   int n = 0;
   const gr_param_bound *t = gr_snow_deformation_param_bounds(&n);
-  CHECK(n == 9);
+  CHECK(n == 10);
   const char *names[] = {"InitialSnowDepth", "InitialDensity",     "MinDensity",
                          "MaxDensity",       "CompressionModel",   "MaxSlope",
-                         "DirectionFalloff", "MaxRelaxIterations", "RelaxTolerance"};
-  for (int r = 0; r < n && r < 9; ++r)
+                         "DirectionFalloff", "MaxRelaxIterations", "RelaxTolerance",
+                         "SlumpSpeed"};
+  for (int r = 0; r < n && r < 10; ++r)
     CHECK(strcmp(t[r].property, names[r]) == 0);
   gr_snow_deformation_params p, q;
   gr_snow_deformation_params_init(&p);
@@ -92,10 +93,17 @@ static void test_param_table(void) {
   CHECK(p.min_density == 100.0 && p.max_density == 400.0 && p.initial_density == 150.0);
   /* Each row: its bounds accepted, beyond them refused with a sentence that
    * names the property; the validator follows the table. */
-  double *fields[] = {
-      &q.initial_snow_depth, &q.initial_density,   &q.min_density, &q.max_density,    NULL,
-      &q.max_slope,          &q.direction_falloff, NULL,           &q.relax_tolerance};
-  for (int r = 0; r < 9; ++r) {
+  double *fields[] = {&q.initial_snow_depth,
+                      &q.initial_density,
+                      &q.min_density,
+                      &q.max_density,
+                      NULL,
+                      &q.max_slope,
+                      &q.direction_falloff,
+                      NULL,
+                      &q.relax_tolerance,
+                      &q.slump_speed};
+  for (int r = 0; r < 10; ++r) {
     double lo = t[r].min * t[r].to_core, hi = t[r].max * t[r].to_core;
     double vals[4] = {lo, hi, lo - 1.0, hi + 1.0};
     if (r == 5 || r == 8) /* open minimum: the bound itself is refused */
@@ -376,6 +384,7 @@ static void test_talus_column(void) {
   gr_snow_deformation_params p;
   gr_snow_deformation_params_init(&p);
   p.initial_snow_depth = 0.0;
+  p.slump_speed = 0.0; /* instant: the talus' own iterations */
   p.max_relax_iterations = 100000;
   p.relax_tolerance = 1e-5;
   int n = 41;
@@ -414,6 +423,7 @@ static void test_talus_resumes(void) {
   gr_snow_deformation_params p;
   gr_snow_deformation_params_init(&p);
   p.initial_snow_depth = 0.0;
+  p.slump_speed = 0.0; /* instant: the talus' own iterations */
   p.max_relax_iterations = 2;
   p.relax_tolerance = 1e-5;
   int n = 41, steps = 0, last = -1;
@@ -462,6 +472,85 @@ static void test_talus_resumes(void) {
 
 /* The thesis' Alg. 4.11 (notes/000.md section 2.9) on the host: it removes
  * the total excess s but hands out only s/m. */
+/* SlumpSpeed: a pile (0.5 m^3 on a block 0.3 m wide, 5.6 m high)
+ * collapses at c = 2 m/s. A talus iteration moves snow one point, and a step
+ * of dt runs ceil(c dt / dx) of them, so the pile's edge (the farthest point
+ * holding snow, in points along x or y from the middle) moves at most that far
+ * each step: 1 + 2k points after k steps of 0.1 s (0.2 m a step), and exactly
+ * that while the pile is steep; without the bound one step spreads the pile
+ * to its final edge. On a grid twice as fine (4 points a step) the edge is at
+ * the same place in metres. Once still, the pile is the cone the relaxation
+ * without the bound makes (its iterations only cut into steps), to the bit. */
+static int pile_edge(const float *d, int n) {
+  int edge = 0, m = n / 2;
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i)
+      if (d[j * n + i] > 0.0f) {
+        int e = abs(i - m) > abs(j - m) ? abs(i - m) : abs(j - m);
+        edge = e > edge ? e : edge;
+      }
+  return edge;
+}
+
+static float *slump(int n, double dx, double speed, int steps, int *edges) {
+  gr_snow_deformation_params p;
+  gr_snow_deformation_params_init(&p);
+  p.initial_snow_depth = 0.0;
+  p.max_relax_iterations = 100000;
+  p.relax_tolerance = 1e-5;
+  p.slump_speed = speed;
+  gr_snow_deformation *s = make_sim(n, n, dx, &p);
+  if (!s)
+    return NULL;
+  float *d0 = calloc((size_t)n * n, sizeof(float)), *d = NULL;
+  const int m = n / 2, hw = dx < 0.075 ? 2 : 1, side = 2 * hw + 1;
+  for (int j = -hw; j <= hw; ++j)
+    for (int i = -hw; i <= hw; ++i)
+      d0[(m + j) * n + m + i] = (float)(0.5 / (side * side * dx * dx));
+  CHECK(gr_snow_deformation_set_field(s, GR_FIELD_SNOW_DEPTH, d0) == GR_OK);
+  CHECK(gr_snow_deformation_set_objects(s, NULL, 0, NULL) == GR_OK);
+  for (int t = 0; t < steps; ++t) {
+    CHECK(gr_snow_deformation_step(s, 0.1) == GR_OK);
+    free(d);
+    d = get(s, GR_FIELD_SNOW_DEPTH, n * n);
+    if (d && edges)
+      edges[t] = pile_edge(d, n);
+  }
+  free(d0);
+  gr_snow_deformation_destroy(s);
+  return d;
+}
+
+static void test_slump_speed(void) {
+  enum { STEPS = 60, SEEN = 8 };
+  const int n = 41;
+  int fast[STEPS], slow[STEPS], fine[3];
+  float *a = slump(n, 0.1, 0.0, 1, fast), *b = slump(n, 0.1, 2.0, STEPS, slow);
+  float *c = slump(2 * n - 1, 0.05, 2.0, 3, fine);
+  if (!a || !b || !c) {
+    free(a), free(b), free(c);
+    return;
+  }
+  int differ = 0, bound_ok = 1;
+  for (int k = 0; k < n * n; ++k)
+    differ += a[k] != b[k];
+  for (int t = 0; t < SEEN; ++t)
+    bound_ok &= slow[t] <= 1 + 2 * (t + 1) && (t >= 2 || slow[t] == 1 + 2 * (t + 1));
+  printf("slump: the edge after one step %d points instant; at 2 m/s %d %d %d %d %d %d %d %d; "
+         "twice as fine %.2f %.2f %.2f m against %.2f %.2f %.2f m; after %d steps %d of %d depths "
+         "differ from the instant cone\n",
+         fast[0], slow[0], slow[1], slow[2], slow[3], slow[4], slow[5], slow[6], slow[7],
+         fine[0] * 0.05, fine[1] * 0.05, fine[2] * 0.05, slow[0] * 0.1, slow[1] * 0.1,
+         slow[2] * 0.1, STEPS, differ, n * n);
+  CHECK_MSG(fast[0] >= 8, "the instant pile spreads to %d points only", fast[0]);
+  CHECK_MSG(bound_ok, "the edge moves faster than 2 points a step, or slower while steep");
+  CHECK(slow[SEEN - 1] == fast[0]);
+  for (int t = 0; t < 3; ++t) /* at most 0.2 m a step, and the same edge while steep */
+    CHECK(fine[t] <= 2 + 4 * (t + 1) && (t >= 2 || fine[t] == 2 * slow[t]));
+  CHECK_MSG(differ == 0, "%d depths differ from the instant cone", differ);
+  free(a), free(b), free(c);
+}
+
 static double alg411_once(const float *h, float *out, int n, double phi) {
   for (int c = 0; c < n * n; ++c)
     out[c] = 0.0f;
@@ -787,6 +876,7 @@ static float *drag_with(int steps, double dt, double speed, int *iterations, int
                         int max_iterations) {
   gr_snow_deformation_params p;
   gr_snow_deformation_params_init(&p);
+  p.slump_speed = 0.0;               /* instant: the talus' own iterations */
   p.initial_density = p.max_density; /* dense snow: all of it is displaced */
   if (max_iterations >= 0)
     p.max_relax_iterations = max_iterations;
@@ -996,6 +1086,7 @@ static void test_talus_room(void) {
   gr_snow_deformation_params p;
   gr_snow_deformation_params_init(&p);
   p.initial_snow_depth = 0.0;
+  p.slump_speed = 0.0; /* instant: the talus' own iterations */
   p.max_relax_iterations = 100000;
   p.relax_tolerance = 1e-5;
   gr_snow_deformation *s = make_sim(nx, ny, dx, &p);
@@ -1689,6 +1780,7 @@ static const gr_subtest tests[] = {
     {"bare_ground", test_bare_ground, 0},
     {"talus_room", test_talus_room, 0},
     {"talus_resumes", test_talus_resumes, 0},
+    {"slump_speed", test_slump_speed, 0},
     {"pieces_x", test_pieces_x, 0},
     {"pieces_y", test_pieces_y, 0},
     {"pieces_abort", test_pieces_abort, 0},

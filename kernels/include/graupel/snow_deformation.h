@@ -80,7 +80,10 @@
  * (mass mixes). Only a point that can move more than RelaxTolerance gives
  * (min(S_a, largest x_ab)), and the relaxation stops when none can (read
  * every 4 iterations, with the box of those points, which bounds the next
- * iterations' window) or after MaxRelaxIterations. A RelaxTolerance below
+ * iterations' window) or after MaxRelaxIterations, or after the iterations
+ * a front moving at SlumpSpeed crosses in the step (ceil(c dt / d): a talus
+ * iteration moves snow one point; the rest goes on in the next steps, so a
+ * pile collapses at the same speed on every grid). A RelaxTolerance below
  * 16 quanta (1.5e-5 m) acts as 16 quanta, so that an iteration always moves
  * something.
  *
@@ -155,6 +158,7 @@ typedef struct gr_snow_deformation_params {
   double direction_falloff;  /**< K of s_w (row DirectionFalloff) */
   int max_relax_iterations;  /**< talus iteration cap per step (row MaxRelaxIterations) */
   double relax_tolerance;    /**< m (row RelaxTolerance) */
+  double slump_speed;        /**< m/s, the talus front's speed; 0: instant (row SlumpSpeed) */
 } gr_snow_deformation_params;
 
 /** The table's defaults. */
@@ -171,7 +175,7 @@ GR_API gr_status gr_snow_deformation_params_validate(const gr_snow_deformation_p
 /**
  * The parameter table (InitialSnowDepth m, InitialDensity kg/m^3,
  * MinDensity kg/m^3, MaxDensity kg/m^3, CompressionModel, MaxSlope m/m,
- * DirectionFalloff, MaxRelaxIterations, RelaxTolerance m); *count gets the
+ * DirectionFalloff, MaxRelaxIterations, RelaxTolerance m, SlumpSpeed m/s); *count gets the
  * number of rows.
  */
 GR_API const gr_param_bound *gr_snow_deformation_param_bounds(int *count);
