@@ -272,7 +272,7 @@ protected:
   double LevelNorth = 0.0;
   int NoDataBoundary = CLOSED;
   int FlowModel = SHALLOW_WATER;
-  double MaxTimeStep = 1.0;
+  double MaxTimeStep = 3600.0; /* no cap: the stability limit sets the step */
   double CourantNumber = 0.7;
   double WettingDepth = 0.01;
   double DebrisFactor = 0.0;

@@ -496,6 +496,80 @@ static void test_tilted_plane(void) {
   gr_rain_runoff_destroy(s);
 }
 
+/* Rain on a dry tilted plane, run with MaxTimeStep 1 s (the old default)
+ * and with no cap (the default now): 3 h of 50 mm/h on a plane of 20 cells
+ * of 80 m, as on the DEM in Data/, tilted toward its west edge
+ * (transmissive: the film leaves at its normal depth; walls elsewhere), n
+ * 0.01. Without a cap the first steps of the dry grid were MaxTimeStep
+ * long (three steps of 3600 s let out a tenth of the water); the bound on
+ * the water the step's rain makes keeps the uncapped run's outflow within
+ * 1% of the capped run's, in under half the steps. At the kinematic-wave
+ * equilibrium, in steps of one length, the outflow equals the rain within
+ * 1e-6 and the depth every column's faces see (the stored depth plus a
+ * step's rain, which a longer step adds before the water leaves) is the
+ * capped run's within 1%. The slope of 0.3 is the case that needs the
+ * thin-film bound (gr_rain_runoff_stable_dt_impl): its film is
+ * supercritical (Froude number up to 8), and in gravity-limited steps of 77 s it
+ * stood two to three times too deep. */
+static void test_tilted_plane_uncapped(void) {
+  gr_grid g = {20, 3, 80.0, 80.0, 0.0, 0.0, 0, 0};
+  const double slopes[2] = {0.01, 0.3}, rain = 50.0 / 3.6e6;
+  float *b = alloc_field(&g, 1);
+  for (int k = 0; k < 2; ++k) {
+    for (int j = 0; j < g.ny; ++j)
+      for (int i = 0; i < g.nx; ++i)
+        b[(size_t)j * g.nx + i] = (float)(slopes[k] * (i + 0.5) * g.dx);
+    double out[2] = {0.0, 0.0}, ratio[2] = {0.0, 0.0};
+    long long steps[2] = {0, 0};
+    float *h[2] = {NULL, NULL};
+    for (int capped = 0; capped < 2; ++capped) {
+      gr_rain_runoff_params p = params_with(rain, 0.0, GR_BOUNDARY_CLOSED);
+      p.boundary[GR_RAIN_RUNOFF_WEST] = GR_BOUNDARY_TRANSMISSIVE;
+      p.manning_n = 0.01;
+      if (capped)
+        p.max_dt = 1.0;
+      gr_rain_runoff *s = make_sim(&g, &p, b, NULL);
+      if (!s)
+        continue;
+      CHECK(gr_rain_runoff_advance(s, 10800.0, NULL) == GR_OK);
+      gr_rain_runoff_ledger l0 = ledger(s);
+      out[capped] = l0.outflow_volume;
+      steps[capped] = l0.steps;
+      /* Steps of one length: the water each adds before it leaves is then
+       * the same; 160 of them to settle from the advance's last ones. */
+      double dt = 0.0;
+      CHECK(gr_rain_runoff_stable_dt(s, &dt) == GR_OK);
+      CHECK(gr_rain_runoff_step(s, dt, 160) == GR_OK);
+      l0 = ledger(s);
+      CHECK(gr_rain_runoff_step(s, dt, 32) == GR_OK);
+      gr_rain_runoff_ledger l1 = ledger(s);
+      ratio[capped] = (l1.outflow_volume - l0.outflow_volume) / (l1.rain_volume - l0.rain_volume);
+      CHECK(fabs(l1.balance_error) <= 1e-7 * l1.rain_volume);
+      h[capped] = get(s, &g, GR_FIELD_WATER_DEPTH);
+      for (size_t c = 0; h[capped] && c < cells_of(&g); ++c)
+        h[capped][c] += (float)(rain * dt);
+      gr_rain_runoff_destroy(s);
+    }
+    double worst = 0.0;
+    for (int i = 0; h[0] && h[1] && i < g.nx; ++i) {
+      size_t c = (size_t)(g.ny / 2) * g.nx + i;
+      worst = fmax(worst, fabs(h[0][c] - h[1][c]) / h[1][c]);
+    }
+    printf("tilted plane, slope %g, uncapped / capped at 1 s: outflow %.6g / %.6g m^3, "
+           "equilibrium outflow / rain %.9f / %.9f, depths within %.3g%%, steps %lld / %lld\n",
+           slopes[k], out[0], out[1], ratio[0], ratio[1], 100.0 * worst, steps[0], steps[1]);
+    CHECK_MSG(fabs(out[0] - out[1]) <= 0.01 * out[1], "outflow %.6g m^3, capped %.6g m^3", out[0],
+              out[1]);
+    CHECK_MSG(fabs(ratio[0] - 1.0) <= 1e-6 && fabs(ratio[1] - 1.0) <= 1e-6,
+              "equilibrium outflow / rain %.9f, capped %.9f", ratio[0], ratio[1]);
+    CHECK_MSG(worst <= 0.01, "depths off the capped run's by %.3g", worst);
+    CHECK_MSG(steps[0] < steps[1] / 2, "steps %lld, capped %lld", steps[0], steps[1]);
+    free(h[0]);
+    free(h[1]);
+  }
+  free(b);
+}
+
 /* A terrain, rain, permeability and initial depth that are symmetric under
  * x -> -x give a mirrored depth (bit for bit: every face's discharge is
  * computed so that its mirror image is its exact negative) and a mirrored,
@@ -917,7 +991,7 @@ static void test_errors(void) {
   gr_rain_runoff_params_init(&p);
   CHECK(gr_rain_runoff_params_validate(&p, msg, sizeof(msg)) == GR_OK);
   CHECK_NEAR(p.rain_rate, 10.0 / 3.6e6, 1e-15);
-  CHECK(p.permeability == 0.0 && p.manning_n == 0.03 && p.cfl == 0.7 && p.max_dt == 1.0 &&
+  CHECK(p.permeability == 0.0 && p.manning_n == 0.03 && p.cfl == 0.7 && p.max_dt == 3600.0 &&
         p.boundary[0] == GR_BOUNDARY_OPEN && p.boundary[3] == GR_BOUNDARY_OPEN &&
         p.boundary_level[2] == 0.0 && p.flow_model == GR_FLOW_SHALLOW_WATER);
   gr_rain_runoff_params q;
@@ -4039,6 +4113,7 @@ static const gr_subtest tests[] = {
     {"conservation", test_conservation, 0},
     {"bowl", test_bowl, 0},
     {"tilted_plane", test_tilted_plane, 0},
+    {"tilted_plane_uncapped", test_tilted_plane_uncapped, 0},
     {"symmetry", test_symmetry, 0},
     {"determinism", test_determinism, 0},
     {"lake_at_rest", test_lake_at_rest, 0},

@@ -15,7 +15,7 @@ core's validators follow, gr_<core>_param_bounds):
     property | default | unit, range | meaning):
 
         | `RainRate` | 10 | mm/h, 0–3600 | rain intensity ... |
-        | `MaxTimeStep` | 1 | s, (0, 3600] | longest step ... |
+        | `MaxTimeStep` | 3600 | s, (0, 3600] | longest step ... |
         | `Octaves` | 6 | 1–16 | ... |
         | `NoiseType` | Ridged Multifractal (0) | 0–2 | ... |
         | `Seed` | 0 | any | ... |

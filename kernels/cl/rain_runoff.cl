@@ -343,6 +343,70 @@ __kernel void rain_runoff_limit(__global const float *restrict h,
   limit[c] = out > wet ? wet / out * GR_RAIN_RUNOFF_KEEP : 1.0f;
 }
 
+/* The kinematic rate (1/s) at a face from cell L to cell R, d apart: the
+ * film's celerity over d, as a step takes it. dq'/dh of gr_rain_runoff_face
+ * is 5/3 of the Manning speed h_f^(2/3) sqrt|S| / n on a long step (friction
+ * dominates) and at most (10/3) g |S| dt on a short one (inertia does), over
+ * the face's depth and surface slope as the face writes them (so L and R
+ * swapped give the same float). Of the two, the bound the step meets first:
+ * min(5/3 u / d, sqrt(cfl (10/3) g |S| / d)), so that dt <= cfl / rate keeps
+ * dt dq'/dh / d <= cfl either way. 0 for a dry face. */
+GR_INLINE float gr_rain_runoff_film_rate(float hL, float hR, float bL, float bR, float n2,
+                                         float inv_d, float g, float cfl) {
+  float db = bR - bL;
+  float hf = db >= 0.0f ? fmax(hR, hL - db) : fmax(hL, hR + db);
+  float slope = fabs(db + (hR - hL)) * inv_d;
+  float friction = (5.0f / 3.0f) * sqrt(hf * cbrt(hf) * slope / n2) * inv_d;
+  float inertia = sqrt(cfl * (10.0f / 3.0f) * g * slope * inv_d);
+  return hf < GR_RAIN_RUNOFF_DRY || !(n2 > 0.0f) ? 0.0f : fmin(friction, inertia);
+}
+
+/* The local inertial model's kinematic rate for the stable step (see
+ * gr_rain_runoff_stable_dt_impl), reduced over the owned cells like
+ * rain_runoff_sw_speed: per cell, the largest rate of its four faces. Faces
+ * within the local array only (the domain's edge faces take their cell's own
+ * depth and bed slope, which its inner face sees too), and none into a
+ * no-data cell (whose wall or cliff is no slope of the terrain). Each face's
+ * rate is the same float from either side, so the maximum is the same
+ * whichever way the domain is split. */
+__kernel void rain_runoff_li_speed(__global const float *restrict h,
+                                   __global const float *restrict b,
+                                   __global const float *restrict nodata, int use_nodata,
+                                   __global const float *restrict n2map, int use_n2, float n2,
+                                   __global float *restrict partial,
+                                   __local float *restrict scratch, int n, int row, int rows,
+                                   int own_x0, int own_x1, int own_y0, int own_y1, float inv_dx,
+                                   float inv_dy, float g, float cfl) {
+  int lid = get_local_id(0), wg = get_local_size(0), start, end;
+  gr_reduce_block(n, &start, &end);
+  float rate = 0.0f;
+  for (int c = start + lid; c < end; c += wg) {
+    int i = c % row, j = c / row;
+    if (i < own_x0 || i >= own_x1 || j < own_y0 || j >= own_y1 || !GR_RAIN_RUNOFF_ACTIVE(c))
+      continue;
+    float hc = h[c], bc = b[c];
+    if (i > 0 && GR_RAIN_RUNOFF_ACTIVE(c - 1))
+      rate = fmax(rate, gr_rain_runoff_film_rate(
+                            h[c - 1], hc, b[c - 1], bc,
+                            gr_rain_runoff_face_n2(n2map, use_n2, n2, c - 1, c), inv_dx, g, cfl));
+    if (i < row - 1 && GR_RAIN_RUNOFF_ACTIVE(c + 1))
+      rate = fmax(rate, gr_rain_runoff_film_rate(
+                            hc, h[c + 1], bc, b[c + 1],
+                            gr_rain_runoff_face_n2(n2map, use_n2, n2, c, c + 1), inv_dx, g, cfl));
+    if (j > 0 && GR_RAIN_RUNOFF_ACTIVE(c - row))
+      rate = fmax(rate, gr_rain_runoff_film_rate(
+                            h[c - row], hc, b[c - row], bc,
+                            gr_rain_runoff_face_n2(n2map, use_n2, n2, c - row, c), inv_dy, g, cfl));
+    if (j < rows - 1 && GR_RAIN_RUNOFF_ACTIVE(c + row))
+      rate = fmax(rate, gr_rain_runoff_film_rate(
+                            hc, h[c + row], bc, b[c + row],
+                            gr_rain_runoff_face_n2(n2map, use_n2, n2, c, c + row), inv_dy, g, cfl));
+  }
+  __local float *mine = gr_reduce_slots(scratch, 0, 1);
+  mine[0] = rate;
+  gr_reduce_group(scratch, 0, 1, partial);
+}
+
 /* Books a cell's flow through the domain's edges, given per edge face as
  * what leaves the cell (m^2/s; negative: what enters), times dt over the
  * face's cell width: outflow and inflow (metres of depth, Kahan sums). */

@@ -68,7 +68,7 @@ static const gr_param_bound gr_rain_runoff_bounds[GR_RAIN_RUNOFF_P_COUNT] = {
     {"RainRate", "mm/h", 0.0, 3600.0, 10.0, 1.0 / 3.6e6, 0, 0},
     {"Permeability", "mm/h", 0.0, 36000.0, 0.0, 1.0 / 3.6e6, 0, 0},
     {"ManningN", "s/m^(1/3)", 0.0, 1.0, 0.03, 1.0, 0, 0},
-    {"MaxTimeStep", "s", 0.0, 3600.0, 1.0, 1.0, 1, 0},
+    {"MaxTimeStep", "s", 0.0, 3600.0, 3600.0, 1.0, 1, 0},
     {"CourantNumber", "", 0.0, 1.0, 0.7, 1.0, 1, 0},
     {"BoundaryWest", "", 0.0, 3.0, 0.0, 1.0, 0, 1},
     {"BoundaryEast", "", 0.0, 3.0, 0.0, 1.0, 0, 1},
@@ -103,6 +103,7 @@ struct gr_rain_runoff {
   int ring[4]; /* gr_rain_runoff_side order: west, east, south, north */
   gr_rain_runoff_params params;
   cl_kernel flux, flux_edges, limit, update, reduce, derive, sw_speed, maps, source;
+  cl_kernel li_speed; /* the local inertial model's kinematic rate (the stable step) */
   /* Shallow water's step: the points of stage 1, then per stage the faces
    * and the cells' update. */
   cl_kernel sw_prep, sw_faces[2], sw_update[2], sw_edges;
@@ -164,6 +165,7 @@ struct gr_rain_runoff {
   long long steps;
   gr_reduction ledger; /* the reduction behind the ledger and the stable step */
   gr_reduction speed;  /* shallow water's stable step: deepest cell, fastest wave rate */
+  gr_reduction film;   /* the local inertial model's: the fastest film (li_speed) */
   /* The step kernels' arguments other than the alternating face arrays are
    * set again only when they change: the parameters, the input fields or
    * dt (steps_dt). */
@@ -704,6 +706,8 @@ gr_status gr_rain_runoff_create(gr_context *ctx, const gr_grid *grid,
   if (st == GR_OK)
     st = gr_kernel_create(ctx, prog, "rain_runoff_sw_speed", &s->sw_speed);
   if (st == GR_OK)
+    st = gr_kernel_create(ctx, prog, "rain_runoff_li_speed", &s->li_speed);
+  if (st == GR_OK)
     st = gr_kernel_create(ctx, prog, "rain_runoff_maps", &s->maps);
   if (st == GR_OK)
     st = gr_kernel_create(ctx, prog, "rain_runoff_source", &s->source);
@@ -734,6 +738,8 @@ gr_status gr_rain_runoff_create(gr_context *ctx, const gr_grid *grid,
                            &s->ledger);
   if (st == GR_OK)
     st = gr_reduction_init(ctx, s->sw_speed, cells, 0, 2, &s->speed);
+  if (st == GR_OK)
+    st = gr_reduction_init(ctx, s->li_speed, cells, 0, 1, &s->film);
   /* Dry, flat ground; nothing infiltrated or gone. */
   cl_mem *zeroed[] = {&s->h,  &s->h_c,  &s->b,  &s->inf, &s->inf_c, &s->out, &s->out_c,
                       &s->in, &s->in_c, &s->h1, &s->qu1, &s->qv1,   &s->dh1, &s->dummy};
@@ -760,7 +766,7 @@ void gr_rain_runoff_destroy(gr_rain_runoff *s) {
   cl_kernel kernels[] = {s->flux,         s->limit,        s->update,      s->reduce,
                          s->derive,       s->sw_prep,      s->sw_faces[0], s->sw_faces[1],
                          s->sw_update[0], s->sw_update[1], s->sw_speed,    s->maps,
-                         s->source,       s->flux_edges,   s->sw_edges};
+                         s->source,       s->flux_edges,   s->sw_edges,    s->li_speed};
   for (size_t i = 0; i < sizeof(kernels) / sizeof(kernels[0]); ++i)
     if (kernels[i])
       clReleaseKernel(kernels[i]);
@@ -776,6 +782,7 @@ void gr_rain_runoff_destroy(gr_rain_runoff *s) {
     gr_buffer_release(&s->map[a]);
   gr_reduction_release(&s->ledger);
   gr_reduction_release(&s->speed);
+  gr_reduction_release(&s->film);
   for (int e = 0; e < 4; ++e) {
     free(s->edge_t[e]);
     free(s->edge_q[e]);
@@ -1993,6 +2000,19 @@ gr_status gr_rain_runoff_step(gr_rain_runoff *s, double dt, int nsteps) {
   return GR_RAIN_RUNOFF_KEEP_ERROR(s, gr_rain_runoff_step_impl(s, dt, nsteps));
 }
 
+/* The longest step dt whose gravity wave, in the water that rain and
+ * inflows arriving at `rate` (m/s of depth) make on dry (or still) ground
+ * within the step, r dt deep, crosses no more than `reach` metres:
+ *   sqrt(g r dt) dt <= reach,   dt = (reach / sqrt(g r))^(2/3).
+ * Both models' stable steps take it, each with its own reach: a step
+ * computed from the water there is before the step's rain lands is
+ * unbounded on dry ground (MaxTimeStep long), and the rain of that step,
+ * which the step's own faces already see, makes water whose waves it
+ * outruns. HUGE_VAL with no water arriving. */
+static double gr_rain_runoff_rain_dt(double rate, double reach) {
+  return rate > 0.0 ? pow(reach / sqrt(GR_GRAVITY * rate), 2.0 / 3.0) : HUGE_VAL;
+}
+
 /* Shallow water: the Courant condition of the explicit finite volumes on the
  * fastest waves of any cell, |u| + sqrt(g h) along x and |v| + sqrt(g h)
  * along y:  dt max(ax / dx + ay / dy) <= cfl / 2,
@@ -2048,8 +2068,8 @@ static gr_status gr_rain_runoff_sw_stable_dt(gr_rain_runoff *s, double *dt) {
    * Without it a dry grid's first step is MaxTimeStep long. */
   double r = maxes[2];
   if (r > 0.0) {
-    double inv = 1.0 / s->grid.dx + 1.0 / s->grid.dy;
-    double wet = pow(0.5 * s->params.cfl / (inv * sqrt(GR_GRAVITY * r)), 2.0 / 3.0);
+    double wet =
+        gr_rain_runoff_rain_dt(r, 0.5 * s->params.cfl / (1.0 / s->grid.dx + 1.0 / s->grid.dy));
     stable = wet < stable ? wet : stable;
   }
   /* Frictionless water on a slope gains g S dt of speed within the step,
@@ -2073,17 +2093,59 @@ static gr_status gr_rain_runoff_sw_stable_dt(gr_rain_runoff *s, double *dt) {
   return GR_OK;
 }
 
+/* The local inertial model's kinematic rate (1/s): rain_runoff_li_speed
+ * reduced over the owned cells. */
+static gr_status gr_rain_runoff_film_rate(gr_rain_runoff *s, double *rate) {
+  cl_int n = (cl_int)gr_rain_runoff_cells(s);
+  cl_int row = s->nxl, rows = s->nyl, own_x0 = s->ring[0], own_x1 = s->nxl - s->ring[1];
+  cl_int own_y0 = s->ring[2], own_y1 = s->nyl - s->ring[3];
+  cl_int use_nodata = s->has_nodata, use_n2 = s->has_n2;
+  cl_float n2 = (cl_float)(s->params.manning_n * s->params.manning_n);
+  cl_float inv_dx = (cl_float)(1.0 / s->grid.dx), inv_dy = (cl_float)(1.0 / s->grid.dy);
+  cl_float g = (cl_float)GR_GRAVITY, cfl = (cl_float)s->params.cfl;
+  const gr_rain_runoff_arg args[] = {
+      {"h", sizeof(cl_mem), &s->h},
+      {"b", sizeof(cl_mem), &s->b},
+      {"nodata", sizeof(cl_mem), s->has_nodata ? &s->nodata : &s->dummy},
+      {"use_nodata", sizeof(use_nodata), &use_nodata},
+      {"n2map", sizeof(cl_mem), s->has_n2 ? &s->n2map : &s->dummy},
+      {"use_n2", sizeof(use_n2), &use_n2},
+      {"n2", sizeof(n2), &n2},
+      {"n", sizeof(n), &n},
+      {"row", sizeof(row), &row},
+      {"rows", sizeof(rows), &rows},
+      {"own_x0", sizeof(own_x0), &own_x0},
+      {"own_x1", sizeof(own_x1), &own_x1},
+      {"own_y0", sizeof(own_y0), &own_y0},
+      {"own_y1", sizeof(own_y1), &own_y1},
+      {"inv_dx", sizeof(inv_dx), &inv_dx},
+      {"inv_dy", sizeof(inv_dy), &inv_dy},
+      {"g", sizeof(g), &g},
+      {"cfl", sizeof(cfl), &cfl},
+  };
+  gr_status st = GR_RAIN_RUNOFF_ARGS(s, s->li_speed, args);
+  if (st == GR_OK)
+    st = gr_reduction_run(s->ctx, &s->film, s->li_speed, NULL, rate);
+  return st;
+}
+
 static gr_status gr_rain_runoff_stable_dt_impl(gr_rain_runoff *s, double *dt) {
   if (s->params.flow_model == GR_FLOW_SHALLOW_WATER)
     return gr_rain_runoff_sw_stable_dt(s, dt);
-  double sums[GR_RAIN_RUNOFF_SUMS], hmax = 0.0;
-  gr_status st = gr_rain_runoff_reduce(s, sums, &hmax);
+  /* The deepest cell and the fastest that water arrives (m/s): the
+   * heaviest rain and the strongest inflow. */
+  double sums[GR_RAIN_RUNOFF_SUMS], maxes[3] = {0.0, 0.0, 0.0};
+  gr_status st = gr_rain_runoff_reduce(s, sums, &maxes[0]);
+  if (st == GR_OK)
+    st = gr_rain_runoff_film_rate(s, &maxes[2]);
+  maxes[1] =
+      (s->has_rain ? s->rain_field_max : gr_rain_runoff_rain_max(s)) + gr_rain_runoff_source_max(s);
   /* A level edge's water counts as the grid's. */
   double edge = gr_rain_runoff_edge_depth(s);
-  hmax = edge > hmax ? edge : hmax;
-  /* The deepest cell of the whole domain: every piece takes the same step. */
+  maxes[0] = edge > maxes[0] ? edge : maxes[0];
+  /* The whole domain's: every piece takes the same step. */
   if (st == GR_OK && s->allreduce)
-    st = gr_rain_runoff_allreduce(s, &hmax, 1, GR_REDUCE_MAX);
+    st = gr_rain_runoff_allreduce(s, maxes, 3, GR_REDUCE_MAX);
   if (st != GR_OK)
     return st;
   /* The scheme's stability limit in 2-D for gravity waves, c = sqrt(g h)
@@ -2094,11 +2156,50 @@ static gr_status gr_rain_runoff_stable_dt_impl(gr_rain_runoff *s, double *dt) {
    * allows steps sqrt(2 / theta) times too long.) cfl is the fraction of the
    * limit taken. The flow speed |u| is left out on purpose: the local
    * inertial equations have no advection term, and q / h of a cell that a
-   * step has just drained would shrink the step for nothing. */
-  double c = sqrt(GR_GRAVITY * hmax);
+   * step has just drained would shrink the step for nothing.
+   *   The rain and inflow of the step add to that: the step's faces see
+   * each cell's depth after them, h + r dt. On dry ground, where h_max
+   * alone allowed any step up to MaxTimeStep, the step also keeps the
+   * waves of r dt within the limit (gr_rain_runoff_rain_dt). Each bound is
+   * a function of one maximum, as shallow water's are, so that pieces taking
+   * the smallest of their steps take the whole grid's; where both bind, h +
+   * r dt is at most twice the depth either allows, a wave sqrt(2) faster:
+   * within the limit while cfl <= 1 / sqrt(2) (the default is 0.7).
+   *   Friction adds a bound of its own on thin films on steep slopes.
+   * It is implicit (Bates et al. 2010):
+   *   q' (1 + kf |q'|) = q~ - g h dt S,   kf = g dt n^2 / h^(7/3),
+   * so a long step tends to the Manning discharge h^(5/3) sqrt|S| / n and
+   * never beyond it, and q's response to the surface slope, dq'/dS =
+   * -g h dt / (1 + 2 kf |q'|), is at most the frictionless g h dt: as a
+   * diffusion of the surface its explicit limit lies within the gravity-wave
+   * limit above. Its response to the depth is not bounded so. With
+   * kf q'^2 = g h dt |S| - q' (for q~ = 0),
+   *   dq'/dh = g dt |S| (10/3 - (7/3) q' / (g h dt |S|)) / (1 + 2 kf |q'|),
+   * the celerity of the film's kinematic wave: 5/3 of the Manning speed
+   * u = h^(2/3) sqrt|S| / n on a long step, at most (10/3) g |S| dt on a
+   * short one. That wave moves upwind and explicitly, monotone only while it
+   * crosses at most a cell a step, dt dq'/dh / dx <= 1, and u / sqrt(g h)
+   * (the Froude number, h^(1/6) sqrt|S| / (n sqrt g): 2.7 for 1 cm on a
+   * slope of 0.3 with n 0.03, 8 with n 0.01) is not bounded: a
+   * supercritical film takes gravity-limited steps in which it would leave
+   * its cell several times over. The limiter then lets each cell empty once
+   * a step, the water moves a cell a step, slower than the film, and piles
+   * up: with no cap, tilted_plane_uncapped's plane of slope 0.3 with n 0.01
+   * stood two to three times too deep. So also dt <= cfl / rate, the rate
+   * the fastest face's of rain_runoff_li_speed: min(5/3 u / d, sqrt(cfl
+   * (10/3) g |S| / d)) per face, each direction's Courant condition on its
+   * own faces (as the faces of the two directions are computed apart). It
+   * takes each face's Manning speed from its depth and surface slope, not
+   * q / h, which a cell just drained makes large for nothing; a lake at
+   * rest has none. */
   double inv = sqrt(1.0 / (s->grid.dx * s->grid.dx) + 1.0 / (s->grid.dy * s->grid.dy));
+  double c = sqrt(GR_GRAVITY * maxes[0]);
   double stable =
       c > 0.0 ? s->params.cfl * sqrt(GR_RAIN_RUNOFF_THETA) / (c * inv) : s->params.max_dt;
+  double wet = gr_rain_runoff_rain_dt(maxes[1], s->params.cfl * sqrt(GR_RAIN_RUNOFF_THETA) / inv);
+  stable = wet < stable ? wet : stable;
+  double film = maxes[2] > 0.0 ? s->params.cfl / maxes[2] : HUGE_VAL;
+  stable = film < stable ? film : stable;
   *dt = stable < s->params.max_dt ? stable : s->params.max_dt;
   return GR_OK;
 }
