@@ -1078,12 +1078,23 @@ typedef struct pc_team {
 
 typedef struct pc_runner {
   pc_team *t;
-  int rank, tilted, exchanges, reductions;
+  int rank, exchanges, reductions;
+  /* Steps k0 .. k1 - 1 of the scene; the state saved after save_at steps
+   * (0: none); a progress callback that stops after stop_at steps (0: none). */
+  int k0, k1, save_at, stop_at, calls, taken;
   gr_grid g;
   gr_snow_accumulation *s;
-  gr_status st;
+  gr_status st, last;
   gr_snow_accumulation_ledger l;
+  void *state;
+  size_t state_bytes;
 } pc_runner;
+
+static int pc_stop(void *user, double time) {
+  pc_runner *r = user;
+  (void)time;
+  return ++r->calls >= r->stop_at;
+}
 
 static gr_status pc_allreduce(void *user, double *values, int n, gr_reduce_op op) {
   pc_runner *r = user;
@@ -1130,14 +1141,24 @@ static void *pc_run(void *arg) {
   pc_scene sc;
   mesh_faces(&sc.box, 1.0, 1.2, 0.6, 6);
   gr_status st = GR_OK;
-  for (int k = 0; st == GR_OK && k < PC_STEPS; ++k) {
+  if (r->stop_at)
+    gr_snow_accumulation_set_progress(r->s, pc_stop, r);
+  for (int k = r->k0; st == GR_OK && k < r->k1; ++k) {
     pc_pose(&sc, k);
     st = gr_snow_accumulation_set_objects(r->s, &sc.box.m, 1);
     if (st == GR_OK)
       st = gr_snow_accumulation_step(r->s, 90.0);
+    if (st == GR_OK && ++r->taken == r->save_at) {
+      st = gr_snow_accumulation_state_size(r->s, &r->state_bytes);
+      r->state = st == GR_OK ? malloc(r->state_bytes) : NULL;
+      if (r->state)
+        st = gr_snow_accumulation_state_save(r->s, r->state, r->state_bytes);
+    }
   }
+  r->last = st;
   gr_status s2 = gr_snow_accumulation_ledger_get(r->s, &r->l);
   r->st = st == GR_OK ? s2 : st;
+  gr_snow_accumulation_set_progress(r->s, NULL, NULL);
   mesh_free(&sc.box);
   return NULL;
 }
@@ -1167,13 +1188,63 @@ static long pc_diff(const float *a, const float *b, size_t n) {
   return d;
 }
 
+/* Every own point of snow depth, surface and exposure, the box's snow and
+ * exposure per mesh point and every ledger value of the pieces against the
+ * whole grid's, to the bit. */
+static void pc_check(const pc_domain *dm, int tilted, int n, pc_runner *rn,
+                     const gr_snow_accumulation_ledger *lw, const float *wf[3], const float *wo[2],
+                     int nv, const char *how) {
+  const gr_field fields[3] = {GR_FIELD_SNOW_DEPTH, GR_FIELD_SNOW_SURFACE, GR_FIELD_EXPOSURE};
+  for (int k = 0; k < n; ++k) {
+    CHECK_MSG(rn[k].st == GR_OK, "%d pieces%s, piece %d: %s", n, how, k,
+              gr_snow_accumulation_last_error(rn[k].s));
+    size_t own = (size_t)dm->g.nx * rn[k].g.ny, at = (size_t)rn[k].g.j0 * dm->g.nx;
+    for (int f = 0; f < 3; ++f) {
+      float *v = get(rn[k].s, fields[f], (int)own);
+      long d = pc_diff(v, wf[f] + at, own);
+      CHECK_MSG(d == 0, "%s, %d pieces%s: piece %d: %ld points of %s differ from the whole grid",
+                tilted ? "tilted" : "vertical", n, how, k, d, gr_field_name(fields[f]));
+      free(v);
+    }
+    for (int f = 0; f < 2; ++f) {
+      float *v = get_object(rn[k].s, 0, f ? GR_FIELD_EXPOSURE : GR_FIELD_SNOW_DEPTH, nv);
+      long d = pc_diff(v, wo[f], (size_t)nv);
+      CHECK_MSG(d == 0, "%d pieces%s: piece %d: %ld mesh points' %s differ", n, how, k, d,
+                f ? "exposure" : "snow depth");
+      free(v);
+    }
+    const gr_snow_accumulation_ledger *a = &rn[k].l;
+    int same = a->steps == lw->steps && a->time == lw->time &&
+               a->initial_volume == lw->initial_volume &&
+               a->snowfall_volume == lw->snowfall_volume && a->stored_volume == lw->stored_volume &&
+               a->stored_volume_terrain == lw->stored_volume_terrain &&
+               a->stored_volume_objects == lw->stored_volume_objects &&
+               a->shed_volume == lw->shed_volume && a->dropped_volume == lw->dropped_volume &&
+               a->balance_error == lw->balance_error;
+    CHECK_MSG(same,
+              "%d pieces%s: piece %d's ledger: stored %.17g fallen %.17g shed %.17g initial "
+              "%.17g, the whole grid's %.17g %.17g %.17g %.17g",
+              n, how, k, a->stored_volume, a->snowfall_volume, a->shed_volume, a->initial_volume,
+              lw->stored_volume, lw->snowfall_volume, lw->shed_volume, lw->initial_volume);
+  }
+}
+
+/* Runs the pieces on n threads. */
+static void pc_team_run(pc_runner *rn, pthread_t *th, int n) {
+  for (int k = 0; k < n; ++k)
+    pthread_create(&th[k], NULL, pc_run, &rn[k]);
+  for (int k = 0; k < n; ++k)
+    pthread_join(th[k], NULL);
+}
+
 /* The whole grid against n pieces (cut at rows cuts[0..n-2]) through the
- * same scene: every own point of snow depth, surface and exposure, the
- * box's snow and exposure per mesh point and every ledger value, to the
- * bit. */
+ * same scene (pc_check); then each piece's checkpoint after half the steps
+ * loaded back, and the second half again (pc_check); then a stop asked by
+ * the last piece's progress callback after 3 steps, which stops every
+ * piece after step 3. */
 static void pc_split(const pc_domain *dm, int tilted, int n, const int *cuts,
-                     gr_snow_accumulation *whole, const gr_snow_accumulation_ledger *lw,
-                     const float *wf[3], const float *wo[2], int nv) {
+                     const gr_snow_accumulation_ledger *lw, const float *wf[3], const float *wo[2],
+                     int nv) {
   gr_snow_accumulation_params p;
   pc_params(&p, tilted);
   int ghost = gr_snow_accumulation_ghost(&p);
@@ -1187,7 +1258,7 @@ static void pc_split(const pc_domain *dm, int tilted, int n, const int *cuts,
   for (int k = 0; k < n; ++k) {
     memset(&rn[k], 0, sizeof(rn[k]));
     int j0 = k ? cuts[k - 1] : 0, j1 = k + 1 < n ? cuts[k] : dm->g.ny;
-    rn[k].t = &t, rn[k].rank = k, rn[k].tilted = tilted;
+    rn[k].t = &t, rn[k].rank = k, rn[k].k1 = PC_STEPS, rn[k].save_at = PC_STEPS / 2;
     rn[k].s = pc_piece(dm, &p, j0, j1 - j0, ghost, &rn[k].g);
     ok = ok && rn[k].s;
     t.slot[k] = malloc(GR_SNOW_ACCUMULATION_REDUCE_CHUNK * sizeof(double));
@@ -1204,49 +1275,42 @@ static void pc_split(const pc_domain *dm, int tilted, int n, const int *cuts,
     }
   }
   if (ok) {
-    for (int k = 0; k < n; ++k)
-      pthread_create(&th[k], NULL, pc_run, &rn[k]);
-    for (int k = 0; k < n; ++k)
-      pthread_join(th[k], NULL);
+    pc_team_run(rn, th, n);
+    pc_check(dm, tilted, n, rn, lw, wf, wo, nv, "");
   }
-  const gr_field fields[3] = {GR_FIELD_SNOW_DEPTH, GR_FIELD_SNOW_SURFACE, GR_FIELD_EXPOSURE};
+  int exchanges = rn[0].exchanges, reductions = rn[0].reductions;
   for (int k = 0; ok && k < n; ++k) {
-    CHECK_MSG(rn[k].st == GR_OK, "%d pieces, piece %d: %s", n, k,
-              gr_snow_accumulation_last_error(rn[k].s));
-    size_t own = (size_t)dm->g.nx * rn[k].g.ny, at = (size_t)rn[k].g.j0 * dm->g.nx;
-    for (int f = 0; f < 3; ++f) {
-      float *v = get(rn[k].s, fields[f], (int)own);
-      long d = pc_diff(v, wf[f] + at, own);
-      CHECK_MSG(d == 0, "%s, %d pieces: piece %d: %ld points of %s differ from the whole grid",
-                tilted ? "tilted" : "vertical", n, k, d, gr_field_name(fields[f]));
-      free(v);
-    }
-    for (int f = 0; f < 2; ++f) {
-      float *v = get_object(rn[k].s, 0, f ? GR_FIELD_EXPOSURE : GR_FIELD_SNOW_DEPTH, nv);
-      long d = pc_diff(v, wo[f], (size_t)nv);
-      CHECK_MSG(d == 0, "%d pieces: piece %d: %ld mesh points' %s differ", n, k, d,
-                f ? "exposure" : "snow depth");
-      free(v);
-    }
-    const gr_snow_accumulation_ledger *a = &rn[k].l;
-    int same = a->steps == lw->steps && a->time == lw->time &&
-               a->initial_volume == lw->initial_volume &&
-               a->snowfall_volume == lw->snowfall_volume && a->stored_volume == lw->stored_volume &&
-               a->stored_volume_terrain == lw->stored_volume_terrain &&
-               a->stored_volume_objects == lw->stored_volume_objects &&
-               a->shed_volume == lw->shed_volume && a->dropped_volume == lw->dropped_volume &&
-               a->balance_error == lw->balance_error;
-    CHECK_MSG(same,
-              "%d pieces: piece %d's ledger: stored %.17g fallen %.17g shed %.17g initial %.17g, "
-              "the whole grid's %.17g %.17g %.17g %.17g",
-              n, k, a->stored_volume, a->snowfall_volume, a->shed_volume, a->initial_volume,
-              lw->stored_volume, lw->snowfall_volume, lw->shed_volume, lw->initial_volume);
+    CHECK(rn[k].state != NULL);
+    ok = rn[k].state &&
+         gr_snow_accumulation_state_load(rn[k].s, rn[k].state, rn[k].state_bytes) == GR_OK;
+    rn[k].k0 = PC_STEPS / 2, rn[k].save_at = 0, rn[k].taken = 0;
   }
-  printf("pieces (%s snow): %d pieces, ring %d rows: fields, box and ledger equal the whole grid; "
-         "piece 0 made %d exchanges and %d reductions in %d steps\n",
-         tilted ? "tilted" : "vertical", n, ghost, rn[0].exchanges, rn[0].reductions, PC_STEPS);
+  if (ok) {
+    /* A piece's state loads into that piece only. */
+    CHECK(gr_snow_accumulation_state_load(rn[1].s, rn[0].state, rn[0].state_bytes) != GR_OK);
+    pc_team_run(rn, th, n);
+    pc_check(dm, tilted, n, rn, lw, wf, wo, nv, " (from the checkpoints)");
+  }
+  for (int k = 0; ok && k < n; ++k) {
+    ok = gr_snow_accumulation_reset(rn[k].s) == GR_OK;
+    rn[k].k0 = 0, rn[k].k1 = PC_STEPS, rn[k].taken = 0, rn[k].calls = 0;
+    rn[k].stop_at = k == n - 1 ? 3 : 0;
+  }
+  if (ok) {
+    pc_team_run(rn, th, n);
+    for (int k = 0; k < n; ++k)
+      CHECK_MSG(rn[k].taken == 3 && rn[k].last == GR_ERR_ABORTED && rn[k].l.steps == 3,
+                "%d pieces, piece %d: %d steps taken (%s) after a stop on piece %d's third", n, k,
+                rn[k].taken, gr_status_string(rn[k].last), n - 1);
+  }
+  CHECK(ok);
+  printf("pieces (%s snow): %d pieces, ring %d rows: fields, box and ledger equal the whole grid, "
+         "from checkpoints too; a stop on one piece stops all; piece 0 made %d exchanges and %d "
+         "reductions in %d steps\n",
+         tilted ? "tilted" : "vertical", n, ghost, exchanges, reductions, PC_STEPS);
   for (int k = 0; k < n; ++k) {
     gr_snow_accumulation_destroy(rn[k].s);
+    free(rn[k].state);
     free(t.slot[k]);
     for (int side = 2; side < 4; ++side)
       free(t.mail[k][side]);
@@ -1317,8 +1381,8 @@ static void test_pieces(void) {
                 "the sunk box's sides: %d hidden, %d open (both expected)", side_hidden, side_open);
     CHECK(fabs(lw.balance_error) < 1e-9 * lw.stored_volume);
     const int cuts2[1] = {24}, cuts3[2] = {16, 32};
-    pc_split(&dm, tilted, 2, cuts2, whole, &lw, (const float **)wf, (const float **)wo, nv);
-    pc_split(&dm, tilted, 3, cuts3, whole, &lw, (const float **)wf, (const float **)wo, nv);
+    pc_split(&dm, tilted, 2, cuts2, &lw, (const float **)wf, (const float **)wo, nv);
+    pc_split(&dm, tilted, 3, cuts3, &lw, (const float **)wf, (const float **)wo, nv);
     for (int f = 0; f < 3; ++f)
       free(wf[f]);
     free(wo[0]), free(wo[1]);

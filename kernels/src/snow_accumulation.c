@@ -516,27 +516,30 @@ static gr_status gr_snac_rows(gr_snow_accumulation *s, double *out) {
 
 /* The grid's ledger sums, m per unit area: stored, fallen, shed and
  * initial snow. Each piece puts its rows' sums at their rows of the domain
- * (zero elsewhere), the allreduce makes every row's the same on every
- * piece (a value plus zeros is exact), and the rows are added in the
- * domain's order: the same bits however the domain is split. A piece
- * without an allreduce adds its own rows. */
+ * (-inf elsewhere), a GR_REDUCE_MAX makes every row's the same on every
+ * piece (one value and -infs: exact in any order and with any reduction
+ * scheme, unlike a sum), and the rows are added in the domain's order: the
+ * same bits however the domain is split. A piece without an allreduce
+ * adds its own rows. */
 static gr_status gr_snac_grid_sums(gr_snow_accumulation *s, double sums[4]) {
   int global = gr_snac_pieced(s) && s->allreduce;
   size_t R = global ? (size_t)s->gny : (size_t)s->own_ny;
   size_t base = global ? (size_t)(s->row0 + s->ring_s) : 0;
-  double *rows = calloc(4 * R, sizeof(double));
+  double *rows = malloc(4 * R * sizeof(double));
   double *own = malloc((size_t)s->own_ny * GR_SNAC_SUMS * sizeof(double));
   gr_status st =
       rows && own ? GR_OK : gr_set_error(s->ctx, GR_ERR_OUT_OF_MEMORY, "Out of host memory.");
   if (st == GR_OK)
     st = gr_snac_rows(s, own);
+  for (size_t k = 0; st == GR_OK && k < 4 * R; ++k)
+    rows[k] = -HUGE_VAL;
   for (size_t r = 0; st == GR_OK && r < (size_t)s->own_ny; ++r) {
     for (int q = 0; q < GR_SNAC_SUMS; ++q)
       rows[4 * (base + r) + (size_t)q] = own[GR_SNAC_SUMS * r + (size_t)q];
     rows[4 * (base + r) + 3] = s->init_rows[r];
   }
   if (st == GR_OK && global)
-    st = gr_snac_allreduce(s, rows, 4 * R, GR_REDUCE_SUM);
+    st = gr_snac_allreduce(s, rows, 4 * R, GR_REDUCE_MAX);
   for (int q = 0; q < 4; ++q)
     sums[q] = 0.0;
   for (size_t r = 0; st == GR_OK && r < R; ++r)

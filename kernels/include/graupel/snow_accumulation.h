@@ -334,10 +334,12 @@ GR_API gr_status gr_snow_accumulation_reset(gr_snow_accumulation *s);
  * The ledger: the grid's stored, fallen and shed snow and its initial
  * snow are summed per row (in a fixed order along the row), and the rows
  * are added in the order of the domain's rows: each piece places its rows'
- * sums in an array of the domain's rows, zero elsewhere, GR_REDUCE_SUM
- * makes it every piece's (a sum of one value and zeros is exact), and the
- * host adds the rows in order. So the ledger is the same bits for 1, 2 or
- * any number of pieces, and the same as the whole grid's.
+ * sums in an array of the domain's rows, -inf elsewhere, GR_REDUCE_MAX
+ * makes it every piece's (one value and -infs: exact in any order), and
+ * the host adds the rows in order. So the ledger is the same bits for 1, 2
+ * or any number of pieces, and the same as the whole grid's. Every
+ * reduction this core asks for is a GR_REDUCE_MAX, so its bits never depend
+ * on how the allreduce orders a sum.
  *
  * Stepping on pieces is collective: every piece sets the same parameters
  * and objects and calls step with the same dt, and each step makes the
