@@ -241,7 +241,11 @@ GR_API gr_status gr_snow_accumulation_set_object_texture(gr_snow_accumulation *s
 GR_API gr_status gr_snow_accumulation_get_object_texture(gr_snow_accumulation *s, int o,
                                                          float *texels, int size);
 
-/** One step of dt seconds (finite, 1e-6 to 86400); enqueues and does not wait. */
+/**
+ * One step of dt seconds (finite, 1e-6 to 86400); enqueues and does not
+ * wait. A piece with neighbours waits for its exchange and reductions, and
+ * steps only with an allreduce and a halo exchange set (collective).
+ */
 GR_API gr_status gr_snow_accumulation_step(gr_snow_accumulation *s, double dt);
 
 /**
