@@ -29,7 +29,9 @@
 #include "GraupelArrays.h"
 #include "GraupelObjects.h"
 #include "GraupelParameterTable.h"
+#include "GraupelPieces.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <string>
@@ -81,6 +83,12 @@ vtkSnowAccumulationFilter::vtkSnowAccumulationFilter() {
   this->StabilityFactor = TableDefault("StabilityFactor", 1.0);
   this->SnowDensity = TableDefault("SnowDensity", 100.0);
   this->AccumulationTextureSize = static_cast<int>(TableDefault("AccumulationTextureSize", 256.0));
+  // The core runs as pieces of a split domain (an MPI run's strips); its
+  // ring follows BlurRadius (RequestInformation sets it again).
+  gr_snow_accumulation_params ring;
+  gr_snow_accumulation_params_init(&ring);
+  ring.blur_radius = this->BlurRadius;
+  this->SetPieceRing(gr_snow_accumulation_ghost(&ring));
 }
 
 vtkSnowAccumulationFilter::~vtkSnowAccumulationFilter() {
@@ -188,6 +196,13 @@ vtkTypeBool vtkSnowAccumulationFilter::ProcessRequest(vtkInformation *request,
 int vtkSnowAccumulationFilter::RequestInformation(vtkInformation *request,
                                                   vtkInformationVector **inputVector,
                                                   vtkInformationVector *outputVector) {
+  // The ring follows BlurRadius, BlurRadius + 2 rows (gr_snow_accumulation_ghost):
+  // a property change comes through here before the next RequestData plans the pieces.
+  gr_snow_accumulation_params ring;
+  gr_snow_accumulation_params_init(&ring);
+  const gr_param_bound *blur = Bound("BlurRadius");
+  ring.blur_radius = std::max(0, std::min(this->BlurRadius, blur ? int(blur->max) : 0));
+  this->SetPieceRing(gr_snow_accumulation_ghost(&ring));
   const int ok = this->Superclass::RequestInformation(request, inputVector, outputVector);
   // The objects' output has the simulation's times, not the input's.
   vtkInformation *image = outputVector->GetInformationObject(0);
@@ -567,12 +582,33 @@ int vtkSnowAccumulationFilter::SetUpState(vtkInformationVector **inputVector) {
   }
   gr_grid grid;
   TerrainGrid(terrain, &grid);
+  // A split run's strip: its rows, its ring and the whole domain around it.
+  // Every rank keeps every object (their snow is the same bits on each);
+  // the core combines the ranks' exposure views, the surface under the
+  // objects and the ledger's rows through the allreduce, so every rank's
+  // snow and ledger are the whole grid's.
+  graupel::Pieces &pieces = this->GetPieces();
+  pieces.PieceGrid(&grid);
   st = gr_snow_accumulation_create(ctx, &grid, &p, &this->Simulation);
   if (st != GR_OK) {
     return this->ReportFailure(st, "Snow Accumulation could not set up the simulation");
   }
+  if (pieces.IsSplit()) {
+    gr_snow_accumulation *sim = this->Simulation;
+    pieces.BindHalo(
+        [sim](int side, size_t *bytes) { return gr_snow_accumulation_halo_size(sim, side, bytes); },
+        [sim](int side, void *host, size_t bytes) {
+          return gr_snow_accumulation_halo_get(sim, side, host, bytes);
+        },
+        [sim](int side, const void *host, size_t bytes) {
+          return gr_snow_accumulation_halo_set(sim, side, host, bytes);
+        });
+    gr_snow_accumulation_set_allreduce(sim, graupel::Pieces::Allreduce, &pieces);
+    gr_snow_accumulation_set_halo_exchange(sim, graupel::Pieces::Exchange, &pieces);
+  }
   for (const Upload &u : uploads) {
-    st = gr_snow_accumulation_set_field(this->Simulation, u.field, u.values->GetPointer(0));
+    const std::vector<float> local = pieces.LocalField(u.values->GetPointer(0), dims[0], 1);
+    st = gr_snow_accumulation_set_field(this->Simulation, u.field, local.data());
     if (st != GR_OK) {
       vtkErrorMacro(
           "Snow Accumulation's Input: " << gr_snow_accumulation_last_error(this->Simulation));

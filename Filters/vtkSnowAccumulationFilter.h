@@ -60,6 +60,14 @@
  * Time defaults (SetTimeDefaults): EndTime 6 h (21600 s), OutputInterval
  * 15 min (900 s), in TimeSteps of 5 min: a snowfall of a few hours.
  *
+ * MPI (pvbatch, pvserver): each rank simulates its strip of the grid with
+ * the core's ring of BlurRadius + 2 rows (gr_snow_accumulation_ghost; see
+ * vtkGraupelSimulation, "Distributed runs"); every rank keeps every object,
+ * the core combines the ranks' exposure views and ledger rows over the
+ * ranks, and every rank's snow, objects and ledger are the whole grid's,
+ * bit for bit. Field data `piece_cells` gives the grid points the rank
+ * simulated, ring included; outputs 1 and 2 come on piece 0 only.
+ *
  * The model is described in kernels/include/graupel/snow_accumulation.h;
  * the setters clamp to its parameter table
  * (gr_snow_accumulation_param_bounds).

@@ -11,6 +11,7 @@
 #include "graupel/snow_accumulation.h"
 
 #include <math.h>
+#include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -1008,6 +1009,424 @@ static void test_textures(void) {
   }
 }
 
+/* ------------------------------------------------------------- pieces */
+
+/* The whole domain of the split tests: 40 x 48 points of 10 cm, ridges
+ * steep enough (slope up to 3) that tilted snow draws the terrain into the
+ * view, and snow of varying depth. */
+typedef struct pc_domain {
+  gr_grid g;
+  float *b, *d;
+} pc_domain;
+
+static pc_domain pc_make_domain(void) {
+  pc_domain dm;
+  gr_grid g = {.nx = 40, .ny = 48, .dx = 0.1, .dy = 0.1, .x0 = 3.0, .y0 = -1.0};
+  dm.g = g;
+  size_t n = (size_t)g.nx * g.ny;
+  dm.b = malloc(n * sizeof(float));
+  dm.d = malloc(n * sizeof(float));
+  for (int j = 0; j < g.ny; ++j)
+    for (int i = 0; i < g.nx; ++i) {
+      double x = i * g.dx, y = j * g.dy;
+      dm.b[(size_t)j * g.nx + i] = (float)(12.0 + 0.45 * sin(x * 6.0) * cos(y * 2.0) + 0.2 * y);
+      dm.d[(size_t)j * g.nx + i] = (float)(0.05 + 0.05 * cos(x * 3.0 + y * 5.0));
+    }
+  return dm;
+}
+
+/* The scene at step k: a box of 2 x 2.4 m crossing every cut (rows 16,
+ * 24, 32), sunk 0.2 m into the ground's middle height and sliding along x;
+ * tilted, fluttering snow (the terrain in the view) or straight down (the
+ * objects alone, buried mesh points found through the pieces' surface). */
+typedef struct pc_scene {
+  int tilted;
+  test_mesh box;
+} pc_scene;
+
+static void pc_params(gr_snow_accumulation_params *p, int tilted) {
+  gr_snow_accumulation_params_init(p);
+  p->snowfall_rate = 3e-4;
+  p->noise_amplitude = 0.3;
+  p->noise_scale = 0.35;
+  p->blur_radius = 2;
+  p->dilation = 1;
+  p->max_depth = 0.4;
+  p->stability_factor = 0.02;
+  p->exposure_resolution = 96;
+  p->seed = 7;
+  if (tilted) {
+    p->direction[0] = 0.5, p->direction[1] = 0.35;
+    p->flutter = 4.0 * M_PI / 180.0;
+  }
+}
+
+static void pc_pose(pc_scene *sc, int k) {
+  /* Grid point (i, j) is at (3 + 0.1 i, -1 + 0.1 j): rows 12 to 36. */
+  mesh_pose(&sc->box, 3.0 + 1.6 + 0.05 * k, -1.0 + 2.4, 12.0 + 0.2 * 2.4 + 0.6 - 0.2);
+}
+
+enum { PC_MAX = 3, PC_STEPS = 12 };
+
+typedef struct pc_team {
+  pthread_barrier_t barrier;
+  int n;
+  double *slot[PC_MAX];
+  void *mail[PC_MAX][4];
+  size_t bytes[PC_MAX][4];
+} pc_team;
+
+typedef struct pc_runner {
+  pc_team *t;
+  int rank, exchanges, reductions;
+  /* Steps k0 .. k1 - 1 of the scene; the state saved after save_at steps
+   * (0: none); a progress callback that stops after stop_at steps (0: none). */
+  int k0, k1, save_at, stop_at, calls, taken;
+  gr_grid g;
+  gr_snow_accumulation *s;
+  gr_status st, last;
+  gr_snow_accumulation_ledger l;
+  void *state;
+  size_t state_bytes;
+} pc_runner;
+
+static int pc_stop(void *user, double time) {
+  pc_runner *r = user;
+  (void)time;
+  return ++r->calls >= r->stop_at;
+}
+
+static gr_status pc_allreduce(void *user, double *values, int n, gr_reduce_op op) {
+  pc_runner *r = user;
+  pc_team *t = r->t;
+  if (n > GR_SNOW_ACCUMULATION_REDUCE_CHUNK)
+    return GR_ERR_INVALID_ARGUMENT;
+  ++r->reductions;
+  memcpy(t->slot[r->rank], values, (size_t)n * sizeof(double));
+  pthread_barrier_wait(&t->barrier);
+  for (int q = 0; q < n; ++q) {
+    double v = t->slot[0][q];
+    for (int k = 1; k < t->n; ++k) {
+      double w = t->slot[k][q];
+      v = op == GR_REDUCE_SUM ? v + w : op == GR_REDUCE_MAX ? fmax(v, w) : fmin(v, w);
+    }
+    values[q] = v;
+  }
+  pthread_barrier_wait(&t->barrier);
+  return GR_OK;
+}
+
+static gr_status pc_exchange(void *user) {
+  pc_runner *r = user;
+  pc_team *t = r->t;
+  gr_status st = GR_OK;
+  ++r->exchanges;
+  for (int side = 2; side < 4; ++side)
+    if (st == GR_OK && t->bytes[r->rank][side])
+      st = gr_snow_accumulation_halo_get(r->s, side, t->mail[r->rank][side],
+                                         t->bytes[r->rank][side]);
+  pthread_barrier_wait(&t->barrier);
+  for (int side = 2; side < 4; ++side) {
+    int other = side == 2 ? r->rank - 1 : r->rank + 1;
+    if (st == GR_OK && t->bytes[r->rank][side])
+      st = gr_snow_accumulation_halo_set(r->s, side, t->mail[other][side ^ 1],
+                                         t->bytes[r->rank][side]);
+  }
+  pthread_barrier_wait(&t->barrier);
+  return st;
+}
+
+static void *pc_run(void *arg) {
+  pc_runner *r = arg;
+  pc_scene sc;
+  mesh_faces(&sc.box, 1.0, 1.2, 0.6, 6);
+  gr_status st = GR_OK;
+  if (r->stop_at)
+    gr_snow_accumulation_set_progress(r->s, pc_stop, r);
+  for (int k = r->k0; st == GR_OK && k < r->k1; ++k) {
+    pc_pose(&sc, k);
+    st = gr_snow_accumulation_set_objects(r->s, &sc.box.m, 1);
+    if (st == GR_OK)
+      st = gr_snow_accumulation_step(r->s, 90.0);
+    if (st == GR_OK && ++r->taken == r->save_at) {
+      st = gr_snow_accumulation_state_size(r->s, &r->state_bytes);
+      r->state = st == GR_OK ? malloc(r->state_bytes) : NULL;
+      if (r->state)
+        st = gr_snow_accumulation_state_save(r->s, r->state, r->state_bytes);
+    }
+  }
+  r->last = st;
+  gr_status s2 = gr_snow_accumulation_ledger_get(r->s, &r->l);
+  r->st = st == GR_OK ? s2 : st;
+  gr_snow_accumulation_set_progress(r->s, NULL, NULL);
+  mesh_free(&sc.box);
+  return NULL;
+}
+
+/* A piece of rows j0 .. j0 + ny - 1 with rings of ghost rows. */
+static gr_snow_accumulation *pc_piece(const pc_domain *dm, const gr_snow_accumulation_params *p,
+                                      int j0, int ny, int ghost, gr_grid *g) {
+  *g = dm->g;
+  g->ny = ny, g->j0 = j0, g->global_ny = dm->g.ny, g->ghost = ghost;
+  int lo = j0 > 0 ? j0 - ghost : 0;
+  gr_snow_accumulation *s = NULL;
+  gr_status st = gr_snow_accumulation_create(ctx, g, p, &s);
+  CHECK_MSG(st == GR_OK, "piece: %s", gr_last_error(ctx));
+  size_t off = (size_t)lo * dm->g.nx;
+  if (st == GR_OK)
+    st = gr_snow_accumulation_set_field(s, GR_FIELD_ELEVATION, dm->b + off);
+  if (st == GR_OK)
+    st = gr_snow_accumulation_set_field(s, GR_FIELD_SNOW_DEPTH, dm->d + off);
+  CHECK_MSG(st == GR_OK, "piece field: %s", s ? gr_snow_accumulation_last_error(s) : "");
+  return s;
+}
+
+static long pc_diff(const float *a, const float *b, size_t n) {
+  long d = 0;
+  for (size_t c = 0; c < n; ++c)
+    d += memcmp(&a[c], &b[c], sizeof(float)) != 0;
+  return d;
+}
+
+/* Every own point of snow depth, surface and exposure, the box's snow and
+ * exposure per mesh point and every ledger value of the pieces against the
+ * whole grid's, to the bit. */
+static void pc_check(const pc_domain *dm, int tilted, int n, pc_runner *rn,
+                     const gr_snow_accumulation_ledger *lw, const float *wf[3], const float *wo[2],
+                     int nv, const char *how) {
+  const gr_field fields[3] = {GR_FIELD_SNOW_DEPTH, GR_FIELD_SNOW_SURFACE, GR_FIELD_EXPOSURE};
+  for (int k = 0; k < n; ++k) {
+    CHECK_MSG(rn[k].st == GR_OK, "%d pieces%s, piece %d: %s", n, how, k,
+              gr_snow_accumulation_last_error(rn[k].s));
+    size_t own = (size_t)dm->g.nx * rn[k].g.ny, at = (size_t)rn[k].g.j0 * dm->g.nx;
+    for (int f = 0; f < 3; ++f) {
+      float *v = get(rn[k].s, fields[f], (int)own);
+      long d = pc_diff(v, wf[f] + at, own);
+      CHECK_MSG(d == 0, "%s, %d pieces%s: piece %d: %ld points of %s differ from the whole grid",
+                tilted ? "tilted" : "vertical", n, how, k, d, gr_field_name(fields[f]));
+      free(v);
+    }
+    for (int f = 0; f < 2; ++f) {
+      float *v = get_object(rn[k].s, 0, f ? GR_FIELD_EXPOSURE : GR_FIELD_SNOW_DEPTH, nv);
+      long d = pc_diff(v, wo[f], (size_t)nv);
+      CHECK_MSG(d == 0, "%d pieces%s: piece %d: %ld mesh points' %s differ", n, how, k, d,
+                f ? "exposure" : "snow depth");
+      free(v);
+    }
+    const gr_snow_accumulation_ledger *a = &rn[k].l;
+    int same = a->steps == lw->steps && a->time == lw->time &&
+               a->initial_volume == lw->initial_volume &&
+               a->snowfall_volume == lw->snowfall_volume && a->stored_volume == lw->stored_volume &&
+               a->stored_volume_terrain == lw->stored_volume_terrain &&
+               a->stored_volume_objects == lw->stored_volume_objects &&
+               a->shed_volume == lw->shed_volume && a->dropped_volume == lw->dropped_volume &&
+               a->balance_error == lw->balance_error;
+    CHECK_MSG(same,
+              "%d pieces%s: piece %d's ledger: stored %.17g fallen %.17g shed %.17g initial "
+              "%.17g, the whole grid's %.17g %.17g %.17g %.17g",
+              n, how, k, a->stored_volume, a->snowfall_volume, a->shed_volume, a->initial_volume,
+              lw->stored_volume, lw->snowfall_volume, lw->shed_volume, lw->initial_volume);
+  }
+}
+
+/* Runs the pieces on n threads. */
+static void pc_team_run(pc_runner *rn, pthread_t *th, int n) {
+  for (int k = 0; k < n; ++k)
+    pthread_create(&th[k], NULL, pc_run, &rn[k]);
+  for (int k = 0; k < n; ++k)
+    pthread_join(th[k], NULL);
+}
+
+/* The whole grid against n pieces (cut at rows cuts[0..n-2]) through the
+ * same scene (pc_check); then each piece's checkpoint after half the steps
+ * loaded back, and the second half again (pc_check); then a stop asked by
+ * the last piece's progress callback after 3 steps, which stops every
+ * piece after step 3. */
+static void pc_split(const pc_domain *dm, int tilted, int n, const int *cuts,
+                     const gr_snow_accumulation_ledger *lw, const float *wf[3], const float *wo[2],
+                     int nv) {
+  gr_snow_accumulation_params p;
+  pc_params(&p, tilted);
+  int ghost = gr_snow_accumulation_ghost(&p);
+  pc_team t;
+  memset(&t, 0, sizeof(t));
+  t.n = n;
+  pthread_barrier_init(&t.barrier, NULL, (unsigned)n);
+  pc_runner rn[PC_MAX];
+  pthread_t th[PC_MAX];
+  int ok = 1;
+  for (int k = 0; k < n; ++k) {
+    memset(&rn[k], 0, sizeof(rn[k]));
+    int j0 = k ? cuts[k - 1] : 0, j1 = k + 1 < n ? cuts[k] : dm->g.ny;
+    rn[k].t = &t, rn[k].rank = k, rn[k].k1 = PC_STEPS, rn[k].save_at = PC_STEPS / 2;
+    rn[k].s = pc_piece(dm, &p, j0, j1 - j0, ghost, &rn[k].g);
+    ok = ok && rn[k].s;
+    t.slot[k] = malloc(GR_SNOW_ACCUMULATION_REDUCE_CHUNK * sizeof(double));
+    for (int side = 2; ok && side < 4; ++side) {
+      CHECK(gr_snow_accumulation_halo_size(rn[k].s, side, &t.bytes[k][side]) == GR_OK);
+      int has = side == 2 ? k > 0 : k + 1 < n;
+      CHECK(has ? t.bytes[k][side] == (size_t)ghost * dm->g.nx * sizeof(float)
+                : t.bytes[k][side] == 0);
+      t.mail[k][side] = t.bytes[k][side] ? malloc(t.bytes[k][side]) : NULL;
+    }
+    if (ok) {
+      gr_snow_accumulation_set_allreduce(rn[k].s, pc_allreduce, &rn[k]);
+      gr_snow_accumulation_set_halo_exchange(rn[k].s, pc_exchange, &rn[k]);
+    }
+  }
+  if (ok) {
+    pc_team_run(rn, th, n);
+    pc_check(dm, tilted, n, rn, lw, wf, wo, nv, "");
+  }
+  int exchanges = rn[0].exchanges, reductions = rn[0].reductions;
+  for (int k = 0; ok && k < n; ++k) {
+    CHECK(rn[k].state != NULL);
+    ok = rn[k].state &&
+         gr_snow_accumulation_state_load(rn[k].s, rn[k].state, rn[k].state_bytes) == GR_OK;
+    rn[k].k0 = PC_STEPS / 2, rn[k].save_at = 0, rn[k].taken = 0;
+  }
+  if (ok) {
+    /* A piece's state loads into that piece only. */
+    CHECK(gr_snow_accumulation_state_load(rn[1].s, rn[0].state, rn[0].state_bytes) != GR_OK);
+    pc_team_run(rn, th, n);
+    pc_check(dm, tilted, n, rn, lw, wf, wo, nv, " (from the checkpoints)");
+  }
+  for (int k = 0; ok && k < n; ++k) {
+    ok = gr_snow_accumulation_reset(rn[k].s) == GR_OK;
+    rn[k].k0 = 0, rn[k].k1 = PC_STEPS, rn[k].taken = 0, rn[k].calls = 0;
+    rn[k].stop_at = k == n - 1 ? 3 : 0;
+  }
+  if (ok) {
+    pc_team_run(rn, th, n);
+    for (int k = 0; k < n; ++k)
+      CHECK_MSG(rn[k].taken == 3 && rn[k].last == GR_ERR_ABORTED && rn[k].l.steps == 3,
+                "%d pieces, piece %d: %d steps taken (%s) after a stop on piece %d's third", n, k,
+                rn[k].taken, gr_status_string(rn[k].last), n - 1);
+  }
+  CHECK(ok);
+  printf("pieces (%s snow): %d pieces, ring %d rows: fields, box and ledger equal the whole grid, "
+         "from checkpoints too; a stop on one piece stops all; piece 0 made %d exchanges and %d "
+         "reductions in %d steps\n",
+         tilted ? "tilted" : "vertical", n, ghost, exchanges, reductions, PC_STEPS);
+  for (int k = 0; k < n; ++k) {
+    gr_snow_accumulation_destroy(rn[k].s);
+    free(rn[k].state);
+    free(t.slot[k]);
+    for (int side = 2; side < 4; ++side)
+      free(t.mail[k][side]);
+  }
+  pthread_barrier_destroy(&t.barrier);
+}
+
+/* Two and three pieces in one process (threads) give the whole grid's bits:
+ * tilted snow over steep ridges (the terrain drawn into the view, the
+ * views combined), and snow straight down on a sunk box (its mesh points
+ * under the snow surface found through the pieces), the box crossing every
+ * cut. Then the error paths of pieces. */
+static void test_pieces(void) {
+  pc_domain dm = pc_make_domain();
+  const int nx = dm.g.nx, ny = dm.g.ny, n = nx * ny;
+  for (int tilted = 1; tilted >= 0; --tilted) {
+    gr_snow_accumulation_params p;
+    pc_params(&p, tilted);
+    gr_snow_accumulation *whole = NULL;
+    gr_status st = gr_snow_accumulation_create(ctx, &dm.g, &p, &whole);
+    CHECK_MSG(st == GR_OK, "whole: %s", gr_last_error(ctx));
+    if (st != GR_OK)
+      break;
+    CHECK(gr_snow_accumulation_set_field(whole, GR_FIELD_ELEVATION, dm.b) == GR_OK);
+    CHECK(gr_snow_accumulation_set_field(whole, GR_FIELD_SNOW_DEPTH, dm.d) == GR_OK);
+    pc_scene sc;
+    mesh_faces(&sc.box, 1.0, 1.2, 0.6, 6);
+    for (int k = 0; k < PC_STEPS; ++k) {
+      pc_pose(&sc, k);
+      CHECK(gr_snow_accumulation_set_objects(whole, &sc.box.m, 1) == GR_OK);
+      st = gr_snow_accumulation_step(whole, 90.0);
+      CHECK_MSG(st == GR_OK, "whole step %d: %s", k, gr_snow_accumulation_last_error(whole));
+    }
+    gr_snow_accumulation_ledger lw;
+    CHECK(gr_snow_accumulation_ledger_get(whole, &lw) == GR_OK);
+    const int nv = sc.box.m.nvertices;
+    float *wf[3] = {get(whole, GR_FIELD_SNOW_DEPTH, n), get(whole, GR_FIELD_SNOW_SURFACE, n),
+                    get(whole, GR_FIELD_EXPOSURE, n)};
+    float *wo[2] = {get_object(whole, 0, GR_FIELD_SNOW_DEPTH, nv),
+                    get_object(whole, 0, GR_FIELD_EXPOSURE, nv)};
+    /* The scene does what it is for: tilted snow leaves grid points in
+     * the lee of the bare ridges hidden (no box), and straight down the
+     * box's side faces are hidden below the snow surface and open above
+     * it. */
+    int lee = 0, side_hidden = 0, side_open = 0, per = 7 * 7;
+    if (tilted) {
+      gr_snow_accumulation *bare = NULL;
+      CHECK(gr_snow_accumulation_create(ctx, &dm.g, &p, &bare) == GR_OK);
+      CHECK(gr_snow_accumulation_set_field(bare, GR_FIELD_ELEVATION, dm.b) == GR_OK);
+      run(bare, 2, 90.0);
+      float *e = get(bare, GR_FIELD_EXPOSURE, n);
+      for (int c = 0; c < n; ++c)
+        lee += e[c] == 0.0f;
+      free(e);
+      gr_snow_accumulation_destroy(bare);
+    }
+    for (int v = 2 * per; v < 6 * per; ++v)
+      side_hidden += wo[1][v] == 0.0f, side_open += wo[1][v] == 1.0f;
+    printf(
+        "pieces (%s snow): whole grid: %d hidden points on the bare ridges, box sides %d hidden, "
+        "%d open; ledger stored %.6g m^3 (balance %.3g)\n",
+        tilted ? "tilted" : "vertical", lee, side_hidden, side_open, lw.stored_volume,
+        lw.balance_error);
+    if (tilted)
+      CHECK_MSG(lee > 10, "tilted snow hides only %d grid points in the ridges' lee", lee);
+    else
+      CHECK_MSG(side_hidden > 10 && side_open > 10,
+                "the sunk box's sides: %d hidden, %d open (both expected)", side_hidden, side_open);
+    CHECK(fabs(lw.balance_error) < 1e-9 * lw.stored_volume);
+    const int cuts2[1] = {24}, cuts3[2] = {16, 32};
+    pc_split(&dm, tilted, 2, cuts2, &lw, (const float **)wf, (const float **)wo, nv);
+    pc_split(&dm, tilted, 3, cuts3, &lw, (const float **)wf, (const float **)wo, nv);
+    for (int f = 0; f < 3; ++f)
+      free(wf[f]);
+    free(wo[0]), free(wo[1]);
+    mesh_free(&sc.box);
+    gr_snow_accumulation_destroy(whole);
+  }
+  /* Error paths: a column split, a ring narrower than BlurRadius needs,
+   * a strip narrower than its ring, a piece stepping without callbacks,
+   * and a wider blur than the ring holds. */
+  gr_snow_accumulation_params p;
+  pc_params(&p, 0);
+  gr_snow_accumulation *s = NULL;
+  gr_grid g = dm.g;
+  g.global_nx = 2 * nx;
+  CHECK(gr_snow_accumulation_create(ctx, &g, &p, &s) == GR_ERR_INVALID_ARGUMENT && !s);
+  CHECK(strstr(gr_last_error(ctx), "along y only") != NULL);
+  g = dm.g;
+  g.ny = 24, g.j0 = 24, g.global_ny = ny, g.ghost = gr_snow_accumulation_ghost(&p) - 1;
+  CHECK(gr_snow_accumulation_create(ctx, &g, &p, &s) == GR_ERR_INVALID_ARGUMENT && !s);
+  CHECK(strstr(gr_last_error(ctx), "ghost ring") != NULL);
+  g.ny = 3, g.j0 = 24, g.ghost = 4;
+  CHECK(gr_snow_accumulation_create(ctx, &g, &p, &s) == GR_ERR_INVALID_ARGUMENT && !s);
+  g.ny = 24, g.j0 = 30;
+  CHECK(gr_snow_accumulation_create(ctx, &g, &p, &s) == GR_ERR_INVALID_ARGUMENT && !s);
+  g.j0 = 24;
+  CHECK(gr_snow_accumulation_create(ctx, &g, &p, &s) == GR_OK && s);
+  if (s) {
+    CHECK(gr_snow_accumulation_step(s, 1.0) == GR_ERR_INVALID_ARGUMENT);
+    CHECK(strstr(gr_snow_accumulation_last_error(s), "allreduce") != NULL);
+    gr_snow_accumulation_params wide = p;
+    wide.blur_radius = 3;
+    CHECK(gr_snow_accumulation_set_params(s, &wide) == GR_ERR_INVALID_ARGUMENT);
+    CHECK(strstr(gr_snow_accumulation_last_error(s), "BlurRadius 3") != NULL);
+    size_t bytes = 1;
+    CHECK(gr_snow_accumulation_halo_size(s, 2, &bytes) == GR_OK && bytes == 4 * (size_t)nx * 4);
+    CHECK(gr_snow_accumulation_halo_size(s, 3, &bytes) == GR_OK && bytes == 0);
+    float strip[4];
+    CHECK(gr_snow_accumulation_halo_get(s, 3, strip, sizeof(strip)) == GR_ERR_INVALID_ARGUMENT);
+    CHECK(gr_snow_accumulation_halo_set(s, 2, strip, sizeof(strip)) == GR_ERR_INVALID_ARGUMENT);
+  }
+  gr_snow_accumulation_destroy(s);
+  free(dm.b), free(dm.d);
+}
+
 static const gr_subtest tests[] = {
     {"param_table", test_param_table, 0},
     {"flat_growth", test_flat_growth, 0},
@@ -1022,6 +1441,7 @@ static const gr_subtest tests[] = {
     {"checkpoint", test_checkpoint, 0},
     {"persistence", test_persistence, 0},
     {"textures", test_textures, 0},
+    {"pieces", test_pieces, 0},
     {"errors", test_errors, 0},
     {"memcheck", test_memcheck, 1},
 };

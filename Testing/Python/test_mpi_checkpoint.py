@@ -1,6 +1,7 @@
 """mpiexec -n 1 and -n 2 pvbatch: checkpoint files and restarts. For Rain
-Runoff (shallow water, a point inflow, a wall and a level edge) and Snow
-Deformation (a sphere ploughing along the strips' edge): a run to output k
+Runoff (shallow water, a point inflow, a wall and a level edge), Snow
+Deformation (a sphere ploughing along the strips' edge) and Snow Accumulation
+(tilted snow over ridges, a box across the strips' edge): a run to output k
 with CheckpointFile writes a manifest and one .vti per rank; a fresh pipeline
 with RestartFile set to it, asked for output 2k, starts from output k (its
 RestartIndex) and gives, on every rank, the fields, the ledger (and Rain
@@ -115,6 +116,18 @@ def snow_deformation(**extra):
                            TimeStep=1.0 / 64.0, EndTime=0.5, OutputInterval=0.125, **extra)
 
 
+def snow_accumulation(**extra):
+    nx, ny, dx = 48, 104, 0.1
+    terrain = ProceduralTerrain(Dimensions=[nx, ny], Spacing=dx, Seed=11, Frequency=300.0,
+                                HeightScale=2.5)
+    box = Box(Center=[0.5 * (nx - 1) * dx, 0.5 * (ny - 1) * dx, 2.2], XLength=1.6, YLength=2.4,
+              ZLength=0.6)
+    return SnowAccumulation(Input=terrain, Objects=box, SnowDirection=[0.3, 1.0, -1.0],
+                            Flutter=3.0, SnowfallRate=8.0, ExposureResolution=96, BlurRadius=2,
+                            Dilation=1, MaxDepth=0.3, StabilityFactor=0.01, TimeStep=300.0,
+                            EndTime=1800.0, OutputInterval=900.0, **extra)
+
+
 def points(source, time):
     source.UpdatePipeline(time)
     return source.GetDataInformation().GetNumberOfPoints()
@@ -178,6 +191,7 @@ def refused(name, make, manifest, time, words):
 
 rr_manifest, rr = check_restart("rain_runoff", rain_runoff, 40.0, 80.0, True)
 sd_manifest, sd = check_restart("snow_deformation", snow_deformation, 0.25, 0.5, False)
+check_restart("snow_accumulation", snow_accumulation, 900.0, 1800.0, False)
 
 # A manifest of another number of ranks: this run's ranks split (or not) otherwise.
 other = dict(rr)

@@ -74,17 +74,20 @@ GR_INLINE float3 snac_project(float x, float y, float z, float tau_x, float tau_
 /* The snow surface as two triangles per grid cell. */
 __kernel void snow_accumulation_raster_terrain(__global const float *restrict ground,
                                                __global const float *restrict depth, int nx, int ny,
-                                               float dx, float dy, float zref, float tau_x,
-                                               float tau_y, float qx0, float qy0, float inv_texel,
-                                               int vw, int vh, __global int *restrict view) {
+                                               int gi0, int gj0, float dx, float dy, float zref,
+                                               float tau_x, float tau_y, float qx0, float qy0,
+                                               float inv_texel, int vw, int vh,
+                                               __global int *restrict view) {
   int i = get_global_id(0), j = get_global_id(1);
   if (i >= nx - 1 || j >= ny - 1)
     return;
   float3 p[4];
   for (int k = 0; k < 4; ++k) {
     int a = i + (k & 1), b = j + (k >> 1), c = gr_idx(a, b, nx);
-    p[k] = snac_project((float)a * dx, (float)b * dy, (ground[c] + depth[c]) - zref, tau_x, tau_y,
-                        qx0, qy0, inv_texel);
+    /* (gi0, gj0): the domain's index of local point (0, 0), so that a
+     * piece's cells are the whole grid's floats. */
+    p[k] = snac_project((float)(gi0 + a) * dx, (float)(gj0 + b) * dy, (ground[c] + depth[c]) - zref,
+                        tau_x, tau_y, qx0, qy0, inv_texel);
   }
   snac_raster(view, vw, vh, p[0], p[1], p[3]);
   snac_raster(view, vw, vh, p[0], p[3], p[2]);
@@ -197,33 +200,33 @@ GR_INLINE float3 snac_normal(__global const float *restrict b, __global const fl
  * tested against the view; the growth faces the ground's normal. */
 /* The noise of every grid point, fixed in space: computed once per seed and
  * scale (snow_accumulation_noise), read every step. */
-__kernel void snow_accumulation_noise(int nx, int ny, float noise_x0, float noise_y0,
-                                      float noise_dx, float noise_dy, uint seed,
+__kernel void snow_accumulation_noise(int nx, int ny, int gi0, int gj0, float noise_x0,
+                                      float noise_y0, float noise_dx, float noise_dy, uint seed,
                                       __global float *restrict noise) {
   int i = get_global_id(0), j = get_global_id(1);
   if (!gr_inside(i, j, nx, ny))
     return;
-  noise[gr_idx(i, j, nx)] =
-      snac_noise(noise_x0 + (float)i * noise_dx, noise_y0 + (float)j * noise_dy, 0.0f, seed);
+  noise[gr_idx(i, j, nx)] = snac_noise(noise_x0 + (float)(gi0 + i) * noise_dx,
+                                       noise_y0 + (float)(gj0 + j) * noise_dy, 0.0f, seed);
 }
 
-__kernel void snow_accumulation_exposure(__global const float *restrict ground,
-                                         __global const float *restrict depth, int nx, int ny,
-                                         float dx, float dy, float zref, float dir_x, float dir_y,
-                                         float dir_z, float tau_x, float tau_y, float qx0,
-                                         float qy0, float inv_texel, float texel, int vw, int vh,
-                                         __global const int *restrict view, float rate_dt,
-                                         float amplitude, __global const float *restrict noise,
-                                         __global float *restrict exposure,
-                                         __global float *restrict growth) {
+__kernel void
+snow_accumulation_exposure(__global const float *restrict ground,
+                           __global const float *restrict depth, int nx, int ny, int gi0, int gj0,
+                           float dx, float dy, float zref, float dir_x, float dir_y, float dir_z,
+                           float tau_x, float tau_y, float qx0, float qy0, float inv_texel,
+                           float texel, int vw, int vh, __global const int *restrict view,
+                           float rate_dt, float amplitude, __global const float *restrict noise,
+                           __global float *restrict exposure, __global float *restrict growth) {
   int i = get_global_id(0), j = get_global_id(1);
   if (!gr_inside(i, j, nx, ny))
     return;
   int c = gr_idx(i, j, nx);
   float3 d = (float3)(dir_x, dir_y, dir_z);
   float3 nh = snac_normal(ground, depth, i, j, nx, ny, dx, dy);
-  float e = snac_exposed(view, vw, vh, (float)i * dx, (float)j * dy, (ground[c] + depth[c]) - zref,
-                         nh, d, tau_x, tau_y, qx0, qy0, inv_texel, texel);
+  float e =
+      snac_exposed(view, vw, vh, (float)(gi0 + i) * dx, (float)(gj0 + j) * dy,
+                   (ground[c] + depth[c]) - zref, nh, d, tau_x, tau_y, qx0, qy0, inv_texel, texel);
   float3 nb = snac_normal(ground, (__global const float *)0, i, j, nx, ny, dx, dy);
   exposure[c] = e;
   growth[c] = rate_dt * e * fmax(0.0f, -dot(nb, d)) * (1.0f + amplitude * noise[c]);
@@ -311,6 +314,60 @@ snow_accumulation_apply(__global const float *restrict ground, int nx, int ny, f
               shed_lo, c);
 }
 
+/* A mesh point's test position: half a texel out along its normal. One
+ * expression for snow_accumulation_objects and
+ * snow_accumulation_object_surface, so both see the same floats. */
+GR_INLINE float3 snac_mesh_point(__global const float *restrict pos, float3 n, int v, float texel) {
+  return (float3)(pos[3 * v], pos[3 * v + 1], pos[3 * v + 2]) + n * (GR_SNAC_NORMAL_OFFSET * texel);
+}
+
+/* The grid cell under (x, y) (the domain's indices, clamped to it): its
+ * lower-left point's row. */
+GR_INLINE int snac_cell_row(float y, int gny, float gdy) {
+  float fy = clamp(y / gdy, 0.0f, (float)(gny - 1));
+  return min((int)fy, gny - 2 >= 0 ? gny - 2 : 0);
+}
+
+/* The snow surface at (x, y), relative to zref: bilinear between the grid
+ * points of the cell under it (the domain's gnx x gny points; the local
+ * arrays hold the domain's rows from row0 on, nx a row). */
+GR_INLINE float snac_surface_at(__global const float *restrict ground,
+                                __global const float *restrict gdepth, int gnx, int gny, int row0,
+                                float gdx, float gdy, float zref, float x, float y) {
+  float fx = clamp(x / gdx, 0.0f, (float)(gnx - 1)), fy = clamp(y / gdy, 0.0f, (float)(gny - 1));
+  int i0 = min((int)fx, gnx - 2 >= 0 ? gnx - 2 : 0), j0 = min((int)fy, gny - 2 >= 0 ? gny - 2 : 0);
+  int i1 = min(i0 + 1, gnx - 1), j1 = min(j0 + 1, gny - 1);
+  float tx = fx - (float)i0, ty = fy - (float)j0;
+  int a0 = j0 - row0, a1 = j1 - row0;
+  float h00 = ground[gr_idx(i0, a0, gnx)] + gdepth[gr_idx(i0, a0, gnx)];
+  float h10 = ground[gr_idx(i1, a0, gnx)] + gdepth[gr_idx(i1, a0, gnx)];
+  float h01 = ground[gr_idx(i0, a1, gnx)] + gdepth[gr_idx(i0, a1, gnx)];
+  float h11 = ground[gr_idx(i1, a1, gnx)] + gdepth[gr_idx(i1, a1, gnx)];
+  return mix(mix(h00, h10, tx), mix(h01, h11, tx), ty) - zref;
+}
+
+/* A piece's share of the surface under the mesh points: the surface where
+ * this piece owns the cell's lower row (own_lo .. own_hi, the domain's
+ * rows; the row above is then in its arrays, ring included), else -inf;
+ * the maximum over the pieces is the surface. */
+__kernel void snow_accumulation_object_surface(__global const float *restrict pos,
+                                               __global const float *restrict nrm, int nv,
+                                               float texel, __global const float *restrict ground,
+                                               __global const float *restrict gdepth, int gnx,
+                                               int gny, int row0, int own_lo, int own_hi, float gdx,
+                                               float gdy, float zref,
+                                               __global float *restrict surface) {
+  int v = get_global_id(0);
+  if (v >= nv)
+    return;
+  float3 n = (float3)(nrm[3 * v], nrm[3 * v + 1], nrm[3 * v + 2]);
+  float3 p = snac_mesh_point(pos, n, v, texel);
+  int r = snac_cell_row(p.y, gny, gdy);
+  surface[v] = r >= own_lo && r <= own_hi
+                   ? snac_surface_at(ground, gdepth, gnx, gny, row0, gdx, gdy, zref, p.x, p.y)
+                   : -INFINITY;
+}
+
 /* The mesh points: exposure (half a texel out along the normal), growth,
  * increment and stability, like the grid's but without blur. pos and nrm
  * are world (pos relative to grid point (0, 0) and zref), lattice the
@@ -322,34 +379,26 @@ __kernel void snow_accumulation_objects(
     __global const int *restrict view, float rate_dt, float amplitude, uint seed, float max_depth,
     float keep, int terrain_drawn, __global const float *restrict ground,
     __global const float *restrict gdepth, int gnx, int gny, float gdx, float gdy, float zref,
-    __global float *restrict exposure, __global float *restrict depth,
-    __global float *restrict depth_lo, __global float *restrict fall,
-    __global float *restrict fall_lo, __global float *restrict shed,
+    int have_surface, __global const float *restrict surface, __global float *restrict exposure,
+    __global float *restrict depth, __global float *restrict depth_lo,
+    __global float *restrict fall, __global float *restrict fall_lo, __global float *restrict shed,
     __global float *restrict shed_lo) {
   int v = get_global_id(0);
   if (v >= nv)
     return;
   float3 d = (float3)(dir_x, dir_y, dir_z);
   float3 n = (float3)(nrm[3 * v], nrm[3 * v + 1], nrm[3 * v + 2]);
-  float3 p =
-      (float3)(pos[3 * v], pos[3 * v + 1], pos[3 * v + 2]) + n * (GR_SNAC_NORMAL_OFFSET * texel);
+  float3 p = snac_mesh_point(pos, n, v, texel);
   float e =
       snac_exposed(view, vw, vh, p.x, p.y, p.z, n, d, tau_x, tau_y, qx0, qy0, inv_texel, texel);
   /* Without the terrain in the view, a point under the snow surface (an
    * object sunk into the ground) is hidden by it: the surface at its
-   * place, bilinear between the grid points. */
+   * place, bilinear between the grid points (on a piece: the pieces'
+   * reduced snow_accumulation_object_surface, the same floats). */
   if (!terrain_drawn && e > 0.0f) {
-    float fx = clamp(p.x / gdx, 0.0f, (float)(gnx - 1)),
-          fy = clamp(p.y / gdy, 0.0f, (float)(gny - 1));
-    int i0 = min((int)fx, gnx - 2 >= 0 ? gnx - 2 : 0),
-        j0 = min((int)fy, gny - 2 >= 0 ? gny - 2 : 0);
-    int i1 = min(i0 + 1, gnx - 1), j1 = min(j0 + 1, gny - 1);
-    float tx = fx - (float)i0, ty = fy - (float)j0;
-    float h00 = ground[gr_idx(i0, j0, gnx)] + gdepth[gr_idx(i0, j0, gnx)];
-    float h10 = ground[gr_idx(i1, j0, gnx)] + gdepth[gr_idx(i1, j0, gnx)];
-    float h01 = ground[gr_idx(i0, j1, gnx)] + gdepth[gr_idx(i0, j1, gnx)];
-    float h11 = ground[gr_idx(i1, j1, gnx)] + gdepth[gr_idx(i1, j1, gnx)];
-    float hs = mix(mix(h00, h10, tx), mix(h01, h11, tx), ty) - zref;
+    float hs = have_surface
+                   ? surface[v]
+                   : snac_surface_at(ground, gdepth, gnx, gny, 0, gdx, gdy, zref, p.x, p.y);
     if (p.z < hs)
       e = 0.0f;
   }
@@ -397,6 +446,39 @@ __kernel void snow_accumulation_reduce(
     mine[2 * q + 1] = lo[q];
   }
   gr_reduce_group(scratch, GR_SNAC_SUMS, 0, partial);
+}
+
+/* The ledger's sums per row: stored, fallen and shed snow of rows first ..
+ * first + rows - 1 (nx points each, in order along the row, as double-float
+ * pairs): 6 floats per row (hi, lo of each). One work-item per row, so a
+ * row's sum is the same bits whichever piece holds it. */
+__kernel void snow_accumulation_row_sums(__global const float *restrict depth,
+                                         __global const float *restrict depth_lo,
+                                         __global const float *restrict fall,
+                                         __global const float *restrict fall_lo,
+                                         __global const float *restrict shed,
+                                         __global const float *restrict shed_lo, int nx, int first,
+                                         int rows, __global float *restrict out) {
+  int r = get_global_id(0);
+  if (r >= rows)
+    return;
+  float hi[GR_SNAC_SUMS], lo[GR_SNAC_SUMS];
+  for (int q = 0; q < GR_SNAC_SUMS; ++q)
+    hi[q] = lo[q] = 0.0f;
+  int c0 = (first + r) * nx;
+  for (int i = 0; i < nx; ++i) {
+    int c = c0 + i;
+    gr_df_add(&hi[0], &lo[0], depth[c]);
+    gr_df_add(&hi[0], &lo[0], depth_lo[c]);
+    gr_df_add(&hi[1], &lo[1], fall[c]);
+    gr_df_add(&hi[1], &lo[1], fall_lo[c]);
+    gr_df_add(&hi[2], &lo[2], shed[c]);
+    gr_df_add(&hi[2], &lo[2], shed_lo[c]);
+  }
+  for (int q = 0; q < GR_SNAC_SUMS; ++q) {
+    out[2 * GR_SNAC_SUMS * r + 2 * q] = hi[q];
+    out[2 * GR_SNAC_SUMS * r + 2 * q + 1] = lo[q];
+  }
 }
 
 __kernel void snow_accumulation_surface(__global const float *restrict ground,

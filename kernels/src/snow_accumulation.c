@@ -22,7 +22,7 @@
 #define GR_SNAC_PI 3.14159265358979323846
 /* Checkpoints: "GSA1". */
 #define GR_SNAC_STATE_MAGIC 0x31415347u
-#define GR_SNAC_STATE_VERSION 2u
+#define GR_SNAC_STATE_VERSION 3u /* 3: a piece's j0 and the initial snow per row */
 /* Per-point arrays of the state: depth, its low part, fallen and shed
  * snow (pairs) and the exposure. */
 #define GR_SNAC_ARRAYS 7
@@ -71,7 +71,23 @@ struct gr_snow_accumulation {
   gr_grid grid;
   gr_snow_accumulation_params params;
   cl_kernel raster_terrain, raster_objects, exposure_k, noise_k, slope_k, blur, dilate, apply,
-      objects_k, reduce, surface;
+      objects_k, reduce, surface, row_sums, object_surface;
+  /* A piece (graupel.h's contract, "Pieces of a split domain"): grid.nx,
+   * grid.ny count the local arrays (own rows and rings); the domain has
+   * gnx x gny points, local row 0 is its row row0, the own rows are local
+   * rows ring_s .. ring_s + own_ny - 1. A whole grid: no rings, row0 0. */
+  int gnx, gny, row0, own_ny, ring_s, ring_n;
+  gr_allreduce_fn allreduce; /* NULL: this simulation is the whole domain */
+  void *allreduce_user;
+  gr_halo_exchange_fn halo_exchange;
+  void *halo_user;
+  /* The ledger's initial grid snow per own row (m, per unit area), and the
+   * objects' (m^3): see "Pieces" in the header for why per row. */
+  double *init_rows, initial_objects;
+  /* Per local row, the row sums' 6 floats; per mesh point or sample, the
+   * snow surface under it (pieces only). */
+  cl_mem rows_buf, o_surface;
+  size_t o_surface_cap;
   /* The grid: ground, initial snow, the state pairs, exposure, growth and
    * a scratch array, the blur weights and the view. */
   cl_mem ground, depth0, arr[GR_SNAC_ARRAYS], growth, scratch, weights, view;
@@ -105,7 +121,7 @@ struct gr_snow_accumulation {
   double ob_lo[3], ob_hi[3]; /* the objects' world box */
   gr_reduction red, red_slope;
   double zref, bmin, bmax, init_max, snow_bound;
-  double time, initial_volume, retired_fall, retired_shed, dropped;
+  double time, retired_fall, retired_shed, dropped;
   long long steps;
   gr_progress_fn progress;
   void *progress_user;
@@ -383,6 +399,219 @@ static gr_status gr_snac_sums(gr_snow_accumulation *s, int objects, int first, i
   return st;
 }
 
+/* ------------------------------------------------------ pieces and rows */
+
+int gr_snow_accumulation_ghost(const gr_snow_accumulation_params *p) {
+  return p ? p->blur_radius + 2 : 0;
+}
+
+/* The piece contract (graupel.h, snow_accumulation.h): strips of whole rows,
+ * a ring of grid->ghost rows toward each neighbour. */
+static gr_status gr_snac_piece_check(const gr_grid *g, const gr_snow_accumulation_params *p,
+                                     int *ring_s, int *ring_n, char *msg, size_t len) {
+  *ring_s = *ring_n = 0;
+  if (g->global_nx < 0 || g->global_ny < 0 || g->ghost < 0) {
+    snprintf(msg, len,
+             "Invalid grid: global_nx, global_ny and ghost must be 0 or more (got %d, %d, %d).",
+             g->global_nx, g->global_ny, g->ghost);
+    return GR_ERR_INVALID_ARGUMENT;
+  }
+  if (g->i0 != 0 || (g->global_nx != 0 && g->global_nx != g->nx)) {
+    snprintf(msg, len,
+             "Snow accumulation splits a domain along y only, into strips of whole rows (its "
+             "ledger adds whole rows): this piece starts at column %d and has %d of %d columns; "
+             "give i0 = 0 and nx = global_nx.",
+             g->i0, g->nx, g->global_nx);
+    return GR_ERR_INVALID_ARGUMENT;
+  }
+  long long gny = g->global_ny > 0 ? g->global_ny : g->ny;
+  if ((g->global_ny <= 0 && g->j0 != 0) || (long long)g->j0 + g->ny > gny) {
+    snprintf(msg, len,
+             "Invalid grid: the strip of %d rows at row %d reaches beyond the domain of %lld "
+             "rows; give global_ny of the whole domain.",
+             g->ny, g->j0, gny);
+    return GR_ERR_INVALID_ARGUMENT;
+  }
+  int need = gr_snow_accumulation_ghost(p);
+  int south = g->j0 > 0, north = (long long)g->j0 + g->ny < gny;
+  if ((south || north) && g->ghost < need) {
+    snprintf(msg, len,
+             "Invalid grid: a snow accumulation piece with neighbours needs a ghost ring of at "
+             "least %d rows for BlurRadius %d (got ghost = %d); set grid.ghost to %d.",
+             need, p->blur_radius, g->ghost, need);
+    return GR_ERR_INVALID_ARGUMENT;
+  }
+  if ((south || north) && g->ny < g->ghost) {
+    snprintf(msg, len,
+             "Invalid grid: a snow accumulation piece of %d rows is narrower than its ghost ring "
+             "of %d rows; split the domain into fewer pieces.",
+             g->ny, g->ghost);
+    return GR_ERR_INVALID_ARGUMENT;
+  }
+  *ring_s = south ? g->ghost : 0;
+  *ring_n = north ? g->ghost : 0;
+  return GR_OK;
+}
+
+static int gr_snac_pieced(const gr_snow_accumulation *s) {
+  return s->ring_s > 0 || s->ring_n > 0;
+}
+
+void gr_snow_accumulation_set_allreduce(gr_snow_accumulation *s, gr_allreduce_fn fn, void *user) {
+  if (!s)
+    return;
+  s->allreduce = fn;
+  s->allreduce_user = fn ? user : NULL;
+}
+
+void gr_snow_accumulation_set_halo_exchange(gr_snow_accumulation *s, gr_halo_exchange_fn fn,
+                                            void *user) {
+  if (!s)
+    return;
+  s->halo_exchange = fn;
+  s->halo_user = fn ? user : NULL;
+}
+
+/* The caller's allreduce over n values, in calls of at most
+ * GR_SNOW_ACCUMULATION_REDUCE_CHUNK. */
+static gr_status gr_snac_allreduce(gr_snow_accumulation *s, double *v, size_t n, gr_reduce_op op) {
+  for (size_t at = 0; at < n; at += GR_SNOW_ACCUMULATION_REDUCE_CHUNK) {
+    size_t m =
+        n - at < GR_SNOW_ACCUMULATION_REDUCE_CHUNK ? n - at : GR_SNOW_ACCUMULATION_REDUCE_CHUNK;
+    gr_status st = s->allreduce(s->allreduce_user, v + at, (int)m, op);
+    if (st != GR_OK)
+      return gr_set_error(s->ctx, st,
+                          "The snow accumulation simulation's global reduction (the allreduce "
+                          "callback) failed in step %lld with %s.",
+                          s->steps + 1, gr_status_string(st));
+  }
+  return GR_OK;
+}
+
+/* Per own row: stored, fallen and shed snow (m, per unit area), 3 doubles
+ * a row, each a row's sum in order along it (snow_accumulation_row_sums). */
+static gr_status gr_snac_rows(gr_snow_accumulation *s, double *out) {
+  cl_int nx = s->grid.nx, first = s->ring_s, rows = s->own_ny;
+  const gr_snac_arg args[] = {GR_SNAC_MEM("depth", s->arr[0]), GR_SNAC_MEM("depth_lo", s->arr[1]),
+                              GR_SNAC_MEM("fall", s->arr[2]),  GR_SNAC_MEM("fall_lo", s->arr[3]),
+                              GR_SNAC_MEM("shed", s->arr[4]),  GR_SNAC_MEM("shed_lo", s->arr[5]),
+                              GR_SNAC_VAL("nx", nx),           GR_SNAC_VAL("first", first),
+                              GR_SNAC_VAL("rows", rows),       GR_SNAC_MEM("out", s->rows_buf)};
+  size_t n = (size_t)rows * 2 * GR_SNAC_SUMS;
+  float *f = malloc(n * sizeof(float));
+  if (!f)
+    return gr_set_error(s->ctx, GR_ERR_OUT_OF_MEMORY, "Out of host memory.");
+  gr_status st = gr_snac_args(s, s->row_sums, args, sizeof(args) / sizeof(args[0]));
+  if (st == GR_OK)
+    st = gr_enqueue_1d(s->ctx, s->row_sums, (size_t)rows);
+  if (st == GR_OK)
+    st = gr_buffer_read(s->ctx, s->rows_buf, 0, n * sizeof(float), f);
+  for (size_t r = 0; st == GR_OK && r < (size_t)rows; ++r)
+    for (int q = 0; q < GR_SNAC_SUMS; ++q)
+      out[GR_SNAC_SUMS * r + (size_t)q] = (double)f[2 * GR_SNAC_SUMS * r + 2 * (size_t)q] +
+                                          (double)f[2 * GR_SNAC_SUMS * r + 2 * (size_t)q + 1];
+  free(f);
+  return st;
+}
+
+/* The grid's ledger sums, m per unit area: stored, fallen, shed and
+ * initial snow. Each piece puts its rows' sums at their rows of the domain
+ * (-inf elsewhere), a GR_REDUCE_MAX makes every row's the same on every
+ * piece (one value and -infs: exact in any order and with any reduction
+ * scheme, unlike a sum), and the rows are added in the domain's order: the
+ * same bits however the domain is split. A piece without an allreduce
+ * adds its own rows. */
+static gr_status gr_snac_grid_sums(gr_snow_accumulation *s, double sums[4]) {
+  int global = gr_snac_pieced(s) && s->allreduce;
+  size_t R = global ? (size_t)s->gny : (size_t)s->own_ny;
+  size_t base = global ? (size_t)(s->row0 + s->ring_s) : 0;
+  double *rows = malloc(4 * R * sizeof(double));
+  double *own = malloc((size_t)s->own_ny * GR_SNAC_SUMS * sizeof(double));
+  gr_status st =
+      rows && own ? GR_OK : gr_set_error(s->ctx, GR_ERR_OUT_OF_MEMORY, "Out of host memory.");
+  if (st == GR_OK)
+    st = gr_snac_rows(s, own);
+  for (size_t k = 0; st == GR_OK && k < 4 * R; ++k)
+    rows[k] = -HUGE_VAL;
+  for (size_t r = 0; st == GR_OK && r < (size_t)s->own_ny; ++r) {
+    for (int q = 0; q < GR_SNAC_SUMS; ++q)
+      rows[4 * (base + r) + (size_t)q] = own[GR_SNAC_SUMS * r + (size_t)q];
+    rows[4 * (base + r) + 3] = s->init_rows[r];
+  }
+  if (st == GR_OK && global)
+    st = gr_snac_allreduce(s, rows, 4 * R, GR_REDUCE_MAX);
+  for (int q = 0; q < 4; ++q)
+    sums[q] = 0.0;
+  for (size_t r = 0; st == GR_OK && r < R; ++r)
+    for (int q = 0; q < 4; ++q)
+      sums[q] += rows[4 * r + (size_t)q];
+  free(rows), free(own);
+  return st;
+}
+
+/* The strip on `side`: rows of the local arrays and how many. */
+static int gr_snac_strip(const gr_snow_accumulation *s, int side, int set, size_t *row0) {
+  int G = s->grid.ghost;
+  if (side == GR_SNOW_ACCUMULATION_SOUTH && s->ring_s) {
+    *row0 = set ? 0 : (size_t)s->ring_s;
+    return G;
+  }
+  if (side == GR_SNOW_ACCUMULATION_NORTH && s->ring_n) {
+    *row0 = set ? (size_t)(s->grid.ny - G) : (size_t)(s->grid.ny - s->ring_n - G);
+    return G;
+  }
+  return 0;
+}
+
+gr_status gr_snow_accumulation_halo_size(const gr_snow_accumulation *s, int side, size_t *bytes) {
+  if (!s || !bytes)
+    return gr_set_error(s ? s->ctx : NULL, GR_ERR_INVALID_ARGUMENT,
+                        "gr_snow_accumulation_halo_size needs a simulation and a place for the "
+                        "size.");
+  size_t row0 = 0;
+  *bytes = (size_t)gr_snac_strip(s, side, 0, &row0) * (size_t)s->grid.nx * sizeof(float);
+  return GR_OK;
+}
+
+/* The strip's snow depth between the device and the host; waits. */
+static gr_status gr_snac_halo_copy(gr_snow_accumulation *s, int side, void *host, size_t bytes,
+                                   int set) {
+  size_t row0 = 0;
+  size_t rows = (size_t)gr_snac_strip(s, side, set, &row0);
+  if (rows == 0)
+    return gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
+                        "The snow accumulation piece has no neighbour on side %d (2 south, 3 "
+                        "north): only sides with a ring exchange a halo.",
+                        side);
+  size_t row = (size_t)s->grid.nx * sizeof(float), need = rows * row;
+  if (!host || bytes != need)
+    return gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
+                        "The halo buffer has %zu bytes but side %d's strip has %zu: size it with "
+                        "gr_snow_accumulation_halo_size.",
+                        host ? bytes : 0, side, need);
+  return set ? gr_buffer_write(s->ctx, s->arr[0], row0 * row, need, host)
+             : gr_buffer_read(s->ctx, s->arr[0], row0 * row, need, host);
+}
+
+gr_status gr_snow_accumulation_halo_get(gr_snow_accumulation *s, int side, void *host,
+                                        size_t bytes) {
+  if (!s)
+    return gr_set_error(NULL, GR_ERR_INVALID_ARGUMENT,
+                        "gr_snow_accumulation_halo_get needs a simulation.");
+  gr_status st = gr_snac_halo_copy(s, side, host, bytes, 0);
+  return st == GR_OK ? GR_OK : GR_SNAC_KEEP_ERROR(s, st);
+}
+
+gr_status gr_snow_accumulation_halo_set(gr_snow_accumulation *s, int side, const void *host,
+                                        size_t bytes) {
+  if (!s)
+    return gr_set_error(NULL, GR_ERR_INVALID_ARGUMENT,
+                        "gr_snow_accumulation_halo_set needs a simulation.");
+  /* The copy only reads host (set = 1). */
+  gr_status st = gr_snac_halo_copy(s, side, (void *)host, bytes, 1);
+  return st == GR_OK ? GR_OK : GR_SNAC_KEEP_ERROR(s, st);
+}
+
 static gr_status gr_snac_initial_state(gr_snow_accumulation *s) {
   size_t cells = gr_snac_cells(s);
   gr_status st = gr_cl_check(s->ctx,
@@ -399,11 +628,15 @@ static gr_status gr_snac_initial_state(gr_snow_accumulation *s) {
   s->steps = 0;
   s->aborted = 0;
   s->snow_bound = s->init_max;
-  double sums[GR_SNAC_SUMS];
+  s->initial_objects = 0.0;
+  double *rows = malloc((size_t)s->own_ny * GR_SNAC_SUMS * sizeof(double));
+  if (st == GR_OK && !rows)
+    st = gr_set_error(s->ctx, GR_ERR_OUT_OF_MEMORY, "Out of host memory.");
   if (st == GR_OK)
-    st = gr_snac_sums(s, 0, 0, (int)cells, sums);
-  if (st == GR_OK)
-    s->initial_volume = sums[0] * s->grid.dx * s->grid.dy;
+    st = gr_snac_rows(s, rows);
+  for (int r = 0; st == GR_OK && r < s->own_ny; ++r)
+    s->init_rows[r] = rows[GR_SNAC_SUMS * (size_t)r];
+  free(rows);
   return st;
 }
 
@@ -420,15 +653,10 @@ gr_status gr_snow_accumulation_create(gr_context *ctx, const gr_grid *grid,
     return gr_set_error(ctx, GR_ERR_INVALID_ARGUMENT, "%s", msg);
   if (gr_snow_accumulation_params_validate(p, msg, sizeof(msg)) != GR_OK)
     return gr_set_error(ctx, GR_ERR_INVALID_ARGUMENT, "%s", msg);
-  if (grid->i0 != 0 || grid->j0 != 0 || grid->ghost != 0 ||
-      (grid->global_nx != 0 && grid->global_nx != grid->nx) ||
-      (grid->global_ny != 0 && grid->global_ny != grid->ny))
-    return gr_set_error(ctx, GR_ERR_INVALID_ARGUMENT,
-                        "Snow accumulation runs on whole grids only for now: this grid is a "
-                        "piece (i0 %d, j0 %d, ghost %d, global %d x %d); run it on the whole "
-                        "domain.",
-                        grid->i0, grid->j0, grid->ghost, grid->global_nx, grid->global_ny);
-  if ((double)grid->nx * (double)grid->ny > (double)INT_MAX / 2)
+  int ring_s = 0, ring_n = 0;
+  if (gr_snac_piece_check(grid, p, &ring_s, &ring_n, msg, sizeof(msg)) != GR_OK)
+    return gr_set_error(ctx, GR_ERR_INVALID_ARGUMENT, "%s", msg);
+  if ((double)grid->nx * ((double)grid->ny + ring_s + ring_n) > (double)INT_MAX / 2)
     return gr_set_error(ctx, GR_ERR_TOO_LARGE,
                         "The snow accumulation grid of %d x %d points is too large: the kernels "
                         "address at most about 1e9 points; coarsen it.",
@@ -438,7 +666,14 @@ gr_status gr_snow_accumulation_create(gr_context *ctx, const gr_grid *grid,
     return gr_set_error(ctx, GR_ERR_OUT_OF_MEMORY, "Out of host memory.");
   s->ctx = gr_context_retain(ctx);
   s->grid = *grid;
+  s->gnx = grid->nx;
+  s->gny = grid->global_ny > 0 ? grid->global_ny : grid->ny;
+  s->own_ny = grid->ny;
+  s->ring_s = ring_s, s->ring_n = ring_n;
+  s->row0 = grid->j0 - ring_s;
+  s->grid.ny = grid->ny + ring_s + ring_n;
   s->params = *p;
+  s->init_rows = calloc((size_t)grid->ny, sizeof(double));
   size_t cells = gr_snac_cells(s), bytes = cells * sizeof(float);
   cl_program prog = NULL;
   gr_status st = gr_program_get(ctx, "snow_accumulation", NULL, &prog);
@@ -455,7 +690,9 @@ gr_status gr_snow_accumulation_create(gr_context *ctx, const gr_grid *grid,
             {"snow_accumulation_reduce", &s->reduce},
             {"snow_accumulation_surface", &s->surface},
             {"snow_accumulation_noise", &s->noise_k},
-            {"snow_accumulation_slope_reduce", &s->slope_k}};
+            {"snow_accumulation_slope_reduce", &s->slope_k},
+            {"snow_accumulation_row_sums", &s->row_sums},
+            {"snow_accumulation_object_surface", &s->object_surface}};
   for (size_t i = 0; st == GR_OK && i < sizeof(ks) / sizeof(ks[0]); ++i)
     st = gr_kernel_create(ctx, prog, ks[i].name, ks[i].k);
   cl_mem *bufs[] = {&s->ground, &s->depth0, &s->growth, &s->scratch, &s->noise};
@@ -467,9 +704,18 @@ gr_status gr_snow_accumulation_create(gr_context *ctx, const gr_grid *grid,
     st = gr_buffer_create(ctx, CL_MEM_READ_ONLY, (GR_SNAC_MAX_BLUR + 1) * sizeof(float), NULL,
                           &s->weights);
   if (st == GR_OK)
-    st = gr_snac_prepare(s, p);
+    st =
+        gr_buffer_create(ctx, CL_MEM_READ_WRITE,
+                         (size_t)s->grid.ny * 2 * GR_SNAC_SUMS * sizeof(float), NULL, &s->rows_buf);
+  if (st == GR_OK && !s->init_rows)
+    st = gr_set_error(ctx, GR_ERR_OUT_OF_MEMORY, "Out of host memory.");
   if (st == GR_OK)
-    st = gr_reduction_init(ctx, s->reduce, cells, GR_SNAC_SUMS, 0, &s->red);
+    st = gr_snac_prepare(s, p);
+  /* The objects' sums: a launch chosen for the domain's size, so that
+   * every piece of it adds the mesh points in the same groups. */
+  if (st == GR_OK)
+    st = gr_reduction_init(ctx, s->reduce, (size_t)s->gnx * (size_t)s->gny, GR_SNAC_SUMS, 0,
+                           &s->red);
   if (st == GR_OK)
     st = gr_reduction_init(ctx, s->slope_k, cells, 0, 2, &s->red_slope);
   if (st == GR_OK)
@@ -499,14 +745,14 @@ static void gr_snac_release_objects(gr_snow_accumulation *s) {
 void gr_snow_accumulation_destroy(gr_snow_accumulation *s) {
   if (!s)
     return;
-  cl_kernel ks[] = {s->raster_terrain, s->raster_objects, s->exposure_k, s->blur,
-                    s->dilate,         s->apply,          s->objects_k,  s->reduce,
-                    s->surface,        s->noise_k,        s->slope_k};
+  cl_kernel ks[] = {s->raster_terrain, s->raster_objects, s->exposure_k,    s->blur,    s->dilate,
+                    s->apply,          s->objects_k,      s->reduce,        s->surface, s->noise_k,
+                    s->slope_k,        s->row_sums,       s->object_surface};
   for (size_t i = 0; i < sizeof(ks) / sizeof(ks[0]); ++i)
     if (ks[i])
       clReleaseKernel(ks[i]);
-  cl_mem *bufs[] = {&s->ground,  &s->depth0, &s->growth, &s->scratch,
-                    &s->weights, &s->view,   &s->noise};
+  cl_mem *bufs[] = {&s->ground, &s->depth0, &s->growth,   &s->scratch,  &s->weights,
+                    &s->view,   &s->noise,  &s->rows_buf, &s->o_surface};
   for (size_t i = 0; i < sizeof(bufs) / sizeof(bufs[0]); ++i)
     gr_buffer_release(bufs[i]);
   for (int a = 0; a < GR_SNAC_ARRAYS; ++a)
@@ -521,6 +767,7 @@ void gr_snow_accumulation_destroy(gr_snow_accumulation *s) {
   free(s->hv);
   free(s->ht);
   free(s->hnrm);
+  free(s->init_rows);
   gr_context_release(s->ctx);
   free(s);
 }
@@ -533,6 +780,14 @@ gr_status gr_snow_accumulation_set_params(gr_snow_accumulation *s,
                         "gr_snow_accumulation_set_params needs a simulation.");
   if (gr_snow_accumulation_params_validate(p, msg, sizeof(msg)) != GR_OK)
     return GR_SNAC_KEEP_ERROR(s, gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT, "%s", msg));
+  if (gr_snac_pieced(s) && gr_snow_accumulation_ghost(p) > s->grid.ghost)
+    return GR_SNAC_KEEP_ERROR(
+        s, gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
+                        "Invalid snow accumulation parameters: BlurRadius %d needs a ghost ring "
+                        "of %d rows but this piece has %d; keep BlurRadius at most %d or make "
+                        "the piece again with a wider ring.",
+                        p->blur_radius, gr_snow_accumulation_ghost(p), s->grid.ghost,
+                        s->grid.ghost - 2));
   gr_status st = gr_snac_prepare(s, p);
   if (st != GR_OK)
     return GR_SNAC_KEEP_ERROR(s, st);
@@ -600,8 +855,11 @@ static gr_status gr_snac_set_field_impl(gr_snow_accumulation *s, gr_field f, con
   }
   /* The new snow replaces what lies on the grid: the ledger's initial
    * volume moves by the change, so the balance still closes. */
-  double before[GR_SNAC_SUMS], after[GR_SNAC_SUMS];
-  gr_status st = gr_snac_sums(s, 0, 0, (int)cells, before);
+  size_t nr = (size_t)s->own_ny * GR_SNAC_SUMS;
+  double *before = malloc(nr * sizeof(double)), *after = malloc(nr * sizeof(double));
+  gr_status st = before && after
+                     ? gr_snac_rows(s, before)
+                     : gr_set_error(s->ctx, GR_ERR_OUT_OF_MEMORY, "Out of host memory.");
   if (st == GR_OK)
     st = gr_buffer_write(s->ctx, s->depth0, 0, bytes, host);
   if (st == GR_OK)
@@ -609,9 +867,11 @@ static gr_status gr_snac_set_field_impl(gr_snow_accumulation *s, gr_field f, con
   if (st == GR_OK)
     st = gr_snac_fill(s, s->arr[1], cells, 0.0f);
   if (st == GR_OK)
-    st = gr_snac_sums(s, 0, 0, (int)cells, after);
+    st = gr_snac_rows(s, after);
+  for (int r = 0; st == GR_OK && r < s->own_ny; ++r)
+    s->init_rows[r] += after[GR_SNAC_SUMS * (size_t)r] - before[GR_SNAC_SUMS * (size_t)r];
+  free(before), free(after);
   if (st == GR_OK) {
-    s->initial_volume += (after[0] - before[0]) * s->grid.dx * s->grid.dy;
     s->init_max = hi;
     s->snow_bound = fmax(s->snow_bound, hi);
   }
@@ -1120,7 +1380,7 @@ gr_status gr_snow_accumulation_set_object_snow(gr_snow_accumulation *s, int o, c
   if (st == GR_OK)
     st = gr_snac_sums(s, 1, s->first[o], n, after);
   if (st == GR_OK)
-    s->initial_volume += after[0] - before[0];
+    s->initial_objects += after[0] - before[0];
   return st == GR_OK ? GR_OK : GR_SNAC_KEEP_ERROR(s, st);
 }
 
@@ -1266,7 +1526,8 @@ typedef struct gr_snac_view {
 static void gr_snac_view_of(const gr_snow_accumulation *s, const double d[3], gr_snac_view *v) {
   const gr_grid *g = &s->grid;
   double tx = -d[0] / d[2], ty = -d[1] / d[2];
-  double W = (g->nx - 1) * g->dx, H = (g->ny - 1) * g->dy;
+  /* The domain's extent (a piece's view is the whole domain's). */
+  double W = (s->gnx - 1) * g->dx, H = (s->gny - 1) * g->dy;
   double box[2][3][2] = {
       {{0.0, W}, {0.0, H}, {s->bmin - s->zref, s->bmax + s->snow_bound - s->zref}},
       {{0, 0}, {0, 0}, {0, 0}}};
@@ -1302,6 +1563,81 @@ static void gr_snac_view_of(const gr_snow_accumulation *s, const double d[3], gr
   v->vh = (int)fmin(ceil((qhi[1] - qlo[1]) / texel), (double)res) + 2 * m + 1;
 }
 
+/* The maximum of the pieces' views, texel by texel (ints travel exactly as
+ * doubles). Waits. */
+static gr_status gr_snac_view_reduce(gr_snow_accumulation *s, size_t n) {
+  cl_int *keys = malloc(n * sizeof(cl_int));
+  double *v = malloc(n * sizeof(double));
+  gr_status st =
+      keys && v ? GR_OK : gr_set_error(s->ctx, GR_ERR_OUT_OF_MEMORY, "Out of host memory.");
+  if (st == GR_OK)
+    st = gr_buffer_read(s->ctx, s->view, 0, n * sizeof(cl_int), keys);
+  for (size_t t = 0; st == GR_OK && t < n; ++t)
+    v[t] = (double)keys[t];
+  if (st == GR_OK)
+    st = gr_snac_allreduce(s, v, n, GR_REDUCE_MAX);
+  for (size_t t = 0; st == GR_OK && t < n; ++t)
+    keys[t] = (cl_int)v[t];
+  if (st == GR_OK)
+    st = gr_buffer_write(s->ctx, s->view, 0, n * sizeof(cl_int), keys);
+  free(keys), free(v);
+  return st;
+}
+
+/* The snow surface under n mesh points (or samples) at pos, nrm into
+ * s->o_surface: each piece gives the points over its own cells, the
+ * allreduce the rest (snow_accumulation_object_surface). Waits. */
+static gr_status gr_snac_object_surface(gr_snow_accumulation *s, cl_mem pos, cl_mem nrm, cl_int nv,
+                                        float texel) {
+  gr_status st = GR_OK;
+  if ((size_t)nv > s->o_surface_cap) {
+    gr_buffer_release(&s->o_surface);
+    s->o_surface_cap = 0;
+    st = gr_buffer_create(s->ctx, CL_MEM_READ_WRITE, (size_t)nv * sizeof(float), NULL,
+                          &s->o_surface);
+    if (st != GR_OK)
+      return st;
+    s->o_surface_cap = (size_t)nv;
+  }
+  cl_int gnx = s->gnx, gny = s->gny, row0 = s->row0, own_lo = s->row0 + s->ring_s;
+  cl_int own_hi = own_lo + s->own_ny - 1;
+  float gdx = (float)s->grid.dx, gdy = (float)s->grid.dy, zref = (float)s->zref;
+  const gr_snac_arg a[] = {GR_SNAC_MEM("pos", pos),
+                           GR_SNAC_MEM("nrm", nrm),
+                           GR_SNAC_VAL("nv", nv),
+                           GR_SNAC_VAL("texel", texel),
+                           GR_SNAC_MEM("ground", s->ground),
+                           GR_SNAC_MEM("gdepth", s->arr[0]),
+                           GR_SNAC_VAL("gnx", gnx),
+                           GR_SNAC_VAL("gny", gny),
+                           GR_SNAC_VAL("row0", row0),
+                           GR_SNAC_VAL("own_lo", own_lo),
+                           GR_SNAC_VAL("own_hi", own_hi),
+                           GR_SNAC_VAL("gdx", gdx),
+                           GR_SNAC_VAL("gdy", gdy),
+                           GR_SNAC_VAL("zref", zref),
+                           GR_SNAC_MEM("surface", s->o_surface)};
+  st = gr_snac_args(s, s->object_surface, a, sizeof(a) / sizeof(a[0]));
+  if (st == GR_OK)
+    st = gr_enqueue_1d(s->ctx, s->object_surface, (size_t)nv);
+  float *f = malloc((size_t)nv * sizeof(float));
+  double *d = malloc((size_t)nv * sizeof(double));
+  if (st == GR_OK && (!f || !d))
+    st = gr_set_error(s->ctx, GR_ERR_OUT_OF_MEMORY, "Out of host memory.");
+  if (st == GR_OK)
+    st = gr_buffer_read(s->ctx, s->o_surface, 0, (size_t)nv * sizeof(float), f);
+  for (cl_int k = 0; st == GR_OK && k < nv; ++k)
+    d[k] = (double)f[k];
+  if (st == GR_OK)
+    st = gr_snac_allreduce(s, d, (size_t)nv, GR_REDUCE_MAX);
+  for (cl_int k = 0; st == GR_OK && k < nv; ++k)
+    f[k] = (float)d[k];
+  if (st == GR_OK)
+    st = gr_buffer_write(s->ctx, s->o_surface, 0, (size_t)nv * sizeof(float), f);
+  free(f), free(d);
+  return st;
+}
+
 static gr_status gr_snac_step_impl(gr_snow_accumulation *s, double dt) {
   gr_context *ctx = s->ctx;
   const gr_grid *g = &s->grid;
@@ -1314,10 +1650,65 @@ static gr_status gr_snac_step_impl(gr_snow_accumulation *s, double dt) {
   }
   double dd[3];
   gr_snac_direction(s, dd);
+  cl_int nx = g->nx, ny = g->ny, gi0 = 0, gj0 = s->row0;
+  float dx = (float)g->dx, dy = (float)g->dy;
+  int pieced = gr_snac_pieced(s);
+  if (pieced && (!s->allreduce || !s->halo_exchange))
+    return gr_set_error(ctx, GR_ERR_INVALID_ARGUMENT,
+                        "A snow accumulation piece with neighbours steps only with an allreduce "
+                        "and a halo exchange set (gr_snow_accumulation_set_allreduce, "
+                        "gr_snow_accumulation_set_halo_exchange).");
+
+  /* The terrain is drawn into the view only where it could hide itself:
+   * where a triangle of the snow surface rises faster than the snow falls
+   * steeply (snow_accumulation_slope_reduce). Snow straight down, or a
+   * surface gentler than the snow's descent, leaves a view of the objects
+   * alone, and a far cheaper step. A piece's cells (its local arrays, ring
+   * included, are all the domain's) give its share of the maximum. */
+  cl_int terrain_drawn = 1;
+  double horiz = hypot(dd[0], dd[1]);
+  double g2[2] = {0.0, 0.0};
+  {
+    cl_int cells = nx * ny;
+    const gr_snac_arg sa[] = {GR_SNAC_MEM("ground", s->ground),
+                              GR_SNAC_MEM("depth", s->arr[0]),
+                              GR_SNAC_VAL("nx", nx),
+                              GR_SNAC_VAL("ny", ny),
+                              GR_SNAC_VAL("dx", dx),
+                              GR_SNAC_VAL("dy", dy),
+                              GR_SNAC_VAL("n", cells)};
+    /* Snow straight down cannot be hidden by the surface: no reduction
+     * (and no read-back) that step. */
+    gr_status sst =
+        horiz == 0.0 ? GR_OK : gr_snac_args(s, s->slope_k, sa, sizeof(sa) / sizeof(sa[0]));
+    if (sst == GR_OK && horiz > 0.0)
+      sst = gr_reduction_run(ctx, &s->red_slope, s->slope_k, NULL, g2);
+    if (sst != GR_OK)
+      return sst;
+  }
+  if (pieced) {
+    /* What the view's box and the drawing decision rest on, over the
+     * domain: every piece then sets up the same view as the whole grid. */
+    double m[6] = {g2[0], g2[1], -s->bmin, s->bmax, s->init_max, s->snow_bound};
+    gr_status rst = gr_snac_allreduce(s, m, 6, GR_REDUCE_MAX);
+    if (rst != GR_OK)
+      return rst;
+    g2[0] = m[0], g2[1] = m[1];
+    s->bmin = -m[2], s->bmax = m[3], s->init_max = m[4], s->snow_bound = m[5];
+    if (s->zref != s->bmin) {
+      s->zref = s->bmin;
+      rst = gr_snac_upload_geometry(s);
+      if (rst != GR_OK)
+        return rst;
+    }
+  }
+  double steepest = sqrt(g2[0] * g2[0] + g2[1] * g2[1]);
+  if (horiz == 0.0 || steepest * (1.0 + GR_SNAC_SLOPE_MARGIN) * horiz < fabs(dd[2]))
+    terrain_drawn = 0;
   gr_snac_view v;
   gr_snac_view_of(s, dd, &v);
-  cl_int nx = g->nx, ny = g->ny, vw = v.vw, vh = v.vh;
-  float dx = (float)g->dx, dy = (float)g->dy, zref = (float)s->zref;
+  cl_int vw = v.vw, vh = v.vh;
+  float zref = (float)s->zref;
   float dir_x = (float)dd[0], dir_y = (float)dd[1], dir_z = (float)dd[2];
   const gr_snow_accumulation_params *p = &s->params;
   float rate_dt = (float)(p->snowfall_rate * dt), amplitude = (float)p->noise_amplitude;
@@ -1335,6 +1726,8 @@ static gr_status gr_snac_step_impl(gr_snow_accumulation *s, double dt) {
       s->noise_key[1] != noise_y0 || s->noise_key[2] != noise_dx || s->noise_key[3] != noise_dy) {
     const gr_snac_arg na[] = {GR_SNAC_VAL("nx", nx),
                               GR_SNAC_VAL("ny", ny),
+                              GR_SNAC_VAL("gi0", gi0),
+                              GR_SNAC_VAL("gj0", gj0),
                               GR_SNAC_VAL("noise_x0", noise_x0),
                               GR_SNAC_VAL("noise_y0", noise_y0),
                               GR_SNAC_VAL("noise_dx", noise_dx),
@@ -1356,34 +1749,7 @@ static gr_status gr_snac_step_impl(gr_snow_accumulation *s, double dt) {
   if (nst != GR_OK)
     return nst;
 
-  /* 1. the view. The terrain is drawn into it only where it could hide
-   * itself: where a triangle of the snow surface rises faster than the
-   * snow falls steeply (snow_accumulation_slope_reduce). Snow straight
-   * down, or a surface gentler than the snow's descent, leaves a view of
-   * the objects alone, and a far cheaper step. */
-  cl_int terrain_drawn = 1;
-  {
-    double g2[2] = {0.0, 0.0}, horiz = hypot(dd[0], dd[1]);
-    cl_int cells = nx * ny;
-    const gr_snac_arg sa[] = {GR_SNAC_MEM("ground", s->ground),
-                              GR_SNAC_MEM("depth", s->arr[0]),
-                              GR_SNAC_VAL("nx", nx),
-                              GR_SNAC_VAL("ny", ny),
-                              GR_SNAC_VAL("dx", dx),
-                              GR_SNAC_VAL("dy", dy),
-                              GR_SNAC_VAL("n", cells)};
-    /* Snow straight down cannot be hidden by the surface: no reduction
-     * (and no read-back) that step. */
-    gr_status sst =
-        horiz == 0.0 ? GR_OK : gr_snac_args(s, s->slope_k, sa, sizeof(sa) / sizeof(sa[0]));
-    if (sst == GR_OK && horiz > 0.0)
-      sst = gr_reduction_run(ctx, &s->red_slope, s->slope_k, NULL, g2);
-    if (sst != GR_OK)
-      return sst;
-    double steepest = sqrt(g2[0] * g2[0] + g2[1] * g2[1]);
-    if (horiz == 0.0 || steepest * (1.0 + GR_SNAC_SLOPE_MARGIN) * horiz < fabs(dd[2]))
-      terrain_drawn = 0;
-  }
+  /* 1. the view */
   cl_int empty = GR_SNAC_EMPTY;
   gr_status st =
       gr_cl_check(ctx,
@@ -1394,6 +1760,8 @@ static gr_status gr_snac_step_impl(gr_snow_accumulation *s, double dt) {
                             GR_SNAC_MEM("depth", s->arr[0]),
                             GR_SNAC_VAL("nx", nx),
                             GR_SNAC_VAL("ny", ny),
+                            GR_SNAC_VAL("gi0", gi0),
+                            GR_SNAC_VAL("gj0", gj0),
                             GR_SNAC_VAL("dx", dx),
                             GR_SNAC_VAL("dy", dy),
                             GR_SNAC_VAL("zref", zref),
@@ -1425,6 +1793,10 @@ static gr_status gr_snac_step_impl(gr_snow_accumulation *s, double dt) {
     if (st == GR_OK)
       st = gr_enqueue_1d(ctx, s->raster_objects, (size_t)ntri);
   }
+  /* A piece drew its own cells: the views' maximum over the pieces, texel
+   * by texel, is the whole grid's view (see "Pieces" in the header). */
+  if (st == GR_OK && pieced && terrain_drawn)
+    st = gr_snac_view_reduce(s, (size_t)vw * (size_t)vh);
   if (st == GR_OK)
     st = gr_snac_mark(s, &s->tm.view_ms);
 
@@ -1433,6 +1805,8 @@ static gr_status gr_snac_step_impl(gr_snow_accumulation *s, double dt) {
                             GR_SNAC_MEM("depth", s->arr[0]),
                             GR_SNAC_VAL("nx", nx),
                             GR_SNAC_VAL("ny", ny),
+                            GR_SNAC_VAL("gi0", gi0),
+                            GR_SNAC_VAL("gj0", gj0),
                             GR_SNAC_VAL("dx", dx),
                             GR_SNAC_VAL("dy", dy),
                             GR_SNAC_VAL("zref", zref),
@@ -1507,6 +1881,17 @@ static gr_status gr_snac_step_impl(gr_snow_accumulation *s, double dt) {
     st = gr_enqueue_2d(ctx, s->apply, 0, 0, (size_t)nx, (size_t)ny, NULL);
   if (st == GR_OK)
     st = gr_snac_mark(s, &s->tm.apply_ms);
+  /* A piece's ring: the snow depth the next step's normals, blur and view
+   * (and this step's objects) read beyond its own rows. */
+  if (st == GR_OK && pieced) {
+    st = s->halo_exchange(s->halo_user);
+    if (st != GR_OK)
+      st = gr_set_error(ctx, st,
+                        "The snow accumulation piece's halo exchange (the callback given to "
+                        "gr_snow_accumulation_set_halo_exchange) failed in step %lld with %s; the "
+                        "piece's ring is not fresh, so restore a checkpoint before stepping on.",
+                        s->steps + 1, gr_status_string(st));
+  }
 
   /* the mesh points */
   /* the mesh points, then the accumulation textures' samples: the same
@@ -1554,7 +1939,19 @@ static gr_status gr_snac_step_impl(gr_snow_accumulation *s, double dt) {
                               GR_SNAC_MEM("fall_lo", A[3]),
                               GR_SNAC_MEM("shed", A[4]),
                               GR_SNAC_MEM("shed_lo", A[5])};
-    st = gr_snac_args(s, s->objects_k, ob, sizeof(ob) / sizeof(ob[0]));
+    /* On a piece, the surface under the points when the objects kernel
+     * needs it (no terrain in the view) comes from the pieces that hold
+     * it. */
+    cl_int have_surface = pieced && !terrain_drawn;
+    if (have_surface)
+      st = gr_snac_object_surface(s, *P, *N, nv, v.texel);
+    cl_mem surf = have_surface ? s->o_surface : s->ground;
+    const gr_snac_arg ob2[] = {GR_SNAC_VAL("have_surface", have_surface),
+                               GR_SNAC_MEM("surface", surf)};
+    if (st == GR_OK)
+      st = gr_snac_args(s, s->objects_k, ob, sizeof(ob) / sizeof(ob[0]));
+    if (st == GR_OK)
+      st = gr_snac_args(s, s->objects_k, ob2, sizeof(ob2) / sizeof(ob2[0]));
     if (st == GR_OK)
       st = gr_enqueue_1d(ctx, s->objects_k, (size_t)nv);
     if (st == GR_OK)
@@ -1596,6 +1993,14 @@ gr_status gr_snow_accumulation_step(gr_snow_accumulation *s, double dt) {
     s->snow_bound = fmin(s->snow_bound, fmax(s->params.max_depth, s->init_max) + grow);
   if (s->progress && s->progress(s->progress_user, s->time) != 0)
     s->aborted = 1;
+  /* A stop asked on any piece stops every piece after this step. */
+  if (gr_snac_pieced(s)) {
+    double flag = s->aborted ? 1.0 : 0.0;
+    st = gr_snac_allreduce(s, &flag, 1, GR_REDUCE_MAX);
+    if (st != GR_OK)
+      return GR_SNAC_KEEP_ERROR(s, st);
+    s->aborted = flag != 0.0;
+  }
   return GR_OK;
 }
 
@@ -1607,7 +2012,9 @@ gr_status gr_snow_accumulation_get_field(gr_snow_accumulation *s, gr_field f, fl
     return GR_SNAC_KEEP_ERROR(s, gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
                                               "gr_snow_accumulation_get_field needs a place for "
                                               "the values (got NULL)."));
-  size_t cells = gr_snac_cells(s), bytes = cells * sizeof(float);
+  /* The own rows (a piece's local arrays hold its rings around them). */
+  size_t cells = gr_snac_cells(s), own = (size_t)s->grid.nx * (size_t)s->own_ny;
+  size_t offset = (size_t)s->ring_s * (size_t)s->grid.nx * sizeof(float);
   cl_mem src = NULL;
   gr_status st = GR_OK;
   switch (f) {
@@ -1621,7 +2028,7 @@ gr_status gr_snow_accumulation_get_field(gr_snow_accumulation *s, gr_field f, fl
     src = s->ground;
     break;
   case GR_FIELD_SNOW_DENSITY:
-    for (size_t c = 0; c < cells; ++c)
+    for (size_t c = 0; c < own; ++c)
       host[c] = (float)s->params.snow_density;
     return GR_OK;
   case GR_FIELD_SNOW_SURFACE: {
@@ -1644,7 +2051,7 @@ gr_status gr_snow_accumulation_get_field(gr_snow_accumulation *s, gr_field f, fl
   }
   }
   if (st == GR_OK)
-    st = gr_buffer_read(s->ctx, src, 0, bytes, host);
+    st = gr_buffer_read(s->ctx, src, offset, own * sizeof(float), host);
   return st == GR_OK ? GR_OK : GR_SNAC_KEEP_ERROR(s, st);
 }
 
@@ -1656,8 +2063,10 @@ gr_status gr_snow_accumulation_ledger_get(gr_snow_accumulation *s,
                                                   "for the ledger."))
              : gr_set_error(NULL, GR_ERR_INVALID_ARGUMENT,
                             "gr_snow_accumulation_ledger_get needs a simulation.");
-  double gs[GR_SNAC_SUMS], os[GR_SNAC_SUMS];
-  gr_status st = gr_snac_sums(s, 0, 0, (int)gr_snac_cells(s), gs);
+  /* The grid's sums over the domain's rows in order (collective on a
+   * piece); the objects' are the same on every piece and count once. */
+  double gs[4], os[GR_SNAC_SUMS];
+  gr_status st = gr_snac_grid_sums(s, gs);
   if (st == GR_OK)
     st = gr_snac_sums(s, 1, 0, s->nv, os);
   if (st != GR_OK)
@@ -1666,7 +2075,7 @@ gr_status gr_snow_accumulation_ledger_get(gr_snow_accumulation *s,
   memset(out, 0, sizeof(*out));
   out->time = s->time;
   out->steps = s->steps;
-  out->initial_volume = s->initial_volume;
+  out->initial_volume = gs[3] * a + s->initial_objects;
   out->stored_volume_terrain = gs[0] * a;
   out->stored_volume_objects = os[0];
   out->stored_volume = out->stored_volume_terrain + out->stored_volume_objects;
@@ -1690,14 +2099,15 @@ void gr_snow_accumulation_set_progress(gr_snow_accumulation *s, gr_progress_fn f
 
 typedef struct gr_snac_state_header {
   uint32_t magic, version;
-  int32_t nx, ny, nobjects, nv, ns, pad;
+  int32_t nx, ny, nobjects, nv, ns, j0;
   int64_t steps;
-  double time, initial_volume, retired_fall, retired_shed, dropped, snow_bound;
+  double time, initial_objects, retired_fall, retired_shed, dropped, snow_bound;
 } gr_snac_state_header;
 
 static size_t gr_snac_state_bytes(const gr_snow_accumulation *s) {
   return sizeof(gr_snac_state_header) +
-         GR_SNAC_ARRAYS * (gr_snac_cells(s) + (size_t)s->nv + (size_t)s->ns) * sizeof(float);
+         GR_SNAC_ARRAYS * (gr_snac_cells(s) + (size_t)s->nv + (size_t)s->ns) * sizeof(float) +
+         (size_t)s->own_ny * sizeof(double);
 }
 
 gr_status gr_snow_accumulation_state_size(const gr_snow_accumulation *s, size_t *bytes) {
@@ -1727,9 +2137,10 @@ gr_status gr_snow_accumulation_state_save(gr_snow_accumulation *s, void *host, s
   hd.version = GR_SNAC_STATE_VERSION;
   hd.nx = s->grid.nx, hd.ny = s->grid.ny, hd.nobjects = s->nobjects, hd.nv = s->nv;
   hd.ns = s->ns;
+  hd.j0 = s->grid.j0;
   hd.steps = s->steps;
   hd.time = s->time;
-  hd.initial_volume = s->initial_volume;
+  hd.initial_objects = s->initial_objects;
   hd.retired_fall = s->retired_fall;
   hd.retired_shed = s->retired_shed;
   hd.dropped = s->dropped;
@@ -1748,6 +2159,9 @@ gr_status gr_snow_accumulation_state_save(gr_snow_accumulation *s, void *host, s
     if (st == GR_OK && tb > 0)
       st = gr_buffer_read(s->ctx, s->t_arr[a], 0, tb, at + ob);
   }
+  /* The initial snow per own row, last. */
+  if (st == GR_OK)
+    memcpy(at, s->init_rows, (size_t)s->own_ny * sizeof(double));
   return st == GR_OK ? GR_OK : GR_SNAC_KEEP_ERROR(s, st);
 }
 
@@ -1767,13 +2181,14 @@ gr_status gr_snow_accumulation_state_load(gr_snow_accumulation *s, const void *h
   memcpy(&hd, host, sizeof(hd));
   if (hd.magic != GR_SNAC_STATE_MAGIC || hd.version != GR_SNAC_STATE_VERSION ||
       hd.nx != s->grid.nx || hd.ny != s->grid.ny || hd.nobjects != s->nobjects || hd.nv != s->nv ||
-      hd.ns != s->ns)
+      hd.ns != s->ns || hd.j0 != s->grid.j0)
     return GR_SNAC_KEEP_ERROR(
         s, gr_set_error(s->ctx, GR_ERR_FORMAT,
-                        "The bytes are not a snow accumulation state of a %d x %d grid with %d "
-                        "objects (version %u); load one saved by gr_snow_accumulation_state_save "
-                        "with the same objects set.",
-                        s->grid.nx, s->grid.ny, s->nobjects, GR_SNAC_STATE_VERSION));
+                        "The bytes are not a snow accumulation state of a %d x %d grid (a piece "
+                        "from row %d) with %d objects (version %u); load one saved by "
+                        "gr_snow_accumulation_state_save on the same piece with the same objects "
+                        "set.",
+                        s->grid.nx, s->grid.ny, s->grid.j0, s->nobjects, GR_SNAC_STATE_VERSION));
   const char *base = (const char *)host + sizeof(hd);
   size_t gcells = gr_snac_cells(s), gb = gcells * sizeof(float), ob = (size_t)s->nv * sizeof(float);
   size_t tb = (size_t)s->ns * sizeof(float);
@@ -1804,9 +2219,10 @@ gr_status gr_snow_accumulation_state_load(gr_snow_accumulation *s, const void *h
   }
   if (st != GR_OK)
     return GR_SNAC_KEEP_ERROR(s, st);
+  memcpy(s->init_rows, at, (size_t)s->own_ny * sizeof(double));
   s->steps = hd.steps;
   s->time = hd.time;
-  s->initial_volume = hd.initial_volume;
+  s->initial_objects = hd.initial_objects;
   s->retired_fall = hd.retired_fall;
   s->retired_shed = hd.retired_shed;
   s->dropped = hd.dropped;

@@ -71,7 +71,11 @@
  * Objects: triangle meshes (gr_mesh; open surfaces such as a roof plane
  * are fine, triangles wound counter-clockwise seen from the side that
  * receives snow), at the pose of their transform; set them before each
- * step that moves them. Pieces: whole grids only, for now.
+ * step that moves them.
+ *
+ * Pieces of a split domain: see "Pieces of a split domain" below; a piece
+ * computes bit for bit what the whole grid computes at its points, its
+ * objects' snow and the ledger included.
  */
 #ifndef GRAUPEL_SNOW_ACCUMULATION_H
 #define GRAUPEL_SNOW_ACCUMULATION_H
@@ -157,7 +161,8 @@ typedef struct gr_snow_accumulation_ledger {
 typedef struct gr_snow_accumulation gr_snow_accumulation;
 
 /**
- * A simulation on one whole grid: validates grid and parameters, checks
+ * A simulation on a whole grid or a piece of one (see "Pieces of a split
+ * domain" below): validates grid and parameters, checks
  * that the exposure view fits the device (no wider than its largest 2-D
  * image where it has images, and within its largest buffer:
  * GR_ERR_TOO_LARGE with a sentence otherwise), builds the kernels, and
@@ -172,7 +177,8 @@ GR_API gr_status gr_snow_accumulation_set_params(gr_snow_accumulation *s,
                                                  const gr_snow_accumulation_params *p);
 
 /**
- * Uploads ELEVATION or SNOW_DEPTH (nx*ny floats; see field_validate); a
+ * Uploads ELEVATION or SNOW_DEPTH (nx*ny floats, a piece's local array with
+ * its rings; see field_validate); a
  * refused field leaves the state as it was. SNOW_DEPTH replaces the snow
  * on the grid and becomes what reset returns to; the ledger's initial
  * volume moves by the change.
@@ -235,13 +241,24 @@ GR_API gr_status gr_snow_accumulation_set_object_texture(gr_snow_accumulation *s
 GR_API gr_status gr_snow_accumulation_get_object_texture(gr_snow_accumulation *s, int o,
                                                          float *texels, int size);
 
-/** One step of dt seconds (finite, 1e-6 to 86400); enqueues and does not wait. */
+/**
+ * One step of dt seconds (finite, 1e-6 to 86400); enqueues and does not
+ * wait. A piece with neighbours waits for its exchange and reductions, and
+ * steps only with an allreduce and a halo exchange set (collective).
+ */
 GR_API gr_status gr_snow_accumulation_step(gr_snow_accumulation *s, double dt);
 
-/** Reads a grid field back (waits): SNOW_DEPTH, SNOW_SURFACE, SNOW_DENSITY, EXPOSURE, ELEVATION. */
+/**
+ * Reads a grid field back (waits): SNOW_DEPTH, SNOW_SURFACE, SNOW_DENSITY,
+ * EXPOSURE, ELEVATION; nx*ny floats (a piece: its own rows).
+ */
 GR_API gr_status gr_snow_accumulation_get_field(gr_snow_accumulation *s, gr_field f, float *host);
 
-/** The ledger now (waits; reduces on the device). */
+/**
+ * The ledger now (waits; reduces on the device). A piece with an allreduce
+ * gives the whole domain's ledger (a collective call); one without, its own
+ * rows' and the objects'.
+ */
 GR_API gr_status gr_snow_accumulation_ledger_get(gr_snow_accumulation *s,
                                                  gr_snow_accumulation_ledger *out);
 
@@ -258,7 +275,8 @@ GR_API void gr_snow_accumulation_set_progress(gr_snow_accumulation *s, gr_progre
  * exposures, time, steps and ledger as bytes. Loading into a simulation of
  * the same grid with the same objects set (as many, with as many mesh
  * points) makes every later step bit-identical. Elevation, parameters and
- * object poses are not part of it.
+ * object poses are not part of it. A piece's state holds its local arrays,
+ * rings included, and its j0; it loads only into the same piece.
  */
 GR_API gr_status gr_snow_accumulation_state_size(const gr_snow_accumulation *s, size_t *bytes);
 GR_API gr_status gr_snow_accumulation_state_save(gr_snow_accumulation *s, void *host, size_t bytes);
@@ -270,6 +288,109 @@ GR_API gr_status gr_snow_accumulation_state_load(gr_snow_accumulation *s, const 
  * ledger zeroed; elevation and objects kept.
  */
 GR_API gr_status gr_snow_accumulation_reset(gr_snow_accumulation *s);
+
+/**
+ * @name Pieces of a split domain
+ *
+ * A simulation may hold one strip of a domain split along y (the gr_grid
+ * piece fields: j0, global_ny, ghost; a piece spans whole rows: i0 = 0 and
+ * nx = global_nx or 0, because the ledger sums whole rows, see below). On
+ * each side where the strip has a neighbour (south: j0 > 0, north:
+ * j0 + ny < global_ny) it keeps a ring of grid.ghost rows, copies of the
+ * neighbour's rows; grid.ghost must be at least
+ * gr_snow_accumulation_ghost(params) and the strip at least grid.ghost rows
+ * high. The local arrays are the strip and its rings: nx x (ny + rings)
+ * floats for set_field and checkpoints; get_field gives the own nx x ny.
+ *
+ * What is local and what is not. The growth of an own point reads the
+ * snow surface one row away (its normal), the blur reads BlurRadius rows of
+ * growth on each side and the dilation one more: so the ring is BlurRadius +
+ * 2 rows, refreshed once per step (the snow depth, after the increment,
+ * through the caller's exchange), and every own point then computes the
+ * whole grid's bits. The exposure view is not local: a ray along a tilted
+ * snow direction crosses terrain any distance away, so no ring bounds it
+ * (the reach is the relief times the tilt's tangent, up to 3.7 times the
+ * relief). A ring holding the whole terrain would make each piece hold the
+ * whole grid, and a terrain-only march would change the model (snow hides
+ * ground too). Instead each piece rasterizes the surface cells of its
+ * local arrays into a view of the whole domain's extent (the same texels on
+ * every piece: the view's box comes from the elevation's and the snow's
+ * range reduced with GR_REDUCE_MAX), and the views are combined with
+ * GR_REDUCE_MAX, texel by texel: the view keeps the highest crossing of
+ * each texel, so the maximum over the pieces' views is the whole grid's
+ * view, bit for bit, whatever the split. That costs a reduction of the
+ * view (ExposureResolution^2 values, in calls of at most
+ * GR_SNOW_ACCUMULATION_REDUCE_CHUNK) in the steps where the terrain is
+ * drawn at all: where the surface rises slower than the snow falls (snow
+ * straight down always) the view holds the objects alone, which every
+ * piece draws the same, and nothing is reduced.
+ *
+ * Objects: every piece keeps every object and its snow (mesh points and
+ * textures are small beside the grid), takes the same steps on them from
+ * the same view, and so holds the same bits. The one grid value an object
+ * reads is the snow surface under a mesh point (whether it is buried, in
+ * the steps without terrain in the view): the piece that owns the grid
+ * cell under the point gives it, the others -inf, reduced with
+ * GR_REDUCE_MAX (a value per mesh point). An object across the cut thus
+ * sees both pieces' snow. The objects' volumes are the same on every piece
+ * and enter the ledger once.
+ *
+ * The ledger: the grid's stored, fallen and shed snow and its initial
+ * snow are summed per row (in a fixed order along the row), and the rows
+ * are added in the order of the domain's rows: each piece places its rows'
+ * sums in an array of the domain's rows, -inf elsewhere, GR_REDUCE_MAX
+ * makes it every piece's (one value and -infs: exact in any order), and
+ * the host adds the rows in order. So the ledger is the same bits for 1, 2
+ * or any number of pieces, and the same as the whole grid's. Every
+ * reduction this core asks for is a GR_REDUCE_MAX, so its bits never depend
+ * on how the allreduce orders a sum.
+ *
+ * Stepping on pieces is collective: every piece sets the same parameters
+ * and objects and calls step with the same dt, and each step makes the
+ * same sequence of allreduce and exchange calls on every piece; ledger_get
+ * is collective too. A stop asked by one piece's progress callback is
+ * reduced after every step (GR_REDUCE_MAX), so every piece stops after the
+ * same step. An error on one piece returns on that piece only: the others
+ * wait in their next collective call, which the caller's callbacks must end.
+ * @{
+ */
+
+/** Values per allreduce call, at most (longer reductions are cut into calls of this many). */
+#define GR_SNOW_ACCUMULATION_REDUCE_CHUNK 65536
+
+/** Sides of a piece, for the halo calls (as every core numbers them; x sides never have one). */
+typedef enum gr_snow_accumulation_side {
+  GR_SNOW_ACCUMULATION_SOUTH = 2, /**< toward j0 - 1 */
+  GR_SNOW_ACCUMULATION_NORTH = 3  /**< toward j0 + ny */
+} gr_snow_accumulation_side;
+
+/** The ring a piece needs for these parameters, rows: BlurRadius + 2 (0 for NULL). */
+GR_API int gr_snow_accumulation_ghost(const gr_snow_accumulation_params *p);
+
+/**
+ * The global reduction over the pieces (see gr_allreduce_fn); NULL (the
+ * default) for a simulation that is the whole domain. A piece with a
+ * neighbour steps only with one and a halo exchange set.
+ */
+GR_API void gr_snow_accumulation_set_allreduce(gr_snow_accumulation *s, gr_allreduce_fn fn,
+                                               void *user);
+
+/** The halo exchange (see gr_halo_exchange_fn), called once per step; NULL removes it. */
+GR_API void gr_snow_accumulation_set_halo_exchange(gr_snow_accumulation *s, gr_halo_exchange_fn fn,
+                                                   void *user);
+
+/** Bytes of the halo strip on `side` (south 2, north 3): ghost rows of snow depth; 0 for none. */
+GR_API gr_status gr_snow_accumulation_halo_size(const gr_snow_accumulation *s, int side,
+                                                size_t *bytes);
+
+/** Copies the own rows next to `side` out (for the neighbour on that side); waits. */
+GR_API gr_status gr_snow_accumulation_halo_get(gr_snow_accumulation *s, int side, void *host,
+                                               size_t bytes);
+
+/** Copies the neighbour's rows into the ring on `side`; waits. */
+GR_API gr_status gr_snow_accumulation_halo_set(gr_snow_accumulation *s, int side, const void *host,
+                                               size_t bytes);
+/** @} */
 
 /** The latest error of a call on this simulation ("" when none). Never NULL. */
 GR_API const char *gr_snow_accumulation_last_error(const gr_snow_accumulation *s);
