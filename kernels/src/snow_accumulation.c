@@ -102,6 +102,7 @@ struct gr_snow_accumulation {
    * normal, the noise coordinates, the area and the state arrays. */
   int nobjects, nv, ntri;
   int first[GR_SNOW_ACCUMULATION_MAX_OBJECTS + 1], nverts[GR_SNOW_ACCUMULATION_MAX_OBJECTS];
+  gr_mesh_memo memo[GR_SNOW_ACCUMULATION_MAX_OBJECTS]; /* each object's mesh as last checked */
   cl_mem o_tri, o_pos, o_nrm, o_local, o_area, o_arr[GR_SNAC_ARRAYS];
   /* Accumulation textures: per object its size (0: none) and UVs, its
    * samples (first .. first + count - 1 of the sample arrays) and per
@@ -768,6 +769,8 @@ void gr_snow_accumulation_destroy(gr_snow_accumulation *s) {
   free(s->ht);
   free(s->hnrm);
   free(s->init_rows);
+  for (int o = 0; o < GR_SNOW_ACCUMULATION_MAX_OBJECTS; ++o)
+    gr_mesh_memo_free(&s->memo[o]);
   gr_context_release(s->ctx);
   free(s);
 }
@@ -1180,7 +1183,7 @@ static gr_status gr_snac_set_objects_impl(gr_snow_accumulation *s, const gr_mesh
   int first[GR_SNOW_ACCUMULATION_MAX_OBJECTS + 1];
   long long nv = 0, nt = 0;
   for (int o = 0; o < n; ++o) {
-    if (gr_mesh_validate(&meshes[o], 0, msg, sizeof(msg)) != GR_OK)
+    if (gr_mesh_check(&s->memo[o], &meshes[o], 0, msg, sizeof(msg)) != GR_OK)
       return gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT, "Object %d: %s", o, msg);
     first[o] = (int)nv;
     nv += meshes[o].nvertices;
