@@ -52,6 +52,8 @@ vtkRainRunoffFilter::vtkRainRunoffFilter() {
   // The core runs as pieces of a split domain (an MPI run's strips), its
   // ring as wide as the flow model's stencil.
   this->SetPieceRing(GR_RAIN_RUNOFF_GHOST_SW);
+  // Inflows may vary in time (a river's discharge per input time step).
+  this->SetInputPortPolicy(3, TEMPORAL_INPUT);
 }
 
 // The core's parameter table clamps every property: the class writes no
@@ -483,9 +485,13 @@ int vtkRainRunoffFilter::SetUpState(vtkInformationVector **inputVector) {
       return 0;
     }
   }
-  if (!this->SetPointInflows(inputVector, terrain)) {
+  vtkPointSet *inflows = inputVector[3]->GetNumberOfInformationObjects()
+                             ? vtkPointSet::SafeDownCast(this->GetTemporalInput(3))
+                             : nullptr;
+  if (!this->SetPointInflows(inflows, terrain)) {
     return 0;
   }
+  this->InflowsReadAt = this->GetTemporalInputTime(3);
   // Progress with the simulated time, and an abort inside a long interval.
   gr_rain_runoff_set_progress(this->Simulation, &vtkGraupelSimulation::CoreProgress, this);
   this->Ledgers.clear();
@@ -493,12 +499,8 @@ int vtkRainRunoffFilter::SetUpState(vtkInformationVector **inputVector) {
   return this->RecordLedger(0);
 }
 
-int vtkRainRunoffFilter::SetPointInflows(vtkInformationVector **inputVector,
-                                         vtkImageData *terrain) {
-  vtkPointSet *points = inputVector[3]->GetNumberOfInformationObjects()
-                            ? vtkPointSet::GetData(inputVector[3])
-                            : nullptr;
-  if (!points) {
+int vtkRainRunoffFilter::SetPointInflows(vtkPointSet *points, vtkImageData *terrain) {
+  if (!points || !terrain) {
     return 1;
   }
   vtkDataArray *q = points->GetPointData()->GetArray("discharge");
@@ -615,6 +617,7 @@ int vtkRainRunoffFilter::RecordLedger(int index) {
 }
 
 int vtkRainRunoffFilter::ResetState() {
+  this->InflowsReadAt = std::numeric_limits<double>::quiet_NaN();
   const gr_status st = gr_rain_runoff_reset(this->Simulation);
   return st == GR_OK ? this->RecordLedger(0)
                      : this->ReportFailure(st, "Rain Runoff could not restart",
@@ -622,6 +625,15 @@ int vtkRainRunoffFilter::ResetState() {
 }
 
 int vtkRainRunoffFilter::AdvanceState(double t0, double t1) {
+  // Temporal Inflows: the discharges of the input's time step that holds
+  // over [t0, t1] (the base keeps the input at the step the state needs).
+  if (this->IsInputTemporal(3) && this->GetTemporalInputTime(3) != this->InflowsReadAt) {
+    if (!this->SetPointInflows(vtkPointSet::SafeDownCast(this->GetTemporalInput(3)),
+                               vtkImageData::SafeDownCast(this->GetTemporalInput(0)))) {
+      return ADVANCE_FAILED;
+    }
+    this->InflowsReadAt = this->GetTemporalInputTime(3);
+  }
   const gr_status st = gr_rain_runoff_advance(this->Simulation, t1 - t0, nullptr);
   if (st == GR_ERR_ABORTED) {
     return ADVANCE_ABORTED;
@@ -722,6 +734,9 @@ int vtkRainRunoffFilter::LoadState(const std::vector<unsigned char> &bytes) {
   }
   std::copy(ledgers.begin(), ledgers.end(), this->Ledgers.begin());
   std::copy(gaugeRows.begin(), gaugeRows.end(), this->GaugeRows.begin());
+  // The point inflows are not in the core's state: the next advance sets
+  // those of the Inflows input's time step again.
+  this->InflowsReadAt = std::numeric_limits<double>::quiet_NaN();
   return 1;
 }
 

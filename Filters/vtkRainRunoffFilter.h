@@ -54,13 +54,12 @@
  * Gauges are a static input: moving them sets the simulation up again.
  *
  * Inflows: Input 3 (`Inflows`, optional) is a point set with the point
- * array `discharge` (m^3/s, 0 to 1e6, constant in time): each point is
- * snapped to the nearest terrain point and lets that much water in there
- * (a river, a culvert; points on one terrain point add up); a point off the
- * terrain or a bad discharge is refused with a sentence. And per edge an
- * inflow hydrograph (InflowWest ... InflowNorth): rows of time (s) and
- * discharge (m^3/s), times strictly increasing, linear in between, held
- * before the first and after the last row, spread evenly along the edge.
+ * array `discharge` (m^3/s, 0 to 1e6; a temporal input's time steps each
+ * hold until the next, read while stepping): each point is snapped to the nearest terrain point and
+ * lets that much water in there (a river, a culvert; points on one terrain point add up); a point
+ * off the terrain or a bad discharge is refused with a sentence. And per edge an inflow hydrograph
+ * (InflowWest ... InflowNorth): rows of time (s) and discharge (m^3/s), times strictly increasing,
+ * linear in between, held before the first and after the last row, spread evenly along the edge.
  * Both count as the ledger's inflow_volume.
  *
  * MPI (pvbatch, pvserver): each rank simulates its strip of the grid with
@@ -95,6 +94,8 @@
 #include <vector>
 
 struct gr_rain_runoff;
+class vtkImageData;
+class vtkPointSet;
 
 class GRAUPELFILTERS_EXPORT vtkRainRunoffFilter : public vtkGraupelSimulation {
 public:
@@ -291,8 +292,11 @@ private:
   /** Adds the flood maps to the image output, on its extent. */
   int AddMaps(vtkDataObject *output);
 
-  /** Gives the core the Inflows input's points (snapped to the terrain); 0 with a sentence. */
-  int SetPointInflows(vtkInformationVector **inputVector, vtkImageData *terrain);
+  /** Gives the core the Inflows points (snapped to the terrain; none: nothing); 0 with a sentence.
+   */
+  int SetPointInflows(vtkPointSet *points, vtkImageData *terrain);
+  /** The Inflows input's time step the core's point inflows came from (NaN: set them again). */
+  double InflowsReadAt = 0.0;
   void AddInflow(int side, double time, double discharge);
   void RemoveAllInflow(int side);
 
