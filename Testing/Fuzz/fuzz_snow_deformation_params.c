@@ -52,8 +52,9 @@ static int params_documented(const gr_snow_deformation_params *p) {
          in_row("CompressionModel", (double)p->compression_model) &&
          in_row("MaxSlope", p->max_slope) && in_row("DirectionFalloff", p->direction_falloff) &&
          in_row("MaxRelaxIterations", (double)p->max_relax_iterations) &&
-         in_row("RelaxTolerance", p->relax_tolerance) && p->min_density <= p->max_density &&
-         p->initial_density >= p->min_density && p->initial_density <= p->max_density;
+         in_row("RelaxTolerance", p->relax_tolerance) && in_row("SlumpSpeed", p->slump_speed) &&
+         p->min_density <= p->max_density && p->initial_density >= p->min_density &&
+         p->initial_density <= p->max_density;
 }
 
 static int field_documented(const gr_snow_deformation_params *p, gr_field f, const float *v,
@@ -86,7 +87,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
   const size_t small_len = take_byte(&r) % 96;
   const gr_field f = (gr_field)(take_byte(&r) % (GR_FIELD_COUNT + 1));
   const size_t nx = take_byte(&r) % 17;
-  double *d[7];
+  double *d[8];
   int *in[2];
 
   memset(&p, 0, sizeof p);
@@ -97,9 +98,10 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
   d[4] = &p.max_slope;
   d[5] = &p.direction_falloff;
   d[6] = &p.relax_tolerance;
+  d[7] = &p.slump_speed;
   in[0] = &p.compression_model;
   in[1] = &p.max_relax_iterations;
-  for (int k = 0; k < 7; ++k) {
+  for (int k = 0; k < 8; ++k) {
     if (mode == 0)
       take(&r, d[k], sizeof(double));
     else
