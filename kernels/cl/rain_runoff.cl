@@ -498,14 +498,16 @@ __kernel void rain_runoff_source(__global const float *restrict pts, int use_pts
  * words, metres summed over cells) and the deepest cell (its float's bits);
  * masked: only the cells [own_x0, own_x1) x [own_y0, own_y1) of the
  * row-wide local array (a piece without its ring). Integer sums: the
- * pieces of a split domain add up to the whole grid's, bit for bit. */
+ * pieces of a split domain add up to the whole grid's, bit for bit.
+ * with_sums 0: the deepest cell only (the stable step), one float a cell
+ * read instead of eight. */
 __kernel void rain_runoff_reduce(
     __global const float *restrict h, __global const float *restrict h_comp,
     __global const float *restrict infiltrated, __global const float *restrict infiltrated_comp,
     __global const float *restrict outflow, __global const float *restrict outflow_comp,
     __global const float *restrict inflow, __global const float *restrict inflow_comp,
     __global long *restrict partial, __local long *restrict scratch, int n, int row, int own_x0,
-    int own_x1, int own_y0, int own_y1, int masked) {
+    int own_x1, int own_y0, int own_y1, int masked, int with_sums) {
   int lid = get_local_id(0), wg = get_local_size(0), start, end;
   gr_reduce_block(n, &start, &end);
   long w[2 * GR_RAIN_RUNOFF_SUMS];
@@ -520,6 +522,9 @@ __kernel void rain_runoff_reduce(
         continue;
     }
     float d = h[c];
+    hmax = fmax(hmax, d);
+    if (!with_sums)
+      continue;
     gr_fixed_add(&w[0], &w[1], d);
     gr_fixed_add(&w[0], &w[1], -h_comp[c]);
     gr_fixed_add(&w[2], &w[3], infiltrated[c]);
@@ -528,7 +533,6 @@ __kernel void rain_runoff_reduce(
     gr_fixed_add(&w[4], &w[5], -outflow_comp[c]);
     gr_fixed_add(&w[6], &w[7], inflow[c]);
     gr_fixed_add(&w[6], &w[7], -inflow_comp[c]);
-    hmax = fmax(hmax, d);
   }
   const int slots = 2 * GR_RAIN_RUNOFF_SUMS + GR_RAIN_RUNOFF_MAXES;
   __local long *mine = gr_reduce_slots_long(scratch, slots);

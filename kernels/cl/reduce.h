@@ -130,21 +130,26 @@ GR_INLINE void gr_reduce_group_long(__local long *scratch, int nsum,
 }
 
 /* Ledger fixed point (graupel/reduce.h's gr_fixed, which gives the same
- * integers on the host): a float x adds two integers, coarse = x rounded to
- * the nearest multiple of 2^-24, in units of 2^-24, and fine = the rest
- * (exact as a float, |rest| <= 2^-25) rounded to the nearest 2^-54, in units
- * of 2^-54 (|fine| <= 2^29). Sums of them are exact and order-free: the same
- * cells give the same totals however they are split among work-items,
- * work-groups, pieces or devices. |x| >= 2^-31 converts exactly, smaller x
- * to within 2^-55; |x| >= 2^39 saturates (graupel/reduce.h states the
- * totals' bounds). Scaling by powers of two is exact, and x - c 2^-24 is
- * exact (c 2^-24 is x rounded to a coarser grid), so every device that
- * rounds to nearest even gives these very integers. */
+ * integers on the host): a float x adds two integers, coarse = x cut
+ * toward zero to a multiple of 2^-24, in units of 2^-24, and fine = the rest
+ * (exact as a float, |rest| < 2^-24) cut toward zero to a multiple of 2^-54,
+ * in units of 2^-54 (|fine| < 2^30). Sums of them are exact and order-free:
+ * the same cells give the same totals however they are split among
+ * work-items, work-groups, pieces or devices. |x| >= 2^-31 converts
+ * exactly, smaller x to within 2^-54; coarse is clamped to +-2^62 (|x| <
+ * 2^38 fits; graupel/reduce.h states the totals' bounds) and fine to +-2^30.
+ * Scaling by powers of two is exact, a float cut to an integer converts
+ * back exactly, and x - c 2^-24 is exact (c 2^-24 is x cut to a coarser
+ * grid), so every device gives these very integers. Conversions toward
+ * zero, the fine one to int: PoCL vectorises them (rint doubled the
+ * reduction's time again). */
 GR_INLINE void gr_fixed_add(long *coarse, long *fine, float x) {
-  float c = rint(x * 16777216.0f);             /* 2^24 */
-  float rest = x - c * 5.9604644775390625e-8f; /* 2^-24 */
-  *coarse += convert_long_sat(c);
-  *fine += convert_long_sat_rte(rest * 18014398509481984.0f); /* 2^54 */
+  long c = convert_long(fmin(fmax(x * 16777216.0f, -4611686018427387904.0f), /* 2^24, 2^62 */
+                             4611686018427387904.0f));
+  float rest = x - convert_float(c) * 5.9604644775390625e-8f; /* 2^-24 */
+  *coarse += c;
+  *fine += convert_int(fmin(fmax(rest * 18014398509481984.0f, -1073741824.0f), /* 2^54, 2^30 */
+                            1073741824.0f));
 }
 
 #endif

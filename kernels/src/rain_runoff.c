@@ -495,16 +495,17 @@ static gr_status gr_rain_runoff_read_own(gr_rain_runoff *s, cl_mem buf, size_t c
 }
 
 /* Sums the stored, infiltrated, outflow and inflow depths over the owned
- * cells in fixed point (m, so times dx dy for m^3) and finds the deepest
- * cell. */
+ * cells in fixed point (m, so times dx dy for m^3; sums NULL: none) and
+ * finds the deepest cell. */
 static gr_status gr_rain_runoff_reduce_fixed(gr_rain_runoff *s, gr_fixed sums[GR_RAIN_RUNOFF_SUMS],
                                              double *max_depth) {
   cl_int n = (cl_int)gr_rain_runoff_cells(s);
   /* The owned cells of the local arrays (masked only where there is a ring). */
   cl_int row = s->nxl, own_x0 = s->ring[0], own_x1 = s->nxl - s->ring[1];
   cl_int own_y0 = s->ring[2], own_y1 = s->nyl - s->ring[3];
-  cl_int masked = gr_rain_runoff_has_ring(s);
+  cl_int masked = gr_rain_runoff_has_ring(s), with_sums = sums != NULL;
   const gr_rain_runoff_arg args[] = {
+      {"with_sums", sizeof(with_sums), &with_sums},
       {"h", sizeof(cl_mem), &s->h},
       {"h_comp", sizeof(cl_mem), &s->h_c},
       {"infiltrated", sizeof(cl_mem), &s->inf},
@@ -527,7 +528,7 @@ static gr_status gr_rain_runoff_reduce_fixed(gr_rain_runoff *s, gr_fixed sums[GR
     st = gr_reduction_i64_run_max(s->ctx, &s->ledger, s->reduce, words, maxes);
   if (st != GR_OK)
     return st;
-  for (int q = 0; q < GR_RAIN_RUNOFF_SUMS; ++q) {
+  for (int q = 0; sums && q < GR_RAIN_RUNOFF_SUMS; ++q) {
     sums[q].coarse = words[2 * q];
     sums[q].fine = words[2 * q + 1];
   }
@@ -541,14 +542,10 @@ static gr_status gr_rain_runoff_reduce_fixed(gr_rain_runoff *s, gr_fixed sums[GR
   return GR_OK;
 }
 
-/* The same sums as doubles (this piece's own), for the stable step. */
-static gr_status gr_rain_runoff_reduce(gr_rain_runoff *s, double sums[GR_RAIN_RUNOFF_SUMS],
-                                       double *max_depth) {
-  gr_fixed fx[GR_RAIN_RUNOFF_SUMS];
-  gr_status st = gr_rain_runoff_reduce_fixed(s, fx, max_depth);
-  for (int q = 0; st == GR_OK && q < GR_RAIN_RUNOFF_SUMS; ++q)
-    sums[q] = gr_fixed_value(fx[q]);
-  return st;
+/* The deepest owned cell only (the stable step): the ledger's reduction
+ * reading the depth alone. */
+static gr_status gr_rain_runoff_deepest(gr_rain_runoff *s, double *max_depth) {
+  return gr_rain_runoff_reduce_fixed(s, NULL, max_depth);
 }
 
 /* ------------------------------------------------------------ flood maps */
@@ -2139,8 +2136,8 @@ static gr_status gr_rain_runoff_sw_stable_dt(gr_rain_runoff *s, double *dt) {
 static gr_status gr_rain_runoff_stable_dt_impl(gr_rain_runoff *s, double *dt) {
   if (s->params.flow_model == GR_FLOW_SHALLOW_WATER)
     return gr_rain_runoff_sw_stable_dt(s, dt);
-  double sums[GR_RAIN_RUNOFF_SUMS], hmax = 0.0;
-  gr_status st = gr_rain_runoff_reduce(s, sums, &hmax);
+  double hmax = 0.0;
+  gr_status st = gr_rain_runoff_deepest(s, &hmax);
   /* A level edge's water counts as the grid's. */
   double edge = gr_rain_runoff_edge_depth(s);
   hmax = edge > hmax ? edge : hmax;

@@ -229,26 +229,15 @@ void gr_reduction_i64_release(gr_reduction_i64 *r) {
 
 /* ---------------------------------------------------------- fixed point */
 
-/* A float that holds an integer, as int64: saturated as a device's
- * convert_long_sat saturates (NaN gives 0). */
-static long long gr_fixed_word(float integral) {
-  if (!(integral == integral))
-    return 0;
-  if (integral >= 9223372036854775808.0f)
-    return LLONG_MAX;
-  if (integral < -9223372036854775808.0f)
-    return LLONG_MIN;
-  return (long long)integral;
-}
-
 gr_fixed gr_fixed_from_float(float x) {
-  /* cl/reduce.h's gr_fixed_add, step for step (rintf rounds to nearest
-   * even, as the device's rint and convert_long_sat_rte do). */
-  float c = rintf(x * 16777216.0f);
-  float rest = x - c * 5.9604644775390625e-8f;
+  /* cl/reduce.h's gr_fixed_add, step for step: C's conversions cut toward
+   * zero as OpenCL's convert_long and convert_int do, and fmaxf / fminf
+   * take the number over a NaN as fmax / fmin do. */
   gr_fixed f;
-  f.coarse = gr_fixed_word(c);
-  f.fine = gr_fixed_word(rintf(rest * 18014398509481984.0f));
+  f.coarse =
+      (long long)fminf(fmaxf(x * 16777216.0f, -4611686018427387904.0f), 4611686018427387904.0f);
+  float rest = x - (float)f.coarse * 5.9604644775390625e-8f;
+  f.fine = (int)fminf(fmaxf(rest * 18014398509481984.0f, -1073741824.0f), 1073741824.0f);
   return f;
 }
 

@@ -105,19 +105,20 @@ GR_API void gr_reduction_i64_release(gr_reduction_i64 *r);
  * Totals that must be the same bits however a domain is split (among
  * work-groups, the pieces of an MPI run, or devices) are sums of integers:
  * integer addition is exact in any order. A value x (a float per cell: a
- * depth in m, a rate in m/s) becomes two int64 words, coarse = x rounded to
- * the nearest multiple of 2^-24 (in units of 2^-24) and fine = the rest
- * rounded to the nearest 2^-54 (in units of 2^-54; |fine| <= 2^29), the
+ * depth in m, a rate in m/s) becomes two int64 words, coarse = x cut toward
+ * zero to a multiple of 2^-24 (in units of 2^-24) and fine = the rest cut
+ * toward zero to a multiple of 2^-54 (in units of 2^-54; |fine| < 2^30), the
  * device's cl/reduce.h gr_fixed_add and gr_fixed_from_float here giving the
- * same integers. So |x| >= 2^-31 is exact and smaller x is within 2^-55
- * (half a unit): a ledger closes as well as the double-float sums it
- * replaces. Each word is summed on its own.
+ * same integers. So |x| >= 2^-31 is exact and smaller x is within 2^-54 m
+ * (5.6e-17): a ledger closes as well as the double-float sums it replaced.
+ * Each word is summed on its own.
  *
  * Bounds (int64 totals): the coarse words of n cells stay below 2^63 while
- * sum |x| < 2^39 (5.5e11) units x cells, and the fine words while n < 2^33
- * (two floats per cell, a value and its Kahan compensation, 2^30 a cell).
- * For a 65536^2 grid (2^32 cells) that is a mean of 128 m per cell for a
- * depth ledger (stored, infiltrated, outflow, inflow: each on its own).
+ * sum |x| < 2^39 (5.5e11) units x cells, and the fine words while n <= 2^32
+ * (two floats per cell, a value and its Kahan compensation, under 2^31 a
+ * cell). For a 65536^2 grid (2^32 cells) that is a mean of 128 m per cell
+ * for a depth ledger (stored, infiltrated, outflow, inflow: each on its
+ * own); a single cell holds up to 2^38 m.
  *
  * Products (the rain: a rate sum times a step, both exact integers) use
  * gr_wide, a 128-bit integer; gr_fixed_pack / gr_fixed_unpack carry int64s
