@@ -1993,6 +1993,49 @@ static void test_shared_context(void) {
   gr_context_release(shared);
 }
 
+/* The ledger's fixed point on the device is the host's (graupel/reduce.h):
+ * depths from 1e-12 m to 60 m, set as the initial water, reduce on the
+ * device to the very integers the host booked, so the stored volume is the
+ * initial one to the bit and the balance is 0 exactly, before any step and
+ * after a reset; both equal the depths' sum to 1e-15. */
+static void test_ledger_fixed_point(void) {
+  gr_grid g = {23, 17, 1.5, 2.5, 0.0, 0.0, 0, 0};
+  float *b = alloc_field(&g, 1), *d = alloc_field(&g, 1);
+  double exact = 0.0; /* in double: to 1e-16 for a few hundred floats */
+  for (int j = 0; j < g.ny; ++j)
+    for (int i = 0; i < g.nx; ++i) {
+      size_t c = (size_t)j * g.nx + i;
+      b[c] = (float)(0.01 * i);
+      d[c] = (float)(pow(10.0, -12.0 + 13.5 * hash01(i, j, 21)) * (1.0 + hash01(i, j, 22)));
+      exact += d[c];
+    }
+  gr_rain_runoff_params p = params_with(1e-5, 1e-6, GR_BOUNDARY_OPEN);
+  gr_rain_runoff *s = make_sim(&g, &p, b, d);
+  if (s) {
+    for (int pass = 0; pass < 2; ++pass) {
+      gr_rain_runoff_ledger l = ledger(s);
+      CHECK_MSG(memcmp(&l.stored_volume, &l.initial_volume, sizeof(double)) == 0 &&
+                    l.balance_error == 0.0,
+                "%s: stored %.17g, initial %.17g, balance %.3g", pass ? "after a reset" : "set",
+                l.stored_volume, l.initial_volume, l.balance_error);
+      CHECK_NEAR(l.stored_volume, exact * g.dx * g.dy, 1e-15 * exact * g.dx * g.dy);
+      double dt = 0.0;
+      CHECK(gr_rain_runoff_stable_dt(s, &dt) == GR_OK && dt > 0.0);
+      CHECK(gr_rain_runoff_step(s, dt, 20) == GR_OK);
+      l = ledger(s);
+      double in = l.initial_volume + l.rain_volume;
+      /* The steps' float rounding over depths 13 decades apart (2e-8 here,
+       * the same before the fixed point), not the ledger's. */
+      CHECK_MSG(fabs(l.balance_error) <= 1e-7 * in, "after 20 steps: balance %.3g of %.6g",
+                l.balance_error, in);
+      CHECK(gr_rain_runoff_reset(s) == GR_OK);
+    }
+  }
+  gr_rain_runoff_destroy(s);
+  free(b);
+  free(d);
+}
+
 /* ------------------------------------------------------------- pieces */
 
 /* Every entry of a ledger, for the bit-for-bit comparisons of split and
@@ -4133,6 +4176,7 @@ static const gr_subtest tests[] = {
     {"checkpoint", test_checkpoint, 0},
     {"progress", test_progress, 0},
     {"shared_context", test_shared_context, 0},
+    {"ledger_fixed_point", test_ledger_fixed_point, 0},
     {"pieces_x", test_pieces_x, 0},
     {"pieces_y", test_pieces_y, 0},
     {"advance_pieces_x", test_advance_pieces_x, 0},
