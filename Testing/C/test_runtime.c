@@ -8,9 +8,12 @@
  * no_platform`; run with OCL_ICD_VENDORS pointing at an empty folder) checks
  * the no-driver path. */
 #include "graupel/cl_runtime.h"
+#include "graupel/reduce.h"
 #include "gr_test.h"
 
+#include <math.h>
 #include <pthread.h>
+#include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -805,6 +808,102 @@ static void test_enqueue_1d(void) {
   gr_context_release(ctx);
 }
 
+/* The ledger fixed point (graupel/reduce.h): floats convert exactly (or to
+ * within 2^-54 below 2^-31), words add up the same in any order and split,
+ * 128-bit products are exact and round once to double, and packed integers
+ * sum exactly through doubles. */
+static double fixed_exact(gr_fixed f) {
+  /* Exact in double for the values used here (both words small). */
+  return ldexp((double)f.coarse, -GR_FIXED_COARSE_BITS) +
+         ldexp((double)f.fine, -GR_FIXED_FINE_BITS);
+}
+
+static void test_fixed_point(void) {
+  const float xs[] = {0.0f,   1.0f,    -1.0f,    0.1f,     3.3e-5f,
+                      1e-7f,  0.7f,    123.456f, -0.0123f, 4.6566129e-10f /* 2^-31 */,
+                      1e-12f, -3e-15f, 1e-30f,   2.5e5f};
+  int exact = 1, near = 1;
+  for (size_t k = 0; k < sizeof(xs) / sizeof(xs[0]); ++k) {
+    gr_fixed f = gr_fixed_from_float(xs[k]);
+    double back = fixed_exact(f), err = fabs(back - (double)xs[k]);
+    CHECK_MSG(f.fine > -(1ll << 30) && f.fine < (1ll << 30), "%g: fine word %lld", xs[k], f.fine);
+    if (fabsf(xs[k]) >= 4.6566129e-10f)
+      exact &= back == (double)xs[k];
+    else
+      near &= err < ldexp(1.0, -54);
+    CHECK_MSG(gr_fixed_value(f) == back, "%g: gr_fixed_value %.17g, the words %.17g", xs[k],
+              gr_fixed_value(f), back);
+  }
+  CHECK_MSG(exact, "floats from 2^-31 up convert exactly");
+  CHECK_MSG(near, "smaller floats convert to within 2^-54");
+
+  /* A sum of many floats: the same words in any order and any split. */
+  enum { N = 5000 };
+  static float v[N];
+  for (int i = 0; i < N; ++i)
+    v[i] = (float)(0.3 * sin(i * 0.37) * sin(i * 0.37) * (i % 7 == 0 ? 1e4 : 1.0) +
+                   (i % 11 == 0 ? -2e-6 : 0.0));
+  gr_fixed forward = {0, 0}, backward = {0, 0}, parts[2] = {{0, 0}, {0, 0}};
+  double naive_f = 0.0, naive_b = 0.0;
+  for (int i = 0; i < N; ++i) {
+    gr_fixed_add(&forward, gr_fixed_from_float(v[i]));
+    gr_fixed_add(&backward, gr_fixed_from_float(v[N - 1 - i]));
+    gr_fixed_add(&parts[i % 3 == 0], gr_fixed_from_float(v[i]));
+    naive_f += v[i];
+    naive_b += v[N - 1 - i];
+  }
+  gr_fixed_add(&parts[0], parts[1]);
+  CHECK(forward.coarse == backward.coarse && forward.fine == backward.fine);
+  CHECK(forward.coarse == parts[0].coarse && forward.fine == parts[0].fine);
+  CHECK(gr_fixed_value(forward) == gr_fixed_value(parts[0]));
+  CHECK_NEAR(gr_fixed_value(forward), naive_f, 1e-12 * fabs(naive_f));
+  printf("fixed point: %d floats summed forward, backward and split: the same words (%.17g); "
+         "double sums forward and backward differ by %.3g\n",
+         N, gr_fixed_value(forward), naive_f - naive_b);
+
+  /* 128-bit products, signs, and one rounding to double. */
+  gr_wide p = gr_wide_mul(3ll << 40, 5ll << 30);
+  CHECK(gr_wide_value(p, 0) == ldexp(15.0, 70));
+  gr_wide q = gr_wide_mul(-(3ll << 40), 5ll << 30);
+  CHECK(gr_wide_value(q, 10) == -ldexp(15.0, 60));
+  gr_wide_add(&p, q);
+  CHECK(p.lo == 0 && p.hi == 0);
+  gr_wide big = gr_wide_mul(INT64_MAX, INT64_MAX); /* (2^63 - 1)^2 = 2^126 - 2^64 + 1 */
+  CHECK(big.hi == INT64_MAX / 2 && big.lo == 1u);
+  gr_wide s3 = gr_wide_scale(gr_wide_mul(-7, 1ll << 40), 1ll << 50);
+  CHECK(gr_wide_value(s3, 90) == -7.0);
+  /* 2^64 + 2^11 + 1: above the halfway point between 2^64 and its next
+   * double (2^12 away), so it rounds up; without the 1 it ties to even. */
+  gr_wide tie = {(1ull << 11) + 1u, 1};
+  CHECK(gr_wide_value(tie, 0) == ldexp(1.0, 64) + ldexp(1.0, 12));
+  tie.lo = 1ull << 11;
+  CHECK(gr_wide_value(tie, 0) == ldexp(1.0, 64));
+
+  /* Packed through doubles and summed as an allreduce would: exact totals. */
+  const long long vals[3][2] = {{INT64_MAX / 4, -5}, {-(INT64_MAX / 8), 1ll << 40}, {12345, -7}};
+  const gr_wide wides[3] = {gr_wide_mul(1ll << 62, 1ll << 60), gr_wide_mul(-3, 1ll << 62),
+                            gr_wide_mul(-(1ll << 61), 1ll << 61)};
+  double sum[GR_FIXED_PACKED(2, 1)] = {0};
+  long long want[2] = {0, 0};
+  gr_wide want_w = {0, 0};
+  for (int r = 0; r < 3; ++r) {
+    double packed[GR_FIXED_PACKED(2, 1)];
+    gr_fixed_pack(vals[r], 2, &wides[r], 1, packed);
+    for (int k = 0; k < GR_FIXED_PACKED(2, 1); ++k) {
+      CHECK(packed[k] == floor(packed[k]) && fabs(packed[k]) <= 4294967296.0);
+      sum[k] += packed[k];
+    }
+    want[0] += vals[r][0];
+    want[1] += vals[r][1];
+    gr_wide_add(&want_w, wides[r]);
+  }
+  long long got[2];
+  gr_wide got_w;
+  gr_fixed_unpack(sum, got, 2, &got_w, 1);
+  CHECK(got[0] == want[0] && got[1] == want[1]);
+  CHECK(got_w.lo == want_w.lo && got_w.hi == want_w.hi);
+}
+
 static const gr_subtest tests[] = {
     {"no_platform", test_no_platform, 1}, /* only with OCL_ICD_VENDORS at an empty folder */
     {"names", test_names, 0},
@@ -818,6 +917,7 @@ static const gr_subtest tests[] = {
     {"mesh", test_mesh, 0},
     {"mesh_memo", test_mesh_memo, 0},
     {"points", test_points, 0},
+    {"fixed_point", test_fixed_point, 0},
     {"memcheck", test_memcheck, 1}, /* what valgrind runs */
 };
 

@@ -80,10 +80,12 @@ for name in %(fields)r:
     r = vtk_to_numpy(ref.GetPointData().GetArray(name)).reshape(%(ny)d, %(nx)d)
     m = vtk_to_numpy(img.GetPointData().GetArray(name)).reshape(f1 - f0 + 1, e1 - e0 + 1)
     bad += (m.view(np.uint32) != r[f0:f1 + 1, e0:e1 + 1].view(np.uint32)).reshape(-1)
+# Bit for bit: the bytes, so that -0.0 against 0.0 or a NaN would count.
 ledger_bad = 0
 for name in %(ledger)r:
     x, y = img.GetFieldData().GetArray(name), ref.GetFieldData().GetArray(name)
-    if x is None or y is None or x.GetTuple1(0) != y.GetTuple1(0):
+    if x is None or y is None or \
+            np.float64(x.GetTuple1(0)).tobytes() != np.float64(y.GetTuple1(0)).tobytes():
         ledger_bad += 1
 cells = img.GetFieldData().GetArray("piece_cells")
 share = cells.GetTuple1(0) / (%(nx)d * %(ny)d) if cells else -1.0
@@ -115,7 +117,8 @@ if pd.GetNumberOfPoints() > 0:
     # (The programmable filter's sum is a parallel one: count by hand.)
     bad = 0
     for k in ("force", "contact_area"):
-        bad += int(mine.GetArray(k).GetTuple(0) != ref.GetArray(k).GetTuple(0))
+        bad += int(np.array(mine.GetArray(k).GetTuple(0), np.float64).tobytes() !=
+                   np.array(ref.GetArray(k).GetTuple(0), np.float64).tobytes())
     size = abs(ref.GetArray("force").GetTuple(0)[0])
     for name, v in (("force_mismatch", float(bad)), ("force_size", size)):
         arr = numpy_to_vtk(np.full(pd.GetNumberOfPoints(), v, np.float32), deep=1)

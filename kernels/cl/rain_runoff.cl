@@ -557,20 +557,26 @@ __kernel void rain_runoff_source(__global const float *restrict pts, int use_pts
 }
 
 /* One pass over the grid for the ledger (reduce.h): per work-group the
- * stored, infiltrated, outflow and inflow depths (double-float, metres summed over
- * cells) and the deepest cell; masked: only the cells [own_x0, own_x1) x
- * [own_y0, own_y1) of the row-wide local array (a piece without its ring). */
+ * stored, infiltrated, outflow and inflow depths (each cell's Kahan sum,
+ * value and compensation, in fixed point: gr_fixed_add's coarse and fine
+ * words, metres summed over cells) and the deepest cell (its float's bits);
+ * masked: only the cells [own_x0, own_x1) x [own_y0, own_y1) of the
+ * row-wide local array (a piece without its ring). Integer sums: the
+ * pieces of a split domain add up to the whole grid's, bit for bit.
+ * with_sums 0: the deepest cell only (the stable step), one float a cell
+ * read instead of eight. */
 __kernel void rain_runoff_reduce(
     __global const float *restrict h, __global const float *restrict h_comp,
     __global const float *restrict infiltrated, __global const float *restrict infiltrated_comp,
     __global const float *restrict outflow, __global const float *restrict outflow_comp,
     __global const float *restrict inflow, __global const float *restrict inflow_comp,
-    __global float *restrict partial, __local float *restrict scratch, int n, int row, int own_x0,
-    int own_x1, int own_y0, int own_y1, int masked) {
+    __global long *restrict partial, __local long *restrict scratch, int n, int row, int own_x0,
+    int own_x1, int own_y0, int own_y1, int masked, int with_sums) {
   int lid = get_local_id(0), wg = get_local_size(0), start, end;
   gr_reduce_block(n, &start, &end);
-  float s_hi = 0.0f, s_lo = 0.0f, i_hi = 0.0f, i_lo = 0.0f, o_hi = 0.0f, o_lo = 0.0f;
-  float n_hi = 0.0f, n_lo = 0.0f;
+  long w[2 * GR_RAIN_RUNOFF_SUMS];
+  for (int q = 0; q < 2 * GR_RAIN_RUNOFF_SUMS; ++q)
+    w[q] = 0;
   float hmax = 0.0f;
   for (int c = start + lid; c < end; c += wg) {
     if (masked) {
@@ -580,27 +586,24 @@ __kernel void rain_runoff_reduce(
         continue;
     }
     float d = h[c];
-    gr_df_add(&s_hi, &s_lo, d);
-    gr_df_add(&s_hi, &s_lo, -h_comp[c]);
-    gr_df_add(&i_hi, &i_lo, infiltrated[c]);
-    gr_df_add(&i_hi, &i_lo, -infiltrated_comp[c]);
-    gr_df_add(&o_hi, &o_lo, outflow[c]);
-    gr_df_add(&o_hi, &o_lo, -outflow_comp[c]);
-    gr_df_add(&n_hi, &n_lo, inflow[c]);
-    gr_df_add(&n_hi, &n_lo, -inflow_comp[c]);
     hmax = fmax(hmax, d);
+    if (!with_sums)
+      continue;
+    gr_fixed_add(&w[0], &w[1], d);
+    gr_fixed_add(&w[0], &w[1], -h_comp[c]);
+    gr_fixed_add(&w[2], &w[3], infiltrated[c]);
+    gr_fixed_add(&w[2], &w[3], -infiltrated_comp[c]);
+    gr_fixed_add(&w[4], &w[5], outflow[c]);
+    gr_fixed_add(&w[4], &w[5], -outflow_comp[c]);
+    gr_fixed_add(&w[6], &w[7], inflow[c]);
+    gr_fixed_add(&w[6], &w[7], -inflow_comp[c]);
   }
-  __local float *mine = gr_reduce_slots(scratch, GR_RAIN_RUNOFF_SUMS, GR_RAIN_RUNOFF_MAXES);
-  mine[0] = s_hi;
-  mine[1] = s_lo;
-  mine[2] = i_hi;
-  mine[3] = i_lo;
-  mine[4] = o_hi;
-  mine[5] = o_lo;
-  mine[6] = n_hi;
-  mine[7] = n_lo;
-  mine[8] = hmax;
-  gr_reduce_group(scratch, GR_RAIN_RUNOFF_SUMS, GR_RAIN_RUNOFF_MAXES, partial);
+  const int slots = 2 * GR_RAIN_RUNOFF_SUMS + GR_RAIN_RUNOFF_MAXES;
+  __local long *mine = gr_reduce_slots_long(scratch, slots);
+  for (int q = 0; q < 2 * GR_RAIN_RUNOFF_SUMS; ++q)
+    mine[q] = w[q];
+  mine[2 * GR_RAIN_RUNOFF_SUMS] = as_int(hmax); /* >= +0: its bits order as the depths */
+  gr_reduce_group_long_max(scratch, 2 * GR_RAIN_RUNOFF_SUMS, GR_RAIN_RUNOFF_MAXES, partial);
 }
 
 /* Fields derived on read, per cell: 0 water surface (b + h), 1 velocity

@@ -21,9 +21,9 @@
  * rounding of the depth update can never take it below zero. */
 #define GR_RAIN_RUNOFF_KEEP 0.999999f
 
-/* The ledger's reduction (reduce.h): four double-float sums (stored,
- * infiltrated, outflow, inflow, in metres of depth over cells) and one
- * maximum (the deepest cell) per work-group. */
+/* The ledger's reduction (reduce.h): four fixed-point sums (stored,
+ * infiltrated, outflow, inflow, in metres of depth over cells; two int64
+ * words each) and one maximum (the deepest cell) per work-group. */
 #define GR_RAIN_RUNOFF_SUMS 4
 
 /* Edge kinds, the values of gr_boundary (graupel/rain_runoff.h), as the

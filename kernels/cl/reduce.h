@@ -90,30 +90,66 @@ GR_INLINE void gr_reduce_group(__local float *scratch, int nsum, int nmax,
  * addition is exact in any order. A reduction kernel of this kind has the
  * arguments `__global long *partial` and `__local long *scratch` (set by
  * gr_reduction_i64_run); each work-item stores its nsum longs at
- * gr_reduce_slots_long(scratch, nsum) and calls gr_reduce_group_long. */
+ * gr_reduce_slots_long(scratch, nsum) and calls gr_reduce_group_long (or,
+ * with maxima, gr_reduce_group_long_max). */
 GR_INLINE __local long *gr_reduce_slots_long(__local long *scratch, int nsum) {
   return scratch + nsum * get_local_id(0);
 }
 
 /* Adds the work-items' slots (a binary tree; any order gives the same
- * integers) and writes the group's nsum longs to partial[nsum * group ...].
- * Every work-item of the group must call it. */
-GR_INLINE void gr_reduce_group_long(__local long *scratch, int nsum,
-                                    __global long *restrict partial) {
-  int lid = get_local_id(0), wg = get_local_size(0);
-  __local long *mine = scratch + nsum * lid;
+ * integers), keeps the largest of the last nmax slots, and writes the
+ * group's nsum + nmax longs to partial[(nsum + nmax) * group ...] (the
+ * work-items store nsum + nmax longs at gr_reduce_slots_long(scratch,
+ * nsum + nmax)). A maximum of non-negative floats travels as the float's
+ * bits (as_int), which order as the floats do. Every work-item of the group
+ * must call it. */
+GR_INLINE void gr_reduce_group_long_max(__local long *scratch, int nsum, int nmax,
+                                        __global long *restrict partial) {
+  int lid = get_local_id(0), wg = get_local_size(0), slots = nsum + nmax;
+  __local long *mine = scratch + slots * lid;
   barrier(CLK_LOCAL_MEM_FENCE);
   for (int span = wg / 2; span > 0; span /= 2) {
     if (lid < span) {
-      __local const long *other = scratch + nsum * (lid + span);
+      __local const long *other = scratch + slots * (lid + span);
       for (int q = 0; q < nsum; ++q)
         mine[q] += other[q];
+      for (int q = nsum; q < slots; ++q)
+        mine[q] = max(mine[q], other[q]);
     }
     barrier(CLK_LOCAL_MEM_FENCE);
   }
   if (lid == 0)
-    for (int q = 0; q < nsum; ++q)
-      partial[nsum * get_group_id(0) + q] = scratch[q];
+    for (int q = 0; q < slots; ++q)
+      partial[slots * get_group_id(0) + q] = scratch[q];
+}
+
+/* gr_reduce_group_long_max without maxima. */
+GR_INLINE void gr_reduce_group_long(__local long *scratch, int nsum,
+                                    __global long *restrict partial) {
+  gr_reduce_group_long_max(scratch, nsum, 0, partial);
+}
+
+/* Ledger fixed point (graupel/reduce.h's gr_fixed, which gives the same
+ * integers on the host): a float x adds two integers, coarse = x cut
+ * toward zero to a multiple of 2^-24, in units of 2^-24, and fine = the rest
+ * (exact as a float, |rest| < 2^-24) cut toward zero to a multiple of 2^-54,
+ * in units of 2^-54 (|fine| < 2^30). Sums of them are exact and order-free:
+ * the same cells give the same totals however they are split among
+ * work-items, work-groups, pieces or devices. |x| >= 2^-31 converts
+ * exactly, smaller x to within 2^-54; coarse is clamped to +-2^62 (|x| <
+ * 2^38 fits; graupel/reduce.h states the totals' bounds) and fine to +-2^30.
+ * Scaling by powers of two is exact, a float cut to an integer converts
+ * back exactly, and x - c 2^-24 is exact (c 2^-24 is x cut to a coarser
+ * grid), so every device gives these very integers. Conversions toward
+ * zero, the fine one to int: PoCL vectorises them (rint doubled the
+ * reduction's time again). */
+GR_INLINE void gr_fixed_add(long *coarse, long *fine, float x) {
+  long c = convert_long(fmin(fmax(x * 16777216.0f, -4611686018427387904.0f), /* 2^24, 2^62 */
+                             4611686018427387904.0f));
+  float rest = x - convert_float(c) * 5.9604644775390625e-8f; /* 2^-24 */
+  *coarse += c;
+  *fine += convert_int(fmin(fmax(rest * 18014398509481984.0f, -1073741824.0f), /* 2^54, 2^30 */
+                            1073741824.0f));
 }
 
 #endif

@@ -33,8 +33,12 @@
 #define GR_RAIN_RUNOFF_PROGRESS_EVERY 0.1
 /* Checkpoints: "GRR1" and the layout's version. */
 #define GR_RAIN_RUNOFF_STATE_MAGIC 0x31525247u
-/* 2: the piece's i0, j0; 3: qu, qv; 4: the maps; 5: the inflow */
-#define GR_RAIN_RUNOFF_STATE_VERSION 5u
+/* 2: the piece's i0, j0; 3: qu, qv; 4: the maps; 5: the inflow; 6: the
+ * ledger's initial water and rain in fixed point */
+#define GR_RAIN_RUNOFF_STATE_VERSION 6u
+/* The rain ledger's steps: dt in units of 2^-32 s (graupel/reduce.h's fixed
+ * point for the rates; see gr_rain_runoff_rain_book). */
+#define GR_RAIN_RUNOFF_STEP_BITS 32
 /* Per-cell arrays of a checkpoint: h, h_c, k, inf, inf_c, out, out_c, qu, qv,
  * the flood maps' max_depth, max_speed, arrival, wet, wet_c, max_hazard, and
  * the inflow and its compensation. */
@@ -151,8 +155,8 @@ struct gr_rain_runoff {
   cl_mem scratch; /* derived fields on read (3 floats per cell), on first use */
   cl_mem dummy;   /* bound in place of a field that was not set */
   int has_rain, has_perm;
-  double rain_field_sum; /* sum of the rain-rate field's floats, m/s */
-  double rain_field_max; /* its largest value, m/s (the local array's, ring included) */
+  gr_fixed rain_field_sum; /* the rain-rate field's floats summed in fixed point, m/s */
+  double rain_field_max;   /* its largest value, m/s (the local array's, ring included) */
   /* g max(|db/dx| / dx + |db/dy| / dy) over the local array, 1/s^2: the
    * fastest the bed's slope can speed water up, per cell crossed. */
   double slope_rate;
@@ -160,12 +164,20 @@ struct gr_rain_runoff {
    * north; 0 on a side with a neighbour): a level edge's depth over it is
    * water the stable step must see. */
   double edge_bed[4];
-  double initial_sum; /* sum of the initial depth's floats, m */
-  double initial_volume, rain_volume, time;
+  /* The ledger's own cells' water in fixed point (graupel/reduce.h), so
+   * that its sums over the pieces are the whole grid's to the bit: the
+   * initial depth's floats (m), the initial water (m: that sum, and each
+   * WATER_DEPTH set later replacing the water there), and the rain as exact
+   * products of fixed-point rates (m/s) and steps in units of
+   * 2^-GR_RAIN_RUNOFF_STEP_BITS s: rain_book[0] of the rates' coarse
+   * words, rain_book[1] of their fine ones. */
+  gr_fixed initial_sum, initial;
+  gr_wide rain_book[2];
+  double time;
   long long steps;
-  gr_reduction ledger; /* the reduction behind the ledger and the stable step */
-  gr_reduction speed;  /* shallow water's stable step: deepest cell, fastest wave rate */
-  gr_reduction film;   /* the local inertial model's: the fastest film (li_speed) */
+  gr_reduction_i64 ledger; /* the reduction behind the ledger and the stable step */
+  gr_reduction speed;      /* shallow water's stable step: deepest cell, fastest wave rate */
+  gr_reduction film;       /* the local inertial model's: the fastest film (li_speed) */
   /* The step kernels' arguments other than the alternating face arrays are
    * set again only when they change: the parameters, the input fields or
    * dt (steps_dt). */
@@ -399,15 +411,16 @@ static int gr_rain_runoff_has_ring(const gr_rain_runoff *s) {
   return s->ring[0] || s->ring[1] || s->ring[2] || s->ring[3];
 }
 
-/* The sum of a local-array field's floats over the owned cells, in
- * row-major order (for a whole grid: every cell, in order). */
-static double gr_rain_runoff_own_sum(const gr_rain_runoff *s, const float *host) {
-  double sum = 0.0;
+/* The sum of a local-array field's floats over the owned cells in fixed
+ * point: the same integers as the device's reduction of the same floats,
+ * whatever the split. */
+static gr_fixed gr_rain_runoff_own_sum(const gr_rain_runoff *s, const float *host) {
+  gr_fixed sum = {0, 0};
   for (int j = s->ring[2]; j < s->nyl - s->ring[3]; ++j)
     for (int i = s->ring[0]; i < s->nxl - s->ring[1]; ++i) {
       size_t c = (size_t)j * (size_t)s->nxl + (size_t)i;
       if (!s->has_nodata || !s->mask[c]) /* nothing falls on, or stays in, no-data cells */
-        sum += host[c];
+        gr_fixed_add(&sum, gr_fixed_from_float(host[c]));
     }
   return sum;
 }
@@ -483,16 +496,18 @@ static gr_status gr_rain_runoff_read_own(gr_rain_runoff *s, cl_mem buf, size_t c
                              (size_t)s->grid.nx, (size_t)s->grid.ny, host, 0);
 }
 
-/* Sums the stored, infiltrated, outflow and inflow depths over the cells (m, so
- * times dx dy for m^3) and finds the deepest cell. */
-static gr_status gr_rain_runoff_reduce(gr_rain_runoff *s, double sums[GR_RAIN_RUNOFF_SUMS],
-                                       double *max_depth) {
+/* Sums the stored, infiltrated, outflow and inflow depths over the owned
+ * cells in fixed point (m, so times dx dy for m^3; sums NULL: none) and
+ * finds the deepest cell. */
+static gr_status gr_rain_runoff_reduce_fixed(gr_rain_runoff *s, gr_fixed sums[GR_RAIN_RUNOFF_SUMS],
+                                             double *max_depth) {
   cl_int n = (cl_int)gr_rain_runoff_cells(s);
   /* The owned cells of the local arrays (masked only where there is a ring). */
   cl_int row = s->nxl, own_x0 = s->ring[0], own_x1 = s->nxl - s->ring[1];
   cl_int own_y0 = s->ring[2], own_y1 = s->nyl - s->ring[3];
-  cl_int masked = gr_rain_runoff_has_ring(s);
+  cl_int masked = gr_rain_runoff_has_ring(s), with_sums = sums != NULL;
   const gr_rain_runoff_arg args[] = {
+      {"with_sums", sizeof(with_sums), &with_sums},
       {"h", sizeof(cl_mem), &s->h},
       {"h_comp", sizeof(cl_mem), &s->h_c},
       {"infiltrated", sizeof(cl_mem), &s->inf},
@@ -509,13 +524,30 @@ static gr_status gr_rain_runoff_reduce(gr_rain_runoff *s, double sums[GR_RAIN_RU
       {"own_y1", sizeof(own_y1), &own_y1},
       {"masked", sizeof(masked), &masked},
   };
-  double maxes[GR_RAIN_RUNOFF_MAXES];
+  long long words[2 * GR_RAIN_RUNOFF_SUMS], maxes[GR_RAIN_RUNOFF_MAXES];
   gr_status st = GR_RAIN_RUNOFF_ARGS(s, s->reduce, args);
   if (st == GR_OK)
-    st = gr_reduction_run(s->ctx, &s->ledger, s->reduce, sums, maxes);
-  if (st == GR_OK && max_depth)
-    *max_depth = maxes[0];
-  return st;
+    st = gr_reduction_i64_run_max(s->ctx, &s->ledger, s->reduce, words, maxes);
+  if (st != GR_OK)
+    return st;
+  for (int q = 0; sums && q < GR_RAIN_RUNOFF_SUMS; ++q) {
+    sums[q].coarse = words[2 * q];
+    sums[q].fine = words[2 * q + 1];
+  }
+  if (max_depth) {
+    /* The deepest cell's float, by its bits (a depth is never below 0). */
+    int32_t bits = (int32_t)maxes[0];
+    float deepest;
+    memcpy(&deepest, &bits, sizeof(deepest));
+    *max_depth = deepest;
+  }
+  return GR_OK;
+}
+
+/* The deepest owned cell only (the stable step): the ledger's reduction
+ * reading the depth alone. */
+static gr_status gr_rain_runoff_deepest(gr_rain_runoff *s, double *max_depth) {
+  return gr_rain_runoff_reduce_fixed(s, NULL, max_depth);
 }
 
 /* ------------------------------------------------------------ flood maps */
@@ -734,8 +766,8 @@ gr_status gr_rain_runoff_create(gr_context *ctx, const gr_grid *grid,
   if (st == GR_OK)
     st = gr_buffer_create(ctx, CL_MEM_READ_ONLY, sizeof(cl_float), NULL, &s->dummy);
   if (st == GR_OK)
-    st = gr_reduction_init(ctx, s->reduce, cells, GR_RAIN_RUNOFF_SUMS, GR_RAIN_RUNOFF_MAXES,
-                           &s->ledger);
+    st = gr_reduction_i64_init_max(ctx, s->reduce, cells, 2 * GR_RAIN_RUNOFF_SUMS,
+                                   GR_RAIN_RUNOFF_MAXES, &s->ledger);
   if (st == GR_OK)
     st = gr_reduction_init(ctx, s->sw_speed, cells, 0, 2, &s->speed);
   if (st == GR_OK)
@@ -780,7 +812,7 @@ void gr_rain_runoff_destroy(gr_rain_runoff *s) {
     gr_buffer_release(bufs[i]);
   for (int a = 0; a < GR_RAIN_RUNOFF_MAP_ARRAYS; ++a)
     gr_buffer_release(&s->map[a]);
-  gr_reduction_release(&s->ledger);
+  gr_reduction_i64_release(&s->ledger);
   gr_reduction_release(&s->speed);
   gr_reduction_release(&s->film);
   for (int e = 0; e < 4; ++e) {
@@ -1063,7 +1095,7 @@ static gr_status gr_rain_runoff_set_field_impl(gr_rain_runoff *s, gr_field f, co
       s->has_perm = 1;
     break;
   case GR_FIELD_RAIN_RATE: {
-    double sum = gr_rain_runoff_own_sum(s, host);
+    gr_fixed sum = gr_rain_runoff_own_sum(s, host);
     st = gr_rain_runoff_upload(s, &s->rain, host);
     if (st == GR_OK) {
       s->has_rain = 1;
@@ -1088,8 +1120,8 @@ static gr_status gr_rain_runoff_set_field_impl(gr_rain_runoff *s, gr_field f, co
         dry[c] = s->mask[c] ? 0.0f : host[c];
       host = dry;
     }
-    double now[GR_RAIN_RUNOFF_SUMS], sum = gr_rain_runoff_own_sum(s, host);
-    st = gr_rain_runoff_reduce(s, now, NULL);
+    gr_fixed now[GR_RAIN_RUNOFF_SUMS], sum = gr_rain_runoff_own_sum(s, host);
+    st = gr_rain_runoff_reduce_fixed(s, now, NULL);
     if (st == GR_OK)
       st = gr_rain_runoff_upload(s, &s->h0, host);
     if (st == GR_OK)
@@ -1101,9 +1133,10 @@ static gr_status gr_rain_runoff_set_field_impl(gr_rain_runoff *s, gr_field f, co
     /* No discharge: the initial velocity, if any, was of other water. */
     gr_buffer_release(&s->qu0);
     gr_buffer_release(&s->qv0);
-    if (st == GR_OK) {
+    if (st == GR_OK) { /* exact: the device's sum of the old water is in the same units */
       s->initial_sum = sum;
-      s->initial_volume += (sum - now[0]) * s->grid.dx * s->grid.dy;
+      s->initial.coarse += sum.coarse - now[0].coarse;
+      s->initial.fine += sum.fine - now[0].fine;
     }
     /* The maps count the new water from the time it is set. */
     if (st == GR_OK)
@@ -1661,11 +1694,46 @@ static double gr_rain_runoff_source_max(const gr_rain_runoff *s) {
   return (s->has_pts ? s->pts_max : 0.0) + edge;
 }
 
+/* The ledger's rain for `done` steps of the float dtf: the owned cells'
+ * rates (the rain field's, RainRate's, or with a hyetograph the sum of the
+ * rates the steps took) in fixed point, times the steps in units of
+ * 2^-GR_RAIN_RUNOFF_STEP_BITS s, as exact integer products. dtf >= 2^-9 s
+ * is exact in those units (smaller steps round to them); every piece books
+ * the same step integers, so the pieces' rain adds up to the whole grid's,
+ * bit for bit. Bounds: rates up to RainRate's 3600 mm/h (coarse words up to
+ * 2^14 a cell), steps up to MaxTimeStep's 3600 s (2^44 units) and simulated
+ * time below 2^31 s keep rain_book[0] below 2^109 and rain_book[1] below 2^125 on a
+ * 65536^2 grid. */
+static void gr_rain_runoff_rain_book(gr_rain_runoff *s, const gr_fixed *hyetograph, cl_float dtf,
+                                     int done) {
+  long long step = llrint(ldexp((double)dtf, GR_RAIN_RUNOFF_STEP_BITS));
+  /* The owned cells of the domain: no rain falls on no-data cells. */
+  long long active =
+      s->has_nodata ? (long long)s->active_own : (long long)gr_rain_runoff_own_cells(s);
+  gr_fixed rate;
+  long long times;
+  if (s->has_rain) {
+    rate = s->rain_field_sum;
+    times = 1;
+  } else if (s->hy_n) { /* each step its own rate, as the device took it */
+    rate = *hyetograph;
+    times = active;
+    done = 1;
+  } else {
+    rate = gr_fixed_from_float((cl_float)s->params.rain_rate);
+    times = active;
+  }
+  gr_wide coarse = gr_wide_scale(gr_wide_mul(rate.coarse, times), step * done);
+  gr_wide fine = gr_wide_scale(gr_wide_mul(rate.fine, times), step * done);
+  gr_wide_add(&s->rain_book[0], coarse);
+  gr_wide_add(&s->rain_book[1], fine);
+}
+
 /* The hyetograph's rain for the step [t0, t1]: the table's exact mean over
  * it, as the float the kernels take in place of RainRate (a rain_rate field
- * still wins); *sum adds that float for the ledger. */
+ * still wins); *sum adds that float (in fixed point) for the ledger. */
 static gr_status gr_rain_runoff_hyetograph_step(gr_rain_runoff *s, double t0, double t1,
-                                                double *sum) {
+                                                gr_fixed *sum) {
   cl_float rf =
       (cl_float)(gr_rain_runoff_table_integral(s->hy_t, s->hy_r, s->hy_n, t0, t1) / (t1 - t0));
   int sw = s->params.flow_model == GR_FLOW_SHALLOW_WATER;
@@ -1675,7 +1743,7 @@ static gr_status gr_rain_runoff_hyetograph_step(gr_rain_runoff *s, double t0, do
   for (int k = 0; st == GR_OK && k < (sw ? 5 : 4); ++k)
     st = gr_kernel_arg(s->ctx, sw ? swk[k] : li[k], "rain_uniform", sizeof(rf), &rf);
   if (st == GR_OK)
-    *sum += (double)rf;
+    gr_fixed_add(sum, gr_fixed_from_float(rf));
   return st;
 }
 
@@ -1865,7 +1933,6 @@ static gr_status gr_rain_runoff_bind(gr_rain_runoff *s, cl_float dt) {
  * boundary: *stop becomes 1. */
 static gr_status gr_rain_runoff_enqueue(gr_rain_runoff *s, double dt, int nsteps,
                                         gr_rain_runoff_watch *w, int *done_out, int *stop) {
-  const gr_grid *gd = &s->grid;
   cl_float dtf = (cl_float)dt;
   const size_t m = sizeof(cl_mem);
   gr_status st = gr_rain_runoff_bind(s, dtf);
@@ -1879,7 +1946,7 @@ static gr_status gr_rain_runoff_enqueue(gr_rain_runoff *s, double dt, int nsteps
   int edges = 0;
   for (int e = 0; e < 4; ++e)
     edges |= !s->ring[e] && s->params.boundary[e] != GR_BOUNDARY_OPEN;
-  double rate_sum = 0.0; /* the hyetograph's rates the steps took (m/s, floats) */
+  gr_fixed rate_sum = {0, 0}; /* the hyetograph's rates the steps took (m/s, floats) */
   while (sw && st == GR_OK && done < nsteps && !*stop) {
     if (per_step)
       st = gr_rain_runoff_sources_update(s, t_end, t_end + dt);
@@ -1955,14 +2022,7 @@ static gr_status gr_rain_runoff_enqueue(gr_rain_runoff *s, double dt, int nsteps
   }
   /* The ledger counts the steps whose launches were all enqueued, with the
    * rain the device added: the float dt it was given. */
-  /* The owned cells of the domain: no rain falls on no-data cells. */
-  double active = s->has_nodata ? s->active_own : (double)gr_rain_runoff_own_cells(s);
-  double rain_sum =
-      s->has_rain ? s->rain_field_sum : active * (double)(cl_float)s->params.rain_rate;
-  if (s->hy_n && !s->has_rain) /* each step its own rate, as the device took it */
-    s->rain_volume += active * rate_sum * gd->dx * gd->dy * (double)dtf;
-  else
-    s->rain_volume += rain_sum * gd->dx * gd->dy * (double)dtf * (double)done;
+  gr_rain_runoff_rain_book(s, &rate_sum, dtf, done);
   /* Step by step, not dt * done: a piece that steps one step per call (to
    * exchange its halo) then keeps the same time, to the bit, as the whole
    * grid stepping many per call. */
@@ -2134,8 +2194,8 @@ static gr_status gr_rain_runoff_stable_dt_impl(gr_rain_runoff *s, double *dt) {
     return gr_rain_runoff_sw_stable_dt(s, dt);
   /* The deepest cell and the fastest that water arrives (m/s): the
    * heaviest rain and the strongest inflow. */
-  double sums[GR_RAIN_RUNOFF_SUMS], maxes[3] = {0.0, 0.0, 0.0};
-  gr_status st = gr_rain_runoff_reduce(s, sums, &maxes[0]);
+  double maxes[3] = {0.0, 0.0, 0.0};
+  gr_status st = gr_rain_runoff_deepest(s, &maxes[0]);
   if (st == GR_OK)
     st = gr_rain_runoff_film_rate(s, &maxes[2]);
   maxes[1] =
@@ -2456,29 +2516,44 @@ gr_status gr_rain_runoff_ledger_get(gr_rain_runoff *s, gr_rain_runoff_ledger *ou
     return GR_RAIN_RUNOFF_KEEP_ERROR(
         s, gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
                         "gr_rain_runoff_ledger_get needs a simulation and a ledger to fill."));
-  double sums[GR_RAIN_RUNOFF_SUMS], hmax = 0.0;
-  gr_status st = gr_rain_runoff_reduce(s, sums, &hmax);
-  /* Over every piece of the domain: the device's sums and the host's. */
-  double all[GR_RAIN_RUNOFF_SUMS + 2];
-  memcpy(all, sums, sizeof(sums));
-  all[GR_RAIN_RUNOFF_SUMS] = s->rain_volume;
-  all[GR_RAIN_RUNOFF_SUMS + 1] = s->initial_volume;
-  if (st == GR_OK && s->allreduce)
-    st = gr_rain_runoff_allreduce(s, all, GR_RAIN_RUNOFF_SUMS + 2, GR_REDUCE_SUM);
+  gr_fixed sums[GR_RAIN_RUNOFF_SUMS + 1];
+  double hmax = 0.0;
+  gr_status st = gr_rain_runoff_reduce_fixed(s, sums, &hmax);
+  sums[GR_RAIN_RUNOFF_SUMS] = s->initial;
+  /* Over every piece of the domain, as integers: the device's sums, the
+   * initial water and the rain, exact in any order, so every split gives
+   * the whole grid's bits. */
+  long long words[2 * (GR_RAIN_RUNOFF_SUMS + 1)];
+  gr_wide rain[2] = {s->rain_book[0], s->rain_book[1]};
+  for (int q = 0; q <= GR_RAIN_RUNOFF_SUMS; ++q) {
+    words[2 * q] = sums[q].coarse;
+    words[2 * q + 1] = sums[q].fine;
+  }
+  if (st == GR_OK && s->allreduce) {
+    double packed[GR_FIXED_PACKED(2 * (GR_RAIN_RUNOFF_SUMS + 1), 2)];
+    gr_fixed_pack(words, 2 * (GR_RAIN_RUNOFF_SUMS + 1), rain, 2, packed);
+    st = gr_rain_runoff_allreduce(s, packed, (int)(sizeof(packed) / sizeof(packed[0])),
+                                  GR_REDUCE_SUM);
+    gr_fixed_unpack(packed, words, 2 * (GR_RAIN_RUNOFF_SUMS + 1), rain, 2);
+  }
   if (st == GR_OK && s->allreduce)
     st = gr_rain_runoff_allreduce(s, &hmax, 1, GR_REDUCE_MAX);
   if (st != GR_OK)
     return GR_RAIN_RUNOFF_KEEP_ERROR(s, st);
-  double area = s->grid.dx * s->grid.dy;
+  double area = s->grid.dx * s->grid.dy, depth[GR_RAIN_RUNOFF_SUMS + 1];
+  for (int q = 0; q <= GR_RAIN_RUNOFF_SUMS; ++q)
+    depth[q] = gr_fixed_value((gr_fixed){words[2 * q], words[2 * q + 1]});
   memset(out, 0, sizeof(*out));
   out->time = s->time;
   out->steps = s->steps;
-  out->initial_volume = all[GR_RAIN_RUNOFF_SUMS + 1];
-  out->rain_volume = all[GR_RAIN_RUNOFF_SUMS];
-  out->stored_volume = all[0] * area;
-  out->infiltrated_volume = all[1] * area;
-  out->outflow_volume = all[2] * area;
-  out->inflow_volume = all[3] * area;
+  out->initial_volume = depth[GR_RAIN_RUNOFF_SUMS] * area;
+  out->rain_volume = (gr_wide_value(rain[0], GR_FIXED_COARSE_BITS + GR_RAIN_RUNOFF_STEP_BITS) +
+                      gr_wide_value(rain[1], GR_FIXED_FINE_BITS + GR_RAIN_RUNOFF_STEP_BITS)) *
+                     area;
+  out->stored_volume = depth[0] * area;
+  out->infiltrated_volume = depth[1] * area;
+  out->outflow_volume = depth[2] * area;
+  out->inflow_volume = depth[3] * area;
   out->balance_error = out->initial_volume + out->rain_volume + out->inflow_volume -
                        out->infiltrated_volume - out->outflow_volume - out->stored_volume;
   out->max_depth = hmax;
@@ -2509,8 +2584,8 @@ static gr_status gr_rain_runoff_reset_impl(gr_rain_runoff *s) {
     return st;
   s->time = 0.0;
   s->steps = 0;
-  s->rain_volume = 0.0;
-  s->initial_volume = s->initial_sum * s->grid.dx * s->grid.dy;
+  memset(s->rain_book, 0, sizeof(s->rain_book));
+  s->initial = s->initial_sum;
   return gr_rain_runoff_maps_restart(s);
 }
 
@@ -2598,7 +2673,12 @@ typedef struct gr_rain_runoff_state_header {
   int32_t nx, ny; /* the local arrays' */
   int32_t i0, j0; /* the piece's first owned point (0, 0 for a whole grid) */
   int64_t steps;
-  double time, rain_volume, initial_volume;
+  double time;
+  /* The ledger's fixed point: the initial water's words, the rain's two
+   * 128-bit sums (lo, hi each). */
+  int64_t initial[2];
+  uint64_t rain_lo[2];
+  int64_t rain_hi[2];
 } gr_rain_runoff_state_header;
 
 static size_t gr_rain_runoff_xfaces(const gr_rain_runoff *s) {
@@ -2656,8 +2736,12 @@ static gr_status gr_rain_runoff_state_save_impl(gr_rain_runoff *s, void *host, s
   hd.j0 = s->grid.j0;
   hd.steps = s->steps;
   hd.time = s->time;
-  hd.rain_volume = s->rain_volume;
-  hd.initial_volume = s->initial_volume;
+  hd.initial[0] = s->initial.coarse;
+  hd.initial[1] = s->initial.fine;
+  for (int q = 0; q < 2; ++q) {
+    hd.rain_lo[q] = s->rain_book[q].lo;
+    hd.rain_hi[q] = s->rain_book[q].hi;
+  }
   unsigned char *at = host;
   memcpy(at, &hd, sizeof(hd));
   at += sizeof(hd);
@@ -2715,8 +2799,10 @@ static gr_status gr_rain_runoff_state_load_impl(gr_rain_runoff *s, const void *h
                         "The rain runoff state has %zu bytes but a %d x %d simulation's state "
                         "has %zu: pass the whole buffer gr_rain_runoff_state_save filled.",
                         bytes, s->nxl, s->nyl, need);
-  if (!(hd.time >= 0.0 && hd.time < HUGE_VAL) || hd.steps < 0 || !isfinite(hd.rain_volume) ||
-      !isfinite(hd.initial_volume))
+  /* The rain's sums stay below 2^109 and 2^125 (gr_rain_runoff_rain_book). */
+  const int64_t rain_top = INT64_C(1) << 61;
+  if (!(hd.time >= 0.0 && hd.time < HUGE_VAL) || hd.steps < 0 || hd.rain_hi[0] < 0 ||
+      hd.rain_hi[0] > rain_top || hd.rain_hi[1] < -rain_top || hd.rain_hi[1] > rain_top)
     return gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
                         "The rain runoff state's header is damaged (time %g s, %lld steps): "
                         "pass the bytes gr_rain_runoff_state_save wrote.",
@@ -2736,8 +2822,12 @@ static gr_status gr_rain_runoff_state_load_impl(gr_rain_runoff *s, const void *h
   s->cur = 0;
   s->steps = hd.steps;
   s->time = hd.time;
-  s->rain_volume = hd.rain_volume;
-  s->initial_volume = hd.initial_volume;
+  s->initial.coarse = hd.initial[0];
+  s->initial.fine = hd.initial[1];
+  for (int q = 0; q < 2; ++q) {
+    s->rain_book[q].lo = hd.rain_lo[q];
+    s->rain_book[q].hi = hd.rain_hi[q];
+  }
   return GR_OK;
 }
 

@@ -2,6 +2,7 @@
  * device half is cl/reduce.h). */
 #include "graupel/reduce.h"
 
+#include <limits.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -137,13 +138,21 @@ void gr_reduction_release(gr_reduction *r) {
 
 gr_status gr_reduction_i64_init(gr_context *ctx, cl_kernel k, size_t items, int nsum,
                                 gr_reduction_i64 *r) {
-  if (!ctx || !k || !r || nsum < 1 || nsum > GR_REDUCTION_MAX_SLOTS)
+  return gr_reduction_i64_init_max(ctx, k, items, nsum, 0, r);
+}
+
+gr_status gr_reduction_i64_init_max(gr_context *ctx, cl_kernel k, size_t items, int nsum, int nmax,
+                                    gr_reduction_i64 *r) {
+  if (!ctx || !k || !r || nsum < 0 || nmax < 0 || nsum + nmax < 1 ||
+      nsum + nmax > GR_REDUCTION_MAX_SLOTS)
     return gr_set_error(ctx, GR_ERR_INVALID_ARGUMENT,
                         "gr_reduction_i64_init needs a context, a kernel, a reduction and 1 to %d "
-                        "sums (got %d).",
-                        GR_REDUCTION_MAX_SLOTS, nsum);
+                        "slots (got %d sums and %d maxima).",
+                        GR_REDUCTION_MAX_SLOTS, nsum, nmax);
   memset(r, 0, sizeof(*r));
   r->nsum = nsum;
+  r->nmax = nmax;
+  const int slots = nsum + nmax;
   size_t kmax = 0;
   gr_status st =
       gr_cl_check(ctx,
@@ -160,10 +169,10 @@ gr_status gr_reduction_i64_init(gr_context *ctx, cl_kernel k, size_t items, int 
     r->groups = GR_REDUCE_GROUPS;
   if (r->groups < 1)
     r->groups = 1;
-  size_t bytes = r->groups * (size_t)nsum * sizeof(cl_long);
+  size_t bytes = r->groups * (size_t)slots * sizeof(cl_long);
   st = gr_buffer_create(ctx, CL_MEM_WRITE_ONLY, bytes, NULL, &r->partial);
   if (st == GR_OK) {
-    r->host = malloc(r->groups * (size_t)nsum * sizeof(long long));
+    r->host = malloc(r->groups * (size_t)slots * sizeof(long long));
     if (!r->host)
       st = gr_set_error(ctx, GR_ERR_OUT_OF_MEMORY, "Out of host memory.");
   }
@@ -173,13 +182,19 @@ gr_status gr_reduction_i64_init(gr_context *ctx, cl_kernel k, size_t items, int 
 }
 
 gr_status gr_reduction_i64_run(gr_context *ctx, gr_reduction_i64 *r, cl_kernel k, long long *sums) {
-  if (!ctx || !r || !r->partial || !k || !sums)
+  return gr_reduction_i64_run_max(ctx, r, k, sums, NULL);
+}
+
+gr_status gr_reduction_i64_run_max(gr_context *ctx, gr_reduction_i64 *r, cl_kernel k,
+                                   long long *sums, long long *maxes) {
+  if (!ctx || !r || !r->partial || !k || (r->nsum > 0 && !sums) || (r->nmax > 0 && !maxes))
     return gr_set_error(ctx, GR_ERR_INVALID_ARGUMENT,
                         "gr_reduction_i64_run needs a context, an initialised reduction, its "
-                        "kernel and room for the sums.");
+                        "kernel and room for the sums and maxima.");
+  const int slots = r->nsum + r->nmax;
   gr_status st = gr_kernel_arg(ctx, k, "partial", sizeof(cl_mem), &r->partial);
   if (st == GR_OK)
-    st = gr_kernel_arg(ctx, k, "scratch", r->local * (size_t)r->nsum * sizeof(cl_long), NULL);
+    st = gr_kernel_arg(ctx, k, "scratch", r->local * (size_t)slots * sizeof(cl_long), NULL);
   size_t global = r->groups * r->local;
   if (st == GR_OK)
     st = gr_cl_check(ctx,
@@ -187,14 +202,20 @@ gr_status gr_reduction_i64_run(gr_context *ctx, gr_reduction_i64 *r, cl_kernel k
                                             0, NULL, NULL),
                      "Enqueueing a reduction");
   if (st == GR_OK)
-    st = gr_buffer_read(ctx, r->partial, 0, r->groups * (size_t)r->nsum * sizeof(cl_long), r->host);
+    st = gr_buffer_read(ctx, r->partial, 0, r->groups * (size_t)slots * sizeof(cl_long), r->host);
   if (st != GR_OK)
     return st;
   for (int q = 0; q < r->nsum; ++q)
     sums[q] = 0;
-  for (size_t grp = 0; grp < r->groups; ++grp)
+  for (int q = 0; q < r->nmax; ++q)
+    maxes[q] = LLONG_MIN;
+  for (size_t grp = 0; grp < r->groups; ++grp) {
+    const long long *p = r->host + (size_t)slots * grp;
     for (int q = 0; q < r->nsum; ++q)
-      sums[q] += r->host[(size_t)r->nsum * grp + q];
+      sums[q] += p[q];
+    for (int q = 0; q < r->nmax; ++q)
+      maxes[q] = p[r->nsum + q] > maxes[q] ? p[r->nsum + q] : maxes[q];
+  }
   return GR_OK;
 }
 
@@ -204,4 +225,154 @@ void gr_reduction_i64_release(gr_reduction_i64 *r) {
   gr_buffer_release(&r->partial);
   free(r->host);
   r->host = NULL;
+}
+
+/* ---------------------------------------------------------- fixed point */
+
+gr_fixed gr_fixed_from_float(float x) {
+  /* cl/reduce.h's gr_fixed_add, step for step: C's conversions cut toward
+   * zero as OpenCL's convert_long and convert_int do, and fmaxf / fminf
+   * take the number over a NaN as fmax / fmin do. */
+  gr_fixed f;
+  f.coarse =
+      (long long)fminf(fmaxf(x * 16777216.0f, -4611686018427387904.0f), 4611686018427387904.0f);
+  float rest = x - (float)f.coarse * 5.9604644775390625e-8f;
+  f.fine = (int)fminf(fmaxf(rest * 18014398509481984.0f, -1073741824.0f), 1073741824.0f);
+  return f;
+}
+
+void gr_fixed_add(gr_fixed *sum, gr_fixed x) {
+  sum->coarse += x.coarse;
+  sum->fine += x.fine;
+}
+
+static gr_wide gr_wide_of(long long v) {
+  gr_wide w;
+  w.lo = (unsigned long long)v;
+  w.hi = v < 0 ? -1 : 0;
+  return w;
+}
+
+void gr_wide_add(gr_wide *sum, gr_wide x) {
+  unsigned long long lo = sum->lo + x.lo;
+  sum->hi = (long long)((unsigned long long)sum->hi + (unsigned long long)x.hi + (lo < x.lo));
+  sum->lo = lo;
+}
+
+static gr_wide gr_wide_neg(gr_wide x) {
+  gr_wide r;
+  r.lo = ~x.lo + 1u;
+  r.hi = (long long)(~(unsigned long long)x.hi + (r.lo == 0u));
+  return r;
+}
+
+/* x 2^32, modulo 2^128. */
+static gr_wide gr_wide_shift32(gr_wide x) {
+  gr_wide r;
+  r.hi = (long long)(((unsigned long long)x.hi << 32) | (x.lo >> 32));
+  r.lo = x.lo << 32;
+  return r;
+}
+
+/* a b for unsigned 64-bit a, b: the high and low words. */
+static void gr_umul(unsigned long long a, unsigned long long b, unsigned long long *hi,
+                    unsigned long long *lo) {
+  const unsigned long long m = 0xffffffffull;
+  unsigned long long a0 = a & m, a1 = a >> 32, b0 = b & m, b1 = b >> 32;
+  unsigned long long p00 = a0 * b0, p01 = a0 * b1, p10 = a1 * b0, p11 = a1 * b1;
+  unsigned long long mid = (p00 >> 32) + (p01 & m) + (p10 & m);
+  *lo = (mid << 32) | (p00 & m);
+  *hi = p11 + (p01 >> 32) + (p10 >> 32) + (mid >> 32);
+}
+
+static unsigned long long gr_magnitude(long long v) {
+  return v < 0 ? 0ull - (unsigned long long)v : (unsigned long long)v;
+}
+
+gr_wide gr_wide_mul(long long a, long long b) {
+  gr_wide r;
+  unsigned long long hi;
+  gr_umul(gr_magnitude(a), gr_magnitude(b), &hi, &r.lo);
+  r.hi = (long long)hi;
+  return (a < 0) != (b < 0) ? gr_wide_neg(r) : r;
+}
+
+gr_wide gr_wide_scale(gr_wide x, long long m) {
+  int negative = (x.hi < 0) != (m < 0);
+  gr_wide mag = x.hi < 0 ? gr_wide_neg(x) : x;
+  unsigned long long um = gr_magnitude(m), hi;
+  gr_wide r;
+  gr_umul(mag.lo, um, &hi, &r.lo);
+  r.hi = (long long)(hi + (unsigned long long)mag.hi * um);
+  return negative ? gr_wide_neg(r) : r;
+}
+
+double gr_wide_value(gr_wide x, int frac_bits) {
+  int negative = x.hi < 0;
+  gr_wide mag = negative ? gr_wide_neg(x) : x;
+  unsigned long long hi = (unsigned long long)mag.hi, lo = mag.lo;
+  double v;
+  if (hi == 0u) {
+    v = (double)lo;
+  } else {
+    /* The top 64 bits, the ones below folded into the last (sticky) bit,
+     * so that the one conversion to double rounds as the exact value would. */
+    int s = 0;
+    while (s < 64 && (hi >> s) != 0u)
+      ++s;
+    unsigned long long top = s == 64 ? hi : (hi << (64 - s)) | (lo >> s);
+    unsigned long long below = s == 64 ? lo : lo & ((1ull << s) - 1u);
+    v = ldexp((double)(top | (below != 0u)), s);
+  }
+  v = ldexp(v, -frac_bits);
+  return negative ? -v : v;
+}
+
+double gr_fixed_value(gr_fixed x) {
+  gr_wide w = gr_wide_mul(x.coarse, 1ll << (GR_FIXED_FINE_BITS - GR_FIXED_COARSE_BITS));
+  gr_wide_add(&w, gr_wide_of(x.fine));
+  return gr_wide_value(w, GR_FIXED_FINE_BITS);
+}
+
+/* The 32-bit chunks of an integer, as doubles: the low ones 0 .. 2^32 - 1,
+ * the top one signed. */
+static double gr_chunk_low(unsigned long long bits) {
+  return (double)(bits & 0xffffffffull);
+}
+static double gr_chunk_top(unsigned long long bits) {
+  long long top = (long long)(bits >> 32);
+  return (double)(top >= 2147483648ll ? top - 4294967296ll : top);
+}
+
+void gr_fixed_pack(const long long *v, int nv, const gr_wide *w, int nw, double *packed) {
+  for (int q = 0; q < nv; ++q) {
+    unsigned long long u = (unsigned long long)v[q];
+    *packed++ = gr_chunk_top(u);
+    *packed++ = gr_chunk_low(u);
+  }
+  for (int q = 0; q < nw; ++q) {
+    unsigned long long hi = (unsigned long long)w[q].hi;
+    *packed++ = gr_chunk_top(hi);
+    *packed++ = gr_chunk_low(hi);
+    *packed++ = gr_chunk_low(w[q].lo >> 32);
+    *packed++ = gr_chunk_low(w[q].lo);
+  }
+}
+
+void gr_fixed_unpack(const double *packed, long long *v, int nv, gr_wide *w, int nw) {
+  /* Each chunk's sum is an exact integer below 2^53; the totals follow
+   * modulo 2^64 (2^128), which gives the true ones when they fit. */
+  for (int q = 0; q < nv; ++q, packed += 2) {
+    unsigned long long u =
+        ((unsigned long long)(long long)packed[0] << 32) + (unsigned long long)(long long)packed[1];
+    v[q] = (long long)u;
+  }
+  for (int q = 0; q < nw; ++q, packed += 4) {
+    gr_wide r = gr_wide_of((long long)packed[0]);
+    for (int c = 1; c < 4; ++c) {
+      r = gr_wide_shift32(r);
+      gr_wide_add(&r, gr_wide_of((long long)packed[c]));
+    }
+    w[q] = r;
+  }
 }

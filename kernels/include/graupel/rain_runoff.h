@@ -210,10 +210,14 @@ GR_API gr_status gr_rain_runoff_field_validate(gr_field f, const float *values, 
                                                size_t msg_len);
 
 /**
- * Water book-keeping, volumes in m^3, accumulated in double. The rain is
- * summed on the host (the rain-rate floats times dx dy times each step's dt
- * as the float the device used); the other volumes are reduced on the device
- * when the ledger is read.
+ * Water book-keeping, volumes in m^3. Every volume is a sum of integers
+ * (graupel/reduce.h's ledger fixed point: each cell's float to 2^-54 m,
+ * exact in any order), turned into a double once when the ledger is read,
+ * so a domain split into pieces gives the whole grid's ledger bit for bit.
+ * The rain is booked on the host (the owned cells' rain-rate floats times
+ * each step's dt as the float the device used, an exact integer product);
+ * the other volumes are reduced on the device when the ledger is read (each
+ * cell's Kahan sum, value and compensation).
  */
 typedef struct gr_rain_runoff_ledger {
   double time;               /**< simulated time since the start (or reset), s */
@@ -493,9 +497,11 @@ GR_API gr_status gr_rain_runoff_state_load(gr_rain_runoff *s, const void *host, 
  * advance (both refused with a sentence). The stable step and the ledger are
  * global through the allreduce callback (the deepest cell by GR_REDUCE_MAX;
  * the stored, infiltrated, outflow, inflow, rain and initial volumes by
- * GR_REDUCE_SUM), so every piece takes the same dt and the same steps as the
+ * GR_REDUCE_SUM of their fixed-point integers, 32 bits to a double:
+ * gr_fixed_pack), so every piece takes the same dt and the same steps as the
  * whole grid, which makes every owned cell bit-identical to the whole
- * grid's; advance on a piece with a ring needs both callbacks.
+ * grid's, and the global ledger is the whole grid's to the bit, however the
+ * domain is cut; advance on a piece with a ring needs both callbacks.
  *
  * Advance on pieces is collective: every piece calls gr_rain_runoff_advance
  * with the same duration, and each call makes the same sequence of

@@ -68,13 +68,22 @@ GR_API void gr_reduction_release(gr_reduction *r);
 typedef struct gr_reduction_i64 {
   int nsum;             /**< int64 sums per group */
   size_t local, groups; /**< work-group size (a power of two) and count */
-  cl_mem partial;       /**< nsum longs per group */
+  cl_mem partial;       /**< nsum + nmax longs per group */
   long long *host;      /**< the partials, read back */
+  int nmax;             /**< int64 maxima per group (gr_reduce_group_long_max) */
 } gr_reduction_i64;
 
 /** As gr_reduction_init, for nsum (1 to GR_REDUCTION_MAX_SLOTS) integer sums. */
 GR_API gr_status gr_reduction_i64_init(gr_context *ctx, cl_kernel k, size_t items, int nsum,
                                        gr_reduction_i64 *r);
+
+/**
+ * As gr_reduction_i64_init, with nmax integer maxima after the sums (the
+ * kernel ends with gr_reduce_group_long_max); nsum + nmax is 1 to
+ * GR_REDUCTION_MAX_SLOTS.
+ */
+GR_API gr_status gr_reduction_i64_init_max(gr_context *ctx, cl_kernel k, size_t items, int nsum,
+                                           int nmax, gr_reduction_i64 *r);
 
 /**
  * Runs k (its own arguments already set; this sets `partial` and `scratch`
@@ -83,8 +92,90 @@ GR_API gr_status gr_reduction_i64_init(gr_context *ctx, cl_kernel k, size_t item
 GR_API gr_status gr_reduction_i64_run(gr_context *ctx, gr_reduction_i64 *r, cl_kernel k,
                                       long long *sums);
 
+/** gr_reduction_i64_run that also returns the nmax maxima (maxes may be NULL when nmax is 0). */
+GR_API gr_status gr_reduction_i64_run_max(gr_context *ctx, gr_reduction_i64 *r, cl_kernel k,
+                                          long long *sums, long long *maxes);
+
 /** Frees the buffers; a zeroed or released reduction is fine. */
 GR_API void gr_reduction_i64_release(gr_reduction_i64 *r);
+
+/**
+ * @name Ledger fixed point
+ *
+ * Totals that must be the same bits however a domain is split (among
+ * work-groups, the pieces of an MPI run, or devices) are sums of integers:
+ * integer addition is exact in any order. A value x (a float per cell: a
+ * depth in m, a rate in m/s) becomes two int64 words, coarse = x cut toward
+ * zero to a multiple of 2^-24 (in units of 2^-24) and fine = the rest cut
+ * toward zero to a multiple of 2^-54 (in units of 2^-54; |fine| < 2^30), the
+ * device's cl/reduce.h gr_fixed_add and gr_fixed_from_float here giving the
+ * same integers. So |x| >= 2^-31 is exact and smaller x is within 2^-54 m
+ * (5.6e-17): a ledger closes as well as the double-float sums it replaced.
+ * Each word is summed on its own.
+ *
+ * Bounds (int64 totals): the coarse words of n cells stay below 2^63 while
+ * sum |x| < 2^39 (5.5e11) units x cells, and the fine words while n <= 2^32
+ * (two floats per cell, a value and its Kahan compensation, under 2^31 a
+ * cell). For a 65536^2 grid (2^32 cells) that is a mean of 128 m per cell
+ * for a depth ledger (stored, infiltrated, outflow, inflow: each on its
+ * own); a single cell holds up to 2^38 m.
+ *
+ * Products (the rain: a rate sum times a step, both exact integers) use
+ * gr_wide, a 128-bit integer; gr_fixed_pack / gr_fixed_unpack carry int64s
+ * and gr_wides through a gr_allreduce_fn as doubles of 32 bits each, whose
+ * sums are exact for fewer than 2^21 pieces.
+ * @{
+ */
+
+/** The fixed point's two words: value = coarse 2^-24 + fine 2^-54. */
+#define GR_FIXED_COARSE_BITS 24
+#define GR_FIXED_FINE_BITS 54
+
+/** A fixed-point value or sum (zero-initialise for 0). */
+typedef struct gr_fixed {
+  long long coarse; /**< units of 2^-GR_FIXED_COARSE_BITS */
+  long long fine;   /**< units of 2^-GR_FIXED_FINE_BITS */
+} gr_fixed;
+
+/** A signed 128-bit integer, two's complement: hi 2^64 + lo. */
+typedef struct gr_wide {
+  unsigned long long lo;
+  long long hi;
+} gr_wide;
+
+/** x as cl/reduce.h's gr_fixed_add adds it on a device (the same integers). */
+GR_API gr_fixed gr_fixed_from_float(float x);
+
+/** *sum += x, word by word (exact). */
+GR_API void gr_fixed_add(gr_fixed *sum, gr_fixed x);
+
+/** The value of x (coarse 2^30 + fine, exactly, then rounded once to double). */
+GR_API double gr_fixed_value(gr_fixed x);
+
+/** a b exactly. */
+GR_API gr_wide gr_wide_mul(long long a, long long b);
+
+/** x m, exact while it fits in 127 bits and a sign. */
+GR_API gr_wide gr_wide_scale(gr_wide x, long long m);
+
+/** *sum += x (exact while it fits). */
+GR_API void gr_wide_add(gr_wide *sum, gr_wide x);
+
+/** x 2^-frac_bits, rounded once to the nearest double. */
+GR_API double gr_wide_value(gr_wide x, int frac_bits);
+
+/** Doubles that gr_fixed_pack writes for nv int64s and nw gr_wides. */
+#define GR_FIXED_PACKED(nv, nw) (2 * (nv) + 4 * (nw))
+
+/**
+ * Writes v[0..nv-1] and w[0..nw-1] as GR_FIXED_PACKED(nv, nw) doubles, each
+ * holding 32 bits (exact integers), for a gr_allreduce_fn with
+ * GR_REDUCE_SUM; gr_fixed_unpack turns the summed doubles back into the
+ * exact int64 and 128-bit totals (exact for fewer than 2^21 pieces).
+ */
+GR_API void gr_fixed_pack(const long long *v, int nv, const gr_wide *w, int nw, double *packed);
+GR_API void gr_fixed_unpack(const double *packed, long long *v, int nv, gr_wide *w, int nw);
+/** @} */
 
 #ifdef __cplusplus
 }
