@@ -26,6 +26,12 @@
 /* advance re-reads the stable step after 4 to 64 steps. */
 #define GR_RAIN_RUNOFF_CHUNK_MIN 4
 #define GR_RAIN_RUNOFF_CHUNK_MAX 64
+/* gr_rain_runoff_step waits after every this many steps: an OpenCL queue
+ * holding thousands of launches grows the runtime's own pools for good
+ * (PoCL here: 16-22 MB more resident after 1000-step calls than after
+ * 100-step ones, measured by the soak), and a wait per 64 steps costs the
+ * device nothing it would not idle anyway. */
+#define GR_RAIN_RUNOFF_IN_FLIGHT 64
 /* With a progress callback, advance waits on the queue after a batch of
  * steps that takes about this long (s), and calls the callback when at least
  * GR_RAIN_RUNOFF_PROGRESS_EVERY has passed since the last call. */
@@ -2050,8 +2056,16 @@ static gr_status gr_rain_runoff_step_impl(gr_rain_runoff *s, double dt, int nste
                         "per call (got %d): exchange its halo between steps, or give it an "
                         "exchange with gr_rain_runoff_set_halo_exchange.",
                         nsteps);
-  int done = 0, stop = 0;
-  return gr_rain_runoff_enqueue(s, dt, nsteps, NULL, &done, &stop);
+  gr_status st = GR_OK;
+  for (int left = nsteps; st == GR_OK && left > 0;) {
+    int k = left < GR_RAIN_RUNOFF_IN_FLIGHT ? left : GR_RAIN_RUNOFF_IN_FLIGHT, done = 0, stop = 0;
+    if (k < left || left < nsteps) /* not the only batch: wait for the one before */
+      st = left < nsteps ? gr_finish(s->ctx) : GR_OK;
+    if (st == GR_OK)
+      st = gr_rain_runoff_enqueue(s, dt, k, NULL, &done, &stop);
+    left -= k;
+  }
+  return st;
 }
 
 gr_status gr_rain_runoff_step(gr_rain_runoff *s, double dt, int nsteps) {
