@@ -93,7 +93,10 @@
  *  - second order in space: minmod-limited slopes of the depth, the water
  *    surface and the velocities (the surface as bed differences plus depth
  *    differences, so that large elevations lose nothing to rounding), with
- *    the matching centred bed source term;
+ *    the matching centred bed source term. A surface whose rise between two
+ *    cells is within the depths' own rounding, 2 FLT_EPSILON (h1 + h2), is
+ *    flat: a lake given as depths level - elevation, or as its level
+ *    (WATER_SURFACE), has its depths rounded, and stays exactly at rest;
  *  - second order in time: Heun's method (SSP-RK2), two launches a step;
  *  - Manning friction in each stage, implicit in the new discharge:
  *    |q'| (1 + g dt n^2 |q'| / h^(7/3)) = |q| (solved exactly, as the local
