@@ -11,6 +11,47 @@
  * host's final sum is instant. */
 #define GR_REDUCE_GROUPS 256
 #define GR_REDUCE_LOCAL 64
+/* The launch of a reduction whose result does not depend on how the cells
+ * are grouped (integer sums, maxima) on a GPU: 256 groups of 64 items are
+ * 16384 items, a few percent of what an H200 runs at once, and such a
+ * reduction over 4096^2 cells took 1.5-2 ms (a stream of that size: 0.07
+ * ms); 1024 groups of 256 fill it. Float sums keep the fixed shape above,
+ * which their bits depend on (CPUs and GPUs agree). */
+#define GR_REDUCE_GROUPS_WIDE 1024
+#define GR_REDUCE_LOCAL_WIDE 256
+
+/* The work-group size and count of a reduction of `items` cells by kernel
+ * k with `slot_bytes` of scratch per item; wide: the result is order-free,
+ * so a GPU may take the wide shape. */
+static gr_status gr_reduce_shape(gr_context *ctx, cl_kernel k, size_t items, size_t slot_bytes,
+                                 int wide, size_t *local, size_t *groups) {
+  cl_device_id dev = gr_context_device(ctx);
+  size_t kmax = 0;
+  cl_device_type type = 0;
+  cl_ulong lmem = 0;
+  cl_int err =
+      clGetKernelWorkGroupInfo(k, dev, CL_KERNEL_WORK_GROUP_SIZE, sizeof(kmax), &kmax, NULL);
+  if (err == CL_SUCCESS)
+    err = clGetDeviceInfo(dev, CL_DEVICE_TYPE, sizeof(type), &type, NULL);
+  if (err == CL_SUCCESS)
+    err = clGetDeviceInfo(dev, CL_DEVICE_LOCAL_MEM_SIZE, sizeof(lmem), &lmem, NULL);
+  gr_status st = gr_cl_check(ctx, err, "Querying a reduction's work-group size");
+  if (st != GR_OK)
+    return st;
+  wide = wide && (type & CL_DEVICE_TYPE_GPU);
+  size_t cap = wide ? GR_REDUCE_LOCAL_WIDE : GR_REDUCE_LOCAL,
+         most = wide ? GR_REDUCE_GROUPS_WIDE : GR_REDUCE_GROUPS;
+  *local = 1;
+  while (*local * 2 <= cap && *local * 2 <= kmax &&
+         (!wide || *local * 2 * slot_bytes <= (size_t)lmem / 2))
+    *local *= 2;
+  *groups = (items + *local - 1) / *local;
+  if (*groups > most)
+    *groups = most;
+  if (*groups < 1)
+    *groups = 1;
+  return GR_OK;
+}
 
 gr_status gr_reduction_init(gr_context *ctx, cl_kernel k, size_t items, int nsum, int nmax,
                             gr_reduction *r) {
@@ -23,22 +64,11 @@ gr_status gr_reduction_init(gr_context *ctx, cl_kernel k, size_t items, int nsum
   memset(r, 0, sizeof(*r));
   r->nsum = nsum;
   r->nmax = nmax;
-  size_t kmax = 0;
-  gr_status st =
-      gr_cl_check(ctx,
-                  clGetKernelWorkGroupInfo(k, gr_context_device(ctx), CL_KERNEL_WORK_GROUP_SIZE,
-                                           sizeof(kmax), &kmax, NULL),
-                  "Querying a reduction's work-group size");
+  /* maxima alone are order-free; float sums are not */
+  gr_status st = gr_reduce_shape(ctx, k, items, (size_t)(2 * nsum + nmax) * sizeof(cl_float),
+                                 nsum == 0, &r->local, &r->groups);
   if (st != GR_OK)
     return st;
-  r->local = 1;
-  while (r->local * 2 <= GR_REDUCE_LOCAL && r->local * 2 <= kmax)
-    r->local *= 2;
-  r->groups = (items + r->local - 1) / r->local;
-  if (r->groups > GR_REDUCE_GROUPS)
-    r->groups = GR_REDUCE_GROUPS;
-  if (r->groups < 1)
-    r->groups = 1;
   size_t bytes = r->groups * (size_t)(2 * nsum + nmax) * sizeof(cl_float);
   st = gr_buffer_create(ctx, CL_MEM_WRITE_ONLY, bytes, NULL, &r->partial);
   if (st == GR_OK) {
@@ -153,22 +183,10 @@ gr_status gr_reduction_i64_init_max(gr_context *ctx, cl_kernel k, size_t items, 
   r->nsum = nsum;
   r->nmax = nmax;
   const int slots = nsum + nmax;
-  size_t kmax = 0;
   gr_status st =
-      gr_cl_check(ctx,
-                  clGetKernelWorkGroupInfo(k, gr_context_device(ctx), CL_KERNEL_WORK_GROUP_SIZE,
-                                           sizeof(kmax), &kmax, NULL),
-                  "Querying a reduction's work-group size");
+      gr_reduce_shape(ctx, k, items, (size_t)slots * sizeof(cl_long), 1, &r->local, &r->groups);
   if (st != GR_OK)
     return st;
-  r->local = 1;
-  while (r->local * 2 <= GR_REDUCE_LOCAL && r->local * 2 <= kmax)
-    r->local *= 2;
-  r->groups = (items + r->local - 1) / r->local;
-  if (r->groups > GR_REDUCE_GROUPS)
-    r->groups = GR_REDUCE_GROUPS;
-  if (r->groups < 1)
-    r->groups = 1;
   size_t bytes = r->groups * (size_t)slots * sizeof(cl_long);
   st = gr_buffer_create(ctx, CL_MEM_WRITE_ONLY, bytes, NULL, &r->partial);
   if (st == GR_OK) {

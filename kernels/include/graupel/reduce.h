@@ -30,8 +30,10 @@ typedef struct gr_reduction {
 
 /**
  * Chooses the launch of kernel k over `items` cells (a power-of-two group
- * size of at most 64 that k allows, at most 256 groups) and allocates the
- * partials. 2 nsum + nmax must be 1 to GR_REDUCTION_MAX_SLOTS.
+ * size of at most 64 that k allows, at most 256 groups: float sums depend
+ * on that shape, so every device keeps it; maxima alone, order-free, take
+ * up to 1024 groups of 256 on a GPU) and allocates the partials. 2 nsum +
+ * nmax must be 1 to GR_REDUCTION_MAX_SLOTS.
  */
 GR_API gr_status gr_reduction_init(gr_context *ctx, cl_kernel k, size_t items, int nsum, int nmax,
                                    gr_reduction *r);
@@ -73,7 +75,8 @@ typedef struct gr_reduction_i64 {
   int nmax;             /**< int64 maxima per group (gr_reduce_group_long_max) */
 } gr_reduction_i64;
 
-/** As gr_reduction_init, for nsum (1 to GR_REDUCTION_MAX_SLOTS) integer sums. */
+/** As gr_reduction_init, for nsum (1 to GR_REDUCTION_MAX_SLOTS) integer sums (order-free: up
+ * to 1024 groups of 256 on a GPU). */
 GR_API gr_status gr_reduction_i64_init(gr_context *ctx, cl_kernel k, size_t items, int nsum,
                                        gr_reduction_i64 *r);
 
