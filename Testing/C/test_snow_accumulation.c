@@ -1079,6 +1079,7 @@ typedef struct pc_team {
 typedef struct pc_runner {
   pc_team *t;
   int rank, exchanges, reductions;
+  double values; /* reduced, over every call */
   /* Steps k0 .. k1 - 1 of the scene; the state saved after save_at steps
    * (0: none); a progress callback that stops after stop_at steps (0: none). */
   int k0, k1, save_at, stop_at, calls, taken;
@@ -1102,6 +1103,7 @@ static gr_status pc_allreduce(void *user, double *values, int n, gr_reduce_op op
   if (n > GR_SNOW_ACCUMULATION_REDUCE_CHUNK)
     return GR_ERR_INVALID_ARGUMENT;
   ++r->reductions;
+  r->values += n;
   memcpy(t->slot[r->rank], values, (size_t)n * sizeof(double));
   pthread_barrier_wait(&t->barrier);
   for (int q = 0; q < n; ++q) {
@@ -1136,10 +1138,14 @@ static gr_status pc_exchange(void *user) {
   return st;
 }
 
+/* The box's points along an edge of a face, less one: 6 (294 points), or
+ * 40 (10086 points, more than the view rows under the box hold texels). */
+static int pc_subdiv = 6;
+
 static void *pc_run(void *arg) {
   pc_runner *r = arg;
   pc_scene sc;
-  mesh_faces(&sc.box, 1.0, 1.2, 0.6, 6);
+  mesh_faces(&sc.box, 1.0, 1.2, 0.6, pc_subdiv);
   gr_status st = GR_OK;
   if (r->stop_at)
     gr_snow_accumulation_set_progress(r->s, pc_stop, r);
@@ -1279,6 +1285,21 @@ static void pc_split(const pc_domain *dm, int tilted, int n, const int *cuts,
     pc_check(dm, tilted, n, rn, lw, wf, wo, nv, "");
   }
   int exchanges = rn[0].exchanges, reductions = rn[0].reductions;
+  double values = rn[0].values;
+  /* What is combined: with the terrain in the view, the view rows where the
+   * pieces' bands meet, and the box's exposure per point or the rows under
+   * it, whichever is fewer values (before: every texel of the view each
+   * step, ExposureResolution^2 or nearly). */
+  double res2 = (double)p.exposure_resolution * p.exposure_resolution;
+  if (tilted && n == 2 && nv < 1000)
+    CHECK_MSG(values / PC_STEPS < 0.5 * res2,
+              "2 pieces reduce %.0f values a step, not less than half the view's %.0f texels",
+              values / PC_STEPS, res2);
+  if (tilted && nv > res2)
+    CHECK_MSG(values / PC_STEPS < nv,
+              "%d pieces reduce %.0f values a step, more than the box's %d points: the rows "
+              "under it cost less",
+              n, values / PC_STEPS, nv);
   for (int k = 0; ok && k < n; ++k) {
     CHECK(rn[k].state != NULL);
     ok = rn[k].state &&
@@ -1304,10 +1325,10 @@ static void pc_split(const pc_domain *dm, int tilted, int n, const int *cuts,
                 rn[k].taken, gr_status_string(rn[k].last), n - 1);
   }
   CHECK(ok);
-  printf("pieces (%s snow): %d pieces, ring %d rows: fields, box and ledger equal the whole grid, "
-         "from checkpoints too; a stop on one piece stops all; piece 0 made %d exchanges and %d "
-         "reductions in %d steps\n",
-         tilted ? "tilted" : "vertical", n, ghost, exchanges, reductions, PC_STEPS);
+  printf("pieces (%s snow, %d box points): %d pieces, ring %d rows: fields, box and ledger equal "
+         "the whole grid, from checkpoints too; a stop on one piece stops all; piece 0 made %d "
+         "exchanges and %d reductions of %.0f values in %d steps\n",
+         tilted ? "tilted" : "vertical", nv, n, ghost, exchanges, reductions, values, PC_STEPS);
   for (int k = 0; k < n; ++k) {
     gr_snow_accumulation_destroy(rn[k].s);
     free(rn[k].state);
@@ -1326,7 +1347,10 @@ static void pc_split(const pc_domain *dm, int tilted, int n, const int *cuts,
 static void test_pieces(void) {
   pc_domain dm = pc_make_domain();
   const int nx = dm.g.nx, ny = dm.g.ny, n = nx * ny;
-  for (int tilted = 1; tilted >= 0; --tilted) {
+  const int cases[3][2] = {{1, 6}, {1, 40}, {0, 6}}; /* tilted, the box's subdivision */
+  for (int c = 0; c < 3; ++c) {
+    int tilted = cases[c][0];
+    pc_subdiv = cases[c][1];
     gr_snow_accumulation_params p;
     pc_params(&p, tilted);
     gr_snow_accumulation *whole = NULL;
@@ -1337,7 +1361,7 @@ static void test_pieces(void) {
     CHECK(gr_snow_accumulation_set_field(whole, GR_FIELD_ELEVATION, dm.b) == GR_OK);
     CHECK(gr_snow_accumulation_set_field(whole, GR_FIELD_SNOW_DEPTH, dm.d) == GR_OK);
     pc_scene sc;
-    mesh_faces(&sc.box, 1.0, 1.2, 0.6, 6);
+    mesh_faces(&sc.box, 1.0, 1.2, 0.6, pc_subdiv);
     for (int k = 0; k < PC_STEPS; ++k) {
       pc_pose(&sc, k);
       CHECK(gr_snow_accumulation_set_objects(whole, &sc.box.m, 1) == GR_OK);
@@ -1355,7 +1379,7 @@ static void test_pieces(void) {
      * the lee of the bare ridges hidden (no box), and straight down the
      * box's side faces are hidden below the snow surface and open above
      * it. */
-    int lee = 0, side_hidden = 0, side_open = 0, per = 7 * 7;
+    int lee = 0, side_hidden = 0, side_open = 0, per = (pc_subdiv + 1) * (pc_subdiv + 1);
     if (tilted) {
       gr_snow_accumulation *bare = NULL;
       CHECK(gr_snow_accumulation_create(ctx, &dm.g, &p, &bare) == GR_OK);

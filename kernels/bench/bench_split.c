@@ -73,7 +73,10 @@ static void barrier_break(split_barrier *b) {
 
 /* ------------------------------------------------------------- the team */
 
-#define SPLIT_SLOTS 32 /* doubles per piece in one allreduce */
+/* Doubles per piece in one allreduce: the longest call any core makes
+ * (Snow Accumulation reduces its exposure view in calls of
+ * GR_SNOW_ACCUMULATION_REDUCE_CHUNK values). */
+#define SPLIT_SLOTS 65536
 
 typedef struct split_team split_team;
 
@@ -88,8 +91,10 @@ typedef struct split_member {
   /* seconds since the timed steps began */
   double wait_s, halo_s, barrier_s, allreduce_s;
   int allreduce_calls;
+  double allreduce_values; /* values reduced (8 bytes each) */
   double step_allreduce_s; /* of allreduce_s: in the timed steps */
   int step_allreduce_calls;
+  double step_allreduce_values;
   unsigned long step_exchanges;
   double t0, t1; /* the timed steps' start and end */
   gr_status st;
@@ -141,6 +146,7 @@ static gr_status split_allreduce(void *user, double *values, int n, gr_reduce_op
     return gr_set_error(m->ctx, GR_ERR_ABORTED, "Another piece failed during the allreduce.");
   m->allreduce_s += gr_bench_now_s() - t0;
   m->allreduce_calls++;
+  m->allreduce_values += n;
   return GR_OK;
 }
 
@@ -232,6 +238,7 @@ static void *member_run(void *arg) {
   /* The set-up's allreduce waited for the slowest program build: count from here. */
   m->wait_s = m->halo_s = m->barrier_s = m->allreduce_s = 0.0;
   m->allreduce_calls = 0;
+  m->allreduce_values = 0.0;
   unsigned long exchanges0 = m->exchanges;
   m->t0 = gr_bench_now_s();
   for (int i = 0; st == GR_OK && i < t->steps; ++i)
@@ -241,6 +248,7 @@ static void *member_run(void *arg) {
   m->t1 = gr_bench_now_s();
   m->step_allreduce_s = m->allreduce_s;
   m->step_allreduce_calls = m->allreduce_calls;
+  m->step_allreduce_values = m->allreduce_values;
   m->step_exchanges = m->exchanges - exchanges0;
   if (st != GR_OK) {
     member_fail(m, st, "steps");
@@ -317,6 +325,18 @@ static long verify_whole(split_team *t, gr_context *ctx, const char *name) {
   printf("verify: %s, %d pieces against one whole grid after %d steps: %ld of %zu values in %d "
          "outputs differ in any bit (max |diff| %.6g)\n",
          name, t->k, 2 + t->steps, total, values, sp->outputs, worst);
+  if (sp->summary) {
+    char line[sizeof(t->summary)] = "";
+    if (sp->summary(state, line, sizeof(line)) != GR_OK) {
+      fprintf(stderr, "graupel-bench: --verify's whole grid: %s\n", sp->last_error(state));
+      t->core->teardown(state);
+      return -1;
+    }
+    /* Equal to rounding in general (sums over pieces); the same bits where
+     * a core's header promises its ledger so. */
+    printf("verify: the whole grid's summary (%s the pieces'):\n%s\n",
+           strcmp(line, t->summary) == 0 ? "the same bits as" : "differs from", line);
+  }
   t->core->teardown(state);
   return total;
 }
@@ -481,6 +501,7 @@ int gr_bench_split_run(const char *name, const gr_bench_core *core, int n, int s
   double t0 = m[0].t0, t1 = m[0].t1, halo = 0.0, wait = 0.0, barrier = 0.0;
   double allreduce = 0.0, step_allreduce = 0.0;
   int calls = 0, step_calls = 0;
+  double step_values = 0.0;
   unsigned long exchanges = 0;
   size_t halo_bytes = 0;
   for (int r = 0; r < k; ++r) {
@@ -492,6 +513,7 @@ int gr_bench_split_run(const char *name, const gr_bench_core *core, int n, int s
     step_allreduce = fmax(step_allreduce, m[r].step_allreduce_s);
     allreduce = fmax(allreduce, m[r].allreduce_s - m[r].step_allreduce_s);
     step_calls = m[r].step_allreduce_calls;
+    step_values = fmax(step_values, m[r].step_allreduce_values);
     calls = m[r].allreduce_calls - m[r].step_allreduce_calls;
     exchanges = m[r].step_exchanges;
     halo_bytes += m[r].halo_bytes[0] + m[r].halo_bytes[1];
@@ -515,6 +537,9 @@ int gr_bench_split_run(const char *name, const gr_bench_core *core, int n, int s
          "(%.4g calls a step), %.4f ms in %d calls after the steps (the summary)\n",
          name, 1e3 * halo / steps, (double)exchanges / steps, halo_bytes, 1e3 * barrier / steps,
          1e3 * step_allreduce / steps, (double)step_calls / steps, 1e3 * allreduce, calls);
+  /* What an MPI run would send through MPI_Allreduce: 8 bytes a value. */
+  printf("%s: allreduce %.0f bytes a step per piece (%.4g values of 8 bytes)\n", name,
+         8.0 * step_values / steps, step_values / steps);
   if (t.summary[0])
     printf("%s\n", t.summary);
   rc = 0;
@@ -523,8 +548,9 @@ int gr_bench_split_run(const char *name, const gr_bench_core *core, int n, int s
     rc = differ == 0 ? 0 : 1;
   }
   printf("core=%s size=%d steps=%d devices=%d ms_per_step=%.6g mcells_per_s=%.6g "
-         "bw_fraction=%.4g halo_ms_per_step=%.6g device=\"%s\"\n",
-         name, n, steps, k, ms, mcells, frac, 1e3 * halo / steps, gr_context_device_name(m[0].ctx));
+         "bw_fraction=%.4g halo_ms_per_step=%.6g allreduce_bytes_per_step=%.0f device=\"%s\"\n",
+         name, n, steps, k, ms, mcells, frac, 1e3 * halo / steps, 8.0 * step_values / steps,
+         gr_context_device_name(m[0].ctx));
 
 done:
   for (int r = 0; r < k; ++r) {

@@ -71,7 +71,7 @@ struct gr_snow_accumulation {
   gr_grid grid;
   gr_snow_accumulation_params params;
   cl_kernel raster_terrain, raster_objects, exposure_k, noise_k, slope_k, blur, dilate, apply,
-      objects_k, reduce, surface, row_sums, object_surface;
+      objects_k, reduce, surface, row_sums, object_surface, object_exposure;
   /* A piece (graupel.h's contract, "Pieces of a split domain"): grid.nx,
    * grid.ny count the local arrays (own rows and rings); the domain has
    * gnx x gny points, local row 0 is its row row0, the own rows are local
@@ -85,9 +85,16 @@ struct gr_snow_accumulation {
    * objects' (m^3): see "Pieces" in the header for why per row. */
   double *init_rows, initial_objects;
   /* Per local row, the row sums' 6 floats; per mesh point or sample, the
-   * snow surface under it (pieces only). */
+   * snow surface under it or its exposure (pieces only). */
   cl_mem rows_buf, o_surface;
   size_t o_surface_cap;
+  /* Pieces, the steps with the terrain in the view: which view rows the
+   * pieces combine (1) this step, and whether the objects' exposure is
+   * combined per point instead of through the view rows under them. */
+  unsigned char *view_rows;
+  double *view_cover;
+  size_t view_rows_cap;
+  int objects_by_point;
   /* The grid: ground, initial snow, the state pairs, exposure, growth and
    * a scratch array, the blur weights and the view. */
   cl_mem ground, depth0, arr[GR_SNAC_ARRAYS], growth, scratch, weights, view;
@@ -693,7 +700,8 @@ gr_status gr_snow_accumulation_create(gr_context *ctx, const gr_grid *grid,
             {"snow_accumulation_noise", &s->noise_k},
             {"snow_accumulation_slope_reduce", &s->slope_k},
             {"snow_accumulation_row_sums", &s->row_sums},
-            {"snow_accumulation_object_surface", &s->object_surface}};
+            {"snow_accumulation_object_surface", &s->object_surface},
+            {"snow_accumulation_object_exposure", &s->object_exposure}};
   for (size_t i = 0; st == GR_OK && i < sizeof(ks) / sizeof(ks[0]); ++i)
     st = gr_kernel_create(ctx, prog, ks[i].name, ks[i].k);
   cl_mem *bufs[] = {&s->ground, &s->depth0, &s->growth, &s->scratch, &s->noise};
@@ -746,9 +754,10 @@ static void gr_snac_release_objects(gr_snow_accumulation *s) {
 void gr_snow_accumulation_destroy(gr_snow_accumulation *s) {
   if (!s)
     return;
-  cl_kernel ks[] = {s->raster_terrain, s->raster_objects, s->exposure_k,    s->blur,    s->dilate,
-                    s->apply,          s->objects_k,      s->reduce,        s->surface, s->noise_k,
-                    s->slope_k,        s->row_sums,       s->object_surface};
+  cl_kernel ks[] = {s->raster_terrain, s->raster_objects, s->exposure_k, s->blur,
+                    s->dilate,         s->apply,          s->objects_k,  s->reduce,
+                    s->surface,        s->noise_k,        s->slope_k,    s->row_sums,
+                    s->object_surface, s->object_exposure};
   for (size_t i = 0; i < sizeof(ks) / sizeof(ks[0]); ++i)
     if (ks[i])
       clReleaseKernel(ks[i]);
@@ -768,6 +777,7 @@ void gr_snow_accumulation_destroy(gr_snow_accumulation *s) {
   free(s->hv);
   free(s->ht);
   free(s->hnrm);
+  free(s->view_rows), free(s->view_cover);
   free(s->init_rows);
   for (int o = 0; o < GR_SNOW_ACCUMULATION_MAX_OBJECTS; ++o)
     gr_mesh_memo_free(&s->memo[o]);
@@ -1566,24 +1576,177 @@ static void gr_snac_view_of(const gr_snow_accumulation *s, const double d[3], gr
   v->vh = (int)fmin(ceil((qhi[1] - qlo[1]) / texel), (double)res) + 2 * m + 1;
 }
 
-/* The maximum of the pieces' views, texel by texel (ints travel exactly as
- * doubles). Waits. */
-static gr_status gr_snac_view_reduce(gr_snow_accumulation *s, size_t n) {
-  cl_int *keys = malloc(n * sizeof(cl_int));
-  double *v = malloc(n * sizeof(double));
+/* The view rows [lo, hi] that points projected between heights zlo and
+ * zhi (relative to zref) at y from ylo to yhi (relative to grid point
+ * (0, 0)) can fall in, with two rows to spare beyond the float rounding of
+ * the kernels' projection; lo > hi when none. */
+static void gr_snac_band(const gr_snac_view *v, double ylo, double yhi, double zlo, double zhi,
+                         int *lo, int *hi) {
+  double ty = v->tau_y, qy0 = v->qy0, inv = v->inv_texel, qmin = HUGE_VAL, qmax = -HUGE_VAL;
+  for (int k = 0; k < 4; ++k) {
+    double y = k & 1 ? yhi : ylo, z = k & 2 ? zhi : zlo;
+    double q = (y + z * ty - qy0) * inv;
+    qmin = fmin(qmin, q), qmax = fmax(qmax, q);
+  }
+  double big = fmax(fabs(ylo), fabs(yhi)) + fmax(fabs(zlo), fabs(zhi)) * fabs(ty) + fabs(qy0);
+  double slack = 2.0 + 1e-5 * big * inv;
+  double a = floor(qmin - slack), b = ceil(qmax + slack);
+  *lo = a < 0.0 ? 0 : (int)fmin(a, (double)v->vh);
+  *hi = b > v->vh - 1.0 ? v->vh - 1 : (int)fmax(b, -1.0);
+}
+
+/* The pieces' views combined, texel by texel, with a maximum (ints travel
+ * exactly as doubles), in the rows where that can change a texel that a
+ * piece reads. A piece draws its local cells (ring included) into rows of
+ * a band its rows and the surface's height range bound, and its grid
+ * points read only there; outside every other piece's band the others'
+ * views hold the objects alone, which every piece draws the same, so a
+ * piece's own texel is already the maximum. The rows two or more bands
+ * cover are found by one reduction of 2 values a row (the highest and
+ * lowest piece covering it) and only they are combined: a band of about
+ * the ring plus the relief times the snow's slope across the cut, instead
+ * of the whole view. The objects' points read rows anywhere: their
+ * exposure is combined per point (snow_accumulation_object_exposure),
+ * unless combining the rows under them costs fewer values. Waits. */
+static gr_status gr_snac_view_reduce(gr_snow_accumulation *s, const gr_snac_view *v) {
+  size_t vh = (size_t)v->vh, vw = (size_t)v->vw;
+  if (vh > s->view_rows_cap) {
+    unsigned char *r = realloc(s->view_rows, vh);
+    if (r)
+      s->view_rows = r;
+    double *c = r ? realloc(s->view_cover, 2 * vh * sizeof(double)) : NULL;
+    if (c)
+      s->view_cover = c;
+    if (!r || !c)
+      return gr_set_error(s->ctx, GR_ERR_OUT_OF_MEMORY, "Out of host memory.");
+    s->view_rows_cap = vh;
+  }
+  unsigned char *rows = s->view_rows;
+  double *cover = s->view_cover;
+  /* This piece's band: its local rows, every height the view's box allows. */
+  double zlo = fmin(0.0, s->bmin - s->zref), zhi = s->bmax + s->snow_bound - s->zref;
+  int lo, hi;
+  gr_snac_band(v, (double)s->row0 * s->grid.dy, (double)(s->row0 + s->grid.ny - 1) * s->grid.dy,
+               zlo, zhi, &lo, &hi);
+  double id = (double)(s->row0 + s->ring_s); /* the first own row: one per piece */
+  for (size_t r = 0; r < vh; ++r) {
+    int in = (int)r >= lo && (int)r <= hi;
+    cover[2 * r] = in ? id : -HUGE_VAL;
+    cover[2 * r + 1] = in ? -id : -HUGE_VAL;
+  }
+  gr_status st = gr_snac_allreduce(s, cover, 2 * vh, GR_REDUCE_MAX);
+  if (st != GR_OK)
+    return st;
+  for (size_t r = 0; r < vh; ++r)
+    rows[r] = cover[2 * r] > -HUGE_VAL && cover[2 * r] != -cover[2 * r + 1];
+  /* The objects: the rows under their box (the same on every piece), or a
+   * value per mesh point and sample, whichever is fewer values. */
+  s->objects_by_point = 0;
+  size_t points = (size_t)s->nv + (size_t)s->ns;
+  if (points > 0) {
+    double half = GR_SNAC_NORMAL_OFFSET * v->texel; /* a mesh point's test position */
+    gr_snac_band(v, s->ob_lo[1] - s->grid.y0 - half, s->ob_hi[1] - s->grid.y0 + half,
+                 s->ob_lo[2] - s->zref - half, s->ob_hi[2] - s->zref + half, &lo, &hi);
+    size_t extra = 0;
+    for (int r = lo; r <= hi; ++r)
+      extra += !rows[r];
+    if (extra * vw > points)
+      s->objects_by_point = 1;
+    else
+      for (int r = lo; r <= hi; ++r)
+        rows[r] = 1;
+  }
+  size_t longest = 0, run = 0;
+  for (size_t r = 0; r < vh; ++r) {
+    run = rows[r] ? run + 1 : 0;
+    longest = run > longest ? run : longest;
+  }
+  if (longest == 0)
+    return GR_OK;
+  cl_int *keys = malloc(longest * vw * sizeof(cl_int));
+  double *vals = malloc(longest * vw * sizeof(double));
+  if (!keys || !vals)
+    st = gr_set_error(s->ctx, GR_ERR_OUT_OF_MEMORY, "Out of host memory.");
+  for (size_t r = 0; st == GR_OK && r < vh;) {
+    if (!rows[r]) {
+      ++r;
+      continue;
+    }
+    size_t r1 = r;
+    while (r1 < vh && rows[r1])
+      ++r1;
+    size_t n = (r1 - r) * vw, at = r * vw;
+    st = gr_buffer_read(s->ctx, s->view, at * sizeof(cl_int), n * sizeof(cl_int), keys);
+    for (size_t t = 0; st == GR_OK && t < n; ++t)
+      vals[t] = (double)keys[t];
+    if (st == GR_OK)
+      st = gr_snac_allreduce(s, vals, n, GR_REDUCE_MAX);
+    for (size_t t = 0; st == GR_OK && t < n; ++t)
+      keys[t] = (cl_int)vals[t];
+    if (st == GR_OK)
+      st = gr_buffer_write(s->ctx, s->view, at * sizeof(cl_int), n * sizeof(cl_int), keys);
+    r = r1;
+  }
+  free(keys), free(vals);
+  return st;
+}
+
+/* Room for n values per mesh point or sample in s->o_surface. */
+static gr_status gr_snac_point_buffer(gr_snow_accumulation *s, size_t n) {
+  if (n <= s->o_surface_cap)
+    return GR_OK;
+  gr_buffer_release(&s->o_surface);
+  s->o_surface_cap = 0;
   gr_status st =
-      keys && v ? GR_OK : gr_set_error(s->ctx, GR_ERR_OUT_OF_MEMORY, "Out of host memory.");
+      gr_buffer_create(s->ctx, CL_MEM_READ_WRITE, n * sizeof(float), NULL, &s->o_surface);
   if (st == GR_OK)
-    st = gr_buffer_read(s->ctx, s->view, 0, n * sizeof(cl_int), keys);
-  for (size_t t = 0; st == GR_OK && t < n; ++t)
-    v[t] = (double)keys[t];
+    s->o_surface_cap = n;
+  return st;
+}
+
+/* The exposure of n mesh points (or samples) at pos, nrm in the pieces'
+ * combined view into s->o_surface: each piece's from its own view, the
+ * minimum over the pieces (snow_accumulation_object_exposure). Waits. */
+static gr_status gr_snac_object_exposure(gr_snow_accumulation *s, cl_mem pos, cl_mem nrm, cl_int nv,
+                                         const gr_snac_view *v, const float dir[3]) {
+  gr_status st = gr_snac_point_buffer(s, (size_t)nv);
+  if (st != GR_OK)
+    return st;
+  cl_int vw = v->vw, vh = v->vh;
+  const gr_snac_arg a[] = {GR_SNAC_MEM("pos", pos),
+                           GR_SNAC_MEM("nrm", nrm),
+                           GR_SNAC_VAL("nv", nv),
+                           GR_SNAC_VAL("dir_x", dir[0]),
+                           GR_SNAC_VAL("dir_y", dir[1]),
+                           GR_SNAC_VAL("dir_z", dir[2]),
+                           GR_SNAC_VAL("tau_x", v->tau_x),
+                           GR_SNAC_VAL("tau_y", v->tau_y),
+                           GR_SNAC_VAL("qx0", v->qx0),
+                           GR_SNAC_VAL("qy0", v->qy0),
+                           GR_SNAC_VAL("inv_texel", v->inv_texel),
+                           GR_SNAC_VAL("texel", v->texel),
+                           GR_SNAC_VAL("vw", vw),
+                           GR_SNAC_VAL("vh", vh),
+                           GR_SNAC_MEM("view", s->view),
+                           GR_SNAC_MEM("exposure", s->o_surface)};
+  st = gr_snac_args(s, s->object_exposure, a, sizeof(a) / sizeof(a[0]));
   if (st == GR_OK)
-    st = gr_snac_allreduce(s, v, n, GR_REDUCE_MAX);
-  for (size_t t = 0; st == GR_OK && t < n; ++t)
-    keys[t] = (cl_int)v[t];
+    st = gr_enqueue_1d(s->ctx, s->object_exposure, (size_t)nv);
+  float *f = malloc((size_t)nv * sizeof(float));
+  double *d = malloc((size_t)nv * sizeof(double));
+  if (st == GR_OK && (!f || !d))
+    st = gr_set_error(s->ctx, GR_ERR_OUT_OF_MEMORY, "Out of host memory.");
   if (st == GR_OK)
-    st = gr_buffer_write(s->ctx, s->view, 0, n * sizeof(cl_int), keys);
-  free(keys), free(v);
+    st = gr_buffer_read(s->ctx, s->o_surface, 0, (size_t)nv * sizeof(float), f);
+  for (cl_int k = 0; st == GR_OK && k < nv; ++k)
+    d[k] = -(double)f[k];
+  if (st == GR_OK)
+    st = gr_snac_allreduce(s, d, (size_t)nv, GR_REDUCE_MAX);
+  for (cl_int k = 0; st == GR_OK && k < nv; ++k)
+    f[k] = (float)-d[k];
+  if (st == GR_OK)
+    st = gr_buffer_write(s->ctx, s->o_surface, 0, (size_t)nv * sizeof(float), f);
+  free(f), free(d);
   return st;
 }
 
@@ -1592,16 +1755,9 @@ static gr_status gr_snac_view_reduce(gr_snow_accumulation *s, size_t n) {
  * allreduce the rest (snow_accumulation_object_surface). Waits. */
 static gr_status gr_snac_object_surface(gr_snow_accumulation *s, cl_mem pos, cl_mem nrm, cl_int nv,
                                         float texel) {
-  gr_status st = GR_OK;
-  if ((size_t)nv > s->o_surface_cap) {
-    gr_buffer_release(&s->o_surface);
-    s->o_surface_cap = 0;
-    st = gr_buffer_create(s->ctx, CL_MEM_READ_WRITE, (size_t)nv * sizeof(float), NULL,
-                          &s->o_surface);
-    if (st != GR_OK)
-      return st;
-    s->o_surface_cap = (size_t)nv;
-  }
+  gr_status st = gr_snac_point_buffer(s, (size_t)nv);
+  if (st != GR_OK)
+    return st;
   cl_int gnx = s->gnx, gny = s->gny, row0 = s->row0, own_lo = s->row0 + s->ring_s;
   cl_int own_hi = own_lo + s->own_ny - 1;
   float gdx = (float)s->grid.dx, gdy = (float)s->grid.dy, zref = (float)s->zref;
@@ -1798,8 +1954,9 @@ static gr_status gr_snac_step_impl(gr_snow_accumulation *s, double dt) {
   }
   /* A piece drew its own cells: the views' maximum over the pieces, texel
    * by texel, is the whole grid's view (see "Pieces" in the header). */
+  s->objects_by_point = 0;
   if (st == GR_OK && pieced && terrain_drawn)
-    st = gr_snac_view_reduce(s, (size_t)vw * (size_t)vh);
+    st = gr_snac_view_reduce(s, &v);
   if (st == GR_OK)
     st = gr_snac_mark(s, &s->tm.view_ms);
 
@@ -1946,10 +2103,16 @@ static gr_status gr_snac_step_impl(gr_snow_accumulation *s, double dt) {
      * needs it (no terrain in the view) comes from the pieces that hold
      * it. */
     cl_int have_surface = pieced && !terrain_drawn;
+    cl_int have_exposure = pieced && terrain_drawn && s->objects_by_point;
     if (have_surface)
       st = gr_snac_object_surface(s, *P, *N, nv, v.texel);
-    cl_mem surf = have_surface ? s->o_surface : s->ground;
+    if (have_exposure) {
+      const float dir[3] = {dir_x, dir_y, dir_z};
+      st = gr_snac_object_exposure(s, *P, *N, nv, &v, dir);
+    }
+    cl_mem surf = have_surface || have_exposure ? s->o_surface : s->ground;
     const gr_snac_arg ob2[] = {GR_SNAC_VAL("have_surface", have_surface),
+                               GR_SNAC_VAL("have_exposure", have_exposure),
                                GR_SNAC_MEM("surface", surf)};
     if (st == GR_OK)
       st = gr_snac_args(s, s->objects_k, ob, sizeof(ob) / sizeof(ob[0]));

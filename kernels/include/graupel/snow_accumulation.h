@@ -318,12 +318,25 @@ GR_API gr_status gr_snow_accumulation_reset(gr_snow_accumulation *s);
  * range reduced with GR_REDUCE_MAX), and the views are combined with
  * GR_REDUCE_MAX, texel by texel: the view keeps the highest crossing of
  * each texel, so the maximum over the pieces' views is the whole grid's
- * view, bit for bit, whatever the split. That costs a reduction of the
- * view (ExposureResolution^2 values, in calls of at most
- * GR_SNOW_ACCUMULATION_REDUCE_CHUNK) in the steps where the terrain is
- * drawn at all: where the surface rises slower than the snow falls (snow
- * straight down always) the view holds the objects alone, which every
- * piece draws the same, and nothing is reduced.
+ * view, bit for bit, whatever the split. Only the texels that can differ
+ * and are read are combined. A piece's cells, and its grid points' rays,
+ * fall in a band of view rows that its rows and the view box's heights
+ * bound; elsewhere its view holds the objects alone, the same on every
+ * piece. So the pieces agree (a GR_REDUCE_MAX of 2 values per view row:
+ * the highest and lowest piece whose band covers it) on the rows two or
+ * more bands cover, a band about as wide as the ring plus the relief times
+ * the snow's slope along y, and combine those rows alone (in calls of at
+ * most GR_SNOW_ACCUMULATION_REDUCE_CHUNK values); every other row a piece
+ * reads is already the maximum. The objects' points read rows anywhere:
+ * their exposure (a point is exposed when every piece's view leaves it
+ * exposed) is combined per mesh point and sample, GR_REDUCE_MAX of minus
+ * the exposure, or, where that is more values, the view rows under the
+ * objects are combined too. At 1024^2 with ExposureResolution 1024 and two
+ * pieces, graupel-bench's scene reduces about 0.37 MB a step per piece
+ * instead of the whole view's 8 MB. This happens in the steps where the
+ * terrain is drawn at all: where the surface rises slower than the snow
+ * falls (snow straight down always) the view holds the objects alone,
+ * which every piece draws the same, and nothing is reduced.
  *
  * Objects: every piece keeps every object and its snow (mesh points and
  * textures are small beside the grid), takes the same steps on them from
