@@ -680,7 +680,9 @@ rain_runoff_derive(__global const float *restrict h, __global const float *restr
  * rain_runoff_sw_edges (the rim's cells book the stage's edge flows).
  * Every face reads two cells either side of it, so a stage reads two cells
  * away and a step four: a piece's ring is GR_RAIN_RUNOFF_GHOST_SW cells and
- * the halo is exchanged once per step. Computing each face once instead of
+ * the halo is exchanged once per step. On GPUs the step is two launches
+ * instead (rain_runoff_sw_stage1, 2: the same functions, faces in local
+ * memory; see gr_sw_fused). Computing each face once instead of
  * in both its cells, and keeping <2 x float> values out of the kernels (see
  * gr_sw_pt, gr_sw_hll), made the step 4-6x faster on PoCL, the same floats. */
 
