@@ -2160,6 +2160,10 @@ static gr_flow_model piece_model = GR_FLOW_LOCAL_INERTIAL;
  * and an outfall north, inflows (piece_inflows) and two no-data holes
  * across the splits, outfalls; 0: every edge an outfall. */
 static int piece_edges = 0;
+/* The shallow-water step's launch path in the pieces tests
+ * (gr_rain_runoff_set_sw_fused): -1 the device's default, 0 the stages'
+ * separate launches, 1 one launch a stage (sw_pieces_paths). */
+static int piece_sw_fused = -1;
 
 static gr_rain_runoff_params piece_params(void) {
   gr_rain_runoff_params p = params_with(0.0, 0.0, GR_BOUNDARY_OPEN);
@@ -2279,6 +2283,8 @@ static int make_piece(piece *p, const domain *dm, const gr_rain_runoff_params *p
   }
   if (st == GR_OK)
     piece_inflows(p->s);
+  if (st == GR_OK && piece_sw_fused >= 0)
+    gr_rain_runoff_set_sw_fused(p->s, piece_sw_fused);
   return st == GR_OK;
 }
 
@@ -2288,6 +2294,8 @@ static gr_rain_runoff *make_whole(const domain *dm, const gr_rain_runoff_params 
   if (s) {
     CHECK(gr_rain_runoff_set_field(s, GR_FIELD_RAIN_RATE, dm->r) == GR_OK);
     CHECK(gr_rain_runoff_set_field(s, GR_FIELD_PERMEABILITY, dm->k) == GR_OK);
+    if (piece_sw_fused >= 0)
+      gr_rain_runoff_set_sw_fused(s, piece_sw_fused);
   }
   return s;
 }
@@ -3636,6 +3644,167 @@ static void test_sw_advance_pieces_edges_x(void) {
   run_with_edges(test_sw_advance_pieces_x);
 }
 
+/* The shallow-water pieces tests with each launch path forced (the fused
+ * stages read the ring through their tiles' halos), with every kind of edge
+ * and without: every owned cell of every field and the ledger bit for bit
+ * the whole grid's. */
+static void test_sw_pieces_paths(void) {
+  for (int f = 0; f < 2; ++f) {
+    piece_sw_fused = f;
+    printf("%s:\n", f ? "one launch a stage" : "separate launches");
+    test_sw_pieces_x();
+    run_with_edges(test_sw_pieces_y);
+    run_with_edges(test_sw_advance_pieces_x);
+  }
+  piece_sw_fused = -1;
+}
+
+/* The shallow-water step with each stage in one launch
+ * (gr_rain_runoff_set_sw_fused) gives the separate launches' bits: on a
+ * 75 x 41 grid (no multiple of any tile: partial tiles at the far edges),
+ * bumpy and tilted, (0) with a rain field, a permeability map, a Manning
+ * map, point inflows, no-data holes (outfalls, one across tile borders) and
+ * a level, a transmissive, a wall and an open edge with a hydrograph on the
+ * wall; (1) every edge open, a hyetograph and uniform inputs; (2)
+ * frictionless, walls, a transmissive north edge and no-data walls. After
+ * 300 steps the whole state (depth and its compensation, discharges,
+ * infiltration, outflow, inflow, flood maps) and the ledger are the same to
+ * the bit for the fused path with the device's tile, and for a run that
+ * switches between the paths every 30 steps with a tile of 8 x 4. A tile
+ * that is no tile, or larger than the device takes, is refused. */
+static void test_sw_fused(void) {
+  gr_grid g = {75, 41, 2.0, 1.5, 0.0, 0.0, 0, 0};
+  size_t n = cells_of(&g);
+  float *b = alloc_field(&g, 1), *r = alloc_field(&g, 1), *k = alloc_field(&g, 1);
+  float *d = alloc_field(&g, 1);
+  double *nmap = malloc(n * sizeof(double));
+  for (int j = 0; j < g.ny; ++j)
+    for (int i = 0; i < g.nx; ++i) {
+      size_t c = (size_t)j * g.nx + i;
+      double x = i * g.dx, y = j * g.dy;
+      b[c] =
+          (float)(0.03 * x + 0.02 * y + 0.4 * sin(x / 7.0) * cos(y / 5.0) + 0.2 * hash01(i, j, 71));
+      r[c] = (float)(4e-5 * hash01(i, j, 72));
+      k[c] = hash01(i, j, 73) < 0.5 ? 0.0f : (float)(4e-6 * hash01(i, j, 74));
+      d[c] = (float)(0.08 * hash01(i, j, 75));
+      nmap[c] = 0.02 + 0.05 * hash01(i, j, 76);
+      int hole_a = i >= 58 && i < 66 && j >= 11 && j < 18; /* across tiles' corners */
+      int hole_b = i >= 20 && i < 23 && j >= 30 && j < 33;
+      if (hole_a || hole_b)
+        b[c] = NAN;
+    }
+  const double ht[3] = {0.0, 30.0, 90.0}, hq[3] = {0.0, 0.5, 0.1};
+  const double hyt[3] = {0.0, 40.0, 200.0}, hyr[3] = {1e-5, 6e-5, 2e-5};
+  const int ij[4] = {37, 20, 5, 38};
+  const double pq[2] = {0.05, 0.02};
+  for (int config = 0; config < 3; ++config) {
+    gr_rain_runoff_params p = params_with(0.0, 0.0, GR_BOUNDARY_OPEN);
+    p.flow_model = GR_FLOW_SHALLOW_WATER;
+    if (config == 0) {
+      p.boundary[GR_RAIN_RUNOFF_WEST] = GR_BOUNDARY_LEVEL;
+      p.boundary_level[GR_RAIN_RUNOFF_WEST] = 0.5;
+      p.boundary[GR_RAIN_RUNOFF_EAST] = GR_BOUNDARY_TRANSMISSIVE;
+      p.boundary[GR_RAIN_RUNOFF_SOUTH] = GR_BOUNDARY_CLOSED;
+      p.no_data = GR_BOUNDARY_OPEN;
+    } else if (config == 1) {
+      p.permeability = 2e-6;
+    } else {
+      set_edges(&p, GR_BOUNDARY_CLOSED);
+      p.boundary[GR_RAIN_RUNOFF_NORTH] = GR_BOUNDARY_TRANSMISSIVE;
+      p.no_data = GR_BOUNDARY_CLOSED;
+      p.manning_n = 0.0;
+    }
+    gr_rain_runoff *sim[3] = {NULL, NULL, NULL};
+    for (int v = 0; v < 3; ++v) {
+      sim[v] = make_sim(&g, &p, b, d);
+      if (!sim[v])
+        continue;
+      gr_rain_runoff_set_sw_fused(sim[v], v != 0);
+      if (v == 2)
+        CHECK_MSG(gr_rain_runoff_set_sw_tile(sim[v], 8, 4) == GR_OK, "tile 8 x 4: %s",
+                  gr_rain_runoff_last_error(sim[v]));
+      if (config != 1) {
+        CHECK(gr_rain_runoff_set_field(sim[v], GR_FIELD_RAIN_RATE, r) == GR_OK);
+        CHECK(gr_rain_runoff_set_field(sim[v], GR_FIELD_PERMEABILITY, k) == GR_OK);
+        CHECK(gr_rain_runoff_set_point_inflows(sim[v], ij, pq, 2) == GR_OK);
+      }
+      if (config == 0) {
+        CHECK(gr_rain_runoff_set_manning_map(sim[v], nmap) == GR_OK);
+        CHECK(gr_rain_runoff_set_edge_inflow(sim[v], GR_RAIN_RUNOFF_SOUTH, ht, hq, 3) == GR_OK);
+      }
+      if (config == 1)
+        CHECK(gr_rain_runoff_set_hyetograph(sim[v], hyt, hyr, 3) == GR_OK);
+    }
+    if (!sim[0] || !sim[1] || !sim[2]) {
+      for (int v = 0; v < 3; ++v)
+        gr_rain_runoff_destroy(sim[v]);
+      continue;
+    }
+    for (int chunk = 0; chunk < 10; ++chunk) {
+      gr_rain_runoff_set_sw_fused(sim[2], chunk % 2 == 0);
+      for (int v = 0; v < 3; ++v)
+        run_stable(sim[v], 1, 30);
+    }
+    size_t bytes = 0;
+    CHECK(gr_rain_runoff_state_size(sim[0], &bytes) == GR_OK && bytes > 0);
+    unsigned char *st[3];
+    for (int v = 0; v < 3; ++v) {
+      st[v] = calloc(bytes ? bytes : 1, 1);
+      CHECK(gr_rain_runoff_state_save(sim[v], st[v], bytes) == GR_OK);
+    }
+    long diff[2] = {0, 0};
+    for (int v = 1; v < 3; ++v)
+      for (size_t q = 0; q + 4 <= bytes; q += 4)
+        diff[v - 1] += memcmp(st[0] + q, st[v] + q, 4) != 0;
+    gr_rain_runoff_ledger l0 = ledger(sim[0]), l1 = ledger(sim[1]), l2 = ledger(sim[2]);
+    int same_ledger = memcmp(&l0, &l1, sizeof(l0)) == 0 && memcmp(&l2, &l0, sizeof(l0)) == 0;
+    CHECK_MSG(diff[0] == 0 && diff[1] == 0 && same_ledger,
+              "config %d: %ld (fused) and %ld (switching) words of the state of %zu bytes differ "
+              "from the separate launches'; ledgers %s",
+              config, diff[0], diff[1], bytes, same_ledger ? "agree" : "differ");
+    /* Water moved and left (or, walled in, came in through the north edge
+     * or from the inflows): the comparison is of a flow, not of still water. */
+    float *speed = get_map(sim[0], &g, GR_RAIN_RUNOFF_MAX_SPEED);
+    double vmax = 0.0;
+    for (size_t c = 0; c < n; ++c)
+      vmax = isnan(speed[c]) ? vmax : fmax(vmax, speed[c]);
+    CHECK_MSG(l0.steps == 300 && l0.outflow_volume + l0.inflow_volume > 1.0 && vmax > 0.05,
+              "config %d: %lld steps, outflow %g m^3, inflow %g m^3, fastest %g m/s", config,
+              l0.steps, l0.outflow_volume, l0.inflow_volume, vmax);
+    CHECK(fabs(l0.balance_error) < 1e-6 * (l0.rain_volume + l0.inflow_volume + l0.initial_volume));
+    printf("config %d: after %lld steps %ld words of %zu differ (fused), %ld (switching, tile 8 x "
+           "4); outflow %.4f m^3, inflow %.4f m^3, fastest %.3f m/s\n",
+           config, l0.steps, diff[0], bytes / 4, diff[1], l0.outflow_volume, l0.inflow_volume,
+           vmax);
+    if (config == 0) {
+      /* Tiles that are none, or too large for any device, are refused and
+       * the tile kept (the run above is unchanged by the attempt). */
+      const int bad[3][2] = {{0, 4}, {-8, 8}, {4096, 4096}};
+      for (int t = 0; t < 3; ++t) {
+        gr_status e = gr_rain_runoff_set_sw_tile(sim[1], bad[t][0], bad[t][1]);
+        const char *msg = gr_rain_runoff_last_error(sim[1]);
+        CHECK_MSG(e == GR_ERR_INVALID_ARGUMENT && strstr(msg, "tile") != NULL,
+                  "tile %d x %d: status %d, '%s'", bad[t][0], bad[t][1], (int)e, msg);
+      }
+      run_stable(sim[1], 1, 2);
+      run_stable(sim[0], 1, 2);
+      CHECK(gr_rain_runoff_state_save(sim[0], st[0], bytes) == GR_OK);
+      CHECK(gr_rain_runoff_state_save(sim[1], st[1], bytes) == GR_OK);
+      CHECK(memcmp(st[0], st[1], bytes) == 0);
+    }
+    free(speed);
+    for (int v = 0; v < 3; ++v) {
+      free(st[v]);
+      gr_rain_runoff_destroy(sim[v]);
+    }
+  }
+  free(b);
+  free(r);
+  free(k);
+  free(d);
+  free(nmap);
+}
+
 /* ------------------------------------------------ boundaries per edge */
 
 static const char *const model_names[2] = {"shallow water", "local inertial"};
@@ -4327,6 +4496,8 @@ static const gr_subtest tests[] = {
     {"sw_pieces_edges_x", test_sw_pieces_edges_x, 0},
     {"sw_pieces_edges_y", test_sw_pieces_edges_y, 0},
     {"sw_advance_pieces_edges_x", test_sw_advance_pieces_edges_x, 0},
+    {"sw_fused", test_sw_fused, 0},
+    {"sw_pieces_paths", test_sw_pieces_paths, 0},
     {"inflow_point", test_inflow_point, 0},
     {"inflow_edge", test_inflow_edge, 0},
     {"inflow_errors", test_inflow_errors, 0},

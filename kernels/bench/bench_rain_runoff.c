@@ -3,7 +3,10 @@
  * that every face flows from the first step, 50 mm/h of rain, 5 mm/h of
  * infiltration, an open boundary; a fixed stable step taken once at set-up.
  * The local inertial model, as the earlier figures in RESULTS.md;
- * GRAUPEL_BENCH_FLOW_MODEL=0 benchmarks the shallow-water model. */
+ * GRAUPEL_BENCH_FLOW_MODEL=0 benchmarks the shallow-water model;
+ * GRAUPEL_BENCH_SW_FUSED=0/1 forces its stages' separate launches or one
+ * launch each (gr_rain_runoff_set_sw_fused), GRAUPEL_BENCH_SW_TILE=TXxTY
+ * the fused stages' tile (gr_rain_runoff_set_sw_tile). */
 #include "bench.h"
 
 #include <math.h>
@@ -77,6 +80,15 @@ static gr_status rain_runoff_setup_piece(gr_context *ctx, int n, int j0, int ny,
     gr_rain_runoff_set_allreduce(r->sim, link->allreduce, link->allreduce_user);
     gr_rain_runoff_set_halo_exchange(r->sim, link->exchange, link->exchange_user);
   }
+  /* The shallow-water step's launch path and tile, when asked for (the
+   * device's defaults without them). */
+  const char *sw_fused = getenv("GRAUPEL_BENCH_SW_FUSED"),
+             *sw_tile = getenv("GRAUPEL_BENCH_SW_TILE");
+  if (st == GR_OK && sw_fused && *sw_fused)
+    gr_rain_runoff_set_sw_fused(r->sim, atoi(sw_fused));
+  int tx = 0, ty = 0;
+  if (st == GR_OK && sw_tile && sscanf(sw_tile, "%dx%d", &tx, &ty) == 2)
+    st = gr_rain_runoff_set_sw_tile(r->sim, tx, ty);
   if (st == GR_OK)
     st = gr_rain_runoff_set_field(r->sim, GR_FIELD_ELEVATION, b);
   if (st == GR_OK)

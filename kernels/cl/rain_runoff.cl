@@ -680,7 +680,9 @@ rain_runoff_derive(__global const float *restrict h, __global const float *restr
  * rain_runoff_sw_edges (the rim's cells book the stage's edge flows).
  * Every face reads two cells either side of it, so a stage reads two cells
  * away and a step four: a piece's ring is GR_RAIN_RUNOFF_GHOST_SW cells and
- * the halo is exchanged once per step. Computing each face once instead of
+ * the halo is exchanged once per step. On GPUs the step is two launches
+ * instead (rain_runoff_sw_stage1, 2: the same functions, faces in local
+ * memory; see gr_sw_fused). Computing each face once instead of
  * in both its cells, and keeping <2 x float> values out of the kernels (see
  * gr_sw_pt, gr_sw_hll), made the step 4-6x faster on PoCL, the same floats. */
 
@@ -908,16 +910,16 @@ GR_INLINE void gr_sw_continue(gr_sw_pt *q0, gr_sw_pt *q1, gr_sw_pt *q2, gr_sw_pt
 /* Face k of a line of n cells (between cells k - 1 and k; 0 and n are the
  * grid's edge faces), from the cells k - 2 .. k + 1: the depth flux fh,
  * the normal momentum flux as seen by the low cell (fmL) and by the high
- * cell (fmR) (gr_sw_face), and the tangential flux ft, written to out[f]
- * and the three planes after it (plane floats apart). kind_lo, kind_hi, lvl_lo, lvl_hi: the kinds
+ * cell (fmR) (gr_sw_face), and the tangential flux ft. kind_lo, kind_hi, lvl_lo, lvl_hi: the kinds
  * and levels of the line's low and high edges. A transmissive edge continues the line
  * (gr_sw_continue), so its face is computed as an inner one; the other
  * edges' faces have a ghost (gr_sw_ghost): a wall passes no water, an open
  * edge only outflow, a level edge both ways. Each face is computed once per
- * stage and read by the two cells that share it (rain_runoff_sw_update*). */
-GR_INLINE void gr_sw_line_face(gr_sw_pt q0, gr_sw_pt q1, gr_sw_pt q2, gr_sw_pt q3, int k, int n,
+ * stage and read by the two cells that share it (rain_runoff_sw_update*,
+ * or within a work-group's tile: rain_runoff_sw_stage*). */
+GR_INLINE void gr_sw_line_flux(gr_sw_pt q0, gr_sw_pt q1, gr_sw_pt q2, gr_sw_pt q3, int k, int n,
                                int kind_lo, int kind_hi, float lvl_lo, float lvl_hi, float g,
-                               __global float *restrict out, int f, int plane) {
+                               float *out_fh, float *out_fmL, float *out_fmR, float *out_ft) {
   bool tlo = kind_lo == GR_RAIN_RUNOFF_B_TRANSMISSIVE,
        thi = kind_hi == GR_RAIN_RUNOFF_B_TRANSMISSIVE;
   gr_sw_continue(&q0, &q1, &q2, &q3, k, n, tlo, thi);
@@ -945,6 +947,19 @@ GR_INLINE void gr_sw_line_face(gr_sw_pt q0, gr_sw_pt q1, gr_sw_pt q2, gr_sw_pt q
   bool stop = stop_lo || stop_hi;
   fh = stop ? 0.0f : fh;
   ft = stop ? 0.0f : ft;
+  *out_fh = fh;
+  *out_fmL = fmL;
+  *out_fmR = fmR;
+  *out_ft = ft;
+}
+
+/* gr_sw_line_flux's four values written to out[f] and the three planes
+ * after it (plane floats apart). */
+GR_INLINE void gr_sw_line_face(gr_sw_pt q0, gr_sw_pt q1, gr_sw_pt q2, gr_sw_pt q3, int k, int n,
+                               int kind_lo, int kind_hi, float lvl_lo, float lvl_hi, float g,
+                               __global float *restrict out, int f, int plane) {
+  float fh, fmL, fmR, ft;
+  gr_sw_line_flux(q0, q1, q2, q3, k, n, kind_lo, kind_hi, lvl_lo, lvl_hi, g, &fh, &fmL, &fmR, &ft);
   out[f] = fh;
   out[f + plane] = fmL;
   out[f + 2 * plane] = fmR;
@@ -952,14 +967,13 @@ GR_INLINE void gr_sw_line_face(gr_sw_pt q0, gr_sw_pt q1, gr_sw_pt q2, gr_sw_pt q
 }
 
 /* The flux balance of cell i (p2, between p1 and p3) of a line of n cells
- * along one axis, from its low face lo and high face hi in f (planes of
- * gr_sw_line_face, plane floats apart):
+ * along one axis, from its low face's fh, fmR, ft and its high face's fh,
+ * fmL, ft (gr_sw_line_flux):
  * dh (mass in minus out), dqn and dqt (momentum, with the bed's source),
  * per unit of the axis' face length. */
-GR_INLINE void gr_sw_balance(gr_sw_pt p1, gr_sw_pt p2, gr_sw_pt p3,
-                             __global const float *restrict f, int lo, int hi, int plane, int i,
-                             int n, int kind_lo, int kind_hi, float g, float *dh, float *dqn,
-                             float *dqt) {
+GR_INLINE void gr_sw_balance(gr_sw_pt p1, gr_sw_pt p2, gr_sw_pt p3, float fh_lo, float fmR_lo,
+                             float ft_lo, float fh_hi, float fmL_hi, float ft_hi, int i, int n,
+                             int kind_lo, int kind_hi, float g, float *dh, float *dqn, float *dqt) {
   bool tlo = kind_lo == GR_RAIN_RUNOFF_B_TRANSMISSIVE,
        thi = kind_hi == GR_RAIN_RUNOFF_B_TRANSMISSIVE;
   if (tlo || thi) {
@@ -969,13 +983,12 @@ GR_INLINE void gr_sw_balance(gr_sw_pt p1, gr_sw_pt p2, gr_sw_pt p3,
     p3 = gr_sw_pick_pt(thi && i == n - 1, gr_sw_extend(p2, in_hi, 1.0f), p3);
   }
   gr_sw_cell C = gr_sw_recon(p1, p2, p3, (i > 0 || tlo) && (i < n - 1 || thi));
-  float fh_lo = f[lo], fh_hi = f[hi];
   float hw = C.h - 0.5f * C.sh, he = C.h + 0.5f * C.sh;
   *dh = fh_lo - fh_hi;
   /* (fmw + g hw^2 / 2) - (fme + g he^2 / 2) - g (hw + he) / 2 (bed slope)
    * = fmw - fme - g (hw + he) / 2 (surface slope). */
-  *dqn = (f[lo + 2 * plane] - f[hi + plane]) - 0.5f * g * (hw + he) * C.se;
-  *dqt = f[lo + 3 * plane] - f[hi + 3 * plane];
+  *dqn = (fmR_lo - fmL_hi) - 0.5f * g * (hw + he) * C.se;
+  *dqt = ft_lo - ft_hi;
 }
 /* Manning friction on the discharge (qx, qy) of water h deep over dt,
  * implicit in the new discharge: |q'| (1 + g dt n^2 |q'| / h^(7/3)) = |q|,
@@ -1104,44 +1117,52 @@ __kernel void rain_runoff_sw_faces2(GR_SW_STEP_ARGS) {
  *            h, qu, qv (each cell reads its own old values only), with the
  *            infiltration and half of each stage's edge outflow booked in
  *            Kahan sums. */
-GR_INLINE void gr_sw_update(
-    __global float *restrict h, __global float *restrict qu, __global float *restrict qv,
-    __global float *restrict h_comp, __global float *restrict h1, __global float *restrict qu1,
-    __global float *restrict qv1, __global float *restrict dh1, __global float *restrict u1,
-    __global float *restrict v1, __global const float *restrict fx,
-    __global const float *restrict fy, __global const float *restrict b,
-    __global const float *restrict rain, __global const float *restrict perm,
-    __global const float *restrict src, int use_src, __global const float *restrict nodata,
-    int use_nodata, __global float *restrict infiltrated, __global float *restrict infiltrated_comp,
-    __global float *restrict outflow, __global float *restrict outflow_comp,
-    __global float *restrict inflow, __global float *restrict inflow_comp, int nx, int ny, float dt,
-    float inv_dx, float inv_dy, float g, float n2, __global const float *restrict n2map, int use_n2,
-    int use_rain, float rain_uniform, int use_perm, float perm_uniform, int bnd_w, int bnd_e,
-    int bnd_s, int bnd_n, GR_RAIN_RUNOFF_MAP_ARGS, float map_time,
-    __global const float *restrict ph, __global const float *restrict pu,
-    __global const float *restrict pv, __global const float *restrict su,
-    __global const float *restrict sv, const int stage) {
-  int i = get_global_id(0), j = get_global_id(1);
-  if (!gr_inside(i, j, nx, ny))
-    return;
+/* The arguments of a stage's cell update (gr_sw_update_cell), the state,
+ * the stage and the ledger of GR_SW_STEP_ARGS. */
+#define GR_SW_CELL_ARGS                                                                            \
+  __global float *restrict h, __global float *restrict qu, __global float *restrict qv,            \
+      __global float *restrict h_comp, __global float *restrict h1, __global float *restrict qu1,  \
+      __global float *restrict qv1, __global float *restrict dh1, __global float *restrict u1,     \
+      __global float *restrict v1, __global const float *restrict b,                               \
+      __global const float *restrict rain, __global const float *restrict perm,                    \
+      __global const float *restrict src, int use_src, __global const float *restrict nodata,      \
+      int use_nodata, __global float *restrict infiltrated,                                        \
+      __global float *restrict infiltrated_comp, __global float *restrict outflow,                 \
+      __global float *restrict outflow_comp, __global float *restrict inflow,                      \
+      __global float *restrict inflow_comp, int nx, int ny, float dt, float inv_dx, float inv_dy,  \
+      float g, float n2, __global const float *restrict n2map, int use_n2, int use_rain,           \
+      float rain_uniform, int use_perm, float perm_uniform, int bnd_w, int bnd_e, int bnd_s,       \
+      int bnd_n, GR_RAIN_RUNOFF_MAP_ARGS, float map_time
+#define GR_SW_CELL_PASS                                                                            \
+  h, qu, qv, h_comp, h1, qu1, qv1, dh1, u1, v1, b, rain, perm, src, use_src, nodata, use_nodata,   \
+      infiltrated, infiltrated_comp, outflow, outflow_comp, inflow, inflow_comp, nx, ny, dt,       \
+      inv_dx, inv_dy, g, n2, n2map, use_n2, use_rain, rain_uniform, use_perm, perm_uniform, bnd_w, \
+      bnd_e, bnd_s, bnd_n, max_depth, max_speed, arrival, wet_time, wet_time_comp, max_hazard,     \
+      wetting_depth, debris_factor, map_time
+
+/* Cell (i, j)'s update in a stage (see gr_sw_update) from its points and
+ * its neighbours' along x (x1, x2, x3) and y (y1, y3), its four faces'
+ * values as gr_sw_balance takes them (west, east, south, north) and its
+ * momenta before the stage (suc, svc; stage 2's, stage 1 takes the wet
+ * ones); with velocities, stage 1 also writes U1's velocities u1, v1. Both
+ * launch paths call it, so they give the same floats. */
+GR_INLINE void gr_sw_update_cell(GR_SW_CELL_ARGS, int i, int j, gr_sw_pt x1, gr_sw_pt x2,
+                                 gr_sw_pt x3, gr_sw_pt y1, gr_sw_pt y3, float fh_w, float fm_w,
+                                 float ft_w, float fh_e, float fm_e, float ft_e, float fh_s,
+                                 float fm_s, float ft_s, float fh_n, float fm_n, float ft_n,
+                                 float suc, float svc, const int stage, const int velocities) {
   int c = gr_idx(i, j, nx);
   float n2c = use_n2 ? n2map[c] : n2; /* the cell's own roughness, n^2 */
-  gr_sw_pt x1 = gr_sw_point(ph, pu, pv, b, i >= 1, c - 1);
-  gr_sw_pt x2 = gr_sw_point(ph, pu, pv, b, true, c);
-  gr_sw_pt x3 = gr_sw_point(ph, pu, pv, b, i + 1 < nx, c + 1);
-  gr_sw_pt y1 = gr_sw_point(ph, pv, pu, b, j >= 1, c - nx);
-  gr_sw_pt y3 = gr_sw_point(ph, pv, pu, b, j + 1 < ny, c + nx);
   gr_sw_pt y2 = {x2.h, x2.b, x2.ut, x2.un, 0.0f};
   float dhx, dqx_x, dqy_x, dhy, dqy_y, dqx_y;
-  int f = j * (nx + 1) + i;
-  gr_sw_balance(x1, x2, x3, fx, f, f + 1, (nx + 1) * ny, i, nx, bnd_w, bnd_e, g, &dhx, &dqx_x,
-                &dqy_x);
-  gr_sw_balance(y1, y2, y3, fy, c, c + nx, nx * (ny + 1), j, ny, bnd_s, bnd_n, g, &dhy, &dqy_y,
-                &dqx_y);
+  gr_sw_balance(x1, x2, x3, fh_w, fm_w, ft_w, fh_e, fm_e, ft_e, i, nx, bnd_w, bnd_e, g, &dhx,
+                &dqx_x, &dqy_x);
+  gr_sw_balance(y1, y2, y3, fh_s, fm_s, ft_s, fh_n, fm_n, ft_n, j, ny, bnd_s, bnd_n, g, &dhy,
+                &dqy_y, &dqx_y);
   float dh = dt * (dhx * inv_dx + dhy * inv_dy);
   float hn = x2.h + dh;
-  float qun = su[c] + dt * (dqx_x * inv_dx + dqx_y * inv_dy);
-  float qvn = sv[c] + dt * (dqy_x * inv_dx + dqy_y * inv_dy);
+  float qun = suc + dt * (dqx_x * inv_dx + dqx_y * inv_dy);
+  float qvn = svc + dt * (dqy_x * inv_dx + dqy_y * inv_dy);
   if (stage == 1) {
     /* su, sv are the momenta before rain: take the wet ones. */
     float r = GR_RAIN_RUNOFF_RAIN(c);
@@ -1158,8 +1179,12 @@ GR_INLINE void gr_sw_update(
     dh1[c] = dh;
     qu1[c] = qus;
     qv1[c] = qvs;
-    u1[c] = gr_sw_velocity(hs, qus);
-    v1[c] = gr_sw_velocity(hs, qvs);
+    /* The fused path computes them again from h1, qu1, qv1 (the same
+     * floats) instead of reading them. */
+    if (velocities) {
+      u1[c] = gr_sw_velocity(hs, qus);
+      v1[c] = gr_sw_velocity(hs, qvs);
+    }
   } else {
     float h0 = h[c];
     float r = GR_RAIN_RUNOFF_RAIN(c);
@@ -1196,27 +1221,43 @@ GR_INLINE void gr_sw_update(
     if (sc != 0.0f)
       gr_kahan_add(inflow, inflow_comp, c, sc * dt);
   }
-  /* Half of each stage's edge flows (Heun's average) are booked by
-   * rain_runoff_sw_edges after this launch: here, their sums paired into
-   * <2 x float> values kept CPU compilers from vectorising the update. */
+  /* Half of each stage's edge flows (Heun's average) are booked after
+   * this (rain_runoff_sw_edges after the launch; in the fused stages by the
+   * same work-item): here, their sums paired into <2 x float> values kept
+   * CPU compilers from vectorising the update. */
+}
+
+GR_INLINE void gr_sw_update(GR_SW_CELL_ARGS, __global const float *restrict fx,
+                            __global const float *restrict fy, __global const float *restrict ph,
+                            __global const float *restrict pu, __global const float *restrict pv,
+                            __global const float *restrict su, __global const float *restrict sv,
+                            const int stage) {
+  int i = get_global_id(0), j = get_global_id(1);
+  if (!gr_inside(i, j, nx, ny))
+    return;
+  int c = gr_idx(i, j, nx);
+  gr_sw_pt x1 = gr_sw_point(ph, pu, pv, b, i >= 1, c - 1);
+  gr_sw_pt x2 = gr_sw_point(ph, pu, pv, b, true, c);
+  gr_sw_pt x3 = gr_sw_point(ph, pu, pv, b, i + 1 < nx, c + 1);
+  gr_sw_pt y1 = gr_sw_point(ph, pv, pu, b, j >= 1, c - nx);
+  gr_sw_pt y3 = gr_sw_point(ph, pv, pu, b, j + 1 < ny, c + nx);
+  /* The planes of gr_sw_line_face: fh, fmL, fmR, ft. */
+  int f = j * (nx + 1) + i, px = (nx + 1) * ny, py = nx * (ny + 1);
+  gr_sw_update_cell(GR_SW_CELL_PASS, i, j, x1, x2, x3, y1, y3, fx[f], fx[f + 2 * px],
+                    fx[f + 3 * px], fx[f + 1], fx[f + 1 + px], fx[f + 1 + 3 * px], fy[c],
+                    fy[c + 2 * py], fy[c + 3 * py], fy[c + nx], fy[c + nx + py],
+                    fy[c + nx + 3 * py], su[c], sv[c], stage, 1);
 }
 
 /* The two stages' updates as two kernels, each reading one state and
  * writing another that the compiler can tell apart (a pointer chosen at
  * run time between them kept PoCL from vectorising across work-items). */
-#define GR_SW_UPDATE_PASS                                                                          \
-  h, qu, qv, h_comp, h1, qu1, qv1, dh1, u1, v1, fx, fy, b, rain, perm, src, use_src, nodata,       \
-      use_nodata, infiltrated, infiltrated_comp, outflow, outflow_comp, inflow, inflow_comp, nx,   \
-      ny, dt, inv_dx, inv_dy, g, n2, n2map, use_n2, use_rain, rain_uniform, use_perm,              \
-      perm_uniform, bnd_w, bnd_e, bnd_s, bnd_n, max_depth, max_speed, arrival, wet_time,           \
-      wet_time_comp, max_hazard, wetting_depth, debris_factor, map_time
-
 __kernel void rain_runoff_sw_update1(GR_SW_STEP_ARGS) {
-  gr_sw_update(GR_SW_UPDATE_PASS, wh, wu, wv, qu, qv, 1);
+  gr_sw_update(GR_SW_CELL_PASS, fx, fy, wh, wu, wv, qu, qv, 1);
 }
 
 __kernel void rain_runoff_sw_update2(GR_SW_STEP_ARGS) {
-  gr_sw_update(GR_SW_UPDATE_PASS, h1, u1, v1, qu1, qv1, 2);
+  gr_sw_update(GR_SW_CELL_PASS, fx, fy, h1, u1, v1, qu1, qv1, 2);
 }
 
 /* Half of a stage's flows through the domain's edges (Heun's average),
@@ -1244,6 +1285,137 @@ __kernel void rain_runoff_sw_edges(GR_SW_STEP_ARGS) {
   gr_rain_runoff_book_edges(outflow, outflow_comp, inflow, inflow_comp, c, 0.5f * dt, inv_dx,
                             inv_dy, olx, ohx, oly, ohy);
 }
+
+/* ------------------------------------- shallow water, one launch a stage
+ *
+ * The fused path (gr_rain_runoff_set_sw_fused): each stage of Heun's method
+ * in one launch, rain_runoff_sw_stage1 and rain_runoff_sw_stage2, in place
+ * of sw_prep, faces, update and edges, with the same inline functions on
+ * the same floats, so the same bits. A work-group owns a tile of
+ * get_local_size(0) x get_local_size(1) cells: it gathers the stage's points
+ * of the tile and two cells either side of it (the limited reconstruction's
+ * reach; the corners are not needed) into local memory (stage 1 makes them
+ * from the state, rain and infiltration as sw_prep does; stage 2 from h1,
+ * qu1, qv1, the velocities as stage 1 would have stored them), computes its
+ * tile's faces there (each face once: an x-face and a y-face per cell, one
+ * more column and row), then updates its cells and books the rim's edge
+ * flows. Points and faces never go to global memory: per cell a step reads
+ * the state, bed and stage (h, qu, qv, b; h1, qu1, qv1, dh1, h_comp) and
+ * writes the stage and the state. The local array `tile` holds four planes
+ * of points ((tx + 4) (ty + 4) each: h, b, u, v) and four of x-faces
+ * ((tx + 1) ty) and y-faces (tx (ty + 1)): fh, fmL, fmR, ft. */
+
+/* Point p of the tile as a line's point along x (normal u) or y (normal v). */
+GR_INLINE gr_sw_pt gr_sw_tile_pt(__local const float *restrict th, __local const float *restrict tb,
+                                 __local const float *restrict tn, __local const float *restrict tt,
+                                 int p) {
+  gr_sw_pt q;
+  q.h = th[p];
+  q.b = tb[p];
+  q.un = tn[p];
+  q.ut = tt[p];
+  q.abi = 0.0f;
+  return q;
+}
+
+GR_INLINE void gr_sw_fused(GR_SW_CELL_ARGS, float lvl_w, float lvl_e, float lvl_s, float lvl_n,
+                           __local float *restrict tile, const int stage) {
+  int lx = get_local_id(0), ly = get_local_id(1);
+  int tx = get_local_size(0), ty = get_local_size(1);
+  int i0 = get_group_id(0) * tx, j0 = get_group_id(1) * ty;
+  int i = i0 + lx, j = j0 + ly, lid = ly * tx + lx, wg = tx * ty;
+  int pw = tx + 4, np = pw * (ty + 4), nfx = (tx + 1) * ty, nfy = tx * (ty + 1);
+  __local float *th = tile, *tb = th + np, *tu = tb + np, *tv = tu + np;
+  __local float *xh = tv + np, *xl = xh + nfx, *xr = xl + nfx, *xt = xr + nfx;
+  __local float *yh = xt + nfx, *yl = yh + nfy, *yr = yl + nfy, *yt = yr + nfy;
+  /* The points: 0 beyond the local array, as gr_sw_point masks them. */
+  for (int t = lid; t < np; t += wg) {
+    int a = t % pw, e = t / pw, pi = i0 - 2 + a, pj = j0 - 2 + e;
+    bool corner = (a < 2 || a >= tx + 2) && (e < 2 || e >= ty + 2);
+    bool in = !corner && pi >= 0 && pi < nx && pj >= 0 && pj < ny;
+    float ph = 0.0f, pb = 0.0f, pu = 0.0f, pv = 0.0f;
+    if (in) {
+      int q = pj * nx + pi;
+      pb = b[q];
+      if (stage == 1) {
+        /* rain_runoff_sw_prep's points. */
+        float h0 = h[q], r = GR_RAIN_RUNOFF_RAIN(q), k = GR_RAIN_RUNOFF_PERM(q);
+        float sc = GR_RAIN_RUNOFF_SRC(q);
+        float hw = gr_rain_runoff_wet(h0, r, sc, k, dt);
+        ph = hw;
+        pu = gr_sw_velocity(hw, gr_sw_wet_q(h0, qu[q], r, sc, dt, hw));
+        pv = gr_sw_velocity(hw, gr_sw_wet_q(h0, qv[q], r, sc, dt, hw));
+      } else {
+        /* Stage 1's u1, v1. */
+        ph = h1[q];
+        pu = gr_sw_velocity(ph, qu1[q]);
+        pv = gr_sw_velocity(ph, qv1[q]);
+      }
+    }
+    th[t] = ph;
+    tb[t] = pb;
+    tu[t] = pu;
+    tv[t] = pv;
+  }
+  barrier(CLK_LOCAL_MEM_FENCE);
+  /* The tile's faces, x-faces then y-faces in one index space: one call
+   * of the face's expression, its inputs selected. A face beyond the local
+   * array's is computed from zeros and never read. */
+  for (int t = lid; t < nfx + nfy; t += wg) {
+    bool xs = t < nfx;
+    int u = xs ? t : t - nfx, w = xs ? tx + 1 : tx;
+    int a = u % w, e = u / w;
+    int p = (e + 2) * pw + a + 2, step = xs ? 1 : pw; /* the high cell's point */
+    __local const float *tn = xs ? tu : tv, *tt = xs ? tv : tu;
+    gr_sw_pt q0 = gr_sw_tile_pt(th, tb, tn, tt, p - 2 * step);
+    gr_sw_pt q1 = gr_sw_tile_pt(th, tb, tn, tt, p - step);
+    gr_sw_pt q2 = gr_sw_tile_pt(th, tb, tn, tt, p);
+    gr_sw_pt q3 = gr_sw_tile_pt(th, tb, tn, tt, p + step);
+    float fh, fmL, fmR, ft;
+    gr_sw_line_flux(q0, q1, q2, q3, xs ? i0 + a : j0 + e, xs ? nx : ny, xs ? bnd_w : bnd_s,
+                    xs ? bnd_e : bnd_n, xs ? lvl_w : lvl_s, xs ? lvl_e : lvl_n, g, &fh, &fmL, &fmR,
+                    &ft);
+    __local float *oh = xs ? xh : yh, *ol = xs ? xl : yl, *orr = xs ? xr : yr, *ot = xs ? xt : yt;
+    oh[u] = fh;
+    ol[u] = fmL;
+    orr[u] = fmR;
+    ot[u] = ft;
+  }
+  barrier(CLK_LOCAL_MEM_FENCE);
+  if (i >= nx || j >= ny)
+    return;
+  int c = gr_idx(i, j, nx), p = (ly + 2) * pw + lx + 2;
+  gr_sw_pt x1 = gr_sw_tile_pt(th, tb, tu, tv, p - 1);
+  gr_sw_pt x2 = gr_sw_tile_pt(th, tb, tu, tv, p);
+  gr_sw_pt x3 = gr_sw_tile_pt(th, tb, tu, tv, p + 1);
+  gr_sw_pt y1 = gr_sw_tile_pt(th, tb, tv, tu, p - pw);
+  gr_sw_pt y3 = gr_sw_tile_pt(th, tb, tv, tu, p + pw);
+  int fw = ly * (tx + 1) + lx, fs = ly * tx + lx, fn = fs + tx;
+  float suc = stage == 1 ? qu[c] : qu1[c], svc = stage == 1 ? qv[c] : qv1[c];
+  gr_sw_update_cell(GR_SW_CELL_PASS, i, j, x1, x2, x3, y1, y3, xh[fw], xr[fw], xt[fw], xh[fw + 1],
+                    xl[fw + 1], xt[fw + 1], yh[fs], yr[fs], yt[fs], yh[fn], yl[fn], yt[fn], suc,
+                    svc, stage, 0);
+  /* Half of the stage's edge flows, as rain_runoff_sw_edges books them
+   * after the update. */
+  if (i == 0 || j == 0 || i == nx - 1 || j == ny - 1) {
+    float olx = i > 0 ? 0.0f : -xh[fw], ohx = i < nx - 1 ? 0.0f : xh[fw + 1];
+    float oly = j > 0 ? 0.0f : -yh[fs], ohy = j < ny - 1 ? 0.0f : yh[fn];
+    gr_rain_runoff_book_edges(outflow, outflow_comp, inflow, inflow_comp, c, 0.5f * dt, inv_dx,
+                              inv_dy, olx, ohx, oly, ohy);
+  }
+}
+
+/* Both stages take GR_SW_STEP_ARGS (the host binds the same table) and the
+ * tile's local memory: 4 (tx + 4) (ty + 4) + 4 (tx + 1) ty + 4 tx (ty + 1)
+ * floats. */
+__kernel void rain_runoff_sw_stage1(GR_SW_STEP_ARGS, __local float *restrict tile) {
+  gr_sw_fused(GR_SW_CELL_PASS, lvl_w, lvl_e, lvl_s, lvl_n, tile, 1);
+}
+
+__kernel void rain_runoff_sw_stage2(GR_SW_STEP_ARGS, __local float *restrict tile) {
+  gr_sw_fused(GR_SW_CELL_PASS, lvl_w, lvl_e, lvl_s, lvl_n, tile, 2);
+}
+
 /* The stable step's inputs, per work-group: the deepest cell and the
  * fastest rate (|u| + sqrt(g h)) / dx + (|v| + sqrt(g h)) / dy of the owned
  * cells (a cell's own sum: what its update needs, and the same maximum

@@ -560,6 +560,25 @@ GR_API gr_status gr_rain_runoff_halo_set(gr_rain_runoff *s, int side, const void
 /** @} */
 
 /**
+ * How a shallow-water step (FlowModel 0) is launched: each of Heun's two
+ * stages in one launch, each work-group computing its tile's faces in local
+ * memory from the tile and two cells either side of it (non-zero), or in
+ * the stages' separate launches (points, faces, cells, edge flows) through
+ * global memory (0). Both give the same bits; only the speed differs, and a
+ * simulation may switch between steps. The default is the device's faster
+ * one (see the implementation: fused on GPUs).
+ */
+GR_API void gr_rain_runoff_set_sw_fused(gr_rain_runoff *s, int on);
+
+/**
+ * The fused shallow-water stages' tile, tx x ty cells (a work-group of as
+ * many work-items); 0 x 0: the device's default. A tuning knob: the bits do
+ * not depend on it. Refused (GR_ERR_INVALID_ARGUMENT, the tile kept) where
+ * the device's work-groups or local memory are too small for it.
+ */
+GR_API gr_status gr_rain_runoff_set_sw_tile(gr_rain_runoff *s, int tx, int ty);
+
+/**
  * The latest error of a call on this simulation ("" when there was none):
  * its own, never another handle's on the same context. Never NULL.
  */
