@@ -1,9 +1,11 @@
 #include "vtkWaterSurfaceFilter.h"
 
+#include "vtkDoubleArray.h"
 #include "vtkFieldData.h"
 #include "vtkFloatArray.h"
 #include "vtkImageData.h"
 #include "vtkInformation.h"
+#include "vtkInformationVector.h"
 #include "vtkNew.h"
 #include "vtkObjectFactory.h"
 #include "vtkPointData.h"
@@ -14,8 +16,11 @@
 
 #include "GraupelArrays.h"
 #include "GraupelParameterTable.h"
+#include "GraupelPieces.h"
 
+#include <algorithm>
 #include <cmath>
+#include <string>
 #include <limits>
 #include <vector>
 
@@ -24,6 +29,20 @@ vtkStandardNewMacro(vtkWaterSurfaceFilter);
 namespace {
 using graupel::AddValue;
 using graupel::AsFloat;
+
+// The core's ring for DropRadius on rows dy apart; the widest ring when the
+// spacing is not known yet (a wider ring than needed is accepted).
+int Ring(double dropRadius, double dy) {
+  gr_water_surface_params p;
+  gr_water_surface_params_init(&p);
+  int count = 0;
+  const gr_param_bound *b =
+      gr_param_find(gr_water_surface_param_bounds(&count), count, "DropRadius");
+  if (b && dropRadius > 0.0 && dropRadius <= b->max) {
+    p.drop_radius = dropRadius;
+  }
+  return dy > 0.0 ? gr_water_surface_ghost(&p, dy) : gr_water_surface_ghost(&p, 1e-30);
+}
 } // namespace
 
 vtkWaterSurfaceFilter::vtkWaterSurfaceFilter() {
@@ -31,6 +50,24 @@ vtkWaterSurfaceFilter::vtkWaterSurfaceFilter() {
   this->SetInputPortPolicy(0, TEMPORAL_INPUT);
   // Ripples live for seconds: a minute in half-second frames.
   this->SetTimeDefaults(60.0, 0.5);
+  // The core runs as pieces of a split domain (an MPI run's strips); its
+  // ring follows DropRadius and the spacing (RequestInformation sets it).
+  this->SetPieceRing(Ring(this->DropRadius, 0.0));
+}
+
+int vtkWaterSurfaceFilter::RequestInformation(vtkInformation *request,
+                                              vtkInformationVector **inputVector,
+                                              vtkInformationVector *outputVector) {
+  // The ring, 1 + the drops' reach in rows (gr_water_surface_ghost): a
+  // property change comes through here before the next RequestData plans
+  // the pieces.
+  vtkInformation *in = inputVector[0]->GetInformationObject(0);
+  double dy = 0.0;
+  if (in && in->Has(vtkDataObject::SPACING())) {
+    dy = in->Get(vtkDataObject::SPACING())[1];
+  }
+  this->SetPieceRing(Ring(this->DropRadius, dy));
+  return this->Superclass::RequestInformation(request, inputVector, outputVector);
 }
 
 vtkWaterSurfaceFilter::~vtkWaterSurfaceFilter() {
@@ -118,8 +155,10 @@ int vtkWaterSurfaceFilter::ReadWater(vtkDataObject *input) {
                                                     << "' must have one value per point.");
       return 0;
     }
-    const gr_status st =
-        gr_water_surface_set_field(this->Simulation, u.field, values->GetPointer(0));
+    // A split run's local array: its strip and ring.
+    const std::vector<float> local =
+        this->GetPieces().LocalField(values->GetPointer(0), dims[0], 1);
+    const gr_status st = gr_water_surface_set_field(this->Simulation, u.field, local.data());
     if (st != GR_OK) {
       return this->ReportFailure(st, "Water Surface could not use its Input",
                                  gr_water_surface_last_error(this->Simulation));
@@ -169,9 +208,32 @@ int vtkWaterSurfaceFilter::SetUpState(vtkInformationVector **inputVector) {
   TerrainGrid(terrain, &grid);
   this->Dimensions[0] = dims[0];
   this->Dimensions[1] = dims[1];
-  gr_status st = gr_water_surface_create(this->GetContext(), &grid, &p, &this->Simulation);
+  // A split run's strip: its rows, its ring and the whole domain around it.
+  // The core exchanges a row of wave height with the neighbouring ranks
+  // every step and reduces the ledger over the ranks, so every rank's waves
+  // and ledger are the whole grid's.
+  graupel::Pieces &pieces = this->GetPieces();
+  pieces.PieceGrid(&grid);
+  gr_context *ctx = this->GetContext();
+  if (!ctx) {
+    return 0;
+  }
+  gr_status st = gr_water_surface_create(ctx, &grid, &p, &this->Simulation);
   if (st != GR_OK) {
     return this->ReportFailure(st, "Water Surface could not set up the simulation");
+  }
+  if (pieces.IsSplit()) {
+    gr_water_surface *sim = this->Simulation;
+    pieces.BindHalo(
+        [sim](int side, size_t *bytes) { return gr_water_surface_halo_size(sim, side, bytes); },
+        [sim](int side, void *host, size_t bytes) {
+          return gr_water_surface_halo_get(sim, side, host, bytes);
+        },
+        [sim](int side, const void *host, size_t bytes) {
+          return gr_water_surface_halo_set(sim, side, host, bytes);
+        });
+    gr_water_surface_set_allreduce(sim, graupel::Pieces::Allreduce, &pieces);
+    gr_water_surface_set_halo_exchange(sim, graupel::Pieces::Exchange, &pieces);
   }
   if (!this->ReadWater(terrain)) {
     this->ReleaseState();
@@ -259,14 +321,27 @@ int vtkWaterSurfaceFilter::FillOutput(vtkDataObject *outputObject, vtkInformatio
   } else {
     input->GetExtent(extent);
   }
-  const vtkIdType n = static_cast<vtkIdType>(this->Dimensions[0]) * this->Dimensions[1];
+  const int *inExtent = input->GetExtent();
+  graupel::Pieces &pieces = this->GetPieces();
+  // The core's own points: the whole grid, or a split run's own rows; the
+  // rows handed out: the whole grid's, or the requested rows (the row a
+  // strip shares with the next comes from that rank). Cropped below.
+  const int nx = this->Dimensions[0];
+  const int ownRows = pieces.IsSplit() ? pieces.GetOwnRows() : this->Dimensions[1];
+  const vtkIdType n = static_cast<vtkIdType>(nx) * ownRows;
+  int rows[2] = {inExtent[2], inExtent[3]};
+  if (pieces.IsSplit()) {
+    rows[0] = extent[2];
+    rows[1] = extent[3];
+  }
   vtkNew<vtkImageData> whole;
-  whole->SetExtent(input->GetExtent());
+  whole->SetExtent(inExtent[0], inExtent[1], rows[0], rows[1], inExtent[4], inExtent[5]);
   whole->SetOrigin(input->GetOrigin());
   whole->SetSpacing(input->GetSpacing());
   const gr_water_surface_output outputs[] = {GR_WATER_WAVE_HEIGHT, GR_WATER_SURFACE,
                                              GR_WATER_NORMAL,      GR_WATER_WET,
                                              GR_WATER_ELEVATION,   GR_WATER_DEPTH};
+  std::vector<float> assembled;
   for (gr_water_surface_output o : outputs) {
     const int components = gr_water_surface_output_components(o);
     vtkNew<vtkFloatArray> a;
@@ -282,12 +357,30 @@ int vtkWaterSurfaceFilter::FillOutput(vtkDataObject *outputObject, vtkInformatio
       return this->ReportFailure(st, "Water Surface could not read its fields back",
                                  gr_water_surface_last_error(this->Simulation));
     }
+    if (pieces.IsSplit()) {
+      std::string why;
+      if (!pieces.Rows(a->GetPointer(0), nx, components, rows[0] - inExtent[2],
+                       rows[1] - inExtent[2], assembled, why)) {
+        vtkErrorMacro("Water Surface could not assemble its piece from the neighbouring ranks: "
+                      << why << ".");
+        return 0;
+      }
+      a->SetNumberOfTuples(static_cast<vtkIdType>(assembled.size()) / components);
+      std::copy(assembled.begin(), assembled.end(), a->GetPointer(0));
+    }
     whole->GetPointData()->AddArray(a);
   }
   whole->GetPointData()->SetActiveScalars("wave_height");
   whole->GetPointData()->SetActiveNormals("normal");
   output->ShallowCopy(whole);
   output->Crop(extent);
+  // What this rank simulated, ring included: the split a user can see.
+  vtkNew<vtkDoubleArray> cells;
+  cells->SetName("piece_cells");
+  cells->InsertNextValue(
+      static_cast<double>(pieces.IsSplit() ? pieces.GetPieceCells()
+                                           : static_cast<vtkIdType>(nx) * this->Dimensions[1]));
+  output->GetFieldData()->AddArray(cells);
 
   gr_water_surface_ledger ledger;
   const gr_status st = gr_water_surface_ledger_get(this->Simulation, &ledger);

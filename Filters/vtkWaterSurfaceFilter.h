@@ -22,6 +22,13 @@
  * is conserved), `energy` (m^4/s^2) and `max_wave` (m). The model is
  * described in kernels/include/graupel/water_surface.h.
  *
+ * In an MPI run (pvbatch, pvserver) each rank simulates its strip along y
+ * with the core's ring of 1 + the drops' reach in rows
+ * (gr_water_surface_ghost), exchanging one row of wave height per step;
+ * the ledger is reduced over the ranks exactly, so every rank reports the
+ * whole grid's, and the field data `piece_cells` gives the points a rank
+ * simulated (see vtkGraupelSimulation's "Distributed runs").
+ *
  * The setters clamp to the core's parameter table
  * (gr_water_surface_param_bounds); a value that is not a number, or at the
  * open end of a range such as WaveSpeed's 0, is refused at the next update
@@ -105,6 +112,8 @@ protected:
   vtkWaterSurfaceFilter();
   ~vtkWaterSurfaceFilter() override;
 
+  int RequestInformation(vtkInformation *request, vtkInformationVector **inputVector,
+                         vtkInformationVector *outputVector) override;
   int SetUpState(vtkInformationVector **inputVector) override;
   int ResetState() override;
   int AdvanceState(double t0, double t1) override;

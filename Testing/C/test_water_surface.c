@@ -6,14 +6,18 @@
  * (dry points never move; a pulse comes back from the shore at the right
  * time with its sign), normals (exactly (0, 0, 1) on a level surface, those
  * of a tilted plane), raindrops (only on wet points, none at DropRate 0),
- * determinism and checkpoints (bit for bit), the error paths and the
- * parameter table.
+ * determinism and checkpoints (bit for bit), pieces of a split domain (2
+ * and 3 strips on threads give the whole grid's bits, fields and ledger),
+ * the error paths and the parameter table.
  *
  *   test_water_surface            every subtest but memcheck
  *   test_water_surface memcheck   the host-code paths only, on tiny grids */
 #include "graupel/water_surface.h"
 #include "gr_test.h"
 
+#include <math.h>
+#include <pthread.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -579,11 +583,11 @@ static void test_errors(void) {
   p.damping = NAN;
   CHECK(gr_water_surface_params_validate(&p, NULL, 0) == GR_ERR_INVALID_ARGUMENT);
   gr_water_surface_params_init(&p);
-  /* A piece of a split domain is refused. */
+  /* A piece split along x is refused (strips of whole rows only). */
   gr_grid piece = g;
-  piece.global_nx = 32;
+  piece.global_nx = 2 * g.nx;
   CHECK(gr_water_surface_create(ctx, &piece, &p, &t) == GR_ERR_INVALID_ARGUMENT);
-  CHECK(strstr(gr_last_error(NULL), "whole grid") != NULL);
+  CHECK(strstr(gr_last_error(NULL), "along y only") != NULL);
   /* NULLs. */
   CHECK(gr_water_surface_step(NULL, 0.1, 1) == GR_ERR_INVALID_ARGUMENT);
   CHECK(gr_water_surface_get(NULL, GR_WATER_WET, out) == GR_ERR_INVALID_ARGUMENT);
@@ -703,6 +707,412 @@ static void teardown(void) {
   gr_context_release(ctx);
 }
 
+/* ------------------------------------------------------------- pieces */
+
+/* The split domain: 40 x 48 points of 0.5 m, a lake at 0 over a bed with
+ * islands (shores cross every cut), a wave bump across row 24 and drops of
+ * DropRadius 0.5 m (a ring of 1 + 4 rows), damping on. */
+enum { PC_NX = 40, PC_NY = 48, PC_MAX = 3, PC_STEPS = 40 };
+
+typedef struct pc_domain {
+  gr_grid g;
+  float *b, *h0;
+} pc_domain;
+
+static pc_domain pc_make_domain(void) {
+  pc_domain dm;
+  gr_grid g = {.nx = PC_NX, .ny = PC_NY, .dx = 0.5, .dy = 0.5, .x0 = 2.0, .y0 = -3.0};
+  dm.g = g;
+  size_t n = (size_t)g.nx * g.ny;
+  dm.b = malloc(n * sizeof(float));
+  dm.h0 = malloc(n * sizeof(float));
+  for (int j = 0; j < g.ny; ++j)
+    for (int i = 0; i < g.nx; ++i) {
+      double x = i * g.dx, y = j * g.dy;
+      dm.b[(size_t)j * g.nx + i] = (float)(-0.6 + 0.75 * sin(x * 0.55) * cos(y * 0.45));
+      double r2 = (x - 9.0) * (x - 9.0) + (y - 12.0) * (y - 12.0);
+      dm.h0[(size_t)j * g.nx + i] = (float)(0.05 * exp(-r2 / 4.0));
+    }
+  return dm;
+}
+
+static void pc_params(gr_water_surface_params *p) {
+  gr_water_surface_params_init(p);
+  p->use_lake_level = 1;
+  p->lake_level = 0.0;
+  p->damping = 0.05;
+  p->drop_rate = 0.5;
+  p->drop_amplitude = 0.01;
+  p->drop_radius = 0.5;
+  p->seed = 11;
+}
+
+typedef struct pc_team {
+  pthread_barrier_t barrier;
+  int n;
+  double slot[PC_MAX][16];
+  float *mail[PC_MAX][4];
+  size_t bytes[PC_MAX][4];
+} pc_team;
+
+typedef struct pc_runner {
+  pc_team *t;
+  int rank, exchanges, reductions, skip_exchange;
+  /* Steps k0 .. k1 - 1 of dt; the state saved after save_at of them (0:
+   * none); or, with duration > 0, one advance by it, stopped by this
+   * piece's progress callback when stop is set. */
+  int k0, k1, save_at, taken, stop;
+  double dt, duration;
+  gr_grid g;
+  gr_water_surface *s;
+  gr_status st;
+  gr_water_surface_ledger l;
+  void *state;
+  size_t state_bytes;
+} pc_runner;
+
+static int pc_stop(void *user, double time) {
+  (void)user, (void)time;
+  return 1;
+}
+
+static gr_status pc_allreduce(void *user, double *values, int n, gr_reduce_op op) {
+  pc_runner *r = user;
+  pc_team *t = r->t;
+  if (n > 16)
+    return GR_ERR_INVALID_ARGUMENT;
+  ++r->reductions;
+  memcpy(t->slot[r->rank], values, (size_t)n * sizeof(double));
+  pthread_barrier_wait(&t->barrier);
+  for (int q = 0; q < n; ++q) {
+    double v = t->slot[0][q];
+    for (int k = 1; k < t->n; ++k) {
+      double w = t->slot[k][q];
+      v = op == GR_REDUCE_SUM ? v + w : op == GR_REDUCE_MAX ? fmax(v, w) : fmin(v, w);
+    }
+    values[q] = v;
+  }
+  pthread_barrier_wait(&t->barrier);
+  return GR_OK;
+}
+
+/* Each piece's strips out, then the neighbours' in; with skip_exchange,
+ * nothing (the rings keep their first values). */
+static gr_status pc_exchange(void *user) {
+  pc_runner *r = user;
+  pc_team *t = r->t;
+  gr_status st = GR_OK;
+  ++r->exchanges;
+  if (r->skip_exchange)
+    return GR_OK;
+  for (int side = 2; side < 4; ++side)
+    if (st == GR_OK && t->bytes[r->rank][side])
+      st = gr_water_surface_halo_get(r->s, side, t->mail[r->rank][side], t->bytes[r->rank][side]);
+  pthread_barrier_wait(&t->barrier);
+  for (int side = 2; side < 4; ++side) {
+    int other = side == 2 ? r->rank - 1 : r->rank + 1;
+    if (st == GR_OK && t->bytes[r->rank][side])
+      st = gr_water_surface_halo_set(r->s, side, t->mail[other][side ^ 1], t->bytes[r->rank][side]);
+  }
+  pthread_barrier_wait(&t->barrier);
+  return st;
+}
+
+static void *pc_run(void *arg) {
+  pc_runner *r = arg;
+  gr_status st = GR_OK;
+  if (r->duration > 0.0) {
+    gr_water_surface_set_progress(r->s, r->stop ? pc_stop : NULL, r);
+    st = gr_water_surface_advance(r->s, r->duration, &r->taken);
+  }
+  for (int k = r->k0; st == GR_OK && k < r->k1; ++k) {
+    st = gr_water_surface_step(r->s, r->dt, 1);
+    if (st == GR_OK && ++r->taken == r->save_at) {
+      st = gr_water_surface_state_size(r->s, &r->state_bytes);
+      r->state = st == GR_OK ? malloc(r->state_bytes) : NULL;
+      if (r->state)
+        st = gr_water_surface_state_save(r->s, r->state, r->state_bytes);
+    }
+  }
+  gr_status s2 = gr_water_surface_ledger_get(r->s, &r->l);
+  r->st = st != GR_OK ? st : s2;
+  gr_water_surface_set_progress(r->s, NULL, NULL);
+  return NULL;
+}
+
+static void pc_team_run(pc_runner *rn, int n) {
+  pthread_t th[PC_MAX];
+  for (int k = 0; k < n; ++k)
+    pthread_create(&th[k], NULL, pc_run, &rn[k]);
+  for (int k = 0; k < n; ++k)
+    pthread_join(th[k], NULL);
+}
+
+/* A piece of rows j0 .. j0 + ny - 1 with rings of ghost rows: its local
+ * arrays cut from the domain's. */
+static gr_water_surface *pc_piece(const pc_domain *dm, const gr_water_surface_params *p, int j0,
+                                  int ny, int ghost, gr_grid *g) {
+  *g = dm->g;
+  g->ny = ny, g->j0 = j0, g->global_ny = dm->g.ny, g->ghost = ghost;
+  int lo = j0 > 0 ? j0 - ghost : 0;
+  gr_water_surface *s = NULL;
+  gr_status st = gr_water_surface_create(ctx, g, p, &s);
+  CHECK_MSG(st == GR_OK, "piece: %s", gr_last_error(NULL));
+  size_t off = (size_t)lo * dm->g.nx;
+  if (st == GR_OK)
+    st = gr_water_surface_set_field(s, GR_FIELD_ELEVATION, dm->b + off);
+  if (st == GR_OK)
+    st = gr_water_surface_set_wave(s, dm->h0 + off);
+  CHECK_MSG(st == GR_OK, "piece input: %s", s ? gr_water_surface_last_error(s) : "");
+  return s;
+}
+
+/* The outputs compared, and the points of the own rows that differ in any. */
+static const gr_water_surface_output pc_outputs[4] = {GR_WATER_WAVE_HEIGHT, GR_WATER_NORMAL,
+                                                      GR_WATER_SURFACE, GR_WATER_WET};
+
+static long pc_differ(gr_water_surface *s, const gr_grid *g, float *const whole[4]) {
+  long d = 0;
+  for (int o = 0; o < 4; ++o) {
+    size_t comps = (size_t)gr_water_surface_output_components(pc_outputs[o]);
+    size_t own = comps * (size_t)g->nx * (size_t)g->ny, at = comps * (size_t)g->j0 * g->nx;
+    float *v = malloc(own * sizeof(float));
+    CHECK(gr_water_surface_get(s, pc_outputs[o], v) == GR_OK);
+    for (size_t c = 0; c < own; ++c)
+      d += memcmp(&v[c], &whole[o][at + c], sizeof(float)) != 0;
+    free(v);
+  }
+  return d;
+}
+
+static int pc_same_ledger(const gr_water_surface_ledger *a, const gr_water_surface_ledger *b) {
+  return memcmp(&a->time, &b->time, sizeof(double)) == 0 && a->steps == b->steps &&
+         a->wet_points == b->wet_points &&
+         memcmp(&a->wave_volume, &b->wave_volume, sizeof(double)) == 0 &&
+         memcmp(&a->initial_volume, &b->initial_volume, sizeof(double)) == 0 &&
+         memcmp(&a->energy, &b->energy, sizeof(double)) == 0 &&
+         memcmp(&a->max_wave, &b->max_wave, sizeof(double)) == 0;
+}
+
+/* The whole grid's outputs and ledger after `steps` steps of dt (from rest
+ * at the bump), or after an advance by duration when steps < 0. */
+static void pc_whole(const pc_domain *dm, int steps, double dt, float *out[4],
+                     gr_water_surface_ledger *l) {
+  gr_water_surface_params p;
+  pc_params(&p);
+  gr_water_surface *w = NULL;
+  CHECK(gr_water_surface_create(ctx, &dm->g, &p, &w) == GR_OK);
+  CHECK(gr_water_surface_set_field(w, GR_FIELD_ELEVATION, dm->b) == GR_OK);
+  CHECK(gr_water_surface_set_wave(w, dm->h0) == GR_OK);
+  CHECK(gr_water_surface_step(w, dt, steps) == GR_OK);
+  CHECK(gr_water_surface_ledger_get(w, l) == GR_OK);
+  for (int o = 0; o < 4; ++o) {
+    size_t comps = (size_t)gr_water_surface_output_components(pc_outputs[o]);
+    out[o] = malloc(comps * PC_NX * PC_NY * sizeof(float));
+    CHECK(gr_water_surface_get(w, pc_outputs[o], out[o]) == GR_OK);
+  }
+  gr_water_surface_destroy(w);
+}
+
+/* n pieces (cut at rows cuts[0..n-2]) against the whole grid: PC_STEPS
+ * steps, bit for bit in every output and the ledger; the second half again
+ * from each piece's checkpoint; a stop asked by the last piece's progress
+ * callback stops every piece after the same step, the whole grid's state
+ * after that many steps; and, with the exchange skipped, the pieces differ.
+ * Returns piece 0's exchanges in the first run. */
+static int pc_split(const pc_domain *dm, int n, const int *cuts, double dt, float *const wf[4],
+                    const gr_water_surface_ledger *lw) {
+  gr_water_surface_params p;
+  pc_params(&p);
+  int ghost = gr_water_surface_ghost(&p, dm->g.dy);
+  pc_team t;
+  memset(&t, 0, sizeof(t));
+  t.n = n;
+  pthread_barrier_init(&t.barrier, NULL, (unsigned)n);
+  pc_runner rn[PC_MAX];
+  int ok = 1;
+  for (int k = 0; k < n; ++k) {
+    memset(&rn[k], 0, sizeof(rn[k]));
+    int j0 = k ? cuts[k - 1] : 0, j1 = k + 1 < n ? cuts[k] : dm->g.ny;
+    rn[k].t = &t, rn[k].rank = k, rn[k].k1 = PC_STEPS, rn[k].save_at = PC_STEPS / 2;
+    rn[k].dt = dt;
+    rn[k].s = pc_piece(dm, &p, j0, j1 - j0, ghost, &rn[k].g);
+    ok = ok && rn[k].s;
+    for (int side = 2; ok && side < 4; ++side) {
+      CHECK(gr_water_surface_halo_size(rn[k].s, side, &t.bytes[k][side]) == GR_OK);
+      int has = side == 2 ? k > 0 : k + 1 < n;
+      CHECK(t.bytes[k][side] == (has ? (size_t)PC_NX * sizeof(float) : 0));
+      t.mail[k][side] = t.bytes[k][side] ? malloc(t.bytes[k][side]) : NULL;
+    }
+    if (ok) {
+      gr_water_surface_set_allreduce(rn[k].s, pc_allreduce, &rn[k]);
+      gr_water_surface_set_halo_exchange(rn[k].s, pc_exchange, &rn[k]);
+    }
+  }
+  int exchanges = 0, reductions = 0;
+  if (ok) {
+    pc_team_run(rn, n);
+    exchanges = rn[0].exchanges, reductions = rn[0].reductions;
+    for (int k = 0; k < n; ++k) {
+      CHECK_MSG(rn[k].st == GR_OK, "%d pieces, piece %d: %s", n, k,
+                gr_water_surface_last_error(rn[k].s));
+      long d = pc_differ(rn[k].s, &rn[k].g, wf);
+      CHECK_MSG(d == 0,
+                "%d pieces: piece %d: %ld values of its own rows differ from the whole grid", n, k,
+                d);
+      CHECK_MSG(pc_same_ledger(&rn[k].l, lw),
+                "%d pieces: piece %d's ledger: wave %.17g energy %.17g wet %lld max %.17g, the "
+                "whole grid's %.17g %.17g %lld %.17g",
+                n, k, rn[k].l.wave_volume, rn[k].l.energy, rn[k].l.wet_points, rn[k].l.max_wave,
+                lw->wave_volume, lw->energy, lw->wet_points, lw->max_wave);
+    }
+    CHECK_MSG(exchanges == PC_STEPS, "%d exchanges in %d steps", exchanges, PC_STEPS);
+  }
+  /* From the checkpoints after half the steps. */
+  for (int k = 0; ok && k < n; ++k) {
+    CHECK(rn[k].state != NULL);
+    ok = rn[k].state &&
+         gr_water_surface_state_load(rn[k].s, rn[k].state, rn[k].state_bytes) == GR_OK;
+    rn[k].k0 = PC_STEPS / 2, rn[k].save_at = 0, rn[k].taken = 0;
+  }
+  if (ok) {
+    /* A piece's state loads into that piece only. */
+    CHECK(gr_water_surface_state_load(rn[1].s, rn[0].state, rn[0].state_bytes) != GR_OK);
+    pc_team_run(rn, n);
+    for (int k = 0; k < n; ++k) {
+      CHECK(rn[k].st == GR_OK);
+      long d = pc_differ(rn[k].s, &rn[k].g, wf);
+      CHECK_MSG(d == 0 && pc_same_ledger(&rn[k].l, lw),
+                "%d pieces from the checkpoints: piece %d: %ld values differ (ledger %s)", n, k, d,
+                pc_same_ledger(&rn[k].l, lw) ? "equal" : "differs");
+    }
+  }
+  /* A stop on the last piece, inside an advance of 4000 steps. */
+  double stable = 0.0;
+  CHECK(gr_water_surface_stable_dt(rn[0].s, &stable) == GR_OK);
+  for (int k = 0; ok && k < n; ++k) {
+    ok = gr_water_surface_reset(rn[k].s) == GR_OK;
+    rn[k].k0 = rn[k].k1 = 0, rn[k].taken = 0, rn[k].stop = k == n - 1;
+    rn[k].duration = 4000.0 * stable;
+  }
+  int stopped = 0;
+  if (ok) {
+    pc_team_run(rn, n);
+    stopped = rn[0].taken;
+    for (int k = 0; k < n; ++k)
+      CHECK_MSG(rn[k].st == GR_ERR_ABORTED && rn[k].taken == stopped && rn[k].l.steps == stopped &&
+                    stopped > 0 && stopped < 4000,
+                "%d pieces, piece %d: %d steps taken (%s), piece 0 %d, after a stop on piece %d", n,
+                k, rn[k].taken, gr_status_string(rn[k].st), stopped, n - 1);
+    float *sf[4];
+    gr_water_surface_ledger ls;
+    double nsteps = ceil(rn[0].duration / stable);
+    pc_whole(dm, stopped, rn[0].duration / nsteps, sf, &ls);
+    for (int k = 0; k < n; ++k) {
+      long d = pc_differ(rn[k].s, &rn[k].g, sf);
+      CHECK_MSG(d == 0 && pc_same_ledger(&rn[k].l, &ls),
+                "%d pieces stopped after %d steps: piece %d: %ld values differ from the whole "
+                "grid's after as many steps",
+                n, stopped, k, d);
+    }
+    for (int o = 0; o < 4; ++o)
+      free(sf[o]);
+  }
+  /* Without the exchange the rings go stale and the pieces go wrong. */
+  long wrong = 0;
+  for (int k = 0; ok && k < n; ++k) {
+    ok = gr_water_surface_reset(rn[k].s) == GR_OK;
+    rn[k].k0 = 0, rn[k].k1 = PC_STEPS, rn[k].taken = 0, rn[k].stop = 0, rn[k].duration = 0.0;
+    rn[k].skip_exchange = 1;
+  }
+  if (ok) {
+    pc_team_run(rn, n);
+    for (int k = 0; k < n; ++k)
+      wrong += pc_differ(rn[k].s, &rn[k].g, wf);
+    CHECK_MSG(wrong > 0, "%d pieces without the exchange still give the whole grid", n);
+  }
+  CHECK(ok);
+  printf("pieces: %d pieces, ring %d rows: outputs and ledger equal the whole grid's after %d "
+         "steps (%d exchanges, %d reductions on piece 0), from the checkpoints too; a stop on "
+         "piece %d stopped all after %d steps, equal to the whole grid's; without the "
+         "exchange %ld values differ\n",
+         n, ghost, PC_STEPS, exchanges, reductions, n - 1, stopped, wrong);
+  for (int k = 0; k < n; ++k) {
+    gr_water_surface_destroy(rn[k].s);
+    free(rn[k].state);
+    for (int side = 2; side < 4; ++side)
+      free(t.mail[k][side]);
+  }
+  pthread_barrier_destroy(&t.barrier);
+  return exchanges;
+}
+
+/* Two and three pieces in one process (threads) give the whole grid's bits,
+ * waves crossing the cuts, shores on them and drops near them; then the
+ * error paths of pieces. */
+static void test_pieces(void) {
+  pc_domain dm = pc_make_domain();
+  gr_water_surface_params p;
+  pc_params(&p);
+  CHECK(gr_water_surface_ghost(&p, dm.g.dy) == 5);
+  CHECK(gr_water_surface_ghost(&p, 2.0) == 2);
+  CHECK(gr_water_surface_ghost(NULL, 1.0) == 0);
+  double dt = 0.0;
+  {
+    gr_water_surface *w = NULL;
+    CHECK(gr_water_surface_create(ctx, &dm.g, &p, &w) == GR_OK);
+    CHECK(gr_water_surface_stable_dt(w, &dt) == GR_OK);
+    gr_water_surface_destroy(w);
+  }
+  float *wf[4];
+  gr_water_surface_ledger lw;
+  pc_whole(&dm, PC_STEPS, dt, wf, &lw);
+  /* The scene does what it is for: shores (dry points) and drops. */
+  long dry = 0;
+  for (int c = 0; c < PC_NX * PC_NY; ++c)
+    dry += wf[3][c] == 0.0f;
+  printf("pieces: whole grid: %lld wet, %ld dry points; wave %.6g m^3 (initial %.6g), energy "
+         "%.4g, max |h| %.4g m\n",
+         lw.wet_points, dry, lw.wave_volume, lw.initial_volume, lw.energy, lw.max_wave);
+  CHECK(dry > 100 && lw.wet_points > 1000);
+  CHECK(lw.max_wave > 0.01);
+  const int cuts2[1] = {24}, cuts3[2] = {16, 32};
+  pc_split(&dm, 2, cuts2, dt, wf, &lw);
+  pc_split(&dm, 3, cuts3, dt, wf, &lw);
+  for (int o = 0; o < 4; ++o)
+    free(wf[o]);
+  /* Error paths: a ring narrower than the drops need, a strip narrower than
+   * its ring, a strip beyond the domain, a piece stepping without
+   * callbacks, a wider drop than the ring holds, halo sides. */
+  gr_water_surface *s = NULL;
+  gr_grid g = dm.g;
+  g.ny = 24, g.j0 = 24, g.global_ny = PC_NY, g.ghost = 4;
+  CHECK(gr_water_surface_create(ctx, &g, &p, &s) == GR_ERR_INVALID_ARGUMENT && !s);
+  CHECK(strstr(gr_last_error(NULL), "ghost ring") != NULL);
+  g.ny = 4, g.ghost = 5;
+  CHECK(gr_water_surface_create(ctx, &g, &p, &s) == GR_ERR_INVALID_ARGUMENT && !s);
+  g.ny = 24, g.j0 = 30;
+  CHECK(gr_water_surface_create(ctx, &g, &p, &s) == GR_ERR_INVALID_ARGUMENT && !s);
+  g.j0 = 24;
+  CHECK(gr_water_surface_create(ctx, &g, &p, &s) == GR_OK && s);
+  if (s) {
+    CHECK(gr_water_surface_step(s, dt, 1) == GR_ERR_INVALID_ARGUMENT);
+    CHECK(strstr(gr_water_surface_last_error(s), "allreduce") != NULL);
+    gr_water_surface_params wide = p;
+    wide.drop_radius = 0.7;
+    CHECK(gr_water_surface_set_params(s, &wide) == GR_ERR_INVALID_ARGUMENT);
+    CHECK(strstr(gr_water_surface_last_error(s), "DropRadius 0.7") != NULL);
+    size_t bytes = 1;
+    CHECK(gr_water_surface_halo_size(s, 2, &bytes) == GR_OK && bytes == PC_NX * sizeof(float));
+    CHECK(gr_water_surface_halo_size(s, 3, &bytes) == GR_OK && bytes == 0);
+    float strip[4];
+    CHECK(gr_water_surface_halo_get(s, 3, strip, sizeof(strip)) == GR_ERR_INVALID_ARGUMENT);
+    CHECK(gr_water_surface_halo_set(s, 2, strip, sizeof(strip)) == GR_ERR_INVALID_ARGUMENT);
+  }
+  gr_water_surface_destroy(s);
+  free(dm.b), free(dm.h0);
+}
+
 static const gr_subtest tests[] = {
     {"pulse_speed", test_pulse_speed, 0},
     {"standing_modes", test_standing_modes, 0},
@@ -712,6 +1122,7 @@ static const gr_subtest tests[] = {
     {"normals", test_normals, 0},
     {"drops", test_drops, 0},
     {"determinism", test_determinism, 0},
+    {"pieces", test_pieces, 0},
     {"errors", test_errors, 0},
     {"param_table", test_param_table, 0},
     {"memcheck", test_memcheck, 1},

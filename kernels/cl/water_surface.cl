@@ -25,13 +25,17 @@ GR_INLINE float gr_ws_offset(uint h) {
  * threshold (the chance rate dx dy dt times 2^24), at a position hashed
  * uniformly within the point's cell. Every point's g is computed here once,
  * so the step's Laplacian of g takes the same value from both sides of a
- * face. */
+ * face. Rows j_lo .. j_hi - 1 of the local arrays, whose row 0 is the
+ * domain's row gj0: a piece of a split domain hashes the domain's indices,
+ * so it makes the whole grid's drops, and computes g on its own rows and
+ * the ring row next to them (the step's Laplacian reads it), the ring's
+ * further rows giving the wet points within reach. */
 __kernel void water_surface_drops(__global const uchar *restrict wet, __global float *restrict g,
                                   int nx, int ny, float dx, float dy, float inv_2sig2, int reach_x,
                                   int reach_y, uint threshold, uint seed, uint step_lo,
-                                  uint step_hi) {
+                                  uint step_hi, int j_lo, int j_hi, int gj0) {
   int i = get_global_id(0), j = get_global_id(1);
-  if (!gr_inside(i, j, nx, ny))
+  if (i >= nx || j < j_lo || j >= j_hi)
     return;
   int c = gr_idx(i, j, nx);
   float sum = 0.0f;
@@ -40,7 +44,7 @@ __kernel void water_surface_drops(__global const uchar *restrict wet, __global f
     int b0 = max(j - reach_y, 0), b1 = min(j + reach_y, ny - 1);
     for (int b = b0; b <= b1; ++b)
       for (int a = a0; a <= a1; ++a) {
-        uint h = gr_ws_drop_hash(a, b, step_lo, step_hi, seed);
+        uint h = gr_ws_drop_hash(a, b + gj0, step_lo, step_hi, seed);
         if ((h >> 8) >= threshold || !wet[gr_idx(a, b, nx)])
           continue;
         float ox = gr_ws_offset(gr_hash_u32(h ^ 0x68e31da4U));
@@ -61,15 +65,17 @@ __kernel void water_surface_drops(__global const uchar *restrict wet, __global f
  * h over the wet points stays constant to rounding. The drops add
  * drop_coef * lap(g), the same masked Laplacian of this step's Gaussians:
  * a dimple of depth DropAmplitude with a ring around it, whose sum is zero
- * in the same way. Dry points hold no wave. */
+ * in the same way. Dry points hold no wave. Rows j_lo .. j_hi - 1: a
+ * piece's own rows (its ring's first row is the neighbour's, exchanged
+ * after the step). */
 __kernel void water_surface_step(__global const float *restrict h_in,
                                  __global float *restrict h_out, __global float *restrict v,
                                  __global const uchar *restrict wet,
                                  __global const float *restrict g, int nx, int ny, float inv_dx2,
                                  float inv_dy2, float c2dt, float dt, float damp, int drops,
-                                 float drop_coef) {
+                                 float drop_coef, int j_lo, int j_hi) {
   int i = get_global_id(0), j = get_global_id(1);
-  if (!gr_inside(i, j, nx, ny))
+  if (i >= nx || j < j_lo || j >= j_hi)
     return;
   int c = gr_idx(i, j, nx);
   if (!wet[c]) {
@@ -107,27 +113,33 @@ __kernel void water_surface_step(__global const float *restrict h_in,
   h_out[c] = hn;
 }
 
-/* The ledger's sums over the wet points: the wave height; the energy that
- * the scheme conserves without damping,
+/* The ledger's sums over the wet points of the own rows own_y0 .. own_y1 - 1
+ * of the local arrays (nx x ny; a piece's ring belongs to its neighbour):
+ * the wave height and the energy that the scheme conserves without damping,
  *   1/2 v^2 + 1/2 c^2 |grad h|^2 + 1/2 dt c^2 v L(h)
  * (the last term is symplectic Euler's correction for v being half a step
  * ahead of h; |grad h|^2 takes each wet-wet face once, on the point west or
  * south of it; m^2/s^2, the host multiplies by dx dy), with half_dt_c2 =
- * dt c^2 / 2 of the last step; and the count; and the largest |h|. */
+ * dt c^2 / 2 of the last step, each in fixed point (reduce.h's gr_fixed_add:
+ * integer sums, so the totals are the same bits however the cells are
+ * split among work-groups or the pieces of a domain); the wet count; and
+ * the largest |h| (its float's bits). */
 __kernel void water_surface_reduce(__global const float *restrict h,
                                    __global const float *restrict v,
                                    __global const uchar *restrict wet,
-                                   __global float *restrict partial,
-                                   __local float *restrict scratch, int n, int nx, float c2,
+                                   __global long *restrict partial, __local long *restrict scratch,
+                                   int n, int nx, int ny, int own_y0, int own_y1, float c2,
                                    float half_dt_c2, float inv_dx2, float inv_dy2) {
   int lid = get_local_id(0), wg = get_local_size(0), start, end;
   gr_reduce_block(n, &start, &end);
-  float s_hi = 0.0f, s_lo = 0.0f, e_hi = 0.0f, e_lo = 0.0f, n_hi = 0.0f, n_lo = 0.0f;
+  long w[GR_WATER_SURFACE_WORDS];
+  for (int q = 0; q < GR_WATER_SURFACE_WORDS; ++q)
+    w[q] = 0;
   float hmax = 0.0f;
   for (int c = start + lid; c < end; c += wg) {
-    if (!wet[c])
+    int i = c % nx, j = c / nx;
+    if (j < own_y0 || j >= own_y1 || !wet[c])
       continue;
-    int i = c % nx;
     float hc = h[c], vc = v[c];
     float grad = 0.0f, lap = 0.0f;
     if (i < nx - 1 && wet[c + 1]) {
@@ -135,29 +147,26 @@ __kernel void water_surface_reduce(__global const float *restrict h,
       grad += d * d * inv_dx2;
       lap += d * inv_dx2;
     }
-    if (c + nx < n && wet[c + nx]) {
+    if (j < ny - 1 && wet[c + nx]) {
       float d = h[c + nx] - hc;
       grad += d * d * inv_dy2;
       lap += d * inv_dy2;
     }
     if (i > 0 && wet[c - 1])
       lap += (h[c - 1] - hc) * inv_dx2;
-    if (c >= nx && wet[c - nx])
+    if (j > 0 && wet[c - nx])
       lap += (h[c - nx] - hc) * inv_dy2;
-    gr_df_add(&s_hi, &s_lo, hc);
-    gr_df_add(&e_hi, &e_lo, 0.5f * vc * vc + 0.5f * c2 * grad + half_dt_c2 * vc * lap);
-    gr_df_add(&n_hi, &n_lo, 1.0f);
+    gr_fixed_add(&w[0], &w[1], hc);
+    gr_fixed_add(&w[2], &w[3], 0.5f * vc * vc + 0.5f * c2 * grad + half_dt_c2 * vc * lap);
+    w[4] += 1;
     hmax = fmax(hmax, fabs(hc));
   }
-  __local float *mine = gr_reduce_slots(scratch, GR_WATER_SURFACE_SUMS, GR_WATER_SURFACE_MAXES);
-  mine[0] = s_hi;
-  mine[1] = s_lo;
-  mine[2] = e_hi;
-  mine[3] = e_lo;
-  mine[4] = n_hi;
-  mine[5] = n_lo;
-  mine[6] = hmax;
-  gr_reduce_group(scratch, GR_WATER_SURFACE_SUMS, GR_WATER_SURFACE_MAXES, partial);
+  const int slots = GR_WATER_SURFACE_WORDS + GR_WATER_SURFACE_MAXES;
+  __local long *mine = gr_reduce_slots_long(scratch, slots);
+  for (int q = 0; q < GR_WATER_SURFACE_WORDS; ++q)
+    mine[q] = w[q];
+  mine[GR_WATER_SURFACE_WORDS] = as_int(hmax); /* >= +0: its bits order as the heights */
+  gr_reduce_group_long_max(scratch, GR_WATER_SURFACE_WORDS, GR_WATER_SURFACE_MAXES, partial);
 }
 
 /* One derivative of the water surface base + h along an axis at a wet point:

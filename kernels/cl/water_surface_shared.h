@@ -4,10 +4,11 @@
 #ifndef GRAUPEL_CL_WATER_SURFACE_SHARED_H
 #define GRAUPEL_CL_WATER_SURFACE_SHARED_H
 
-/* The ledger's reduction (reduce.h): three double-float sums (the wave height
- * over wet points, the wave energy, the wet points) and one maximum (the
- * largest |wave height|) per work-group. */
-#define GR_WATER_SURFACE_SUMS 3
+/* The ledger's reduction (reduce.h, integer): five int64 words per
+ * work-group (the wave height over the wet points and the wave energy, each
+ * a fixed-point coarse and fine word, and the wet points) and one maximum
+ * (the largest |wave height|, its float's bits). */
+#define GR_WATER_SURFACE_WORDS 5
 #define GR_WATER_SURFACE_MAXES 1
 
 /* A raindrop's Gaussian is summed over a window of this many spacings per

@@ -26,7 +26,7 @@
 #define GR_WS_PROGRESS_EVERY 0.1
 /* Checkpoints: "GRW1" and the layout's version. */
 #define GR_WS_STATE_MAGIC 0x31575247u
-#define GR_WS_STATE_VERSION 1u
+#define GR_WS_STATE_VERSION 2u /* 2: a piece's j0 */
 
 /* The parameter table's rows, in gr_water_surface_param_bounds' order. */
 enum {
@@ -147,7 +147,16 @@ gr_status gr_water_surface_params_validate(const gr_water_surface_params *p, cha
 
 struct gr_water_surface {
   gr_context *ctx;
+  /* A piece (graupel.h's contract, water_surface.h's "Pieces of a split
+   * domain"): grid.ny counts the local rows (own rows and rings); local row
+   * 0 is the domain's row row0, the own rows are ring_s .. ring_s + own_ny
+   * - 1. A whole grid: no rings, row0 0. */
   gr_grid grid;
+  int gny, row0, own_ny, ring_s, ring_n;
+  gr_allreduce_fn allreduce; /* NULL: this simulation is the whole domain */
+  void *allreduce_user;
+  gr_halo_exchange_fn halo_exchange;
+  void *halo_user;
   gr_water_surface_params params;
   cl_kernel drops, step, reduce, derive;
   cl_mem h[2]; /* wave height; [cur] is the latest */
@@ -170,7 +179,7 @@ struct gr_water_surface {
   double time;
   long long steps;
   double last_dt; /* the last step's, for the ledger's energy (0 before any) */
-  gr_reduction ledger;
+  gr_reduction_i64 ledger;
   gr_progress_fn progress;
   void *progress_user;
   char error[1024];
@@ -182,8 +191,33 @@ const char *gr_water_surface_last_error(const gr_water_surface *s) {
   return s ? s->error : "";
 }
 
+/* The local arrays' points (a piece: own rows and rings). */
 static size_t gr_ws_points(const gr_water_surface *s) {
   return (size_t)s->grid.nx * (size_t)s->grid.ny;
+}
+
+/* The own points and the first own point's index in the local arrays. */
+static size_t gr_ws_own_points(const gr_water_surface *s) {
+  return (size_t)s->grid.nx * (size_t)s->own_ny;
+}
+static size_t gr_ws_own_first(const gr_water_surface *s) {
+  return (size_t)s->grid.nx * (size_t)s->ring_s;
+}
+
+static int gr_ws_pieced(const gr_water_surface *s) {
+  return s->ring_s > 0 || s->ring_n > 0;
+}
+
+/* Rows of the drop Gaussians' reach: 4 DropRadius, at most
+ * GR_WATER_SURFACE_MAX_REACH. */
+static int gr_ws_reach(double radius, double d) {
+  return (int)fmin(ceil(GR_WATER_SURFACE_REACH_SIGMAS * radius / d), GR_WATER_SURFACE_MAX_REACH);
+}
+
+int gr_water_surface_ghost(const gr_water_surface_params *p, double dy) {
+  if (!p || !(dy > 0.0) || !(p->drop_radius > 0.0))
+    return 0;
+  return 1 + gr_ws_reach(p->drop_radius, dy);
 }
 
 /* One kernel argument by its name in the kernel's source. */
@@ -218,11 +252,139 @@ void gr_water_surface_destroy(gr_water_surface *s) {
   cl_mem *bufs[] = {&s->h[0], &s->h[1], &s->v, &s->wet, &s->base, &s->g, &s->h0, &s->scratch};
   for (size_t i = 0; i < sizeof(bufs) / sizeof(bufs[0]); ++i)
     gr_buffer_release(bufs[i]);
-  gr_reduction_release(&s->ledger);
+  gr_reduction_i64_release(&s->ledger);
   free(s->elevation);
   free(s->depth);
   gr_context_release(s->ctx);
   free(s);
+}
+
+/* ------------------------------------------------------------- pieces */
+
+/* The piece contract (graupel.h, water_surface.h): strips of whole rows, a
+ * ring of grid->ghost rows toward each neighbour. */
+static gr_status gr_ws_piece_check(const gr_grid *g, const gr_water_surface_params *p, int *ring_s,
+                                   int *ring_n, char *msg, size_t len) {
+  *ring_s = *ring_n = 0;
+  if (g->global_nx < 0 || g->global_ny < 0 || g->ghost < 0) {
+    snprintf(msg, len,
+             "Invalid grid: global_nx, global_ny and ghost must be 0 or more (got %d, %d, %d).",
+             g->global_nx, g->global_ny, g->ghost);
+    return GR_ERR_INVALID_ARGUMENT;
+  }
+  if (g->i0 != 0 || (g->global_nx != 0 && g->global_nx != g->nx)) {
+    snprintf(msg, len,
+             "The water surface splits a domain along y only, into strips of whole rows: this "
+             "piece starts at column %d and has %d of %d columns; give i0 = 0 and nx = "
+             "global_nx.",
+             g->i0, g->nx, g->global_nx);
+    return GR_ERR_INVALID_ARGUMENT;
+  }
+  long long gny = g->global_ny > 0 ? g->global_ny : g->ny;
+  if (g->j0 < 0 || (g->global_ny <= 0 && g->j0 != 0) || (long long)g->j0 + g->ny > gny) {
+    snprintf(msg, len,
+             "Invalid grid: the strip of %d rows at row %d reaches beyond the domain of %lld "
+             "rows; give global_ny of the whole domain.",
+             g->ny, g->j0, gny);
+    return GR_ERR_INVALID_ARGUMENT;
+  }
+  int need = gr_water_surface_ghost(p, g->dy);
+  int south = g->j0 > 0, north = (long long)g->j0 + g->ny < gny;
+  if ((south || north) && g->ghost < need) {
+    snprintf(msg, len,
+             "Invalid grid: a water surface piece with neighbours needs a ghost ring of at least "
+             "%d rows for DropRadius %g m on a spacing of %g m (got ghost = %d); set grid.ghost "
+             "to gr_water_surface_ghost's %d.",
+             need, p->drop_radius, g->dy, g->ghost, need);
+    return GR_ERR_INVALID_ARGUMENT;
+  }
+  if ((south || north) && g->ny < g->ghost) {
+    snprintf(msg, len,
+             "Invalid grid: a water surface piece of %d rows is narrower than its ghost ring of "
+             "%d rows; split the domain into fewer pieces.",
+             g->ny, g->ghost);
+    return GR_ERR_INVALID_ARGUMENT;
+  }
+  *ring_s = south ? g->ghost : 0;
+  *ring_n = north ? g->ghost : 0;
+  return GR_OK;
+}
+
+void gr_water_surface_set_allreduce(gr_water_surface *s, gr_allreduce_fn fn, void *user) {
+  if (!s)
+    return;
+  s->allreduce = fn;
+  s->allreduce_user = fn ? user : NULL;
+}
+
+void gr_water_surface_set_halo_exchange(gr_water_surface *s, gr_halo_exchange_fn fn, void *user) {
+  if (!s)
+    return;
+  s->halo_exchange = fn;
+  s->halo_user = fn ? user : NULL;
+}
+
+/* The caller's allreduce. */
+static gr_status gr_ws_allreduce(gr_water_surface *s, double *v, int n, gr_reduce_op op) {
+  gr_status st = s->allreduce(s->allreduce_user, v, n, op);
+  if (st != GR_OK)
+    return gr_set_error(s->ctx, st,
+                        "The water surface's global reduction (the allreduce callback) failed "
+                        "after step %lld with %s.",
+                        s->steps, gr_status_string(st));
+  return GR_OK;
+}
+
+/* The local row the strip on `side` is read from (set 0) or written to
+ * (set 1): one row of h, the own row next to the neighbour or the ring row
+ * next to the own rows; -1 without a neighbour there. */
+static int gr_ws_strip_row(const gr_water_surface *s, int side, int set) {
+  if (side == GR_WATER_SURFACE_SOUTH && s->ring_s)
+    return set ? s->ring_s - 1 : s->ring_s;
+  if (side == GR_WATER_SURFACE_NORTH && s->ring_n)
+    return set ? s->ring_s + s->own_ny : s->ring_s + s->own_ny - 1;
+  return -1;
+}
+
+gr_status gr_water_surface_halo_size(const gr_water_surface *s, int side, size_t *bytes) {
+  if (!s || !bytes)
+    return gr_set_error(s ? s->ctx : NULL, GR_ERR_INVALID_ARGUMENT,
+                        "gr_water_surface_halo_size needs a simulation and a place for the size.");
+  *bytes = gr_ws_strip_row(s, side, 0) < 0 ? 0 : (size_t)s->grid.nx * sizeof(float);
+  return GR_OK;
+}
+
+/* The strip's wave height between the device and the host; waits. */
+static gr_status gr_ws_halo_copy(gr_water_surface *s, int side, void *host, size_t bytes, int set) {
+  int row = gr_ws_strip_row(s, side, set);
+  if (row < 0)
+    return gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
+                        "The water surface piece has no neighbour on side %d (2 south, 3 north): "
+                        "only sides with a ring exchange a halo.",
+                        side);
+  size_t need = (size_t)s->grid.nx * sizeof(float), at = (size_t)row * need;
+  if (!host || bytes != need)
+    return gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
+                        "The halo buffer has %zu bytes but side %d's strip has %zu: size it with "
+                        "gr_water_surface_halo_size.",
+                        host ? bytes : 0, side, need);
+  return set ? gr_buffer_write(s->ctx, s->h[s->cur], at, need, host)
+             : gr_buffer_read(s->ctx, s->h[s->cur], at, need, host);
+}
+
+gr_status gr_water_surface_halo_get(gr_water_surface *s, int side, void *host, size_t bytes) {
+  if (!s)
+    return gr_set_error(NULL, GR_ERR_INVALID_ARGUMENT,
+                        "gr_water_surface_halo_get needs a simulation.");
+  return GR_WS_KEEP(s, gr_ws_halo_copy(s, side, host, bytes, 0));
+}
+
+gr_status gr_water_surface_halo_set(gr_water_surface *s, int side, const void *host, size_t bytes) {
+  if (!s)
+    return gr_set_error(NULL, GR_ERR_INVALID_ARGUMENT,
+                        "gr_water_surface_halo_set needs a simulation.");
+  /* The copy only reads host (set = 1). */
+  return GR_WS_KEEP(s, gr_ws_halo_copy(s, side, (void *)host, bytes, 1));
 }
 
 gr_status gr_water_surface_create(gr_context *ctx, const gr_grid *grid,
@@ -234,15 +396,12 @@ gr_status gr_water_surface_create(gr_context *ctx, const gr_grid *grid,
   *out = NULL;
   if (gr_grid_validate(grid, msg, sizeof(msg)) != GR_OK)
     return gr_set_error(ctx, GR_ERR_INVALID_ARGUMENT, "%s", msg);
-  if ((grid->global_nx && grid->global_nx != grid->nx) ||
-      (grid->global_ny && grid->global_ny != grid->ny) || grid->ghost)
-    return gr_set_error(ctx, GR_ERR_INVALID_ARGUMENT,
-                        "The water surface needs the whole grid; it was given a piece of %d x %d "
-                        "points of a %d x %d domain with a ring of %d: simulate it on one rank.",
-                        grid->nx, grid->ny, grid->global_nx, grid->global_ny, grid->ghost);
   if (gr_water_surface_params_validate(p, msg, sizeof(msg)) != GR_OK)
     return gr_set_error(ctx, GR_ERR_INVALID_ARGUMENT, "%s", msg);
-  size_t n = (size_t)grid->nx * (size_t)grid->ny;
+  int ring_s = 0, ring_n = 0;
+  if (gr_ws_piece_check(grid, p, &ring_s, &ring_n, msg, sizeof(msg)) != GR_OK)
+    return gr_set_error(ctx, GR_ERR_INVALID_ARGUMENT, "%s", msg);
+  size_t n = (size_t)grid->nx * ((size_t)grid->ny + (size_t)ring_s + (size_t)ring_n);
   if ((double)n > (double)INT_MAX - 1048576.0)
     return gr_set_error(ctx, GR_ERR_TOO_LARGE,
                         "The water surface grid of %d x %d points is too large: the kernels "
@@ -265,6 +424,11 @@ gr_status gr_water_surface_create(gr_context *ctx, const gr_grid *grid,
     return gr_set_error(ctx, GR_ERR_OUT_OF_MEMORY, "Out of host memory.");
   s->ctx = gr_context_retain(ctx);
   s->grid = *grid;
+  s->gny = grid->global_ny > 0 ? grid->global_ny : grid->ny;
+  s->own_ny = grid->ny;
+  s->ring_s = ring_s, s->ring_n = ring_n;
+  s->row0 = grid->j0 - ring_s;
+  s->grid.ny = grid->ny + ring_s + ring_n;
   s->params = *p;
   s->elevation = calloc(n, sizeof(float));
   if (!s->elevation) {
@@ -288,8 +452,8 @@ gr_status gr_water_surface_create(gr_context *ctx, const gr_grid *grid,
   if (st == GR_OK)
     st = gr_buffer_create(ctx, CL_MEM_READ_WRITE, n, NULL, &s->wet);
   if (st == GR_OK)
-    st = gr_reduction_init(ctx, s->reduce, n, GR_WATER_SURFACE_SUMS, GR_WATER_SURFACE_MAXES,
-                           &s->ledger);
+    st = gr_reduction_i64_init_max(ctx, s->reduce, n, GR_WATER_SURFACE_WORDS,
+                                   GR_WATER_SURFACE_MAXES, &s->ledger);
   for (size_t i = 0; st == GR_OK && i < sizeof(floats) / sizeof(floats[0]); ++i)
     st = gr_ws_fill(s, *floats[i], 0.0f, fb);
   if (st == GR_OK)
@@ -309,6 +473,14 @@ gr_status gr_water_surface_set_params(gr_water_surface *s, const gr_water_surfac
                         "gr_water_surface_set_params needs a simulation.");
   if (gr_water_surface_params_validate(p, msg, sizeof(msg)) != GR_OK)
     return GR_WS_KEEP(s, gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT, "%s", msg));
+  int need = gr_water_surface_ghost(p, s->grid.dy);
+  if (gr_ws_pieced(s) && need > s->grid.ghost)
+    return GR_WS_KEEP(s, gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
+                                      "Invalid water surface parameters: DropRadius %g m needs a "
+                                      "ghost ring of %d rows but this piece has %d; keep "
+                                      "DropRadius smaller or make the piece again with a wider "
+                                      "ring.",
+                                      p->drop_radius, need, s->grid.ghost));
   s->params = *p;
   s->water_ready = 0;
   s->initial_known = s->initial_known && s->steps > 0;
@@ -327,7 +499,7 @@ static gr_status gr_ws_check(gr_water_surface *s, const char *what, const float 
     return gr_set_error(
         s->ctx, GR_ERR_INVALID_ARGUMENT, "The water surface's %s has %s at point (%zu, %zu): %s.",
         what, isnan(v) ? "NaN" : (isinf(v) ? "an infinite value" : "a value out of range"),
-        c % (size_t)nx, c / (size_t)nx, rule);
+        c % (size_t)nx, c / (size_t)nx + (size_t)s->row0, rule);
   }
   return GR_OK;
 }
@@ -415,7 +587,7 @@ static gr_status gr_ws_prepare(gr_water_surface *s) {
       base[c] = b + d;
     }
     wet[c] = (unsigned char)w;
-    count += w;
+    count += w && c >= gr_ws_own_first(s) && c < gr_ws_own_first(s) + gr_ws_own_points(s);
   }
   gr_status st = GR_OK;
   if (st == GR_OK)
@@ -431,11 +603,14 @@ static gr_status gr_ws_prepare(gr_water_surface *s) {
   return st;
 }
 
-/* The ledger's device sums (wave, energy per area, wet count) and max |h|. */
-static gr_status gr_ws_reduce(gr_water_surface *s, double sums[GR_WATER_SURFACE_SUMS],
-                              double *max_wave) {
+/* The ledger's device sums (wave, energy per area, wet count) and max |h|
+ * over the own points. The sums are fixed-point integers (reduce.h), and a
+ * piece adds the other pieces' through the allreduce as exact 32-bit parts
+ * (gr_fixed_pack): the same bits for the whole grid and any split. */
+static gr_status gr_ws_reduce(gr_water_surface *s, double sums[3], double *max_wave) {
   const gr_grid *g = &s->grid;
-  cl_int n = (cl_int)gr_ws_points(s), nx = g->nx;
+  cl_int n = (cl_int)gr_ws_points(s), nx = g->nx, ny = g->ny;
+  cl_int own_y0 = s->ring_s, own_y1 = s->ring_s + s->own_ny;
   cl_float c2 = (cl_float)(s->params.wave_speed * s->params.wave_speed);
   cl_float half_dt_c2 = (cl_float)(0.5 * s->last_dt * s->params.wave_speed * s->params.wave_speed);
   cl_float inv_dx2 = (cl_float)(1.0 / (g->dx * g->dx)), inv_dy2 = (cl_float)(1.0 / (g->dy * g->dy));
@@ -446,25 +621,49 @@ static gr_status gr_ws_reduce(gr_water_surface *s, double sums[GR_WATER_SURFACE_
       {"wet", m, &s->wet},
       {"n", sizeof(n), &n},
       {"nx", sizeof(nx), &nx},
+      {"ny", sizeof(ny), &ny},
+      {"own_y0", sizeof(own_y0), &own_y0},
+      {"own_y1", sizeof(own_y1), &own_y1},
       {"c2", sizeof(c2), &c2},
       {"half_dt_c2", sizeof(half_dt_c2), &half_dt_c2},
       {"inv_dx2", sizeof(inv_dx2), &inv_dx2},
       {"inv_dy2", sizeof(inv_dy2), &inv_dy2},
   };
-  double maxes[GR_WATER_SURFACE_MAXES];
+  long long words[GR_WATER_SURFACE_WORDS], maxes[GR_WATER_SURFACE_MAXES];
   gr_status st = GR_WS_ARGS(s, s->reduce, args);
   if (st == GR_OK)
-    st = gr_reduction_run(s->ctx, &s->ledger, s->reduce, sums, maxes);
-  if (st == GR_OK && max_wave)
-    *max_wave = maxes[0];
-  return st;
+    st = gr_reduction_i64_run_max(s->ctx, &s->ledger, s->reduce, words, maxes);
+  if (st != GR_OK)
+    return st;
+  /* The largest |h|, by its float's bits (never below +0). */
+  int32_t bits = (int32_t)maxes[0];
+  float largest;
+  memcpy(&largest, &bits, sizeof(largest));
+  double hmax = largest;
+  if (gr_ws_pieced(s) && s->allreduce) {
+    double packed[GR_FIXED_PACKED(GR_WATER_SURFACE_WORDS, 0)];
+    gr_fixed_pack(words, GR_WATER_SURFACE_WORDS, NULL, 0, packed);
+    st = gr_ws_allreduce(s, packed, GR_FIXED_PACKED(GR_WATER_SURFACE_WORDS, 0), GR_REDUCE_SUM);
+    if (st == GR_OK)
+      st = gr_ws_allreduce(s, &hmax, 1, GR_REDUCE_MAX);
+    if (st != GR_OK)
+      return st;
+    gr_fixed_unpack(packed, words, GR_WATER_SURFACE_WORDS, NULL, 0);
+  }
+  gr_fixed wave = {words[0], words[1]}, energy = {words[2], words[3]};
+  sums[0] = gr_fixed_value(wave);
+  sums[1] = gr_fixed_value(energy);
+  sums[2] = (double)words[4];
+  if (max_wave)
+    *max_wave = hmax;
+  return GR_OK;
 }
 
 /* Records the wave's sum at time 0 when it is not known yet. */
 static gr_status gr_ws_know_initial(gr_water_surface *s) {
   if (s->initial_known || s->steps > 0)
     return GR_OK;
-  double sums[GR_WATER_SURFACE_SUMS];
+  double sums[3];
   gr_status st = gr_ws_reduce(s, sums, NULL);
   if (st == GR_OK) {
     s->initial_sum = sums[0];
@@ -532,9 +731,11 @@ static gr_status gr_ws_enqueue_one(gr_water_surface *s, double dt) {
     st = gr_buffer_create(s->ctx, CL_MEM_READ_WRITE, gr_ws_points(s) * sizeof(cl_float), NULL,
                           &s->g);
   if (st == GR_OK && drops) {
-    double sigma = p->drop_radius, reach = GR_WATER_SURFACE_REACH_SIGMAS * sigma;
-    cl_int rx = (cl_int)fmin(ceil(reach / gd->dx), GR_WATER_SURFACE_MAX_REACH);
-    cl_int ry = (cl_int)fmin(ceil(reach / gd->dy), GR_WATER_SURFACE_MAX_REACH);
+    double sigma = p->drop_radius;
+    cl_int rx = gr_ws_reach(sigma, gd->dx), ry = gr_ws_reach(sigma, gd->dy);
+    /* The own rows and the ring row next to them (the step reads its g). */
+    cl_int j_lo = s->ring_s ? s->ring_s - 1 : 0;
+    cl_int j_hi = s->ring_n ? s->ring_s + s->own_ny + 1 : ny, gj0 = s->row0;
     cl_float dx = (cl_float)gd->dx, dy = (cl_float)gd->dy;
     cl_float inv_2sig2 = (cl_float)(1.0 / (2.0 * sigma * sigma));
     cl_uint seed = (cl_uint)p->seed;
@@ -554,10 +755,14 @@ static gr_status gr_ws_enqueue_one(gr_water_surface *s, double dt) {
         {"seed", sizeof(seed), &seed},
         {"step_lo", sizeof(step_lo), &step_lo},
         {"step_hi", sizeof(step_hi), &step_hi},
+        {"j_lo", sizeof(j_lo), &j_lo},
+        {"j_hi", sizeof(j_hi), &j_hi},
+        {"gj0", sizeof(gj0), &gj0},
     };
     st = GR_WS_ARGS(s, s->drops, args);
     if (st == GR_OK)
-      st = gr_enqueue_2d(s->ctx, s->drops, 0, 0, (size_t)nx, (size_t)ny, NULL);
+      st =
+          gr_enqueue_2d(s->ctx, s->drops, 0, (size_t)j_lo, (size_t)nx, (size_t)(j_hi - j_lo), NULL);
   }
   if (st != GR_OK)
     return st;
@@ -568,6 +773,7 @@ static gr_status gr_ws_enqueue_one(gr_water_surface *s, double dt) {
   cl_float drop_coef = (cl_float)(0.5 * p->drop_amplitude * p->drop_radius * p->drop_radius);
   cl_mem g = s->g ? s->g : s->base; /* bound but not read without drops */
   int now = 1 - s->cur;
+  cl_int j_lo = s->ring_s, j_hi = s->ring_s + s->own_ny;
   const gr_ws_arg args[] = {
       {"h_in", m, &s->h[s->cur]},
       {"h_out", m, &s->h[now]},
@@ -583,21 +789,39 @@ static gr_status gr_ws_enqueue_one(gr_water_surface *s, double dt) {
       {"damp", sizeof(damp), &damp},
       {"drops", sizeof(drops), &drops},
       {"drop_coef", sizeof(drop_coef), &drop_coef},
+      {"j_lo", sizeof(j_lo), &j_lo},
+      {"j_hi", sizeof(j_hi), &j_hi},
   };
   st = GR_WS_ARGS(s, s->step, args);
   if (st == GR_OK)
-    st = gr_enqueue_2d(s->ctx, s->step, 0, 0, (size_t)nx, (size_t)ny, NULL);
-  if (st == GR_OK) {
-    s->cur = now;
-    s->steps += 1;
-    s->time += dt;
-    s->last_dt = dt;
+    st = gr_enqueue_2d(s->ctx, s->step, 0, (size_t)j_lo, (size_t)nx, (size_t)(j_hi - j_lo), NULL);
+  if (st != GR_OK)
+    return st;
+  s->cur = now;
+  s->steps += 1;
+  s->time += dt;
+  s->last_dt = dt;
+  /* A piece's ring row of h: the neighbour's new row, for the next step
+   * (and the ledger's and the normals' differences across the cut). */
+  if (gr_ws_pieced(s)) {
+    st = s->halo_exchange(s->halo_user);
+    if (st != GR_OK)
+      return gr_set_error(s->ctx, st,
+                          "The water surface piece's halo exchange (the callback given to "
+                          "gr_water_surface_set_halo_exchange) failed in step %lld with %s; the "
+                          "piece's ring is not fresh, so restore a checkpoint before stepping on.",
+                          s->steps, gr_status_string(st));
   }
-  return st;
+  return GR_OK;
 }
 
 /* What every stepping call checks first: water, and the wave's time-0 sum. */
 static gr_status gr_ws_ready(gr_water_surface *s) {
+  if (gr_ws_pieced(s) && (!s->allreduce || !s->halo_exchange))
+    return gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
+                        "A water surface piece with neighbours steps only with an allreduce and "
+                        "a halo exchange set (gr_water_surface_set_allreduce, "
+                        "gr_water_surface_set_halo_exchange).");
   gr_status st = gr_ws_prepare(s);
   return st == GR_OK ? gr_ws_know_initial(s) : st;
 }
@@ -651,30 +875,38 @@ static gr_status gr_ws_advance_impl(gr_water_surface *s, double duration, int *t
   /* Equal steps ending exactly at the duration; the progress watch only adds
    * waits, so what is computed never depends on it. */
   double dt = duration / n, last_call = gr_ws_now(), last_wait = last_call;
-  int total = (int)n, batch = 1, since = 0;
+  int total = (int)n, batch = 1, since = 0, stop = 0;
   for (int k = 0; st == GR_OK && k < total; ++k) {
     st = gr_ws_enqueue_one(s, dt);
     if (st != GR_OK)
       break;
     ++*taken;
-    if (!s->progress || ++since < batch || k + 1 == total)
-      continue;
-    st = gr_finish(s->ctx);
-    double now = gr_ws_now(), span = now - last_wait;
-    if (span < 0.5 * GR_WS_BATCH_S && batch < (1 << 20))
-      batch *= 2;
-    else if (span > GR_WS_BATCH_S && batch > 1)
-      batch /= 2;
-    since = 0;
-    last_wait = now;
-    if (st == GR_OK && now - last_call >= GR_WS_PROGRESS_EVERY) {
-      last_call = now;
-      if (s->progress(s->progress_user, s->time) != 0)
-        return gr_set_error(s->ctx, GR_ERR_ABORTED,
-                            "The water surface advance was stopped by its progress callback at "
-                            "%g s of simulated time; the state is valid there.",
-                            s->time);
+    if (s->progress && ++since >= batch && k + 1 < total) {
+      st = gr_finish(s->ctx);
+      double now = gr_ws_now(), span = now - last_wait;
+      if (span < 0.5 * GR_WS_BATCH_S && batch < (1 << 20))
+        batch *= 2;
+      else if (span > GR_WS_BATCH_S && batch > 1)
+        batch /= 2;
+      since = 0;
+      last_wait = now;
+      if (st == GR_OK && now - last_call >= GR_WS_PROGRESS_EVERY) {
+        last_call = now;
+        stop = s->progress(s->progress_user, s->time) != 0;
+      }
     }
+    /* The pieces' callbacks run at their own wall times: a stop asked on
+     * any piece stops every piece after this same step. */
+    if (st == GR_OK && gr_ws_pieced(s) && k + 1 < total) {
+      double flag = stop;
+      st = gr_ws_allreduce(s, &flag, 1, GR_REDUCE_MAX);
+      stop = flag > 0.0;
+    }
+    if (st == GR_OK && stop)
+      return gr_set_error(s->ctx, GR_ERR_ABORTED,
+                          "The water surface advance was stopped by its progress callback at %g s "
+                          "of simulated time; the state is valid there.",
+                          s->time);
   }
   return st;
 }
@@ -723,9 +955,12 @@ static gr_status gr_ws_derive(gr_water_surface *s, cl_int what, size_t comps, fl
   if (st == GR_OK)
     st = GR_WS_ARGS(s, s->derive, args);
   if (st == GR_OK)
-    st = gr_enqueue_2d(s->ctx, s->derive, 0, 0, (size_t)nx, (size_t)ny, NULL);
+    st =
+        gr_enqueue_2d(s->ctx, s->derive, 0, (size_t)s->ring_s, (size_t)nx, (size_t)s->own_ny, NULL);
+  /* The own rows (a piece's local arrays hold its rings around them). */
   if (st == GR_OK)
-    st = gr_buffer_read(s->ctx, s->scratch, 0, comps * n * sizeof(cl_float), host);
+    st = gr_buffer_read(s->ctx, s->scratch, comps * gr_ws_own_first(s) * sizeof(cl_float),
+                        comps * gr_ws_own_points(s) * sizeof(cl_float), host);
   return st;
 }
 
@@ -735,9 +970,9 @@ static gr_status gr_ws_get_impl(gr_water_surface *s, gr_water_surface_output o, 
                         "The water surface has no output %d; its outputs are wave_height, "
                         "normal, water_surface, wet, elevation and water_depth.",
                         (int)o);
-  size_t n = gr_ws_points(s);
+  size_t n = gr_ws_own_points(s), first = gr_ws_own_first(s);
   if (o == GR_WATER_ELEVATION) {
-    memcpy(host, s->elevation, n * sizeof(float));
+    memcpy(host, s->elevation + first, n * sizeof(float));
     return GR_OK;
   }
   gr_status st = gr_ws_prepare(s);
@@ -756,10 +991,11 @@ static gr_status gr_ws_get_impl(gr_water_surface *s, gr_water_surface_output o, 
     /* water_depth: the input, or the lake's depth over its wet points. */
     float level = (float)s->params.lake_level;
     for (size_t c = 0; c < n; ++c) {
+      float b = s->elevation[first + c];
       if (!gr_ws_lake(s))
-        host[c] = s->depth[c];
+        host[c] = s->depth[first + c];
       else
-        host[c] = s->elevation[c] < level ? level - s->elevation[c] : 0.0f;
+        host[c] = b < level ? level - b : 0.0f;
     }
     return GR_OK;
   }
@@ -778,7 +1014,7 @@ gr_status gr_water_surface_get(gr_water_surface *s, gr_water_surface_output o, f
 }
 
 static gr_status gr_ws_ledger_impl(gr_water_surface *s, gr_water_surface_ledger *out) {
-  double sums[GR_WATER_SURFACE_SUMS], hmax = 0.0;
+  double sums[3], hmax = 0.0;
   gr_status st = gr_ws_ready(s);
   if (st == GR_OK)
     st = gr_ws_reduce(s, sums, &hmax);
@@ -841,7 +1077,7 @@ typedef struct gr_ws_state_header {
   uint32_t magic, version;
   int32_t nx, ny;
   int64_t steps;
-  int32_t initial_known, pad;
+  int32_t initial_known, j0;
   double time, initial_sum, last_dt;
 } gr_ws_state_header;
 
@@ -873,6 +1109,7 @@ static gr_status gr_ws_save_impl(gr_water_surface *s, void *host, size_t bytes) 
   hd.ny = s->grid.ny;
   hd.steps = s->steps;
   hd.initial_known = s->initial_known;
+  hd.j0 = s->grid.j0;
   hd.time = s->time;
   hd.initial_sum = s->initial_sum;
   hd.last_dt = s->last_dt;
@@ -908,12 +1145,13 @@ static gr_status gr_ws_load_impl(gr_water_surface *s, const void *host, size_t b
     return gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
                         "The bytes given are not a water surface state of this version: pass the "
                         "bytes gr_water_surface_state_save wrote.");
-  if (hd.nx != s->grid.nx || hd.ny != s->grid.ny || bytes != need)
+  if (hd.nx != s->grid.nx || hd.ny != s->grid.ny || hd.j0 != s->grid.j0 || bytes != need)
     return gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
-                        "The water surface state is of a %d x %d grid (%zu bytes) but this "
-                        "simulation's grid is %d x %d (%zu bytes): load it into a simulation of "
-                        "the grid it was saved from.",
-                        (int)hd.nx, (int)hd.ny, bytes, s->grid.nx, s->grid.ny, need);
+                        "The water surface state is of a %d x %d grid at row %d (%zu bytes) but "
+                        "this simulation's grid is %d x %d at row %d (%zu bytes): load it into a "
+                        "simulation of the grid (or piece) it was saved from.",
+                        (int)hd.nx, (int)hd.ny, (int)hd.j0, bytes, s->grid.nx, s->grid.ny,
+                        s->grid.j0, need);
   if (!(hd.time >= 0.0 && hd.time < HUGE_VAL) || hd.steps < 0 || !isfinite(hd.initial_sum))
     return gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
                         "The water surface state's header is damaged (time %g s, %lld steps): "

@@ -74,7 +74,8 @@
  * nx*ny floats, finite; and an initial wave (gr_water_surface_set_wave).
  * Outputs by gr_water_surface_get: the gr_water_surface_output list below.
  *
- * The grid is whole: a piece of a split domain is refused.
+ * A simulation holds a whole grid or one strip of a split domain: see
+ * "Pieces of a split domain" below.
  */
 #ifndef GRAUPEL_WATER_SURFACE_H
 #define GRAUPEL_WATER_SURFACE_H
@@ -132,7 +133,11 @@ GR_API gr_status gr_water_surface_params_validate(const gr_water_surface_params 
  */
 GR_API const gr_param_bound *gr_water_surface_param_bounds(int *count);
 
-/** The book-keeping (sums over the wet points, accumulated in double). */
+/**
+ * The book-keeping: sums over the wet points, each cell's float added in
+ * the fixed point of graupel/reduce.h (integer sums: exact, the same bits
+ * however the grid is split), then turned into a double once.
+ */
 typedef struct gr_water_surface_ledger {
   double time;           /**< simulated time since the start (or reset), s */
   long long steps;       /**< steps taken */
@@ -145,7 +150,10 @@ typedef struct gr_water_surface_ledger {
 
 typedef struct gr_water_surface gr_water_surface;
 
-/** A simulation on one whole grid, at rest, with flat ground at 0 and no water yet. */
+/**
+ * A simulation on a whole grid or a piece of one (see "Pieces of a split
+ * domain"), at rest, with flat ground at 0 and no water yet.
+ */
 GR_API gr_status gr_water_surface_create(gr_context *ctx, const gr_grid *grid,
                                          const gr_water_surface_params *p, gr_water_surface **out);
 
@@ -157,14 +165,16 @@ GR_API gr_status gr_water_surface_create(gr_context *ctx, const gr_grid *grid,
 GR_API gr_status gr_water_surface_set_params(gr_water_surface *s, const gr_water_surface_params *p);
 
 /**
- * Uploads GR_FIELD_ELEVATION or GR_FIELD_WATER_DEPTH (nx*ny floats): every
+ * Uploads GR_FIELD_ELEVATION or GR_FIELD_WATER_DEPTH (nx*ny floats; a piece:
+ * its local arrays, rings included): every
  * value finite, elevations within +-1e6 m, depths 0 to 1e4 m; a refused
  * field names the point (i, j) and leaves the state as it was.
  */
 GR_API gr_status gr_water_surface_set_field(gr_water_surface *s, gr_field f, const float *host);
 
 /**
- * Sets the wave height h (nx*ny floats, m, finite, |h| <= 1e4) with v = 0,
+ * Sets the wave height h (nx*ny floats, a piece's local arrays; m, finite,
+ * |h| <= 1e4) with v = 0,
  * as the state now and the state reset returns to; it is zeroed on dry
  * points at the next step.
  */
@@ -192,26 +202,105 @@ GR_API gr_status gr_water_surface_advance(gr_water_surface *s, double duration, 
 GR_API void gr_water_surface_set_progress(gr_water_surface *s, gr_progress_fn fn, void *user);
 
 /**
- * Reads an output back (waits): nx*ny floats, 3*nx*ny for the normal.
+ * Reads an output back (waits): nx*ny floats, 3*nx*ny for the normal (a
+ * piece: its own rows).
  * Refused while there is no water.
  */
 GR_API gr_status gr_water_surface_get(gr_water_surface *s, gr_water_surface_output o, float *host);
 
-/** The ledger now (waits; reduces on the device). */
+/** The ledger now (waits; reduces on the device; collective on pieces). */
 GR_API gr_status gr_water_surface_ledger_get(gr_water_surface *s, gr_water_surface_ledger *out);
 
 /** Back to the initial wave (set_wave's, else rest), time 0, step 0. Inputs are kept. */
 GR_API gr_status gr_water_surface_reset(gr_water_surface *s);
 
 /**
- * Checkpoints: h, v, time and steps as bytes. Loaded into a simulation of
- * the same grid, inputs and parameters, every later step is bit-identical
+ * Checkpoints: h, v, time and steps as bytes (a piece: its local arrays
+ * and its j0; it loads only into the same piece). Loaded into a simulation
+ * of the same grid, inputs and parameters, every later step is bit-identical
  * to those that followed the save (the drops included: they follow the
  * step count).
  */
 GR_API gr_status gr_water_surface_state_size(const gr_water_surface *s, size_t *bytes);
 GR_API gr_status gr_water_surface_state_save(gr_water_surface *s, void *host, size_t bytes);
 GR_API gr_status gr_water_surface_state_load(gr_water_surface *s, const void *host, size_t bytes);
+
+/**
+ * @name Pieces of a split domain
+ *
+ * A simulation may hold one strip of a domain split along y (the gr_grid
+ * piece fields: j0, global_ny, ghost; a piece spans whole rows: i0 = 0 and
+ * nx = global_nx or 0). On each side where the strip has a neighbour
+ * (south: j0 > 0, north: j0 + ny < global_ny) it keeps a ring of grid.ghost
+ * rows, copies of the neighbour's points; grid.ghost must be at least
+ * gr_water_surface_ghost(params, dy) and the strip at least grid.ghost rows
+ * high. The local arrays are the strip and its rings: nx x (ny + rings)
+ * floats for set_field, set_wave and checkpoints; get gives the own nx x ny.
+ *
+ * What the ring holds. The wave stencil reaches one row: a step of an own
+ * point reads h and the drops' Gaussians g one row away, and the ledger's
+ * energy and the normals read h one row away. So one row of h is exchanged
+ * per step (the halo calls: the own row next to the cut goes to the
+ * neighbour's first ring row, after every step, through the caller's
+ * exchange). The rest of the ring serves the drops: g at a point sums the
+ * drops within reach (4 DropRadius, at most 12 rows) that fall on wet
+ * points, and whether a point is wet follows from the inputs alone, which
+ * the ring holds (set_field's local arrays). So the ring is 1 + that reach
+ * in rows, and g is computed on the own rows and the first ring row from
+ * the ring's inputs, never exchanged. Raindrops are a hash of the domain's
+ * point index (i, j0 + local row), the seed and the step, so every piece
+ * makes the whole grid's drops and the whole grid's bits.
+ *
+ * The ledger is a fixed-point integer sum per piece (see the ledger),
+ * added over the pieces by the allreduce (GR_REDUCE_SUM of gr_fixed_pack's
+ * exact 32-bit parts) and the largest |h| by GR_REDUCE_MAX: the same bits
+ * for the whole grid and any split, whatever order the allreduce adds in.
+ *
+ * Stepping on pieces is collective: every piece sets the same parameters
+ * and calls step or advance with the same arguments; each step makes one
+ * exchange call, and ledger_get (and the first step after the wave is set,
+ * which records the initial volume) one allreduce of 10 values and one of 1.
+ * advance reduces a stop flag after every step but the last (GR_REDUCE_MAX),
+ * so a stop asked by one piece's progress callback stops every piece after
+ * the same step. An error on one piece returns on that piece only: the
+ * others wait in their next collective call, which the caller's callbacks
+ * must end.
+ * @{
+ */
+
+/** Sides of a piece, for the halo calls (as every core numbers them; x sides never have one). */
+typedef enum gr_water_surface_side {
+  GR_WATER_SURFACE_SOUTH = 2, /**< toward j0 - 1 */
+  GR_WATER_SURFACE_NORTH = 3  /**< toward j0 + ny */
+} gr_water_surface_side;
+
+/**
+ * The ring a piece needs for these parameters on rows dy apart: 1 +
+ * min(ceil(4 DropRadius / dy), 12) rows (0 for NULL or dy not above 0).
+ */
+GR_API int gr_water_surface_ghost(const gr_water_surface_params *p, double dy);
+
+/**
+ * The global reduction over the pieces (see gr_allreduce_fn); NULL (the
+ * default) for a simulation that is the whole domain. A piece with a
+ * neighbour steps only with one and a halo exchange set.
+ */
+GR_API void gr_water_surface_set_allreduce(gr_water_surface *s, gr_allreduce_fn fn, void *user);
+
+/** The halo exchange (see gr_halo_exchange_fn), called once per step; NULL removes it. */
+GR_API void gr_water_surface_set_halo_exchange(gr_water_surface *s, gr_halo_exchange_fn fn,
+                                               void *user);
+
+/** Bytes of the halo strip on `side` (south 2, north 3): one row of h, nx floats; 0 for none. */
+GR_API gr_status gr_water_surface_halo_size(const gr_water_surface *s, int side, size_t *bytes);
+
+/** Copies the own row next to `side` out (for the neighbour on that side); waits. */
+GR_API gr_status gr_water_surface_halo_get(gr_water_surface *s, int side, void *host, size_t bytes);
+
+/** Copies the neighbour's row into the ring's first row on `side`; waits. */
+GR_API gr_status gr_water_surface_halo_set(gr_water_surface *s, int side, const void *host,
+                                           size_t bytes);
+/** @} */
 
 /**
  * The latest error of a call on this simulation ("" when none); for s ==

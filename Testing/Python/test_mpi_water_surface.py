@@ -1,0 +1,132 @@
+"""mpiexec -n 1, -n 2 and -n 4 pvbatch: Water Surface split over the ranks. With 2 ranks
+each rank simulates its strip along y with the core's ring of 1 + the raindrops' reach
+rows (field data piece_cells at most 55% of the grid), exchanging a row of wave height
+every step through ParaView's MPI controller. A lake over rolling ground (shores cross
+the strips' edges) takes raindrops everywhere, so ripples cross the cuts. Each rank's
+piece (every output array) and its ledger must equal, bit for bit, what one process
+computes on the whole grid (computed in that rank by the wrapped classes): the -n 1,
+-n 2 and -n 4 runs thus give the same bits."""
+import os
+import sys
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import gr_check as T  # noqa: E402
+
+
+def extra(p):
+    p.add_argument("--ranks", type=int, default=2)
+
+
+a = T.args(extra)
+
+from paraview import servermanager  # noqa: E402
+from paraview.simple import *  # noqa: E402,F401,F403
+
+LoadPlugin(a.plugin, ns=globals())
+pm = servermanager.vtkProcessModule.GetProcessModule()
+ranks = pm.GetNumberOfLocalPartitions()
+T.check(ranks == a.ranks, "running on %d ranks (%d)" % (a.ranks, ranks))
+
+NX, NY, DX = 64, 120, 1.0
+END = 6.0
+terrain = ProceduralTerrain(Dimensions=[NX, NY], Spacing=DX, Seed=5, Frequency=40.0,
+                            HeightScale=4.0)
+terrain.UpdatePipeline()
+low, high = terrain.PointData["elevation"].GetRange()
+# A lake over the lower 60% of the ground's range: islands and shores everywhere.
+LEVEL = low + 0.6 * (high - low)
+
+# The scenario, built by the proxy below and, the same, by the wrapped classes.
+SCENARIO = """
+def scenario(terrain_cls, water_cls):
+    t = terrain_cls()
+    t.SetDimensions(%(nx)d, %(ny)d)
+    t.SetSpacing(%(dx)r)
+    t.SetSeed(5)
+    t.SetFrequency(40.0)
+    t.SetHeightScale(4.0)
+    f = water_cls()
+    f.SetInputConnection(t.GetOutputPort())
+    f.SetUseLakeLevel(1)
+    f.SetLakeLevel(%(level)r)
+    f.SetDropRate(0.05)
+    f.SetDropAmplitude(0.01)
+    f.SetDropRadius(0.5)
+    f.SetSeed(3)
+    f.SetEndTime(%(end)r)
+    f.SetOutputInterval(3.0)
+    return t, f
+""" % {"nx": NX, "ny": NY, "dx": DX, "end": END, "level": LEVEL}
+
+LEDGER = ["time", "steps", "wet_points", "wave_volume", "initial_volume", "energy", "max_wave"]
+FIELDS = ["wave_height", "water_surface", "normal", "wet", "elevation", "water_depth"]
+
+# Each rank compares its piece with the whole grid computed there; the
+# per-point mismatch counts are then reduced over the ranks by ParaView's
+# data information (Fetch brings only rank 0's piece in pvbatch).
+COMPARE = SCENARIO + """
+import numpy as np
+from vtkmodules.util.numpy_support import vtk_to_numpy, numpy_to_vtk
+from graupel import vtkProceduralTerrainSource, vtkWaterSurfaceFilter
+img = self.GetInputDataObject(0, 0)
+out = self.GetOutputDataObject(0)
+out.ShallowCopy(img)
+_, whole = scenario(vtkProceduralTerrainSource, vtkWaterSurfaceFilter)
+whole.UpdateTimeStep(%(end)r)
+ref = whole.GetOutput()
+e0, e1, f0, f1, _, _ = img.GetExtent()
+bad = np.zeros((f1 - f0 + 1) * (e1 - e0 + 1), dtype=np.float32)
+for name in %(fields)r:
+    r = vtk_to_numpy(ref.GetPointData().GetArray(name)).reshape(%(ny)d, %(nx)d, -1)
+    m = vtk_to_numpy(img.GetPointData().GetArray(name)).reshape(f1 - f0 + 1, e1 - e0 + 1, -1)
+    bad += (m.view(np.uint32) != r[f0:f1 + 1, e0:e1 + 1].view(np.uint32)).any(axis=2).reshape(-1)
+ledger_bad = 0
+for name in %(ledger)r:
+    x, y = img.GetFieldData().GetArray(name), ref.GetFieldData().GetArray(name)
+    if x is None or y is None or x.GetTuple1(0) != y.GetTuple1(0):
+        ledger_bad += 1
+cells = img.GetFieldData().GetArray("piece_cells")
+share = cells.GetTuple1(0) / (%(nx)d * %(ny)d) if cells else -1.0
+fd = ref.GetFieldData()
+n = bad.size
+for arr_name, values in (("mismatch", bad), ("ledger_mismatch", np.full(n, ledger_bad, np.float32)),
+                         ("piece_share", np.full(n, share, np.float32)),
+                         ("ref_max_wave", np.full(n, fd.GetArray("max_wave").GetTuple1(0),
+                                                  np.float32)),
+                         ("ref_dry", np.full(n, float(np.count_nonzero(vtk_to_numpy(
+                             ref.GetPointData().GetArray("wet")) == 0.0)), np.float32))):
+    arr = numpy_to_vtk(np.ascontiguousarray(values), deep=1)
+    arr.SetName(arr_name)
+    out.GetPointData().AddArray(arr)
+""" % {"end": END, "fields": FIELDS, "ledger": LEDGER, "nx": NX, "ny": NY}
+
+water = WaterSurface(Input=terrain, UseLakeLevel=1, LakeLevel=LEVEL, DropRate=0.05,
+                     DropAmplitude=0.01, DropRadius=0.5, Seed=3, EndTime=END, OutputInterval=3.0)
+
+pid = ProcessIdScalars(Input=water)
+cmp = ProgrammableFilter(Input=pid)
+cmp.Script = COMPARE
+cmp.UpdatePipeline(END)
+T.check(cmp.PointData["ProcessId"].GetRange() == (0.0, ranks - 1.0),
+        "every rank computed a piece")
+T.check(cmp.GetDataInformation().GetNumberOfPoints() >= NX * NY, "the pieces cover the grid")
+T.check(cmp.PointData["mismatch"].GetRange() == (0.0, 0.0),
+        "every rank's fields (%d arrays) equal that part of the whole grid's, bit for bit"
+        % len(FIELDS))
+T.check(cmp.PointData["ledger_mismatch"].GetRange() == (0.0, 0.0),
+        "every rank's ledger (%d values) equals the whole grid's, bit for bit" % len(LEDGER))
+T.check(cmp.PointData["ref_max_wave"].GetRange()[0] > 0.001,
+        "raindrops made ripples (max |h| %g m)" % cmp.PointData["ref_max_wave"].GetRange()[0])
+T.check(cmp.PointData["ref_dry"].GetRange()[0] > 100,
+        "the lake has shores (%g dry points)" % cmp.PointData["ref_dry"].GetRange()[0])
+share = cmp.PointData["piece_share"].GetRange()
+if ranks == 1:
+    T.check(share == (1.0, 1.0), "one rank simulates the whole grid (%r)" % (share,))
+elif ranks > 2:
+    T.check(share[0] > 0.0 and share[1] < 0.5,
+            "each of %d ranks simulates a strip (%r)" % (ranks, share))
+else:
+    T.check(share[0] > 0.0 and share[1] <= 0.55,
+            "each of %d ranks simulates at most 55%% of the grid (%r)" % (ranks, share))
+print("piece_cells share of the grid per rank: %.4f to %.4f" % share)
+T.finish()
