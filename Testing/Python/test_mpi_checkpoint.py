@@ -1,6 +1,7 @@
 """mpiexec -n 1 and -n 2 pvbatch: checkpoint files and restarts. For Rain
 Runoff (shallow water, a point inflow, a wall and a level edge), Snow
-Deformation (a sphere ploughing along the strips' edge) and Snow Accumulation
+Deformation (a sphere ploughing along the strips' edge), Water Surface (a lake
+with raindrops) and Snow Accumulation
 (tilted snow over ridges, a box across the strips' edge): a run to output k
 with CheckpointFile writes a manifest and one .vti per rank; a fresh pipeline
 with RestartFile set to it, asked for output 2k, starts from output k (its
@@ -128,6 +129,13 @@ def snow_accumulation(**extra):
                             EndTime=1800.0, OutputInterval=900.0, **extra)
 
 
+def water_surface(**extra):
+    terrain = ProceduralTerrain(Dimensions=[48, 104], Spacing=1.0, Seed=9, HeightScale=4.0)
+    return WaterSurface(Input=terrain, UseLakeLevel=1, LakeLevel=2.0, DropRate=0.05,
+                        DropAmplitude=0.01, DropRadius=0.5, Seed=3, EndTime=12.0,
+                        OutputInterval=3.0, **extra)
+
+
 def points(source, time):
     source.UpdatePipeline(time)
     return source.GetDataInformation().GetNumberOfPoints()
@@ -192,6 +200,7 @@ def refused(name, make, manifest, time, words):
 rr_manifest, rr = check_restart("rain_runoff", rain_runoff, 40.0, 80.0, True)
 sd_manifest, sd = check_restart("snow_deformation", snow_deformation, 0.25, 0.5, False)
 check_restart("snow_accumulation", snow_accumulation, 900.0, 1800.0, False)
+check_restart("water_surface", water_surface, 6.0, 12.0, False)
 
 # A manifest of another number of ranks: this run's ranks split (or not) otherwise.
 other = dict(rr)
