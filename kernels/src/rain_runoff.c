@@ -497,12 +497,14 @@ static gr_status gr_rain_runoff_step_indices(gr_rain_runoff *s) {
 
 /* The fused local inertial step's work-group (rain_runoff_li_step: a tile
  * 3 cells smaller each way, whose faces it computes again for the ring
- * around the tile) and whether it is the default. A GPU: 32 x 16 (a tile
- * of 29 x 13), as the kernel's registers and the local memory allow; one
- * launch by default, the step's traffic in one pass. A CPU: 64 x 16 (61 x
- * 13), three launches by default: with PoCL on this project's 2-core
- * machine the one launch took 1.4-1.7x the CPU time of the three at 256^2
- * to 1024^2 (its ring's faces again, and every cell's limiter five times),
+ * around the tile) and whether it is the default. A GPU: the largest of 32
+ * x 32, 32 x 16, 16 x 16, 16 x 8 and 8 x 8 that the kernel's registers and
+ * the local memory allow (a tile of 29 x 29 does 1.22 times the faces of
+ * its cells, 13 x 13 1.5 times); one launch by default, the step's traffic
+ * in one pass. A CPU: 64 x 16 (61 x 13), three launches by default: with
+ * PoCL on this project's 2-core machine the one launch took about 1.5 times
+ * the CPU time of the three at 256^2 to 1024^2 (its ring's faces again,
+ * every cell's limiter five times, and LLVM's code for its two regions),
  * where the caches hide most of what the three launches read again. */
 static gr_status gr_rain_runoff_li_shape(gr_rain_runoff *s) {
   cl_device_id dev = gr_context_device(s->ctx);
@@ -518,17 +520,20 @@ static gr_status gr_rain_runoff_li_shape(gr_rain_runoff *s) {
   if (err != CL_SUCCESS)
     return gr_cl_check(s->ctx, err, "Querying the device for the local inertial step's work-group");
   int gpu = (type & CL_DEVICE_TYPE_GPU) != 0;
-  size_t lx = gpu ? 32 : 64, ly = 16;
-  while (ly > 4 && (lx * ly > wg || 3 * lx * ly * sizeof(cl_float) > local_mem))
-    ly /= 2;
-  while (lx > 4 && (lx * ly > wg || 3 * lx * ly * sizeof(cl_float) > local_mem))
-    lx /= 2;
-  s->li_local[0] = lx;
-  s->li_local[1] = ly;
-  /* Too small a work-group to be worth it (a tile of 1 x 1 cells): the
-   * three launches. */
-  s->fused =
-      gpu && lx >= 8 && ly >= 8 && lx * ly <= wg && 3 * lx * ly * sizeof(cl_float) <= local_mem;
+  static const size_t gpu_shapes[][2] = {{32, 32}, {32, 16}, {16, 16}, {16, 8}, {8, 8}};
+  static const size_t cpu_shapes[][2] = {{64, 16}, {32, 16}, {16, 16}, {16, 8}, {8, 8}};
+  const size_t(*shapes)[2] = gpu ? gpu_shapes : cpu_shapes;
+  int fits = 0;
+  for (int k = 0; k < 5 && !fits; ++k) {
+    s->li_local[0] = shapes[k][0];
+    s->li_local[1] = shapes[k][1];
+    size_t items = shapes[k][0] * shapes[k][1];
+    fits = items <= wg && 3 * items * sizeof(cl_float) <= local_mem;
+  }
+  /* Where not even 8 x 8 fits (a tile of 5 x 5), the three launches only. */
+  if (!fits)
+    s->li_local[0] = s->li_local[1] = 0;
+  s->fused = gpu && fits;
   return GR_OK;
 }
 
@@ -1503,7 +1508,7 @@ void gr_rain_runoff_set_halo_exchange(gr_rain_runoff *s, gr_halo_exchange_fn fn,
 void gr_rain_runoff_set_fused(gr_rain_runoff *s, int on) {
   if (!s)
     return;
-  s->fused = on != 0 && s->li_local[0] >= 8 && s->li_local[1] >= 8;
+  s->fused = on != 0 && s->li_local[0] > 0; /* the device allows its work-group */
   s->args_set = 0;
 }
 
@@ -1985,7 +1990,7 @@ static gr_status gr_rain_runoff_bind(gr_rain_runoff *s, cl_float dt) {
     fixed |= bnd[e] != GR_RAIN_RUNOFF_B_OPEN ? 1 << e : 0;
   if (st == GR_OK)
     st = gr_kernel_arg(s->ctx, s->li_step, "fixed", sizeof(fixed), &fixed);
-  if (st == GR_OK)
+  if (st == GR_OK && s->li_local[0] > 0)
     st = gr_kernel_arg(s->ctx, s->li_step, "lmem",
                        3 * s->li_local[0] * s->li_local[1] * sizeof(cl_float), NULL);
   s->args_set = st == GR_OK;
@@ -2051,7 +2056,7 @@ static gr_status gr_rain_runoff_enqueue(gr_rain_runoff *s, double dt, int nsteps
       st = gr_buffer_create(s->ctx, CL_MEM_READ_WRITE, bytes, NULL, &s->k_alt);
   }
   /* The fused step's work-groups: tiles of li_local - 3 cells each way. */
-  size_t tx = s->li_local[0] - 3, ty = s->li_local[1] - 3;
+  size_t tx = fused ? s->li_local[0] - 3 : 1, ty = fused ? s->li_local[1] - 3 : 1;
   size_t gx = ((size_t)s->nxl + tx - 1) / tx * s->li_local[0];
   size_t gy = ((size_t)s->nyl + ty - 1) / ty * s->li_local[1];
   while (!sw && st == GR_OK && done < nsteps && !*stop) {
