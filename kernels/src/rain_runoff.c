@@ -117,6 +117,7 @@ struct gr_rain_runoff {
    * map_time), flux_edges' (h, limit, qx_old, qy_old, qx, qy), flux's
    * (qx_old, qy_old, qx, qy), limit's and update's (qx, qy; map_time). */
   cl_uint ix_step[9], ix_edges[6], ix_flux[4], ix_limit[2], ix_update[3];
+  cl_uint ix_rain[5]; /* rain_uniform of flux_edges, li_step, flux, limit, update */
   /* Shallow water's step: the points of stage 1, then per stage the faces
    * and the cells' update. */
   cl_kernel sw_prep, sw_faces[2], sw_update[2], sw_edges;
@@ -492,20 +493,23 @@ static gr_status gr_rain_runoff_step_indices(gr_rain_runoff *s) {
     st = gr_rain_runoff_arg_indices(s, s->limit, update, 2, s->ix_limit);
   if (st == GR_OK)
     st = gr_rain_runoff_arg_indices(s, s->update, update, 3, s->ix_update);
+  static const char *const rain[] = {"rain_uniform"};
+  cl_kernel li[5] = {s->flux_edges, s->li_step, s->flux, s->limit, s->update};
+  for (int k = 0; st == GR_OK && k < 5; ++k)
+    st = gr_rain_runoff_arg_indices(s, li[k], rain, 1, &s->ix_rain[k]);
   return st;
 }
 
 /* The fused local inertial step's work-group (rain_runoff_li_step: a tile
  * 3 cells smaller each way, whose faces it computes again for the ring
  * around the tile) and whether it is the default. A GPU: the largest of 32
- * x 32, 32 x 16, 16 x 16, 16 x 8 and 8 x 8 that the kernel's registers and
- * the local memory allow (a tile of 29 x 29 does 1.22 times the faces of
- * its cells, 13 x 13 1.5 times); one launch by default, the step's traffic
- * in one pass. A CPU: 64 x 16 (61 x 13), three launches by default: with
- * PoCL on this project's 2-core machine the one launch took about 1.5 times
- * the CPU time of the three at 256^2 to 1024^2 (its ring's faces again,
- * every cell's limiter five times, and LLVM's code for its two regions),
- * where the caches hide most of what the three launches read again. */
+ * x 16, 16 x 16, 16 x 8 and 8 x 8 that the kernel's registers and the local
+ * memory allow (a tile of 29 x 13 computes 1.36 times the faces of its
+ * cells, 13 x 13 1.5 times; the redundant reads hit the caches); one launch
+ * by default, the step's traffic in one pass. A CPU: 64 x 16 (61 x 13), three launches by default:
+ * with PoCL on this project's 2-core machine the one launch took about 1.5 times the CPU time of
+ * the three at 256^2 to 1024^2 (its ring's faces again, every cell's limiter five times, and LLVM's
+ * code for its two regions), where the caches hide most of what the three launches read again. */
 static gr_status gr_rain_runoff_li_shape(gr_rain_runoff *s) {
   cl_device_id dev = gr_context_device(s->ctx);
   cl_device_type type = 0;
@@ -520,7 +524,7 @@ static gr_status gr_rain_runoff_li_shape(gr_rain_runoff *s) {
   if (err != CL_SUCCESS)
     return gr_cl_check(s->ctx, err, "Querying the device for the local inertial step's work-group");
   int gpu = (type & CL_DEVICE_TYPE_GPU) != 0;
-  static const size_t gpu_shapes[][2] = {{32, 32}, {32, 16}, {16, 16}, {16, 8}, {8, 8}};
+  static const size_t gpu_shapes[][2] = {{32, 16}, {16, 16}, {16, 8}, {8, 8}, {8, 8}};
   static const size_t cpu_shapes[][2] = {{64, 16}, {32, 16}, {16, 16}, {16, 8}, {8, 8}};
   const size_t(*shapes)[2] = gpu ? gpu_shapes : cpu_shapes;
   int fits = 0;
@@ -1789,7 +1793,8 @@ static gr_status gr_rain_runoff_hyetograph_step(gr_rain_runoff *s, double t0, do
   cl_kernel swk[5] = {s->sw_prep, s->sw_faces[0], s->sw_update[0], s->sw_faces[1], s->sw_update[1]};
   gr_status st = GR_OK;
   for (int k = 0; st == GR_OK && k < (sw ? 5 : (s->fused ? 2 : 5)); ++k)
-    st = gr_kernel_arg(s->ctx, sw ? swk[k] : li[k], "rain_uniform", sizeof(rf), &rf);
+    st = sw ? gr_kernel_arg(s->ctx, swk[k], "rain_uniform", sizeof(rf), &rf)
+            : gr_rain_runoff_arg_at(s, li[k], s->ix_rain[k], sizeof(rf), &rf);
   if (st == GR_OK)
     *sum += (double)rf;
   return st;
