@@ -6,7 +6,9 @@
  * GRAUPEL_BENCH_FLOW_MODEL=0 benchmarks the shallow-water model;
  * GRAUPEL_BENCH_SW_FUSED=0/1 forces its stages' separate launches or one
  * launch each (gr_rain_runoff_set_sw_fused), GRAUPEL_BENCH_SW_TILE=TXxTY
- * the fused stages' tile (gr_rain_runoff_set_sw_tile). */
+ * the fused stages' tile (gr_rain_runoff_set_sw_tile);
+ * GRAUPEL_BENCH_FUSED=0/1 forces the local inertial step's three launches
+ * or its one (gr_rain_runoff_set_fused). */
 #include "bench.h"
 
 #include <math.h>
@@ -76,6 +78,11 @@ static gr_status rain_runoff_setup_piece(gr_context *ctx, int n, int j0, int ny,
       d[(size_t)jl * n + i] = 0.05f;
     }
   gr_status st = gr_rain_runoff_create(ctx, &g, &p, &r->sim);
+  /* GRAUPEL_BENCH_FUSED=0/1: the local inertial step in three launches or
+   * one (the device's default without it). */
+  const char *fused = getenv("GRAUPEL_BENCH_FUSED");
+  if (st == GR_OK && fused && *fused)
+    gr_rain_runoff_set_fused(r->sim, atoi(fused));
   if (st == GR_OK && !whole && link) {
     gr_rain_runoff_set_allreduce(r->sim, link->allreduce, link->allreduce_user);
     gr_rain_runoff_set_halo_exchange(r->sim, link->exchange, link->exchange_user);

@@ -35,7 +35,7 @@
 #include "reduce.h"
 
 GR_INLINE float gr_rain_runoff_input(__global const float *restrict field, int use_field,
-                                     float uniform, int c) {
+                                     float uniform, long c) {
   return use_field ? field[c] : uniform;
 }
 
@@ -314,7 +314,22 @@ __kernel void rain_runoff_flux_edges(
 }
 
 /* K = min(1, depth / outgoing depth in dt), a little less when limiting (see
- * GR_RAIN_RUNOFF_KEEP). Outgoing terms are summed in mirror-symmetric pairs. */
+ * GR_RAIN_RUNOFF_KEEP), from the cell's depth after rain and infiltration
+ * (wet) and its four faces' q*. Outgoing terms are summed in
+ * mirror-symmetric pairs.
+ * The x and y sums written differently (-min(qw, 0) is max(-qw, 0) but
+ * for the sign of a zero, which adding a value >= +0 drops) and the y sum
+ * waiting for the x sum (+ 0 ox: ox is finite and >= 0), so that CPU
+ * compilers do not pair them into <2 x float> values, which kept PoCL
+ * from vectorising the limit kernel; the same floats. */
+GR_INLINE float gr_rain_runoff_k(float wet, float qw, float qe, float qs, float qn, float dt,
+                                 float inv_dx, float inv_dy) {
+  float ox = -fmin(qw, 0.0f) + fmax(qe, 0.0f);
+  float oy = (fmax(-qs, 0.0f) + fmax(qn, 0.0f)) + 0.0f * ox;
+  float out = dt * (ox * inv_dx + oy * inv_dy);
+  return out > wet ? wet / out * GR_RAIN_RUNOFF_KEEP : 1.0f;
+}
+
 __kernel void rain_runoff_limit(__global const float *restrict h,
                                 __global const float *restrict rain,
                                 __global const float *restrict perm,
@@ -332,15 +347,7 @@ __kernel void rain_runoff_limit(__global const float *restrict h,
                                  GR_RAIN_RUNOFF_PERM(c), dt);
   float qw = qx[j * (nx + 1) + i], qe = qx[j * (nx + 1) + i + 1];
   float qs = qy[j * nx + i], qn = qy[(j + 1) * nx + i];
-  /* The x and y sums written differently (-min(qw, 0) is max(-qw, 0) but
-   * for the sign of a zero, which adding a value >= +0 drops) and the y sum
-   * waiting for the x sum (+ 0 ox: ox is finite and >= 0), so that CPU
-   * compilers do not pair them into <2 x float> values, which kept PoCL
-   * from vectorising this kernel; the same floats. */
-  float ox = -fmin(qw, 0.0f) + fmax(qe, 0.0f);
-  float oy = (fmax(-qs, 0.0f) + fmax(qn, 0.0f)) + 0.0f * ox;
-  float out = dt * (ox * inv_dx + oy * inv_dy);
-  limit[c] = out > wet ? wet / out * GR_RAIN_RUNOFF_KEEP : 1.0f;
+  limit[c] = gr_rain_runoff_k(wet, qw, qe, qs, qn, dt, inv_dx, inv_dy);
 }
 
 /* The kinematic rate (1/s) at a face from cell L to cell R, d apart: the
@@ -362,13 +369,17 @@ GR_INLINE float gr_rain_runoff_film_rate(float hL, float hR, float bL, float bR,
 }
 
 /* The local inertial model's kinematic rate for the stable step (see
- * gr_rain_runoff_stable_dt_impl), reduced over the owned cells like
- * rain_runoff_sw_speed: per cell, the largest rate of its four faces. Faces
- * within the local array only (the domain's edge faces take their cell's own
- * depth and bed slope, which its inner face sees too), and none into a
- * no-data cell (whose wall or cliff is no slope of the terrain). Each face's
- * rate is the same float from either side, so the maximum is the same
- * whichever way the domain is split. */
+ * gr_rain_runoff_stable_dt_impl), reduced like rain_runoff_sw_speed: the
+ * largest rate of the faces of the owned cells. Faces within the local
+ * array only (the domain's edge faces take their cell's own depth and bed
+ * slope, which its inner face sees too), and none into a no-data cell
+ * (whose wall or cliff is no slope of the terrain). Each face once: cell c
+ * takes the face west of it in the owned rows from the first owned column
+ * to the one past the last (whose west neighbour is owned), and the face
+ * south of it likewise; a face's rate is the same float whichever side
+ * computes it, so the maximum is the same whichever way the domain is
+ * split (and as when each cell took its four faces, at half the cost: the
+ * rate's cbrt is a call per face on PoCL). */
 __kernel void rain_runoff_li_speed(__global const float *restrict h,
                                    __global const float *restrict b,
                                    __global const float *restrict nodata, int use_nodata,
@@ -382,25 +393,19 @@ __kernel void rain_runoff_li_speed(__global const float *restrict h,
   float rate = 0.0f;
   for (int c = start + lid; c < end; c += wg) {
     int i = c % row, j = c / row;
-    if (i < own_x0 || i >= own_x1 || j < own_y0 || j >= own_y1 || !GR_RAIN_RUNOFF_ACTIVE(c))
+    if (!GR_RAIN_RUNOFF_ACTIVE(c))
       continue;
     float hc = h[c], bc = b[c];
-    if (i > 0 && GR_RAIN_RUNOFF_ACTIVE(c - 1))
+    if (j >= own_y0 && j < own_y1 && i >= own_x0 && i <= own_x1 && i > 0 &&
+        GR_RAIN_RUNOFF_ACTIVE(c - 1))
       rate = fmax(rate, gr_rain_runoff_film_rate(
                             h[c - 1], hc, b[c - 1], bc,
                             gr_rain_runoff_face_n2(n2map, use_n2, n2, c - 1, c), inv_dx, g, cfl));
-    if (i < row - 1 && GR_RAIN_RUNOFF_ACTIVE(c + 1))
-      rate = fmax(rate, gr_rain_runoff_film_rate(
-                            hc, h[c + 1], bc, b[c + 1],
-                            gr_rain_runoff_face_n2(n2map, use_n2, n2, c, c + 1), inv_dx, g, cfl));
-    if (j > 0 && GR_RAIN_RUNOFF_ACTIVE(c - row))
+    if (i >= own_x0 && i < own_x1 && j >= own_y0 && j <= own_y1 && j > 0 && j < rows &&
+        GR_RAIN_RUNOFF_ACTIVE(c - row))
       rate = fmax(rate, gr_rain_runoff_film_rate(
                             h[c - row], hc, b[c - row], bc,
                             gr_rain_runoff_face_n2(n2map, use_n2, n2, c - row, c), inv_dy, g, cfl));
-    if (j < rows - 1 && GR_RAIN_RUNOFF_ACTIVE(c + row))
-      rate = fmax(rate, gr_rain_runoff_film_rate(
-                            hc, h[c + row], bc, b[c + row],
-                            gr_rain_runoff_face_n2(n2map, use_n2, n2, c, c + row), inv_dy, g, cfl));
   }
   __local float *mine = gr_reduce_slots(scratch, 0, 1);
   mine[0] = rate;
@@ -463,13 +468,70 @@ GR_INLINE void gr_rain_runoff_map_cell(int c, float d, float u, float v, GR_RAIN
   }
 }
 
-/* The new depth from rain, infiltration and the four faces' limited
- * discharges; edge cells book what left (outflow) and what came in (inflow)
- * through the domain's edges.
+/* The new depth of cell c = (i, j) from its depth h0 before the step, its
+ * rain r, permeability k and source sc, its limiter kc and its neighbours'
+ * (kw, ke, ks, kn; 1 beyond the grid) and its four faces' q* (qw, qe, qs,
+ * qn), written to h_out; edge cells book what left (outflow) and what came
+ * in (inflow) through the domain's edges; the new state goes into the
+ * flood maps. rain_runoff_update and rain_runoff_li_step both call it.
  * The depth is Kahan-summed too (h - h_comp is the water to about twice
  * float precision): its rounding would otherwise be the same in every step
  * where a pond gains the same rain, and 10^5 such steps would show in the
  * water balance. */
+GR_INLINE void gr_rain_runoff_update_cell(
+    int i, int j, long c, int nx, int ny, float h0, float r, float k, float sc, float kc, float kw,
+    float ke, float ks, float kn, float qw, float qe, float qs, float qn,
+    __global float *restrict h_out, __global float *restrict h_comp,
+    __global const float *restrict nodata, int use_nodata, __global float *restrict infiltrated,
+    __global float *restrict infiltrated_comp, __global float *restrict outflow,
+    __global float *restrict outflow_comp, __global float *restrict inflow,
+    __global float *restrict inflow_comp, float dt, float inv_dx, float inv_dy,
+    GR_RAIN_RUNOFF_MAP_ARGS, float map_time) {
+  float inf = gr_rain_runoff_infiltration(h0, r, sc, k, dt);
+  float fw = gr_rain_runoff_limited(qw, kw, kc);
+  float fe = gr_rain_runoff_limited(qe, kc, ke);
+  float fs = gr_rain_runoff_limited(qs, ks, kc);
+  float fn = gr_rain_runoff_limited(qn, kc, kn);
+  float delta = ((r * dt - inf) + sc * dt) + dt * ((fw - fe) * inv_dx + (fs - fn) * inv_dy);
+  float y = delta - h_comp[c];
+  float t = h0 + y;
+  float comp = (t - h0) - y;
+  /* The limiter keeps t >= 0 but for rounding; a cell that ends at or
+   * below 0 is dry, with nothing owed. An outfall no-data cell drains. */
+  /* The helpers below get the arrays from cell c on (their index 0): c
+   * is a long here, whose addresses CPU compilers see as consecutive in
+   * rain_runoff_li_step, where an int's are not (see there). */
+  float gone = gr_rain_runoff_drain(nodata + c, use_nodata, 0, t, comp);
+  float d = t > 0.0f && gone == 0.0f ? t : 0.0f;
+  h_out[c] = d;
+  h_comp[c] = t > 0.0f && gone == 0.0f ? comp : 0.0f;
+  /* The flood maps from the new state, with the velocity VELOCITY reads
+   * (rain_runoff_derive's: an edge face limited by its own cell's K). */
+  float mw = i > 0 ? fw : gr_rain_runoff_limited(qw, kc, kc);
+  float me = i < nx - 1 ? fe : gr_rain_runoff_limited(qe, kc, kc);
+  float ms = j > 0 ? fs : gr_rain_runoff_limited(qs, kc, kc);
+  float mn = j < ny - 1 ? fn : gr_rain_runoff_limited(qn, kc, kc);
+  gr_rain_runoff_map_cell(0, d, 0.5f * (mw + me), 0.5f * (ms + mn), max_depth + c, max_speed + c,
+                          arrival + c, wet_time + c, wet_time_comp + c, max_hazard + c,
+                          wetting_depth, debris_factor, map_time, dt);
+  if (gone != 0.0f)
+    gr_kahan_add(outflow + c, outflow_comp + c, 0, gone);
+  if (inf != 0.0f)
+    gr_kahan_add(infiltrated + c, infiltrated_comp + c, 0, inf);
+  /* The sources' water is inflow, the very float the depth gained. */
+  if (sc != 0.0f)
+    gr_kahan_add(inflow + c, inflow_comp + c, 0, sc * dt);
+  if (i == 0 || j == 0 || i == nx - 1 || j == ny - 1) {
+    /* What the edge faces carry out of the cell (negative: in). */
+    float ow = i == 0 ? -fw : 0.0f, oe = i == nx - 1 ? fe : 0.0f;
+    float os = j == 0 ? -fs : 0.0f, on = j == ny - 1 ? fn : 0.0f;
+    gr_rain_runoff_book_edges(outflow + c, outflow_comp + c, inflow + c, inflow_comp + c, 0, dt,
+                              inv_dx, inv_dy, ow, oe, os, on);
+  }
+}
+
+/* The new depth from rain, infiltration and the four faces' limited
+ * discharges (gr_rain_runoff_update_cell). */
 __kernel void
 rain_runoff_update(__global float *restrict h, __global float *restrict h_comp,
                    __global const float *restrict rain, __global const float *restrict perm,
@@ -486,11 +548,6 @@ rain_runoff_update(__global float *restrict h, __global float *restrict h_comp,
   if (!gr_inside(i, j, nx, ny))
     return;
   int c = gr_idx(i, j, nx);
-  float r = GR_RAIN_RUNOFF_RAIN(c);
-  float k = GR_RAIN_RUNOFF_PERM(c);
-  float sc = GR_RAIN_RUNOFF_SRC(c);
-  float h0 = h[c];
-  float inf = gr_rain_runoff_infiltration(h0, r, sc, k, dt);
   float kc = limit[c];
   /* Masked, not clamped, neighbours (see rain_runoff_flux): an edge face
    * never uses the limiter beyond the grid. */
@@ -498,42 +555,161 @@ rain_runoff_update(__global float *restrict h, __global float *restrict h_comp,
   float ks = j > 0 ? limit[c - nx] : 1.0f, kn = j < ny - 1 ? limit[c + nx] : 1.0f;
   float qw = qx[j * (nx + 1) + i], qe = qx[j * (nx + 1) + i + 1];
   float qs = qy[j * nx + i], qn = qy[(j + 1) * nx + i];
-  float fw = gr_rain_runoff_limited(qw, kw, kc);
-  float fe = gr_rain_runoff_limited(qe, kc, ke);
-  float fs = gr_rain_runoff_limited(qs, ks, kc);
-  float fn = gr_rain_runoff_limited(qn, kc, kn);
-  float delta = ((r * dt - inf) + sc * dt) + dt * ((fw - fe) * inv_dx + (fs - fn) * inv_dy);
-  float y = delta - h_comp[c];
-  float t = h0 + y;
-  float comp = (t - h0) - y;
-  /* The limiter keeps t >= 0 but for rounding; a cell that ends at or
-   * below 0 is dry, with nothing owed. An outfall no-data cell drains. */
-  float gone = gr_rain_runoff_drain(nodata, use_nodata, c, t, comp);
-  float d = t > 0.0f && gone == 0.0f ? t : 0.0f;
-  h[c] = d;
-  h_comp[c] = t > 0.0f && gone == 0.0f ? comp : 0.0f;
-  /* The flood maps from the new state, with the velocity VELOCITY reads
-   * (rain_runoff_derive's: an edge face limited by its own cell's K). */
-  float mw = i > 0 ? fw : gr_rain_runoff_limited(qw, kc, kc);
-  float me = i < nx - 1 ? fe : gr_rain_runoff_limited(qe, kc, kc);
-  float ms = j > 0 ? fs : gr_rain_runoff_limited(qs, kc, kc);
-  float mn = j < ny - 1 ? fn : gr_rain_runoff_limited(qn, kc, kc);
-  gr_rain_runoff_map_cell(c, d, 0.5f * (mw + me), 0.5f * (ms + mn), max_depth, max_speed, arrival,
-                          wet_time, wet_time_comp, max_hazard, wetting_depth, debris_factor,
-                          map_time, dt);
-  if (gone != 0.0f)
-    gr_kahan_add(outflow, outflow_comp, c, gone);
-  if (inf != 0.0f)
-    gr_kahan_add(infiltrated, infiltrated_comp, c, inf);
-  /* The sources' water is inflow, the very float the depth gained. */
-  if (sc != 0.0f)
-    gr_kahan_add(inflow, inflow_comp, c, sc * dt);
-  if (i == 0 || j == 0 || i == nx - 1 || j == ny - 1) {
-    /* What the edge faces carry out of the cell (negative: in). */
-    float ow = i == 0 ? -fw : 0.0f, oe = i == nx - 1 ? fe : 0.0f;
-    float os = j == 0 ? -fs : 0.0f, on = j == ny - 1 ? fn : 0.0f;
-    gr_rain_runoff_book_edges(outflow, outflow_comp, inflow, inflow_comp, c, dt, inv_dx, inv_dy, ow,
-                              oe, os, on);
+  gr_rain_runoff_update_cell(i, j, c, nx, ny, h[c], GR_RAIN_RUNOFF_RAIN(c), GR_RAIN_RUNOFF_PERM(c),
+                             GR_RAIN_RUNOFF_SRC(c), kc, kw, ke, ks, kn, qw, qe, qs, qn, h, h_comp,
+                             nodata, use_nodata, infiltrated, infiltrated_comp, outflow,
+                             outflow_comp, inflow, inflow_comp, dt, inv_dx, inv_dy, max_depth,
+                             max_speed, arrival, wet_time, wet_time_comp, max_hazard, wetting_depth,
+                             debris_factor, map_time);
+}
+
+/* The local inertial step in one launch (FlowModel 1; the same floats as
+ * rain_runoff_flux, rain_runoff_limit and rain_runoff_update in turn: the
+ * same expressions, FP_CONTRACT off). A work-group of lx x ly work-items
+ * owns a tile of (lx - 3) x (ly - 3) cells; tiles overlap by 3 columns and
+ * rows, and work-item (a, b) stands for cell (x0 - 1 + a, y0 - 1 + b) of
+ * the tile at (x0, y0):
+ *   1. the x-face left of its cell (rows b < ly - 1) and the y-face below
+ *      it (columns a < lx - 1), as rain_runoff_flux writes them: every face
+ *      of the tile's cells and of the ring of cells around them, into
+ *      local memory with the cell's depth after rain and infiltration; the
+ *      tile's own faces (and the grid's east and north edge faces in the
+ *      last tiles) also to qx, qy;
+ *   2. for the tile's cells, the limiter K of the cell and of its four
+ *      neighbours from the faces in local memory (the cell's own also to
+ *      limit_out), then the continuity update (gr_rain_runoff_update_cell).
+ * A face reads cells up to two away (and the limiters up to two more in
+ * line), all of the step's start: h and limit are read and h_out and
+ * limit_out written (the host swaps them after the step), as the face
+ * arrays alternate. Edges of other kinds than open (bit e of `fixed`: west,
+ * east, south, north) were written to qx, qy by rain_runoff_flux_edges,
+ * launched before: those faces are read from there. Local memory: 3 lx ly
+ * floats (lmem). */
+__kernel void rain_runoff_li_step(
+    __global const float *restrict h, __global float *restrict h_out,
+    __global float *restrict h_comp, __global const float *restrict b,
+    __global const float *restrict rain, __global const float *restrict perm,
+    __global const float *restrict src, int use_src, __global const float *restrict nodata,
+    int use_nodata, __global const float *restrict qx_old, __global const float *restrict qy_old,
+    __global float *restrict qx, __global float *restrict qy, __global const float *restrict limit,
+    __global float *restrict limit_out, int nx, int ny, float dt, float inv_dx, float inv_dy,
+    float g, float n2, __global const float *restrict n2map, int use_n2, float theta, int use_rain,
+    float rain_uniform, int use_perm, float perm_uniform, __global float *restrict infiltrated,
+    __global float *restrict infiltrated_comp, __global float *restrict outflow,
+    __global float *restrict outflow_comp, __global float *restrict inflow,
+    __global float *restrict inflow_comp, int fixed, GR_RAIN_RUNOFF_MAP_ARGS, float map_time,
+    __local float *restrict lmem) {
+  const int lx = (int)get_local_size(0), ly = (int)get_local_size(1);
+  const int a = (int)get_local_id(0), bl = (int)get_local_id(1);
+  const int x0 = (int)get_group_id(0) * (lx - 3), y0 = (int)get_group_id(1) * (ly - 3);
+  const int i = x0 - 1 + a, j = y0 - 1 + bl, l = bl * lx + a;
+  __local float *fxl = lmem, *fyl = lmem + lx * ly, *wl = lmem + 2 * lx * ly;
+  int c = j * nx + i;
+  bool in_c = i >= 0 && j >= 0 && i < nx && j < ny;
+  float hc = in_c ? gr_rain_runoff_wet(h[c], GR_RAIN_RUNOFF_RAIN(c), GR_RAIN_RUNOFF_SRC(c),
+                                       GR_RAIN_RUNOFF_PERM(c), dt)
+                  : 0.0f;
+  float bc = in_c ? b[c] : 0.0f;
+  float kc = in_c ? limit[c] : 1.0f;
+  /* Rows and columns the tile owns (faces: also the grid's far edge). */
+  bool row_own = bl >= 1 && bl < ly - 2, col_own = a >= 1 && a < lx - 2;
+  float fxv = 0.0f, fyv = 0.0f;
+  if (bl < ly - 1 && j >= 0 && j < ny && i >= 0 && i <= nx) {
+    /* rain_runoff_flux's x-face (i, j). */
+    int w = c - 1;
+    bool in_w = i > 0;
+    float hw = in_w ? gr_rain_runoff_wet(h[w], GR_RAIN_RUNOFF_RAIN(w), GR_RAIN_RUNOFF_SRC(w),
+                                         GR_RAIN_RUNOFF_PERM(w), dt)
+                    : 0.0f;
+    float bw = in_w ? b[w] : 0.0f;
+    float kw = in_w ? limit[w] : 1.0f;
+    float hL = i == 0 ? 0.0f : hw, bL = i == 0 ? bc : bw;
+    float hR = i == nx ? 0.0f : hc, bR = i == nx ? bw : bc;
+    int f = j * (nx + 1) + i;
+    float own = gr_rain_runoff_limited(qx_old[f], kw, kc);
+    float before =
+        i > 0 ? gr_rain_runoff_limited(qx_old[f - 1], i > 1 ? limit[c - 2] : 1.0f, kw) : 0.0f;
+    float after =
+        i < nx ? gr_rain_runoff_limited(qx_old[f + 1], kc, i < nx - 1 ? limit[c + 1] : 1.0f) : 0.0f;
+    float prev = gr_rain_runoff_smooth(own, before, after, theta, i == 0 || i == nx);
+    float n2f = gr_rain_runoff_face_n2(n2map, use_n2, n2, in_w ? w : c, i < nx ? c : w);
+    float q = gr_rain_runoff_face(hL, hR, bL, bR, prev, own, dt, g, n2f, inv_dx);
+    if (i == 0)
+      q = fmin(q, 0.0f);
+    if (i == nx)
+      q = fmax(q, 0.0f);
+    bool kept = (i == 0 && (fixed & 1)) || (i == nx && (fixed & 2));
+    if (kept)
+      q = qx[f];
+    else if (row_own && (col_own || (a == lx - 2 && i == nx)))
+      qx[f] = q;
+    fxv = q;
+  }
+  if (a < lx - 1 && i >= 0 && i < nx && j >= 0 && j <= ny) {
+    /* rain_runoff_flux's y-face (i, j). */
+    int s = c - nx;
+    bool in_s = j > 0;
+    float hs = in_s ? gr_rain_runoff_wet(h[s], GR_RAIN_RUNOFF_RAIN(s), GR_RAIN_RUNOFF_SRC(s),
+                                         GR_RAIN_RUNOFF_PERM(s), dt)
+                    : 0.0f;
+    float bs = in_s ? b[s] : 0.0f;
+    float ks = in_s ? limit[s] : 1.0f;
+    float hL = j == 0 ? 0.0f : hs, bL = j == 0 ? bc : bs;
+    float hR = j == ny ? 0.0f : hc, bR = j == ny ? bs : bc;
+    int f = c;
+    float own = gr_rain_runoff_limited(qy_old[f], ks, kc);
+    float before =
+        j > 0 ? gr_rain_runoff_limited(qy_old[f - nx], j > 1 ? limit[c - 2 * nx] : 1.0f, ks) : 0.0f;
+    float after =
+        j < ny ? gr_rain_runoff_limited(qy_old[f + nx], kc, j < ny - 1 ? limit[c + nx] : 1.0f)
+               : 0.0f;
+    float prev = gr_rain_runoff_smooth(own, before, after, theta, j == 0 || j == ny);
+    float n2f = gr_rain_runoff_face_n2(n2map, use_n2, n2, in_s ? s : c, j < ny ? c : s);
+    float q = gr_rain_runoff_face(hL, hR, bL, bR, prev, own, dt, g, n2f, inv_dy);
+    if (j == 0)
+      q = fmin(q, 0.0f);
+    if (j == ny)
+      q = fmax(q, 0.0f);
+    bool kept = (j == 0 && (fixed & 4)) || (j == ny && (fixed & 8));
+    if (kept)
+      q = qy[f];
+    else if (col_own && (row_own || (bl == ly - 2 && j == ny)))
+      qy[f] = q;
+    fyv = q;
+  }
+  fxl[l] = fxv;
+  fyl[l] = fyv;
+  /* The cell's depth after rain and infiltration for the limiter, -1 off
+   * the grid. */
+  wl[l] = in_c ? hc : -1.0f;
+  barrier(CLK_LOCAL_MEM_FENCE);
+  /* Nothing computed before the barrier is used after it, and the
+   * work-item's indices are computed anew as longs, so that the compiler
+   * cannot share them with the ints above: PoCL keeps values that live
+   * across a barrier in an array per work-item, and indices read back from
+   * there made LLVM gather and scatter every access after the barrier (a
+   * step 4x slower on PoCL). */
+  const long a2 = (long)get_local_id(0), b2 = (long)get_local_id(1);
+  const long i2 = x0 - 1 + a2, j2 = y0 - 1 + b2, l2 = b2 * lx + a2, c2 = j2 * nx + i2;
+  if (i2 < nx && j2 < ny && a2 >= 1 && a2 < lx - 2 && b2 >= 1 && b2 < ly - 2) {
+    /* rain_runoff_limit's K of the cell and its four neighbours (each
+     * neighbour's again in the cells around it: a third region would need
+     * a third way to compute the indices, see above); 1 beyond the grid,
+     * as rain_runoff_update takes it there. */
+#define GR_LI_K(m)                                                                                 \
+  (wl[m] >= 0.0f                                                                                   \
+       ? gr_rain_runoff_k(wl[m], fxl[m], fxl[(m) + 1], fyl[m], fyl[(m) + lx], dt, inv_dx, inv_dy)  \
+       : 1.0f)
+    float kc = GR_LI_K(l2);
+    limit_out[c2] = kc;
+    gr_rain_runoff_update_cell(
+        (int)i2, (int)j2, c2, nx, ny, h[c2], GR_RAIN_RUNOFF_RAIN(c2), GR_RAIN_RUNOFF_PERM(c2),
+        GR_RAIN_RUNOFF_SRC(c2), kc, GR_LI_K(l2 - 1), GR_LI_K(l2 + 1), GR_LI_K(l2 - lx),
+        GR_LI_K(l2 + lx), fxl[l2], fxl[l2 + 1], fyl[l2], fyl[l2 + lx], h_out, h_comp, nodata,
+        use_nodata, infiltrated, infiltrated_comp, outflow, outflow_comp, inflow, inflow_comp, dt,
+        inv_dx, inv_dy, max_depth, max_speed, arrival, wet_time, wet_time_comp, max_hazard,
+        wetting_depth, debris_factor, map_time);
+#undef GR_LI_K
   }
 }
 

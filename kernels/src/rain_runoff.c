@@ -114,6 +114,20 @@ struct gr_rain_runoff {
   gr_rain_runoff_params params;
   cl_kernel flux, flux_edges, limit, update, reduce, derive, sw_speed, maps, source;
   cl_kernel li_speed; /* the local inertial model's kinematic rate (the stable step) */
+  /* The local inertial step in one launch (rain_runoff_li_step; fused: it
+   * is used), its work-group (li_local; the tile is 3 smaller each way),
+   * and the depth and limiter it writes, swapped with h and k after every
+   * such step (h_alt, k_alt: made on first use). */
+  cl_kernel li_step;
+  int fused;
+  size_t li_local[2];
+  cl_mem h_alt, k_alt;
+  /* The indices of the arguments that change every step, looked up once:
+   * li_step's (h, h_out, limit, limit_out, qx_old, qy_old, qx, qy,
+   * map_time), flux_edges' (h, limit, qx_old, qy_old, qx, qy), flux's
+   * (qx_old, qy_old, qx, qy), limit's and update's (qx, qy; map_time). */
+  cl_uint ix_step[9], ix_edges[6], ix_flux[4], ix_limit[2], ix_update[3];
+  cl_uint ix_rain[5]; /* rain_uniform of flux_edges, li_step, flux, limit, update */
   /* Shallow water's step: the points of stage 1, then per stage the faces
    * and the cells' update. */
   cl_kernel sw_prep, sw_faces[2], sw_update[2], sw_edges;
@@ -195,7 +209,8 @@ struct gr_rain_runoff {
    * dt (steps_dt). */
   int args_set;
   cl_float args_dt;
-  int maps_bound; /* the maps kernel's arguments that change only with the parameters */
+  cl_mem args_h, args_k; /* the depth and limiter the step kernels were bound to */
+  int maps_bound;        /* the maps kernel's arguments that change only with the parameters */
   gr_progress_fn progress;
   void *progress_user;
   gr_allreduce_fn allreduce; /* NULL: this simulation is the whole domain's only piece */
@@ -456,6 +471,101 @@ static gr_status gr_rain_runoff_args(gr_rain_runoff *s, cl_kernel k, const gr_ra
 #define GR_RAIN_RUNOFF_ARGS(s, k, args)                                                            \
   gr_rain_runoff_args((s), (k), (args), sizeof(args) / sizeof((args)[0]))
 
+/* The indices of kernel k's arguments called names[0..n) (the programs
+ * carry argument names, gr_program_get): the step loops set the arguments
+ * that change every step by index, without gr_kernel_arg's look-up (a
+ * mutex and a query per argument), which shows on small grids. */
+static gr_status gr_rain_runoff_arg_indices(gr_rain_runoff *s, cl_kernel k,
+                                            const char *const *names, int n, cl_uint *out) {
+  cl_uint nargs = 0;
+  cl_int err = clGetKernelInfo(k, CL_KERNEL_NUM_ARGS, sizeof(nargs), &nargs, NULL);
+  for (int a = 0; err == CL_SUCCESS && a < n; ++a) {
+    out[a] = nargs;
+    for (cl_uint i = 0; err == CL_SUCCESS && i < nargs && out[a] == nargs; ++i) {
+      char name[64] = "";
+      err = clGetKernelArgInfo(k, i, CL_KERNEL_ARG_NAME, sizeof(name), name, NULL);
+      if (err == CL_SUCCESS && strcmp(name, names[a]) == 0)
+        out[a] = i;
+    }
+    if (err == CL_SUCCESS && out[a] == nargs)
+      return gr_set_error(s->ctx, GR_ERR_OPENCL,
+                          "A rain runoff step kernel has no argument '%s': the kernels' source "
+                          "and rain_runoff.c disagree; rebuild Graupel.",
+                          names[a]);
+  }
+  return gr_cl_check(s->ctx, err, "Reading the rain runoff step kernels' argument names");
+}
+
+/* Sets argument `index` of kernel k (see gr_rain_runoff_arg_indices). */
+static gr_status gr_rain_runoff_arg_at(gr_rain_runoff *s, cl_kernel k, cl_uint index, size_t size,
+                                       const void *value) {
+  return gr_cl_check(s->ctx, clSetKernelArg(k, index, size, value),
+                     "Setting a rain runoff step kernel's argument");
+}
+
+/* Looks up the indices of the step kernels' changing arguments. */
+static gr_status gr_rain_runoff_step_indices(gr_rain_runoff *s) {
+  static const char *const step[] = {"h",      "h_out", "limit", "limit_out", "qx_old",
+                                     "qy_old", "qx",    "qy",    "map_time"};
+  static const char *const edges[] = {"h", "limit", "qx_old", "qy_old", "qx", "qy"};
+  static const char *const update[] = {"qx", "qy", "map_time"};
+  gr_status st = gr_rain_runoff_arg_indices(s, s->li_step, step, 9, s->ix_step);
+  if (st == GR_OK)
+    st = gr_rain_runoff_arg_indices(s, s->flux_edges, edges, 6, s->ix_edges);
+  if (st == GR_OK)
+    st = gr_rain_runoff_arg_indices(s, s->flux, edges + 2, 4, s->ix_flux);
+  if (st == GR_OK)
+    st = gr_rain_runoff_arg_indices(s, s->limit, update, 2, s->ix_limit);
+  if (st == GR_OK)
+    st = gr_rain_runoff_arg_indices(s, s->update, update, 3, s->ix_update);
+  static const char *const rain[] = {"rain_uniform"};
+  cl_kernel li[5] = {s->flux_edges, s->li_step, s->flux, s->limit, s->update};
+  for (int k = 0; st == GR_OK && k < 5; ++k)
+    st = gr_rain_runoff_arg_indices(s, li[k], rain, 1, &s->ix_rain[k]);
+  return st;
+}
+
+/* The fused local inertial step's work-group (rain_runoff_li_step: a tile
+ * 3 cells smaller each way, whose faces it computes again for the ring
+ * around the tile) and whether it is the default. A GPU: the largest of 32
+ * x 16, 16 x 16, 16 x 8 and 8 x 8 that the kernel's registers and the local
+ * memory allow (a tile of 29 x 13 computes 1.36 times the faces of its
+ * cells, 13 x 13 1.5 times; the redundant reads hit the caches); one launch
+ * by default, the step's traffic in one pass. A CPU: 64 x 16 (61 x 13), three launches by default:
+ * with PoCL on this project's 2-core machine the one launch took about 1.5 times the CPU time of
+ * the three at 256^2 to 1024^2 (its ring's faces again, every cell's limiter five times, and LLVM's
+ * code for its two regions), where the caches hide most of what the three launches read again. */
+static gr_status gr_rain_runoff_li_shape(gr_rain_runoff *s) {
+  cl_device_id dev = gr_context_device(s->ctx);
+  cl_device_type type = 0;
+  cl_ulong local_mem = 0;
+  size_t wg = 0;
+  cl_int err = clGetDeviceInfo(dev, CL_DEVICE_TYPE, sizeof(type), &type, NULL);
+  if (err == CL_SUCCESS)
+    err = clGetDeviceInfo(dev, CL_DEVICE_LOCAL_MEM_SIZE, sizeof(local_mem), &local_mem, NULL);
+  if (err == CL_SUCCESS)
+    err =
+        clGetKernelWorkGroupInfo(s->li_step, dev, CL_KERNEL_WORK_GROUP_SIZE, sizeof(wg), &wg, NULL);
+  if (err != CL_SUCCESS)
+    return gr_cl_check(s->ctx, err, "Querying the device for the local inertial step's work-group");
+  int gpu = (type & CL_DEVICE_TYPE_GPU) != 0;
+  static const size_t gpu_shapes[][2] = {{32, 16}, {16, 16}, {16, 8}, {8, 8}, {8, 8}};
+  static const size_t cpu_shapes[][2] = {{64, 16}, {32, 16}, {16, 16}, {16, 8}, {8, 8}};
+  const size_t(*shapes)[2] = gpu ? gpu_shapes : cpu_shapes;
+  int fits = 0;
+  for (int k = 0; k < 5 && !fits; ++k) {
+    s->li_local[0] = shapes[k][0];
+    s->li_local[1] = shapes[k][1];
+    size_t items = shapes[k][0] * shapes[k][1];
+    fits = items <= wg && 3 * items * sizeof(cl_float) <= local_mem;
+  }
+  /* Where not even 8 x 8 fits (a tile of 5 x 5), the three launches only. */
+  if (!fits)
+    s->li_local[0] = s->li_local[1] = 0;
+  s->fused = gpu && fits;
+  return GR_OK;
+}
+
 static gr_status gr_rain_runoff_fill(gr_rain_runoff *s, cl_mem buf, float value, size_t bytes) {
   return gr_cl_check(s->ctx,
                      clEnqueueFillBuffer(gr_context_queue(s->ctx), buf, &value, sizeof(value), 0,
@@ -573,10 +683,8 @@ static gr_status gr_rain_runoff_maps_update(gr_rain_runoff *s, double time, doub
     cl_int nx = s->nxl, ny = s->nyl, sw = s->params.flow_model == GR_FLOW_SHALLOW_WATER;
     cl_float wd = (cl_float)s->params.wetting_depth, df = (cl_float)s->params.debris_factor;
     const gr_rain_runoff_arg args[] = {
-        {"h", m, &s->h},
         {"qu", m, &s->qu},
         {"qv", m, &s->qv},
-        {"limit", m, &s->k},
         {"max_depth", m, &s->map[0]},
         {"max_speed", m, &s->map[1]},
         {"arrival", m, &s->map[2]},
@@ -593,11 +701,10 @@ static gr_status gr_rain_runoff_maps_update(gr_rain_runoff *s, double time, doub
     s->maps_bound = st == GR_OK;
   }
   cl_float t = (cl_float)time, dtf = (cl_float)dt;
+  /* The depth and limiter alternate with the fused local inertial step. */
   const gr_rain_runoff_arg step[] = {
-      {"qx", m, &s->qx[s->cur]},
-      {"qy", m, &s->qy[s->cur]},
-      {"time", sizeof(t), &t},
-      {"dt", sizeof(dtf), &dtf},
+      {"h", m, &s->h},           {"limit", m, &s->k},     {"qx", m, &s->qx[s->cur]},
+      {"qy", m, &s->qy[s->cur]}, {"time", sizeof(t), &t}, {"dt", sizeof(dtf), &dtf},
   };
   if (st == GR_OK)
     st = GR_RAIN_RUNOFF_ARGS(s, s->maps, step);
@@ -820,6 +927,12 @@ gr_status gr_rain_runoff_create(gr_context *ctx, const gr_grid *grid,
     st = gr_kernel_create(ctx, prog, "rain_runoff_maps", &s->maps);
   if (st == GR_OK)
     st = gr_kernel_create(ctx, prog, "rain_runoff_source", &s->source);
+  if (st == GR_OK)
+    st = gr_kernel_create(ctx, prog, "rain_runoff_li_step", &s->li_step);
+  if (st == GR_OK)
+    st = gr_rain_runoff_step_indices(s);
+  if (st == GR_OK)
+    st = gr_rain_runoff_li_shape(s);
   for (int a = 0; st == GR_OK && a < GR_RAIN_RUNOFF_MAP_ARRAYS; ++a)
     st = gr_buffer_create(ctx, CL_MEM_READ_WRITE, bytes, NULL, &s->map[a]);
   cl_mem *per_cell[] = {&s->h,     &s->h_c, &s->b,    &s->k,  &s->inf, &s->inf_c, &s->out,
@@ -872,10 +985,10 @@ gr_status gr_rain_runoff_create(gr_context *ctx, const gr_grid *grid,
 void gr_rain_runoff_destroy(gr_rain_runoff *s) {
   if (!s)
     return;
-  cl_kernel kernels[] = {s->flux,         s->limit,        s->update,      s->reduce,
-                         s->derive,       s->sw_prep,      s->sw_faces[0], s->sw_faces[1],
-                         s->sw_update[0], s->sw_update[1], s->sw_speed,    s->maps,
-                         s->source,       s->flux_edges,   s->sw_edges,    s->li_speed};
+  cl_kernel kernels[] = {
+      s->flux,        s->limit,       s->update,       s->reduce,       s->derive,   s->sw_prep,
+      s->sw_faces[0], s->sw_faces[1], s->sw_update[0], s->sw_update[1], s->sw_speed, s->maps,
+      s->source,      s->flux_edges,  s->sw_edges,     s->li_speed,     s->li_step};
   for (size_t i = 0; i < sizeof(kernels) / sizeof(kernels[0]); ++i)
     if (kernels[i])
       clReleaseKernel(kernels[i]);
@@ -884,7 +997,7 @@ void gr_rain_runoff_destroy(gr_rain_runoff *s) {
                     &s->perm, &s->scratch, &s->dummy,  &s->qu,    &s->qv,    &s->h1,    &s->qu1,
                     &s->qv1,  &s->qu0,     &s->qv0,    &s->dh1,   &s->in,    &s->in_c,  &s->pts,
                     &s->src,  &s->n2map,   &s->nodata, &s->wh,    &s->wu,    &s->wv,    &s->u1,
-                    &s->v1,   &s->fx,      &s->fy};
+                    &s->v1,   &s->fx,      &s->fy,     &s->h_alt, &s->k_alt};
   for (size_t i = 0; i < sizeof(bufs) / sizeof(bufs[0]); ++i)
     gr_buffer_release(bufs[i]);
   for (int a = 0; a < GR_RAIN_RUNOFF_MAP_ARRAYS; ++a)
@@ -1527,6 +1640,13 @@ gr_status gr_rain_runoff_set_sw_tile(gr_rain_runoff *s, int tx, int ty) {
   return GR_RAIN_RUNOFF_KEEP_ERROR(s, gr_rain_runoff_sw_shape(s, (size_t)tx, (size_t)ty, 0));
 }
 
+void gr_rain_runoff_set_fused(gr_rain_runoff *s, int on) {
+  if (!s)
+    return;
+  s->fused = on != 0 && s->li_local[0] > 0; /* the device allows its work-group */
+  s->args_set = 0;
+}
+
 /* After a step of a piece with a ring: the caller's exchange refreshes it. */
 static gr_status gr_rain_runoff_exchange(gr_rain_runoff *s, long long step) {
   gr_status st = s->halo_exchange(s->halo_user);
@@ -1835,11 +1955,12 @@ static gr_status gr_rain_runoff_hyetograph_step(gr_rain_runoff *s, double t0, do
   cl_float rf =
       (cl_float)(gr_rain_runoff_table_integral(s->hy_t, s->hy_r, s->hy_n, t0, t1) / (t1 - t0));
   int sw = s->params.flow_model == GR_FLOW_SHALLOW_WATER;
-  cl_kernel li[4] = {s->flux, s->flux_edges, s->limit, s->update};
+  cl_kernel li[5] = {s->flux_edges, s->li_step, s->flux, s->limit, s->update};
   cl_kernel swk[5] = {s->sw_prep, s->sw_faces[0], s->sw_update[0], s->sw_faces[1], s->sw_update[1]};
   gr_status st = GR_OK;
-  for (int k = 0; st == GR_OK && k < (sw ? 5 : 4); ++k)
-    st = gr_kernel_arg(s->ctx, sw ? swk[k] : li[k], "rain_uniform", sizeof(rf), &rf);
+  for (int k = 0; st == GR_OK && k < (sw ? 5 : (s->fused ? 2 : 5)); ++k)
+    st = sw ? gr_kernel_arg(s->ctx, swk[k], "rain_uniform", sizeof(rf), &rf)
+            : gr_rain_runoff_arg_at(s, li[k], s->ix_rain[k], sizeof(rf), &rf);
   for (int k = 0; st == GR_OK && sw && k < 2; ++k)
     st = gr_kernel_arg(s->ctx, s->sw_stage[k], "rain_uniform", sizeof(rf), &rf);
   if (st == GR_OK)
@@ -1863,8 +1984,13 @@ static double gr_rain_runoff_min_n(const gr_rain_runoff *s) {
 /* Binds every step-kernel argument but the alternating face arrays, when
  * something they hold has changed since the last step. */
 static gr_status gr_rain_runoff_bind(gr_rain_runoff *s, cl_float dt) {
-  if (s->args_set && s->args_dt == dt)
+  /* The fused step sets the depth and limiter every step (they alternate);
+   * the other kernels keep those they were bound to. */
+  int fused = s->fused && s->params.flow_model == GR_FLOW_LOCAL_INERTIAL;
+  if (s->args_set && s->args_dt == dt && (fused || (s->args_h == s->h && s->args_k == s->k)))
     return GR_OK;
+  s->args_h = s->h;
+  s->args_k = s->k;
   const gr_rain_runoff_params *p = &s->params;
   const gr_grid *gd = &s->grid;
   cl_int nx = s->nxl, ny = s->nyl;
@@ -2014,22 +2140,39 @@ static gr_status gr_rain_runoff_bind(gr_rain_runoff *s, cl_float dt) {
     s->args_dt = dt;
     return st;
   }
-  cl_kernel kernels[] = {s->flux, s->flux_edges, s->limit, s->update};
+  cl_kernel kernels[] = {s->flux, s->flux_edges, s->limit, s->update, s->li_step};
   gr_status st = GR_OK;
-  for (int i = 0; st == GR_OK && i < 4; ++i)
+  for (int i = 0; st == GR_OK && i < 5; ++i)
     st = GR_RAIN_RUNOFF_ARGS(s, kernels[i], common);
   if (st == GR_OK)
     st = GR_RAIN_RUNOFF_ARGS(s, s->flux, flux);
   if (st == GR_OK)
     st = GR_RAIN_RUNOFF_ARGS(s, s->flux_edges, flux);
   if (st == GR_OK)
+    st = GR_RAIN_RUNOFF_ARGS(s, s->li_step, flux);
+  if (st == GR_OK)
     st = gr_kernel_arg(s->ctx, s->flux, "theta", sizeof(theta), &theta);
+  if (st == GR_OK)
+    st = gr_kernel_arg(s->ctx, s->li_step, "theta", sizeof(theta), &theta);
   if (st == GR_OK)
     st = GR_RAIN_RUNOFF_ARGS(s, s->flux_edges, edges);
   if (st == GR_OK)
     st = GR_RAIN_RUNOFF_ARGS(s, s->update, update);
   if (st == GR_OK)
     st = GR_RAIN_RUNOFF_ARGS(s, s->update, maps);
+  if (st == GR_OK)
+    st = GR_RAIN_RUNOFF_ARGS(s, s->li_step, update);
+  if (st == GR_OK)
+    st = GR_RAIN_RUNOFF_ARGS(s, s->li_step, maps);
+  /* The edges rain_runoff_flux_edges writes, which the fused step reads. */
+  cl_int fixed = 0;
+  for (int e = 0; e < 4; ++e)
+    fixed |= bnd[e] != GR_RAIN_RUNOFF_B_OPEN ? 1 << e : 0;
+  if (st == GR_OK)
+    st = gr_kernel_arg(s->ctx, s->li_step, "fixed", sizeof(fixed), &fixed);
+  if (st == GR_OK && s->li_local[0] > 0)
+    st = gr_kernel_arg(s->ctx, s->li_step, "lmem",
+                       3 * s->li_local[0] * s->li_local[1] * sizeof(cl_float), NULL);
   s->args_set = st == GR_OK;
   s->args_dt = dt;
   return st;
@@ -2091,42 +2234,73 @@ static gr_status gr_rain_runoff_enqueue(gr_rain_runoff *s, double dt, int nsteps
     if (st == GR_OK && w)
       st = gr_rain_runoff_watch_step(s, w, s->time + dt * (double)done, stop);
   }
+  int fused = !sw && s->fused;
+  if (st == GR_OK && fused && !s->h_alt) {
+    size_t bytes = gr_rain_runoff_cells(s) * sizeof(cl_float);
+    st = gr_buffer_create(s->ctx, CL_MEM_READ_WRITE, bytes, NULL, &s->h_alt);
+    if (st == GR_OK)
+      st = gr_buffer_create(s->ctx, CL_MEM_READ_WRITE, bytes, NULL, &s->k_alt);
+  }
+  /* The fused step's work-groups: tiles of li_local - 3 cells each way. */
+  size_t tx = fused ? s->li_local[0] - 3 : 1, ty = fused ? s->li_local[1] - 3 : 1;
+  size_t gx = ((size_t)s->nxl + tx - 1) / tx * s->li_local[0];
+  size_t gy = ((size_t)s->nyl + ty - 1) / ty * s->li_local[1];
   while (!sw && st == GR_OK && done < nsteps && !*stop) {
     int old = s->cur, now = 1 - s->cur;
-    const gr_rain_runoff_arg flux[] = {
-        {"qx_old", m, &s->qx[old]},
-        {"qy_old", m, &s->qy[old]},
-        {"qx", m, &s->qx[now]},
-        {"qy", m, &s->qy[now]},
-    };
-    const gr_rain_runoff_arg faces[] = {{"qx", m, &s->qx[now]}, {"qy", m, &s->qy[now]}};
     if (per_step)
       st = gr_rain_runoff_sources_update(s, t_end, t_end + dt);
     if (st == GR_OK && s->hy_n)
       st = gr_rain_runoff_hyetograph_step(s, t_end, t_end + dt, &rate_sum);
-    if (st == GR_OK)
-      st = GR_RAIN_RUNOFF_ARGS(s, s->flux, flux);
-    if (st == GR_OK && edges)
-      st = GR_RAIN_RUNOFF_ARGS(s, s->flux_edges, flux);
-    if (st == GR_OK)
-      st = GR_RAIN_RUNOFF_ARGS(s, s->limit, faces);
-    if (st == GR_OK)
-      st = GR_RAIN_RUNOFF_ARGS(s, s->update, faces);
     /* The update folds the new state into the flood maps at the step's end. */
     cl_float map_time = (cl_float)(t_end += dt);
-    if (st == GR_OK)
-      st = gr_kernel_arg(s->ctx, s->update, "map_time", sizeof(map_time), &map_time);
-    if (st == GR_OK)
-      st = gr_enqueue_2d(s->ctx, s->flux, 0, 0, (size_t)s->nxl + 1, (size_t)s->nyl + 1, NULL);
-    /* The edges that are not open, after the flux kernel wrote them so. */
-    if (st == GR_OK && edges)
-      st = gr_enqueue_1d(s->ctx, s->flux_edges, 2 * ((size_t)s->nxl + (size_t)s->nyl));
-    if (st == GR_OK)
-      s->cur = now; /* the flux kernel is enqueued: the new faces are current */
-    if (st == GR_OK)
-      st = gr_enqueue_2d(s->ctx, s->limit, 0, 0, (size_t)s->nxl, (size_t)s->nyl, NULL);
-    if (st == GR_OK)
-      st = gr_enqueue_2d(s->ctx, s->update, 0, 0, (size_t)s->nxl, (size_t)s->nyl, NULL);
+    /* The edges that are not open, from the step's start: the fused step
+     * reads them, the three launches' flux kernel writes them open first. */
+    const cl_mem *eargs[6] = {&s->h, &s->k, &s->qx[old], &s->qy[old], &s->qx[now], &s->qy[now]};
+    for (int a = 0; st == GR_OK && edges && a < (fused ? 6 : 4); ++a)
+      st = gr_rain_runoff_arg_at(s, s->flux_edges, s->ix_edges[fused ? a : a + 2], m,
+                                 eargs[fused ? a : a + 2]);
+    if (fused) {
+      const cl_mem *sargs[8] = {&s->h,       &s->h_alt,   &s->k,       &s->k_alt,
+                                &s->qx[old], &s->qy[old], &s->qx[now], &s->qy[now]};
+      for (int a = 0; st == GR_OK && a < 8; ++a)
+        st = gr_rain_runoff_arg_at(s, s->li_step, s->ix_step[a], m, sargs[a]);
+      if (st == GR_OK)
+        st = gr_rain_runoff_arg_at(s, s->li_step, s->ix_step[8], sizeof(map_time), &map_time);
+      if (st == GR_OK && edges)
+        st = gr_enqueue_1d(s->ctx, s->flux_edges, 2 * ((size_t)s->nxl + (size_t)s->nyl));
+      if (st == GR_OK)
+        st = gr_enqueue_2d(s->ctx, s->li_step, 0, 0, gx, gy, s->li_local);
+      if (st == GR_OK) {
+        /* The new faces, depth and limiters are current. */
+        cl_mem t = s->h;
+        s->h = s->h_alt;
+        s->h_alt = t;
+        t = s->k;
+        s->k = s->k_alt;
+        s->k_alt = t;
+        s->cur = now;
+      }
+    } else {
+      for (int a = 0; st == GR_OK && a < 4; ++a)
+        st = gr_rain_runoff_arg_at(s, s->flux, s->ix_flux[a], m, eargs[a + 2]);
+      for (int a = 0; st == GR_OK && a < 2; ++a)
+        st = gr_rain_runoff_arg_at(s, s->limit, s->ix_limit[a], m, eargs[a + 4]);
+      for (int a = 0; st == GR_OK && a < 2; ++a)
+        st = gr_rain_runoff_arg_at(s, s->update, s->ix_update[a], m, eargs[a + 4]);
+      if (st == GR_OK)
+        st = gr_rain_runoff_arg_at(s, s->update, s->ix_update[2], sizeof(map_time), &map_time);
+      if (st == GR_OK)
+        st = gr_enqueue_2d(s->ctx, s->flux, 0, 0, (size_t)s->nxl + 1, (size_t)s->nyl + 1, NULL);
+      /* The edges that are not open, after the flux kernel wrote them so. */
+      if (st == GR_OK && edges)
+        st = gr_enqueue_1d(s->ctx, s->flux_edges, 2 * ((size_t)s->nxl + (size_t)s->nyl));
+      if (st == GR_OK)
+        s->cur = now; /* the flux kernel is enqueued: the new faces are current */
+      if (st == GR_OK)
+        st = gr_enqueue_2d(s->ctx, s->limit, 0, 0, (size_t)s->nxl, (size_t)s->nyl, NULL);
+      if (st == GR_OK)
+        st = gr_enqueue_2d(s->ctx, s->update, 0, 0, (size_t)s->nxl, (size_t)s->nyl, NULL);
+    }
     if (st == GR_OK)
       ++done;
     if (st == GR_OK && exchange)

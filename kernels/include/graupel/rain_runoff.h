@@ -593,6 +593,17 @@ GR_API const char *gr_rain_runoff_last_error(const gr_rain_runoff *s);
  */
 GR_API const gr_param_bound *gr_rain_runoff_param_bounds(int *count);
 
+/**
+ * How a local inertial step (FlowModel 1) is launched: in one launch, each
+ * work-group computing its tile's faces, limiters and depths in local
+ * memory from the tile and a ring of two cells (non-zero), or as three
+ * launches, faces, limiters and depths, each through global memory (0).
+ * Edges of other kinds than open add one launch either way. Both give the
+ * same bits; only the speed differs. The default is the device's faster
+ * one (see the implementation).
+ */
+GR_API void gr_rain_runoff_set_fused(gr_rain_runoff *s, int on);
+
 /** Frees the simulation; NULL is fine. */
 GR_API void gr_rain_runoff_destroy(gr_rain_runoff *s);
 
