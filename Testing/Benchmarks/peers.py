@@ -35,8 +35,8 @@ all it waited for (on a shared machine they move less with the load).
     python3 Testing/Benchmarks/peers.py --build build-vtk --profile  # where Graupel's time goes
 
 `--only graupel,grass,landlab` picks runs; `--hours`, `--rain`, `--manning`,
-`--max-time-step` change the scenario (MaxTimeStep is Graupel's; 1 s is its
-default). Not part of the test command: its figures go in RESULTS.md.
+`--max-time-step` change the scenario (MaxTimeStep is Graupel's; its default, 3600 s, is no
+cap). Not part of the test command: its figures go in RESULTS.md.
 """
 import argparse
 import glob
