@@ -21,6 +21,21 @@ def args(extra=None):
     return a
 
 
+def mpi_setup(ns):
+    """For the tests pvbatch runs under mpiexec: parses the arguments (with
+    --ranks, the ranks the run should have), brings paraview.simple's names
+    into the test's namespace ns (as `from paraview.simple import *` does),
+    loads the plugin there and checks the ranks. Returns (args, ranks)."""
+    a = args(lambda p: p.add_argument("--ranks", type=int, default=2))
+    from paraview import servermanager
+    import paraview.simple as simple
+    ns.update({k: getattr(simple, k) for k in dir(simple) if not k.startswith("_")})
+    simple.LoadPlugin(a.plugin, ns=ns)
+    ranks = servermanager.vtkProcessModule.GetProcessModule().GetNumberOfLocalPartitions()
+    check(ranks == a.ranks, "running on %d ranks (%d)" % (a.ranks, ranks))
+    return a, ranks
+
+
 def check(cond, what):
     _checks[0] += 1
     if not cond:

@@ -18,20 +18,7 @@ import sys
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import gr_check as T  # noqa: E402
 
-
-def extra(p):
-    p.add_argument("--ranks", type=int, default=2)
-
-
-a = T.args(extra)
-
-from paraview import servermanager  # noqa: E402
-from paraview.simple import *  # noqa: E402,F401,F403
-
-LoadPlugin(a.plugin, ns=globals())
-pm = servermanager.vtkProcessModule.GetProcessModule()
-ranks = pm.GetNumberOfLocalPartitions()
-T.check(ranks == a.ranks, "running on %d ranks (%d)" % (a.ranks, ranks))
+a, ranks = T.mpi_setup(globals())
 folder = os.path.join(a.scratch, "checkpoint_%d" % ranks)
 os.makedirs(folder, exist_ok=True)
 

@@ -19,20 +19,7 @@ import sys
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import gr_check as T  # noqa: E402
 
-
-def extra(p):
-    p.add_argument("--ranks", type=int, default=2)
-
-
-a = T.args(extra)
-
-from paraview import servermanager  # noqa: E402
-from paraview.simple import *  # noqa: E402,F401,F403
-
-LoadPlugin(a.plugin, ns=globals())
-pm = servermanager.vtkProcessModule.GetProcessModule()
-ranks = pm.GetNumberOfLocalPartitions()
-T.check(ranks == a.ranks, "running on %d ranks (%d)" % (a.ranks, ranks))
+a, ranks = T.mpi_setup(globals())
 
 NX, NY, DX = 40, 104, 5.0
 END, EVERY = 60.0, 20.0
