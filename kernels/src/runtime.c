@@ -245,6 +245,43 @@ static int gr_edge_cmp(const void *pa, const void *pb) {
   return (a->triangle > b->triangle) - (a->triangle < b->triangle);
 }
 
+gr_status gr_grid_strip_check(const gr_grid *g, const char *core, const char *split_why, int need,
+                              const char *need_for, int *ring_s, int *ring_n, char *msg,
+                              size_t msg_len) {
+  *ring_s = *ring_n = 0;
+  if (g->global_nx < 0 || g->global_ny < 0 || g->ghost < 0)
+    return gr_invalid(msg, msg_len,
+                      "Invalid grid: global_nx, global_ny and ghost must be 0 or more (got %d, "
+                      "%d, %d).",
+                      g->global_nx, g->global_ny, g->ghost);
+  if (g->i0 != 0 || (g->global_nx != 0 && g->global_nx != g->nx))
+    return gr_invalid(msg, msg_len,
+                      "The %s splits a domain along y only, into strips of whole rows%s: this "
+                      "piece starts at column %d and has %d of %d columns; give i0 = 0 and nx = "
+                      "global_nx.",
+                      core, split_why, g->i0, g->nx, g->global_nx);
+  long long gny = g->global_ny > 0 ? g->global_ny : g->ny;
+  if (g->j0 < 0 || (g->global_ny <= 0 && g->j0 != 0) || (long long)g->j0 + g->ny > gny)
+    return gr_invalid(msg, msg_len,
+                      "Invalid grid: the strip of %d rows at row %d reaches beyond the domain of "
+                      "%lld rows; give global_ny of the whole domain.",
+                      g->ny, g->j0, gny);
+  int south = g->j0 > 0, north = (long long)g->j0 + g->ny < gny;
+  if ((south || north) && g->ghost < need)
+    return gr_invalid(msg, msg_len,
+                      "Invalid grid: a %s piece with neighbours needs a ghost ring of at least %d "
+                      "rows %s (got ghost = %d); set grid.ghost to %d.",
+                      core, need, need_for, g->ghost, need);
+  if ((south || north) && g->ny < g->ghost)
+    return gr_invalid(msg, msg_len,
+                      "Invalid grid: a %s piece of %d rows is narrower than its ghost ring of %d "
+                      "rows; split the domain into fewer pieces.",
+                      core, g->ny, g->ghost);
+  *ring_s = south ? g->ghost : 0;
+  *ring_n = north ? g->ghost : 0;
+  return GR_OK;
+}
+
 /* The transform's part of gr_mesh_validate. */
 static gr_status gr_mesh_transform_check(const double *T, char *msg, size_t msg_len) {
   for (int k = 0; k < 16; ++k)

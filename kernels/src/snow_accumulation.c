@@ -417,48 +417,10 @@ int gr_snow_accumulation_ghost(const gr_snow_accumulation_params *p) {
  * a ring of grid->ghost rows toward each neighbour. */
 static gr_status gr_snac_piece_check(const gr_grid *g, const gr_snow_accumulation_params *p,
                                      int *ring_s, int *ring_n, char *msg, size_t len) {
-  *ring_s = *ring_n = 0;
-  if (g->global_nx < 0 || g->global_ny < 0 || g->ghost < 0) {
-    snprintf(msg, len,
-             "Invalid grid: global_nx, global_ny and ghost must be 0 or more (got %d, %d, %d).",
-             g->global_nx, g->global_ny, g->ghost);
-    return GR_ERR_INVALID_ARGUMENT;
-  }
-  if (g->i0 != 0 || (g->global_nx != 0 && g->global_nx != g->nx)) {
-    snprintf(msg, len,
-             "Snow accumulation splits a domain along y only, into strips of whole rows (its "
-             "ledger adds whole rows): this piece starts at column %d and has %d of %d columns; "
-             "give i0 = 0 and nx = global_nx.",
-             g->i0, g->nx, g->global_nx);
-    return GR_ERR_INVALID_ARGUMENT;
-  }
-  long long gny = g->global_ny > 0 ? g->global_ny : g->ny;
-  if ((g->global_ny <= 0 && g->j0 != 0) || (long long)g->j0 + g->ny > gny) {
-    snprintf(msg, len,
-             "Invalid grid: the strip of %d rows at row %d reaches beyond the domain of %lld "
-             "rows; give global_ny of the whole domain.",
-             g->ny, g->j0, gny);
-    return GR_ERR_INVALID_ARGUMENT;
-  }
-  int need = gr_snow_accumulation_ghost(p);
-  int south = g->j0 > 0, north = (long long)g->j0 + g->ny < gny;
-  if ((south || north) && g->ghost < need) {
-    snprintf(msg, len,
-             "Invalid grid: a snow accumulation piece with neighbours needs a ghost ring of at "
-             "least %d rows for BlurRadius %d (got ghost = %d); set grid.ghost to %d.",
-             need, p->blur_radius, g->ghost, need);
-    return GR_ERR_INVALID_ARGUMENT;
-  }
-  if ((south || north) && g->ny < g->ghost) {
-    snprintf(msg, len,
-             "Invalid grid: a snow accumulation piece of %d rows is narrower than its ghost ring "
-             "of %d rows; split the domain into fewer pieces.",
-             g->ny, g->ghost);
-    return GR_ERR_INVALID_ARGUMENT;
-  }
-  *ring_s = south ? g->ghost : 0;
-  *ring_n = north ? g->ghost : 0;
-  return GR_OK;
+  char why[48];
+  snprintf(why, sizeof(why), "for BlurRadius %d", p->blur_radius);
+  return gr_grid_strip_check(g, "snow accumulation", " (its ledger adds whole rows)",
+                             gr_snow_accumulation_ghost(p), why, ring_s, ring_n, msg, len);
 }
 
 static int gr_snac_pieced(const gr_snow_accumulation *s) {

@@ -265,49 +265,10 @@ void gr_water_surface_destroy(gr_water_surface *s) {
  * ring of grid->ghost rows toward each neighbour. */
 static gr_status gr_ws_piece_check(const gr_grid *g, const gr_water_surface_params *p, int *ring_s,
                                    int *ring_n, char *msg, size_t len) {
-  *ring_s = *ring_n = 0;
-  if (g->global_nx < 0 || g->global_ny < 0 || g->ghost < 0) {
-    snprintf(msg, len,
-             "Invalid grid: global_nx, global_ny and ghost must be 0 or more (got %d, %d, %d).",
-             g->global_nx, g->global_ny, g->ghost);
-    return GR_ERR_INVALID_ARGUMENT;
-  }
-  if (g->i0 != 0 || (g->global_nx != 0 && g->global_nx != g->nx)) {
-    snprintf(msg, len,
-             "The water surface splits a domain along y only, into strips of whole rows: this "
-             "piece starts at column %d and has %d of %d columns; give i0 = 0 and nx = "
-             "global_nx.",
-             g->i0, g->nx, g->global_nx);
-    return GR_ERR_INVALID_ARGUMENT;
-  }
-  long long gny = g->global_ny > 0 ? g->global_ny : g->ny;
-  if (g->j0 < 0 || (g->global_ny <= 0 && g->j0 != 0) || (long long)g->j0 + g->ny > gny) {
-    snprintf(msg, len,
-             "Invalid grid: the strip of %d rows at row %d reaches beyond the domain of %lld "
-             "rows; give global_ny of the whole domain.",
-             g->ny, g->j0, gny);
-    return GR_ERR_INVALID_ARGUMENT;
-  }
-  int need = gr_water_surface_ghost(p, g->dy);
-  int south = g->j0 > 0, north = (long long)g->j0 + g->ny < gny;
-  if ((south || north) && g->ghost < need) {
-    snprintf(msg, len,
-             "Invalid grid: a water surface piece with neighbours needs a ghost ring of at least "
-             "%d rows for DropRadius %g m on a spacing of %g m (got ghost = %d); set grid.ghost "
-             "to gr_water_surface_ghost's %d.",
-             need, p->drop_radius, g->dy, g->ghost, need);
-    return GR_ERR_INVALID_ARGUMENT;
-  }
-  if ((south || north) && g->ny < g->ghost) {
-    snprintf(msg, len,
-             "Invalid grid: a water surface piece of %d rows is narrower than its ghost ring of "
-             "%d rows; split the domain into fewer pieces.",
-             g->ny, g->ghost);
-    return GR_ERR_INVALID_ARGUMENT;
-  }
-  *ring_s = south ? g->ghost : 0;
-  *ring_n = north ? g->ghost : 0;
-  return GR_OK;
+  char why[96];
+  snprintf(why, sizeof(why), "for DropRadius %g m on a spacing of %g m", p->drop_radius, g->dy);
+  return gr_grid_strip_check(g, "water surface", "", gr_water_surface_ghost(p, g->dy), why, ring_s,
+                             ring_n, msg, len);
 }
 
 void gr_water_surface_set_allreduce(gr_water_surface *s, gr_allreduce_fn fn, void *user) {

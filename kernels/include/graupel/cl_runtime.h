@@ -46,6 +46,21 @@ GR_API gr_status gr_mesh_check(gr_mesh_memo *memo, const gr_mesh *m, int closed,
 
 GR_API void gr_mesh_memo_free(gr_mesh_memo *memo);
 
+/**
+ * The contract of a core that splits a domain into strips of whole rows
+ * (graupel.h's pieces, along y only), checked on grid g: non-negative
+ * global sizes and ghost, whole rows (i0 = 0, nx = global_nx), the strip
+ * within the domain, and, where it has a neighbour, a ring of at least
+ * `need` rows (need_for says why, e.g. "for BlurRadius 2") and rows enough
+ * to fill it. `core` names the core in the sentences ("snow accumulation"),
+ * split_why adds to the first (e.g. " (its ledger adds whole rows)", or
+ * ""). On success *ring_s and *ring_n get the ring toward each side (0
+ * where the strip ends the domain); otherwise a sentence goes to msg.
+ */
+GR_API gr_status gr_grid_strip_check(const gr_grid *g, const char *core, const char *split_why,
+                                     int need, const char *need_for, int *ring_s, int *ring_n,
+                                     char *msg, size_t msg_len);
+
 /** Name of an OpenCL error code, e.g. "CL_OUT_OF_RESOURCES". */
 GR_API const char *gr_cl_error_name(cl_int err);
 
