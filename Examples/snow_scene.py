@@ -148,10 +148,13 @@ def show(snow, time, size=(1024, 768), bar=True, label=True, close=False):
         _legend(GetScalarBar(lut, view), "snow density (kg/m\u00b3)", "%.0f")
     _note(view, 1.0)
     if label:
-        text = Show(Text(Text="Snow Deformation: a wheel (radius %.2f m) at %.1f m/s through "
-                              "%.1f m of snow, t = %.1f s" % (RADIUS, SPEED, DEPTH, time)), view)
+        # Two lines, the first short: on one line it ran into the exaggeration
+        # note (upper right) in pictures narrower than about 700 pixels.
+        text = Show(Text(Text="Snow Deformation, t = %.1f s\na wheel (r = %.2f m) at %.1f m/s in "
+                              "%.1f m of snow" % (time, RADIUS, SPEED, DEPTH)), view)
         text.WindowLocation = "Upper Left Corner"
-        text.FontSize = 16
+        text.Justification = "Left"
+        text.FontSize = 15
         text.Color = [1.0, 1.0, 1.0]
     wheel = Show(OutputPort(snow, 1), view)
     wheel.Representation = "Surface"
