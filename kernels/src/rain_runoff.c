@@ -2347,8 +2347,8 @@ static gr_status gr_rain_runoff_step_impl(gr_rain_runoff *s, double dt, int nste
   gr_status st = GR_OK;
   for (int left = nsteps; st == GR_OK && left > 0;) {
     int k = left < GR_RAIN_RUNOFF_IN_FLIGHT ? left : GR_RAIN_RUNOFF_IN_FLIGHT, done = 0, stop = 0;
-    if (k < left || left < nsteps) /* not the only batch: wait for the one before */
-      st = left < nsteps ? gr_finish(s->ctx) : GR_OK;
+    if (left < nsteps) /* after the first batch: wait for the one before */
+      st = gr_finish(s->ctx);
     if (st == GR_OK)
       st = gr_rain_runoff_enqueue(s, dt, k, NULL, &done, &stop);
     left -= k;
