@@ -3651,6 +3651,30 @@ static void test_sw_advance_pieces_edges_x(void) {
   run_with_edges(test_sw_advance_pieces_x);
 }
 
+/* The inputs of the launch-path tests (sw_fused, li_fused, specialised) on
+ * g: a bumpy, tilted bed b with two no-data holes (NaN; the first hole_w x
+ * hole_h cells from (58, 11), the second 3 x 3 from (20, 30)), a rain field
+ * r (m/s), a permeability map k with dry patches, an initial depth d and a
+ * Manning map nmap, all from hashes of the cell. */
+static void paths_fields(const gr_grid *g, float *b, float *r, float *k, float *d, double *nmap,
+                         int hole_w, int hole_h) {
+  for (int j = 0; j < g->ny; ++j)
+    for (int i = 0; i < g->nx; ++i) {
+      size_t c = (size_t)j * g->nx + i;
+      double x = i * g->dx, y = j * g->dy;
+      b[c] =
+          (float)(0.03 * x + 0.02 * y + 0.4 * sin(x / 7.0) * cos(y / 5.0) + 0.2 * hash01(i, j, 71));
+      r[c] = (float)(4e-5 * hash01(i, j, 72));
+      k[c] = hash01(i, j, 73) < 0.5 ? 0.0f : (float)(4e-6 * hash01(i, j, 74));
+      d[c] = (float)(0.08 * hash01(i, j, 75));
+      nmap[c] = 0.02 + 0.05 * hash01(i, j, 76);
+      int hole_a = i >= 58 && i < 58 + hole_w && j >= 11 && j < 11 + hole_h;
+      int hole_b = i >= 20 && i < 23 && j >= 30 && j < 33;
+      if (hole_a || hole_b)
+        b[c] = NAN;
+    }
+}
+
 /* The shallow-water pieces tests with each launch path forced (the fused
  * stages read the ring through their tiles' halos), with every kind of edge
  * and without: every owned cell of every field and the ledger bit for bit
@@ -3685,21 +3709,7 @@ static void test_sw_fused(void) {
   float *b = alloc_field(&g, 1), *r = alloc_field(&g, 1), *k = alloc_field(&g, 1);
   float *d = alloc_field(&g, 1);
   double *nmap = malloc(n * sizeof(double));
-  for (int j = 0; j < g.ny; ++j)
-    for (int i = 0; i < g.nx; ++i) {
-      size_t c = (size_t)j * g.nx + i;
-      double x = i * g.dx, y = j * g.dy;
-      b[c] =
-          (float)(0.03 * x + 0.02 * y + 0.4 * sin(x / 7.0) * cos(y / 5.0) + 0.2 * hash01(i, j, 71));
-      r[c] = (float)(4e-5 * hash01(i, j, 72));
-      k[c] = hash01(i, j, 73) < 0.5 ? 0.0f : (float)(4e-6 * hash01(i, j, 74));
-      d[c] = (float)(0.08 * hash01(i, j, 75));
-      nmap[c] = 0.02 + 0.05 * hash01(i, j, 76);
-      int hole_a = i >= 58 && i < 66 && j >= 11 && j < 18; /* across tiles' corners */
-      int hole_b = i >= 20 && i < 23 && j >= 30 && j < 33;
-      if (hole_a || hole_b)
-        b[c] = NAN;
-    }
+  paths_fields(&g, b, r, k, d, nmap, 8, 7); /* the first hole across tiles' corners */
   const double ht[3] = {0.0, 30.0, 90.0}, hq[3] = {0.0, 0.5, 0.1};
   const double hyt[3] = {0.0, 40.0, 200.0}, hyr[3] = {1e-5, 6e-5, 2e-5};
   const int ij[4] = {37, 20, 5, 38};
@@ -4474,21 +4484,7 @@ static void test_li_fused(void) {
   float *b = alloc_field(&g, 1), *r = alloc_field(&g, 1), *k = alloc_field(&g, 1);
   float *d = alloc_field(&g, 1);
   double *nmap = malloc(n * sizeof(double));
-  for (int j = 0; j < g.ny; ++j)
-    for (int i = 0; i < g.nx; ++i) {
-      size_t c = (size_t)j * g.nx + i;
-      double x = i * g.dx, y = j * g.dy;
-      b[c] =
-          (float)(0.03 * x + 0.02 * y + 0.4 * sin(x / 7.0) * cos(y / 5.0) + 0.2 * hash01(i, j, 71));
-      r[c] = (float)(4e-5 * hash01(i, j, 72));
-      k[c] = hash01(i, j, 73) < 0.5 ? 0.0f : (float)(4e-6 * hash01(i, j, 74));
-      d[c] = (float)(0.08 * hash01(i, j, 75));
-      nmap[c] = 0.02 + 0.05 * hash01(i, j, 76);
-      int hole_a = i >= 58 && i < 64 && j >= 11 && j < 16; /* across a tile's corner */
-      int hole_b = i >= 20 && i < 23 && j >= 30 && j < 33;
-      if (hole_a || hole_b)
-        b[c] = NAN;
-    }
+  paths_fields(&g, b, r, k, d, nmap, 6, 5); /* the first hole across a tile's corner */
   const double ht[3] = {0.0, 30.0, 90.0}, hq[3] = {0.0, 0.5, 0.1};
   const double hyt[3] = {0.0, 40.0, 200.0}, hyr[3] = {1e-5, 6e-5, 2e-5};
   const int ij[4] = {37, 20, 5, 38};
@@ -4574,6 +4570,124 @@ static void test_li_fused(void) {
   free(nmap);
 }
 
+/* Gives sim the optional inputs of `bits` (GR_RAIN_RUNOFF_INPUT_*) from the
+ * paths_fields inputs; the no-data holes come with the elevation (make_sim). */
+static void give_inputs(gr_rain_runoff *sim, int bits, const float *r, const float *k,
+                        const double *nmap) {
+  const int ij[4] = {37, 20, 5, 38};
+  const double pq[2] = {0.05, 0.02};
+  if (bits & GR_RAIN_RUNOFF_INPUT_RAIN)
+    CHECK(gr_rain_runoff_set_field(sim, GR_FIELD_RAIN_RATE, r) == GR_OK);
+  if (bits & GR_RAIN_RUNOFF_INPUT_PERMEABILITY)
+    CHECK(gr_rain_runoff_set_field(sim, GR_FIELD_PERMEABILITY, k) == GR_OK);
+  if (bits & GR_RAIN_RUNOFF_INPUT_INFLOWS)
+    CHECK(gr_rain_runoff_set_point_inflows(sim, ij, pq, 2) == GR_OK);
+  if (bits & GR_RAIN_RUNOFF_INPUT_MANNING)
+    CHECK(gr_rain_runoff_set_manning_map(sim, nmap) == GR_OK);
+}
+
+/* The step kernels compiled for the optional inputs in use
+ * (gr_rain_runoff_set_specialised, the default) give the general kernels'
+ * bits. Both models on the 75 x 41 bumpy grid of the launch-path tests,
+ * with no optional input, each of the five alone (a rain field, a
+ * permeability map, point inflows, no-data holes, a Manning map) and all of
+ * them; and a run that gains them on the way (none for 40 steps, then the
+ * rain and permeability maps, then the Manning map and the inflows after 80
+ * steps), whose kernels follow the inputs at each step
+ * (gr_rain_runoff_specialised_for), against a general run given the same.
+ * After 120 steps the whole state (depth and its compensation, limiters or
+ * discharges, infiltration, outflow, inflow, flood maps) and the ledger are
+ * the same to the bit. */
+static void test_specialised(void) {
+  gr_grid g = {75, 41, 2.0, 1.5, 0.0, 0.0, 0, 0};
+  size_t n = cells_of(&g);
+  float *b = alloc_field(&g, 1), *r = alloc_field(&g, 1), *k = alloc_field(&g, 1);
+  float *d = alloc_field(&g, 1), *solid = alloc_field(&g, 1);
+  double *nmap = malloc(n * sizeof(double));
+  paths_fields(&g, b, r, k, d, nmap, 6, 5);
+  for (size_t c = 0; c < n; ++c) /* the same bed without holes */
+    solid[c] = isnan(b[c]) ? 0.5f : b[c];
+  const int sets[] = {0,
+                      GR_RAIN_RUNOFF_INPUT_RAIN,
+                      GR_RAIN_RUNOFF_INPUT_PERMEABILITY,
+                      GR_RAIN_RUNOFF_INPUT_INFLOWS,
+                      GR_RAIN_RUNOFF_INPUT_NO_DATA,
+                      GR_RAIN_RUNOFF_INPUT_MANNING,
+                      GR_RAIN_RUNOFF_INPUT_ALL,
+                      -1 /* gained on the way */};
+  const int nsets = (int)(sizeof(sets) / sizeof(sets[0]));
+  for (int m = 0; m < 2; ++m)
+    for (int t = 0; t < nsets; ++t) {
+      int bits = sets[t], staged = bits < 0;
+      gr_rain_runoff_params p = params_with(2e-5, 1e-6, GR_BOUNDARY_OPEN);
+      p.flow_model = m ? GR_FLOW_LOCAL_INERTIAL : GR_FLOW_SHALLOW_WATER; /* model_names' order */
+      p.no_data = GR_BOUNDARY_OPEN;
+      int holes = !staged && (bits & GR_RAIN_RUNOFF_INPUT_NO_DATA);
+      gr_rain_runoff *sim[2] = {NULL, NULL}; /* general, specialised */
+      for (int v = 0; v < 2; ++v) {
+        sim[v] = make_sim(&g, &p, holes ? b : solid, d);
+        if (!sim[v])
+          continue;
+        gr_rain_runoff_set_specialised(sim[v], v);
+        give_inputs(sim[v], staged ? 0 : bits, r, k, nmap);
+      }
+      if (!sim[0] || !sim[1]) {
+        gr_rain_runoff_destroy(sim[0]);
+        gr_rain_runoff_destroy(sim[1]);
+        continue;
+      }
+      const int gained[3] = {0, GR_RAIN_RUNOFF_INPUT_RAIN | GR_RAIN_RUNOFF_INPUT_PERMEABILITY,
+                             GR_RAIN_RUNOFF_INPUT_MANNING | GR_RAIN_RUNOFF_INPUT_INFLOWS};
+      int have = staged ? 0 : bits, follows = 1;
+      for (int part = 0; part < 3; ++part) {
+        if (staged && part > 0) {
+          for (int v = 0; v < 2; ++v)
+            give_inputs(sim[v], gained[part], r, k, nmap);
+          have |= gained[part];
+        }
+        for (int v = 0; v < 2; ++v)
+          run_stable(sim[v], 4, 10);
+        follows &= gr_rain_runoff_specialised_for(sim[1]) == have &&
+                   gr_rain_runoff_specialised_for(sim[0]) == GR_RAIN_RUNOFF_INPUT_ALL;
+      }
+      size_t bytes = 0;
+      CHECK(gr_rain_runoff_state_size(sim[0], &bytes) == GR_OK && bytes > 0);
+      unsigned char *st[2];
+      for (int v = 0; v < 2; ++v) {
+        st[v] = calloc(bytes ? bytes : 1, 1);
+        CHECK(gr_rain_runoff_state_save(sim[v], st[v], bytes) == GR_OK);
+      }
+      long diff = 0;
+      for (size_t q = 0; q + 4 <= bytes; q += 4)
+        diff += memcmp(st[0] + q, st[1] + q, 4) != 0;
+      gr_rain_runoff_ledger l0 = ledger(sim[0]), l1 = ledger(sim[1]);
+      int same_ledger = memcmp(&l0, &l1, sizeof(l0)) == 0;
+      CHECK_MSG(follows, "%s, inputs %d: the kernels are built for %d, not the inputs in use (%d)",
+                model_names[m], bits, gr_rain_runoff_specialised_for(sim[1]), have);
+      CHECK_MSG(diff == 0 && same_ledger,
+                "%s, inputs %d: %ld words of the state of %zu bytes differ from the general "
+                "kernels'; ledgers %s",
+                model_names[m], bits, diff, bytes, same_ledger ? "agree" : "differ");
+      /* A flow: water left through the edges and infiltrated. */
+      CHECK_MSG(l0.steps == 120 && l0.outflow_volume > 0.0 && l0.infiltrated_volume > 0.0,
+                "%s, inputs %d: %lld steps, outflow %g m^3, infiltrated %g m^3", model_names[m],
+                bits, l0.steps, l0.outflow_volume, l0.infiltrated_volume);
+      printf("%s, inputs %2d: kernels for %2d, %ld words of %zu differ; outflow %.4f m^3\n",
+             model_names[m], bits, gr_rain_runoff_specialised_for(sim[1]), diff, bytes / 4,
+             l0.outflow_volume);
+      for (int v = 0; v < 2; ++v) {
+        free(st[v]);
+        gr_rain_runoff_destroy(sim[v]);
+      }
+    }
+  free(b);
+  free(r);
+  free(k);
+  free(d);
+  free(solid);
+  free(nmap);
+}
+
 static const gr_subtest tests[] = {
     {"rain_gain", test_rain_gain, 0},
     {"infiltration", test_infiltration, 0},
@@ -4642,6 +4756,7 @@ static const gr_subtest tests[] = {
     {"manning_map", test_manning_map, 0},
     {"no_data", test_no_data, 0},
     {"li_fused", test_li_fused, 0},
+    {"specialised", test_specialised, 0},
     {"pieces_paths", test_pieces_paths, 0},
 };
 

@@ -8,7 +8,8 @@
  * launch each (gr_rain_runoff_set_sw_fused), GRAUPEL_BENCH_SW_TILE=TXxTY
  * the fused stages' tile (gr_rain_runoff_set_sw_tile);
  * GRAUPEL_BENCH_FUSED=0/1 forces the local inertial step's three launches
- * or its one (gr_rain_runoff_set_fused). */
+ * or its one (gr_rain_runoff_set_fused); GRAUPEL_BENCH_SPECIALISED=0 takes
+ * the kernels compiled for every optional input. */
 #include "bench.h"
 
 #include <math.h>
@@ -83,6 +84,12 @@ static gr_status rain_runoff_setup_piece(gr_context *ctx, int n, int j0, int ny,
   const char *fused = getenv("GRAUPEL_BENCH_FUSED");
   if (st == GR_OK && fused && *fused)
     gr_rain_runoff_set_fused(r->sim, atoi(fused));
+  /* GRAUPEL_BENCH_SPECIALISED=0: the kernels for every optional input
+   * (gr_rain_runoff_set_specialised), as before they were compiled for the
+   * inputs in use. */
+  const char *spec = getenv("GRAUPEL_BENCH_SPECIALISED");
+  if (st == GR_OK && spec && *spec)
+    gr_rain_runoff_set_specialised(r->sim, atoi(spec));
   if (st == GR_OK && !whole && link) {
     gr_rain_runoff_set_allreduce(r->sim, link->allreduce, link->allreduce_user);
     gr_rain_runoff_set_halo_exchange(r->sim, link->exchange, link->exchange_user);

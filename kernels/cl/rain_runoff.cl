@@ -34,6 +34,21 @@
 #include "rain_runoff_shared.h"
 #include "reduce.h"
 
+/* The optional inputs this program is built for (GR_RAIN_RUNOFF_IN_* bits,
+ * -DGR_RAIN_RUNOFF_INPUTS=...; all of them by default). The kernels still
+ * take every input and its use_* flag, and a program is right for any
+ * simulation whose inputs in use are among its bits: an input the program
+ * is not built for reads as absent at compile time, and the compiler drops
+ * its loads and tests. On CPUs that is most of the step's cost: PoCL's
+ * vectorised local inertial step at 1024^2 took 17 ms with every input
+ * possible and 6.3 ms without (a uniform rain and permeability). The host
+ * builds the program for the inputs in use (gr_rain_runoff_specialise);
+ * the same expressions give the same floats either way. */
+#ifndef GR_RAIN_RUNOFF_INPUTS
+#define GR_RAIN_RUNOFF_INPUTS GR_RAIN_RUNOFF_IN_ALL
+#endif
+#define GR_RAIN_RUNOFF_USES(bit, flag) ((GR_RAIN_RUNOFF_INPUTS & (bit)) != 0 && (flag))
+
 GR_INLINE float gr_rain_runoff_input(__global const float *restrict field, int use_field,
                                      float uniform, long c) {
   return use_field ? field[c] : uniform;
@@ -63,28 +78,39 @@ GR_INLINE float gr_rain_runoff_infiltration(float h, float r, float s, float k, 
  * float whichever side computes it; n2 itself where both are n2). */
 GR_INLINE float gr_rain_runoff_face_n2(__global const float *restrict n2map, int use_n2, float n2,
                                        int a, int b) {
-  return use_n2 ? 0.5f * (n2map[a] + n2map[b]) : n2;
+  return GR_RAIN_RUNOFF_USES(GR_RAIN_RUNOFF_IN_N2, use_n2) ? 0.5f * (n2map[a] + n2map[b]) : n2;
 }
 
 /* No-data cells (NaN elevations, graupel/rain_runoff.h): nodata[c] is 0 for
  * a cell of the domain, 1 for a wall, 2 for an outfall (use_nodata: there
  * are some). Nothing rains, enters or infiltrates there. */
-#define GR_RAIN_RUNOFF_ACTIVE(c) (!use_nodata || nodata[(c)] == 0.0f)
+#define GR_RAIN_RUNOFF_ACTIVE(c)                                                                   \
+  (!GR_RAIN_RUNOFF_USES(GR_RAIN_RUNOFF_IN_NODATA, use_nodata) || nodata[(c)] == 0.0f)
 #define GR_RAIN_RUNOFF_RAIN(c)                                                                     \
-  (GR_RAIN_RUNOFF_ACTIVE(c) ? gr_rain_runoff_input(rain, use_rain, rain_uniform, (c)) : 0.0f)
+  (GR_RAIN_RUNOFF_ACTIVE(c)                                                                        \
+       ? gr_rain_runoff_input(rain, GR_RAIN_RUNOFF_USES(GR_RAIN_RUNOFF_IN_RAIN, use_rain),         \
+                              rain_uniform, (c))                                                   \
+       : 0.0f)
 #define GR_RAIN_RUNOFF_PERM(c)                                                                     \
-  (GR_RAIN_RUNOFF_ACTIVE(c) ? gr_rain_runoff_input(perm, use_perm, perm_uniform, (c)) : 0.0f)
+  (GR_RAIN_RUNOFF_ACTIVE(c)                                                                        \
+       ? gr_rain_runoff_input(perm, GR_RAIN_RUNOFF_USES(GR_RAIN_RUNOFF_IN_PERM, use_perm),         \
+                              perm_uniform, (c))                                                   \
+       : 0.0f)
 
 /* A cell's source rate (m/s of depth): the source field's, 0 without one. */
 #define GR_RAIN_RUNOFF_SRC(c)                                                                      \
-  (GR_RAIN_RUNOFF_ACTIVE(c) ? gr_rain_runoff_input(src, use_src, 0.0f, (c)) : 0.0f)
+  (GR_RAIN_RUNOFF_ACTIVE(c)                                                                        \
+       ? gr_rain_runoff_input(src, GR_RAIN_RUNOFF_USES(GR_RAIN_RUNOFF_IN_SRC, use_src), 0.0f, (c)) \
+       : 0.0f)
 
 /* The water an outfall no-data cell received in a step leaves the domain:
  * its new depth t (and Kahan compensation comp) go to the outflow, and the
  * cell ends dry. Returns the water booked (0 for every other cell). */
 GR_INLINE float gr_rain_runoff_drain(__global const float *restrict nodata, int use_nodata, int c,
                                      float t, float comp) {
-  return use_nodata && nodata[c] == 2.0f && t > 0.0f ? t - comp : 0.0f;
+  return GR_RAIN_RUNOFF_USES(GR_RAIN_RUNOFF_IN_NODATA, use_nodata) && nodata[c] == 2.0f && t > 0.0f
+             ? t - comp
+             : 0.0f;
 }
 
 /* x^(-7/3) for x > 0 (a normal float), the friction's depth factor: x^(-1/3)
@@ -1328,7 +1354,9 @@ GR_INLINE void gr_sw_update_cell(GR_SW_CELL_ARGS, int i, int j, gr_sw_pt x1, gr_
                                  float fm_s, float ft_s, float fh_n, float fm_n, float ft_n,
                                  float suc, float svc, const int stage, const int velocities) {
   int c = gr_idx(i, j, nx);
-  float n2c = use_n2 ? n2map[c] : n2; /* the cell's own roughness, n^2 */
+  float n2c = GR_RAIN_RUNOFF_USES(GR_RAIN_RUNOFF_IN_N2, use_n2)
+                  ? n2map[c]
+                  : n2; /* the cell's own roughness, n^2 */
   gr_sw_pt y2 = {x2.h, x2.b, x2.ut, x2.un, 0.0f};
   float dhx, dqx_x, dqy_x, dhy, dqy_y, dqx_y;
   gr_sw_balance(x1, x2, x3, fh_w, fm_w, ft_w, fh_e, fm_e, ft_e, i, nx, bnd_w, bnd_e, g, &dhx,

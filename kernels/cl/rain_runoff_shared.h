@@ -35,6 +35,16 @@
 #define GR_RAIN_RUNOFF_B_LEVEL 3
 #define GR_RAIN_RUNOFF_MAXES 1
 
+/* The optional inputs a program of rain_runoff.cl is built for, a bit each
+ * (GR_RAIN_RUNOFF_INPUTS there): a rain map, a permeability map, sources
+ * (inflows), no-data cells and a Manning map. */
+#define GR_RAIN_RUNOFF_IN_RAIN 1
+#define GR_RAIN_RUNOFF_IN_PERM 2
+#define GR_RAIN_RUNOFF_IN_SRC 4
+#define GR_RAIN_RUNOFF_IN_NODATA 8
+#define GR_RAIN_RUNOFF_IN_N2 16
+#define GR_RAIN_RUNOFF_IN_ALL 31
+
 /* The flood-hazard rating's debris factor applies where the depth exceeds
  * this (m): FD2321/TR2 (HR Wallingford 2006, Table 3.1) gives DF = 0 up to
  * 0.25 m under every land use. */

@@ -137,6 +137,12 @@ struct gr_rain_runoff {
   cl_kernel sw_stage[2];
   int sw_fused;
   size_t sw_local[2], sw_tile_bytes;
+  /* The step kernels above (gr_rain_runoff_step_kernels) come from the
+   * program built for the optional inputs `inputs` (GR_RAIN_RUNOFF_IN_*
+   * bits; -1 before the first); specialise 0 keeps them general (every
+   * input possible, as a program without the option), which
+   * gr_rain_runoff_set_specialised sets for tests. */
+  int inputs, specialise;
   cl_mem h, h_c, b, k, inf, inf_c, out, out_c;
   cl_mem in, in_c; /* inflow (edges and sources), per cell (m), and its compensation */
   /* Sources (m/s of depth): the point inflows' field (pts, once set) and
@@ -563,12 +569,13 @@ static gr_status gr_rain_runoff_li_shape(gr_rain_runoff *s) {
   /* Where not even 8 x 8 fits (a tile of 5 x 5), the three launches only. */
   if (!fits)
     s->li_local[0] = s->li_local[1] = 0;
-  /* Not the default anywhere: the fused step recomputes the ring's faces
-   * and each cell's limiter five times, and measured slower on both kinds
-   * of device (the H200 at 4096^2: 1.34 ms a step against 1.14; PoCL here
-   * about 1.5x). gr_rain_runoff_set_fused picks it. */
+  /* Not the default anywhere (gr_rain_runoff_create): the fused step
+   * recomputes the ring's faces and each cell's limiter five times, and
+   * measured slower on both kinds of device (the H200 at 4096^2: 1.34 ms a
+   * step against 1.14; PoCL here about 1.5x). gr_rain_runoff_set_fused
+   * picks it, where the device allows its work-group. */
   (void)gpu;
-  s->fused = 0;
+  s->fused = s->fused && s->li_local[0] > 0;
   return GR_OK;
 }
 
@@ -843,6 +850,123 @@ static gr_status gr_rain_runoff_sw_shape(gr_rain_runoff *s, size_t tx, size_t ty
   return GR_OK;
 }
 
+/* The ledger's and the stable steps' reductions, (re)made for their
+ * kernels' work-groups. */
+static gr_status gr_rain_runoff_reductions(gr_rain_runoff *s) {
+  size_t cells = (size_t)s->nxl * (size_t)s->nyl;
+  gr_reduction_i64_release(&s->ledger);
+  gr_reduction_release(&s->speed);
+  gr_reduction_release(&s->film);
+  gr_status st = gr_reduction_i64_init_max(s->ctx, s->reduce, cells, 2 * GR_RAIN_RUNOFF_SUMS,
+                                           GR_RAIN_RUNOFF_MAXES, &s->ledger);
+  if (st == GR_OK)
+    st = gr_reduction_init(s->ctx, s->sw_speed, cells, 0, 2, &s->speed);
+  if (st == GR_OK)
+    st = gr_reduction_init(s->ctx, s->li_speed, cells, 0, 1, &s->film);
+  return st;
+}
+
+/* The optional inputs in use, GR_RAIN_RUNOFF_IN_* bits. */
+static int gr_rain_runoff_inputs_used(const gr_rain_runoff *s) {
+  return (s->has_rain ? GR_RAIN_RUNOFF_IN_RAIN : 0) | (s->has_perm ? GR_RAIN_RUNOFF_IN_PERM : 0) |
+         (gr_rain_runoff_has_sources(s) ? GR_RAIN_RUNOFF_IN_SRC : 0) |
+         (s->has_nodata ? GR_RAIN_RUNOFF_IN_NODATA : 0) | (s->has_n2 ? GR_RAIN_RUNOFF_IN_N2 : 0);
+}
+
+/* Takes the step kernels from the program built for the inputs in use
+ * (every input where specialise is 0) when they are not already from it:
+ * the program is found or built (gr_program_get: once per context and
+ * options), the kernels made, and only then the old ones released; the
+ * argument indices, the fused work-groups and the arguments follow. Called
+ * at creation and before every batch of steps, so that a map set or
+ * cleared since takes effect at the next step. */
+static gr_status gr_rain_runoff_specialise(gr_rain_runoff *s) {
+  int want = s->specialise ? gr_rain_runoff_inputs_used(s) : GR_RAIN_RUNOFF_IN_ALL;
+  if (want == s->inputs)
+    return GR_OK;
+  static const char *const names[] = {
+      "rain_runoff_flux",       "rain_runoff_flux_edges", "rain_runoff_limit",
+      "rain_runoff_update",     "rain_runoff_li_step",    "rain_runoff_sw_prep",
+      "rain_runoff_sw_faces1",  "rain_runoff_sw_faces2",  "rain_runoff_sw_update1",
+      "rain_runoff_sw_update2", "rain_runoff_sw_edges",   "rain_runoff_sw_stage1",
+      "rain_runoff_sw_stage2",  "rain_runoff_reduce",     "rain_runoff_derive",
+      "rain_runoff_sw_speed",   "rain_runoff_li_speed",   "rain_runoff_maps",
+      "rain_runoff_source"};
+  enum { GR_RR_KERNELS = sizeof(names) / sizeof(names[0]) };
+  cl_kernel *slots[GR_RR_KERNELS] = {
+      &s->flux,     &s->flux_edges,  &s->limit,       &s->update,       &s->li_step,
+      &s->sw_prep,  &s->sw_faces[0], &s->sw_faces[1], &s->sw_update[0], &s->sw_update[1],
+      &s->sw_edges, &s->sw_stage[0], &s->sw_stage[1], &s->reduce,       &s->derive,
+      &s->sw_speed, &s->li_speed,    &s->maps,        &s->source};
+  char opt[64];
+  snprintf(opt, sizeof(opt), "-DGR_RAIN_RUNOFF_INPUTS=%d", want);
+  cl_program prog = NULL;
+  gr_status st =
+      gr_program_get(s->ctx, "rain_runoff", want == GR_RAIN_RUNOFF_IN_ALL ? NULL : opt, &prog);
+  cl_kernel made[GR_RR_KERNELS] = {NULL};
+  for (int k = 0; st == GR_OK && k < GR_RR_KERNELS; ++k)
+    st = gr_kernel_create(s->ctx, prog, names[k], &made[k]);
+  if (st != GR_OK) {
+    for (int k = 0; k < GR_RR_KERNELS; ++k)
+      if (made[k])
+        clReleaseKernel(made[k]);
+    return st;
+  }
+  int first = s->inputs < 0;
+  for (int k = 0; k < GR_RR_KERNELS; ++k) {
+    if (*slots[k])
+      clReleaseKernel(*slots[k]);
+    *slots[k] = made[k];
+  }
+  /* Until all that follows holds, the next call builds them again. */
+  s->inputs = -1;
+  s->args_set = 0;
+  s->maps_bound = 0;
+  st = gr_rain_runoff_step_indices(s);
+  if (st == GR_OK)
+    st = gr_rain_runoff_li_shape(s);
+  /* The shallow-water tile, checked against the new kernels (at creation
+   * the caller picks the default); one that no longer fits becomes it. */
+  if (st == GR_OK && !first && gr_rain_runoff_sw_shape(s, s->sw_local[0], s->sw_local[1], 0))
+    st = gr_rain_runoff_sw_shape(s, 0, 0, 0);
+  /* The reductions' work-groups, from their new kernels (at creation the
+   * caller makes them). */
+  if (st == GR_OK && !first)
+    st = gr_rain_runoff_reductions(s);
+  if (st == GR_OK)
+    s->inputs = want;
+  return st;
+}
+
+/* After a setter (its status st) that may have changed the inputs in use:
+ * the kernels follow at once. Kernels built for more inputs than are in use
+ * are right too; where a build fails (out of memory), the kernels that read
+ * inputs (the steps' and the local inertial stable step's) are made again
+ * before they next run: gr_rain_runoff_enqueue and
+ * gr_rain_runoff_stable_dt_impl call gr_rain_runoff_specialise first. The
+ * other kernels read no optional input. */
+static gr_status gr_rain_runoff_inputs_changed(gr_rain_runoff *s, gr_status st) {
+  return st == GR_OK ? gr_rain_runoff_specialise(s) : st;
+}
+
+void gr_rain_runoff_set_specialised(gr_rain_runoff *s, int on) {
+  if (s)
+    s->specialise = on != 0;
+}
+
+/* The public bits are the kernels' (rain_runoff_shared.h). */
+_Static_assert(GR_RAIN_RUNOFF_INPUT_RAIN == GR_RAIN_RUNOFF_IN_RAIN &&
+                   GR_RAIN_RUNOFF_INPUT_PERMEABILITY == GR_RAIN_RUNOFF_IN_PERM &&
+                   GR_RAIN_RUNOFF_INPUT_INFLOWS == GR_RAIN_RUNOFF_IN_SRC &&
+                   GR_RAIN_RUNOFF_INPUT_NO_DATA == GR_RAIN_RUNOFF_IN_NODATA &&
+                   GR_RAIN_RUNOFF_INPUT_MANNING == GR_RAIN_RUNOFF_IN_N2 &&
+                   GR_RAIN_RUNOFF_INPUT_ALL == GR_RAIN_RUNOFF_IN_ALL,
+               "the optional inputs' bits");
+
+int gr_rain_runoff_specialised_for(const gr_rain_runoff *s) {
+  return s ? s->inputs : -1;
+}
+
 gr_status gr_rain_runoff_create(gr_context *ctx, const gr_grid *grid,
                                 const gr_rain_runoff_params *p, gr_rain_runoff **out) {
   char msg[256];
@@ -892,53 +1016,16 @@ gr_status gr_rain_runoff_create(gr_context *ctx, const gr_grid *grid,
   s->nyl = (int)ny;
   memcpy(s->ring, ring, sizeof(ring));
   s->params = *p;
-  cl_program prog = NULL;
   size_t bytes = cells * sizeof(cl_float);
-  st = gr_program_get(ctx, "rain_runoff", NULL, &prog);
-  if (st == GR_OK)
-    st = gr_kernel_create(ctx, prog, "rain_runoff_flux", &s->flux);
-  if (st == GR_OK)
-    st = gr_kernel_create(ctx, prog, "rain_runoff_flux_edges", &s->flux_edges);
-  if (st == GR_OK)
-    st = gr_kernel_create(ctx, prog, "rain_runoff_limit", &s->limit);
-  if (st == GR_OK)
-    st = gr_kernel_create(ctx, prog, "rain_runoff_update", &s->update);
-  if (st == GR_OK)
-    st = gr_kernel_create(ctx, prog, "rain_runoff_reduce", &s->reduce);
-  if (st == GR_OK)
-    st = gr_kernel_create(ctx, prog, "rain_runoff_derive", &s->derive);
-  if (st == GR_OK)
-    st = gr_kernel_create(ctx, prog, "rain_runoff_sw_prep", &s->sw_prep);
-  if (st == GR_OK)
-    st = gr_kernel_create(ctx, prog, "rain_runoff_sw_faces1", &s->sw_faces[0]);
-  if (st == GR_OK)
-    st = gr_kernel_create(ctx, prog, "rain_runoff_sw_faces2", &s->sw_faces[1]);
-  if (st == GR_OK)
-    st = gr_kernel_create(ctx, prog, "rain_runoff_sw_update1", &s->sw_update[0]);
-  if (st == GR_OK)
-    st = gr_kernel_create(ctx, prog, "rain_runoff_sw_update2", &s->sw_update[1]);
-  if (st == GR_OK)
-    st = gr_kernel_create(ctx, prog, "rain_runoff_sw_edges", &s->sw_edges);
-  if (st == GR_OK)
-    st = gr_kernel_create(ctx, prog, "rain_runoff_sw_speed", &s->sw_speed);
-  if (st == GR_OK)
-    st = gr_kernel_create(ctx, prog, "rain_runoff_sw_stage1", &s->sw_stage[0]);
-  if (st == GR_OK)
-    st = gr_kernel_create(ctx, prog, "rain_runoff_sw_stage2", &s->sw_stage[1]);
+  /* The kernels: for the inputs in use (none yet), made again when they
+   * change (gr_rain_runoff_specialise). */
+  s->inputs = -1;
+  s->specialise = 1;
+  st = gr_rain_runoff_specialise(s);
   if (st == GR_OK)
     st = gr_rain_runoff_sw_shape(s, 0, 0, 1);
-  if (st == GR_OK)
-    st = gr_kernel_create(ctx, prog, "rain_runoff_li_speed", &s->li_speed);
-  if (st == GR_OK)
-    st = gr_kernel_create(ctx, prog, "rain_runoff_maps", &s->maps);
-  if (st == GR_OK)
-    st = gr_kernel_create(ctx, prog, "rain_runoff_source", &s->source);
-  if (st == GR_OK)
-    st = gr_kernel_create(ctx, prog, "rain_runoff_li_step", &s->li_step);
-  if (st == GR_OK)
-    st = gr_rain_runoff_step_indices(s);
-  if (st == GR_OK)
-    st = gr_rain_runoff_li_shape(s);
+  /* The fused local inertial step is not the default (see li_shape). */
+  s->fused = 0;
   for (int a = 0; st == GR_OK && a < GR_RAIN_RUNOFF_MAP_ARRAYS; ++a)
     st = gr_buffer_create(ctx, CL_MEM_READ_WRITE, bytes, NULL, &s->map[a]);
   cl_mem *per_cell[] = {&s->h,     &s->h_c, &s->b,    &s->k,  &s->inf, &s->inf_c, &s->out,
@@ -962,12 +1049,7 @@ gr_status gr_rain_runoff_create(gr_context *ctx, const gr_grid *grid,
   if (st == GR_OK)
     st = gr_buffer_create(ctx, CL_MEM_READ_ONLY, sizeof(cl_float), NULL, &s->dummy);
   if (st == GR_OK)
-    st = gr_reduction_i64_init_max(ctx, s->reduce, cells, 2 * GR_RAIN_RUNOFF_SUMS,
-                                   GR_RAIN_RUNOFF_MAXES, &s->ledger);
-  if (st == GR_OK)
-    st = gr_reduction_init(ctx, s->sw_speed, cells, 0, 2, &s->speed);
-  if (st == GR_OK)
-    st = gr_reduction_init(ctx, s->li_speed, cells, 0, 1, &s->film);
+    st = gr_rain_runoff_reductions(s);
   /* Dry, flat ground; nothing infiltrated or gone. */
   cl_mem *zeroed[] = {&s->h,  &s->h_c,  &s->b,  &s->inf, &s->inf_c, &s->out, &s->out_c,
                       &s->in, &s->in_c, &s->h1, &s->qu1, &s->qv1,   &s->dh1, &s->dummy};
@@ -1357,7 +1439,8 @@ gr_status gr_rain_runoff_set_field(gr_rain_runoff *s, gr_field f, const float *h
     return GR_RAIN_RUNOFF_KEEP_ERROR(
         s, gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
                         "gr_rain_runoff_set_field needs a simulation and the field's values."));
-  return GR_RAIN_RUNOFF_KEEP_ERROR(s, gr_rain_runoff_set_field_impl(s, f, host));
+  return GR_RAIN_RUNOFF_KEEP_ERROR(
+      s, gr_rain_runoff_inputs_changed(s, gr_rain_runoff_set_field_impl(s, f, host)));
 }
 
 /* ------------------------------------------------------------- inflows */
@@ -1465,7 +1548,9 @@ gr_status gr_rain_runoff_set_point_inflows(gr_rain_runoff *s, const int *ij,
   if (!s)
     return gr_set_error(NULL, GR_ERR_INVALID_ARGUMENT,
                         "gr_rain_runoff_set_point_inflows needs a simulation.");
-  return GR_RAIN_RUNOFF_KEEP_ERROR(s, gr_rain_runoff_set_point_inflows_impl(s, ij, discharge, n));
+  return GR_RAIN_RUNOFF_KEEP_ERROR(
+      s,
+      gr_rain_runoff_inputs_changed(s, gr_rain_runoff_set_point_inflows_impl(s, ij, discharge, n)));
 }
 
 static gr_status gr_rain_runoff_set_edge_inflow_impl(gr_rain_runoff *s, int side, const double *t,
@@ -1512,7 +1597,8 @@ gr_status gr_rain_runoff_set_edge_inflow(gr_rain_runoff *s, int side, const doub
     return gr_set_error(NULL, GR_ERR_INVALID_ARGUMENT,
                         "gr_rain_runoff_set_edge_inflow needs a simulation.");
   return GR_RAIN_RUNOFF_KEEP_ERROR(
-      s, gr_rain_runoff_set_edge_inflow_impl(s, side, times, discharge, n));
+      s, gr_rain_runoff_inputs_changed(
+             s, gr_rain_runoff_set_edge_inflow_impl(s, side, times, discharge, n)));
 }
 
 /* ------------------------------------------------ rain and roughness maps */
@@ -1557,7 +1643,8 @@ gr_status gr_rain_runoff_set_manning_map(gr_rain_runoff *s, const double *n) {
   if (!s)
     return gr_set_error(NULL, GR_ERR_INVALID_ARGUMENT,
                         "gr_rain_runoff_set_manning_map needs a simulation.");
-  return GR_RAIN_RUNOFF_KEEP_ERROR(s, gr_rain_runoff_set_manning_map_impl(s, n));
+  return GR_RAIN_RUNOFF_KEEP_ERROR(
+      s, gr_rain_runoff_inputs_changed(s, gr_rain_runoff_set_manning_map_impl(s, n)));
 }
 
 static gr_status gr_rain_runoff_set_hyetograph_impl(gr_rain_runoff *s, const double *t,
@@ -2191,7 +2278,9 @@ static gr_status gr_rain_runoff_enqueue(gr_rain_runoff *s, double dt, int nsteps
                                         gr_rain_runoff_watch *w, int *done_out, int *stop) {
   cl_float dtf = (cl_float)dt;
   const size_t m = sizeof(cl_mem);
-  gr_status st = gr_rain_runoff_bind(s, dtf);
+  gr_status st = gr_rain_runoff_specialise(s);
+  if (st == GR_OK)
+    st = gr_rain_runoff_bind(s, dtf);
   int done = 0, exchange = s->halo_exchange && gr_rain_runoff_has_ring(s);
   int sw = s->params.flow_model == GR_FLOW_SHALLOW_WATER;
   /* The end time of each step, summed as s->time is below (the flood maps'
@@ -2494,10 +2583,14 @@ static gr_status gr_rain_runoff_film_rate(gr_rain_runoff *s, double *rate) {
 static gr_status gr_rain_runoff_stable_dt_impl(gr_rain_runoff *s, double *dt) {
   if (s->params.flow_model == GR_FLOW_SHALLOW_WATER)
     return gr_rain_runoff_sw_stable_dt(s, dt);
+  /* li_speed reads the no-data cells and the Manning map. */
+  gr_status st = gr_rain_runoff_specialise(s);
+  if (st != GR_OK)
+    return st;
   /* The deepest cell and the fastest that water arrives (m/s): the
    * heaviest rain and the strongest inflow. */
   double maxes[3] = {0.0, 0.0, 0.0};
-  gr_status st = gr_rain_runoff_deepest(s, &maxes[0]);
+  st = gr_rain_runoff_deepest(s, &maxes[0]);
   if (st == GR_OK)
     st = gr_rain_runoff_film_rate(s, &maxes[2]);
   maxes[1] =
