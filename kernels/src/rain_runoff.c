@@ -23,8 +23,9 @@
 #define GR_RAIN_RUNOFF_MAX_ELEVATION 1.0e6
 #define GR_RAIN_RUNOFF_MAX_DEPTH 1.0e4
 #define GR_RAIN_RUNOFF_MIN_DT 1.0e-30
-/* advance re-reads the stable step after 4 to 64 steps. */
-#define GR_RAIN_RUNOFF_CHUNK_MIN 4
+/* advance re-reads the stable step after 1 to 64 steps (see
+ * gr_rain_runoff_advance_impl). */
+#define GR_RAIN_RUNOFF_CHUNK_MIN 1
 #define GR_RAIN_RUNOFF_CHUNK_MAX 64
 /* gr_rain_runoff_step waits after every this many steps: an OpenCL queue
  * holding thousands of launches grows the runtime's own pools for good
@@ -2687,11 +2688,16 @@ static gr_status gr_rain_runoff_advance_impl(gr_rain_runoff *s, double duration,
   /* The stable step is read back again after a few steps, not once: rain
    * filling a dry bowl deepens it, and a step that was stable at the start
    * of a long advance is not by its end. The stretch between reads starts
-   * at GR_RAIN_RUNOFF_CHUNK_MIN steps and doubles (to GR_RAIN_RUNOFF_CHUNK_MAX) while the
-   * stable step holds; the last stretch is split into equal steps that end
-   * exactly at the duration. All of it depends on the state only, so the
-   * same state and duration give the same steps; the progress watch only
-   * adds waits. */
+   * at one step (GR_RAIN_RUNOFF_CHUNK_MIN) and doubles (to
+   * GR_RAIN_RUNOFF_CHUNK_MAX) while the stable step holds, back to one
+   * when it shrinks by more than 5 %; the last stretch is split into equal
+   * steps that end exactly at the duration. One step, not four, at the
+   * start: on dry ground the first stable step sees still water only rain
+   * deep, and the water's own speed and depth shrink it by half and more
+   * within a few steps (advance_dry_start: four steps of the first took the
+   * shallow-water model past its Courant limit, where cut negative depths
+   * made water). All of it depends on the state only, so the same state and
+   * duration give the same steps; the progress watch only adds waits. */
   double left = duration, last_dt = 0.0;
   int chunk = GR_RAIN_RUNOFF_CHUNK_MIN, stop = 0;
   gr_rain_runoff_watch watch = {0.0, 0.0, 1, 0, s->allreduce != NULL};
