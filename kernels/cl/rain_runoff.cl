@@ -113,16 +113,23 @@ GR_INLINE float gr_rain_runoff_drain(__global const float *restrict nodata, int 
              : 0.0f;
 }
 
-/* x^(-7/3) for x > 0 (a normal float), the friction's depth factor: x^(-1/3)
- * from an exponent-thirding first guess and three Newton steps (2e-7
- * relative), to the seventh power. Plain multiplications, unlike a library
- * cbrt or pow, which PoCL calls per work-item (the flux kernel was seven
- * times slower with cbrt); and the same answer on every IEEE device. */
-GR_INLINE float gr_rain_runoff_pow_m73(float x) {
+/* x^(-1/3) for x > 0 (a normal float): an exponent-thirding first guess and
+ * three Newton steps (2e-7 relative). Plain multiplications, unlike a
+ * library cbrt or pow, which PoCL calls per work-item (the flux kernel was
+ * seven times slower with cbrt, and the stable step's film rate spent a
+ * third of a run on the real DEM in it); and the same answer on every IEEE
+ * device. */
+GR_INLINE float gr_rain_runoff_rcbrt(float x) {
   float y = as_float(0x54a21d2au - as_uint(x) / 3u);
   y = y * (4.0f - x * y * y * y) * (1.0f / 3.0f);
   y = y * (4.0f - x * y * y * y) * (1.0f / 3.0f);
   y = y * (4.0f - x * y * y * y) * (1.0f / 3.0f);
+  return y;
+}
+
+/* x^(-7/3) for x > 0, the friction's depth factor. */
+GR_INLINE float gr_rain_runoff_pow_m73(float x) {
+  float y = gr_rain_runoff_rcbrt(x);
   float y2 = y * y;
   return y2 * y2 * y2 * y;
 }
@@ -389,7 +396,9 @@ GR_INLINE float gr_rain_runoff_film_rate(float hL, float hR, float bL, float bR,
   float db = bR - bL;
   float hf = db >= 0.0f ? fmax(hR, hL - db) : fmax(hL, hR + db);
   float slope = fabs(db + (hR - hL)) * inv_d;
-  float friction = (5.0f / 3.0f) * sqrt(hf * cbrt(hf) * slope / n2) * inv_d;
+  /* hf^(4/3) = hf^2 hf^(-2/3) */
+  float y = gr_rain_runoff_rcbrt(fmax(hf, GR_RAIN_RUNOFF_DRY));
+  float friction = (5.0f / 3.0f) * sqrt(hf * hf * (y * y) * slope / n2) * inv_d;
   float inertia = sqrt(cfl * (10.0f / 3.0f) * g * slope * inv_d);
   return hf < GR_RAIN_RUNOFF_DRY || !(n2 > 0.0f) ? 0.0f : fmin(friction, inertia);
 }
@@ -405,7 +414,7 @@ GR_INLINE float gr_rain_runoff_film_rate(float hL, float hR, float bL, float bR,
  * south of it likewise; a face's rate is the same float whichever side
  * computes it, so the maximum is the same whichever way the domain is
  * split (and as when each cell took its four faces, at half the cost: the
- * rate's cbrt is a call per face on PoCL). */
+ * rate's cube root costs a few multiplications per face). */
 __kernel void rain_runoff_li_speed(__global const float *restrict h,
                                    __global const float *restrict b,
                                    __global const float *restrict nodata, int use_nodata,
