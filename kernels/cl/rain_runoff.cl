@@ -1573,7 +1573,15 @@ GR_INLINE void gr_sw_fused(GR_SW_CELL_ARGS, float lvl_w, float lvl_e, float lvl_
   barrier(CLK_LOCAL_MEM_FENCE);
   /* The tile's faces, x-faces then y-faces in one index space: one call
    * of the face's expression, its inputs selected. A face beyond the local
-   * array's is computed from zeros and never read. */
+   * array's is computed from zeros and never read. A tile whose faces all
+   * lie two cells or more inside the grid (nearly every tile of a large
+   * grid) takes the face's expression without the edges' cases: each face
+   * is inner, both its cells have both neighbours, no line is continued,
+   * no ghost is picked and no edge stops a flux, as gr_sw_line_flux finds
+   * face by face in the other tiles; the same floats in fewer
+   * instructions (the H200's step at 4096^2: 2.09 ms before, 1.88 ms). The
+   * whole work-group takes the same branch. */
+  bool interior = i0 >= 2 && i0 + tx + 2 <= nx && j0 >= 2 && j0 + ty + 2 <= ny;
   for (int t = lid; t < nfx + nfy; t += wg) {
     bool xs = t < nfx;
     int u = xs ? t : t - nfx, w = xs ? tx + 1 : tx;
@@ -1585,9 +1593,13 @@ GR_INLINE void gr_sw_fused(GR_SW_CELL_ARGS, float lvl_w, float lvl_e, float lvl_
     gr_sw_pt q2 = gr_sw_tile_pt(th, tb, tn, tt, p);
     gr_sw_pt q3 = gr_sw_tile_pt(th, tb, tn, tt, p + step);
     float fh, fmL, fmR, ft;
-    gr_sw_line_flux(q0, q1, q2, q3, xs ? i0 + a : j0 + e, xs ? nx : ny, xs ? bnd_w : bnd_s,
-                    xs ? bnd_e : bnd_n, xs ? lvl_w : lvl_s, xs ? lvl_e : lvl_n, g, &fh, &fmL, &fmR,
-                    &ft);
+    if (interior)
+      gr_sw_face(gr_sw_recon(q0, q1, q2, true), gr_sw_recon(q1, q2, q3, true), true,
+                 gr_sw_rise(q1, q2, 0.0f), g, &fh, &fmL, &fmR, &ft);
+    else
+      gr_sw_line_flux(q0, q1, q2, q3, xs ? i0 + a : j0 + e, xs ? nx : ny, xs ? bnd_w : bnd_s,
+                      xs ? bnd_e : bnd_n, xs ? lvl_w : lvl_s, xs ? lvl_e : lvl_n, g, &fh, &fmL,
+                      &fmR, &ft);
     __local float *oh = xs ? xh : yh, *ol = xs ? xl : yl, *orr = xs ? xr : yr, *ot = xs ? xt : yt;
     oh[u] = fh;
     ol[u] = fmL;
