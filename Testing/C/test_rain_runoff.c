@@ -3743,6 +3743,27 @@ static void paths_fields(const gr_grid *g, float *b, float *r, float *k, float *
     }
 }
 
+/* The 4-byte words in which the saved states of a and b differ (-1 where
+ * either cannot be saved); *words gets the state's length in words. */
+static long state_words_differ(gr_rain_runoff *a, gr_rain_runoff *b, size_t *words) {
+  size_t bytes = 0;
+  *words = 0;
+  CHECK(gr_rain_runoff_state_size(a, &bytes) == GR_OK && bytes > 0);
+  unsigned char *st[2] = {calloc(bytes ? bytes : 1, 1), calloc(bytes ? bytes : 1, 1)};
+  long diff = -1;
+  if (st[0] && st[1] && gr_rain_runoff_state_save(a, st[0], bytes) == GR_OK &&
+      gr_rain_runoff_state_save(b, st[1], bytes) == GR_OK) {
+    diff = 0;
+    for (size_t q = 0; q + 4 <= bytes; q += 4)
+      diff += memcmp(st[0] + q, st[1] + q, 4) != 0;
+  }
+  CHECK_MSG(diff >= 0, "saving the states of %zu bytes failed", bytes);
+  free(st[0]);
+  free(st[1]);
+  *words = bytes / 4;
+  return diff;
+}
+
 /* The shallow-water pieces tests with each launch path forced (the fused
  * stages read the ring through their tiles' halos), with every kind of edge
  * and without: every owned cell of every field and the ledger bit for bit
@@ -3830,23 +3851,15 @@ static void test_sw_fused(void) {
       for (int v = 0; v < 3; ++v)
         run_stable(sim[v], 1, 30);
     }
-    size_t bytes = 0;
-    CHECK(gr_rain_runoff_state_size(sim[0], &bytes) == GR_OK && bytes > 0);
-    unsigned char *st[3];
-    for (int v = 0; v < 3; ++v) {
-      st[v] = calloc(bytes ? bytes : 1, 1);
-      CHECK(gr_rain_runoff_state_save(sim[v], st[v], bytes) == GR_OK);
-    }
-    long diff[2] = {0, 0};
-    for (int v = 1; v < 3; ++v)
-      for (size_t q = 0; q + 4 <= bytes; q += 4)
-        diff[v - 1] += memcmp(st[0] + q, st[v] + q, 4) != 0;
+    size_t words = 0;
+    long diff[2] = {state_words_differ(sim[0], sim[1], &words),
+                    state_words_differ(sim[0], sim[2], &words)};
     gr_rain_runoff_ledger l0 = ledger(sim[0]), l1 = ledger(sim[1]), l2 = ledger(sim[2]);
     int same_ledger = memcmp(&l0, &l1, sizeof(l0)) == 0 && memcmp(&l2, &l0, sizeof(l0)) == 0;
     CHECK_MSG(diff[0] == 0 && diff[1] == 0 && same_ledger,
-              "config %d: %ld (fused) and %ld (switching) words of the state of %zu bytes differ "
+              "config %d: %ld (fused) and %ld (switching) words of the state of %zu differ "
               "from the separate launches'; ledgers %s",
-              config, diff[0], diff[1], bytes, same_ledger ? "agree" : "differ");
+              config, diff[0], diff[1], words, same_ledger ? "agree" : "differ");
     /* Water moved and left (or, walled in, came in through the north edge
      * or from the inflows): the comparison is of a flow, not of still water. */
     float *speed = get_map(sim[0], &g, GR_RAIN_RUNOFF_MAX_SPEED);
@@ -3859,8 +3872,7 @@ static void test_sw_fused(void) {
     CHECK(fabs(l0.balance_error) < 1e-6 * (l0.rain_volume + l0.inflow_volume + l0.initial_volume));
     printf("config %d: after %lld steps %ld words of %zu differ (fused), %ld (switching, tile 8 x "
            "4); outflow %.4f m^3, inflow %.4f m^3, fastest %.3f m/s\n",
-           config, l0.steps, diff[0], bytes / 4, diff[1], l0.outflow_volume, l0.inflow_volume,
-           vmax);
+           config, l0.steps, diff[0], words, diff[1], l0.outflow_volume, l0.inflow_volume, vmax);
     if (config == 0) {
       /* Tiles that are none, or too large for any device, are refused and
        * the tile kept (the run above is unchanged by the attempt). */
@@ -3873,15 +3885,11 @@ static void test_sw_fused(void) {
       }
       run_stable(sim[1], 1, 2);
       run_stable(sim[0], 1, 2);
-      CHECK(gr_rain_runoff_state_save(sim[0], st[0], bytes) == GR_OK);
-      CHECK(gr_rain_runoff_state_save(sim[1], st[1], bytes) == GR_OK);
-      CHECK(memcmp(st[0], st[1], bytes) == 0);
+      CHECK(state_words_differ(sim[0], sim[1], &words) == 0);
     }
     free(speed);
-    for (int v = 0; v < 3; ++v) {
-      free(st[v]);
+    for (int v = 0; v < 3; ++v)
       gr_rain_runoff_destroy(sim[v]);
-    }
   }
   free(b);
   free(r);
@@ -4592,23 +4600,15 @@ static void test_li_fused(void) {
       for (int v = 0; v < 3; ++v)
         run_stable(sim[v], 1, 30);
     }
-    size_t bytes = 0;
-    CHECK(gr_rain_runoff_state_size(sim[0], &bytes) == GR_OK && bytes > 0);
-    unsigned char *st[3];
-    for (int v = 0; v < 3; ++v) {
-      st[v] = calloc(bytes ? bytes : 1, 1);
-      CHECK(gr_rain_runoff_state_save(sim[v], st[v], bytes) == GR_OK);
-    }
-    long diff[2] = {0, 0};
-    for (int v = 0; v < 2; ++v)
-      for (size_t q = 0; q + 4 <= bytes; q += 4)
-        diff[v] += memcmp(st[1] + q, st[v == 0 ? 0 : 2] + q, 4) != 0;
+    size_t words = 0;
+    long diff[2] = {state_words_differ(sim[1], sim[0], &words),
+                    state_words_differ(sim[1], sim[2], &words)};
     gr_rain_runoff_ledger l0 = ledger(sim[0]), l1 = ledger(sim[1]), l2 = ledger(sim[2]);
     int same_ledger = memcmp(&l0, &l1, sizeof(l0)) == 0 && memcmp(&l2, &l1, sizeof(l0)) == 0;
     CHECK_MSG(diff[0] == 0 && diff[1] == 0 && same_ledger,
-              "config %d: %ld (fused) and %ld (switching) words of the state of %zu bytes differ "
+              "config %d: %ld (fused) and %ld (switching) words of the state of %zu differ "
               "from the three launches'; ledgers %s",
-              config, diff[0], diff[1], bytes, same_ledger ? "agree" : "differ");
+              config, diff[0], diff[1], words, same_ledger ? "agree" : "differ");
     /* Water moved and left through the edges, the holes filled in part:
      * the comparison is of a flow, not of still water. */
     float *speed = get_map(sim[1], &g, GR_RAIN_RUNOFF_MAX_SPEED);
@@ -4621,13 +4621,10 @@ static void test_li_fused(void) {
     CHECK(fabs(l1.balance_error) < 1e-6 * (l1.rain_volume + l1.inflow_volume + l1.initial_volume));
     printf("config %d: after %lld steps %ld words of %zu differ (one launch), %ld (switching); "
            "outflow %.4f m^3, inflow %.4f m^3, fastest %.3f m/s\n",
-           config, l1.steps, diff[0], bytes / 4, diff[1], l1.outflow_volume, l1.inflow_volume,
-           vmax);
+           config, l1.steps, diff[0], words, diff[1], l1.outflow_volume, l1.inflow_volume, vmax);
     free(speed);
-    for (int v = 0; v < 3; ++v) {
-      free(st[v]);
+    for (int v = 0; v < 3; ++v)
       gr_rain_runoff_destroy(sim[v]);
-    }
   }
   free(b);
   free(r);
@@ -4716,35 +4713,25 @@ static void test_specialised(void) {
         follows &= gr_rain_runoff_specialised_for(sim[1]) == have &&
                    gr_rain_runoff_specialised_for(sim[0]) == GR_RAIN_RUNOFF_INPUT_ALL;
       }
-      size_t bytes = 0;
-      CHECK(gr_rain_runoff_state_size(sim[0], &bytes) == GR_OK && bytes > 0);
-      unsigned char *st[2];
-      for (int v = 0; v < 2; ++v) {
-        st[v] = calloc(bytes ? bytes : 1, 1);
-        CHECK(gr_rain_runoff_state_save(sim[v], st[v], bytes) == GR_OK);
-      }
-      long diff = 0;
-      for (size_t q = 0; q + 4 <= bytes; q += 4)
-        diff += memcmp(st[0] + q, st[1] + q, 4) != 0;
+      size_t words = 0;
+      long diff = state_words_differ(sim[0], sim[1], &words);
       gr_rain_runoff_ledger l0 = ledger(sim[0]), l1 = ledger(sim[1]);
       int same_ledger = memcmp(&l0, &l1, sizeof(l0)) == 0;
       CHECK_MSG(follows, "%s, inputs %d: the kernels are built for %d, not the inputs in use (%d)",
                 model_names[m], bits, gr_rain_runoff_specialised_for(sim[1]), have);
       CHECK_MSG(diff == 0 && same_ledger,
-                "%s, inputs %d: %ld words of the state of %zu bytes differ from the general "
+                "%s, inputs %d: %ld words of the state of %zu differ from the general "
                 "kernels'; ledgers %s",
-                model_names[m], bits, diff, bytes, same_ledger ? "agree" : "differ");
+                model_names[m], bits, diff, words, same_ledger ? "agree" : "differ");
       /* A flow: water left through the edges and infiltrated. */
       CHECK_MSG(l0.steps == 120 && l0.outflow_volume > 0.0 && l0.infiltrated_volume > 0.0,
                 "%s, inputs %d: %lld steps, outflow %g m^3, infiltrated %g m^3", model_names[m],
                 bits, l0.steps, l0.outflow_volume, l0.infiltrated_volume);
       printf("%s, inputs %2d: kernels for %2d, %ld words of %zu differ; outflow %.4f m^3\n",
-             model_names[m], bits, gr_rain_runoff_specialised_for(sim[1]), diff, bytes / 4,
+             model_names[m], bits, gr_rain_runoff_specialised_for(sim[1]), diff, words,
              l0.outflow_volume);
-      for (int v = 0; v < 2; ++v) {
-        free(st[v]);
+      for (int v = 0; v < 2; ++v)
         gr_rain_runoff_destroy(sim[v]);
-      }
     }
   free(b);
   free(r);
