@@ -207,6 +207,55 @@ GR_INLINE float gr_rain_runoff_edge_q(int kind, float q, bool low) {
   return kind == GR_RAIN_RUNOFF_B_CLOSED ? 0.0f : (kind == GR_RAIN_RUNOFF_B_LEVEL ? q : out_only);
 }
 
+/* The arguments of gr_rain_runoff_li_face that rain_runoff_flux and
+ * rain_runoff_li_step pass as they got them. */
+#define GR_RAIN_RUNOFF_LI_FACE_ARGS                                                                \
+  __global const float *restrict h, __global const float *restrict b,                              \
+      __global const float *restrict rain, __global const float *restrict perm,                    \
+      __global const float *restrict src, int use_src, __global const float *restrict nodata,      \
+      int use_nodata, __global const float *restrict limit, float dt, float g, float n2,           \
+      __global const float *restrict n2map, int use_n2, float theta, int use_rain,                 \
+      float rain_uniform, int use_perm, float perm_uniform
+#define GR_RAIN_RUNOFF_LI_FACE_PASS                                                                \
+  h, b, rain, perm, src, use_src, nodata, use_nodata, limit, dt, g, n2, n2map, use_n2, theta,      \
+      use_rain, rain_uniform, use_perm, perm_uniform
+
+/* The local inertial q* through the face below cell c along one axis:
+ * between cell c - cs (the low side; cs 1 along x, nx along y) and cell c
+ * (hc, bc, kc: its depth after rain and infiltration, bed and limiter; 0,
+ * 0, 1 beyond the grid), the face's index along the axis k of 0 .. n (0
+ * and n: the grid's edge faces, which lead into a dry ghost at the edge
+ * cell's ground and pass outflow only), the face f in the discharges q_old
+ * of the previous step, fs apart along the axis. The previous discharges
+ * are limited by their upwind cells' K and smoothed along the axis
+ * (gr_rain_runoff_smooth); an edge face takes its one cell's roughness.
+ * rain_runoff_flux and rain_runoff_li_step call it, so their faces are the
+ * same floats. */
+GR_INLINE float gr_rain_runoff_li_face(GR_RAIN_RUNOFF_LI_FACE_ARGS,
+                                       __global const float *restrict q_old, int k, int n, int c,
+                                       int cs, int f, int fs, float inv_d, float hc, float bc,
+                                       float kc) {
+  int w = c - cs;
+  bool in_w = k > 0;
+  float hw = in_w ? gr_rain_runoff_wet(h[w], GR_RAIN_RUNOFF_RAIN(w), GR_RAIN_RUNOFF_SRC(w),
+                                       GR_RAIN_RUNOFF_PERM(w), dt)
+                  : 0.0f;
+  float bw = in_w ? b[w] : 0.0f;
+  float kw = in_w ? limit[w] : 1.0f;
+  float hL = k == 0 ? 0.0f : hw, bL = k == 0 ? bc : bw;
+  float hR = k == n ? 0.0f : hc, bR = k == n ? bw : bc;
+  float own = gr_rain_runoff_limited(q_old[f], kw, kc);
+  float before =
+      k > 0 ? gr_rain_runoff_limited(q_old[f - fs], k > 1 ? limit[c - 2 * cs] : 1.0f, kw) : 0.0f;
+  float after =
+      k < n ? gr_rain_runoff_limited(q_old[f + fs], kc, k < n - 1 ? limit[c + cs] : 1.0f) : 0.0f;
+  float prev = gr_rain_runoff_smooth(own, before, after, theta, k == 0 || k == n);
+  float n2f = gr_rain_runoff_face_n2(n2map, use_n2, n2, in_w ? w : c, k < n ? c : w);
+  float q = gr_rain_runoff_face(hL, hR, bL, bR, prev, own, dt, g, n2f, inv_d);
+  q = k == 0 ? fmin(q, 0.0f) : q;
+  return k == n ? fmax(q, 0.0f) : q;
+}
+
 /* Work-item (i, j) of an (nx+1) x (ny+1) launch owns the x-face left of cell
  * (i, j) (for j < ny) and the y-face below it (for i < nx). The grid's edge
  * faces are those of an open edge here: they lead into a dry ghost cell at
@@ -241,59 +290,14 @@ rain_runoff_flux(__global const float *restrict h, __global const float *restric
                   : 0.0f;
   float bc = in_c ? b[c] : 0.0f;
   float kc = in_c ? limit[c] : 1.0f;
-  if (j < ny) {
-    /* Cell (i-1, j) is L, cell (i, j) is R; at the edges one is the ghost. */
-    int w = c - 1;
-    bool in_w = i > 0;
-    float hw = in_w ? gr_rain_runoff_wet(h[w], GR_RAIN_RUNOFF_RAIN(w), GR_RAIN_RUNOFF_SRC(w),
-                                         GR_RAIN_RUNOFF_PERM(w), dt)
-                    : 0.0f;
-    float bw = in_w ? b[w] : 0.0f;
-    float kw = in_w ? limit[w] : 1.0f;
-    float hL = i == 0 ? 0.0f : hw, bL = i == 0 ? bc : bw;
-    float hR = i == nx ? 0.0f : hc, bR = i == nx ? bw : bc;
-    int f = j * (nx + 1) + i;
-    float own = gr_rain_runoff_limited(qx_old[f], kw, kc);
-    float before =
-        i > 0 ? gr_rain_runoff_limited(qx_old[f - 1], i > 1 ? limit[c - 2] : 1.0f, kw) : 0.0f;
-    float after =
-        i < nx ? gr_rain_runoff_limited(qx_old[f + 1], kc, i < nx - 1 ? limit[c + 1] : 1.0f) : 0.0f;
-    float prev = gr_rain_runoff_smooth(own, before, after, theta, i == 0 || i == nx);
-    /* An edge face takes its one cell's roughness. */
-    float n2f = gr_rain_runoff_face_n2(n2map, use_n2, n2, in_w ? w : c, i < nx ? c : w);
-    float q = gr_rain_runoff_face(hL, hR, bL, bR, prev, own, dt, g, n2f, inv_dx);
-    if (i == 0)
-      q = fmin(q, 0.0f);
-    if (i == nx)
-      q = fmax(q, 0.0f);
-    qx[f] = q;
-  }
-  if (i < nx) {
-    int s = c - nx;
-    bool in_s = j > 0;
-    float hs = in_s ? gr_rain_runoff_wet(h[s], GR_RAIN_RUNOFF_RAIN(s), GR_RAIN_RUNOFF_SRC(s),
-                                         GR_RAIN_RUNOFF_PERM(s), dt)
-                    : 0.0f;
-    float bs = in_s ? b[s] : 0.0f;
-    float ks = in_s ? limit[s] : 1.0f;
-    float hL = j == 0 ? 0.0f : hs, bL = j == 0 ? bc : bs;
-    float hR = j == ny ? 0.0f : hc, bR = j == ny ? bs : bc;
-    int f = c; /* y-faces are numbered like cells, with one more row */
-    float own = gr_rain_runoff_limited(qy_old[f], ks, kc);
-    float before =
-        j > 0 ? gr_rain_runoff_limited(qy_old[f - nx], j > 1 ? limit[c - 2 * nx] : 1.0f, ks) : 0.0f;
-    float after =
-        j < ny ? gr_rain_runoff_limited(qy_old[f + nx], kc, j < ny - 1 ? limit[c + nx] : 1.0f)
-               : 0.0f;
-    float prev = gr_rain_runoff_smooth(own, before, after, theta, j == 0 || j == ny);
-    float n2f = gr_rain_runoff_face_n2(n2map, use_n2, n2, in_s ? s : c, j < ny ? c : s);
-    float q = gr_rain_runoff_face(hL, hR, bL, bR, prev, own, dt, g, n2f, inv_dy);
-    if (j == 0)
-      q = fmin(q, 0.0f);
-    if (j == ny)
-      q = fmax(q, 0.0f);
-    qy[f] = q;
-  }
+  /* Cell (i-1, j) is L, cell (i, j) is R; at the edges one is the ghost. */
+  if (j < ny)
+    qx[j * (nx + 1) + i] = gr_rain_runoff_li_face(GR_RAIN_RUNOFF_LI_FACE_PASS, qx_old, i, nx, c, 1,
+                                                  j * (nx + 1) + i, 1, inv_dx, hc, bc, kc);
+  /* y-faces are numbered like cells, with one more row. */
+  if (i < nx)
+    qy[c] = gr_rain_runoff_li_face(GR_RAIN_RUNOFF_LI_FACE_PASS, qy_old, j, ny, c, nx, c, nx, inv_dy,
+                                   hc, bc, kc);
 }
 
 /* The faces of the domain's edges whose kind is not open (those the flux
@@ -651,28 +655,9 @@ __kernel void rain_runoff_li_step(
   float fxv = 0.0f, fyv = 0.0f;
   if (bl < ly - 1 && j >= 0 && j < ny && i >= 0 && i <= nx) {
     /* rain_runoff_flux's x-face (i, j). */
-    int w = c - 1;
-    bool in_w = i > 0;
-    float hw = in_w ? gr_rain_runoff_wet(h[w], GR_RAIN_RUNOFF_RAIN(w), GR_RAIN_RUNOFF_SRC(w),
-                                         GR_RAIN_RUNOFF_PERM(w), dt)
-                    : 0.0f;
-    float bw = in_w ? b[w] : 0.0f;
-    float kw = in_w ? limit[w] : 1.0f;
-    float hL = i == 0 ? 0.0f : hw, bL = i == 0 ? bc : bw;
-    float hR = i == nx ? 0.0f : hc, bR = i == nx ? bw : bc;
     int f = j * (nx + 1) + i;
-    float own = gr_rain_runoff_limited(qx_old[f], kw, kc);
-    float before =
-        i > 0 ? gr_rain_runoff_limited(qx_old[f - 1], i > 1 ? limit[c - 2] : 1.0f, kw) : 0.0f;
-    float after =
-        i < nx ? gr_rain_runoff_limited(qx_old[f + 1], kc, i < nx - 1 ? limit[c + 1] : 1.0f) : 0.0f;
-    float prev = gr_rain_runoff_smooth(own, before, after, theta, i == 0 || i == nx);
-    float n2f = gr_rain_runoff_face_n2(n2map, use_n2, n2, in_w ? w : c, i < nx ? c : w);
-    float q = gr_rain_runoff_face(hL, hR, bL, bR, prev, own, dt, g, n2f, inv_dx);
-    if (i == 0)
-      q = fmin(q, 0.0f);
-    if (i == nx)
-      q = fmax(q, 0.0f);
+    float q = gr_rain_runoff_li_face(GR_RAIN_RUNOFF_LI_FACE_PASS, qx_old, i, nx, c, 1, f, 1, inv_dx,
+                                     hc, bc, kc);
     bool kept = (i == 0 && (fixed & 1)) || (i == nx && (fixed & 2));
     if (kept)
       q = qx[f];
@@ -682,29 +667,9 @@ __kernel void rain_runoff_li_step(
   }
   if (a < lx - 1 && i >= 0 && i < nx && j >= 0 && j <= ny) {
     /* rain_runoff_flux's y-face (i, j). */
-    int s = c - nx;
-    bool in_s = j > 0;
-    float hs = in_s ? gr_rain_runoff_wet(h[s], GR_RAIN_RUNOFF_RAIN(s), GR_RAIN_RUNOFF_SRC(s),
-                                         GR_RAIN_RUNOFF_PERM(s), dt)
-                    : 0.0f;
-    float bs = in_s ? b[s] : 0.0f;
-    float ks = in_s ? limit[s] : 1.0f;
-    float hL = j == 0 ? 0.0f : hs, bL = j == 0 ? bc : bs;
-    float hR = j == ny ? 0.0f : hc, bR = j == ny ? bs : bc;
     int f = c;
-    float own = gr_rain_runoff_limited(qy_old[f], ks, kc);
-    float before =
-        j > 0 ? gr_rain_runoff_limited(qy_old[f - nx], j > 1 ? limit[c - 2 * nx] : 1.0f, ks) : 0.0f;
-    float after =
-        j < ny ? gr_rain_runoff_limited(qy_old[f + nx], kc, j < ny - 1 ? limit[c + nx] : 1.0f)
-               : 0.0f;
-    float prev = gr_rain_runoff_smooth(own, before, after, theta, j == 0 || j == ny);
-    float n2f = gr_rain_runoff_face_n2(n2map, use_n2, n2, in_s ? s : c, j < ny ? c : s);
-    float q = gr_rain_runoff_face(hL, hR, bL, bR, prev, own, dt, g, n2f, inv_dy);
-    if (j == 0)
-      q = fmin(q, 0.0f);
-    if (j == ny)
-      q = fmax(q, 0.0f);
+    float q = gr_rain_runoff_li_face(GR_RAIN_RUNOFF_LI_FACE_PASS, qy_old, j, ny, c, nx, c, nx,
+                                     inv_dy, hc, bc, kc);
     bool kept = (j == 0 && (fixed & 4)) || (j == ny && (fixed & 8));
     if (kept)
       q = qy[f];
