@@ -6,7 +6,7 @@
  * DEM.f32: NX * NY floats, row 0 south. It times the context, the set-up
  * (gr_rain_runoff_create: the program build) and the first step, then
  * advances HOURS the way gr_rain_runoff_advance does (the stable step read
- * back, then 4 to 64 steps, doubling while it holds), but with the stretches
+ * back, then 1 to 64 steps, doubling while it holds), but with the stretches
  * apart: each stretch of steps is waited for (a one-point sample), so
  * "stepping" is the steps' own time and "read-backs" the stable step's
  * reduction and read on an idle queue. It also counts how often the step
@@ -104,7 +104,7 @@ int main(int argc, char **argv) {
   /* advance's loop, each part timed. */
   double left = duration, last_dt = 0.0, t_steps = 0.0, t_reads = 0.0, dt_min = HUGE_VAL;
   long long steps = 0, reads = 0, capped = 0;
-  int chunk = 4;
+  int chunk = 1;
   double c0 = cpu(), w0 = now();
   while (left > 0.0) {
     t0 = now();
@@ -112,7 +112,7 @@ int main(int argc, char **argv) {
     t_reads += now() - t0;
     ++reads;
     if (last_dt > 0.0)
-      chunk = dt >= 0.95 * last_dt ? (chunk * 2 < 64 ? chunk * 2 : 64) : 4;
+      chunk = dt >= 0.95 * last_dt ? (chunk * 2 < 64 ? chunk * 2 : 64) : 1;
     last_dt = dt;
     int k = chunk;
     double h = dt, nn = ceil(left / dt);
