@@ -605,14 +605,15 @@ GR_API const gr_param_bound *gr_rain_runoff_param_bounds(int *count);
 GR_API void gr_rain_runoff_set_fused(gr_rain_runoff *s, int on);
 
 /**
- * Whether the step kernels are compiled for the optional inputs in use
+ * Whether the kernels are compiled for the optional inputs in use
  * (non-zero, the default) or for every input possible (0). An input map
  * (rain, permeability, Manning n), inflows and no-data cells each cost the
  * step loads and tests; compiled without those that are absent, the local
- * inertial step on a CPU is two to three times faster. Setting or clearing
- * such an input builds the matching program (once per context; OpenCL
- * drivers cache the binaries) before the next step. Both give the same
- * bits; only the speed differs.
+ * inertial step on a CPU is two to three times faster. The call that sets
+ * or clears such an input takes the matching program (built once per
+ * context and set of inputs; OpenCL drivers also cache the binaries);
+ * this switch takes effect at the next step. Both give the same bits; only
+ * the speed differs.
  */
 GR_API void gr_rain_runoff_set_specialised(gr_rain_runoff *s, int on);
 
