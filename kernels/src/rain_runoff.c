@@ -874,13 +874,15 @@ static int gr_rain_runoff_inputs_used(const gr_rain_runoff *s) {
          (s->has_nodata ? GR_RAIN_RUNOFF_IN_NODATA : 0) | (s->has_n2 ? GR_RAIN_RUNOFF_IN_N2 : 0);
 }
 
-/* Takes the step kernels from the program built for the inputs in use
- * (every input where specialise is 0) when they are not already from it:
- * the program is found or built (gr_program_get: once per context and
+/* Takes every kernel from the program built for the inputs in use (every
+ * input where specialise is 0) when they are not already from it: the
+ * program is found or built (gr_program_get: once per context and
  * options), the kernels made, and only then the old ones released; the
- * argument indices, the fused work-groups and the arguments follow. Called
- * at creation and before every batch of steps, so that a map set or
- * cleared since takes effect at the next step. */
+ * argument indices, the fused work-groups, the reductions and the
+ * arguments follow. Called at creation, by the setters of inputs
+ * (gr_rain_runoff_inputs_changed), and before every batch of steps and
+ * every local inertial stable step (a switch of specialise, or a build
+ * that failed before). */
 static gr_status gr_rain_runoff_specialise(gr_rain_runoff *s) {
   int want = s->specialise ? gr_rain_runoff_inputs_used(s) : GR_RAIN_RUNOFF_IN_ALL;
   if (want == s->inputs)
