@@ -4660,7 +4660,7 @@ static void give_inputs(gr_rain_runoff *sim, int bits, const float *r, const flo
  * (gr_rain_runoff_specialised_for), against a general run given the same.
  * After 120 steps the whole state (depth and its compensation, limiters or
  * discharges, infiltration, outflow, inflow, flood maps) and the ledger are
- * the same to the bit. */
+ * the same to the bit; also after switching the model between steps. */
 static void test_specialised(void) {
   gr_grid g = {75, 41, 2.0, 1.5, 0.0, 0.0, 0, 0};
   size_t n = cells_of(&g);
@@ -4733,6 +4733,36 @@ static void test_specialised(void) {
       for (int v = 0; v < 2; ++v)
         gr_rain_runoff_destroy(sim[v]);
     }
+  /* The model switched between steps (gr_rain_runoff_set_params): a local
+   * inertial program has no shallow-water kernels, so the switch takes the
+   * shallow-water program, and back; against a general run switched alike. */
+  gr_rain_runoff *sim[2] = {NULL, NULL};
+  gr_rain_runoff_params p = params_with(2e-5, 1e-6, GR_BOUNDARY_OPEN);
+  for (int v = 0; v < 2; ++v) {
+    sim[v] = make_sim(&g, &p, solid, d);
+    if (sim[v]) {
+      gr_rain_runoff_set_specialised(sim[v], v);
+      give_inputs(sim[v], GR_RAIN_RUNOFF_INPUT_RAIN, r, k, nmap);
+    }
+  }
+  for (int part = 0; sim[0] && sim[1] && part < 3; ++part) {
+    p.flow_model = part == 1 ? GR_FLOW_SHALLOW_WATER : GR_FLOW_LOCAL_INERTIAL;
+    for (int v = 0; v < 2; ++v) {
+      CHECK(gr_rain_runoff_set_params(sim[v], &p) == GR_OK);
+      run_stable(sim[v], 4, 10);
+    }
+    size_t words = 0;
+    long diff = state_words_differ(sim[0], sim[1], &words);
+    gr_rain_runoff_ledger l0 = ledger(sim[0]), l1 = ledger(sim[1]);
+    CHECK_MSG(diff == 0 && memcmp(&l0, &l1, sizeof(l0)) == 0 &&
+                  gr_rain_runoff_specialised_for(sim[1]) == GR_RAIN_RUNOFF_INPUT_RAIN,
+              "switched to %s: %ld words of %zu differ, kernels for %d", model_names[p.flow_model],
+              diff, words, gr_rain_runoff_specialised_for(sim[1]));
+    printf("switched to %s: %ld words of %zu differ; outflow %.4f m^3\n", model_names[p.flow_model],
+           diff, words, l0.outflow_volume);
+  }
+  gr_rain_runoff_destroy(sim[0]);
+  gr_rain_runoff_destroy(sim[1]);
   free(b);
   free(r);
   free(k);

@@ -48,6 +48,10 @@
 #define GR_RAIN_RUNOFF_INPUTS GR_RAIN_RUNOFF_IN_ALL
 #endif
 #define GR_RAIN_RUNOFF_USES(bit, flag) ((GR_RAIN_RUNOFF_INPUTS & (bit)) != 0 && (flag))
+/* Whether the program has the shallow-water model's kernels (below). */
+#ifndef GR_RAIN_RUNOFF_SW
+#define GR_RAIN_RUNOFF_SW 1
+#endif
 
 GR_INLINE float gr_rain_runoff_input(__global const float *restrict field, int use_field,
                                      float uniform, long c) {
@@ -862,6 +866,10 @@ rain_runoff_derive(__global const float *restrict h, __global const float *restr
  * in both its cells, and keeping <2 x float> values out of the kernels (see
  * gr_sw_pt, gr_sw_hll), made the step 4-6x faster on PoCL, the same floats. */
 
+/* The shallow-water model's functions and kernels, left out of a program
+ * built for the local inertial model alone (-DGR_RAIN_RUNOFF_SW=0: half the
+ * source, a third less time to build on PoCL). */
+#if GR_RAIN_RUNOFF_SW
 /* Depth below which a cell's velocity is desingularised (Kurganov & Petrova
  * 2007): u = 2 h q / (h^2 + max(h^2, eps^2)), which is q / h above it and
  * falls smoothly to 0 with the depth below it, so films a step leaves
@@ -1646,6 +1654,8 @@ rain_runoff_sw_speed(__global const float *restrict h, __global const float *res
   mine[1] = rate;
   gr_reduce_group(scratch, 0, 2, partial);
 }
+
+#endif /* GR_RAIN_RUNOFF_SW */
 
 /* ------------------------------------------------------- flood maps
  *

@@ -818,9 +818,14 @@ static gr_status gr_rain_runoff_sw_shape(gr_rain_runoff *s, size_t tx, size_t ty
   cl_int err = clGetDeviceInfo(dev, CL_DEVICE_TYPE, sizeof(type), &type, NULL);
   if (err == CL_SUCCESS)
     err = clGetDeviceInfo(dev, CL_DEVICE_LOCAL_MEM_SIZE, sizeof(local_mem), &local_mem, NULL);
+  /* A local inertial program has no stages: the device's largest
+   * work-group until the model changes, when the tile is checked again
+   * (gr_rain_runoff_specialise). */
   for (int k = 0; err == CL_SUCCESS && k < 2; ++k)
-    err = clGetKernelWorkGroupInfo(s->sw_stage[k], dev, CL_KERNEL_WORK_GROUP_SIZE, sizeof(wg[k]),
-                                   &wg[k], NULL);
+    err = s->sw_stage[k]
+              ? clGetKernelWorkGroupInfo(s->sw_stage[k], dev, CL_KERNEL_WORK_GROUP_SIZE,
+                                         sizeof(wg[k]), &wg[k], NULL)
+              : clGetDeviceInfo(dev, CL_DEVICE_MAX_WORK_GROUP_SIZE, sizeof(wg[k]), &wg[k], NULL);
   if (err != CL_SUCCESS)
     return gr_cl_check(s->ctx, err, "Querying the device for the shallow-water stages' work-group");
   int gpu = (type & CL_DEVICE_TYPE_GPU) != 0;
@@ -860,7 +865,7 @@ static gr_status gr_rain_runoff_reductions(gr_rain_runoff *s) {
   gr_reduction_release(&s->film);
   gr_status st = gr_reduction_i64_init_max(s->ctx, s->reduce, cells, 2 * GR_RAIN_RUNOFF_SUMS,
                                            GR_RAIN_RUNOFF_MAXES, &s->ledger);
-  if (st == GR_OK)
+  if (st == GR_OK && s->sw_speed) /* a shallow-water program's */
     st = gr_reduction_init(s->ctx, s->sw_speed, cells, 0, 2, &s->speed);
   if (st == GR_OK)
     st = gr_reduction_init(s->ctx, s->li_speed, cells, 0, 1, &s->film);
@@ -884,7 +889,11 @@ static int gr_rain_runoff_inputs_used(const gr_rain_runoff *s) {
  * every local inertial stable step (a switch of specialise, or a build
  * that failed before). */
 static gr_status gr_rain_runoff_specialise(gr_rain_runoff *s) {
-  int want = s->specialise ? gr_rain_runoff_inputs_used(s) : GR_RAIN_RUNOFF_IN_ALL;
+  /* The inputs' bits, and the shallow-water kernels above them: a local
+   * inertial simulation's program leaves those out. */
+  int sw = !s->specialise || s->params.flow_model == GR_FLOW_SHALLOW_WATER;
+  int inputs = s->specialise ? gr_rain_runoff_inputs_used(s) : GR_RAIN_RUNOFF_IN_ALL;
+  int want = inputs | (sw ? GR_RAIN_RUNOFF_IN_ALL + 1 : 0);
   if (want == s->inputs)
     return GR_OK;
   static const char *const names[] = {
@@ -896,19 +905,22 @@ static gr_status gr_rain_runoff_specialise(gr_rain_runoff *s) {
       "rain_runoff_sw_speed",   "rain_runoff_li_speed",   "rain_runoff_maps",
       "rain_runoff_source"};
   enum { GR_RR_KERNELS = sizeof(names) / sizeof(names[0]) };
+  /* The shallow-water model's kernels (none in a local inertial program). */
+  static const unsigned char sw_only[GR_RR_KERNELS] = {0, 0, 0, 0, 0, 1, 1, 1, 1, 1,
+                                                       1, 1, 1, 0, 0, 1, 0, 0, 0};
   cl_kernel *slots[GR_RR_KERNELS] = {
       &s->flux,     &s->flux_edges,  &s->limit,       &s->update,       &s->li_step,
       &s->sw_prep,  &s->sw_faces[0], &s->sw_faces[1], &s->sw_update[0], &s->sw_update[1],
       &s->sw_edges, &s->sw_stage[0], &s->sw_stage[1], &s->reduce,       &s->derive,
       &s->sw_speed, &s->li_speed,    &s->maps,        &s->source};
-  char opt[64];
-  snprintf(opt, sizeof(opt), "-DGR_RAIN_RUNOFF_INPUTS=%d", want);
+  char opt[96];
+  snprintf(opt, sizeof(opt), "-DGR_RAIN_RUNOFF_INPUTS=%d -DGR_RAIN_RUNOFF_SW=%d", inputs, sw);
   cl_program prog = NULL;
-  gr_status st =
-      gr_program_get(s->ctx, "rain_runoff", want == GR_RAIN_RUNOFF_IN_ALL ? NULL : opt, &prog);
+  gr_status st = gr_program_get(s->ctx, "rain_runoff", s->specialise ? opt : NULL, &prog);
   cl_kernel made[GR_RR_KERNELS] = {NULL};
   for (int k = 0; st == GR_OK && k < GR_RR_KERNELS; ++k)
-    st = gr_kernel_create(s->ctx, prog, names[k], &made[k]);
+    if (sw || !sw_only[k])
+      st = gr_kernel_create(s->ctx, prog, names[k], &made[k]);
   if (st != GR_OK) {
     for (int k = 0; k < GR_RR_KERNELS; ++k)
       if (made[k])
@@ -967,7 +979,7 @@ _Static_assert(GR_RAIN_RUNOFF_INPUT_RAIN == GR_RAIN_RUNOFF_IN_RAIN &&
                "the optional inputs' bits");
 
 int gr_rain_runoff_specialised_for(const gr_rain_runoff *s) {
-  return s ? s->inputs : -1;
+  return s && s->inputs >= 0 ? s->inputs & GR_RAIN_RUNOFF_IN_ALL : -1;
 }
 
 gr_status gr_rain_runoff_create(gr_context *ctx, const gr_grid *grid,
@@ -1156,9 +1168,10 @@ gr_status gr_rain_runoff_set_params(gr_rain_runoff *s, const gr_rain_runoff_para
     if (st == GR_OK)
       st = gr_rain_runoff_set_elevation(s, b);
     free(b);
-    return GR_RAIN_RUNOFF_KEEP_ERROR(s, st);
+    return GR_RAIN_RUNOFF_KEEP_ERROR(s, gr_rain_runoff_inputs_changed(s, st));
   }
-  return GR_OK;
+  /* A new FlowModel takes its program. */
+  return GR_RAIN_RUNOFF_KEEP_ERROR(s, gr_rain_runoff_inputs_changed(s, GR_OK));
 }
 
 /* Uploads into *buf, allocating it on first use. */
