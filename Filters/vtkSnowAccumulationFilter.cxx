@@ -1,17 +1,12 @@
 #include "vtkSnowAccumulationFilter.h"
 
 #include "vtkAlgorithmOutput.h"
-#include "vtkCellArray.h"
-#include "vtkCellData.h"
-#include "vtkCompositeDataIterator.h"
-#include "vtkCompositeDataSet.h"
 #include "vtkDemandDrivenPipeline.h"
 #include "vtkDoubleArray.h"
 #include "vtkExecutive.h"
 #include "vtkFieldData.h"
 #include "vtkFloatArray.h"
 #include "vtkGraupelMotion.h"
-#include "vtkIdList.h"
 #include "vtkImageData.h"
 #include "vtkInformation.h"
 #include "vtkInformationVector.h"
@@ -19,7 +14,6 @@
 #include "vtkNew.h"
 #include "vtkObjectFactory.h"
 #include "vtkPointData.h"
-#include "vtkPoints.h"
 #include "vtkPolyData.h"
 #include "vtkSmartPointer.h"
 #include "vtkStreamingDemandDrivenPipeline.h"
@@ -42,7 +36,6 @@ vtkStandardNewMacro(vtkSnowAccumulationFilter);
 namespace {
 using graupel::AddValue;
 using graupel::AsFloat;
-using graupel::Leaves;
 using graupel::Posed;
 const gr_param_bound *Bound(const char *property) {
   int count = 0;
@@ -150,22 +143,7 @@ vtkTypeBool vtkSnowAccumulationFilter::ProcessRequest(vtkInformation *request,
                                                       vtkInformationVector **inInfo,
                                                       vtkInformationVector *outInfo) {
   if (request->Has(vtkDemandDrivenPipeline::REQUEST_DATA_OBJECT())) {
-    vtkInformation *objInfo = inInfo[1]->GetInformationObject(0);
-    vtkDataObject *objects = objInfo ? objInfo->Get(vtkDataObject::DATA_OBJECT()) : nullptr;
-    const bool composite = vtkCompositeDataSet::SafeDownCast(objects) != nullptr;
-    vtkInformation *info = outInfo->GetInformationObject(1);
-    vtkDataObject *current = info->Get(vtkDataObject::DATA_OBJECT());
-    const bool fits =
-        current && (composite ? current->IsA("vtkMultiBlockDataSet") : current->IsA("vtkPolyData"));
-    if (!fits) {
-      vtkSmartPointer<vtkDataObject> made;
-      if (composite) {
-        made = vtkSmartPointer<vtkMultiBlockDataSet>::New();
-      } else {
-        made = vtkSmartPointer<vtkPolyData>::New();
-      }
-      info->Set(vtkDataObject::DATA_OBJECT(), made);
-    }
+    graupel::MatchObjectsOutput(inInfo, outInfo, 1);
     return this->Superclass::ProcessRequest(request, inInfo, outInfo);
   }
   if ((request->Has(vtkStreamingDemandDrivenPipeline::REQUEST_UPDATE_EXTENT()) ||
@@ -207,13 +185,7 @@ int vtkSnowAccumulationFilter::RequestInformation(vtkInformation *request,
   // The objects' output has the simulation's times, not the input's.
   vtkInformation *image = outputVector->GetInformationObject(0);
   for (int port = 1; port < 3; ++port) {
-    vtkInformation *objects = outputVector->GetInformationObject(port);
-    objects->Remove(vtkStreamingDemandDrivenPipeline::TIME_STEPS());
-    objects->Remove(vtkStreamingDemandDrivenPipeline::TIME_RANGE());
-    if (image->Has(vtkStreamingDemandDrivenPipeline::TIME_STEPS())) {
-      objects->CopyEntry(image, vtkStreamingDemandDrivenPipeline::TIME_STEPS());
-      objects->CopyEntry(image, vtkStreamingDemandDrivenPipeline::TIME_RANGE());
-    }
+    graupel::CopyTimes(image, outputVector->GetInformationObject(port));
   }
   return ok;
 }
@@ -221,7 +193,6 @@ int vtkSnowAccumulationFilter::RequestInformation(vtkInformation *request,
 int vtkSnowAccumulationFilter::RequestData(vtkInformation *request,
                                            vtkInformationVector **inputVector,
                                            vtkInformationVector *outputVector) {
-  vtkInformation *objInfo = outputVector->GetInformationObject(1);
   for (int port = 1; port < 3; ++port) {
     if (vtkDataObject *objects =
             outputVector->GetInformationObject(port)->Get(vtkDataObject::DATA_OBJECT())) {
@@ -235,13 +206,8 @@ int vtkSnowAccumulationFilter::RequestData(vtkInformation *request,
   if (ok && this->ObjectsFilled) {
     vtkDataObject *image = outputVector->GetInformationObject(0)->Get(vtkDataObject::DATA_OBJECT());
     for (int port = 1; port < 3; ++port) {
-      vtkDataObject *objects =
-          outputVector->GetInformationObject(port)->Get(vtkDataObject::DATA_OBJECT());
-      if (objects && image->GetInformation()->Has(vtkDataObject::DATA_TIME_STEP())) {
-        objects->GetInformation()->Set(
-            vtkDataObject::DATA_TIME_STEP(),
-            image->GetInformation()->Get(vtkDataObject::DATA_TIME_STEP()));
-      }
+      graupel::StampTime(
+          image, outputVector->GetInformationObject(port)->Get(vtkDataObject::DATA_OBJECT()));
     }
   }
   return ok;
@@ -292,115 +258,14 @@ int vtkSnowAccumulationFilter::CheckParameters() {
 }
 
 int vtkSnowAccumulationFilter::ReadObjects(vtkDataObject *objects) {
-  this->Objects.clear();
-  bool other = false;
-  const std::vector<vtkPolyData *> leaves = Leaves(objects, &other);
-  if (other) {
-    vtkErrorMacro("Snow Accumulation's Objects must be vtkPolyData or a multiblock of them; "
-                  "convert the other blocks with Extract Surface.");
+  // One vertex per point: the snow is handed back per point.
+  const std::string error = graupel::ReadObjects(
+      "Snow Accumulation", objects, GR_SNOW_ACCUMULATION_MAX_OBJECTS, this->ObjectVelocity,
+      graupel::Vertices::PerPoint, 0, this->IsInputTemporal(1), this->Path, this->Objects,
+      this->ObjectsTemporal);
+  if (!error.empty()) {
+    vtkErrorMacro(<< error);
     return 0;
-  }
-  if (leaves.size() > GR_SNOW_ACCUMULATION_MAX_OBJECTS) {
-    vtkErrorMacro("Snow Accumulation's Objects has " << leaves.size() << " blocks; at most "
-                                                     << GR_SNOW_ACCUMULATION_MAX_OBJECTS
-                                                     << " objects are simulated. Merge some.");
-    return 0;
-  }
-  for (size_t k = 0; k < leaves.size(); ++k) {
-    vtkPolyData *pd = leaves[k];
-    Object o;
-    double b[6];
-    pd->GetBounds(b);
-    for (int c = 0; c < 3; ++c) {
-      o.centre[c] = 0.5 * (b[2 * c] + b[2 * c + 1]);
-      o.velocity[c] = this->ObjectVelocity[c];
-    }
-    vtkDataArray *v = pd->GetFieldData()->GetArray("velocity");
-    if (v) {
-      if (v->GetNumberOfComponents() != 3 || v->GetNumberOfTuples() < 1) {
-        vtkErrorMacro("Snow Accumulation's Objects block "
-                      << k << " has a field array 'velocity' that is not one 3-component "
-                      << "value (m/s); give it 3 components or remove it.");
-        return 0;
-      }
-      v->GetTuple(0, o.velocity);
-    }
-    // One mesh point per point of the polydata, unmerged: the snow is
-    // handed back per point, and a box's faces keep their own corners (and
-    // flat normals), so its top holds a flat cap and its sides none.
-    const vtkIdType n = pd->GetNumberOfPoints();
-    o.vertices.resize(3 * static_cast<size_t>(n));
-    for (vtkIdType i = 0; i < n; ++i) {
-      double p[3];
-      pd->GetPoint(i, p);
-      for (int c = 0; c < 3; ++c) {
-        o.vertices[3 * static_cast<size_t>(i) + c] = static_cast<float>(p[c] - o.centre[c]);
-      }
-    }
-    // Texture coordinates (the first two components) give the object an
-    // accumulation texture.
-    if (vtkDataArray *tc = pd->GetPointData()->GetTCoords()) {
-      if (tc->GetNumberOfComponents() >= 2 && tc->GetNumberOfTuples() == n) {
-        o.uv.resize(2 * static_cast<size_t>(n));
-        for (vtkIdType i = 0; i < n; ++i) {
-          for (int c = 0; c < 2; ++c) {
-            o.uv[2 * static_cast<size_t>(i) + c] = static_cast<float>(tc->GetComponent(i, c));
-          }
-        }
-      }
-    }
-    // An id out of range becomes -1, which gr_mesh_validate names.
-    auto vertex = [&](vtkIdType id) { return id >= 0 && id < n ? static_cast<int>(id) : -1; };
-    // Polygons as fans, strips with alternating winding: the triangles the
-    // core takes, without a dependency on VTK's filters.
-    vtkNew<vtkIdList> ids;
-    vtkCellArray *polys = pd->GetPolys();
-    for (polys->InitTraversal(); polys->GetNextCell(ids);) {
-      for (vtkIdType j = 2; j < ids->GetNumberOfIds(); ++j) {
-        o.triangles.insert(o.triangles.end(), {vertex(ids->GetId(0)), vertex(ids->GetId(j - 1)),
-                                               vertex(ids->GetId(j))});
-      }
-    }
-    vtkCellArray *strips = pd->GetStrips();
-    for (strips->InitTraversal(); strips->GetNextCell(ids);) {
-      for (vtkIdType j = 2; j < ids->GetNumberOfIds(); ++j) {
-        const int a = vertex(ids->GetId(j - 2));
-        const int b1 = vertex(ids->GetId(j - 1));
-        const int c = vertex(ids->GetId(j));
-        if (j % 2 == 0) {
-          o.triangles.insert(o.triangles.end(), {a, b1, c});
-        } else {
-          o.triangles.insert(o.triangles.end(), {b1, a, c});
-        }
-      }
-    }
-    gr_mesh mesh = {};
-    mesh.vertices = o.vertices.data();
-    mesh.nvertices = static_cast<int>(n);
-    mesh.triangles = o.triangles.data();
-    mesh.ntriangles = static_cast<int>(o.triangles.size() / 3);
-    for (int i = 0; i < 16; ++i) {
-      mesh.transform[i] = (i % 5 == 0) ? 1.0 : 0.0;
-    }
-    char msg[512];
-    if (gr_mesh_validate(&mesh, 0, msg, sizeof(msg)) != GR_OK) {
-      vtkErrorMacro("Snow Accumulation's Objects"
-                    << (leaves.size() > 1 ? " block " + std::to_string(k) : std::string()) << ": "
-                    << msg);
-      return 0;
-    }
-    this->Objects.push_back(std::move(o));
-  }
-  this->ObjectsTemporal = this->IsInputTemporal(1);
-  if (!this->Path.empty() && !this->ObjectsTemporal) {
-    for (size_t k = 0; k < this->Objects.size(); ++k) {
-      const std::string error =
-          vtkGraupelMotion::CheckPathSpeed("Snow Accumulation", k, this->Objects[k].velocity);
-      if (!error.empty()) {
-        vtkErrorMacro(<< error);
-        return 0;
-      }
-    }
   }
   return 1;
 }
@@ -415,19 +280,8 @@ int vtkSnowAccumulationFilter::ReadPath(vtkPolyData *path) {
 }
 
 void vtkSnowAccumulationFilter::Pose(size_t k, double t, double m[16]) const {
-  const Object &o = this->Objects[k];
-  if (this->ObjectsTemporal) {
-    // The geometry is the pose: back to where it was read.
-    for (int i = 0; i < 16; ++i) {
-      m[i] = (i % 5 == 0) ? 1.0 : 0.0;
-    }
-    for (int c = 0; c < 3; ++c) {
-      m[12 + c] = o.centre[c];
-    }
-    return;
-  }
-  vtkGraupelMotion::PoseObject(o.centre, o.velocity, this->ObjectAngularVelocity,
-                               this->RotationAxis, this->Path, t, m);
+  graupel::PoseObject(this->Objects[k], this->ObjectsTemporal, this->ObjectAngularVelocity,
+                      this->RotationAxis, this->Path, t, m);
 }
 
 bool vtkSnowAccumulationFilter::ObjectsMove() const {
@@ -438,7 +292,7 @@ bool vtkSnowAccumulationFilter::ObjectsMove() const {
   if (!this->Path.empty() || this->ObjectAngularVelocity != 0.0) {
     return true;
   }
-  for (const Object &o : this->Objects) {
+  for (const graupel::Object &o : this->Objects) {
     if (o.velocity[0] != 0.0 || o.velocity[1] != 0.0 || o.velocity[2] != 0.0) {
       return true;
     }
@@ -450,19 +304,14 @@ int vtkSnowAccumulationFilter::SetObjects(double t) {
   const size_t n = this->Objects.size();
   std::vector<gr_mesh> meshes(n);
   for (size_t k = 0; k < n; ++k) {
-    const Object &o = this->Objects[k];
-    gr_mesh &m = meshes[k];
-    m.vertices = o.vertices.data();
-    m.nvertices = static_cast<int>(o.vertices.size() / 3);
-    m.triangles = o.triangles.data();
-    m.ntriangles = static_cast<int>(o.triangles.size() / 3);
-    this->Pose(k, t, m.transform);
+    meshes[k] = graupel::MeshOf(this->Objects[k]);
+    this->Pose(k, t, meshes[k].transform);
   }
   gr_status st =
       gr_snow_accumulation_set_objects(this->Simulation, meshes.data(), static_cast<int>(n));
   // The same texture again keeps its snow: the core compares.
   for (size_t k = 0; st == GR_OK && k < n; ++k) {
-    const Object &o = this->Objects[k];
+    const graupel::Object &o = this->Objects[k];
     const bool textured = !o.uv.empty() && this->AccumulationTextureSize > 0;
     st = gr_snow_accumulation_set_object_texture(this->Simulation, static_cast<int>(k),
                                                  textured ? o.uv.data() : nullptr,
@@ -690,12 +539,6 @@ int vtkSnowAccumulationFilter::FillObjects(vtkDataObject *output, double t) {
   if (!input || !output) {
     return 1;
   }
-  const size_t n = this->Objects.size();
-  bool other = false;
-  const std::vector<vtkPolyData *> leaves = Leaves(input, &other);
-  if (leaves.size() != n) {
-    return 1; // the objects changed since the state was made; nothing to pose
-  }
   // One object at its pose with its snow per point.
   auto snowy = [this, t](size_t k, vtkPolyData *leaf) -> vtkSmartPointer<vtkPolyData> {
     double matrix[16];
@@ -727,38 +570,7 @@ int vtkSnowAccumulationFilter::FillObjects(vtkDataObject *output, double t) {
     posed->GetPointData()->SetActiveVectors("snow_offset");
     return posed;
   };
-  if (auto *pd = vtkPolyData::SafeDownCast(output)) {
-    if (n == 1) {
-      vtkSmartPointer<vtkPolyData> posed = snowy(0, leaves[0]);
-      if (!posed) {
-        return 0;
-      }
-      pd->ShallowCopy(posed);
-    }
-    return 1;
-  }
-  auto *mb = vtkMultiBlockDataSet::SafeDownCast(output);
-  auto *in = vtkCompositeDataSet::SafeDownCast(input);
-  if (!mb || !in) {
-    return 1;
-  }
-  mb->CopyStructure(in);
-  vtkSmartPointer<vtkCompositeDataIterator> it;
-  it.TakeReference(in->NewIterator());
-  size_t k = 0;
-  for (it->InitTraversal(); !it->IsDoneWithTraversal() && k < n; it->GoToNextItem()) {
-    auto *leaf = vtkPolyData::SafeDownCast(it->GetCurrentDataObject());
-    if (!leaf || leaf->GetNumberOfPoints() == 0) {
-      continue;
-    }
-    vtkSmartPointer<vtkPolyData> posed = snowy(k, leaf);
-    if (!posed) {
-      return 0;
-    }
-    mb->SetDataSet(it, posed);
-    ++k;
-  }
-  return 1;
+  return graupel::FillObjectsOutput(input, output, this->Objects.size(), snowy) ? 1 : 0;
 }
 
 int vtkSnowAccumulationFilter::FillOutput(vtkDataObject *outputObject, vtkInformation *outInfo) {
@@ -799,9 +611,7 @@ int vtkSnowAccumulationFilter::FillOutput(vtkDataObject *outputObject, vtkInform
   if (this->OutputVector) {
     vtkInformation *objInfo = this->OutputVector->GetInformationObject(1);
     vtkDataObject *objects = objInfo->Get(vtkDataObject::DATA_OBJECT());
-    const int piece = objInfo->Has(vtkStreamingDemandDrivenPipeline::UPDATE_PIECE_NUMBER())
-                          ? objInfo->Get(vtkStreamingDemandDrivenPipeline::UPDATE_PIECE_NUMBER())
-                          : 0;
+    const int piece = graupel::RequestedPiece(objInfo);
     if (piece == 0 && !this->FillObjects(objects, this->GetStateTime())) {
       return 0;
     }
@@ -820,7 +630,7 @@ int vtkSnowAccumulationFilter::FillTextures(vtkMultiBlockDataSet *output) {
   output->SetNumberOfBlocks(n);
   for (unsigned int k = 0; k < n; ++k) {
     vtkNew<vtkImageData> image;
-    const Object &o = this->Objects[k];
+    const graupel::Object &o = this->Objects[k];
     const int size = this->AccumulationTextureSize;
     if (!o.uv.empty() && size > 0) {
       // Texel centres in UV units: texel (i, j) at ((i + 0.5) / size, (j + 0.5) / size).

@@ -84,6 +84,9 @@ struct gr_snow_accumulation;
 class vtkDataObject;
 class vtkMultiBlockDataSet;
 class vtkPolyData;
+namespace graupel {
+struct Object; // one object as the core sees it (GraupelObjects.h)
+}
 
 class GRAUPELFILTERS_EXPORT vtkSnowAccumulationFilter : public vtkGraupelSimulation {
 public:
@@ -252,15 +255,6 @@ private:
   vtkSnowAccumulationFilter(const vtkSnowAccumulationFilter &) = delete;
   void operator=(const vtkSnowAccumulationFilter &) = delete;
 
-  /** One object as the core sees it: its points about its centre, one mesh point each. */
-  struct Object {
-    std::vector<float> vertices;
-    std::vector<int> triangles;
-    std::vector<float> uv; // 2 per mesh point, empty without texture coordinates
-    double centre[3];
-    double velocity[3]; // m/s: the leaf's `velocity`, else ObjectVelocity
-  };
-
   int CheckParameters();
   /** Reads the objects into Objects; 0 after one sentence. */
   int ReadObjects(vtkDataObject *objects);
@@ -277,8 +271,8 @@ private:
   int FillTextures(vtkMultiBlockDataSet *output);
 
   gr_snow_accumulation *Simulation = nullptr;
-  std::vector<Object> Objects;
-  std::vector<double> Path; // xyz per point; empty when none
+  std::vector<graupel::Object> Objects; // GraupelObjects.h
+  std::vector<double> Path;             // xyz per point; empty when none
   bool ObjectsTemporal = false;
   double ObjectsReadAt = 0.0;
   vtkInformationVector *OutputVector = nullptr; // during RequestData only

@@ -1,17 +1,12 @@
 #include "vtkSnowDeformationFilter.h"
 
 #include "vtkAlgorithmOutput.h"
-#include "vtkCellArray.h"
-#include "vtkCompositeDataIterator.h"
-#include "vtkCompositeDataSet.h"
-#include "vtkCellData.h"
 #include "vtkDemandDrivenPipeline.h"
 #include "vtkDoubleArray.h"
 #include "vtkExecutive.h"
 #include "vtkFieldData.h"
 #include "vtkFloatArray.h"
 #include "vtkGraupelMotion.h"
-#include "vtkIdList.h"
 #include "vtkImageData.h"
 #include "vtkInformation.h"
 #include "vtkInformationVector.h"
@@ -19,7 +14,6 @@
 #include "vtkNew.h"
 #include "vtkObjectFactory.h"
 #include "vtkPointData.h"
-#include "vtkPoints.h"
 #include "vtkPolyData.h"
 #include "vtkSmartPointer.h"
 #include "vtkStreamingDemandDrivenPipeline.h"
@@ -32,9 +26,7 @@
 #include "GraupelPieces.h"
 
 #include <algorithm>
-#include <array>
 #include <chrono>
-#include <map>
 #include <cmath>
 #include <string>
 #include <vector>
@@ -44,7 +36,6 @@ vtkStandardNewMacro(vtkSnowDeformationFilter);
 namespace {
 using graupel::AddValue;
 using graupel::AsFloat;
-using graupel::Leaves;
 using graupel::Posed;
 const gr_param_bound *Bound(const char *property) {
   int count = 0;
@@ -187,22 +178,7 @@ vtkTypeBool vtkSnowDeformationFilter::ProcessRequest(vtkInformation *request,
                                                      vtkInformationVector **inInfo,
                                                      vtkInformationVector *outInfo) {
   if (request->Has(vtkDemandDrivenPipeline::REQUEST_DATA_OBJECT())) {
-    vtkInformation *objInfo = inInfo[1]->GetInformationObject(0);
-    vtkDataObject *objects = objInfo ? objInfo->Get(vtkDataObject::DATA_OBJECT()) : nullptr;
-    const bool composite = vtkCompositeDataSet::SafeDownCast(objects) != nullptr;
-    vtkInformation *info = outInfo->GetInformationObject(1);
-    vtkDataObject *current = info->Get(vtkDataObject::DATA_OBJECT());
-    const bool fits =
-        current && (composite ? current->IsA("vtkMultiBlockDataSet") : current->IsA("vtkPolyData"));
-    if (!fits) {
-      vtkSmartPointer<vtkDataObject> made;
-      if (composite) {
-        made = vtkSmartPointer<vtkMultiBlockDataSet>::New();
-      } else {
-        made = vtkSmartPointer<vtkPolyData>::New();
-      }
-      info->Set(vtkDataObject::DATA_OBJECT(), made);
-    }
+    graupel::MatchObjectsOutput(inInfo, outInfo, 1);
     return this->Superclass::ProcessRequest(request, inInfo, outInfo);
   }
   // A request from the objects' port asks for the same time of the
@@ -226,14 +202,7 @@ int vtkSnowDeformationFilter::RequestInformation(vtkInformation *request,
                                                  vtkInformationVector *outputVector) {
   const int ok = this->Superclass::RequestInformation(request, inputVector, outputVector);
   // The objects' output has the simulation's times, not the input's.
-  vtkInformation *image = outputVector->GetInformationObject(0);
-  vtkInformation *objects = outputVector->GetInformationObject(1);
-  objects->Remove(vtkStreamingDemandDrivenPipeline::TIME_STEPS());
-  objects->Remove(vtkStreamingDemandDrivenPipeline::TIME_RANGE());
-  if (image->Has(vtkStreamingDemandDrivenPipeline::TIME_STEPS())) {
-    objects->CopyEntry(image, vtkStreamingDemandDrivenPipeline::TIME_STEPS());
-    objects->CopyEntry(image, vtkStreamingDemandDrivenPipeline::TIME_RANGE());
-  }
+  graupel::CopyTimes(outputVector->GetInformationObject(0), outputVector->GetInformationObject(1));
   return ok;
 }
 
@@ -250,11 +219,7 @@ int vtkSnowDeformationFilter::RequestData(vtkInformation *request,
   this->OutputVector = nullptr;
   if (ok && this->ObjectsFilled) {
     vtkDataObject *image = outputVector->GetInformationObject(0)->Get(vtkDataObject::DATA_OBJECT());
-    vtkDataObject *objects = objInfo->Get(vtkDataObject::DATA_OBJECT());
-    if (image->GetInformation()->Has(vtkDataObject::DATA_TIME_STEP())) {
-      objects->GetInformation()->Set(vtkDataObject::DATA_TIME_STEP(),
-                                     image->GetInformation()->Get(vtkDataObject::DATA_TIME_STEP()));
-    }
+    graupel::StampTime(image, objInfo->Get(vtkDataObject::DATA_OBJECT()));
   }
   return ok;
 }
@@ -329,110 +294,14 @@ int vtkSnowDeformationFilter::ReadPath(vtkPolyData *path) {
 }
 
 int vtkSnowDeformationFilter::ReadObjects(vtkDataObject *objects) {
-  this->Objects.clear();
-  bool other = false;
-  const std::vector<vtkPolyData *> leaves = Leaves(objects, &other);
-  if (other) {
-    vtkErrorMacro("Snow Deformation's Objects must be vtkPolyData or a multiblock of them; "
-                  "convert the other blocks with Extract Surface.");
+  // Closed meshes: points at the same place are one vertex.
+  const std::string error = graupel::ReadObjects(
+      "Snow Deformation", objects, GR_SNOW_DEFORMATION_MAX_OBJECTS, this->ObjectVelocity,
+      graupel::Vertices::Merged, 1, this->IsInputTemporal(1), this->Path, this->Objects,
+      this->ObjectsTemporal);
+  if (!error.empty()) {
+    vtkErrorMacro(<< error);
     return 0;
-  }
-  if (leaves.size() > GR_SNOW_DEFORMATION_MAX_OBJECTS) {
-    vtkErrorMacro("Snow Deformation's Objects has " << leaves.size() << " blocks; at most "
-                                                    << GR_SNOW_DEFORMATION_MAX_OBJECTS
-                                                    << " objects are simulated. Merge some.");
-    return 0;
-  }
-  for (size_t k = 0; k < leaves.size(); ++k) {
-    vtkPolyData *pd = leaves[k];
-    Object o;
-    double b[6];
-    pd->GetBounds(b);
-    for (int c = 0; c < 3; ++c) {
-      o.centre[c] = 0.5 * (b[2 * c] + b[2 * c + 1]);
-      o.velocity[c] = this->ObjectVelocity[c];
-    }
-    vtkDataArray *v = pd->GetFieldData()->GetArray("velocity");
-    if (v) {
-      if (v->GetNumberOfComponents() != 3 || v->GetNumberOfTuples() < 1) {
-        vtkErrorMacro("Snow Deformation's Objects block "
-                      << k << " has a field array 'velocity' that is not one 3-component "
-                      << "value (m/s); give it 3 components or remove it.");
-        return 0;
-      }
-      v->GetTuple(0, o.velocity);
-    }
-    // Points at the same place are one vertex: sources such as a box or a
-    // capped cylinder repeat corners per face (for their normals), which
-    // would leave every edge open.
-    const vtkIdType n = pd->GetNumberOfPoints();
-    std::vector<int> vertexOf(static_cast<size_t>(n));
-    std::map<std::array<double, 3>, int> merged;
-    for (vtkIdType i = 0; i < n; ++i) {
-      std::array<double, 3> p;
-      pd->GetPoint(i, p.data());
-      auto found = merged.emplace(p, static_cast<int>(merged.size()));
-      vertexOf[static_cast<size_t>(i)] = found.first->second;
-      if (found.second) {
-        for (int c = 0; c < 3; ++c) {
-          o.vertices.push_back(static_cast<float>(p[static_cast<size_t>(c)] - o.centre[c]));
-        }
-      }
-    }
-    // An id out of range becomes -1, which gr_mesh_validate names.
-    auto vertex = [&](vtkIdType id) {
-      return id >= 0 && id < n ? vertexOf[static_cast<size_t>(id)] : -1;
-    };
-    // Polygons as fans, strips with alternating winding: the triangles the
-    // core takes, without a dependency on VTK's filters.
-    vtkNew<vtkIdList> ids;
-    vtkCellArray *polys = pd->GetPolys();
-    for (polys->InitTraversal(); polys->GetNextCell(ids);) {
-      for (vtkIdType j = 2; j < ids->GetNumberOfIds(); ++j) {
-        o.triangles.insert(o.triangles.end(), {vertex(ids->GetId(0)), vertex(ids->GetId(j - 1)),
-                                               vertex(ids->GetId(j))});
-      }
-    }
-    vtkCellArray *strips = pd->GetStrips();
-    for (strips->InitTraversal(); strips->GetNextCell(ids);) {
-      for (vtkIdType j = 2; j < ids->GetNumberOfIds(); ++j) {
-        const int a = vertex(ids->GetId(j - 2));
-        const int b1 = vertex(ids->GetId(j - 1));
-        const int c = vertex(ids->GetId(j));
-        if (j % 2 == 0) {
-          o.triangles.insert(o.triangles.end(), {a, b1, c});
-        } else {
-          o.triangles.insert(o.triangles.end(), {b1, a, c});
-        }
-      }
-    }
-    gr_mesh mesh = {};
-    mesh.vertices = o.vertices.data();
-    mesh.nvertices = static_cast<int>(o.vertices.size() / 3);
-    mesh.triangles = o.triangles.data();
-    mesh.ntriangles = static_cast<int>(o.triangles.size() / 3);
-    for (int i = 0; i < 16; ++i) {
-      mesh.transform[i] = (i % 5 == 0) ? 1.0 : 0.0;
-    }
-    char msg[512];
-    if (gr_mesh_validate(&mesh, 1, msg, sizeof(msg)) != GR_OK) {
-      vtkErrorMacro("Snow Deformation's Objects"
-                    << (leaves.size() > 1 ? " block " + std::to_string(k) : std::string()) << ": "
-                    << msg);
-      return 0;
-    }
-    this->Objects.push_back(std::move(o));
-  }
-  this->ObjectsTemporal = this->IsInputTemporal(1);
-  if (!this->Path.empty() && !this->ObjectsTemporal) {
-    for (size_t k = 0; k < this->Objects.size(); ++k) {
-      const std::string error =
-          vtkGraupelMotion::CheckPathSpeed("Snow Deformation", k, this->Objects[k].velocity);
-      if (!error.empty()) {
-        vtkErrorMacro(<< error);
-        return 0;
-      }
-    }
   }
   return 1;
 }
@@ -468,7 +337,7 @@ int vtkSnowDeformationFilter::CheckObjectsReachGrid(const double grid[4], double
     }
   }
   for (size_t k = 0; k < this->Objects.size(); ++k) {
-    const Object &o = this->Objects[k];
+    const graupel::Object &o = this->Objects[k];
     double lo[3] = {1e300, 1e300, 1e300}, hi[3] = {-1e300, -1e300, -1e300};
     for (size_t v = 0; v + 2 < o.vertices.size(); v += 3) {
       for (int c = 0; c < 3; ++c) {
@@ -520,19 +389,8 @@ int vtkSnowDeformationFilter::CheckObjectsReachGrid(const double grid[4], double
 }
 
 void vtkSnowDeformationFilter::Pose(size_t k, double t, double m[16]) const {
-  const Object &o = this->Objects[k];
-  if (this->ObjectsTemporal) {
-    // The geometry is the pose: back to where it was read.
-    for (int i = 0; i < 16; ++i) {
-      m[i] = (i % 5 == 0) ? 1.0 : 0.0;
-    }
-    m[12] = o.centre[0];
-    m[13] = o.centre[1];
-    m[14] = o.centre[2];
-    return;
-  }
-  vtkGraupelMotion::PoseObject(o.centre, o.velocity, this->ObjectAngularVelocity,
-                               this->RotationAxis, this->Path, t, m);
+  graupel::PoseObject(this->Objects[k], this->ObjectsTemporal, this->ObjectAngularVelocity,
+                      this->RotationAxis, this->Path, t, m);
 }
 
 int vtkSnowDeformationFilter::SetObjects(double t, double h) {
@@ -540,12 +398,9 @@ int vtkSnowDeformationFilter::SetObjects(double t, double h) {
   std::vector<gr_mesh> meshes(n);
   std::vector<double> velocities(3 * n, 0.0);
   for (size_t k = 0; k < n; ++k) {
-    const Object &o = this->Objects[k];
+    const graupel::Object &o = this->Objects[k];
     gr_mesh &m = meshes[k];
-    m.vertices = o.vertices.data();
-    m.nvertices = static_cast<int>(o.vertices.size() / 3);
-    m.triangles = o.triangles.data();
-    m.ntriangles = static_cast<int>(o.triangles.size() / 3);
+    m = graupel::MeshOf(o);
     this->Pose(k, t, m.transform);
     if (!this->ObjectsTemporal && !this->Path.empty()) {
       // The centre's velocity over the step: along a path it turns with the
@@ -772,46 +627,28 @@ int vtkSnowDeformationFilter::FillObjects(vtkDataObject *output, double t) {
                                  gr_snow_deformation_last_error(this->Simulation));
     }
   }
-  bool other = false;
-  const std::vector<vtkPolyData *> leaves = Leaves(input, &other);
-  if (leaves.size() != n) {
-    return 1; // the objects changed since the state was made; nothing to pose
-  }
-  double matrix[16];
-  if (auto *pd = vtkPolyData::SafeDownCast(output)) {
-    if (n == 1) {
-      this->Pose(0, t, matrix);
-      pd->ShallowCopy(Posed(leaves[0], this->Objects[0].centre, matrix));
-      AddForce(pd->GetFieldData(), &force[0], area[0]);
-    }
-    return 1;
-  }
-  auto *mb = vtkMultiBlockDataSet::SafeDownCast(output);
-  auto *in = vtkCompositeDataSet::SafeDownCast(input);
-  if (!mb || !in) {
-    return 1;
-  }
-  mb->CopyStructure(in);
-  vtkSmartPointer<vtkCompositeDataIterator> it;
-  it.TakeReference(in->NewIterator());
-  size_t k = 0;
-  double total[3] = {0.0, 0.0, 0.0}, totalArea = 0.0;
-  for (it->InitTraversal(); !it->IsDoneWithTraversal() && k < n; it->GoToNextItem()) {
-    auto *leaf = vtkPolyData::SafeDownCast(it->GetCurrentDataObject());
-    if (!leaf || leaf->GetNumberOfPoints() == 0) {
-      continue;
-    }
+  auto posed = [this, t, &force, &area](size_t k, vtkPolyData *leaf) {
+    double matrix[16];
     this->Pose(k, t, matrix);
-    vtkSmartPointer<vtkPolyData> posed = Posed(leaf, this->Objects[k].centre, matrix);
-    AddForce(posed->GetFieldData(), &force[3 * k], area[k]);
-    mb->SetDataSet(it, posed);
-    for (int c = 0; c < 3; ++c) {
-      total[c] += force[3 * k + c];
-    }
-    totalArea += area[k];
-    ++k;
+    vtkSmartPointer<vtkPolyData> one = Posed(leaf, this->Objects[k].centre, matrix);
+    AddForce(one->GetFieldData(), &force[3 * k], area[k]);
+    return one;
+  };
+  vtkMultiBlockDataSet *blocks = nullptr;
+  if (!graupel::FillObjectsOutput(input, output, n, posed, &blocks)) {
+    return 0;
   }
-  AddForce(mb->GetFieldData(), total, totalArea);
+  if (blocks) {
+    // The whole: every object's force and contact area summed.
+    double total[3] = {0.0, 0.0, 0.0}, totalArea = 0.0;
+    for (size_t k = 0; k < n; ++k) {
+      for (int c = 0; c < 3; ++c) {
+        total[c] += force[3 * k + c];
+      }
+      totalArea += area[k];
+    }
+    AddForce(blocks->GetFieldData(), total, totalArea);
+  }
   return 1;
 }
 
@@ -854,9 +691,7 @@ int vtkSnowDeformationFilter::FillOutput(vtkDataObject *outputObject, vtkInforma
   if (this->OutputVector) {
     vtkInformation *objInfo = this->OutputVector->GetInformationObject(1);
     vtkDataObject *objects = objInfo->Get(vtkDataObject::DATA_OBJECT());
-    const int piece = objInfo->Has(vtkStreamingDemandDrivenPipeline::UPDATE_PIECE_NUMBER())
-                          ? objInfo->Get(vtkStreamingDemandDrivenPipeline::UPDATE_PIECE_NUMBER())
-                          : 0;
+    const int piece = graupel::RequestedPiece(objInfo);
     if (piece == 0 && !this->FillObjects(objects, this->GetStateTime())) {
       return 0;
     }

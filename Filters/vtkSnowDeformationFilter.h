@@ -75,6 +75,9 @@
 struct gr_snow_deformation;
 class vtkDataObject;
 class vtkPolyData;
+namespace graupel {
+struct Object; // one object as the core sees it (GraupelObjects.h)
+}
 
 class GRAUPELFILTERS_EXPORT vtkSnowDeformationFilter : public vtkGraupelSimulation {
 public:
@@ -266,14 +269,6 @@ private:
   vtkSnowDeformationFilter(const vtkSnowDeformationFilter &) = delete;
   void operator=(const vtkSnowDeformationFilter &) = delete;
 
-  /** One object as the core sees it: vertices about its centre. */
-  struct Object {
-    std::vector<float> vertices;
-    std::vector<int> triangles;
-    double centre[3];
-    double velocity[3]; // m/s: the leaf's `velocity`, else ObjectVelocity
-  };
-
   int CheckParameters();
   /** Refuses an object that is over the terrain's grid at no step up to EndTime. */
   int CheckObjectsReachGrid(const double gridBounds[4], double margin);
@@ -287,8 +282,8 @@ private:
   int FillObjects(vtkDataObject *output, double t);
 
   gr_snow_deformation *Simulation = nullptr;
-  std::vector<Object> Objects;
-  std::vector<double> Path; // xyz per point; empty when none
+  std::vector<graupel::Object> Objects; // GraupelObjects.h
+  std::vector<double> Path;             // xyz per point; empty when none
   bool ObjectsTemporal = false;
   double ObjectsReadAt = 0.0;
   vtkInformationVector *OutputVector = nullptr; // during RequestData only
