@@ -28,6 +28,7 @@
 #include "GraupelPieces.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -458,6 +459,20 @@ int vtkGraupelSimulation::ReportProgress(double t) {
 
 int vtkGraupelSimulation::CoreProgress(void *user, double time) {
   return static_cast<vtkGraupelSimulation *>(user)->ReportProgress(time);
+}
+
+int vtkGraupelSimulation::ThrottledProgress(void *user, double time) {
+  auto *self = static_cast<vtkGraupelSimulation *>(user);
+  if (self->GetAbortExecute()) {
+    return 1;
+  }
+  const double now =
+      std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+  if (now - self->LastProgressWall < 0.1) {
+    return 0;
+  }
+  self->LastProgressWall = now;
+  return CoreProgress(user, time);
 }
 
 int vtkGraupelSimulation::CheckTerrain(vtkImageData *terrain) {

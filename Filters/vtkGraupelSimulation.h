@@ -362,6 +362,12 @@ protected:
   int ReportProgress(double t);
   /** ReportProgress as a gr_progress_fn; user is the filter. */
   static int CoreProgress(void *user, double time);
+  /**
+   * CoreProgress for a core that reports every step (many a second): an
+   * abort is seen at every step, the text and the event come at most every
+   * 0.1 s of wall time.
+   */
+  static int ThrottledProgress(void *user, double time);
 
   /**
    * The terrain's `elevation` point array: refuses an input without it (one
@@ -452,6 +458,7 @@ private:
   bool Continuing = false;
   int Target = 0;
   double ProgressStart = 0.0;
+  double LastProgressWall = 0.0; // s, steady clock: ThrottledProgress's last report
   Key StateKey;
   Key FailedKey;
   bool HasFailed = false;

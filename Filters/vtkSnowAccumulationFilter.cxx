@@ -26,7 +26,6 @@
 #include "GraupelPieces.h"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <string>
 #include <vector>
@@ -248,35 +247,20 @@ int vtkSnowAccumulationFilter::CheckParameters() {
                   << this->TimeStep << " s. Set it within that range.");
     return 0;
   }
-  const std::string motion = vtkGraupelMotion::CheckObjectMotion(
-      "Snow Accumulation", this->ObjectVelocity, this->ObjectAngularVelocity, this->RotationAxis);
-  if (!motion.empty()) {
-    vtkErrorMacro(<< motion);
-    return 0;
-  }
-  return 1;
+  return this->ReportError(vtkGraupelMotion::CheckObjectMotion(
+      "Snow Accumulation", this->ObjectVelocity, this->ObjectAngularVelocity, this->RotationAxis));
 }
 
 int vtkSnowAccumulationFilter::ReadObjects(vtkDataObject *objects) {
   // One vertex per point: the snow is handed back per point.
-  const std::string error = graupel::ReadObjects(
+  return this->ReportError(graupel::ReadObjects(
       "Snow Accumulation", objects, GR_SNOW_ACCUMULATION_MAX_OBJECTS, this->ObjectVelocity,
       graupel::Vertices::PerPoint, 0, this->IsInputTemporal(1), this->Path, this->Objects,
-      this->ObjectsTemporal);
-  if (!error.empty()) {
-    vtkErrorMacro(<< error);
-    return 0;
-  }
-  return 1;
+      this->ObjectsTemporal));
 }
 
 int vtkSnowAccumulationFilter::ReadPath(vtkPolyData *path) {
-  const std::string error = vtkGraupelMotion::ReadPath("Snow Accumulation", path, this->Path);
-  if (!error.empty()) {
-    vtkErrorMacro(<< error);
-    return 0;
-  }
-  return 1;
+  return this->ReportError(vtkGraupelMotion::ReadPath("Snow Accumulation", path, this->Path));
 }
 
 void vtkSnowAccumulationFilter::Pose(size_t k, double t, double m[16]) const {
@@ -322,21 +306,6 @@ int vtkSnowAccumulationFilter::SetObjects(double t) {
                                gr_snow_accumulation_last_error(this->Simulation));
   }
   return 1;
-}
-
-int vtkSnowAccumulationFilter::StepProgress(void *user, double time) {
-  auto *self = static_cast<vtkSnowAccumulationFilter *>(user);
-  if (self->GetAbortExecute()) {
-    return 1;
-  }
-  // Every step reports; the text and the event only a few times a second.
-  const double now =
-      std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
-  if (now - self->LastProgressWall < 0.1) {
-    return 0;
-  }
-  self->LastProgressWall = now;
-  return vtkGraupelSimulation::CoreProgress(user, time);
 }
 
 int vtkSnowAccumulationFilter::SetUpState(vtkInformationVector **inputVector) {
@@ -464,14 +433,14 @@ int vtkSnowAccumulationFilter::SetUpState(vtkInformationVector **inputVector) {
       return 0;
     }
   }
-  gr_snow_accumulation_set_progress(this->Simulation, &vtkSnowAccumulationFilter::StepProgress,
+  gr_snow_accumulation_set_progress(this->Simulation, &vtkGraupelSimulation::ThrottledProgress,
                                     this);
   return this->SetObjects(0.0);
 }
 
 int vtkSnowAccumulationFilter::ResetState() {
   gr_status st = gr_snow_accumulation_reset(this->Simulation);
-  gr_snow_accumulation_set_progress(this->Simulation, &vtkSnowAccumulationFilter::StepProgress,
+  gr_snow_accumulation_set_progress(this->Simulation, &vtkGraupelSimulation::ThrottledProgress,
                                     this);
   if (st != GR_OK) {
     return this->ReportFailure(st, "Snow Accumulation could not restart",
@@ -491,7 +460,7 @@ int vtkSnowAccumulationFilter::AdvanceState(double t0, double t1) {
   }
   // A progress callback that asked to stop leaves the core refusing steps
   // until it is set again; an abort consumed since must not stop this call.
-  gr_snow_accumulation_set_progress(this->Simulation, &vtkSnowAccumulationFilter::StepProgress,
+  gr_snow_accumulation_set_progress(this->Simulation, &vtkGraupelSimulation::ThrottledProgress,
                                     this);
   // Steps of TimeStep from t0, the last one ending on t1; the step ends are
   // t0 + k dt (not a running sum), so they depend on t0, t1 and dt only.
@@ -529,7 +498,7 @@ int vtkSnowAccumulationFilter::SaveState(std::vector<unsigned char> &bytes) {
 
 int vtkSnowAccumulationFilter::LoadState(const std::vector<unsigned char> &bytes) {
   // An abort inside a step leaves the core refusing until set_progress.
-  gr_snow_accumulation_set_progress(this->Simulation, &vtkSnowAccumulationFilter::StepProgress,
+  gr_snow_accumulation_set_progress(this->Simulation, &vtkGraupelSimulation::ThrottledProgress,
                                     this);
   return gr_snow_accumulation_state_load(this->Simulation, bytes.data(), bytes.size()) == GR_OK;
 }

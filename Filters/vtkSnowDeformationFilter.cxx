@@ -26,7 +26,6 @@
 #include "GraupelPieces.h"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <string>
 #include <vector>
@@ -275,35 +274,20 @@ int vtkSnowDeformationFilter::CheckParameters() {
                   << " kg/m^3); set it within the range or pick a DensityPreset.");
     return 0;
   }
-  const std::string motion = vtkGraupelMotion::CheckObjectMotion(
-      "Snow Deformation", this->ObjectVelocity, this->ObjectAngularVelocity, this->RotationAxis);
-  if (!motion.empty()) {
-    vtkErrorMacro(<< motion);
-    return 0;
-  }
-  return 1;
+  return this->ReportError(vtkGraupelMotion::CheckObjectMotion(
+      "Snow Deformation", this->ObjectVelocity, this->ObjectAngularVelocity, this->RotationAxis));
 }
 
 int vtkSnowDeformationFilter::ReadPath(vtkPolyData *path) {
-  const std::string error = vtkGraupelMotion::ReadPath("Snow Deformation", path, this->Path);
-  if (!error.empty()) {
-    vtkErrorMacro(<< error);
-    return 0;
-  }
-  return 1;
+  return this->ReportError(vtkGraupelMotion::ReadPath("Snow Deformation", path, this->Path));
 }
 
 int vtkSnowDeformationFilter::ReadObjects(vtkDataObject *objects) {
   // Closed meshes: points at the same place are one vertex.
-  const std::string error = graupel::ReadObjects(
+  return this->ReportError(graupel::ReadObjects(
       "Snow Deformation", objects, GR_SNOW_DEFORMATION_MAX_OBJECTS, this->ObjectVelocity,
       graupel::Vertices::Merged, 1, this->IsInputTemporal(1), this->Path, this->Objects,
-      this->ObjectsTemporal);
-  if (!error.empty()) {
-    vtkErrorMacro(<< error);
-    return 0;
-  }
-  return 1;
+      this->ObjectsTemporal));
 }
 
 int vtkSnowDeformationFilter::CheckObjectsReachGrid(const double grid[4], double margin) {
@@ -425,21 +409,6 @@ int vtkSnowDeformationFilter::SetObjects(double t, double h) {
   return 1;
 }
 
-int vtkSnowDeformationFilter::StepProgress(void *user, double time) {
-  auto *self = static_cast<vtkSnowDeformationFilter *>(user);
-  if (self->GetAbortExecute()) {
-    return 1;
-  }
-  // Every step reports; the text and the event only a few times a second.
-  const double now =
-      std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
-  if (now - self->LastProgressWall < 0.1) {
-    return 0;
-  }
-  self->LastProgressWall = now;
-  return vtkGraupelSimulation::CoreProgress(user, time);
-}
-
 int vtkSnowDeformationFilter::SetUpState(vtkInformationVector **inputVector) {
   vtkImageData *terrain = vtkImageData::GetData(inputVector[0]);
   if (!this->CheckTerrain(terrain)) {
@@ -549,14 +518,16 @@ int vtkSnowDeformationFilter::SetUpState(vtkInformationVector **inputVector) {
       return 0;
     }
   }
-  gr_snow_deformation_set_progress(this->Simulation, &vtkSnowDeformationFilter::StepProgress, this);
+  gr_snow_deformation_set_progress(this->Simulation, &vtkGraupelSimulation::ThrottledProgress,
+                                   this);
   // The objects at time 0: the forces (zero) have their count before a step.
   return this->SetObjects(0.0, 0.0);
 }
 
 int vtkSnowDeformationFilter::ResetState() {
   const gr_status st = gr_snow_deformation_reset(this->Simulation);
-  gr_snow_deformation_set_progress(this->Simulation, &vtkSnowDeformationFilter::StepProgress, this);
+  gr_snow_deformation_set_progress(this->Simulation, &vtkGraupelSimulation::ThrottledProgress,
+                                   this);
   return st == GR_OK ? 1
                      : this->ReportFailure(st, "Snow Deformation could not restart",
                                            gr_snow_deformation_last_error(this->Simulation));
@@ -572,7 +543,8 @@ int vtkSnowDeformationFilter::AdvanceState(double t0, double t1) {
   }
   // A progress callback that asked to stop leaves the core refusing steps
   // until it is set again; an abort consumed since must not stop this call.
-  gr_snow_deformation_set_progress(this->Simulation, &vtkSnowDeformationFilter::StepProgress, this);
+  gr_snow_deformation_set_progress(this->Simulation, &vtkGraupelSimulation::ThrottledProgress,
+                                   this);
   // Steps of TimeStep from t0, the last one ending on t1; the step ends are
   // t0 + k dt (not a running sum), so they depend on t0, t1 and dt only.
   const double dt = this->TimeStep;
@@ -608,7 +580,8 @@ int vtkSnowDeformationFilter::SaveState(std::vector<unsigned char> &bytes) {
 
 int vtkSnowDeformationFilter::LoadState(const std::vector<unsigned char> &bytes) {
   // An abort inside a step leaves the core refusing until set_progress.
-  gr_snow_deformation_set_progress(this->Simulation, &vtkSnowDeformationFilter::StepProgress, this);
+  gr_snow_deformation_set_progress(this->Simulation, &vtkGraupelSimulation::ThrottledProgress,
+                                   this);
   return gr_snow_deformation_state_load(this->Simulation, bytes.data(), bytes.size()) == GR_OK;
 }
 

@@ -288,8 +288,6 @@ private:
   double ObjectsReadAt = 0.0;
   vtkInformationVector *OutputVector = nullptr; // during RequestData only
   bool ObjectsFilled = false;
-  double LastProgressWall = 0.0;
-  static int StepProgress(void *user, double time);
 };
 
 #endif
