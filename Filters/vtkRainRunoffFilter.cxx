@@ -110,18 +110,8 @@ int vtkRainRunoffFilter::CheckParameters() {
                 {"DebrisFactor", this->DebrisFactor},
                 {"NoDataBoundary", double(this->NoDataBoundary)}};
   for (const auto &p : values) {
-    const gr_param_bound *b = Bound(p.property);
-    if (!b) {
-      continue;
-    }
-    if (!gr_param_accepts(b, p.value * b->to_core)) {
-      const char *unit = (b->unit && *b->unit) ? b->unit : "";
-      const char *space = *unit ? " " : "";
-      vtkErrorMacro("Rain Runoff: " << p.property << " must be "
-                                    << (b->min_open ? "above " : "from ") << b->min << space << unit
-                                    << (b->min_open ? " and up to " : " to ") << b->max << space
-                                    << unit << "; it is " << p.value << space << unit
-                                    << ". Set it within that range.");
+    if (!this->ReportError(
+            graupel::OutOfRange("Rain Runoff", p.property, Bound(p.property), p.value))) {
       return 0;
     }
   }

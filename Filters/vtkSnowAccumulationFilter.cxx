@@ -229,18 +229,10 @@ int vtkSnowAccumulationFilter::CheckParameters() {
                 {"SnowDensity", this->SnowDensity},
                 {"AccumulationTextureSize", double(this->AccumulationTextureSize)}};
   for (const auto &p : values) {
-    const gr_param_bound *b = Bound(p.property);
-    if (!b || gr_param_accepts(b, p.value * b->to_core)) {
-      continue;
+    if (!this->ReportError(
+            graupel::OutOfRange("Snow Accumulation", p.property, Bound(p.property), p.value))) {
+      return 0;
     }
-    const char *unit = (b->unit && *b->unit) ? b->unit : "";
-    const char *space = *unit ? " " : "";
-    vtkErrorMacro("Snow Accumulation: " << p.property << " must be "
-                                        << (b->min_open ? "above " : "from ") << b->min << space
-                                        << unit << (b->min_open ? " and up to " : " to ") << b->max
-                                        << space << unit << "; it is " << p.value << space << unit
-                                        << ". Set it within that range.");
-    return 0;
   }
   if (!(this->TimeStep >= 1.0e-6 && this->TimeStep <= 86400.0)) {
     vtkErrorMacro("Snow Accumulation: TimeStep must be from 1e-6 s to 86400 s; it is "

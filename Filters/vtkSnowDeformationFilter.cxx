@@ -243,17 +243,10 @@ int vtkSnowDeformationFilter::CheckParameters() {
                 {"RelaxTolerance", "RelaxTolerance", this->RelaxTolerance},
                 {"SlumpSpeed", "SlumpSpeed", this->SlumpSpeed}};
   for (const auto &p : values) {
-    const gr_param_bound *b = Bound(p.property);
-    if (!b || gr_param_accepts(b, p.value * b->to_core)) {
-      continue;
+    if (!this->ReportError(
+            graupel::OutOfRange("Snow Deformation", p.name, Bound(p.property), p.value))) {
+      return 0;
     }
-    const char *unit = (b->unit && *b->unit) ? b->unit : "";
-    const char *space = *unit ? " " : "";
-    vtkErrorMacro("Snow Deformation: "
-                  << p.name << " must be " << (b->min_open ? "above " : "from ") << b->min << space
-                  << unit << (b->min_open ? " and up to " : " to ") << b->max << space << unit
-                  << "; it is " << p.value << space << unit << ". Set it within that range.");
-    return 0;
   }
   if (!(this->TimeStep >= 1.0e-6 && this->TimeStep <= 60.0)) {
     vtkErrorMacro("Snow Deformation: TimeStep must be from 1e-6 s to 60 s; it is "
