@@ -409,18 +409,12 @@ int vtkSnowDeformationFilter::SetUpState(vtkInformationVector **inputVector) {
   }
   int dims[3];
   terrain->GetDimensions(dims);
-  double spacing[3];
-  terrain->GetSpacing(spacing);
   vtkDataArray *elevationArray = this->GetElevation(terrain, "Input");
   if (!elevationArray || !this->CheckParameters()) {
     return 0;
   }
   const size_t npoints = static_cast<size_t>(dims[0]) * static_cast<size_t>(dims[1]);
-  struct Upload {
-    gr_field field;
-    vtkSmartPointer<vtkFloatArray> values;
-  };
-  std::vector<Upload> uploads;
+  std::vector<graupel::Upload> uploads;
   uploads.push_back({GR_FIELD_ELEVATION, AsFloat(elevationArray)});
   vtkPointData *pd = terrain->GetPointData();
   if (vtkDataArray *depth = pd->GetArray("snow_depth")) {
@@ -429,14 +423,8 @@ int vtkSnowDeformationFilter::SetUpState(vtkInformationVector **inputVector) {
   if (vtkDataArray *density = pd->GetArray("snow_density")) {
     uploads.push_back({GR_FIELD_SNOW_DENSITY, AsFloat(density)});
   }
-  for (const Upload &u : uploads) {
-    if (u.values->GetNumberOfComponents() != 1 ||
-        static_cast<size_t>(u.values->GetNumberOfTuples()) != npoints) {
-      vtkErrorMacro("Snow Deformation's Input array '"
-                    << gr_field_name(u.field) << "' has " << u.values->GetNumberOfTuples()
-                    << " tuples of " << u.values->GetNumberOfComponents()
-                    << " component(s); it must have one value per point (" << npoints
-                    << "): resample it onto the terrain's grid or remove it.");
+  for (const graupel::Upload &u : uploads) {
+    if (!this->ReportError(graupel::CheckPerPoint("Snow Deformation", u, npoints))) {
       return 0;
     }
   }
@@ -502,7 +490,7 @@ int vtkSnowDeformationFilter::SetUpState(vtkInformationVector **inputVector) {
     gr_snow_deformation_set_allreduce(sim, graupel::Pieces::Allreduce, &pieces);
     gr_snow_deformation_set_halo_exchange(sim, graupel::Pieces::Exchange, &pieces);
   }
-  for (const Upload &u : uploads) {
+  for (const graupel::Upload &u : uploads) {
     const std::vector<float> local = pieces.LocalField(u.values->GetPointer(0), dims[0], 1);
     st = gr_snow_deformation_set_field(this->Simulation, u.field, local.data());
     if (st != GR_OK) {
