@@ -475,6 +475,15 @@ int vtkGraupelSimulation::ThrottledProgress(void *user, double time) {
   return CoreProgress(user, time);
 }
 
+long long vtkGraupelSimulation::CountSteps(double t0, double t1, double dt) {
+  const double count = std::ceil((t1 - t0) / dt - 1e-9);
+  return count < 1.0 ? 1 : static_cast<long long>(count);
+}
+
+double vtkGraupelSimulation::StepEnd(double t0, double t1, double dt, long long k, long long n) {
+  return k == n ? t1 : t0 + static_cast<double>(k) * dt;
+}
+
 int vtkGraupelSimulation::CheckTerrain(vtkImageData *terrain) {
   const char *label = this->GetSimulationLabel();
   if (!terrain) {

@@ -370,6 +370,14 @@ protected:
   static int ThrottledProgress(void *user, double time);
 
   /**
+   * The steps of dt (s) from t0 to t1: at least one, the last shortened to
+   * end on t1. Step k of n (1..n) ends at StepEnd, t0 + k dt (not a running
+   * sum, so the ends depend on t0, t1 and dt only) and t1 for the last.
+   */
+  static long long CountSteps(double t0, double t1, double dt);
+  static double StepEnd(double t0, double t1, double dt, long long k, long long n);
+
+  /**
    * The terrain's `elevation` point array: refuses an input without it (one
    * sentence naming the array and the fix) and warns, once per terrain, when
    * the spacing is still 1 m while the heights span 100 m or more (a

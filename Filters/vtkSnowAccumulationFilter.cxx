@@ -442,15 +442,13 @@ int vtkSnowAccumulationFilter::AdvanceState(double t0, double t1) {
   // until it is set again; an abort consumed since must not stop this call.
   gr_snow_accumulation_set_progress(this->Simulation, &vtkGraupelSimulation::ThrottledProgress,
                                     this);
-  // Steps of TimeStep from t0, the last one ending on t1; the step ends are
-  // t0 + k dt (not a running sum), so they depend on t0, t1 and dt only.
+  // Steps of TimeStep from t0, the last one ending on t1.
   const double dt = this->TimeStep;
-  const double count = std::ceil((t1 - t0) / dt - 1e-9);
-  const long long n = count < 1.0 ? 1 : static_cast<long long>(count);
+  const long long n = CountSteps(t0, t1, dt);
   const bool moving = this->ObjectsMove();
   double t = t0;
   for (long long k = 1; k <= n; ++k) {
-    const double next = k == n ? t1 : t0 + static_cast<double>(k) * dt;
+    const double next = StepEnd(t0, t1, dt, k, n);
     if (moving && !this->SetObjects(next)) {
       return ADVANCE_FAILED;
     }

@@ -302,10 +302,9 @@ int vtkSnowDeformationFilter::CheckObjectsReachGrid(const double grid[4], double
   if (exact) {
     for (int k = 1; k < outputs; ++k) {
       const double t0 = this->GetOutputTime(k - 1), t1 = this->GetOutputTime(k);
-      const double count = std::ceil((t1 - t0) / dt - 1e-9);
-      const long long n = count < 1.0 ? 1 : static_cast<long long>(count);
+      const long long n = CountSteps(t0, t1, dt);
       for (long long j = 1; j <= n; ++j) {
-        times.push_back(j == n ? t1 : t0 + static_cast<double>(j) * dt);
+        times.push_back(StepEnd(t0, t1, dt, j, n));
       }
     }
   } else {
@@ -526,14 +525,12 @@ int vtkSnowDeformationFilter::AdvanceState(double t0, double t1) {
   // until it is set again; an abort consumed since must not stop this call.
   gr_snow_deformation_set_progress(this->Simulation, &vtkGraupelSimulation::ThrottledProgress,
                                    this);
-  // Steps of TimeStep from t0, the last one ending on t1; the step ends are
-  // t0 + k dt (not a running sum), so they depend on t0, t1 and dt only.
+  // Steps of TimeStep from t0, the last one ending on t1.
   const double dt = this->TimeStep;
-  const double count = std::ceil((t1 - t0) / dt - 1e-9);
-  const long long n = count < 1.0 ? 1 : static_cast<long long>(count);
+  const long long n = CountSteps(t0, t1, dt);
   double t = t0;
   for (long long k = 1; k <= n; ++k) {
-    const double next = k == n ? t1 : t0 + static_cast<double>(k) * dt;
+    const double next = StepEnd(t0, t1, dt, k, n);
     if (!this->SetObjects(next, next - t)) {
       return ADVANCE_FAILED;
     }
