@@ -54,11 +54,10 @@ double TableToCore(const char *property) {
 
 } // namespace
 
-vtkSnowAccumulationFilter::vtkSnowAccumulationFilter() {
-  this->SetNumberOfInputPorts(3);
+vtkSnowAccumulationFilter::vtkSnowAccumulationFilter()
+    // One vertex per point (the snow is handed back per point); open meshes.
+    : vtkGraupelObjectsSimulation(GR_SNOW_ACCUMULATION_MAX_OBJECTS, false, 0) {
   this->SetNumberOfOutputPorts(3);
-  // Objects with time steps are read in time; others stand or are posed by the properties.
-  this->SetInputPortPolicy(1, TEMPORAL_INPUT);
   // A snowfall of a few hours: 6 h of 15 min outputs, three 5 min steps
   // each (72 exposure views). Growth is a rate times dt, so longer steps
   // give the same snow; they only see the exposure change less often.
@@ -107,29 +106,6 @@ GRAUPEL_TABLE_SETTER(vtkSnowAccumulationFilter, SnowDensity, double,
 GRAUPEL_TABLE_SETTER(vtkSnowAccumulationFilter, AccumulationTextureSize, int,
                      gr_snow_accumulation_param_bounds)
 
-void vtkSnowAccumulationFilter::SetObjectsConnection(vtkAlgorithmOutput *output) {
-  this->SetInputConnection(1, output);
-}
-
-void vtkSnowAccumulationFilter::SetPathConnection(vtkAlgorithmOutput *output) {
-  this->SetInputConnection(2, output);
-}
-
-int vtkSnowAccumulationFilter::FillInputPortInformation(int port, vtkInformation *info) {
-  if (port == 0) {
-    info->Set(vtkAlgorithm::INPUT_REQUIRED_DATA_TYPE(), "vtkImageData");
-    return 1;
-  }
-  // A multiblock is taken whole (one object per leaf): a composite pipeline
-  // would otherwise run the filter once per block.
-  info->Set(vtkAlgorithm::INPUT_REQUIRED_DATA_TYPE(), "vtkPolyData");
-  if (port == 1) {
-    info->Append(vtkAlgorithm::INPUT_REQUIRED_DATA_TYPE(), "vtkMultiBlockDataSet");
-  }
-  info->Set(vtkAlgorithm::INPUT_IS_OPTIONAL(), 1);
-  return 1;
-}
-
 int vtkSnowAccumulationFilter::FillOutputPortInformation(int port, vtkInformation *info) {
   // Port 1 follows the Objects input's type (REQUEST_DATA_OBJECT below).
   info->Set(vtkDataObject::DATA_TYPE_NAME(), port == 0   ? "vtkImageData"
@@ -141,10 +117,6 @@ int vtkSnowAccumulationFilter::FillOutputPortInformation(int port, vtkInformatio
 vtkTypeBool vtkSnowAccumulationFilter::ProcessRequest(vtkInformation *request,
                                                       vtkInformationVector **inInfo,
                                                       vtkInformationVector *outInfo) {
-  if (request->Has(vtkDemandDrivenPipeline::REQUEST_DATA_OBJECT())) {
-    graupel::MatchObjectsOutput(inInfo, outInfo, 1);
-    return this->Superclass::ProcessRequest(request, inInfo, outInfo);
-  }
   if ((request->Has(vtkStreamingDemandDrivenPipeline::REQUEST_UPDATE_EXTENT()) ||
        request->Has(vtkDemandDrivenPipeline::REQUEST_DATA())) &&
       request->Has(vtkExecutive::FROM_OUTPUT_PORT())) {
@@ -158,14 +130,8 @@ vtkTypeBool vtkSnowAccumulationFilter::ProcessRequest(vtkInformation *request,
       from->Set(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP(),
                 this->GetOutputTime(outputs - 1));
     }
-    // A request from the objects' or the textures' port asks for the same
-    // time of the simulation, which the base reads from port 0.
-    if ((port == 1 || port == 2) &&
-        from->Has(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP())) {
-      outInfo->GetInformationObject(0)->Set(
-          vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP(),
-          from->Get(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP()));
-    }
+    // The base passes a request from the objects' or the textures' port on
+    // to port 0 at the time this sets.
   }
   return this->Superclass::ProcessRequest(request, inInfo, outInfo);
 }
@@ -180,36 +146,8 @@ int vtkSnowAccumulationFilter::RequestInformation(vtkInformation *request,
   const gr_param_bound *blur = Bound("BlurRadius");
   ring.blur_radius = std::max(0, std::min(this->BlurRadius, blur ? int(blur->max) : 0));
   this->SetPieceRing(gr_snow_accumulation_ghost(&ring));
-  const int ok = this->Superclass::RequestInformation(request, inputVector, outputVector);
-  // The objects' output has the simulation's times, not the input's.
-  vtkInformation *image = outputVector->GetInformationObject(0);
-  for (int port = 1; port < 3; ++port) {
-    graupel::CopyTimes(image, outputVector->GetInformationObject(port));
-  }
-  return ok;
-}
-
-int vtkSnowAccumulationFilter::RequestData(vtkInformation *request,
-                                           vtkInformationVector **inputVector,
-                                           vtkInformationVector *outputVector) {
-  for (int port = 1; port < 3; ++port) {
-    if (vtkDataObject *objects =
-            outputVector->GetInformationObject(port)->Get(vtkDataObject::DATA_OBJECT())) {
-      objects->Initialize();
-    }
-  }
-  this->OutputVector = outputVector;
-  this->ObjectsFilled = false;
-  const int ok = this->Superclass::RequestData(request, inputVector, outputVector);
-  this->OutputVector = nullptr;
-  if (ok && this->ObjectsFilled) {
-    vtkDataObject *image = outputVector->GetInformationObject(0)->Get(vtkDataObject::DATA_OBJECT());
-    for (int port = 1; port < 3; ++port) {
-      graupel::StampTime(
-          image, outputVector->GetInformationObject(port)->Get(vtkDataObject::DATA_OBJECT()));
-    }
-  }
-  return ok;
+  // The base gives the objects' and the textures' outputs the simulation's times.
+  return this->Superclass::RequestInformation(request, inputVector, outputVector);
 }
 
 int vtkSnowAccumulationFilter::CheckParameters() {
@@ -239,25 +177,7 @@ int vtkSnowAccumulationFilter::CheckParameters() {
                   << this->TimeStep << " s. Set it within that range.");
     return 0;
   }
-  return this->ReportError(vtkGraupelMotion::CheckObjectMotion(
-      "Snow Accumulation", this->ObjectVelocity, this->ObjectAngularVelocity, this->RotationAxis));
-}
-
-int vtkSnowAccumulationFilter::ReadObjects(vtkDataObject *objects) {
-  // One vertex per point: the snow is handed back per point.
-  return this->ReportError(graupel::ReadObjects(
-      "Snow Accumulation", objects, GR_SNOW_ACCUMULATION_MAX_OBJECTS, this->ObjectVelocity,
-      graupel::Vertices::PerPoint, 0, this->IsInputTemporal(1), this->Path, this->Objects,
-      this->ObjectsTemporal));
-}
-
-int vtkSnowAccumulationFilter::ReadPath(vtkPolyData *path) {
-  return this->ReportError(vtkGraupelMotion::ReadPath("Snow Accumulation", path, this->Path));
-}
-
-void vtkSnowAccumulationFilter::Pose(size_t k, double t, double m[16]) const {
-  graupel::PoseObject(this->Objects[k], this->ObjectsTemporal, this->ObjectAngularVelocity,
-                      this->RotationAxis, this->Path, t, m);
+  return this->CheckObjectMotion();
 }
 
 bool vtkSnowAccumulationFilter::ObjectsMove() const {
@@ -330,14 +250,9 @@ int vtkSnowAccumulationFilter::SetUpState(vtkInformationVector **inputVector) {
       return 0;
     }
   }
-  vtkPolyData *path =
-      this->GetNumberOfInputConnections(2) ? vtkPolyData::GetData(inputVector[2]) : nullptr;
-  if (!this->ReadPath(path) || !this->ReadObjects(this->GetNumberOfInputConnections(1)
-                                                      ? vtkDataObject::GetData(inputVector[1])
-                                                      : nullptr)) {
+  if (!this->ReadObjectInputs(inputVector)) {
     return 0;
   }
-  this->ObjectsReadAt = this->GetTemporalInputTime(1);
 
   gr_snow_accumulation_params p;
   gr_snow_accumulation_params_init(&p);
@@ -623,9 +538,5 @@ void vtkSnowAccumulationFilter::PrintSelf(ostream &os, vtkIndent indent) {
   os << indent << "StabilityFactor: " << this->StabilityFactor << " 1/s\n";
   os << indent << "SnowDensity: " << this->SnowDensity << " kg/m^3\n";
   os << indent << "AccumulationTextureSize: " << this->AccumulationTextureSize << "\n";
-  os << indent << "ObjectVelocity: " << this->ObjectVelocity[0] << " " << this->ObjectVelocity[1]
-     << " " << this->ObjectVelocity[2] << " m/s\n";
-  os << indent << "ObjectAngularVelocity: " << this->ObjectAngularVelocity << " deg/s\n";
-  os << indent << "RotationAxis: " << this->RotationAxis[0] << " " << this->RotationAxis[1] << " "
-     << this->RotationAxis[2] << "\n";
+  this->PrintObjectMotion(os, indent);
 }

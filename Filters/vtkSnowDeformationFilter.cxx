@@ -76,11 +76,10 @@ void AddForce(vtkFieldData *fd, const double force[3], double area) {
 
 } // namespace
 
-vtkSnowDeformationFilter::vtkSnowDeformationFilter() {
-  this->SetNumberOfInputPorts(3);
+vtkSnowDeformationFilter::vtkSnowDeformationFilter()
+    // Closed meshes: points at the same place are one vertex.
+    : vtkGraupelObjectsSimulation(GR_SNOW_DEFORMATION_MAX_OBJECTS, true, 1) {
   this->SetNumberOfOutputPorts(2);
-  // Objects with time steps are read in time; others are posed by the properties.
-  this->SetInputPortPolicy(1, TEMPORAL_INPUT);
   // Steps of 1/60 s: 600 outputs of 10 s would be 36000 steps, and a wheel
   // at 2 m/s would move 20 m between outputs. 10 s of 0.25 s outputs show a
   // crossing of a few metres, 15 steps per output.
@@ -144,83 +143,10 @@ double vtkSnowDeformationFilter::GetInitialDensityInUse() const {
   return GetDensityPresetRange(this->DensityPreset, range) ? range[0] : this->InitialDensity;
 }
 
-void vtkSnowDeformationFilter::SetObjectsConnection(vtkAlgorithmOutput *output) {
-  this->SetInputConnection(1, output);
-}
-
-void vtkSnowDeformationFilter::SetPathConnection(vtkAlgorithmOutput *output) {
-  this->SetInputConnection(2, output);
-}
-
-int vtkSnowDeformationFilter::FillInputPortInformation(int port, vtkInformation *info) {
-  if (port == 0) {
-    info->Set(vtkAlgorithm::INPUT_REQUIRED_DATA_TYPE(), "vtkImageData");
-    return 1;
-  }
-  // A multiblock is taken whole (one object per leaf): a composite pipeline
-  // would otherwise run the filter once per block.
-  info->Set(vtkAlgorithm::INPUT_REQUIRED_DATA_TYPE(), "vtkPolyData");
-  if (port == 1) {
-    info->Append(vtkAlgorithm::INPUT_REQUIRED_DATA_TYPE(), "vtkMultiBlockDataSet");
-  }
-  info->Set(vtkAlgorithm::INPUT_IS_OPTIONAL(), 1);
-  return 1;
-}
-
 int vtkSnowDeformationFilter::FillOutputPortInformation(int port, vtkInformation *info) {
   // Port 1 follows the Objects input's type (REQUEST_DATA_OBJECT below).
   info->Set(vtkDataObject::DATA_TYPE_NAME(), port == 0 ? "vtkImageData" : "vtkDataObject");
   return 1;
-}
-
-vtkTypeBool vtkSnowDeformationFilter::ProcessRequest(vtkInformation *request,
-                                                     vtkInformationVector **inInfo,
-                                                     vtkInformationVector *outInfo) {
-  if (request->Has(vtkDemandDrivenPipeline::REQUEST_DATA_OBJECT())) {
-    graupel::MatchObjectsOutput(inInfo, outInfo, 1);
-    return this->Superclass::ProcessRequest(request, inInfo, outInfo);
-  }
-  // A request from the objects' port asks for the same time of the
-  // simulation, which the base reads from port 0.
-  if ((request->Has(vtkStreamingDemandDrivenPipeline::REQUEST_UPDATE_EXTENT()) ||
-       request->Has(vtkDemandDrivenPipeline::REQUEST_DATA())) &&
-      request->Has(vtkExecutive::FROM_OUTPUT_PORT()) &&
-      request->Get(vtkExecutive::FROM_OUTPUT_PORT()) == 1) {
-    vtkInformation *from = outInfo->GetInformationObject(1);
-    vtkInformation *to = outInfo->GetInformationObject(0);
-    if (from->Has(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP())) {
-      to->Set(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP(),
-              from->Get(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP()));
-    }
-  }
-  return this->Superclass::ProcessRequest(request, inInfo, outInfo);
-}
-
-int vtkSnowDeformationFilter::RequestInformation(vtkInformation *request,
-                                                 vtkInformationVector **inputVector,
-                                                 vtkInformationVector *outputVector) {
-  const int ok = this->Superclass::RequestInformation(request, inputVector, outputVector);
-  // The objects' output has the simulation's times, not the input's.
-  graupel::CopyTimes(outputVector->GetInformationObject(0), outputVector->GetInformationObject(1));
-  return ok;
-}
-
-int vtkSnowDeformationFilter::RequestData(vtkInformation *request,
-                                          vtkInformationVector **inputVector,
-                                          vtkInformationVector *outputVector) {
-  vtkInformation *objInfo = outputVector->GetInformationObject(1);
-  if (vtkDataObject *objects = objInfo->Get(vtkDataObject::DATA_OBJECT())) {
-    objects->Initialize();
-  }
-  this->OutputVector = outputVector;
-  this->ObjectsFilled = false;
-  const int ok = this->Superclass::RequestData(request, inputVector, outputVector);
-  this->OutputVector = nullptr;
-  if (ok && this->ObjectsFilled) {
-    vtkDataObject *image = outputVector->GetInformationObject(0)->Get(vtkDataObject::DATA_OBJECT());
-    graupel::StampTime(image, objInfo->Get(vtkDataObject::DATA_OBJECT()));
-  }
-  return ok;
 }
 
 int vtkSnowDeformationFilter::CheckParameters() {
@@ -267,20 +193,7 @@ int vtkSnowDeformationFilter::CheckParameters() {
                   << " kg/m^3); set it within the range or pick a DensityPreset.");
     return 0;
   }
-  return this->ReportError(vtkGraupelMotion::CheckObjectMotion(
-      "Snow Deformation", this->ObjectVelocity, this->ObjectAngularVelocity, this->RotationAxis));
-}
-
-int vtkSnowDeformationFilter::ReadPath(vtkPolyData *path) {
-  return this->ReportError(vtkGraupelMotion::ReadPath("Snow Deformation", path, this->Path));
-}
-
-int vtkSnowDeformationFilter::ReadObjects(vtkDataObject *objects) {
-  // Closed meshes: points at the same place are one vertex.
-  return this->ReportError(graupel::ReadObjects(
-      "Snow Deformation", objects, GR_SNOW_DEFORMATION_MAX_OBJECTS, this->ObjectVelocity,
-      graupel::Vertices::Merged, 1, this->IsInputTemporal(1), this->Path, this->Objects,
-      this->ObjectsTemporal));
+  return this->CheckObjectMotion();
 }
 
 int vtkSnowDeformationFilter::CheckObjectsReachGrid(const double grid[4], double margin) {
@@ -364,11 +277,6 @@ int vtkSnowDeformationFilter::CheckObjectsReachGrid(const double grid[4], double
   return 1;
 }
 
-void vtkSnowDeformationFilter::Pose(size_t k, double t, double m[16]) const {
-  graupel::PoseObject(this->Objects[k], this->ObjectsTemporal, this->ObjectAngularVelocity,
-                      this->RotationAxis, this->Path, t, m);
-}
-
 int vtkSnowDeformationFilter::SetObjects(double t, double h) {
   const size_t n = this->Objects.size();
   std::vector<gr_mesh> meshes(n);
@@ -428,14 +336,9 @@ int vtkSnowDeformationFilter::SetUpState(vtkInformationVector **inputVector) {
     }
   }
 
-  const int nobjects = this->GetNumberOfInputConnections(1);
-  vtkPolyData *path =
-      this->GetNumberOfInputConnections(2) ? vtkPolyData::GetData(inputVector[2]) : nullptr;
-  if (!this->ReadPath(path) ||
-      !this->ReadObjects(nobjects ? vtkDataObject::GetData(inputVector[1]) : nullptr)) {
+  if (!this->ReadObjectInputs(inputVector)) {
     return 0;
   }
-  this->ObjectsReadAt = this->GetTemporalInputTime(1);
 
   gr_snow_deformation_params p;
   gr_snow_deformation_params_init(&p);
@@ -669,9 +572,5 @@ void vtkSnowDeformationFilter::PrintSelf(ostream &os, vtkIndent indent) {
   os << indent << "MaxRelaxIterations: " << this->MaxRelaxIterations << "\n";
   os << indent << "RelaxTolerance: " << this->RelaxTolerance << " m\n";
   os << indent << "SlumpSpeed: " << this->SlumpSpeed << " m/s\n";
-  os << indent << "ObjectVelocity: " << this->ObjectVelocity[0] << " " << this->ObjectVelocity[1]
-     << " " << this->ObjectVelocity[2] << " m/s\n";
-  os << indent << "ObjectAngularVelocity: " << this->ObjectAngularVelocity << " deg/s\n";
-  os << indent << "RotationAxis: " << this->RotationAxis[0] << " " << this->RotationAxis[1] << " "
-     << this->RotationAxis[2] << "\n";
+  this->PrintObjectMotion(os, indent);
 }

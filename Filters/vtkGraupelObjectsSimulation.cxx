@@ -1,0 +1,152 @@
+#include "vtkGraupelObjectsSimulation.h"
+
+#include "vtkAlgorithmOutput.h"
+#include "vtkDemandDrivenPipeline.h"
+#include "vtkExecutive.h"
+#include "vtkGraupelMotion.h"
+#include "vtkInformation.h"
+#include "vtkInformationVector.h"
+#include "vtkPolyData.h"
+#include "vtkStreamingDemandDrivenPipeline.h"
+
+#include "GraupelObjects.h"
+
+#include <string>
+
+vtkGraupelObjectsSimulation::vtkGraupelObjectsSimulation(size_t maxObjects, bool mergePoints,
+                                                         int closed)
+    : MaxObjects(maxObjects), MergePoints(mergePoints), ClosedObjects(closed) {
+  this->SetNumberOfInputPorts(3);
+  // Objects with time steps are read in time; others stand or are posed by the properties.
+  this->SetInputPortPolicy(1, TEMPORAL_INPUT);
+}
+
+vtkGraupelObjectsSimulation::~vtkGraupelObjectsSimulation() = default;
+
+void vtkGraupelObjectsSimulation::SetObjectsConnection(vtkAlgorithmOutput *output) {
+  this->SetInputConnection(1, output);
+}
+
+void vtkGraupelObjectsSimulation::SetPathConnection(vtkAlgorithmOutput *output) {
+  this->SetInputConnection(2, output);
+}
+
+int vtkGraupelObjectsSimulation::FillInputPortInformation(int port, vtkInformation *info) {
+  if (port == 0) {
+    info->Set(vtkAlgorithm::INPUT_REQUIRED_DATA_TYPE(), "vtkImageData");
+    return 1;
+  }
+  // A multiblock is taken whole (one object per leaf): a composite pipeline
+  // would otherwise run the filter once per block.
+  info->Set(vtkAlgorithm::INPUT_REQUIRED_DATA_TYPE(), "vtkPolyData");
+  if (port == 1) {
+    info->Append(vtkAlgorithm::INPUT_REQUIRED_DATA_TYPE(), "vtkMultiBlockDataSet");
+  }
+  info->Set(vtkAlgorithm::INPUT_IS_OPTIONAL(), 1);
+  return 1;
+}
+
+vtkTypeBool vtkGraupelObjectsSimulation::ProcessRequest(vtkInformation *request,
+                                                        vtkInformationVector **inInfo,
+                                                        vtkInformationVector *outInfo) {
+  if (request->Has(vtkDemandDrivenPipeline::REQUEST_DATA_OBJECT())) {
+    graupel::MatchObjectsOutput(inInfo, outInfo, 1);
+    return this->Superclass::ProcessRequest(request, inInfo, outInfo);
+  }
+  // A request from an objects' port asks for the same time of the
+  // simulation, which the base reads from port 0.
+  if ((request->Has(vtkStreamingDemandDrivenPipeline::REQUEST_UPDATE_EXTENT()) ||
+       request->Has(vtkDemandDrivenPipeline::REQUEST_DATA())) &&
+      request->Has(vtkExecutive::FROM_OUTPUT_PORT()) &&
+      request->Get(vtkExecutive::FROM_OUTPUT_PORT()) >= 1) {
+    vtkInformation *from =
+        outInfo->GetInformationObject(request->Get(vtkExecutive::FROM_OUTPUT_PORT()));
+    if (from->Has(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP())) {
+      outInfo->GetInformationObject(0)->Set(
+          vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP(),
+          from->Get(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP()));
+    }
+  }
+  return this->Superclass::ProcessRequest(request, inInfo, outInfo);
+}
+
+int vtkGraupelObjectsSimulation::RequestInformation(vtkInformation *request,
+                                                    vtkInformationVector **inputVector,
+                                                    vtkInformationVector *outputVector) {
+  const int ok = this->Superclass::RequestInformation(request, inputVector, outputVector);
+  // The objects' outputs have the simulation's times, not the input's.
+  vtkInformation *image = outputVector->GetInformationObject(0);
+  for (int port = 1; port < this->GetNumberOfOutputPorts(); ++port) {
+    graupel::CopyTimes(image, outputVector->GetInformationObject(port));
+  }
+  return ok;
+}
+
+int vtkGraupelObjectsSimulation::RequestData(vtkInformation *request,
+                                             vtkInformationVector **inputVector,
+                                             vtkInformationVector *outputVector) {
+  const int outputs = this->GetNumberOfOutputPorts();
+  for (int port = 1; port < outputs; ++port) {
+    if (vtkDataObject *objects =
+            outputVector->GetInformationObject(port)->Get(vtkDataObject::DATA_OBJECT())) {
+      objects->Initialize();
+    }
+  }
+  this->OutputVector = outputVector;
+  this->ObjectsFilled = false;
+  const int ok = this->Superclass::RequestData(request, inputVector, outputVector);
+  this->OutputVector = nullptr;
+  if (ok && this->ObjectsFilled) {
+    vtkDataObject *image = outputVector->GetInformationObject(0)->Get(vtkDataObject::DATA_OBJECT());
+    for (int port = 1; port < outputs; ++port) {
+      graupel::StampTime(
+          image, outputVector->GetInformationObject(port)->Get(vtkDataObject::DATA_OBJECT()));
+    }
+  }
+  return ok;
+}
+
+int vtkGraupelObjectsSimulation::CheckObjectMotion() {
+  return this->ReportError(
+      vtkGraupelMotion::CheckObjectMotion(this->GetSimulationLabel(), this->ObjectVelocity,
+                                          this->ObjectAngularVelocity, this->RotationAxis));
+}
+
+int vtkGraupelObjectsSimulation::ReadObjectInputs(vtkInformationVector **inputVector) {
+  vtkPolyData *path =
+      this->GetNumberOfInputConnections(2) ? vtkPolyData::GetData(inputVector[2]) : nullptr;
+  if (!this->ReportError(
+          vtkGraupelMotion::ReadPath(this->GetSimulationLabel(), path, this->Path)) ||
+      !this->ReadObjects(this->GetNumberOfInputConnections(1)
+                             ? vtkDataObject::GetData(inputVector[1])
+                             : nullptr)) {
+    return 0;
+  }
+  this->ObjectsReadAt = this->GetTemporalInputTime(1);
+  return 1;
+}
+
+int vtkGraupelObjectsSimulation::ReadObjects(vtkDataObject *objects) {
+  return this->ReportError(graupel::ReadObjects(
+      this->GetSimulationLabel(), objects, this->MaxObjects, this->ObjectVelocity,
+      this->MergePoints ? graupel::Vertices::Merged : graupel::Vertices::PerPoint,
+      this->ClosedObjects, this->IsInputTemporal(1), this->Path, this->Objects,
+      this->ObjectsTemporal));
+}
+
+void vtkGraupelObjectsSimulation::Pose(size_t k, double t, double m[16]) const {
+  graupel::PoseObject(this->Objects[k], this->ObjectsTemporal, this->ObjectAngularVelocity,
+                      this->RotationAxis, this->Path, t, m);
+}
+
+void vtkGraupelObjectsSimulation::PrintObjectMotion(ostream &os, vtkIndent indent) {
+  os << indent << "ObjectVelocity: " << this->ObjectVelocity[0] << " " << this->ObjectVelocity[1]
+     << " " << this->ObjectVelocity[2] << " m/s\n";
+  os << indent << "ObjectAngularVelocity: " << this->ObjectAngularVelocity << " deg/s\n";
+  os << indent << "RotationAxis: " << this->RotationAxis[0] << " " << this->RotationAxis[1] << " "
+     << this->RotationAxis[2] << "\n";
+}
+
+void vtkGraupelObjectsSimulation::PrintSelf(ostream &os, vtkIndent indent) {
+  this->Superclass::PrintSelf(os, indent);
+}
