@@ -1,7 +1,6 @@
 #include "GraupelObjects.h"
 
 #include "vtkCellArray.h"
-#include "vtkDemandDrivenPipeline.h"
 #include "vtkIdList.h"
 #include "vtkInformation.h"
 #include "vtkInformationVector.h"
@@ -231,22 +230,6 @@ void MatchObjectsOutput(vtkInformationVector **inInfo, vtkInformationVector *out
       made = vtkSmartPointer<vtkPolyData>::New();
     }
     info->Set(vtkDataObject::DATA_OBJECT(), made);
-  }
-}
-
-void CopyTimes(vtkInformation *image, vtkInformation *objects) {
-  objects->Remove(vtkStreamingDemandDrivenPipeline::TIME_STEPS());
-  objects->Remove(vtkStreamingDemandDrivenPipeline::TIME_RANGE());
-  if (image->Has(vtkStreamingDemandDrivenPipeline::TIME_STEPS())) {
-    objects->CopyEntry(image, vtkStreamingDemandDrivenPipeline::TIME_STEPS());
-    objects->CopyEntry(image, vtkStreamingDemandDrivenPipeline::TIME_RANGE());
-  }
-}
-
-void StampTime(vtkDataObject *image, vtkDataObject *objects) {
-  if (objects && image->GetInformation()->Has(vtkDataObject::DATA_TIME_STEP())) {
-    objects->GetInformation()->Set(vtkDataObject::DATA_TIME_STEP(),
-                                   image->GetInformation()->Get(vtkDataObject::DATA_TIME_STEP()));
   }
 }
 

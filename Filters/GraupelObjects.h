@@ -171,12 +171,6 @@ bool FillObjectsOutput(vtkDataObject *input, vtkDataObject *output, size_t n,
  */
 void MatchObjectsOutput(vtkInformationVector **inInfo, vtkInformationVector *outInfo, int port);
 
-/** An objects' output has the simulation's times (image's), not the input's. */
-void CopyTimes(vtkInformation *image, vtkInformation *objects);
-
-/** objects (if any) stamped with image's DATA_TIME_STEP, where it has one. */
-void StampTime(vtkDataObject *image, vtkDataObject *objects);
-
 /** The piece an output's request asks for (UPDATE_PIECE_NUMBER), 0 without one. */
 int RequestedPiece(vtkInformation *info);
 } // namespace graupel

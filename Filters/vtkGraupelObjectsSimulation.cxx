@@ -2,12 +2,10 @@
 
 #include "vtkAlgorithmOutput.h"
 #include "vtkDemandDrivenPipeline.h"
-#include "vtkExecutive.h"
 #include "vtkGraupelMotion.h"
 #include "vtkInformation.h"
 #include "vtkInformationVector.h"
 #include "vtkPolyData.h"
-#include "vtkStreamingDemandDrivenPipeline.h"
 
 #include "GraupelObjects.h"
 
@@ -51,59 +49,8 @@ vtkTypeBool vtkGraupelObjectsSimulation::ProcessRequest(vtkInformation *request,
                                                         vtkInformationVector *outInfo) {
   if (request->Has(vtkDemandDrivenPipeline::REQUEST_DATA_OBJECT())) {
     graupel::MatchObjectsOutput(inInfo, outInfo, 1);
-    return this->Superclass::ProcessRequest(request, inInfo, outInfo);
-  }
-  // A request from an objects' port asks for the same time of the
-  // simulation, which the base reads from port 0.
-  if ((request->Has(vtkStreamingDemandDrivenPipeline::REQUEST_UPDATE_EXTENT()) ||
-       request->Has(vtkDemandDrivenPipeline::REQUEST_DATA())) &&
-      request->Has(vtkExecutive::FROM_OUTPUT_PORT()) &&
-      request->Get(vtkExecutive::FROM_OUTPUT_PORT()) >= 1) {
-    vtkInformation *from =
-        outInfo->GetInformationObject(request->Get(vtkExecutive::FROM_OUTPUT_PORT()));
-    if (from->Has(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP())) {
-      outInfo->GetInformationObject(0)->Set(
-          vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP(),
-          from->Get(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP()));
-    }
   }
   return this->Superclass::ProcessRequest(request, inInfo, outInfo);
-}
-
-int vtkGraupelObjectsSimulation::RequestInformation(vtkInformation *request,
-                                                    vtkInformationVector **inputVector,
-                                                    vtkInformationVector *outputVector) {
-  const int ok = this->Superclass::RequestInformation(request, inputVector, outputVector);
-  // The objects' outputs have the simulation's times, not the input's.
-  vtkInformation *image = outputVector->GetInformationObject(0);
-  for (int port = 1; port < this->GetNumberOfOutputPorts(); ++port) {
-    graupel::CopyTimes(image, outputVector->GetInformationObject(port));
-  }
-  return ok;
-}
-
-int vtkGraupelObjectsSimulation::RequestData(vtkInformation *request,
-                                             vtkInformationVector **inputVector,
-                                             vtkInformationVector *outputVector) {
-  const int outputs = this->GetNumberOfOutputPorts();
-  for (int port = 1; port < outputs; ++port) {
-    if (vtkDataObject *objects =
-            outputVector->GetInformationObject(port)->Get(vtkDataObject::DATA_OBJECT())) {
-      objects->Initialize();
-    }
-  }
-  this->OutputVector = outputVector;
-  this->ObjectsFilled = false;
-  const int ok = this->Superclass::RequestData(request, inputVector, outputVector);
-  this->OutputVector = nullptr;
-  if (ok && this->ObjectsFilled) {
-    vtkDataObject *image = outputVector->GetInformationObject(0)->Get(vtkDataObject::DATA_OBJECT());
-    for (int port = 1; port < outputs; ++port) {
-      graupel::StampTime(
-          image, outputVector->GetInformationObject(port)->Get(vtkDataObject::DATA_OBJECT()));
-    }
-  }
-  return ok;
 }
 
 int vtkGraupelObjectsSimulation::CheckObjectMotion() {

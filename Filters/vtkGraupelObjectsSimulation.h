@@ -15,9 +15,8 @@
  * Objects that advertise time steps are read at each: their geometry is the
  * pose.
  *
- * Outputs 1 and up are the objects' outputs: they carry the simulation's
- * times (not the input's) and the time of output 0's data; output 1 is a
- * vtkPolyData or a multiblock, following the Objects input's type.
+ * Output 1 is the objects, a vtkPolyData or a multiblock following the
+ * Objects input's type (vtkGraupelSimulation gives it the simulation's times).
  */
 #ifndef vtkGraupelObjectsSimulation_h
 #define vtkGraupelObjectsSimulation_h
@@ -65,10 +64,7 @@ public:
   /** Connects the optional path (input port 2). */
   void SetPathConnection(vtkAlgorithmOutput *output);
 
-  /**
-   * Output 1 takes the Objects input's type, and a request from an objects'
-   * output asks for the simulation's time it names; the rest goes to the base.
-   */
+  /** Output 1 takes the Objects input's type; the rest goes to the base. */
   vtkTypeBool ProcessRequest(vtkInformation *request, vtkInformationVector **inInfo,
                              vtkInformationVector *outInfo) override;
 
@@ -83,9 +79,6 @@ protected:
   ~vtkGraupelObjectsSimulation() override;
 
   int FillInputPortInformation(int port, vtkInformation *info) override;
-  int RequestInformation(vtkInformation *, vtkInformationVector **,
-                         vtkInformationVector *) override;
-  int RequestData(vtkInformation *, vtkInformationVector **, vtkInformationVector *) override;
 
   /** ObjectVelocity, ObjectAngularVelocity and RotationAxis are finite; 0 after one sentence. */
   int CheckObjectMotion();
@@ -106,8 +99,6 @@ protected:
   std::vector<double> Path; // xyz per point; empty when none
   bool ObjectsTemporal = false;
   double ObjectsReadAt = 0.0;
-  vtkInformationVector *OutputVector = nullptr; // during RequestData only
-  bool ObjectsFilled = false;                   // FillOutput filled the objects' outputs
 
 private:
   vtkGraupelObjectsSimulation(const vtkGraupelObjectsSimulation &) = delete;

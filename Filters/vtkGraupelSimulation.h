@@ -274,6 +274,14 @@ public:
   /** Whether input port is read in time now (policy TEMPORAL and >= 2 time steps). */
   bool IsInputTemporal(int port) const;
 
+  /**
+   * A request from an output other than 0 (objects, textures, a
+   * hydrograph) asks for the simulation's time it names: output 0 gets it,
+   * which the time logic reads.
+   */
+  vtkTypeBool ProcessRequest(vtkInformation *request, vtkInformationVector **inInfo,
+                             vtkInformationVector *outInfo) override;
+
 protected:
   vtkGraupelSimulation();
   ~vtkGraupelSimulation() override;
@@ -415,9 +423,24 @@ protected:
   int CheckpointInterval = 10;
   double CheckpointMemoryLimit = 1024.0;
 
+  /**
+   * Outputs 1 and up: RequestData empties them before each pass and holds
+   * the outputs here while it runs (nullptr otherwise), so that FillOutput
+   * can fill them; it sets OutputsFilled when it did, and they then take
+   * output 0's time. They advertise the simulation's times.
+   */
+  vtkInformationVector *OutputVector = nullptr;
+  bool OutputsFilled = false;
+
 private:
   vtkGraupelSimulation(const vtkGraupelSimulation &) = delete;
   void operator=(const vtkGraupelSimulation &) = delete;
+
+  /** RequestInformation for output 0: the input times read, the output times advertised. */
+  int AdvertiseTimes(vtkInformationVector **inputVector, vtkInformationVector *outputVector);
+  /** RequestData for output 0: the state brought to the requested time and filled in. */
+  int UpdateState(vtkInformation *request, vtkInformationVector **inputVector,
+                  vtkInformationVector *outputVector);
 
   double DefaultEndTime = EndTime; // the base's, until SetTimeDefaults
   double DefaultOutputInterval = OutputInterval;

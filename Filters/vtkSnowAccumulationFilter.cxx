@@ -1,12 +1,10 @@
 #include "vtkSnowAccumulationFilter.h"
 
-#include "vtkAlgorithmOutput.h"
 #include "vtkDemandDrivenPipeline.h"
 #include "vtkDoubleArray.h"
 #include "vtkExecutive.h"
 #include "vtkFieldData.h"
 #include "vtkFloatArray.h"
-#include "vtkGraupelMotion.h"
 #include "vtkImageData.h"
 #include "vtkInformation.h"
 #include "vtkInformationVector.h"
@@ -482,7 +480,7 @@ int vtkSnowAccumulationFilter::FillOutput(vtkDataObject *outputObject, vtkInform
     if (piece == 0 && textures && !this->FillTextures(textures)) {
       return 0;
     }
-    this->ObjectsFilled = true;
+    this->OutputsFilled = true;
   }
   return 1;
 }

@@ -1,12 +1,8 @@
 #include "vtkSnowDeformationFilter.h"
 
-#include "vtkAlgorithmOutput.h"
-#include "vtkDemandDrivenPipeline.h"
 #include "vtkDoubleArray.h"
-#include "vtkExecutive.h"
 #include "vtkFieldData.h"
 #include "vtkFloatArray.h"
-#include "vtkGraupelMotion.h"
 #include "vtkImageData.h"
 #include "vtkInformation.h"
 #include "vtkInformationVector.h"
@@ -16,7 +12,6 @@
 #include "vtkPointData.h"
 #include "vtkPolyData.h"
 #include "vtkSmartPointer.h"
-#include "vtkStreamingDemandDrivenPipeline.h"
 
 #include "graupel/snow_deformation.h"
 
@@ -549,7 +544,7 @@ int vtkSnowDeformationFilter::FillOutput(vtkDataObject *outputObject, vtkInforma
     if (piece == 0 && !this->FillObjects(objects, this->GetStateTime())) {
       return 0;
     }
-    this->ObjectsFilled = true;
+    this->OutputsFilled = true;
   }
   return 1;
 }
