@@ -86,6 +86,23 @@ void vtkGraupelObjectsSimulation::Pose(size_t k, double t, double m[16]) const {
                       this->RotationAxis, this->Path, t, m);
 }
 
+int vtkGraupelObjectsSimulation::FillObjectOutputs() {
+  if (!this->OutputVector) {
+    return 1;
+  }
+  if (graupel::RequestedPiece(this->OutputVector->GetInformationObject(1)) == 0) {
+    for (int port = 1; port < this->GetNumberOfOutputPorts(); ++port) {
+      vtkDataObject *output =
+          this->OutputVector->GetInformationObject(port)->Get(vtkDataObject::DATA_OBJECT());
+      if (!this->FillObjectOutput(port, output, this->GetStateTime())) {
+        return 0;
+      }
+    }
+  }
+  this->OutputsFilled = true;
+  return 1;
+}
+
 void vtkGraupelObjectsSimulation::PrintObjectMotion(ostream &os, vtkIndent indent) {
   os << indent << "ObjectVelocity: " << this->ObjectVelocity[0] << " " << this->ObjectVelocity[1]
      << " " << this->ObjectVelocity[2] << " m/s\n";

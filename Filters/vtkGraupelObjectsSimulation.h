@@ -88,6 +88,14 @@ protected:
   int ReadObjects(vtkDataObject *objects);
   /** The pose (column-major) of object k at time t. */
   void Pose(size_t k, double t, double matrix[16]) const;
+  /**
+   * For FillOutput: the objects' outputs (1 and up) at the state's time,
+   * each through FillObjectOutput, on piece 0 only so that an MPI run shows
+   * each object once; 0 after one sentence.
+   */
+  int FillObjectOutputs();
+  /** Fills output `port` (1 and up, emptied) at time t; 0 after one sentence. */
+  virtual int FillObjectOutput(int port, vtkDataObject *output, double t) = 0;
   /** The motion properties, as the subclasses' PrintSelf ends. */
   void PrintObjectMotion(ostream &os, vtkIndent indent);
 

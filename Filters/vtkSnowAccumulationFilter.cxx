@@ -466,23 +466,16 @@ int vtkSnowAccumulationFilter::FillOutput(vtkDataObject *outputObject, vtkInform
   AddValue(fd, "dropped_volume", ledger.dropped_volume);
   AddValue(fd, "balance_error", ledger.balance_error);
 
-  // The objects' output, at the same time; only piece 0 carries them, so
-  // an MPI run shows each object once.
-  if (this->OutputVector) {
-    vtkInformation *objInfo = this->OutputVector->GetInformationObject(1);
-    vtkDataObject *objects = objInfo->Get(vtkDataObject::DATA_OBJECT());
-    const int piece = graupel::RequestedPiece(objInfo);
-    if (piece == 0 && !this->FillObjects(objects, this->GetStateTime())) {
-      return 0;
-    }
-    auto *textures = vtkMultiBlockDataSet::SafeDownCast(
-        this->OutputVector->GetInformationObject(2)->Get(vtkDataObject::DATA_OBJECT()));
-    if (piece == 0 && textures && !this->FillTextures(textures)) {
-      return 0;
-    }
-    this->OutputsFilled = true;
+  // The objects and their textures, at the same time.
+  return this->FillObjectOutputs();
+}
+
+int vtkSnowAccumulationFilter::FillObjectOutput(int port, vtkDataObject *output, double t) {
+  if (port == 1) {
+    return this->FillObjects(output, t);
   }
-  return 1;
+  auto *textures = vtkMultiBlockDataSet::SafeDownCast(output);
+  return !textures || this->FillTextures(textures) ? 1 : 0;
 }
 
 int vtkSnowAccumulationFilter::FillTextures(vtkMultiBlockDataSet *output) {

@@ -224,6 +224,9 @@ private:
   bool ObjectsMove() const;
   /** Hands the objects at their poses at time t to the core. */
   int SetObjects(double t);
+  /** Output 1: FillObjects; output 2: FillTextures. */
+  int FillObjectOutput(int port, vtkDataObject *output, double t) override;
+  /** The objects at their poses at time t with their snow per point. */
   int FillObjects(vtkDataObject *output, double t);
   /** One image per object, its accumulation texture or empty. */
   int FillTextures(vtkMultiBlockDataSet *output);

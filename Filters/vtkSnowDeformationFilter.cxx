@@ -461,7 +461,7 @@ int vtkSnowDeformationFilter::LoadState(const std::vector<unsigned char> &bytes)
   return gr_snow_deformation_state_load(this->Simulation, bytes.data(), bytes.size()) == GR_OK;
 }
 
-int vtkSnowDeformationFilter::FillObjects(vtkDataObject *output, double t) {
+int vtkSnowDeformationFilter::FillObjectOutput(int, vtkDataObject *output, double t) {
   vtkDataObject *input = this->GetNumberOfInputConnections(1) ? this->GetTemporalInput(1) : nullptr;
   if (!input || !output) {
     return 1;
@@ -535,18 +535,8 @@ int vtkSnowDeformationFilter::FillOutput(vtkDataObject *outputObject, vtkInforma
   AddValue(fd, "volume_error", ledger.volume_error);
   AddValue(fd, "relax_iterations", ledger.relax_iterations);
 
-  // The objects' output, at the same time; only piece 0 carries them, so
-  // an MPI run shows each object once.
-  if (this->OutputVector) {
-    vtkInformation *objInfo = this->OutputVector->GetInformationObject(1);
-    vtkDataObject *objects = objInfo->Get(vtkDataObject::DATA_OBJECT());
-    const int piece = graupel::RequestedPiece(objInfo);
-    if (piece == 0 && !this->FillObjects(objects, this->GetStateTime())) {
-      return 0;
-    }
-    this->OutputsFilled = true;
-  }
-  return 1;
+  // The objects with their forces, at the same time.
+  return this->FillObjectOutputs();
 }
 
 void vtkSnowDeformationFilter::ReleaseState() {

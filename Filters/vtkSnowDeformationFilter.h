@@ -234,7 +234,8 @@ private:
   int CheckObjectsReachGrid(const double gridBounds[4], double margin);
   /** Hands the objects at their poses at time t to the core (velocities over [t - h, t]). */
   int SetObjects(double t, double h);
-  int FillObjects(vtkDataObject *output, double t);
+  /** The objects at their poses at time t with their forces and contact areas (output 1). */
+  int FillObjectOutput(int port, vtkDataObject *output, double t) override;
 
   gr_snow_deformation *Simulation = nullptr;
 };
