@@ -10,8 +10,9 @@
  * block); input 2 (`Path`, optional) is a polyline. Objects that do not
  * advertise time steps move by the properties (vtkGraupelMotion): the centre
  * at ObjectVelocity (m/s, a leaf's field data `velocity` replaces it for
- * that object), or along the Path at its length; the object turns at
- * ObjectAngularVelocity (deg/s) about RotationAxis through its centre.
+ * that object), or along the Path at that velocity's length; the object
+ * turns at ObjectAngularVelocity (deg/s) about RotationAxis through its
+ * centre.
  * Objects that advertise time steps are read at each: their geometry is the
  * pose.
  *
