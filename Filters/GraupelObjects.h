@@ -1,5 +1,6 @@
 // Private to Filters/: the Objects input every simulation filter with
-// objects reads (a polydata or a composite of them) and poses.
+// objects reads (a polydata or a composite of them) and poses, and the
+// objects' output it fills (GraupelObjects.cxx).
 #ifndef GraupelObjects_h
 #define GraupelObjects_h
 
@@ -15,7 +16,15 @@
 #include "vtkPolyData.h"
 #include "vtkSmartPointer.h"
 
+#include "graupel/graupel.h"
+
+#include <functional>
+#include <string>
 #include <vector>
+
+class vtkInformation;
+class vtkInformationVector;
+class vtkMultiBlockDataSet;
 
 namespace graupel {
 // The leaves of an Objects input in order: the polydata itself, or every
@@ -92,6 +101,78 @@ inline vtkSmartPointer<vtkPolyData> Posed(vtkPolyData *pd, const double centre[3
   out->SetFieldData(fd);
   return out;
 }
+
+/** One object as a core sees it: its vertices about its centre. */
+struct Object {
+  std::vector<float> vertices;
+  std::vector<int> triangles;
+  std::vector<float> uv; // 2 per vertex from the texture coordinates (PerPoint), else empty
+  double centre[3];
+  double velocity[3]; // m/s: the leaf's `velocity`, else ObjectVelocity
+};
+
+/** How the points of an object's polydata become its mesh's vertices. */
+enum class Vertices {
+  // One vertex per point, unmerged, with its texture coordinates: the snow
+  // is handed back per point, and a box's faces keep their own corners (and
+  // flat normals), so its top holds a flat cap and its sides none.
+  PerPoint,
+  // Points at the same place are one vertex: sources such as a box or a
+  // capped cylinder repeat corners per face (for their normals), which
+  // would leave every edge open.
+  Merged
+};
+
+/**
+ * Reads an Objects input (nullptr: none) into objects, one per leaf
+ * (Leaves): vertices about the centre of its bounds, its polygons and
+ * strips as triangles, its velocity the leaf's field array `velocity`, else
+ * `velocity` (ObjectVelocity). Each mesh must pass gr_mesh_validate with
+ * `closed`. Once every mesh is read, temporal takes inputTemporal (the
+ * input has time steps: its geometry is the pose), and along a path (not
+ * empty) the objects posed by the properties must have a speed
+ * (vtkGraupelMotion::CheckPathSpeed). Returns an empty string, or one
+ * sentence that starts with `filter` (e.g. "Snow Deformation"); the objects
+ * read before it stay.
+ */
+std::string ReadObjects(const char *filter, vtkDataObject *input, size_t maxObjects,
+                        const double velocity[3], Vertices vertices, int closed, bool inputTemporal,
+                        const std::vector<double> &path, std::vector<Object> &objects,
+                        bool &temporal);
+
+/** o's mesh (views of its arrays) at the identity pose. */
+gr_mesh MeshOf(const Object &o);
+
+/**
+ * The pose (column-major) of o at time t: a temporal object's geometry is
+ * its pose, so it goes back to where it was read; the others move by the
+ * properties (vtkGraupelMotion::PoseObject).
+ */
+void PoseObject(const Object &o, bool temporal, double angularVelocity, const double axis[3],
+                const std::vector<double> &path, double t, double m[16]);
+
+/** Object k of the leaf it was read from, at its pose; nullptr after a reported failure. */
+using PosedObject = std::function<vtkSmartPointer<vtkPolyData>(size_t k, vtkPolyData *leaf)>;
+
+/**
+ * Fills the objects' output from the Objects input's n objects: a polydata
+ * output holds the one object (n == 1), a multiblock the input's structure
+ * with object k in the leaf it came from. Nothing is filled when the input
+ * no longer has n objects (it changed since the state was made). Returns
+ * false when `posed` failed; *blocks (if given) is set to the multiblock
+ * when the objects went into one, else nullptr.
+ */
+bool FillObjectsOutput(vtkDataObject *input, vtkDataObject *output, size_t n,
+                       const PosedObject &posed, vtkMultiBlockDataSet **blocks = nullptr);
+
+/**
+ * For REQUEST_DATA_OBJECT: output `port` follows the Objects input's
+ * (input 1) type, a multiblock for a composite, else a polydata.
+ */
+void MatchObjectsOutput(vtkInformationVector **inInfo, vtkInformationVector *outInfo, int port);
+
+/** The piece an output's request asks for (UPDATE_PIECE_NUMBER), 0 without one. */
+int RequestedPiece(vtkInformation *info);
 } // namespace graupel
 
 #endif

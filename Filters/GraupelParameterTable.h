@@ -6,6 +6,8 @@
 #include "graupel/graupel.h"
 
 #include <cmath>
+#include <sstream>
+#include <string>
 
 namespace graupel {
 /** value clamped by the table row of property (unchanged when the table has no such row). */
@@ -15,6 +17,25 @@ inline double ClampToTable(const gr_param_bound *(*bounds)(int *), const char *p
   const gr_param_bound *table = bounds(&count);
   const gr_param_bound *row = gr_param_find(table, count, property);
   return row ? gr_param_clamp(row, value) : value;
+}
+
+/**
+ * Empty when row accepts value (in the property's units; no row accepts
+ * all), else the sentence "<filter>: <name> must be from <min> to <max>
+ * <unit>; it is <value> <unit>. Set it within that range."
+ */
+inline std::string OutOfRange(const char *filter, const char *name, const gr_param_bound *row,
+                              double value) {
+  if (!row || gr_param_accepts(row, value * row->to_core)) {
+    return std::string();
+  }
+  const char *unit = (row->unit && *row->unit) ? row->unit : "";
+  const char *space = *unit ? " " : "";
+  std::ostringstream msg;
+  msg << filter << ": " << name << " must be " << (row->min_open ? "above " : "from ") << row->min
+      << space << unit << (row->min_open ? " and up to " : " to ") << row->max << space << unit
+      << "; it is " << value << space << unit << ". Set it within that range.";
+  return msg.str();
 }
 } // namespace graupel
 

@@ -91,6 +91,14 @@ int vtkGraupelAlgorithm::ReportFailure(int status, const char *what, const char 
   return 0;
 }
 
+int vtkGraupelAlgorithm::ReportError(const std::string &sentence) {
+  if (sentence.empty()) {
+    return 1;
+  }
+  vtkErrorMacro(<< sentence);
+  return 0;
+}
+
 void vtkGraupelAlgorithm::AddDeviceFieldData(vtkDataObject *output) {
   vtkNew<vtkStringArray> device;
   device->SetName("graupel_device");

@@ -37,6 +37,8 @@
 #include "GraupelFiltersModule.h"
 #include "vtkAlgorithm.h"
 
+#include <string>
+
 struct gr_context;
 class vtkDataObject;
 
@@ -108,6 +110,12 @@ protected:
    * the thread's latest core error.
    */
   int ReportFailure(int status, const char *what, const char *detail = nullptr);
+
+  /**
+   * For the checks that return their sentence (empty when all is well):
+   * reports a non-empty one as this filter's error and returns 0, else 1.
+   */
+  int ReportError(const std::string &sentence);
 
   /** Adds the `graupel_device` string to the output's field data. */
   void AddDeviceFieldData(vtkDataObject *output);

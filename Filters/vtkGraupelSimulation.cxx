@@ -28,6 +28,7 @@
 #include "GraupelPieces.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -236,8 +237,43 @@ double vtkGraupelSimulation::InputTimeAt(int port, double t) const {
   return it == times.begin() ? times.front() : *(it - 1);
 }
 
+vtkTypeBool vtkGraupelSimulation::ProcessRequest(vtkInformation *request,
+                                                 vtkInformationVector **inInfo,
+                                                 vtkInformationVector *outInfo) {
+  if ((request->Has(vtkStreamingDemandDrivenPipeline::REQUEST_UPDATE_EXTENT()) ||
+       request->Has(vtkDemandDrivenPipeline::REQUEST_DATA())) &&
+      request->Has(vtkExecutive::FROM_OUTPUT_PORT()) &&
+      request->Get(vtkExecutive::FROM_OUTPUT_PORT()) >= 1) {
+    vtkInformation *from =
+        outInfo->GetInformationObject(request->Get(vtkExecutive::FROM_OUTPUT_PORT()));
+    if (from->Has(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP())) {
+      outInfo->GetInformationObject(0)->Set(
+          vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP(),
+          from->Get(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP()));
+    }
+  }
+  return this->Superclass::ProcessRequest(request, inInfo, outInfo);
+}
+
 int vtkGraupelSimulation::RequestInformation(vtkInformation *, vtkInformationVector **inputVector,
                                              vtkInformationVector *outputVector) {
+  const int ok = this->AdvertiseTimes(inputVector, outputVector);
+  // The other outputs have the simulation's times, not the input's.
+  vtkInformation *image = outputVector->GetInformationObject(0);
+  for (int port = 1; port < this->GetNumberOfOutputPorts(); ++port) {
+    vtkInformation *info = outputVector->GetInformationObject(port);
+    info->Remove(vtkStreamingDemandDrivenPipeline::TIME_STEPS());
+    info->Remove(vtkStreamingDemandDrivenPipeline::TIME_RANGE());
+    if (image->Has(vtkStreamingDemandDrivenPipeline::TIME_STEPS())) {
+      info->CopyEntry(image, vtkStreamingDemandDrivenPipeline::TIME_STEPS());
+      info->CopyEntry(image, vtkStreamingDemandDrivenPipeline::TIME_RANGE());
+    }
+  }
+  return ok;
+}
+
+int vtkGraupelSimulation::AdvertiseTimes(vtkInformationVector **inputVector,
+                                         vtkInformationVector *outputVector) {
   const int nports = this->GetNumberOfInputPorts();
   this->InputTimes.assign(static_cast<size_t>(nports), std::vector<double>());
   this->DeliveredTime.resize(static_cast<size_t>(nports), 0.0);
@@ -460,6 +496,29 @@ int vtkGraupelSimulation::CoreProgress(void *user, double time) {
   return static_cast<vtkGraupelSimulation *>(user)->ReportProgress(time);
 }
 
+int vtkGraupelSimulation::ThrottledProgress(void *user, double time) {
+  auto *self = static_cast<vtkGraupelSimulation *>(user);
+  if (self->GetAbortExecute()) {
+    return 1;
+  }
+  const double now =
+      std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+  if (now - self->LastProgressWall < 0.1) {
+    return 0;
+  }
+  self->LastProgressWall = now;
+  return CoreProgress(user, time);
+}
+
+long long vtkGraupelSimulation::CountSteps(double t0, double t1, double dt) {
+  const double count = std::ceil((t1 - t0) / dt - 1e-9);
+  return count < 1.0 ? 1 : static_cast<long long>(count);
+}
+
+double vtkGraupelSimulation::StepEnd(double t0, double t1, double dt, long long k, long long n) {
+  return k == n ? t1 : t0 + static_cast<double>(k) * dt;
+}
+
 int vtkGraupelSimulation::CheckTerrain(vtkImageData *terrain) {
   const char *label = this->GetSimulationLabel();
   if (!terrain) {
@@ -515,6 +574,33 @@ void vtkGraupelSimulation::Finish(vtkInformation *request) {
 }
 
 int vtkGraupelSimulation::RequestData(vtkInformation *request, vtkInformationVector **inputVector,
+                                      vtkInformationVector *outputVector) {
+  const int outputs = this->GetNumberOfOutputPorts();
+  for (int port = 1; port < outputs; ++port) {
+    if (vtkDataObject *other =
+            outputVector->GetInformationObject(port)->Get(vtkDataObject::DATA_OBJECT())) {
+      other->Initialize();
+    }
+  }
+  this->OutputVector = outputVector;
+  this->OutputsFilled = false;
+  const int ok = this->UpdateState(request, inputVector, outputVector);
+  this->OutputVector = nullptr;
+  vtkInformation *image =
+      outputVector->GetInformationObject(0)->Get(vtkDataObject::DATA_OBJECT())->GetInformation();
+  if (ok && this->OutputsFilled && image->Has(vtkDataObject::DATA_TIME_STEP())) {
+    for (int port = 1; port < outputs; ++port) {
+      if (vtkDataObject *other =
+              outputVector->GetInformationObject(port)->Get(vtkDataObject::DATA_OBJECT())) {
+        other->GetInformation()->Set(vtkDataObject::DATA_TIME_STEP(),
+                                     image->Get(vtkDataObject::DATA_TIME_STEP()));
+      }
+    }
+  }
+  return ok;
+}
+
+int vtkGraupelSimulation::UpdateState(vtkInformation *request, vtkInformationVector **inputVector,
                                       vtkInformationVector *outputVector) {
   vtkInformation *outInfo = outputVector->GetInformationObject(0);
   vtkDataObject *output = outInfo->Get(vtkDataObject::DATA_OBJECT());

@@ -274,6 +274,14 @@ public:
   /** Whether input port is read in time now (policy TEMPORAL and >= 2 time steps). */
   bool IsInputTemporal(int port) const;
 
+  /**
+   * A request from an output other than 0 (objects, textures, a
+   * hydrograph) asks for the simulation's time it names: output 0 gets it,
+   * which the time logic reads.
+   */
+  vtkTypeBool ProcessRequest(vtkInformation *request, vtkInformationVector **inInfo,
+                             vtkInformationVector *outInfo) override;
+
 protected:
   vtkGraupelSimulation();
   ~vtkGraupelSimulation() override;
@@ -362,6 +370,20 @@ protected:
   int ReportProgress(double t);
   /** ReportProgress as a gr_progress_fn; user is the filter. */
   static int CoreProgress(void *user, double time);
+  /**
+   * CoreProgress for a core that reports every step (many a second): an
+   * abort is seen at every step, the text and the event come at most every
+   * 0.1 s of wall time.
+   */
+  static int ThrottledProgress(void *user, double time);
+
+  /**
+   * The steps of dt (s) from t0 to t1: at least one, the last shortened to
+   * end on t1. Step k of n (1..n) ends at StepEnd, t0 + k dt (not a running
+   * sum, so the ends depend on t0, t1 and dt only) and t1 for the last.
+   */
+  static long long CountSteps(double t0, double t1, double dt);
+  static double StepEnd(double t0, double t1, double dt, long long k, long long n);
 
   /**
    * The terrain's `elevation` point array: refuses an input without it (one
@@ -401,9 +423,24 @@ protected:
   int CheckpointInterval = 10;
   double CheckpointMemoryLimit = 1024.0;
 
+  /**
+   * Outputs 1 and up: RequestData empties them before each pass and holds
+   * the outputs here while it runs (nullptr otherwise), so that FillOutput
+   * can fill them; it sets OutputsFilled when it did, and they then take
+   * output 0's time. They advertise the simulation's times.
+   */
+  vtkInformationVector *OutputVector = nullptr;
+  bool OutputsFilled = false;
+
 private:
   vtkGraupelSimulation(const vtkGraupelSimulation &) = delete;
   void operator=(const vtkGraupelSimulation &) = delete;
+
+  /** RequestInformation for output 0: the input times read, the output times advertised. */
+  int AdvertiseTimes(vtkInformationVector **inputVector, vtkInformationVector *outputVector);
+  /** RequestData for output 0: the state brought to the requested time and filled in. */
+  int UpdateState(vtkInformation *request, vtkInformationVector **inputVector,
+                  vtkInformationVector *outputVector);
 
   double DefaultEndTime = EndTime; // the base's, until SetTimeDefaults
   double DefaultOutputInterval = OutputInterval;
@@ -452,6 +489,7 @@ private:
   bool Continuing = false;
   int Target = 0;
   double ProgressStart = 0.0;
+  double LastProgressWall = 0.0; // s, steady clock: ThrottledProgress's last report
   Key StateKey;
   Key FailedKey;
   bool HasFailed = false;

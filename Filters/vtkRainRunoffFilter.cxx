@@ -1,9 +1,7 @@
 #include "vtkRainRunoffFilter.h"
 
 #include "vtkAlgorithmOutput.h"
-#include "vtkDemandDrivenPipeline.h"
 #include "vtkDoubleArray.h"
-#include "vtkExecutive.h"
 #include "vtkFieldData.h"
 #include "vtkFloatArray.h"
 #include "vtkImageData.h"
@@ -14,7 +12,6 @@
 #include "vtkPointData.h"
 #include "vtkPointSet.h"
 #include "vtkSmartPointer.h"
-#include "vtkStreamingDemandDrivenPipeline.h"
 #include "vtkTable.h"
 
 #include "graupel/rain_runoff.h"
@@ -110,18 +107,8 @@ int vtkRainRunoffFilter::CheckParameters() {
                 {"DebrisFactor", this->DebrisFactor},
                 {"NoDataBoundary", double(this->NoDataBoundary)}};
   for (const auto &p : values) {
-    const gr_param_bound *b = Bound(p.property);
-    if (!b) {
-      continue;
-    }
-    if (!gr_param_accepts(b, p.value * b->to_core)) {
-      const char *unit = (b->unit && *b->unit) ? b->unit : "";
-      const char *space = *unit ? " " : "";
-      vtkErrorMacro("Rain Runoff: " << p.property << " must be "
-                                    << (b->min_open ? "above " : "from ") << b->min << space << unit
-                                    << (b->min_open ? " and up to " : " to ") << b->max << space
-                                    << unit << "; it is " << p.value << space << unit
-                                    << ". Set it within that range.");
+    if (!this->ReportError(
+            graupel::OutOfRange("Rain Runoff", p.property, Bound(p.property), p.value))) {
       return 0;
     }
   }
@@ -198,25 +185,6 @@ int vtkRainRunoffFilter::FillOutputPortInformation(int port, vtkInformation *inf
   return 1;
 }
 
-vtkTypeBool vtkRainRunoffFilter::ProcessRequest(vtkInformation *request,
-                                                vtkInformationVector **inInfo,
-                                                vtkInformationVector *outInfo) {
-  // A request from the hydrograph's port asks for the same time of the
-  // simulation, which the base reads from port 0.
-  if ((request->Has(vtkStreamingDemandDrivenPipeline::REQUEST_UPDATE_EXTENT()) ||
-       request->Has(vtkDemandDrivenPipeline::REQUEST_DATA())) &&
-      request->Has(vtkExecutive::FROM_OUTPUT_PORT()) &&
-      request->Get(vtkExecutive::FROM_OUTPUT_PORT()) == 1) {
-    vtkInformation *from = outInfo->GetInformationObject(1);
-    vtkInformation *to = outInfo->GetInformationObject(0);
-    if (from->Has(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP())) {
-      to->Set(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP(),
-              from->Get(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP()));
-    }
-  }
-  return this->Superclass::ProcessRequest(request, inInfo, outInfo);
-}
-
 int vtkRainRunoffFilter::RequestInformation(vtkInformation *request,
                                             vtkInformationVector **inputVector,
                                             vtkInformationVector *outputVector) {
@@ -224,38 +192,8 @@ int vtkRainRunoffFilter::RequestInformation(vtkInformation *request,
   // before the next RequestData plans the pieces).
   this->SetPieceRing(this->FlowModel == LOCAL_INERTIAL ? GR_RAIN_RUNOFF_GHOST
                                                        : GR_RAIN_RUNOFF_GHOST_SW);
-  const int ok = this->Superclass::RequestInformation(request, inputVector, outputVector);
-  // The hydrograph has the simulation's times, not the input's.
-  vtkInformation *image = outputVector->GetInformationObject(0);
-  vtkInformation *table = outputVector->GetInformationObject(1);
-  table->Remove(vtkStreamingDemandDrivenPipeline::TIME_STEPS());
-  table->Remove(vtkStreamingDemandDrivenPipeline::TIME_RANGE());
-  if (image->Has(vtkStreamingDemandDrivenPipeline::TIME_STEPS())) {
-    table->CopyEntry(image, vtkStreamingDemandDrivenPipeline::TIME_STEPS());
-    table->CopyEntry(image, vtkStreamingDemandDrivenPipeline::TIME_RANGE());
-  }
-  return ok;
-}
-
-int vtkRainRunoffFilter::RequestData(vtkInformation *request, vtkInformationVector **inputVector,
-                                     vtkInformationVector *outputVector) {
-  vtkInformation *tableInfo = outputVector->GetInformationObject(1);
-  if (vtkDataObject *table = tableInfo->Get(vtkDataObject::DATA_OBJECT())) {
-    table->Initialize();
-  }
-  this->OutputVector = outputVector;
-  this->HydrographFilled = false;
-  const int ok = this->Superclass::RequestData(request, inputVector, outputVector);
-  this->OutputVector = nullptr;
-  if (ok && this->HydrographFilled) {
-    vtkDataObject *image = outputVector->GetInformationObject(0)->Get(vtkDataObject::DATA_OBJECT());
-    vtkDataObject *table = tableInfo->Get(vtkDataObject::DATA_OBJECT());
-    if (image->GetInformation()->Has(vtkDataObject::DATA_TIME_STEP())) {
-      table->GetInformation()->Set(vtkDataObject::DATA_TIME_STEP(),
-                                   image->GetInformation()->Get(vtkDataObject::DATA_TIME_STEP()));
-    }
-  }
-  return ok;
+  // The base gives the hydrograph the simulation's times.
+  return this->Superclass::RequestInformation(request, inputVector, outputVector);
 }
 
 int vtkRainRunoffFilter::FillInputPortInformation(int port, vtkInformation *info) {
@@ -780,7 +718,7 @@ int vtkRainRunoffFilter::FillOutput(vtkDataObject *outputObject, vtkInformation 
     if (!this->FillHydrograph(table)) {
       return 0;
     }
-    this->HydrographFilled = true;
+    this->OutputsFilled = true;
   }
   return 1;
 }

@@ -245,11 +245,8 @@ protected:
 
   int FillInputPortInformation(int port, vtkInformation *info) override;
   int FillOutputPortInformation(int port, vtkInformation *info) override;
-  vtkTypeBool ProcessRequest(vtkInformation *request, vtkInformationVector **inInfo,
-                             vtkInformationVector *outInfo) override;
   int RequestInformation(vtkInformation *, vtkInformationVector **,
                          vtkInformationVector *) override;
-  int RequestData(vtkInformation *, vtkInformationVector **, vtkInformationVector *) override;
 
   int SetUpState(vtkInformationVector **inputVector) override;
   int ResetState() override;
@@ -312,8 +309,6 @@ private:
    *  surface and discharge (3 floats per gauge). */
   std::vector<int> GaugeCells;
   std::vector<std::vector<float>> GaugeRows;
-  vtkInformationVector *OutputVector = nullptr; // during RequestData only
-  bool HydrographFilled = false;
 };
 
 #endif

@@ -1,17 +1,10 @@
 #include "vtkSnowAccumulationFilter.h"
 
-#include "vtkAlgorithmOutput.h"
-#include "vtkCellArray.h"
-#include "vtkCellData.h"
-#include "vtkCompositeDataIterator.h"
-#include "vtkCompositeDataSet.h"
 #include "vtkDemandDrivenPipeline.h"
 #include "vtkDoubleArray.h"
 #include "vtkExecutive.h"
 #include "vtkFieldData.h"
 #include "vtkFloatArray.h"
-#include "vtkGraupelMotion.h"
-#include "vtkIdList.h"
 #include "vtkImageData.h"
 #include "vtkInformation.h"
 #include "vtkInformationVector.h"
@@ -19,7 +12,6 @@
 #include "vtkNew.h"
 #include "vtkObjectFactory.h"
 #include "vtkPointData.h"
-#include "vtkPoints.h"
 #include "vtkPolyData.h"
 #include "vtkSmartPointer.h"
 #include "vtkStreamingDemandDrivenPipeline.h"
@@ -32,7 +24,6 @@
 #include "GraupelPieces.h"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <string>
 #include <vector>
@@ -42,7 +33,6 @@ vtkStandardNewMacro(vtkSnowAccumulationFilter);
 namespace {
 using graupel::AddValue;
 using graupel::AsFloat;
-using graupel::Leaves;
 using graupel::Posed;
 const gr_param_bound *Bound(const char *property) {
   int count = 0;
@@ -62,11 +52,10 @@ double TableToCore(const char *property) {
 
 } // namespace
 
-vtkSnowAccumulationFilter::vtkSnowAccumulationFilter() {
-  this->SetNumberOfInputPorts(3);
+vtkSnowAccumulationFilter::vtkSnowAccumulationFilter()
+    // One vertex per point (the snow is handed back per point); open meshes.
+    : vtkGraupelObjectsSimulation(GR_SNOW_ACCUMULATION_MAX_OBJECTS, false, 0) {
   this->SetNumberOfOutputPorts(3);
-  // Objects with time steps are read in time; others stand or are posed by the properties.
-  this->SetInputPortPolicy(1, TEMPORAL_INPUT);
   // A snowfall of a few hours: 6 h of 15 min outputs, three 5 min steps
   // each (72 exposure views). Growth is a rate times dt, so longer steps
   // give the same snow; they only see the exposure change less often.
@@ -115,29 +104,6 @@ GRAUPEL_TABLE_SETTER(vtkSnowAccumulationFilter, SnowDensity, double,
 GRAUPEL_TABLE_SETTER(vtkSnowAccumulationFilter, AccumulationTextureSize, int,
                      gr_snow_accumulation_param_bounds)
 
-void vtkSnowAccumulationFilter::SetObjectsConnection(vtkAlgorithmOutput *output) {
-  this->SetInputConnection(1, output);
-}
-
-void vtkSnowAccumulationFilter::SetPathConnection(vtkAlgorithmOutput *output) {
-  this->SetInputConnection(2, output);
-}
-
-int vtkSnowAccumulationFilter::FillInputPortInformation(int port, vtkInformation *info) {
-  if (port == 0) {
-    info->Set(vtkAlgorithm::INPUT_REQUIRED_DATA_TYPE(), "vtkImageData");
-    return 1;
-  }
-  // A multiblock is taken whole (one object per leaf): a composite pipeline
-  // would otherwise run the filter once per block.
-  info->Set(vtkAlgorithm::INPUT_REQUIRED_DATA_TYPE(), "vtkPolyData");
-  if (port == 1) {
-    info->Append(vtkAlgorithm::INPUT_REQUIRED_DATA_TYPE(), "vtkMultiBlockDataSet");
-  }
-  info->Set(vtkAlgorithm::INPUT_IS_OPTIONAL(), 1);
-  return 1;
-}
-
 int vtkSnowAccumulationFilter::FillOutputPortInformation(int port, vtkInformation *info) {
   // Port 1 follows the Objects input's type (REQUEST_DATA_OBJECT below).
   info->Set(vtkDataObject::DATA_TYPE_NAME(), port == 0   ? "vtkImageData"
@@ -149,25 +115,6 @@ int vtkSnowAccumulationFilter::FillOutputPortInformation(int port, vtkInformatio
 vtkTypeBool vtkSnowAccumulationFilter::ProcessRequest(vtkInformation *request,
                                                       vtkInformationVector **inInfo,
                                                       vtkInformationVector *outInfo) {
-  if (request->Has(vtkDemandDrivenPipeline::REQUEST_DATA_OBJECT())) {
-    vtkInformation *objInfo = inInfo[1]->GetInformationObject(0);
-    vtkDataObject *objects = objInfo ? objInfo->Get(vtkDataObject::DATA_OBJECT()) : nullptr;
-    const bool composite = vtkCompositeDataSet::SafeDownCast(objects) != nullptr;
-    vtkInformation *info = outInfo->GetInformationObject(1);
-    vtkDataObject *current = info->Get(vtkDataObject::DATA_OBJECT());
-    const bool fits =
-        current && (composite ? current->IsA("vtkMultiBlockDataSet") : current->IsA("vtkPolyData"));
-    if (!fits) {
-      vtkSmartPointer<vtkDataObject> made;
-      if (composite) {
-        made = vtkSmartPointer<vtkMultiBlockDataSet>::New();
-      } else {
-        made = vtkSmartPointer<vtkPolyData>::New();
-      }
-      info->Set(vtkDataObject::DATA_OBJECT(), made);
-    }
-    return this->Superclass::ProcessRequest(request, inInfo, outInfo);
-  }
   if ((request->Has(vtkStreamingDemandDrivenPipeline::REQUEST_UPDATE_EXTENT()) ||
        request->Has(vtkDemandDrivenPipeline::REQUEST_DATA())) &&
       request->Has(vtkExecutive::FROM_OUTPUT_PORT())) {
@@ -181,14 +128,8 @@ vtkTypeBool vtkSnowAccumulationFilter::ProcessRequest(vtkInformation *request,
       from->Set(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP(),
                 this->GetOutputTime(outputs - 1));
     }
-    // A request from the objects' or the textures' port asks for the same
-    // time of the simulation, which the base reads from port 0.
-    if ((port == 1 || port == 2) &&
-        from->Has(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP())) {
-      outInfo->GetInformationObject(0)->Set(
-          vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP(),
-          from->Get(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP()));
-    }
+    // The base passes a request from the objects' or the textures' port on
+    // to port 0 at the time this sets.
   }
   return this->Superclass::ProcessRequest(request, inInfo, outInfo);
 }
@@ -203,48 +144,8 @@ int vtkSnowAccumulationFilter::RequestInformation(vtkInformation *request,
   const gr_param_bound *blur = Bound("BlurRadius");
   ring.blur_radius = std::max(0, std::min(this->BlurRadius, blur ? int(blur->max) : 0));
   this->SetPieceRing(gr_snow_accumulation_ghost(&ring));
-  const int ok = this->Superclass::RequestInformation(request, inputVector, outputVector);
-  // The objects' output has the simulation's times, not the input's.
-  vtkInformation *image = outputVector->GetInformationObject(0);
-  for (int port = 1; port < 3; ++port) {
-    vtkInformation *objects = outputVector->GetInformationObject(port);
-    objects->Remove(vtkStreamingDemandDrivenPipeline::TIME_STEPS());
-    objects->Remove(vtkStreamingDemandDrivenPipeline::TIME_RANGE());
-    if (image->Has(vtkStreamingDemandDrivenPipeline::TIME_STEPS())) {
-      objects->CopyEntry(image, vtkStreamingDemandDrivenPipeline::TIME_STEPS());
-      objects->CopyEntry(image, vtkStreamingDemandDrivenPipeline::TIME_RANGE());
-    }
-  }
-  return ok;
-}
-
-int vtkSnowAccumulationFilter::RequestData(vtkInformation *request,
-                                           vtkInformationVector **inputVector,
-                                           vtkInformationVector *outputVector) {
-  vtkInformation *objInfo = outputVector->GetInformationObject(1);
-  for (int port = 1; port < 3; ++port) {
-    if (vtkDataObject *objects =
-            outputVector->GetInformationObject(port)->Get(vtkDataObject::DATA_OBJECT())) {
-      objects->Initialize();
-    }
-  }
-  this->OutputVector = outputVector;
-  this->ObjectsFilled = false;
-  const int ok = this->Superclass::RequestData(request, inputVector, outputVector);
-  this->OutputVector = nullptr;
-  if (ok && this->ObjectsFilled) {
-    vtkDataObject *image = outputVector->GetInformationObject(0)->Get(vtkDataObject::DATA_OBJECT());
-    for (int port = 1; port < 3; ++port) {
-      vtkDataObject *objects =
-          outputVector->GetInformationObject(port)->Get(vtkDataObject::DATA_OBJECT());
-      if (objects && image->GetInformation()->Has(vtkDataObject::DATA_TIME_STEP())) {
-        objects->GetInformation()->Set(
-            vtkDataObject::DATA_TIME_STEP(),
-            image->GetInformation()->Get(vtkDataObject::DATA_TIME_STEP()));
-      }
-    }
-  }
-  return ok;
+  // The base gives the objects' and the textures' outputs the simulation's times.
+  return this->Superclass::RequestInformation(request, inputVector, outputVector);
 }
 
 int vtkSnowAccumulationFilter::CheckParameters() {
@@ -264,170 +165,17 @@ int vtkSnowAccumulationFilter::CheckParameters() {
                 {"SnowDensity", this->SnowDensity},
                 {"AccumulationTextureSize", double(this->AccumulationTextureSize)}};
   for (const auto &p : values) {
-    const gr_param_bound *b = Bound(p.property);
-    if (!b || gr_param_accepts(b, p.value * b->to_core)) {
-      continue;
+    if (!this->ReportError(
+            graupel::OutOfRange("Snow Accumulation", p.property, Bound(p.property), p.value))) {
+      return 0;
     }
-    const char *unit = (b->unit && *b->unit) ? b->unit : "";
-    const char *space = *unit ? " " : "";
-    vtkErrorMacro("Snow Accumulation: " << p.property << " must be "
-                                        << (b->min_open ? "above " : "from ") << b->min << space
-                                        << unit << (b->min_open ? " and up to " : " to ") << b->max
-                                        << space << unit << "; it is " << p.value << space << unit
-                                        << ". Set it within that range.");
-    return 0;
   }
   if (!(this->TimeStep >= 1.0e-6 && this->TimeStep <= 86400.0)) {
     vtkErrorMacro("Snow Accumulation: TimeStep must be from 1e-6 s to 86400 s; it is "
                   << this->TimeStep << " s. Set it within that range.");
     return 0;
   }
-  const std::string motion = vtkGraupelMotion::CheckObjectMotion(
-      "Snow Accumulation", this->ObjectVelocity, this->ObjectAngularVelocity, this->RotationAxis);
-  if (!motion.empty()) {
-    vtkErrorMacro(<< motion);
-    return 0;
-  }
-  return 1;
-}
-
-int vtkSnowAccumulationFilter::ReadObjects(vtkDataObject *objects) {
-  this->Objects.clear();
-  bool other = false;
-  const std::vector<vtkPolyData *> leaves = Leaves(objects, &other);
-  if (other) {
-    vtkErrorMacro("Snow Accumulation's Objects must be vtkPolyData or a multiblock of them; "
-                  "convert the other blocks with Extract Surface.");
-    return 0;
-  }
-  if (leaves.size() > GR_SNOW_ACCUMULATION_MAX_OBJECTS) {
-    vtkErrorMacro("Snow Accumulation's Objects has " << leaves.size() << " blocks; at most "
-                                                     << GR_SNOW_ACCUMULATION_MAX_OBJECTS
-                                                     << " objects are simulated. Merge some.");
-    return 0;
-  }
-  for (size_t k = 0; k < leaves.size(); ++k) {
-    vtkPolyData *pd = leaves[k];
-    Object o;
-    double b[6];
-    pd->GetBounds(b);
-    for (int c = 0; c < 3; ++c) {
-      o.centre[c] = 0.5 * (b[2 * c] + b[2 * c + 1]);
-      o.velocity[c] = this->ObjectVelocity[c];
-    }
-    vtkDataArray *v = pd->GetFieldData()->GetArray("velocity");
-    if (v) {
-      if (v->GetNumberOfComponents() != 3 || v->GetNumberOfTuples() < 1) {
-        vtkErrorMacro("Snow Accumulation's Objects block "
-                      << k << " has a field array 'velocity' that is not one 3-component "
-                      << "value (m/s); give it 3 components or remove it.");
-        return 0;
-      }
-      v->GetTuple(0, o.velocity);
-    }
-    // One mesh point per point of the polydata, unmerged: the snow is
-    // handed back per point, and a box's faces keep their own corners (and
-    // flat normals), so its top holds a flat cap and its sides none.
-    const vtkIdType n = pd->GetNumberOfPoints();
-    o.vertices.resize(3 * static_cast<size_t>(n));
-    for (vtkIdType i = 0; i < n; ++i) {
-      double p[3];
-      pd->GetPoint(i, p);
-      for (int c = 0; c < 3; ++c) {
-        o.vertices[3 * static_cast<size_t>(i) + c] = static_cast<float>(p[c] - o.centre[c]);
-      }
-    }
-    // Texture coordinates (the first two components) give the object an
-    // accumulation texture.
-    if (vtkDataArray *tc = pd->GetPointData()->GetTCoords()) {
-      if (tc->GetNumberOfComponents() >= 2 && tc->GetNumberOfTuples() == n) {
-        o.uv.resize(2 * static_cast<size_t>(n));
-        for (vtkIdType i = 0; i < n; ++i) {
-          for (int c = 0; c < 2; ++c) {
-            o.uv[2 * static_cast<size_t>(i) + c] = static_cast<float>(tc->GetComponent(i, c));
-          }
-        }
-      }
-    }
-    // An id out of range becomes -1, which gr_mesh_validate names.
-    auto vertex = [&](vtkIdType id) { return id >= 0 && id < n ? static_cast<int>(id) : -1; };
-    // Polygons as fans, strips with alternating winding: the triangles the
-    // core takes, without a dependency on VTK's filters.
-    vtkNew<vtkIdList> ids;
-    vtkCellArray *polys = pd->GetPolys();
-    for (polys->InitTraversal(); polys->GetNextCell(ids);) {
-      for (vtkIdType j = 2; j < ids->GetNumberOfIds(); ++j) {
-        o.triangles.insert(o.triangles.end(), {vertex(ids->GetId(0)), vertex(ids->GetId(j - 1)),
-                                               vertex(ids->GetId(j))});
-      }
-    }
-    vtkCellArray *strips = pd->GetStrips();
-    for (strips->InitTraversal(); strips->GetNextCell(ids);) {
-      for (vtkIdType j = 2; j < ids->GetNumberOfIds(); ++j) {
-        const int a = vertex(ids->GetId(j - 2));
-        const int b1 = vertex(ids->GetId(j - 1));
-        const int c = vertex(ids->GetId(j));
-        if (j % 2 == 0) {
-          o.triangles.insert(o.triangles.end(), {a, b1, c});
-        } else {
-          o.triangles.insert(o.triangles.end(), {b1, a, c});
-        }
-      }
-    }
-    gr_mesh mesh = {};
-    mesh.vertices = o.vertices.data();
-    mesh.nvertices = static_cast<int>(n);
-    mesh.triangles = o.triangles.data();
-    mesh.ntriangles = static_cast<int>(o.triangles.size() / 3);
-    for (int i = 0; i < 16; ++i) {
-      mesh.transform[i] = (i % 5 == 0) ? 1.0 : 0.0;
-    }
-    char msg[512];
-    if (gr_mesh_validate(&mesh, 0, msg, sizeof(msg)) != GR_OK) {
-      vtkErrorMacro("Snow Accumulation's Objects"
-                    << (leaves.size() > 1 ? " block " + std::to_string(k) : std::string()) << ": "
-                    << msg);
-      return 0;
-    }
-    this->Objects.push_back(std::move(o));
-  }
-  this->ObjectsTemporal = this->IsInputTemporal(1);
-  if (!this->Path.empty() && !this->ObjectsTemporal) {
-    for (size_t k = 0; k < this->Objects.size(); ++k) {
-      const std::string error =
-          vtkGraupelMotion::CheckPathSpeed("Snow Accumulation", k, this->Objects[k].velocity);
-      if (!error.empty()) {
-        vtkErrorMacro(<< error);
-        return 0;
-      }
-    }
-  }
-  return 1;
-}
-
-int vtkSnowAccumulationFilter::ReadPath(vtkPolyData *path) {
-  const std::string error = vtkGraupelMotion::ReadPath("Snow Accumulation", path, this->Path);
-  if (!error.empty()) {
-    vtkErrorMacro(<< error);
-    return 0;
-  }
-  return 1;
-}
-
-void vtkSnowAccumulationFilter::Pose(size_t k, double t, double m[16]) const {
-  const Object &o = this->Objects[k];
-  if (this->ObjectsTemporal) {
-    // The geometry is the pose: back to where it was read.
-    for (int i = 0; i < 16; ++i) {
-      m[i] = (i % 5 == 0) ? 1.0 : 0.0;
-    }
-    for (int c = 0; c < 3; ++c) {
-      m[12 + c] = o.centre[c];
-    }
-    return;
-  }
-  vtkGraupelMotion::PoseObject(o.centre, o.velocity, this->ObjectAngularVelocity,
-                               this->RotationAxis, this->Path, t, m);
+  return this->CheckObjectMotion();
 }
 
 bool vtkSnowAccumulationFilter::ObjectsMove() const {
@@ -438,7 +186,7 @@ bool vtkSnowAccumulationFilter::ObjectsMove() const {
   if (!this->Path.empty() || this->ObjectAngularVelocity != 0.0) {
     return true;
   }
-  for (const Object &o : this->Objects) {
+  for (const graupel::Object &o : this->Objects) {
     if (o.velocity[0] != 0.0 || o.velocity[1] != 0.0 || o.velocity[2] != 0.0) {
       return true;
     }
@@ -450,19 +198,14 @@ int vtkSnowAccumulationFilter::SetObjects(double t) {
   const size_t n = this->Objects.size();
   std::vector<gr_mesh> meshes(n);
   for (size_t k = 0; k < n; ++k) {
-    const Object &o = this->Objects[k];
-    gr_mesh &m = meshes[k];
-    m.vertices = o.vertices.data();
-    m.nvertices = static_cast<int>(o.vertices.size() / 3);
-    m.triangles = o.triangles.data();
-    m.ntriangles = static_cast<int>(o.triangles.size() / 3);
-    this->Pose(k, t, m.transform);
+    meshes[k] = graupel::MeshOf(this->Objects[k]);
+    this->Pose(k, t, meshes[k].transform);
   }
   gr_status st =
       gr_snow_accumulation_set_objects(this->Simulation, meshes.data(), static_cast<int>(n));
   // The same texture again keeps its snow: the core compares.
   for (size_t k = 0; st == GR_OK && k < n; ++k) {
-    const Object &o = this->Objects[k];
+    const graupel::Object &o = this->Objects[k];
     const bool textured = !o.uv.empty() && this->AccumulationTextureSize > 0;
     st = gr_snow_accumulation_set_object_texture(this->Simulation, static_cast<int>(k),
                                                  textured ? o.uv.data() : nullptr,
@@ -475,21 +218,6 @@ int vtkSnowAccumulationFilter::SetObjects(double t) {
   return 1;
 }
 
-int vtkSnowAccumulationFilter::StepProgress(void *user, double time) {
-  auto *self = static_cast<vtkSnowAccumulationFilter *>(user);
-  if (self->GetAbortExecute()) {
-    return 1;
-  }
-  // Every step reports; the text and the event only a few times a second.
-  const double now =
-      std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
-  if (now - self->LastProgressWall < 0.1) {
-    return 0;
-  }
-  self->LastProgressWall = now;
-  return vtkGraupelSimulation::CoreProgress(user, time);
-}
-
 int vtkSnowAccumulationFilter::SetUpState(vtkInformationVector **inputVector) {
   vtkImageData *terrain = vtkImageData::GetData(inputVector[0]);
   if (!this->CheckTerrain(terrain)) {
@@ -497,31 +225,19 @@ int vtkSnowAccumulationFilter::SetUpState(vtkInformationVector **inputVector) {
   }
   int dims[3];
   terrain->GetDimensions(dims);
-  double spacing[3];
-  terrain->GetSpacing(spacing);
   vtkDataArray *elevationArray = this->GetElevation(terrain, "Input");
   if (!elevationArray || !this->CheckParameters()) {
     return 0;
   }
   const size_t npoints = static_cast<size_t>(dims[0]) * static_cast<size_t>(dims[1]);
-  struct Upload {
-    gr_field field;
-    vtkSmartPointer<vtkFloatArray> values;
-  };
-  std::vector<Upload> uploads;
+  std::vector<graupel::Upload> uploads;
   uploads.push_back({GR_FIELD_ELEVATION, AsFloat(elevationArray)});
   if (vtkDataArray *depth = terrain->GetPointData()->GetArray("snow_depth")) {
     uploads.push_back({GR_FIELD_SNOW_DEPTH, AsFloat(depth)});
   }
   char msg[512];
-  for (const Upload &u : uploads) {
-    if (u.values->GetNumberOfComponents() != 1 ||
-        static_cast<size_t>(u.values->GetNumberOfTuples()) != npoints) {
-      vtkErrorMacro("Snow Accumulation's Input array '"
-                    << gr_field_name(u.field) << "' has " << u.values->GetNumberOfTuples()
-                    << " tuples of " << u.values->GetNumberOfComponents()
-                    << " component(s); it must have one value per point (" << npoints
-                    << "): resample it onto the terrain's grid or remove it.");
+  for (const graupel::Upload &u : uploads) {
+    if (!this->ReportError(graupel::CheckPerPoint("Snow Accumulation", u, npoints))) {
       return 0;
     }
     // Checked on the host, before the device is touched.
@@ -532,14 +248,9 @@ int vtkSnowAccumulationFilter::SetUpState(vtkInformationVector **inputVector) {
       return 0;
     }
   }
-  vtkPolyData *path =
-      this->GetNumberOfInputConnections(2) ? vtkPolyData::GetData(inputVector[2]) : nullptr;
-  if (!this->ReadPath(path) || !this->ReadObjects(this->GetNumberOfInputConnections(1)
-                                                      ? vtkDataObject::GetData(inputVector[1])
-                                                      : nullptr)) {
+  if (!this->ReadObjectInputs(inputVector)) {
     return 0;
   }
-  this->ObjectsReadAt = this->GetTemporalInputTime(1);
 
   gr_snow_accumulation_params p;
   gr_snow_accumulation_params_init(&p);
@@ -606,7 +317,7 @@ int vtkSnowAccumulationFilter::SetUpState(vtkInformationVector **inputVector) {
     gr_snow_accumulation_set_allreduce(sim, graupel::Pieces::Allreduce, &pieces);
     gr_snow_accumulation_set_halo_exchange(sim, graupel::Pieces::Exchange, &pieces);
   }
-  for (const Upload &u : uploads) {
+  for (const graupel::Upload &u : uploads) {
     const std::vector<float> local = pieces.LocalField(u.values->GetPointer(0), dims[0], 1);
     st = gr_snow_accumulation_set_field(this->Simulation, u.field, local.data());
     if (st != GR_OK) {
@@ -615,14 +326,14 @@ int vtkSnowAccumulationFilter::SetUpState(vtkInformationVector **inputVector) {
       return 0;
     }
   }
-  gr_snow_accumulation_set_progress(this->Simulation, &vtkSnowAccumulationFilter::StepProgress,
+  gr_snow_accumulation_set_progress(this->Simulation, &vtkGraupelSimulation::ThrottledProgress,
                                     this);
   return this->SetObjects(0.0);
 }
 
 int vtkSnowAccumulationFilter::ResetState() {
   gr_status st = gr_snow_accumulation_reset(this->Simulation);
-  gr_snow_accumulation_set_progress(this->Simulation, &vtkSnowAccumulationFilter::StepProgress,
+  gr_snow_accumulation_set_progress(this->Simulation, &vtkGraupelSimulation::ThrottledProgress,
                                     this);
   if (st != GR_OK) {
     return this->ReportFailure(st, "Snow Accumulation could not restart",
@@ -642,17 +353,15 @@ int vtkSnowAccumulationFilter::AdvanceState(double t0, double t1) {
   }
   // A progress callback that asked to stop leaves the core refusing steps
   // until it is set again; an abort consumed since must not stop this call.
-  gr_snow_accumulation_set_progress(this->Simulation, &vtkSnowAccumulationFilter::StepProgress,
+  gr_snow_accumulation_set_progress(this->Simulation, &vtkGraupelSimulation::ThrottledProgress,
                                     this);
-  // Steps of TimeStep from t0, the last one ending on t1; the step ends are
-  // t0 + k dt (not a running sum), so they depend on t0, t1 and dt only.
+  // Steps of TimeStep from t0, the last one ending on t1.
   const double dt = this->TimeStep;
-  const double count = std::ceil((t1 - t0) / dt - 1e-9);
-  const long long n = count < 1.0 ? 1 : static_cast<long long>(count);
+  const long long n = CountSteps(t0, t1, dt);
   const bool moving = this->ObjectsMove();
   double t = t0;
   for (long long k = 1; k <= n; ++k) {
-    const double next = k == n ? t1 : t0 + static_cast<double>(k) * dt;
+    const double next = StepEnd(t0, t1, dt, k, n);
     if (moving && !this->SetObjects(next)) {
       return ADVANCE_FAILED;
     }
@@ -680,7 +389,7 @@ int vtkSnowAccumulationFilter::SaveState(std::vector<unsigned char> &bytes) {
 
 int vtkSnowAccumulationFilter::LoadState(const std::vector<unsigned char> &bytes) {
   // An abort inside a step leaves the core refusing until set_progress.
-  gr_snow_accumulation_set_progress(this->Simulation, &vtkSnowAccumulationFilter::StepProgress,
+  gr_snow_accumulation_set_progress(this->Simulation, &vtkGraupelSimulation::ThrottledProgress,
                                     this);
   return gr_snow_accumulation_state_load(this->Simulation, bytes.data(), bytes.size()) == GR_OK;
 }
@@ -689,12 +398,6 @@ int vtkSnowAccumulationFilter::FillObjects(vtkDataObject *output, double t) {
   vtkDataObject *input = this->GetNumberOfInputConnections(1) ? this->GetTemporalInput(1) : nullptr;
   if (!input || !output) {
     return 1;
-  }
-  const size_t n = this->Objects.size();
-  bool other = false;
-  const std::vector<vtkPolyData *> leaves = Leaves(input, &other);
-  if (leaves.size() != n) {
-    return 1; // the objects changed since the state was made; nothing to pose
   }
   // One object at its pose with its snow per point.
   auto snowy = [this, t](size_t k, vtkPolyData *leaf) -> vtkSmartPointer<vtkPolyData> {
@@ -727,38 +430,7 @@ int vtkSnowAccumulationFilter::FillObjects(vtkDataObject *output, double t) {
     posed->GetPointData()->SetActiveVectors("snow_offset");
     return posed;
   };
-  if (auto *pd = vtkPolyData::SafeDownCast(output)) {
-    if (n == 1) {
-      vtkSmartPointer<vtkPolyData> posed = snowy(0, leaves[0]);
-      if (!posed) {
-        return 0;
-      }
-      pd->ShallowCopy(posed);
-    }
-    return 1;
-  }
-  auto *mb = vtkMultiBlockDataSet::SafeDownCast(output);
-  auto *in = vtkCompositeDataSet::SafeDownCast(input);
-  if (!mb || !in) {
-    return 1;
-  }
-  mb->CopyStructure(in);
-  vtkSmartPointer<vtkCompositeDataIterator> it;
-  it.TakeReference(in->NewIterator());
-  size_t k = 0;
-  for (it->InitTraversal(); !it->IsDoneWithTraversal() && k < n; it->GoToNextItem()) {
-    auto *leaf = vtkPolyData::SafeDownCast(it->GetCurrentDataObject());
-    if (!leaf || leaf->GetNumberOfPoints() == 0) {
-      continue;
-    }
-    vtkSmartPointer<vtkPolyData> posed = snowy(k, leaf);
-    if (!posed) {
-      return 0;
-    }
-    mb->SetDataSet(it, posed);
-    ++k;
-  }
-  return 1;
+  return graupel::FillObjectsOutput(input, output, this->Objects.size(), snowy) ? 1 : 0;
 }
 
 int vtkSnowAccumulationFilter::FillOutput(vtkDataObject *outputObject, vtkInformation *outInfo) {
@@ -794,25 +466,16 @@ int vtkSnowAccumulationFilter::FillOutput(vtkDataObject *outputObject, vtkInform
   AddValue(fd, "dropped_volume", ledger.dropped_volume);
   AddValue(fd, "balance_error", ledger.balance_error);
 
-  // The objects' output, at the same time; only piece 0 carries them, so
-  // an MPI run shows each object once.
-  if (this->OutputVector) {
-    vtkInformation *objInfo = this->OutputVector->GetInformationObject(1);
-    vtkDataObject *objects = objInfo->Get(vtkDataObject::DATA_OBJECT());
-    const int piece = objInfo->Has(vtkStreamingDemandDrivenPipeline::UPDATE_PIECE_NUMBER())
-                          ? objInfo->Get(vtkStreamingDemandDrivenPipeline::UPDATE_PIECE_NUMBER())
-                          : 0;
-    if (piece == 0 && !this->FillObjects(objects, this->GetStateTime())) {
-      return 0;
-    }
-    auto *textures = vtkMultiBlockDataSet::SafeDownCast(
-        this->OutputVector->GetInformationObject(2)->Get(vtkDataObject::DATA_OBJECT()));
-    if (piece == 0 && textures && !this->FillTextures(textures)) {
-      return 0;
-    }
-    this->ObjectsFilled = true;
+  // The objects and their textures, at the same time.
+  return this->FillObjectOutputs();
+}
+
+int vtkSnowAccumulationFilter::FillObjectOutput(int port, vtkDataObject *output, double t) {
+  if (port == 1) {
+    return this->FillObjects(output, t);
   }
-  return 1;
+  auto *textures = vtkMultiBlockDataSet::SafeDownCast(output);
+  return !textures || this->FillTextures(textures) ? 1 : 0;
 }
 
 int vtkSnowAccumulationFilter::FillTextures(vtkMultiBlockDataSet *output) {
@@ -820,7 +483,7 @@ int vtkSnowAccumulationFilter::FillTextures(vtkMultiBlockDataSet *output) {
   output->SetNumberOfBlocks(n);
   for (unsigned int k = 0; k < n; ++k) {
     vtkNew<vtkImageData> image;
-    const Object &o = this->Objects[k];
+    const graupel::Object &o = this->Objects[k];
     const int size = this->AccumulationTextureSize;
     if (!o.uv.empty() && size > 0) {
       // Texel centres in UV units: texel (i, j) at ((i + 0.5) / size, (j + 0.5) / size).
@@ -866,9 +529,5 @@ void vtkSnowAccumulationFilter::PrintSelf(ostream &os, vtkIndent indent) {
   os << indent << "StabilityFactor: " << this->StabilityFactor << " 1/s\n";
   os << indent << "SnowDensity: " << this->SnowDensity << " kg/m^3\n";
   os << indent << "AccumulationTextureSize: " << this->AccumulationTextureSize << "\n";
-  os << indent << "ObjectVelocity: " << this->ObjectVelocity[0] << " " << this->ObjectVelocity[1]
-     << " " << this->ObjectVelocity[2] << " m/s\n";
-  os << indent << "ObjectAngularVelocity: " << this->ObjectAngularVelocity << " deg/s\n";
-  os << indent << "RotationAxis: " << this->RotationAxis[0] << " " << this->RotationAxis[1] << " "
-     << this->RotationAxis[2] << "\n";
+  this->PrintObjectMotion(os, indent);
 }

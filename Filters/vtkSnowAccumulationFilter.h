@@ -76,19 +76,18 @@
 #define vtkSnowAccumulationFilter_h
 
 #include "GraupelFiltersModule.h"
-#include "vtkGraupelSimulation.h"
+#include "vtkGraupelObjectsSimulation.h"
 
 #include <vector>
 
 struct gr_snow_accumulation;
 class vtkDataObject;
 class vtkMultiBlockDataSet;
-class vtkPolyData;
 
-class GRAUPELFILTERS_EXPORT vtkSnowAccumulationFilter : public vtkGraupelSimulation {
+class GRAUPELFILTERS_EXPORT vtkSnowAccumulationFilter : public vtkGraupelObjectsSimulation {
 public:
   static vtkSnowAccumulationFilter *New();
-  vtkTypeMacro(vtkSnowAccumulationFilter, vtkGraupelSimulation);
+  vtkTypeMacro(vtkSnowAccumulationFilter, vtkGraupelObjectsSimulation);
   void PrintSelf(ostream &os, vtkIndent indent) override;
 
   ///@{
@@ -179,34 +178,7 @@ public:
   vtkGetMacro(AccumulationTextureSize, int);
   ///@}
 
-  ///@{
-  /**
-   * Velocity of the centres of the objects that have no time steps, m/s
-   * (default 0 0 0); along a Path its length is the speed.
-   */
-  vtkSetVector3Macro(ObjectVelocity, double);
-  vtkGetVector3Macro(ObjectVelocity, double);
-  ///@}
-
-  ///@{
-  /** Rotation speed of the objects about RotationAxis through their centres, deg/s (default 0). */
-  vtkSetMacro(ObjectAngularVelocity, double);
-  vtkGetMacro(ObjectAngularVelocity, double);
-  ///@}
-
-  ///@{
-  /** Axis of that rotation, object frame (default 0 1 0). */
-  vtkSetVector3Macro(RotationAxis, double);
-  vtkGetVector3Macro(RotationAxis, double);
-  ///@}
-
-  /** Connects the objects (input port 1). */
-  void SetObjectsConnection(vtkAlgorithmOutput *output);
-  /** Connects the optional path (input port 2). */
-  void SetPathConnection(vtkAlgorithmOutput *output);
-
-  /** Dispatches requests; see the .cxx for what the second output and a request without time need.
-   */
+  /** A request without a time gets the last output (see the .cxx); the base does the rest. */
   vtkTypeBool ProcessRequest(vtkInformation *request, vtkInformationVector **inInfo,
                              vtkInformationVector *outInfo) override;
 
@@ -214,12 +186,10 @@ protected:
   vtkSnowAccumulationFilter();
   ~vtkSnowAccumulationFilter() override;
 
-  int FillInputPortInformation(int port, vtkInformation *info) override;
   int FillOutputPortInformation(int port, vtkInformation *info) override;
 
   int RequestInformation(vtkInformation *, vtkInformationVector **,
                          vtkInformationVector *) override;
-  int RequestData(vtkInformation *, vtkInformationVector **, vtkInformationVector *) override;
 
   int SetUpState(vtkInformationVector **inputVector) override;
   int ResetState() override;
@@ -244,47 +214,24 @@ protected:
   double StabilityFactor = 0.0;
   double SnowDensity = 0.0;
   int AccumulationTextureSize = 0;
-  double ObjectVelocity[3] = {0.0, 0.0, 0.0};
-  double ObjectAngularVelocity = 0.0;
-  double RotationAxis[3] = {0.0, 1.0, 0.0};
 
 private:
   vtkSnowAccumulationFilter(const vtkSnowAccumulationFilter &) = delete;
   void operator=(const vtkSnowAccumulationFilter &) = delete;
 
-  /** One object as the core sees it: its points about its centre, one mesh point each. */
-  struct Object {
-    std::vector<float> vertices;
-    std::vector<int> triangles;
-    std::vector<float> uv; // 2 per mesh point, empty without texture coordinates
-    double centre[3];
-    double velocity[3]; // m/s: the leaf's `velocity`, else ObjectVelocity
-  };
-
   int CheckParameters();
-  /** Reads the objects into Objects; 0 after one sentence. */
-  int ReadObjects(vtkDataObject *objects);
-  /** Reads the optional path into Path; 0 after one sentence. */
-  int ReadPath(vtkPolyData *path);
-  /** The pose (column-major) of object k at time t. */
-  void Pose(size_t k, double t, double matrix[16]) const;
   /** Whether any object moves by the properties (poses change between steps). */
   bool ObjectsMove() const;
   /** Hands the objects at their poses at time t to the core. */
   int SetObjects(double t);
+  /** Output 1: FillObjects; output 2: FillTextures. */
+  int FillObjectOutput(int port, vtkDataObject *output, double t) override;
+  /** The objects at their poses at time t with their snow per point. */
   int FillObjects(vtkDataObject *output, double t);
   /** One image per object, its accumulation texture or empty. */
   int FillTextures(vtkMultiBlockDataSet *output);
 
   gr_snow_accumulation *Simulation = nullptr;
-  std::vector<Object> Objects;
-  std::vector<double> Path; // xyz per point; empty when none
-  bool ObjectsTemporal = false;
-  double ObjectsReadAt = 0.0;
-  vtkInformationVector *OutputVector = nullptr; // during RequestData only
-  bool ObjectsFilled = false;
-  double LastProgressWall = 0.0;
-  static int StepProgress(void *user, double time);
 };
 
 #endif

@@ -1,17 +1,8 @@
 #include "vtkSnowDeformationFilter.h"
 
-#include "vtkAlgorithmOutput.h"
-#include "vtkCellArray.h"
-#include "vtkCompositeDataIterator.h"
-#include "vtkCompositeDataSet.h"
-#include "vtkCellData.h"
-#include "vtkDemandDrivenPipeline.h"
 #include "vtkDoubleArray.h"
-#include "vtkExecutive.h"
 #include "vtkFieldData.h"
 #include "vtkFloatArray.h"
-#include "vtkGraupelMotion.h"
-#include "vtkIdList.h"
 #include "vtkImageData.h"
 #include "vtkInformation.h"
 #include "vtkInformationVector.h"
@@ -19,10 +10,8 @@
 #include "vtkNew.h"
 #include "vtkObjectFactory.h"
 #include "vtkPointData.h"
-#include "vtkPoints.h"
 #include "vtkPolyData.h"
 #include "vtkSmartPointer.h"
-#include "vtkStreamingDemandDrivenPipeline.h"
 
 #include "graupel/snow_deformation.h"
 
@@ -32,9 +21,6 @@
 #include "GraupelPieces.h"
 
 #include <algorithm>
-#include <array>
-#include <chrono>
-#include <map>
 #include <cmath>
 #include <string>
 #include <vector>
@@ -44,7 +30,6 @@ vtkStandardNewMacro(vtkSnowDeformationFilter);
 namespace {
 using graupel::AddValue;
 using graupel::AsFloat;
-using graupel::Leaves;
 using graupel::Posed;
 const gr_param_bound *Bound(const char *property) {
   int count = 0;
@@ -86,11 +71,10 @@ void AddForce(vtkFieldData *fd, const double force[3], double area) {
 
 } // namespace
 
-vtkSnowDeformationFilter::vtkSnowDeformationFilter() {
-  this->SetNumberOfInputPorts(3);
+vtkSnowDeformationFilter::vtkSnowDeformationFilter()
+    // Closed meshes: points at the same place are one vertex.
+    : vtkGraupelObjectsSimulation(GR_SNOW_DEFORMATION_MAX_OBJECTS, true, 1) {
   this->SetNumberOfOutputPorts(2);
-  // Objects with time steps are read in time; others are posed by the properties.
-  this->SetInputPortPolicy(1, TEMPORAL_INPUT);
   // Steps of 1/60 s: 600 outputs of 10 s would be 36000 steps, and a wheel
   // at 2 m/s would move 20 m between outputs. 10 s of 0.25 s outputs show a
   // crossing of a few metres, 15 steps per output.
@@ -154,109 +138,10 @@ double vtkSnowDeformationFilter::GetInitialDensityInUse() const {
   return GetDensityPresetRange(this->DensityPreset, range) ? range[0] : this->InitialDensity;
 }
 
-void vtkSnowDeformationFilter::SetObjectsConnection(vtkAlgorithmOutput *output) {
-  this->SetInputConnection(1, output);
-}
-
-void vtkSnowDeformationFilter::SetPathConnection(vtkAlgorithmOutput *output) {
-  this->SetInputConnection(2, output);
-}
-
-int vtkSnowDeformationFilter::FillInputPortInformation(int port, vtkInformation *info) {
-  if (port == 0) {
-    info->Set(vtkAlgorithm::INPUT_REQUIRED_DATA_TYPE(), "vtkImageData");
-    return 1;
-  }
-  // A multiblock is taken whole (one object per leaf): a composite pipeline
-  // would otherwise run the filter once per block.
-  info->Set(vtkAlgorithm::INPUT_REQUIRED_DATA_TYPE(), "vtkPolyData");
-  if (port == 1) {
-    info->Append(vtkAlgorithm::INPUT_REQUIRED_DATA_TYPE(), "vtkMultiBlockDataSet");
-  }
-  info->Set(vtkAlgorithm::INPUT_IS_OPTIONAL(), 1);
-  return 1;
-}
-
 int vtkSnowDeformationFilter::FillOutputPortInformation(int port, vtkInformation *info) {
   // Port 1 follows the Objects input's type (REQUEST_DATA_OBJECT below).
   info->Set(vtkDataObject::DATA_TYPE_NAME(), port == 0 ? "vtkImageData" : "vtkDataObject");
   return 1;
-}
-
-vtkTypeBool vtkSnowDeformationFilter::ProcessRequest(vtkInformation *request,
-                                                     vtkInformationVector **inInfo,
-                                                     vtkInformationVector *outInfo) {
-  if (request->Has(vtkDemandDrivenPipeline::REQUEST_DATA_OBJECT())) {
-    vtkInformation *objInfo = inInfo[1]->GetInformationObject(0);
-    vtkDataObject *objects = objInfo ? objInfo->Get(vtkDataObject::DATA_OBJECT()) : nullptr;
-    const bool composite = vtkCompositeDataSet::SafeDownCast(objects) != nullptr;
-    vtkInformation *info = outInfo->GetInformationObject(1);
-    vtkDataObject *current = info->Get(vtkDataObject::DATA_OBJECT());
-    const bool fits =
-        current && (composite ? current->IsA("vtkMultiBlockDataSet") : current->IsA("vtkPolyData"));
-    if (!fits) {
-      vtkSmartPointer<vtkDataObject> made;
-      if (composite) {
-        made = vtkSmartPointer<vtkMultiBlockDataSet>::New();
-      } else {
-        made = vtkSmartPointer<vtkPolyData>::New();
-      }
-      info->Set(vtkDataObject::DATA_OBJECT(), made);
-    }
-    return this->Superclass::ProcessRequest(request, inInfo, outInfo);
-  }
-  // A request from the objects' port asks for the same time of the
-  // simulation, which the base reads from port 0.
-  if ((request->Has(vtkStreamingDemandDrivenPipeline::REQUEST_UPDATE_EXTENT()) ||
-       request->Has(vtkDemandDrivenPipeline::REQUEST_DATA())) &&
-      request->Has(vtkExecutive::FROM_OUTPUT_PORT()) &&
-      request->Get(vtkExecutive::FROM_OUTPUT_PORT()) == 1) {
-    vtkInformation *from = outInfo->GetInformationObject(1);
-    vtkInformation *to = outInfo->GetInformationObject(0);
-    if (from->Has(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP())) {
-      to->Set(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP(),
-              from->Get(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP()));
-    }
-  }
-  return this->Superclass::ProcessRequest(request, inInfo, outInfo);
-}
-
-int vtkSnowDeformationFilter::RequestInformation(vtkInformation *request,
-                                                 vtkInformationVector **inputVector,
-                                                 vtkInformationVector *outputVector) {
-  const int ok = this->Superclass::RequestInformation(request, inputVector, outputVector);
-  // The objects' output has the simulation's times, not the input's.
-  vtkInformation *image = outputVector->GetInformationObject(0);
-  vtkInformation *objects = outputVector->GetInformationObject(1);
-  objects->Remove(vtkStreamingDemandDrivenPipeline::TIME_STEPS());
-  objects->Remove(vtkStreamingDemandDrivenPipeline::TIME_RANGE());
-  if (image->Has(vtkStreamingDemandDrivenPipeline::TIME_STEPS())) {
-    objects->CopyEntry(image, vtkStreamingDemandDrivenPipeline::TIME_STEPS());
-    objects->CopyEntry(image, vtkStreamingDemandDrivenPipeline::TIME_RANGE());
-  }
-  return ok;
-}
-
-int vtkSnowDeformationFilter::RequestData(vtkInformation *request,
-                                          vtkInformationVector **inputVector,
-                                          vtkInformationVector *outputVector) {
-  vtkInformation *objInfo = outputVector->GetInformationObject(1);
-  if (vtkDataObject *objects = objInfo->Get(vtkDataObject::DATA_OBJECT())) {
-    objects->Initialize();
-  }
-  this->OutputVector = outputVector;
-  this->ObjectsFilled = false;
-  const int ok = this->Superclass::RequestData(request, inputVector, outputVector);
-  this->OutputVector = nullptr;
-  if (ok && this->ObjectsFilled) {
-    vtkDataObject *image = outputVector->GetInformationObject(0)->Get(vtkDataObject::DATA_OBJECT());
-    vtkDataObject *objects = objInfo->Get(vtkDataObject::DATA_OBJECT());
-    if (image->GetInformation()->Has(vtkDataObject::DATA_TIME_STEP())) {
-      objects->GetInformation()->Set(vtkDataObject::DATA_TIME_STEP(),
-                                     image->GetInformation()->Get(vtkDataObject::DATA_TIME_STEP()));
-    }
-  }
-  return ok;
 }
 
 int vtkSnowDeformationFilter::CheckParameters() {
@@ -279,17 +164,10 @@ int vtkSnowDeformationFilter::CheckParameters() {
                 {"RelaxTolerance", "RelaxTolerance", this->RelaxTolerance},
                 {"SlumpSpeed", "SlumpSpeed", this->SlumpSpeed}};
   for (const auto &p : values) {
-    const gr_param_bound *b = Bound(p.property);
-    if (!b || gr_param_accepts(b, p.value * b->to_core)) {
-      continue;
+    if (!this->ReportError(
+            graupel::OutOfRange("Snow Deformation", p.name, Bound(p.property), p.value))) {
+      return 0;
     }
-    const char *unit = (b->unit && *b->unit) ? b->unit : "";
-    const char *space = *unit ? " " : "";
-    vtkErrorMacro("Snow Deformation: "
-                  << p.name << " must be " << (b->min_open ? "above " : "from ") << b->min << space
-                  << unit << (b->min_open ? " and up to " : " to ") << b->max << space << unit
-                  << "; it is " << p.value << space << unit << ". Set it within that range.");
-    return 0;
   }
   if (!(this->TimeStep >= 1.0e-6 && this->TimeStep <= 60.0)) {
     vtkErrorMacro("Snow Deformation: TimeStep must be from 1e-6 s to 60 s; it is "
@@ -310,131 +188,7 @@ int vtkSnowDeformationFilter::CheckParameters() {
                   << " kg/m^3); set it within the range or pick a DensityPreset.");
     return 0;
   }
-  const std::string motion = vtkGraupelMotion::CheckObjectMotion(
-      "Snow Deformation", this->ObjectVelocity, this->ObjectAngularVelocity, this->RotationAxis);
-  if (!motion.empty()) {
-    vtkErrorMacro(<< motion);
-    return 0;
-  }
-  return 1;
-}
-
-int vtkSnowDeformationFilter::ReadPath(vtkPolyData *path) {
-  const std::string error = vtkGraupelMotion::ReadPath("Snow Deformation", path, this->Path);
-  if (!error.empty()) {
-    vtkErrorMacro(<< error);
-    return 0;
-  }
-  return 1;
-}
-
-int vtkSnowDeformationFilter::ReadObjects(vtkDataObject *objects) {
-  this->Objects.clear();
-  bool other = false;
-  const std::vector<vtkPolyData *> leaves = Leaves(objects, &other);
-  if (other) {
-    vtkErrorMacro("Snow Deformation's Objects must be vtkPolyData or a multiblock of them; "
-                  "convert the other blocks with Extract Surface.");
-    return 0;
-  }
-  if (leaves.size() > GR_SNOW_DEFORMATION_MAX_OBJECTS) {
-    vtkErrorMacro("Snow Deformation's Objects has " << leaves.size() << " blocks; at most "
-                                                    << GR_SNOW_DEFORMATION_MAX_OBJECTS
-                                                    << " objects are simulated. Merge some.");
-    return 0;
-  }
-  for (size_t k = 0; k < leaves.size(); ++k) {
-    vtkPolyData *pd = leaves[k];
-    Object o;
-    double b[6];
-    pd->GetBounds(b);
-    for (int c = 0; c < 3; ++c) {
-      o.centre[c] = 0.5 * (b[2 * c] + b[2 * c + 1]);
-      o.velocity[c] = this->ObjectVelocity[c];
-    }
-    vtkDataArray *v = pd->GetFieldData()->GetArray("velocity");
-    if (v) {
-      if (v->GetNumberOfComponents() != 3 || v->GetNumberOfTuples() < 1) {
-        vtkErrorMacro("Snow Deformation's Objects block "
-                      << k << " has a field array 'velocity' that is not one 3-component "
-                      << "value (m/s); give it 3 components or remove it.");
-        return 0;
-      }
-      v->GetTuple(0, o.velocity);
-    }
-    // Points at the same place are one vertex: sources such as a box or a
-    // capped cylinder repeat corners per face (for their normals), which
-    // would leave every edge open.
-    const vtkIdType n = pd->GetNumberOfPoints();
-    std::vector<int> vertexOf(static_cast<size_t>(n));
-    std::map<std::array<double, 3>, int> merged;
-    for (vtkIdType i = 0; i < n; ++i) {
-      std::array<double, 3> p;
-      pd->GetPoint(i, p.data());
-      auto found = merged.emplace(p, static_cast<int>(merged.size()));
-      vertexOf[static_cast<size_t>(i)] = found.first->second;
-      if (found.second) {
-        for (int c = 0; c < 3; ++c) {
-          o.vertices.push_back(static_cast<float>(p[static_cast<size_t>(c)] - o.centre[c]));
-        }
-      }
-    }
-    // An id out of range becomes -1, which gr_mesh_validate names.
-    auto vertex = [&](vtkIdType id) {
-      return id >= 0 && id < n ? vertexOf[static_cast<size_t>(id)] : -1;
-    };
-    // Polygons as fans, strips with alternating winding: the triangles the
-    // core takes, without a dependency on VTK's filters.
-    vtkNew<vtkIdList> ids;
-    vtkCellArray *polys = pd->GetPolys();
-    for (polys->InitTraversal(); polys->GetNextCell(ids);) {
-      for (vtkIdType j = 2; j < ids->GetNumberOfIds(); ++j) {
-        o.triangles.insert(o.triangles.end(), {vertex(ids->GetId(0)), vertex(ids->GetId(j - 1)),
-                                               vertex(ids->GetId(j))});
-      }
-    }
-    vtkCellArray *strips = pd->GetStrips();
-    for (strips->InitTraversal(); strips->GetNextCell(ids);) {
-      for (vtkIdType j = 2; j < ids->GetNumberOfIds(); ++j) {
-        const int a = vertex(ids->GetId(j - 2));
-        const int b1 = vertex(ids->GetId(j - 1));
-        const int c = vertex(ids->GetId(j));
-        if (j % 2 == 0) {
-          o.triangles.insert(o.triangles.end(), {a, b1, c});
-        } else {
-          o.triangles.insert(o.triangles.end(), {b1, a, c});
-        }
-      }
-    }
-    gr_mesh mesh = {};
-    mesh.vertices = o.vertices.data();
-    mesh.nvertices = static_cast<int>(o.vertices.size() / 3);
-    mesh.triangles = o.triangles.data();
-    mesh.ntriangles = static_cast<int>(o.triangles.size() / 3);
-    for (int i = 0; i < 16; ++i) {
-      mesh.transform[i] = (i % 5 == 0) ? 1.0 : 0.0;
-    }
-    char msg[512];
-    if (gr_mesh_validate(&mesh, 1, msg, sizeof(msg)) != GR_OK) {
-      vtkErrorMacro("Snow Deformation's Objects"
-                    << (leaves.size() > 1 ? " block " + std::to_string(k) : std::string()) << ": "
-                    << msg);
-      return 0;
-    }
-    this->Objects.push_back(std::move(o));
-  }
-  this->ObjectsTemporal = this->IsInputTemporal(1);
-  if (!this->Path.empty() && !this->ObjectsTemporal) {
-    for (size_t k = 0; k < this->Objects.size(); ++k) {
-      const std::string error =
-          vtkGraupelMotion::CheckPathSpeed("Snow Deformation", k, this->Objects[k].velocity);
-      if (!error.empty()) {
-        vtkErrorMacro(<< error);
-        return 0;
-      }
-    }
-  }
-  return 1;
+  return this->CheckObjectMotion();
 }
 
 int vtkSnowDeformationFilter::CheckObjectsReachGrid(const double grid[4], double margin) {
@@ -456,10 +210,9 @@ int vtkSnowDeformationFilter::CheckObjectsReachGrid(const double grid[4], double
   if (exact) {
     for (int k = 1; k < outputs; ++k) {
       const double t0 = this->GetOutputTime(k - 1), t1 = this->GetOutputTime(k);
-      const double count = std::ceil((t1 - t0) / dt - 1e-9);
-      const long long n = count < 1.0 ? 1 : static_cast<long long>(count);
+      const long long n = CountSteps(t0, t1, dt);
       for (long long j = 1; j <= n; ++j) {
-        times.push_back(j == n ? t1 : t0 + static_cast<double>(j) * dt);
+        times.push_back(StepEnd(t0, t1, dt, j, n));
       }
     }
   } else {
@@ -468,7 +221,7 @@ int vtkSnowDeformationFilter::CheckObjectsReachGrid(const double grid[4], double
     }
   }
   for (size_t k = 0; k < this->Objects.size(); ++k) {
-    const Object &o = this->Objects[k];
+    const graupel::Object &o = this->Objects[k];
     double lo[3] = {1e300, 1e300, 1e300}, hi[3] = {-1e300, -1e300, -1e300};
     for (size_t v = 0; v + 2 < o.vertices.size(); v += 3) {
       for (int c = 0; c < 3; ++c) {
@@ -519,33 +272,14 @@ int vtkSnowDeformationFilter::CheckObjectsReachGrid(const double grid[4], double
   return 1;
 }
 
-void vtkSnowDeformationFilter::Pose(size_t k, double t, double m[16]) const {
-  const Object &o = this->Objects[k];
-  if (this->ObjectsTemporal) {
-    // The geometry is the pose: back to where it was read.
-    for (int i = 0; i < 16; ++i) {
-      m[i] = (i % 5 == 0) ? 1.0 : 0.0;
-    }
-    m[12] = o.centre[0];
-    m[13] = o.centre[1];
-    m[14] = o.centre[2];
-    return;
-  }
-  vtkGraupelMotion::PoseObject(o.centre, o.velocity, this->ObjectAngularVelocity,
-                               this->RotationAxis, this->Path, t, m);
-}
-
 int vtkSnowDeformationFilter::SetObjects(double t, double h) {
   const size_t n = this->Objects.size();
   std::vector<gr_mesh> meshes(n);
   std::vector<double> velocities(3 * n, 0.0);
   for (size_t k = 0; k < n; ++k) {
-    const Object &o = this->Objects[k];
+    const graupel::Object &o = this->Objects[k];
     gr_mesh &m = meshes[k];
-    m.vertices = o.vertices.data();
-    m.nvertices = static_cast<int>(o.vertices.size() / 3);
-    m.triangles = o.triangles.data();
-    m.ntriangles = static_cast<int>(o.triangles.size() / 3);
+    m = graupel::MeshOf(o);
     this->Pose(k, t, m.transform);
     if (!this->ObjectsTemporal && !this->Path.empty()) {
       // The centre's velocity over the step: along a path it turns with the
@@ -570,21 +304,6 @@ int vtkSnowDeformationFilter::SetObjects(double t, double h) {
   return 1;
 }
 
-int vtkSnowDeformationFilter::StepProgress(void *user, double time) {
-  auto *self = static_cast<vtkSnowDeformationFilter *>(user);
-  if (self->GetAbortExecute()) {
-    return 1;
-  }
-  // Every step reports; the text and the event only a few times a second.
-  const double now =
-      std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
-  if (now - self->LastProgressWall < 0.1) {
-    return 0;
-  }
-  self->LastProgressWall = now;
-  return vtkGraupelSimulation::CoreProgress(user, time);
-}
-
 int vtkSnowDeformationFilter::SetUpState(vtkInformationVector **inputVector) {
   vtkImageData *terrain = vtkImageData::GetData(inputVector[0]);
   if (!this->CheckTerrain(terrain)) {
@@ -592,18 +311,12 @@ int vtkSnowDeformationFilter::SetUpState(vtkInformationVector **inputVector) {
   }
   int dims[3];
   terrain->GetDimensions(dims);
-  double spacing[3];
-  terrain->GetSpacing(spacing);
   vtkDataArray *elevationArray = this->GetElevation(terrain, "Input");
   if (!elevationArray || !this->CheckParameters()) {
     return 0;
   }
   const size_t npoints = static_cast<size_t>(dims[0]) * static_cast<size_t>(dims[1]);
-  struct Upload {
-    gr_field field;
-    vtkSmartPointer<vtkFloatArray> values;
-  };
-  std::vector<Upload> uploads;
+  std::vector<graupel::Upload> uploads;
   uploads.push_back({GR_FIELD_ELEVATION, AsFloat(elevationArray)});
   vtkPointData *pd = terrain->GetPointData();
   if (vtkDataArray *depth = pd->GetArray("snow_depth")) {
@@ -612,26 +325,15 @@ int vtkSnowDeformationFilter::SetUpState(vtkInformationVector **inputVector) {
   if (vtkDataArray *density = pd->GetArray("snow_density")) {
     uploads.push_back({GR_FIELD_SNOW_DENSITY, AsFloat(density)});
   }
-  for (const Upload &u : uploads) {
-    if (u.values->GetNumberOfComponents() != 1 ||
-        static_cast<size_t>(u.values->GetNumberOfTuples()) != npoints) {
-      vtkErrorMacro("Snow Deformation's Input array '"
-                    << gr_field_name(u.field) << "' has " << u.values->GetNumberOfTuples()
-                    << " tuples of " << u.values->GetNumberOfComponents()
-                    << " component(s); it must have one value per point (" << npoints
-                    << "): resample it onto the terrain's grid or remove it.");
+  for (const graupel::Upload &u : uploads) {
+    if (!this->ReportError(graupel::CheckPerPoint("Snow Deformation", u, npoints))) {
       return 0;
     }
   }
 
-  const int nobjects = this->GetNumberOfInputConnections(1);
-  vtkPolyData *path =
-      this->GetNumberOfInputConnections(2) ? vtkPolyData::GetData(inputVector[2]) : nullptr;
-  if (!this->ReadPath(path) ||
-      !this->ReadObjects(nobjects ? vtkDataObject::GetData(inputVector[1]) : nullptr)) {
+  if (!this->ReadObjectInputs(inputVector)) {
     return 0;
   }
-  this->ObjectsReadAt = this->GetTemporalInputTime(1);
 
   gr_snow_deformation_params p;
   gr_snow_deformation_params_init(&p);
@@ -685,7 +387,7 @@ int vtkSnowDeformationFilter::SetUpState(vtkInformationVector **inputVector) {
     gr_snow_deformation_set_allreduce(sim, graupel::Pieces::Allreduce, &pieces);
     gr_snow_deformation_set_halo_exchange(sim, graupel::Pieces::Exchange, &pieces);
   }
-  for (const Upload &u : uploads) {
+  for (const graupel::Upload &u : uploads) {
     const std::vector<float> local = pieces.LocalField(u.values->GetPointer(0), dims[0], 1);
     st = gr_snow_deformation_set_field(this->Simulation, u.field, local.data());
     if (st != GR_OK) {
@@ -694,14 +396,16 @@ int vtkSnowDeformationFilter::SetUpState(vtkInformationVector **inputVector) {
       return 0;
     }
   }
-  gr_snow_deformation_set_progress(this->Simulation, &vtkSnowDeformationFilter::StepProgress, this);
+  gr_snow_deformation_set_progress(this->Simulation, &vtkGraupelSimulation::ThrottledProgress,
+                                   this);
   // The objects at time 0: the forces (zero) have their count before a step.
   return this->SetObjects(0.0, 0.0);
 }
 
 int vtkSnowDeformationFilter::ResetState() {
   const gr_status st = gr_snow_deformation_reset(this->Simulation);
-  gr_snow_deformation_set_progress(this->Simulation, &vtkSnowDeformationFilter::StepProgress, this);
+  gr_snow_deformation_set_progress(this->Simulation, &vtkGraupelSimulation::ThrottledProgress,
+                                   this);
   return st == GR_OK ? 1
                      : this->ReportFailure(st, "Snow Deformation could not restart",
                                            gr_snow_deformation_last_error(this->Simulation));
@@ -717,15 +421,14 @@ int vtkSnowDeformationFilter::AdvanceState(double t0, double t1) {
   }
   // A progress callback that asked to stop leaves the core refusing steps
   // until it is set again; an abort consumed since must not stop this call.
-  gr_snow_deformation_set_progress(this->Simulation, &vtkSnowDeformationFilter::StepProgress, this);
-  // Steps of TimeStep from t0, the last one ending on t1; the step ends are
-  // t0 + k dt (not a running sum), so they depend on t0, t1 and dt only.
+  gr_snow_deformation_set_progress(this->Simulation, &vtkGraupelSimulation::ThrottledProgress,
+                                   this);
+  // Steps of TimeStep from t0, the last one ending on t1.
   const double dt = this->TimeStep;
-  const double count = std::ceil((t1 - t0) / dt - 1e-9);
-  const long long n = count < 1.0 ? 1 : static_cast<long long>(count);
+  const long long n = CountSteps(t0, t1, dt);
   double t = t0;
   for (long long k = 1; k <= n; ++k) {
-    const double next = k == n ? t1 : t0 + static_cast<double>(k) * dt;
+    const double next = StepEnd(t0, t1, dt, k, n);
     if (!this->SetObjects(next, next - t)) {
       return ADVANCE_FAILED;
     }
@@ -753,11 +456,12 @@ int vtkSnowDeformationFilter::SaveState(std::vector<unsigned char> &bytes) {
 
 int vtkSnowDeformationFilter::LoadState(const std::vector<unsigned char> &bytes) {
   // An abort inside a step leaves the core refusing until set_progress.
-  gr_snow_deformation_set_progress(this->Simulation, &vtkSnowDeformationFilter::StepProgress, this);
+  gr_snow_deformation_set_progress(this->Simulation, &vtkGraupelSimulation::ThrottledProgress,
+                                   this);
   return gr_snow_deformation_state_load(this->Simulation, bytes.data(), bytes.size()) == GR_OK;
 }
 
-int vtkSnowDeformationFilter::FillObjects(vtkDataObject *output, double t) {
+int vtkSnowDeformationFilter::FillObjectOutput(int, vtkDataObject *output, double t) {
   vtkDataObject *input = this->GetNumberOfInputConnections(1) ? this->GetTemporalInput(1) : nullptr;
   if (!input || !output) {
     return 1;
@@ -772,46 +476,28 @@ int vtkSnowDeformationFilter::FillObjects(vtkDataObject *output, double t) {
                                  gr_snow_deformation_last_error(this->Simulation));
     }
   }
-  bool other = false;
-  const std::vector<vtkPolyData *> leaves = Leaves(input, &other);
-  if (leaves.size() != n) {
-    return 1; // the objects changed since the state was made; nothing to pose
-  }
-  double matrix[16];
-  if (auto *pd = vtkPolyData::SafeDownCast(output)) {
-    if (n == 1) {
-      this->Pose(0, t, matrix);
-      pd->ShallowCopy(Posed(leaves[0], this->Objects[0].centre, matrix));
-      AddForce(pd->GetFieldData(), &force[0], area[0]);
-    }
-    return 1;
-  }
-  auto *mb = vtkMultiBlockDataSet::SafeDownCast(output);
-  auto *in = vtkCompositeDataSet::SafeDownCast(input);
-  if (!mb || !in) {
-    return 1;
-  }
-  mb->CopyStructure(in);
-  vtkSmartPointer<vtkCompositeDataIterator> it;
-  it.TakeReference(in->NewIterator());
-  size_t k = 0;
-  double total[3] = {0.0, 0.0, 0.0}, totalArea = 0.0;
-  for (it->InitTraversal(); !it->IsDoneWithTraversal() && k < n; it->GoToNextItem()) {
-    auto *leaf = vtkPolyData::SafeDownCast(it->GetCurrentDataObject());
-    if (!leaf || leaf->GetNumberOfPoints() == 0) {
-      continue;
-    }
+  auto posed = [this, t, &force, &area](size_t k, vtkPolyData *leaf) {
+    double matrix[16];
     this->Pose(k, t, matrix);
-    vtkSmartPointer<vtkPolyData> posed = Posed(leaf, this->Objects[k].centre, matrix);
-    AddForce(posed->GetFieldData(), &force[3 * k], area[k]);
-    mb->SetDataSet(it, posed);
-    for (int c = 0; c < 3; ++c) {
-      total[c] += force[3 * k + c];
-    }
-    totalArea += area[k];
-    ++k;
+    vtkSmartPointer<vtkPolyData> one = Posed(leaf, this->Objects[k].centre, matrix);
+    AddForce(one->GetFieldData(), &force[3 * k], area[k]);
+    return one;
+  };
+  vtkMultiBlockDataSet *blocks = nullptr;
+  if (!graupel::FillObjectsOutput(input, output, n, posed, &blocks)) {
+    return 0;
   }
-  AddForce(mb->GetFieldData(), total, totalArea);
+  if (blocks) {
+    // The whole: every object's force and contact area summed.
+    double total[3] = {0.0, 0.0, 0.0}, totalArea = 0.0;
+    for (size_t k = 0; k < n; ++k) {
+      for (int c = 0; c < 3; ++c) {
+        total[c] += force[3 * k + c];
+      }
+      totalArea += area[k];
+    }
+    AddForce(blocks->GetFieldData(), total, totalArea);
+  }
   return 1;
 }
 
@@ -849,20 +535,8 @@ int vtkSnowDeformationFilter::FillOutput(vtkDataObject *outputObject, vtkInforma
   AddValue(fd, "volume_error", ledger.volume_error);
   AddValue(fd, "relax_iterations", ledger.relax_iterations);
 
-  // The objects' output, at the same time; only piece 0 carries them, so
-  // an MPI run shows each object once.
-  if (this->OutputVector) {
-    vtkInformation *objInfo = this->OutputVector->GetInformationObject(1);
-    vtkDataObject *objects = objInfo->Get(vtkDataObject::DATA_OBJECT());
-    const int piece = objInfo->Has(vtkStreamingDemandDrivenPipeline::UPDATE_PIECE_NUMBER())
-                          ? objInfo->Get(vtkStreamingDemandDrivenPipeline::UPDATE_PIECE_NUMBER())
-                          : 0;
-    if (piece == 0 && !this->FillObjects(objects, this->GetStateTime())) {
-      return 0;
-    }
-    this->ObjectsFilled = true;
-  }
-  return 1;
+  // The objects with their forces, at the same time.
+  return this->FillObjectOutputs();
 }
 
 void vtkSnowDeformationFilter::ReleaseState() {
@@ -883,9 +557,5 @@ void vtkSnowDeformationFilter::PrintSelf(ostream &os, vtkIndent indent) {
   os << indent << "MaxRelaxIterations: " << this->MaxRelaxIterations << "\n";
   os << indent << "RelaxTolerance: " << this->RelaxTolerance << " m\n";
   os << indent << "SlumpSpeed: " << this->SlumpSpeed << " m/s\n";
-  os << indent << "ObjectVelocity: " << this->ObjectVelocity[0] << " " << this->ObjectVelocity[1]
-     << " " << this->ObjectVelocity[2] << " m/s\n";
-  os << indent << "ObjectAngularVelocity: " << this->ObjectAngularVelocity << " deg/s\n";
-  os << indent << "RotationAxis: " << this->RotationAxis[0] << " " << this->RotationAxis[1] << " "
-     << this->RotationAxis[2] << "\n";
+  this->PrintObjectMotion(os, indent);
 }

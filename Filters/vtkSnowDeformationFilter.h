@@ -68,18 +68,17 @@
 #define vtkSnowDeformationFilter_h
 
 #include "GraupelFiltersModule.h"
-#include "vtkGraupelSimulation.h"
+#include "vtkGraupelObjectsSimulation.h"
 
 #include <vector>
 
 struct gr_snow_deformation;
 class vtkDataObject;
-class vtkPolyData;
 
-class GRAUPELFILTERS_EXPORT vtkSnowDeformationFilter : public vtkGraupelSimulation {
+class GRAUPELFILTERS_EXPORT vtkSnowDeformationFilter : public vtkGraupelObjectsSimulation {
 public:
   static vtkSnowDeformationFilter *New();
-  vtkTypeMacro(vtkSnowDeformationFilter, vtkGraupelSimulation);
+  vtkTypeMacro(vtkSnowDeformationFilter, vtkGraupelObjectsSimulation);
   void PrintSelf(ostream &os, vtkIndent indent) override;
 
   enum CompressionModels { DENSITY_DRIVEN = 0, CONSTANT_FRACTION = 1 };
@@ -198,44 +197,11 @@ public:
   vtkGetMacro(SlumpSpeed, double);
   ///@}
 
-  ///@{
-  /** Velocity of the objects' centres, m/s (default 0 0 0); along a Path its length is the speed.
-   */
-  vtkSetVector3Macro(ObjectVelocity, double);
-  vtkGetVector3Macro(ObjectVelocity, double);
-  ///@}
-
-  ///@{
-  /** Rotation speed of the objects about RotationAxis through their centres, deg/s (default 0). */
-  vtkSetMacro(ObjectAngularVelocity, double);
-  vtkGetMacro(ObjectAngularVelocity, double);
-  ///@}
-
-  ///@{
-  /** Axis of that rotation, object frame (default 0 1 0: a wheel rolling along x). */
-  vtkSetVector3Macro(RotationAxis, double);
-  vtkGetVector3Macro(RotationAxis, double);
-  ///@}
-
-  /** Connects the objects (input port 1). */
-  void SetObjectsConnection(vtkAlgorithmOutput *output);
-  /** Connects the optional path (input port 2). */
-  void SetPathConnection(vtkAlgorithmOutput *output);
-
-  /** Dispatches requests; see the .cxx for what the second output needs. */
-  vtkTypeBool ProcessRequest(vtkInformation *request, vtkInformationVector **inInfo,
-                             vtkInformationVector *outInfo) override;
-
 protected:
   vtkSnowDeformationFilter();
   ~vtkSnowDeformationFilter() override;
 
-  int FillInputPortInformation(int port, vtkInformation *info) override;
   int FillOutputPortInformation(int port, vtkInformation *info) override;
-
-  int RequestInformation(vtkInformation *, vtkInformationVector **,
-                         vtkInformationVector *) override;
-  int RequestData(vtkInformation *, vtkInformationVector **, vtkInformationVector *) override;
 
   int SetUpState(vtkInformationVector **inputVector) override;
   int ResetState() override;
@@ -258,43 +224,20 @@ protected:
   int MaxRelaxIterations = 0; // the table's default, set in the constructor
   double RelaxTolerance = 0.0;
   double SlumpSpeed = 0.0; // the table's default, set in the constructor
-  double ObjectVelocity[3] = {0.0, 0.0, 0.0};
-  double ObjectAngularVelocity = 0.0;
-  double RotationAxis[3] = {0.0, 1.0, 0.0};
 
 private:
   vtkSnowDeformationFilter(const vtkSnowDeformationFilter &) = delete;
   void operator=(const vtkSnowDeformationFilter &) = delete;
 
-  /** One object as the core sees it: vertices about its centre. */
-  struct Object {
-    std::vector<float> vertices;
-    std::vector<int> triangles;
-    double centre[3];
-    double velocity[3]; // m/s: the leaf's `velocity`, else ObjectVelocity
-  };
-
   int CheckParameters();
   /** Refuses an object that is over the terrain's grid at no step up to EndTime. */
   int CheckObjectsReachGrid(const double gridBounds[4], double margin);
-  /** Reads the objects (and, once, the path) into Objects; 0 after one sentence. */
-  int ReadObjects(vtkDataObject *objects);
-  int ReadPath(vtkPolyData *path);
-  /** The pose (column-major) of object k at time t. */
-  void Pose(size_t k, double t, double matrix[16]) const;
   /** Hands the objects at their poses at time t to the core (velocities over [t - h, t]). */
   int SetObjects(double t, double h);
-  int FillObjects(vtkDataObject *output, double t);
+  /** The objects at their poses at time t with their forces and contact areas (output 1). */
+  int FillObjectOutput(int port, vtkDataObject *output, double t) override;
 
   gr_snow_deformation *Simulation = nullptr;
-  std::vector<Object> Objects;
-  std::vector<double> Path; // xyz per point; empty when none
-  bool ObjectsTemporal = false;
-  double ObjectsReadAt = 0.0;
-  vtkInformationVector *OutputVector = nullptr; // during RequestData only
-  bool ObjectsFilled = false;
-  double LastProgressWall = 0.0;
-  static int StepProgress(void *user, double time);
 };
 
 #endif

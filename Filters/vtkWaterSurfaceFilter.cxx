@@ -98,18 +98,10 @@ int vtkWaterSurfaceFilter::CheckParameters() {
   int count = 0;
   const gr_param_bound *table = gr_water_surface_param_bounds(&count);
   for (const auto &p : values) {
-    const gr_param_bound *b = gr_param_find(table, count, p.property);
-    if (!b || gr_param_accepts(b, p.value * b->to_core)) {
-      continue;
+    if (!this->ReportError(graupel::OutOfRange("Water Surface", p.property,
+                                               gr_param_find(table, count, p.property), p.value))) {
+      return 0;
     }
-    const char *unit = (b->unit && *b->unit) ? b->unit : "";
-    const char *space = *unit ? " " : "";
-    vtkErrorMacro("Water Surface: " << p.property << " must be "
-                                    << (b->min_open ? "above " : "from ") << b->min << space << unit
-                                    << (b->min_open ? " and up to " : " to ") << b->max << space
-                                    << unit << "; it is " << p.value << space << unit
-                                    << ". Set it within that range.");
-    return 0;
   }
   return 1;
 }
