@@ -138,11 +138,12 @@ struct gr_rain_runoff {
   cl_kernel sw_stage[2];
   int sw_fused;
   size_t sw_local[2], sw_tile_bytes;
-  /* The step kernels above (gr_rain_runoff_step_kernels) come from the
-   * program built for the optional inputs `inputs` (GR_RAIN_RUNOFF_IN_*
-   * bits; -1 before the first); specialise 0 keeps them general (every
-   * input possible, as a program without the option), which
-   * gr_rain_runoff_set_specialised sets for tests. */
+  /* Every kernel comes from the program built for `inputs`: the optional
+   * inputs' GR_RAIN_RUNOFF_IN_* bits, and GR_RAIN_RUNOFF_IN_ALL + 1 where it
+   * has the shallow-water model's kernels (-1 before the first build;
+   * gr_rain_runoff_specialise). specialise 0 keeps them general (every
+   * input and both models, a program without options), which
+   * gr_rain_runoff_set_specialised sets for tests and the bench. */
   int inputs, specialise;
   cl_mem h, h_c, b, k, inf, inf_c, out, out_c;
   cl_mem in, in_c; /* inflow (edges and sources), per cell (m), and its compensation */
