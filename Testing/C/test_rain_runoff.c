@@ -1332,6 +1332,13 @@ static void test_memcheck(void) {
   progress_log log = {0, 1, 0, 0.0, 0.0};
   gr_rain_runoff_set_progress(s, on_progress, &log);
   CHECK(gr_rain_runoff_advance(s, 1.0, &steps) == GR_OK && log.increasing);
+  /* The programs swapped: the other FlowModel's, then the general one. */
+  p.flow_model = GR_FLOW_SHALLOW_WATER;
+  CHECK(gr_rain_runoff_set_params(s, &p) == GR_OK);
+  CHECK(gr_rain_runoff_step(s, 0.1, 1) == GR_OK);
+  gr_rain_runoff_set_specialised(s, 0);
+  CHECK(gr_rain_runoff_step(s, 0.1, 1) == GR_OK &&
+        gr_rain_runoff_specialised_for(s) == GR_RAIN_RUNOFF_INPUT_ALL);
   gr_rain_runoff_destroy(s);
 }
 
