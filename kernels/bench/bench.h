@@ -76,6 +76,11 @@ GRAUPEL_CORE_LIST(GR_BENCH_DECLARE)
  * limit the bandwidth fraction is of); buffers of at least min_bytes. */
 gr_status gr_bench_copy_bandwidth(gr_context *ctx, size_t min_bytes, double *bytes_per_s);
 
+/* ms per pass of a plain 5-point stencil on an nx x ny grid of ctx's device,
+ * the yardstick a core's step is counted in (issues 8 and 10: timed in the
+ * same run as the steps, so that a busy machine slows both). */
+gr_status gr_bench_stencil_ms(gr_context *ctx, int nx, int ny, double *ms);
+
 /* graupel-bench --devices K (bench_split.c): the core's set-up split into K
  * strips over the devices `device` names (every GPU, ...); prints the
  * figures and, with verify, compares with one whole grid. Returns the exit

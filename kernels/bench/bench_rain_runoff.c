@@ -130,63 +130,6 @@ static gr_status rain_runoff_step(void *state) {
   return gr_rain_runoff_step(r->sim, r->dt, 1);
 }
 
-/* Issue 10's yardstick: one Jacobi pass of the plain 5-point Laplacian,
- * edges clamped (snow_deformation's, built here from source so that the
- * core's program carries no bench kernel). */
-static const char stencil5_source[] =
-    "__kernel void bench_stencil5(__global const float *restrict in, int nx, int ny,\n"
-    "                             __global float *restrict out) {\n"
-    "  int i = get_global_id(0), j = get_global_id(1);\n"
-    "  if (i >= nx || j >= ny) return;\n"
-    "  float w = in[j * nx + max(i - 1, 0)], e = in[j * nx + min(i + 1, nx - 1)];\n"
-    "  float s = in[max(j - 1, 0) * nx + i], n = in[min(j + 1, ny - 1) * nx + i];\n"
-    "  out[j * nx + i] = 0.2f * (in[j * nx + i] + w + e + s + n);\n"
-    "}\n";
-
-/* ms per pass of the plain 5-point stencil on an nx x ny grid: the mean of
- * 30 passes after a warm-up one. */
-static gr_status rain_runoff_stencil_ms(gr_context *ctx, int nx, int ny, double *ms) {
-  cl_program prog = NULL;
-  cl_kernel k = NULL;
-  cl_mem buf[2] = {NULL, NULL};
-  size_t bytes = (size_t)nx * (size_t)ny * sizeof(float);
-  gr_status st = gr_program_build_source(ctx, stencil5_source, NULL, &prog);
-  if (st == GR_OK)
-    st = gr_kernel_create(ctx, prog, "bench_stencil5", &k);
-  for (int a = 0; st == GR_OK && a < 2; ++a)
-    st = gr_buffer_create(ctx, CL_MEM_READ_WRITE, bytes, NULL, &buf[a]);
-  float zero = 0.0f;
-  for (int a = 0; st == GR_OK && a < 2; ++a)
-    st = gr_cl_check(ctx,
-                     clEnqueueFillBuffer(gr_context_queue(ctx), buf[a], &zero, sizeof(zero), 0,
-                                         bytes, 0, NULL, NULL),
-                     "Filling the stencil buffer");
-  double t0 = 0.0;
-  const int passes = 30;
-  for (int p = -1; st == GR_OK && p < passes; ++p) {
-    if (p == 0) {
-      st = gr_finish(ctx);
-      t0 = gr_bench_now_s();
-    }
-    if (st == GR_OK)
-      st = gr_kernel_args(ctx, k, sizeof(cl_mem), &buf[(p + 1) & 1], sizeof(int), &nx, sizeof(int),
-                          &ny, sizeof(cl_mem), &buf[p & 1], (size_t)0);
-    if (st == GR_OK)
-      st = gr_enqueue_2d(ctx, k, 0, 0, (size_t)nx, (size_t)ny, NULL);
-  }
-  if (st == GR_OK)
-    st = gr_finish(ctx);
-  if (st == GR_OK)
-    *ms = 1e3 * (gr_bench_now_s() - t0) / passes;
-  for (int a = 0; a < 2; ++a)
-    gr_buffer_release(&buf[a]);
-  if (k)
-    clReleaseKernel(k);
-  if (prog)
-    clReleaseProgram(prog);
-  return st;
-}
-
 /* What a caller pays besides the steps: the ledger (one reduction and its
  * read-back) and the stable step (the same reduction, reading only the
  * depth in the local inertial model); and a step against
@@ -205,7 +148,7 @@ static gr_status rain_runoff_report(void *state, gr_context *ctx) {
     st = gr_finish(ctx);
   step = 1e3 * (gr_bench_now_s() - s0) / timed;
   if (st == GR_OK)
-    st = rain_runoff_stencil_ms(ctx, r->nx, r->ny, &stencil);
+    st = gr_bench_stencil_ms(ctx, r->nx, r->ny, &stencil);
   if (st == GR_OK)
     printf("rain_runoff: %s step %.4f ms, 5-point stencil pass %.4f ms at %d x %d: a step costs "
            "%.1f passes (issue 10's target for the local inertial step at 1024^2: 30 or fewer)\n",

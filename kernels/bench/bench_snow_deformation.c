@@ -151,53 +151,6 @@ static gr_status snow_deformation_step(void *state) {
   return st;
 }
 
-/* ms per pass of the plain 5-point stencil on the same grid: the mean of
- * 30 passes after a warm-up one. */
-static gr_status snow_deformation_stencil_ms(gr_context *ctx, int n, double *ms) {
-  cl_program prog = NULL;
-  cl_kernel k = NULL;
-  cl_mem buf[2] = {NULL, NULL};
-  size_t bytes = (size_t)n * (size_t)n * sizeof(float);
-  gr_status st = gr_program_get(ctx, "snow_deformation", NULL, &prog);
-  if (st == GR_OK)
-    st = gr_kernel_create(ctx, prog, "snow_bench_stencil5", &k);
-  for (int a = 0; st == GR_OK && a < 2; ++a)
-    st = gr_buffer_create(ctx, CL_MEM_READ_WRITE, bytes, NULL, &buf[a]);
-  float zero = 0.0f;
-  for (int a = 0; st == GR_OK && a < 2; ++a)
-    st = gr_cl_check(ctx,
-                     clEnqueueFillBuffer(gr_context_queue(ctx), buf[a], &zero, sizeof(zero), 0,
-                                         bytes, 0, NULL, NULL),
-                     "Filling the stencil buffer");
-  double t0 = 0.0;
-  const int passes = 30;
-  for (int p = -1; st == GR_OK && p < passes; ++p) {
-    if (p == 0) {
-      st = gr_finish(ctx);
-      t0 = gr_bench_now_s();
-    }
-    if (st == GR_OK)
-      st = gr_kernel_arg(ctx, k, "in", sizeof(cl_mem), &buf[(p + 1) & 1]);
-    if (st == GR_OK)
-      st = gr_kernel_arg(ctx, k, "nx", sizeof(n), &n);
-    if (st == GR_OK)
-      st = gr_kernel_arg(ctx, k, "ny", sizeof(n), &n);
-    if (st == GR_OK)
-      st = gr_kernel_arg(ctx, k, "out", sizeof(cl_mem), &buf[p & 1]);
-    if (st == GR_OK)
-      st = gr_enqueue_2d(ctx, k, 0, 0, (size_t)n, (size_t)n, NULL);
-  }
-  if (st == GR_OK)
-    st = gr_finish(ctx);
-  if (st == GR_OK)
-    *ms = 1e3 * (gr_bench_now_s() - t0) / passes;
-  for (int a = 0; a < 2; ++a)
-    gr_buffer_release(&buf[a]);
-  if (k)
-    clReleaseKernel(k);
-  return st;
-}
-
 static gr_status snow_deformation_report(void *state, gr_context *ctx) {
   snow_deformation_bench *b = state;
   gr_snow_deformation_ledger l;
@@ -232,7 +185,7 @@ static gr_status snow_deformation_report(void *state, gr_context *ctx) {
     place_ms += (gr_bench_now_s() - t0) * 1e3 / timed;
   }
   if (st == GR_OK)
-    st = snow_deformation_stencil_ms(ctx, b->n, &stencil);
+    st = gr_bench_stencil_ms(ctx, b->n, b->n, &stencil);
   if (st == GR_OK) {
     double q = 1.0 / (double)tm.steps;
     double total =

@@ -26,6 +26,48 @@
 
 /* ------------------------------------------------------------ copy probe */
 
+/* ms per pass of the plain 5-point stencil (bench.cl's bench_stencil5) on
+ * an nx x ny grid: the mean of 30 passes after a warm-up one. */
+gr_status gr_bench_stencil_ms(gr_context *ctx, int nx, int ny, double *ms) {
+  cl_program prog = NULL;
+  cl_kernel k = NULL;
+  cl_mem buf[2] = {NULL, NULL};
+  size_t bytes = (size_t)nx * (size_t)ny * sizeof(float);
+  gr_status st = gr_program_get(ctx, "bench", NULL, &prog);
+  if (st == GR_OK)
+    st = gr_kernel_create(ctx, prog, "bench_stencil5", &k);
+  for (int a = 0; st == GR_OK && a < 2; ++a)
+    st = gr_buffer_create(ctx, CL_MEM_READ_WRITE, bytes, NULL, &buf[a]);
+  float zero = 0.0f;
+  for (int a = 0; st == GR_OK && a < 2; ++a)
+    st = gr_cl_check(ctx,
+                     clEnqueueFillBuffer(gr_context_queue(ctx), buf[a], &zero, sizeof(zero), 0,
+                                         bytes, 0, NULL, NULL),
+                     "Filling the stencil buffer");
+  double t0 = 0.0;
+  const int passes = 30;
+  for (int p = -1; st == GR_OK && p < passes; ++p) {
+    if (p == 0) {
+      st = gr_finish(ctx);
+      t0 = gr_bench_now_s();
+    }
+    if (st == GR_OK)
+      st = gr_kernel_args(ctx, k, sizeof(cl_mem), &buf[(p + 1) & 1], sizeof(int), &nx, sizeof(int),
+                          &ny, sizeof(cl_mem), &buf[p & 1], (size_t)0);
+    if (st == GR_OK)
+      st = gr_enqueue_2d(ctx, k, 0, 0, (size_t)nx, (size_t)ny, NULL);
+  }
+  if (st == GR_OK)
+    st = gr_finish(ctx);
+  if (st == GR_OK)
+    *ms = 1e3 * (gr_bench_now_s() - t0) / passes;
+  for (int a = 0; a < 2; ++a)
+    gr_buffer_release(&buf[a]);
+  if (k)
+    clReleaseKernel(k);
+  return st;
+}
+
 /* Bytes per second of a device-to-device float4 copy of at least 64 MiB
  * (or the grid's size if larger), the best of several timed rounds. */
 gr_status gr_bench_copy_bandwidth(gr_context *ctx, size_t min_bytes, double *bytes_per_s) {

@@ -711,16 +711,3 @@ __kernel void snow_surface(__global const float *restrict ground,
   if (c < n)
     out[c] = ground[c] + depth[c];
 }
-
-/* graupel-bench's yardstick (issue 8: a step against plain 5-point stencil
- * passes): one Jacobi pass of the 5-point Laplacian, edges clamped. */
-__kernel void snow_bench_stencil5(__global const float *restrict in, int nx, int ny,
-                                  __global float *restrict out) {
-  int i = get_global_id(0), j = get_global_id(1);
-  if (!gr_inside(i, j, nx, ny))
-    return;
-  int c = gr_idx(i, j, nx);
-  float w = in[gr_idx(max(i - 1, 0), j, nx)], e = in[gr_idx(min(i + 1, nx - 1), j, nx)];
-  float sn = in[gr_idx(i, max(j - 1, 0), nx)], n = in[gr_idx(i, min(j + 1, ny - 1), nx)];
-  out[c] = 0.2f * (in[c] + w + e + sn + n);
-}
