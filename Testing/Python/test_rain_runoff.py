@@ -541,28 +541,18 @@ for xy, q, name, text in (
 # point also walks east each step). Going back in time and
 # forward again gives the same bits (the inflows are set again from the input
 # after a restart), and every time step is read.
-from vtkmodules.util.vtkAlgorithm import VTKPythonAlgorithmBase  # noqa: E402
+from gr_timed import TimedSource  # noqa: E402
 
 
-class River(VTKPythonAlgorithmBase):
+class River(TimedSource):
     TIMES = [0.0, 20.0, 40.0]
     FLOW = [0.2, 0.5, 0.0]  # m^3/s from each time step on
 
     def __init__(self):
-        VTKPythonAlgorithmBase.__init__(self, nInputPorts=0, nOutputPorts=1,
-                                        outputType="vtkPolyData")
-        self.requested = []
-
-    def RequestInformation(self, request, inInfo, outInfo):
-        info = outInfo.GetInformationObject(0)
-        info.Set(SDDP.TIME_STEPS(), self.TIMES, len(self.TIMES))
-        info.Set(SDDP.TIME_RANGE(), [self.TIMES[0], self.TIMES[-1]], 2)
-        return 1
+        TimedSource.__init__(self, "vtkPolyData")
 
     def RequestData(self, request, inInfo, outInfo):
-        info = outInfo.GetInformationObject(0)
-        t = info.Get(SDDP.UPDATE_TIME_STEP()) if info.Has(SDDP.UPDATE_TIME_STEP()) else 0.0
-        self.requested.append(t)
+        t = self.requested_time(outInfo)
         k = max(i for i, tk in enumerate(self.TIMES) if tk <= t + 1e-9)
         # the point walks east by 5 cells per time step
         out = vtkPolyData.GetData(outInfo)

@@ -423,31 +423,20 @@ T.check(po.GetFieldData().GetArray("tag") is not None
         and field(pout, "time") == 2 * HOUR, "port 1 keeps the object's field data at 2 h")
 
 # ---- objects with time steps: a crate carried under a roof keeps its snow -----------
-from vtkmodules.util.vtkAlgorithm import VTKPythonAlgorithmBase  # noqa: E402
-from vtkmodules.vtkCommonExecutionModel import vtkStreamingDemandDrivenPipeline as SDDP  # noqa
+from gr_timed import TimedSource  # noqa: E402
 
 
-class CarriedCrate(VTKPythonAlgorithmBase):
+class CarriedCrate(TimedSource):
     """A roof (an open quad at 3 m over x 6-11 m) and a crate that stands in the
     open until 1 h, then under the roof."""
 
     TIMES = [0.0, HOUR, 2 * HOUR]
 
     def __init__(self):
-        VTKPythonAlgorithmBase.__init__(self, nInputPorts=0, nOutputPorts=1,
-                                        outputType="vtkMultiBlockDataSet")
-        self.requested = []
-
-    def RequestInformation(self, request, inInfo, outInfo):
-        info = outInfo.GetInformationObject(0)
-        info.Set(SDDP.TIME_STEPS(), self.TIMES, len(self.TIMES))
-        info.Set(SDDP.TIME_RANGE(), [self.TIMES[0], self.TIMES[-1]], 2)
-        return 1
+        TimedSource.__init__(self, "vtkMultiBlockDataSet")
 
     def RequestData(self, request, inInfo, outInfo):
-        info = outInfo.GetInformationObject(0)
-        t = info.Get(SDDP.UPDATE_TIME_STEP()) if info.Has(SDDP.UPDATE_TIME_STEP()) else 0.0
-        self.requested.append(t)
+        t = self.requested_time(outInfo)
         x = 1.5 if t < HOUR else 7.5
         out = vtkMultiBlockDataSet.GetData(outInfo)
         out.ShallowCopy(blocks(polys([(6, 1, 3), (11, 1, 3), (11, 10, 3), (6, 10, 3)], [(0, 1, 2, 3)]),

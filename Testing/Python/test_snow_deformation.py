@@ -510,29 +510,19 @@ T.check(s is not None and float(s.min()) < DEPTH - 0.1,
         "a sphere driving onto the grid from outside is simulated")
 
 # ---- objects with time steps: each step's geometry is the pose -------------------
-from vtkmodules.util.vtkAlgorithm import VTKPythonAlgorithmBase  # noqa: E402
+from gr_timed import TimedSource  # noqa: E402
 
 
-class SinkingSphere(VTKPythonAlgorithmBase):
+class SinkingSphere(TimedSource):
     """A sphere whose centre sits at Z0 + VZ t at the time steps 0, 0.25, ... 1 s."""
 
     TIMES = [0.0, 0.25, 0.5, 0.75, 1.0]
 
     def __init__(self):
-        VTKPythonAlgorithmBase.__init__(self, nInputPorts=0, nOutputPorts=1,
-                                        outputType="vtkPolyData")
-        self.requested = []
-
-    def RequestInformation(self, request, inInfo, outInfo):
-        info = outInfo.GetInformationObject(0)
-        info.Set(SDDP.TIME_STEPS(), self.TIMES, len(self.TIMES))
-        info.Set(SDDP.TIME_RANGE(), [self.TIMES[0], self.TIMES[-1]], 2)
-        return 1
+        TimedSource.__init__(self, "vtkPolyData")
 
     def RequestData(self, request, inInfo, outInfo):
-        info = outInfo.GetInformationObject(0)
-        t = info.Get(SDDP.UPDATE_TIME_STEP()) if info.Has(SDDP.UPDATE_TIME_STEP()) else 0.0
-        self.requested.append(t)
+        t = self.requested_time(outInfo)
         out = vtkPolyData.GetData(outInfo)
         out.ShallowCopy(sphere((C[0], C[1], Z0 + VZ * t), R))
         out.GetInformation().Set(out.DATA_TIME_STEP(), t)
