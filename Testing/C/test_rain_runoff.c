@@ -3771,6 +3771,38 @@ static long state_words_differ(gr_rain_runoff *a, gr_rain_runoff *b, size_t *wor
   return diff;
 }
 
+/* The launch-path tests' run: 300 steps of sim[0..2] in stretches of 30,
+ * sim[2] switched between the paths every stretch (set_path(sim, on), on
+ * in the even ones); then every word of the state and the ledger of the two
+ * others against sim[ref] (the path `ref_path`: diff[0] the other fixed
+ * path, diff[1] the switching run). Returns sim[ref]'s fastest max_speed
+ * (m/s) and *l its ledger, for the test's check that water flowed. */
+static double paths_run(gr_rain_runoff *sim[3], int ref, void (*set_path)(gr_rain_runoff *, int),
+                        const gr_grid *g, int config, const char *ref_path,
+                        gr_rain_runoff_ledger *l, long diff[2], size_t *words) {
+  for (int chunk = 0; chunk < 10; ++chunk) {
+    set_path(sim[2], chunk % 2 == 0);
+    for (int v = 0; v < 3; ++v)
+      run_stable(sim[v], 1, 30);
+  }
+  int other = 1 - ref;
+  diff[0] = state_words_differ(sim[ref], sim[other], words);
+  diff[1] = state_words_differ(sim[ref], sim[2], words);
+  gr_rain_runoff_ledger lr = ledger(sim[ref]), lo = ledger(sim[other]), ls = ledger(sim[2]);
+  int same_ledger = memcmp(&lr, &lo, sizeof(lr)) == 0 && memcmp(&ls, &lr, sizeof(lr)) == 0;
+  CHECK_MSG(diff[0] == 0 && diff[1] == 0 && same_ledger,
+            "config %d: %ld (fused) and %ld (switching) words of the state of %zu differ from "
+            "the %s'; ledgers %s",
+            config, diff[0], diff[1], *words, ref_path, same_ledger ? "agree" : "differ");
+  float *speed = get_map(sim[ref], g, GR_RAIN_RUNOFF_MAX_SPEED);
+  double vmax = 0.0;
+  for (size_t c = 0; c < cells_of(g); ++c)
+    vmax = isnan(speed[c]) ? vmax : fmax(vmax, speed[c]);
+  free(speed);
+  *l = lr;
+  return vmax;
+}
+
 /* The shallow-water pieces tests with each launch path forced (the fused
  * stages read the ring through their tiles' halos), with every kind of edge
  * and without: every owned cell of every field and the ledger bit for bit
@@ -3853,26 +3885,13 @@ static void test_sw_fused(void) {
         gr_rain_runoff_destroy(sim[v]);
       continue;
     }
-    for (int chunk = 0; chunk < 10; ++chunk) {
-      gr_rain_runoff_set_sw_fused(sim[2], chunk % 2 == 0);
-      for (int v = 0; v < 3; ++v)
-        run_stable(sim[v], 1, 30);
-    }
     size_t words = 0;
-    long diff[2] = {state_words_differ(sim[0], sim[1], &words),
-                    state_words_differ(sim[0], sim[2], &words)};
-    gr_rain_runoff_ledger l0 = ledger(sim[0]), l1 = ledger(sim[1]), l2 = ledger(sim[2]);
-    int same_ledger = memcmp(&l0, &l1, sizeof(l0)) == 0 && memcmp(&l2, &l0, sizeof(l0)) == 0;
-    CHECK_MSG(diff[0] == 0 && diff[1] == 0 && same_ledger,
-              "config %d: %ld (fused) and %ld (switching) words of the state of %zu differ "
-              "from the separate launches'; ledgers %s",
-              config, diff[0], diff[1], words, same_ledger ? "agree" : "differ");
+    long diff[2];
+    gr_rain_runoff_ledger l0;
+    double vmax = paths_run(sim, 0, gr_rain_runoff_set_sw_fused, &g, config, "separate launches",
+                            &l0, diff, &words);
     /* Water moved and left (or, walled in, came in through the north edge
      * or from the inflows): the comparison is of a flow, not of still water. */
-    float *speed = get_map(sim[0], &g, GR_RAIN_RUNOFF_MAX_SPEED);
-    double vmax = 0.0;
-    for (size_t c = 0; c < n; ++c)
-      vmax = isnan(speed[c]) ? vmax : fmax(vmax, speed[c]);
     CHECK_MSG(l0.steps == 300 && l0.outflow_volume + l0.inflow_volume > 1.0 && vmax > 0.05,
               "config %d: %lld steps, outflow %g m^3, inflow %g m^3, fastest %g m/s", config,
               l0.steps, l0.outflow_volume, l0.inflow_volume, vmax);
@@ -3894,7 +3913,6 @@ static void test_sw_fused(void) {
       run_stable(sim[0], 1, 2);
       CHECK(state_words_differ(sim[0], sim[1], &words) == 0);
     }
-    free(speed);
     for (int v = 0; v < 3; ++v)
       gr_rain_runoff_destroy(sim[v]);
   }
@@ -4602,26 +4620,13 @@ static void test_li_fused(void) {
         gr_rain_runoff_destroy(sim[v]);
       continue;
     }
-    for (int chunk = 0; chunk < 10; ++chunk) {
-      gr_rain_runoff_set_fused(sim[2], chunk % 2 == 0);
-      for (int v = 0; v < 3; ++v)
-        run_stable(sim[v], 1, 30);
-    }
     size_t words = 0;
-    long diff[2] = {state_words_differ(sim[1], sim[0], &words),
-                    state_words_differ(sim[1], sim[2], &words)};
-    gr_rain_runoff_ledger l0 = ledger(sim[0]), l1 = ledger(sim[1]), l2 = ledger(sim[2]);
-    int same_ledger = memcmp(&l0, &l1, sizeof(l0)) == 0 && memcmp(&l2, &l1, sizeof(l0)) == 0;
-    CHECK_MSG(diff[0] == 0 && diff[1] == 0 && same_ledger,
-              "config %d: %ld (fused) and %ld (switching) words of the state of %zu differ "
-              "from the three launches'; ledgers %s",
-              config, diff[0], diff[1], words, same_ledger ? "agree" : "differ");
+    long diff[2];
+    gr_rain_runoff_ledger l1;
+    double vmax = paths_run(sim, 1, gr_rain_runoff_set_fused, &g, config, "three launches", &l1,
+                            diff, &words);
     /* Water moved and left through the edges, the holes filled in part:
      * the comparison is of a flow, not of still water. */
-    float *speed = get_map(sim[1], &g, GR_RAIN_RUNOFF_MAX_SPEED);
-    double vmax = 0.0;
-    for (size_t c = 0; c < n; ++c)
-      vmax = isnan(speed[c]) ? vmax : fmax(vmax, speed[c]);
     CHECK_MSG(l1.steps == 300 && l1.outflow_volume > 0.0 && vmax > 0.05,
               "config %d: %lld steps, outflow %g m^3, fastest %g m/s", config, l1.steps,
               l1.outflow_volume, vmax);
@@ -4629,7 +4634,6 @@ static void test_li_fused(void) {
     printf("config %d: after %lld steps %ld words of %zu differ (one launch), %ld (switching); "
            "outflow %.4f m^3, inflow %.4f m^3, fastest %.3f m/s\n",
            config, l1.steps, diff[0], words, diff[1], l1.outflow_volume, l1.inflow_volume, vmax);
-    free(speed);
     for (int v = 0; v < 3; ++v)
       gr_rain_runoff_destroy(sim[v]);
   }
