@@ -55,6 +55,21 @@ def finish():
         sys.exit(1)
 
 
+def piece_share(share, ranks, label=None):
+    """Checks the range of a split run's piece_share (each rank's owned
+    points over the grid's): the whole grid on one rank, at most 55 % each
+    on two, a strip (under half) each on more."""
+    pre = "%s: " % label if label else ""
+    if ranks == 1:
+        check(share == (1.0, 1.0), "%sone rank simulates the whole grid (%r)" % (pre, share))
+    elif ranks == 2:
+        check(share[0] > 0.0 and share[1] <= 0.55,
+              "%seach of 2 ranks simulates at most 55%% of the grid (%r)" % (pre, share))
+    else:
+        check(share[0] > 0.0 and share[1] < 0.5,
+              "%seach of %d ranks simulates a strip (%r)" % (pre, ranks, share))
+
+
 class ErrorCatcher:
     """Collects the sentences an algorithm reports (ErrorEvent, or the event
     given, such as WarningEvent)."""

@@ -241,14 +241,7 @@ for model, label in ((0, "shallow water"), (1, "local inertial")):
             % (label, rng("inflow")[0], rng("outflow")[0]))
     T.check(rng("gauge_wet")[0] > 0.0, "%s: a gauge sees water" % label)
     share = rng("piece_share")
-    if ranks == 1:
-        T.check(share == (1.0, 1.0), "%s: one rank simulates the whole grid (%r)" % (label, share))
-    elif ranks == 2:
-        T.check(share[0] > 0.0 and share[1] <= 0.55,
-                "%s: each of 2 ranks simulates at most 55%% of the grid (%r)" % (label, share))
-    else:
-        T.check(share[0] > 0.0 and share[1] < 0.5,
-                "%s: each of %d ranks simulates a strip (%r)" % (label, ranks, share))
+    T.piece_share(share, ranks, label)
     print("%s: piece_cells share of the grid per rank: %.4f to %.4f" % ((label,) + share))
     Delete(cmp)
     Delete(pid)

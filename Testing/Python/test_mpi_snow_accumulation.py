@@ -150,14 +150,7 @@ T.check(cmp.PointData["ridge_hidden"].GetRange()[0] > 0,
         % cmp.PointData["ridge_hidden"].GetRange()[0])
 T.check(cmp.PointData["ref_objects"].GetRange()[0] > 0.0, "snow lies on the box")
 share = cmp.PointData["piece_share"].GetRange()
-if ranks == 1:
-    T.check(share == (1.0, 1.0), "one rank simulates the whole grid (%r)" % (share,))
-elif ranks > 2:
-    T.check(share[0] > 0.0 and share[1] < 0.5,
-            "each of %d ranks simulates a strip (%r)" % (ranks, share))
-else:
-    T.check(share[0] > 0.0 and share[1] <= 0.55,
-            "each of %d ranks simulates at most 55%% of the grid (%r)" % (ranks, share))
+T.piece_share(share, ranks)
 
 boxes = ProgrammableFilter(Input=OutputPort(snow, 1))
 boxes.Script = BOX

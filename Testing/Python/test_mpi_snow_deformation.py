@@ -132,14 +132,7 @@ T.check(cmp.PointData["ledger_mismatch"].GetRange() == (0.0, 0.0),
         "every rank's ledger (%d values) equals the whole grid's, bit for bit" % len(LEDGER))
 T.check(cmp.PointData["ref_overlap"].GetRange()[1] > 0.01, "the sphere presses into the snow")
 share = cmp.PointData["piece_share"].GetRange()
-if ranks == 1:
-    T.check(share == (1.0, 1.0), "one rank simulates the whole grid (%r)" % (share,))
-elif ranks > 2:
-    T.check(share[0] > 0.0 and share[1] < 0.5,
-            "each of %d ranks simulates a strip (%r)" % (ranks, share))
-else:
-    T.check(share[0] > 0.0 and share[1] <= 0.55,
-            "each of %d ranks simulates at most 55%% of the grid (%r)" % (ranks, share))
+T.piece_share(share, ranks)
 
 force = ProgrammableFilter(Input=OutputPort(snow, 1))
 force.Script = FORCE

@@ -107,13 +107,6 @@ T.check(cmp.PointData["ref_max_wave"].GetRange()[0] > 0.001,
 T.check(cmp.PointData["ref_dry"].GetRange()[0] > 100,
         "the lake has shores (%g dry points)" % cmp.PointData["ref_dry"].GetRange()[0])
 share = cmp.PointData["piece_share"].GetRange()
-if ranks == 1:
-    T.check(share == (1.0, 1.0), "one rank simulates the whole grid (%r)" % (share,))
-elif ranks > 2:
-    T.check(share[0] > 0.0 and share[1] < 0.5,
-            "each of %d ranks simulates a strip (%r)" % (ranks, share))
-else:
-    T.check(share[0] > 0.0 and share[1] <= 0.55,
-            "each of %d ranks simulates at most 55%% of the grid (%r)" % (ranks, share))
+T.piece_share(share, ranks)
 print("piece_cells share of the grid per rank: %.4f to %.4f" % share)
 T.finish()
