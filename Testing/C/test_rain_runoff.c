@@ -3829,8 +3829,11 @@ static void test_sw_pieces_paths(void) {
  * 300 steps the whole state (depth and its compensation, discharges,
  * infiltration, outflow, inflow, flood maps) and the ledger are the same to
  * the bit for the fused path with the device's tile, and for a run that
- * switches between the paths every 30 steps with a tile of 8 x 4. A tile
- * that is no tile, or larger than the device takes, is refused. */
+ * switches between the paths every 30 steps with a tile of 8 x 4. Both
+ * tiles leave interior tiles (the faces' expression without the edges'
+ * cases, rain_runoff_sw_inner*) and rim tiles (32 x 8: 1 x 3 of 3 x 6;
+ * 8 x 4: 8 x 8 of 10 x 11). A tile that is no tile, or larger than the
+ * device takes, is refused. */
 static void test_sw_fused(void) {
   gr_grid g = {75, 41, 2.0, 1.5, 0.0, 0.0, 0, 0};
   size_t n = cells_of(&g);

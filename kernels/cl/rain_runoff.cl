@@ -1094,7 +1094,8 @@ GR_INLINE void gr_sw_continue(gr_sw_pt *q0, gr_sw_pt *q1, gr_sw_pt *q2, gr_sw_pt
 /* Face k of a line of n cells (between cells k - 1 and k; 0 and n are the
  * grid's edge faces), from the cells k - 2 .. k + 1: the depth flux fh,
  * the normal momentum flux as seen by the low cell (fmL) and by the high
- * cell (fmR) (gr_sw_face), and the tangential flux ft. kind_lo, kind_hi, lvl_lo, lvl_hi: the kinds
+ * cell (fmR) (gr_sw_face), and the tangential flux ft; and the slopes sh, se
+ * of cell k (gr_sw_cell_slopes' floats, where k < n). kind_lo, kind_hi, lvl_lo, lvl_hi: the kinds
  * and levels of the line's low and high edges. A transmissive edge continues the line
  * (gr_sw_continue), so its face is computed as an inner one; the other
  * edges' faces have a ghost (gr_sw_ghost): a wall passes no water, an open
@@ -1103,7 +1104,8 @@ GR_INLINE void gr_sw_continue(gr_sw_pt *q0, gr_sw_pt *q1, gr_sw_pt *q2, gr_sw_pt
  * or within a work-group's tile: rain_runoff_sw_stage*). */
 GR_INLINE void gr_sw_line_flux(gr_sw_pt q0, gr_sw_pt q1, gr_sw_pt q2, gr_sw_pt q3, int k, int n,
                                int kind_lo, int kind_hi, float lvl_lo, float lvl_hi, float g,
-                               float *out_fh, float *out_fmL, float *out_fmR, float *out_ft) {
+                               float *out_fh, float *out_fmL, float *out_fmR, float *out_ft,
+                               float *out_sh, float *out_se) {
   bool tlo = kind_lo == GR_RAIN_RUNOFF_B_TRANSMISSIVE,
        thi = kind_hi == GR_RAIN_RUNOFF_B_TRANSMISSIVE;
   gr_sw_continue(&q0, &q1, &q2, &q3, k, n, tlo, thi);
@@ -1111,6 +1113,8 @@ GR_INLINE void gr_sw_line_flux(gr_sw_pt q0, gr_sw_pt q1, gr_sw_pt q2, gr_sw_pt q
    * neighbours. */
   gr_sw_cell L = gr_sw_recon(q0, q1, q2, (k > 1 || tlo) && (k < n || thi));
   gr_sw_cell R = gr_sw_recon(q1, q2, q3, (k > 0 || tlo) && (k < n - 1 || thi));
+  *out_sh = R.sh;
+  *out_se = R.se;
   gr_sw_cell gl = gr_sw_ghost(R, true, kind_lo, lvl_lo);
   gr_sw_cell gh = gr_sw_ghost(L, false, kind_hi, lvl_hi);
   L = gr_sw_pick(k == 0 && !tlo, gl, L);
@@ -1145,9 +1149,13 @@ GR_INLINE void gr_sw_line_flux(gr_sw_pt q0, gr_sw_pt q1, gr_sw_pt q2, gr_sw_pt q
  * branch per work-group made PoCL's step 35 % slower (at 1024^2, 26 ms ->
  * 36 ms): CPUs keep gr_sw_line_flux for every face. */
 GR_INLINE void gr_sw_inner_flux(gr_sw_pt q0, gr_sw_pt q1, gr_sw_pt q2, gr_sw_pt q3, float g,
-                                float *fh, float *fmL, float *fmR, float *ft) {
-  gr_sw_face(gr_sw_recon(q0, q1, q2, true), gr_sw_recon(q1, q2, q3, true), true,
-             gr_sw_rise(q1, q2, 0.0f), g, fh, fmL, fmR, ft);
+                                float *fh, float *fmL, float *fmR, float *ft, float *sh,
+                                float *se) {
+  gr_sw_cell R = gr_sw_recon(q1, q2, q3, true);
+  *sh = R.sh;
+  *se = R.se;
+  gr_sw_face(gr_sw_recon(q0, q1, q2, true), R, true, gr_sw_rise(q1, q2, 0.0f), g, fh, fmL, fmR,
+             ft);
 }
 
 /* gr_sw_line_flux's four values written to out[f] and the three planes
@@ -1155,22 +1163,23 @@ GR_INLINE void gr_sw_inner_flux(gr_sw_pt q0, gr_sw_pt q1, gr_sw_pt q2, gr_sw_pt 
 GR_INLINE void gr_sw_line_face(gr_sw_pt q0, gr_sw_pt q1, gr_sw_pt q2, gr_sw_pt q3, int k, int n,
                                int kind_lo, int kind_hi, float lvl_lo, float lvl_hi, float g,
                                __global float *restrict out, int f, int plane) {
-  float fh, fmL, fmR, ft;
-  gr_sw_line_flux(q0, q1, q2, q3, k, n, kind_lo, kind_hi, lvl_lo, lvl_hi, g, &fh, &fmL, &fmR, &ft);
+  float fh, fmL, fmR, ft, sh, se;
+  gr_sw_line_flux(q0, q1, q2, q3, k, n, kind_lo, kind_hi, lvl_lo, lvl_hi, g, &fh, &fmL, &fmR, &ft,
+                  &sh, &se);
   out[f] = fh;
   out[f + plane] = fmL;
   out[f + 2 * plane] = fmR;
   out[f + 3 * plane] = ft;
 }
 
-/* The flux balance of cell i (p2, between p1 and p3) of a line of n cells
- * along one axis, from its low face's fh, fmR, ft and its high face's fh,
- * fmL, ft (gr_sw_line_flux):
- * dh (mass in minus out), dqn and dqt (momentum, with the bed's source),
- * per unit of the axis' face length. */
-GR_INLINE void gr_sw_balance(gr_sw_pt p1, gr_sw_pt p2, gr_sw_pt p3, float fh_lo, float fmR_lo,
-                             float ft_lo, float fh_hi, float fmL_hi, float ft_hi, int i, int n,
-                             int kind_lo, int kind_hi, float g, float *dh, float *dqn, float *dqt) {
+/* The depth and surface slopes (sh, se: gr_sw_recon's) of cell i (p2,
+ * between p1 and p3) of a line of n cells along one axis, its line
+ * continued beyond a transmissive edge as gr_sw_continue continues it: the
+ * same floats as the reconstruction of that cell on either side of its
+ * faces (gr_sw_line_flux's R), which the fused stages keep from their
+ * faces instead (gr_sw_fused). */
+GR_INLINE void gr_sw_cell_slopes(gr_sw_pt p1, gr_sw_pt p2, gr_sw_pt p3, int i, int n, int kind_lo,
+                                 int kind_hi, float *sh, float *se) {
   bool tlo = kind_lo == GR_RAIN_RUNOFF_B_TRANSMISSIVE,
        thi = kind_hi == GR_RAIN_RUNOFF_B_TRANSMISSIVE;
   if (tlo || thi) {
@@ -1180,11 +1189,22 @@ GR_INLINE void gr_sw_balance(gr_sw_pt p1, gr_sw_pt p2, gr_sw_pt p3, float fh_lo,
     p3 = gr_sw_pick_pt(thi && i == n - 1, gr_sw_extend(p2, in_hi, 1.0f), p3);
   }
   gr_sw_cell C = gr_sw_recon(p1, p2, p3, (i > 0 || tlo) && (i < n - 1 || thi));
-  float hw = C.h - 0.5f * C.sh, he = C.h + 0.5f * C.sh;
+  *sh = C.sh;
+  *se = C.se;
+}
+
+/* The flux balance along one axis of a cell of depth h and slopes sh, se
+ * (gr_sw_cell_slopes), from its low face's fh, fmR, ft and its high face's
+ * fh, fmL, ft (gr_sw_line_flux): dh (mass in minus out), dqn and dqt
+ * (momentum, with the bed's source), per unit of the axis' face length. */
+GR_INLINE void gr_sw_balance(float h, float sh, float se, float fh_lo, float fmR_lo, float ft_lo,
+                             float fh_hi, float fmL_hi, float ft_hi, float g, float *dh,
+                             float *dqn, float *dqt) {
+  float hw = h - 0.5f * sh, he = h + 0.5f * sh;
   *dh = fh_lo - fh_hi;
   /* (fmw + g hw^2 / 2) - (fme + g he^2 / 2) - g (hw + he) / 2 (bed slope)
    * = fmw - fme - g (hw + he) / 2 (surface slope). */
-  *dqn = (fmR_lo - fmL_hi) - 0.5f * g * (hw + he) * C.se;
+  *dqn = (fmR_lo - fmL_hi) - 0.5f * g * (hw + he) * se;
   *dqt = ft_lo - ft_hi;
 }
 /* Manning friction on the discharge (qx, qy) of water h deep over dt,
@@ -1337,14 +1357,14 @@ __kernel void rain_runoff_sw_faces2(GR_SW_STEP_ARGS) {
       bnd_e, bnd_s, bnd_n, max_depth, max_speed, arrival, wet_time, wet_time_comp, max_hazard,     \
       wetting_depth, debris_factor, map_time
 
-/* Cell (i, j)'s update in a stage (see gr_sw_update) from its points and
- * its neighbours' along x (x1, x2, x3) and y (y1, y3), its four faces'
- * values as gr_sw_balance takes them (west, east, south, north) and its
+/* Cell (i, j)'s update in a stage (see gr_sw_update) from its point x2
+ * (along x), its slopes along x (shx, sex) and y (shy, sey) (gr_sw_cell_slopes),
+ * its four faces' values as gr_sw_balance takes them (west, east, south, north) and its
  * momenta before the stage (suc, svc; stage 2's, stage 1 takes the wet
  * ones); with velocities, stage 1 also writes U1's velocities u1, v1. Both
  * launch paths call it, so they give the same floats. */
-GR_INLINE void gr_sw_update_cell(GR_SW_CELL_ARGS, int i, int j, gr_sw_pt x1, gr_sw_pt x2,
-                                 gr_sw_pt x3, gr_sw_pt y1, gr_sw_pt y3, float fh_w, float fm_w,
+GR_INLINE void gr_sw_update_cell(GR_SW_CELL_ARGS, int i, int j, gr_sw_pt x2, float shx,
+                                 float sex, float shy, float sey, float fh_w, float fm_w,
                                  float ft_w, float fh_e, float fm_e, float ft_e, float fh_s,
                                  float fm_s, float ft_s, float fh_n, float fm_n, float ft_n,
                                  float suc, float svc, const int stage, const int velocities) {
@@ -1352,12 +1372,9 @@ GR_INLINE void gr_sw_update_cell(GR_SW_CELL_ARGS, int i, int j, gr_sw_pt x1, gr_
   float n2c = GR_RAIN_RUNOFF_USES(GR_RAIN_RUNOFF_IN_N2, use_n2)
                   ? n2map[c]
                   : n2; /* the cell's own roughness, n^2 */
-  gr_sw_pt y2 = {x2.h, x2.b, x2.ut, x2.un, 0.0f};
   float dhx, dqx_x, dqy_x, dhy, dqy_y, dqx_y;
-  gr_sw_balance(x1, x2, x3, fh_w, fm_w, ft_w, fh_e, fm_e, ft_e, i, nx, bnd_w, bnd_e, g, &dhx,
-                &dqx_x, &dqy_x);
-  gr_sw_balance(y1, y2, y3, fh_s, fm_s, ft_s, fh_n, fm_n, ft_n, j, ny, bnd_s, bnd_n, g, &dhy,
-                &dqy_y, &dqx_y);
+  gr_sw_balance(x2.h, shx, sex, fh_w, fm_w, ft_w, fh_e, fm_e, ft_e, g, &dhx, &dqx_x, &dqy_x);
+  gr_sw_balance(x2.h, shy, sey, fh_s, fm_s, ft_s, fh_n, fm_n, ft_n, g, &dhy, &dqy_y, &dqx_y);
   float dh = dt * (dhx * inv_dx + dhy * inv_dy);
   float hn = x2.h + dh;
   float qun = suc + dt * (dqx_x * inv_dx + dqx_y * inv_dy);
@@ -1440,9 +1457,12 @@ GR_INLINE void gr_sw_update(GR_SW_CELL_ARGS, __global const float *restrict fx,
   gr_sw_pt x3 = gr_sw_point(ph, pu, pv, b, i + 1 < nx, c + 1);
   gr_sw_pt y1 = gr_sw_point(ph, pv, pu, b, j >= 1, c - nx);
   gr_sw_pt y3 = gr_sw_point(ph, pv, pu, b, j + 1 < ny, c + nx);
+  float shx, sex, shy, sey;
+  gr_sw_cell_slopes(x1, x2, x3, i, nx, bnd_w, bnd_e, &shx, &sex);
+  gr_sw_cell_slopes(y1, x2, y3, j, ny, bnd_s, bnd_n, &shy, &sey);
   /* The planes of gr_sw_line_face: fh, fmL, fmR, ft. */
   int f = j * (nx + 1) + i, px = (nx + 1) * ny, py = nx * (ny + 1);
-  gr_sw_update_cell(GR_SW_CELL_PASS, i, j, x1, x2, x3, y1, y3, fx[f], fx[f + 2 * px],
+  gr_sw_update_cell(GR_SW_CELL_PASS, i, j, x2, shx, sex, shy, sey, fx[f], fx[f + 2 * px],
                     fx[f + 3 * px], fx[f + 1], fx[f + 1 + px], fx[f + 1 + 3 * px], fy[c],
                     fy[c + 2 * py], fy[c + 3 * py], fy[c + nx], fy[c + nx + py],
                     fy[c + nx + 3 * py], su[c], sv[c], stage, 1);
@@ -1485,11 +1505,12 @@ __kernel void rain_runoff_sw_edges(GR_SW_STEP_ARGS) {
                             inv_dy, olx, ohx, oly, ohy);
 }
 
-/* ------------------------------------- shallow water, one launch a stage
+/* --------------------------------- shallow water, fused stages in tiles
  *
  * The fused path (gr_rain_runoff_set_sw_fused): each stage of Heun's method
- * in one launch, rain_runoff_sw_stage1 and rain_runoff_sw_stage2, in place
- * of sw_prep, faces, update and edges, with the same inline functions on
+ * in one pass over the grid's tiles (two launches: the interior's tiles,
+ * rain_runoff_sw_inner1 and 2, and the rim's, rain_runoff_sw_stage1 and 2),
+ * in place of sw_prep, faces, update and edges, with the same inline functions on
  * the same floats, so the same bits. A work-group owns a tile of
  * get_local_size(0) x get_local_size(1) cells: it gathers the stage's points
  * of the tile and two cells either side of it (the limited reconstruction's
@@ -1497,12 +1518,14 @@ __kernel void rain_runoff_sw_edges(GR_SW_STEP_ARGS) {
  * from the state, rain and infiltration as sw_prep does; stage 2 from h1,
  * qu1, qv1, the velocities as stage 1 would have stored them), computes its
  * tile's faces there (each face once: an x-face and a y-face per cell, one
- * more column and row), then updates its cells and books the rim's edge
+ * more column and row; each face also keeps its high cell's slopes, which
+ * the update takes instead of reconstructing the cell again), then updates its cells and books the rim's edge
  * flows. Points and faces never go to global memory: per cell a step reads
  * the state, bed and stage (h, qu, qv, b; h1, qu1, qv1, dh1, h_comp) and
  * writes the stage and the state. The local array `tile` holds four planes
- * of points ((tx + 4) (ty + 4) each: h, b, u, v) and four of x-faces
- * ((tx + 1) ty) and y-faces (tx (ty + 1)): fh, fmL, fmR, ft. */
+ * of points ((tx + 4) (ty + 4) each: h, b, u, v) and six of x-faces
+ * ((tx + 1) ty) and y-faces (tx (ty + 1)): fh, fmL, fmR, ft and the high
+ * cell's sh, se. */
 
 /* Point p of the tile as a line's point along x (normal u) or y (normal v). */
 GR_INLINE gr_sw_pt gr_sw_tile_pt(__local const float *restrict th, __local const float *restrict tb,
@@ -1517,19 +1540,51 @@ GR_INLINE gr_sw_pt gr_sw_tile_pt(__local const float *restrict th, __local const
   return q;
 }
 
+/* t / w for 0 <= t < 2^20 and w >= 1, from rw = 1 / w: (t + 1/2) / w lies
+ * at least 1 / (2 w) from any integer, far more than the float product's
+ * error, so its floor is the quotient. An integer division by a number
+ * known only at run time is some twenty instructions on GPUs; the tile's
+ * loops take one per point and per face. */
+GR_INLINE int gr_sw_div(int t, float rw) { return (int)(((float)t + 0.5f) * rw); }
+
+/* The tile (*ti, *tj) of the rim's work-group r (rain_runoff_sw_stage*):
+ * the tiles outside the interior ones (tiles: their columns x .. y - 1 and
+ * rows z .. w - 1) of a grid of nti x ntj tiles, row by row: the rows
+ * below the interior's, those above, then the rows between, each the
+ * columns left and right of the interior's. */
+GR_INLINE void gr_sw_rim_tile(int r, int nti, int ntj, int4 tiles, int *ti, int *tj) {
+  int south = tiles.z * nti, north = (ntj - tiles.w) * nti, per = tiles.x + nti - tiles.y;
+  int row = r < south ? 0 : (r < south + north ? tiles.w : tiles.z);
+  int k = r < south ? r : (r < south + north ? r - south : r - south - north);
+  int w = r < south + north ? nti : per;
+  int e = k / w, a = k - e * w;
+  *tj = row + e;
+  *ti = r < south + north || a < tiles.x ? a : tiles.y + (a - tiles.x);
+}
+
+/* One stage for the tiles of the interior (inner: its tile columns tiles.x
+ * .. tiles.y - 1 and rows tiles.z .. tiles.w - 1, one work-group each), or
+ * for those of the rim (a line of work-groups, gr_sw_rim_tile). */
 GR_INLINE void gr_sw_fused(GR_SW_CELL_ARGS, float lvl_w, float lvl_e, float lvl_s, float lvl_n,
-                           __local float *restrict tile, const int stage) {
+                           __local float *restrict tile, int4 tiles, const int stage,
+                           const int inner) {
   int lx = get_local_id(0), ly = get_local_id(1);
   int tx = get_local_size(0), ty = get_local_size(1);
-  int i0 = get_group_id(0) * tx, j0 = get_group_id(1) * ty;
+  int ti = tiles.x + get_group_id(0), tj = tiles.z + get_group_id(1);
+  if (!inner)
+    gr_sw_rim_tile(get_group_id(0), (nx + tx - 1) / tx, (ny + ty - 1) / ty, tiles, &ti, &tj);
+  int i0 = ti * tx, j0 = tj * ty;
   int i = i0 + lx, j = j0 + ly, lid = ly * tx + lx, wg = tx * ty;
   int pw = tx + 4, np = pw * (ty + 4), nfx = (tx + 1) * ty, nfy = tx * (ty + 1);
   __local float *th = tile, *tb = th + np, *tu = tb + np, *tv = tu + np;
   __local float *xh = tv + np, *xl = xh + nfx, *xr = xl + nfx, *xt = xr + nfx;
-  __local float *yh = xt + nfx, *yl = yh + nfy, *yr = yl + nfy, *yt = yr + nfy;
+  __local float *xsh = xt + nfx, *xse = xsh + nfx;
+  __local float *yh = xse + nfx, *yl = yh + nfy, *yr = yl + nfy, *yt = yr + nfy;
+  __local float *ysh = yt + nfy, *yse = ysh + nfy;
   /* The points: 0 beyond the local array, as gr_sw_point masks them. */
+  float rpw = 1.0f / (float)pw, rx1 = 1.0f / (float)(tx + 1), rx = 1.0f / (float)tx;
   for (int t = lid; t < np; t += wg) {
-    int a = t % pw, e = t / pw, pi = i0 - 2 + a, pj = j0 - 2 + e;
+    int e = gr_sw_div(t, rpw), a = t - e * pw, pi = i0 - 2 + a, pj = j0 - 2 + e;
     bool corner = (a < 2 || a >= tx + 2) && (e < 2 || e >= ty + 2);
     bool in = !corner && pi >= 0 && pi < nx && pj >= 0 && pj < ny;
     float ph = 0.0f, pb = 0.0f, pu = 0.0f, pv = 0.0f;
@@ -1559,55 +1614,52 @@ GR_INLINE void gr_sw_fused(GR_SW_CELL_ARGS, float lvl_w, float lvl_e, float lvl_
   barrier(CLK_LOCAL_MEM_FENCE);
   /* The tile's faces, x-faces then y-faces in one index space: one call
    * of the face's expression, its inputs selected. A face beyond the local
-   * array's is computed from zeros and never read. A tile whose faces all
-   * lie two cells or more inside the grid (nearly every tile of a large
-   * grid) takes the face's expression without the edges' cases: each face
-   * is inner, both its cells have both neighbours, no line is continued,
-   * no ghost is picked and no edge stops a flux, as gr_sw_line_flux finds
-   * face by face in the other tiles; the same floats in fewer
-   * instructions (the H200's step at 4096^2: 2.09 ms before, 1.88 ms). The
-   * whole work-group takes the same branch. */
-  bool interior = i0 >= 2 && i0 + tx + 2 <= nx && j0 >= 2 && j0 + ty + 2 <= ny;
+   * array's is computed from zeros and never read. An interior tile (its
+   * faces all two cells or more inside the grid: nearly every tile of a
+   * large grid) takes the face's expression without the edges' cases:
+   * each face is inner, both its cells have both neighbours, no line is
+   * continued, no ghost is picked and no edge stops a flux, as
+   * gr_sw_line_flux finds face by face in the rim's tiles; the same floats
+   * in fewer instructions. */
   for (int t = lid; t < nfx + nfy; t += wg) {
     bool xs = t < nfx;
     int u = xs ? t : t - nfx, w = xs ? tx + 1 : tx;
-    int a = u % w, e = u / w;
+    int e = gr_sw_div(u, xs ? rx1 : rx), a = u - e * w;
     int p = (e + 2) * pw + a + 2, step = xs ? 1 : pw; /* the high cell's point */
     __local const float *tn = xs ? tu : tv, *tt = xs ? tv : tu;
     gr_sw_pt q0 = gr_sw_tile_pt(th, tb, tn, tt, p - 2 * step);
     gr_sw_pt q1 = gr_sw_tile_pt(th, tb, tn, tt, p - step);
     gr_sw_pt q2 = gr_sw_tile_pt(th, tb, tn, tt, p);
     gr_sw_pt q3 = gr_sw_tile_pt(th, tb, tn, tt, p + step);
-    float fh, fmL, fmR, ft;
-    if (interior)
-      gr_sw_inner_flux(q0, q1, q2, q3, g, &fh, &fmL, &fmR, &ft);
+    float fh, fmL, fmR, ft, sh, se;
+    if (inner)
+      gr_sw_inner_flux(q0, q1, q2, q3, g, &fh, &fmL, &fmR, &ft, &sh, &se);
     else
       gr_sw_line_flux(q0, q1, q2, q3, xs ? i0 + a : j0 + e, xs ? nx : ny, xs ? bnd_w : bnd_s,
                       xs ? bnd_e : bnd_n, xs ? lvl_w : lvl_s, xs ? lvl_e : lvl_n, g, &fh, &fmL,
-                      &fmR, &ft);
+                      &fmR, &ft, &sh, &se);
     __local float *oh = xs ? xh : yh, *ol = xs ? xl : yl, *orr = xs ? xr : yr, *ot = xs ? xt : yt;
+    __local float *osh = xs ? xsh : ysh, *ose = xs ? xse : yse;
     oh[u] = fh;
     ol[u] = fmL;
     orr[u] = fmR;
     ot[u] = ft;
+    osh[u] = sh;
+    ose[u] = se;
   }
   barrier(CLK_LOCAL_MEM_FENCE);
   if (i >= nx || j >= ny)
     return;
   int c = gr_idx(i, j, nx), p = (ly + 2) * pw + lx + 2;
-  gr_sw_pt x1 = gr_sw_tile_pt(th, tb, tu, tv, p - 1);
   gr_sw_pt x2 = gr_sw_tile_pt(th, tb, tu, tv, p);
-  gr_sw_pt x3 = gr_sw_tile_pt(th, tb, tu, tv, p + 1);
-  gr_sw_pt y1 = gr_sw_tile_pt(th, tb, tv, tu, p - pw);
-  gr_sw_pt y3 = gr_sw_tile_pt(th, tb, tv, tu, p + pw);
   int fw = ly * (tx + 1) + lx, fs = ly * tx + lx, fn = fs + tx;
   float suc = stage == 1 ? qu[c] : qu1[c], svc = stage == 1 ? qv[c] : qv1[c];
-  gr_sw_update_cell(GR_SW_CELL_PASS, i, j, x1, x2, x3, y1, y3, xh[fw], xr[fw], xt[fw], xh[fw + 1],
+  gr_sw_update_cell(GR_SW_CELL_PASS, i, j, x2, xsh[fw], xse[fw], ysh[fs], yse[fs], xh[fw], xr[fw], xt[fw], xh[fw + 1],
                     xl[fw + 1], xt[fw + 1], yh[fs], yr[fs], yt[fs], yh[fn], yl[fn], yt[fn], suc,
                     svc, stage, 0);
   /* Half of the stage's edge flows, as rain_runoff_sw_edges books them
-   * after the update. */
-  if (i == 0 || j == 0 || i == nx - 1 || j == ny - 1) {
+   * after the update (the rim's tiles hold every edge cell). */
+  if (!inner && (i == 0 || j == 0 || i == nx - 1 || j == ny - 1)) {
     float olx = i > 0 ? 0.0f : -xh[fw], ohx = i < nx - 1 ? 0.0f : xh[fw + 1];
     float oly = j > 0 ? 0.0f : -yh[fs], ohy = j < ny - 1 ? 0.0f : yh[fn];
     gr_rain_runoff_book_edges(outflow, outflow_comp, inflow, inflow_comp, c, 0.5f * dt, inv_dx,
@@ -1615,16 +1667,23 @@ GR_INLINE void gr_sw_fused(GR_SW_CELL_ARGS, float lvl_w, float lvl_e, float lvl_
   }
 }
 
-/* Both stages take GR_SW_STEP_ARGS (the host binds the same table) and the
- * tile's local memory: 4 (tx + 4) (ty + 4) + 4 (tx + 1) ty + 4 tx (ty + 1)
- * floats. */
-__kernel void rain_runoff_sw_stage1(GR_SW_STEP_ARGS, __local float *restrict tile) {
-  gr_sw_fused(GR_SW_CELL_PASS, lvl_w, lvl_e, lvl_s, lvl_n, tile, 1);
-}
-
-__kernel void rain_runoff_sw_stage2(GR_SW_STEP_ARGS, __local float *restrict tile) {
-  gr_sw_fused(GR_SW_CELL_PASS, lvl_w, lvl_e, lvl_s, lvl_n, tile, 2);
-}
+/* Each stage is two kernels: its interior tiles (rain_runoff_sw_inner*,
+ * tiles.x .. tiles.y - 1 by tiles.z .. tiles.w - 1 work-groups) and the
+ * rest, the rim (rain_runoff_sw_stage*, a line of work-groups). The
+ * interior's kernel carries none of the edges' cases, so it needs fewer
+ * registers: on the H200, capped at 32 a work-item, one kernel for every
+ * tile spilled 80-92 bytes, the interior's kernel spills none (4096^2:
+ * 1.55 ms a step with one kernel, 1.51 with two). All take GR_SW_STEP_ARGS (the host
+ * binds the same table), the tiles and the tile's local memory: 4 (tx + 4)
+ * (ty + 4) + 6 (tx + 1) ty + 6 tx (ty + 1) floats. */
+#define GR_SW_FUSED_KERNEL(name, stage, inner)                                                     \
+  __kernel void name(GR_SW_STEP_ARGS, int4 tiles, __local float *restrict tile) {                 \
+    gr_sw_fused(GR_SW_CELL_PASS, lvl_w, lvl_e, lvl_s, lvl_n, tile, tiles, stage, inner);           \
+  }
+GR_SW_FUSED_KERNEL(rain_runoff_sw_stage1, 1, 0)
+GR_SW_FUSED_KERNEL(rain_runoff_sw_stage2, 2, 0)
+GR_SW_FUSED_KERNEL(rain_runoff_sw_inner1, 1, 1)
+GR_SW_FUSED_KERNEL(rain_runoff_sw_inner2, 2, 1)
 
 /* The stable step's inputs, per work-group: the deepest cell and the
  * fastest rate (|u| + sqrt(g h)) / dx + (|v| + sqrt(g h)) / dy of the owned

@@ -139,12 +139,16 @@ struct gr_rain_runoff {
   /* Shallow water's step: the points of stage 1, then per stage the faces
    * and the cells' update. */
   cl_kernel sw_prep, sw_faces[2], sw_update[2], sw_edges;
-  /* Or each stage in one launch (sw_stage: rain_runoff_sw_stage1, 2), when
-   * sw_fused, in work-groups of sw_local cells (the tile; sw_tile_bytes of
-   * local memory, gr_rain_runoff_sw_shape). */
-  cl_kernel sw_stage[2];
+  /* Or each stage in two launches, when sw_fused, in work-groups of
+   * sw_local cells (the tile; sw_tile_bytes of local memory,
+   * gr_rain_runoff_sw_shape): the interior's tiles (sw_inner:
+   * rain_runoff_sw_inner1, 2; tile columns sw_tiles[0] .. sw_tiles[1] - 1,
+   * rows sw_tiles[2] .. sw_tiles[3] - 1), then the sw_rim others (sw_stage:
+   * rain_runoff_sw_stage1, 2). */
+  cl_kernel sw_stage[2], sw_inner[2];
   int sw_fused;
-  size_t sw_local[2], sw_tile_bytes;
+  size_t sw_local[2], sw_tile_bytes, sw_rim;
+  cl_int sw_tiles[4];
   /* Every kernel comes from the program built for `inputs`: the optional
    * inputs' GR_RAIN_RUNOFF_IN_* bits, and GR_RAIN_RUNOFF_IN_ALL + 1 where it
    * has the shallow-water model's kernels (-1 before the first build;
@@ -805,10 +809,10 @@ static gr_status gr_rain_runoff_piece(const gr_grid *g, gr_flow_model model, int
 }
 
 /* The local memory of a fused shallow-water stage's tile of tx x ty cells
- * (gr_sw_fused): four planes of points with two cells either side, four
- * of x-faces and four of y-faces. */
+ * (gr_sw_fused): four planes of points with two cells either side, six
+ * of x-faces and six of y-faces. */
 static size_t gr_rain_runoff_sw_tile_bytes(size_t tx, size_t ty) {
-  return 4 * sizeof(cl_float) * ((tx + 4) * (ty + 4) + (tx + 1) * ty + tx * (ty + 1));
+  return sizeof(cl_float) * (4 * (tx + 4) * (ty + 4) + 6 * ((tx + 1) * ty + tx * (ty + 1)));
 }
 
 /* The fused shallow-water stages' work-group (rain_runoff_sw_stage1, 2): a
@@ -826,25 +830,31 @@ static gr_status gr_rain_runoff_sw_shape(gr_rain_runoff *s, size_t tx, size_t ty
   cl_device_id dev = gr_context_device(s->ctx);
   cl_device_type type = 0;
   cl_ulong local_mem = 0;
-  size_t wg[2] = {0, 0};
+  size_t most = 0;
   cl_int err = clGetDeviceInfo(dev, CL_DEVICE_TYPE, sizeof(type), &type, NULL);
   if (err == CL_SUCCESS)
     err = clGetDeviceInfo(dev, CL_DEVICE_LOCAL_MEM_SIZE, sizeof(local_mem), &local_mem, NULL);
-  /* A local inertial program has no stages: the device's largest
-   * work-group until the model changes, when the tile is checked again
+  if (err == CL_SUCCESS)
+    err = clGetDeviceInfo(dev, CL_DEVICE_MAX_WORK_GROUP_SIZE, sizeof(most), &most, NULL);
+  /* The smallest work-group any of the four kernels takes. A local
+   * inertial program has no stages: the device's largest work-group until
+   * the model changes, when the tile is checked again
    * (gr_rain_runoff_specialise). */
-  for (int k = 0; err == CL_SUCCESS && k < 2; ++k)
-    err = s->sw_stage[k]
-              ? clGetKernelWorkGroupInfo(s->sw_stage[k], dev, CL_KERNEL_WORK_GROUP_SIZE,
-                                         sizeof(wg[k]), &wg[k], NULL)
-              : clGetDeviceInfo(dev, CL_DEVICE_MAX_WORK_GROUP_SIZE, sizeof(wg[k]), &wg[k], NULL);
+  cl_kernel stages[4] = {s->sw_stage[0], s->sw_stage[1], s->sw_inner[0], s->sw_inner[1]};
+  for (int k = 0; err == CL_SUCCESS && k < 4; ++k) {
+    size_t wg = most;
+    if (stages[k])
+      err = clGetKernelWorkGroupInfo(stages[k], dev, CL_KERNEL_WORK_GROUP_SIZE, sizeof(wg), &wg,
+                                     NULL);
+    most = wg < most ? wg : most;
+  }
   if (err != CL_SUCCESS)
     return gr_cl_check(s->ctx, err, "Querying the device for the shallow-water stages' work-group");
   int gpu = (type & CL_DEVICE_TYPE_GPU) != 0;
-  size_t most = wg[0] < wg[1] ? wg[0] : wg[1];
   if (tx == 0 && ty == 0) {
     /* 32 x 8 on GPUs, measured on the H200 at 4096^2 (ms a step): 32 x 8
-     * 2.16, 64 x 4 2.24, 32 x 4 2.25, 16 x 8 2.48, 16 x 16 2.50. */
+     * 1.51, 64 x 4 1.59, 32 x 4 1.63 (and before the interior's kernel and
+     * the register cap, 16 x 8 2.48, 16 x 16 2.50 against 32 x 8 2.16). */
     tx = 32;
     ty = 8;
     while (ty > 1 && (tx * ty > most || gr_rain_runoff_sw_tile_bytes(tx, ty) > local_mem))
@@ -862,6 +872,22 @@ static gr_status gr_rain_runoff_sw_shape(gr_rain_runoff *s, size_t tx, size_t ty
   s->sw_local[0] = tx;
   s->sw_local[1] = ty;
   s->sw_tile_bytes = bytes;
+  /* The interior's tiles: those whose faces all lie two cells or more
+   * inside the local array (i0 >= 2, i0 + tx + 2 <= nx, and so along y);
+   * with none, every tile is the rim's (rows 0 .. ntj - 1 below an empty
+   * interior). */
+  size_t nti = ((size_t)s->nxl + tx - 1) / tx, ntj = ((size_t)s->nyl + ty - 1) / ty;
+  size_t ilo = (2 + tx - 1) / tx, ihi = s->nxl >= 2 ? ((size_t)s->nxl - 2) / tx : 0;
+  size_t jlo = (2 + ty - 1) / ty, jhi = s->nyl >= 2 ? ((size_t)s->nyl - 2) / ty : 0;
+  if (ihi <= ilo || jhi <= jlo) {
+    ilo = ihi = 0;
+    jlo = jhi = ntj;
+  }
+  s->sw_tiles[0] = (cl_int)ilo;
+  s->sw_tiles[1] = (cl_int)ihi;
+  s->sw_tiles[2] = (cl_int)jlo;
+  s->sw_tiles[3] = (cl_int)jhi;
+  s->sw_rim = nti * ntj - (ihi - ilo) * (jhi - jlo);
   if (set_default)
     s->sw_fused = gpu;
   s->args_set = 0;
@@ -915,16 +941,17 @@ static gr_status gr_rain_runoff_specialise(gr_rain_runoff *s) {
       "rain_runoff_sw_update2", "rain_runoff_sw_edges",   "rain_runoff_sw_stage1",
       "rain_runoff_sw_stage2",  "rain_runoff_reduce",     "rain_runoff_derive",
       "rain_runoff_sw_speed",   "rain_runoff_li_speed",   "rain_runoff_maps",
-      "rain_runoff_source"};
+      "rain_runoff_source",     "rain_runoff_sw_inner1",  "rain_runoff_sw_inner2"};
   enum { GR_RR_KERNELS = sizeof(names) / sizeof(names[0]) };
   /* The shallow-water model's kernels (none in a local inertial program). */
-  static const unsigned char sw_only[GR_RR_KERNELS] = {0, 0, 0, 0, 0, 1, 1, 1, 1, 1,
-                                                       1, 1, 1, 0, 0, 1, 0, 0, 0};
+  static const unsigned char sw_only[GR_RR_KERNELS] = {0, 0, 0, 0, 0, 1, 1, 1, 1, 1, 1,
+                                                       1, 1, 0, 0, 1, 0, 0, 0, 1, 1};
   cl_kernel *slots[GR_RR_KERNELS] = {
       &s->flux,     &s->flux_edges,  &s->limit,       &s->update,       &s->li_step,
       &s->sw_prep,  &s->sw_faces[0], &s->sw_faces[1], &s->sw_update[0], &s->sw_update[1],
       &s->sw_edges, &s->sw_stage[0], &s->sw_stage[1], &s->reduce,       &s->derive,
-      &s->sw_speed, &s->li_speed,    &s->maps,        &s->source};
+      &s->sw_speed, &s->li_speed,    &s->maps,        &s->source,       &s->sw_inner[0],
+      &s->sw_inner[1]};
   char opt[128] = "";
   int len = 0;
   if (s->specialise)
@@ -1132,9 +1159,12 @@ void gr_rain_runoff_destroy(gr_rain_runoff *s) {
     gr_buffer_release(bufs[i]);
   for (int a = 0; a < GR_RAIN_RUNOFF_MAP_ARRAYS; ++a)
     gr_buffer_release(&s->map[a]);
-  for (int k = 0; k < 2; ++k)
+  for (int k = 0; k < 2; ++k) {
     if (s->sw_stage[k])
       clReleaseKernel(s->sw_stage[k]);
+    if (s->sw_inner[k])
+      clReleaseKernel(s->sw_inner[k]);
+  }
   gr_reduction_i64_release(&s->ledger);
   gr_reduction_release(&s->speed);
   gr_reduction_release(&s->film);
@@ -2097,8 +2127,9 @@ static gr_status gr_rain_runoff_hyetograph_step(gr_rain_runoff *s, double t0, do
   for (int k = 0; st == GR_OK && k < (sw ? 5 : (s->fused ? 2 : 5)); ++k)
     st = sw ? gr_kernel_arg(s->ctx, swk[k], "rain_uniform", sizeof(rf), &rf)
             : gr_rain_runoff_arg_at(s, li[k], s->ix_rain[k], sizeof(rf), &rf);
-  for (int k = 0; st == GR_OK && sw && k < 2; ++k)
-    st = gr_kernel_arg(s->ctx, s->sw_stage[k], "rain_uniform", sizeof(rf), &rf);
+  for (int k = 0; st == GR_OK && sw && k < 4; ++k)
+    st = gr_kernel_arg(s->ctx, k < 2 ? s->sw_stage[k] : s->sw_inner[k - 2], "rain_uniform",
+                       sizeof(rf), &rf);
   if (st == GR_OK)
     gr_fixed_add(sum, gr_fixed_from_float(rf));
   return st;
@@ -2265,13 +2296,17 @@ static gr_status gr_rain_runoff_bind(gr_rain_runoff *s, cl_float dt) {
       st = GR_RAIN_RUNOFF_ARGS(s, swk[k], sw);
     for (int k = 0; st == GR_OK && k < 6; ++k)
       st = GR_RAIN_RUNOFF_ARGS(s, swk[k], maps);
-    /* The fused stages take the same arguments and their tile. */
-    for (int k = 0; st == GR_OK && k < 2; ++k)
-      st = GR_RAIN_RUNOFF_ARGS(s, s->sw_stage[k], sw);
-    for (int k = 0; st == GR_OK && k < 2; ++k)
-      st = GR_RAIN_RUNOFF_ARGS(s, s->sw_stage[k], maps);
-    for (int k = 0; st == GR_OK && k < 2; ++k)
-      st = gr_kernel_arg(s->ctx, s->sw_stage[k], "tile", s->sw_tile_bytes, NULL);
+    /* The fused stages take the same arguments, the interior's tiles and
+     * their tile's local memory. */
+    cl_kernel fused[4] = {s->sw_stage[0], s->sw_stage[1], s->sw_inner[0], s->sw_inner[1]};
+    for (int k = 0; st == GR_OK && k < 4; ++k)
+      st = GR_RAIN_RUNOFF_ARGS(s, fused[k], sw);
+    for (int k = 0; st == GR_OK && k < 4; ++k)
+      st = GR_RAIN_RUNOFF_ARGS(s, fused[k], maps);
+    for (int k = 0; st == GR_OK && k < 4; ++k)
+      st = gr_kernel_arg(s->ctx, fused[k], "tiles", sizeof(s->sw_tiles), s->sw_tiles);
+    for (int k = 0; st == GR_OK && k < 4; ++k)
+      st = gr_kernel_arg(s->ctx, fused[k], "tile", s->sw_tile_bytes, NULL);
     s->args_set = st == GR_OK;
     s->args_dt = dt;
     return st;
@@ -2343,13 +2378,22 @@ static gr_status gr_rain_runoff_enqueue(gr_rain_runoff *s, double dt, int nsteps
     /* Stage 2's update folds the new state into the flood maps at the
      * step's end. */
     cl_float map_time = (cl_float)(t_end += dt);
-    /* Fused: each of Heun's stages in one launch, its faces in local memory
-     * (rain_runoff_sw_stage1, 2). */
+    /* Fused: each of Heun's stages in two launches, the interior's tiles
+     * and the rim's, their faces in local memory (rain_runoff_sw_inner1, 2
+     * and rain_runoff_sw_stage1, 2). */
     if (st == GR_OK && s->sw_fused)
       st = gr_kernel_arg(s->ctx, s->sw_stage[1], "map_time", sizeof(map_time), &map_time);
-    for (int stage = 0; st == GR_OK && s->sw_fused && stage < 2; ++stage)
-      st = gr_enqueue_2d(s->ctx, s->sw_stage[stage], 0, 0, (size_t)s->nxl, (size_t)s->nyl,
-                         s->sw_local);
+    if (st == GR_OK && s->sw_fused)
+      st = gr_kernel_arg(s->ctx, s->sw_inner[1], "map_time", sizeof(map_time), &map_time);
+    for (int stage = 0; st == GR_OK && s->sw_fused && stage < 2; ++stage) {
+      const cl_int *t = s->sw_tiles;
+      if (t[1] > t[0] && t[3] > t[2])
+        st = gr_enqueue_2d(s->ctx, s->sw_inner[stage], 0, 0, (size_t)(t[1] - t[0]) * s->sw_local[0],
+                           (size_t)(t[3] - t[2]) * s->sw_local[1], s->sw_local);
+      if (st == GR_OK && s->sw_rim)
+        st = gr_enqueue_2d(s->ctx, s->sw_stage[stage], 0, 0, s->sw_rim * s->sw_local[0],
+                           s->sw_local[1], s->sw_local);
+    }
     /* Or stage 1's points, then Heun's two stages: every face once, then
      * every cell from its four faces. */
     if (st == GR_OK && !s->sw_fused)

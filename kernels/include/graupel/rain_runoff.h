@@ -561,8 +561,9 @@ GR_API gr_status gr_rain_runoff_halo_set(gr_rain_runoff *s, int side, const void
 
 /**
  * How a shallow-water step (FlowModel 0) is launched: each of Heun's two
- * stages in one launch, each work-group computing its tile's faces in local
- * memory from the tile and two cells either side of it (non-zero), or in
+ * stages in two launches (the interior's tiles, then the rim's), each
+ * work-group computing its tile's faces in local memory from the tile and
+ * two cells either side of it (non-zero), or in
  * the stages' separate launches (points, faces, cells, edge flows) through
  * global memory (0). Both give the same bits; only the speed differs, and a
  * simulation may switch between steps. The default is the device's faster
