@@ -488,26 +488,37 @@ GR_INLINE void gr_rain_runoff_book_edges(__global float *restrict outflow,
 GR_INLINE void gr_rain_runoff_map_cell(int c, float d, float u, float v, GR_RAIN_RUNOFF_MAP_ARGS,
                                        float time, float dt) {
   int moving = d >= GR_RAIN_RUNOFF_VELOCITY_DEPTH;
-  float ux = moving ? u / d : 0.0f, vy = moving ? v / d : 0.0f;
+  /* Divided either way, then selected (a dry cell's quotient is never
+   * used): a division under a condition is a branch on NVIDIA devices. */
+  float uq = u / d, vq = v / d;
+  float ux = moving ? uq : 0.0f, vy = moving ? vq : 0.0f;
   float speed = sqrt(ux * ux + vy * vy);
   /* FD2321's debris factor applies above 0.25 m only (its table gives 0
    * below that depth for every land use). */
   float hazard = d * (speed + 0.5f) + (d > GR_RAIN_RUNOFF_DEBRIS_DEPTH ? debris_factor : 0.0f);
-  /* Stores only where a value changes: past the peak most cells write
-   * nothing, which keeps the launch's traffic near its reads. */
-  if (d > max_depth[c])
+  /* Every map read first, whether or not its value changes: reads that
+   * wait on the new depth (arrival and wet time only where the cell is
+   * wet) cost the local inertial update on the H200 4 % of its time. Stores
+   * only where a value changes: past the peak most cells write nothing,
+   * which keeps the launch's traffic near its reads. */
+  float md = max_depth[c], msp = max_speed[c], mh = max_hazard[c], ar = arrival[c];
+  float wt = wet_time[c], wc = wet_time_comp[c];
+  bool wet = d > wetting_depth;
+  if (d > md)
     max_depth[c] = d;
   /* The speed of water above the wetting depth only: q / h of the films a
    * front leaves behind says nothing of the flow (hundreds of m/s). */
-  if (d > wetting_depth && speed > max_speed[c])
+  if (wet && speed > msp)
     max_speed[c] = speed;
-  if (hazard > max_hazard[c])
+  if (hazard > mh)
     max_hazard[c] = hazard;
-  if (d > wetting_depth) {
-    if (arrival[c] < 0.0f)
-      arrival[c] = time;
-    if (dt > 0.0f)
-      gr_kahan_add(wet_time, wet_time_comp, c, dt);
+  if (wet && ar < 0.0f)
+    arrival[c] = time;
+  if (wet && dt > 0.0f) {
+    /* gr_kahan_add on the values read. */
+    float y = dt - wc, t = wt + y;
+    wet_time_comp[c] = (t - wt) - y;
+    wet_time[c] = t;
   }
 }
 
@@ -881,8 +892,15 @@ GR_INLINE float gr_sw_velocity(float h, float q) {
   return 2.0f * h * q / (h2 + fmax(h2, GR_RAIN_RUNOFF_SW_EPS * GR_RAIN_RUNOFF_SW_EPS));
 }
 
+/* The smaller slope where both have one sign, else 0: the smaller of the
+ * two where it is positive, the larger where it is negative. Written as
+ * selections of values both computed: the same floats as the tests of each
+ * sign (a > 0 && b > 0 ? fmin : ...), which NVIDIA's compiler made into
+ * branches, eight a face, diverging wherever neighbouring slopes differ in
+ * sign. */
 GR_INLINE float gr_sw_minmod(float a, float b) {
-  return a > 0.0f && b > 0.0f ? fmin(a, b) : (a < 0.0f && b < 0.0f ? fmax(a, b) : 0.0f);
+  float lo = fmin(a, b), hi = fmax(a, b);
+  return lo > 0.0f ? lo : (hi < 0.0f ? hi : 0.0f);
 }
 
 /* A cell of a line: depth, bed, velocity along and across the line. The
@@ -959,8 +977,12 @@ GR_INLINE void gr_sw_hll(float hL, float uL, float vL, float hR, float uR, float
    * that CPU compilers do not pair the two square roots into a <2 x float>
    * before vectorising across work-items, which such values prevent. */
   float cL = sqrt(g * hL), cR = sqrt(g * hR + 0.0f * cL);
-  float sL = dryL ? uR - 2.0f * cR : (dryR ? uL - cL : fmin(uL - cL, uR - cR));
-  float sR = dryR ? uL + 2.0f * cL : (dryL ? uR + cR : fmax(uL + cL, uR + cR));
+  /* Each speed's three cases computed, then selected (nested conditionals
+   * of expressions compiled to branches on NVIDIA devices). */
+  float lo_dl = uR - 2.0f * cR, lo_dr = uL - cL, lo_w = fmin(uL - cL, uR - cR);
+  float hi_dr = uL + 2.0f * cL, hi_dl = uR + cR, hi_w = fmax(uL + cL, uR + cR);
+  float sL = dryL ? lo_dl : (dryR ? lo_dr : lo_w);
+  float sR = dryR ? hi_dr : (dryL ? hi_dl : hi_w);
   float qL = hL * uL, qR = hR * uR;
   float mL = qL * uL + 0.5f * g * hL * hL, mR = qR * uR + 0.5f * g * hR * hR;
   /* (sR F_L - sL F_R + sL sR (U_R - U_L)) / (sR - sL), written as F_L plus
@@ -1211,20 +1233,26 @@ GR_INLINE void gr_sw_balance(float h, float sh, float se, float fh_lo, float fmR
  * implicit in the new discharge: |q'| (1 + g dt n^2 |q'| / h^(7/3)) = |q|,
  * in q's direction (solved exactly, as the local inertial model does). */
 GR_INLINE void gr_sw_friction(float h, float dt, float g, float n2, float *qx, float *qy) {
-  if (!(h > 0.0f && n2 > 0.0f))
-    return;
+  /* Computed whatever the depth and discharge, then selected (none of the
+   * unused values is ever kept): conditions around the divisions were
+   * branches on NVIDIA devices, diverging at every wet/dry edge. */
   float qm = sqrt(*qx * *qx + *qy * *qy);
   float kf = g * dt * n2 * gr_rain_runoff_pow_m73(fmax(h, GR_RAIN_RUNOFF_DRY));
-  float scale = qm > 0.0f ? gr_rain_runoff_solve(qm, kf) / qm : 0.0f;
-  *qx *= scale;
-  *qy *= scale;
+  float ratio = gr_rain_runoff_solve(qm, kf) / qm;
+  float scale = qm > 0.0f ? ratio : 0.0f;
+  bool on = h > 0.0f && n2 > 0.0f;
+  *qx = on ? *qx * scale : *qx;
+  *qy = on ? *qy * scale : *qy;
 }
 
 /* Rain and infiltration on a cell's water (as the local inertial model
  * takes them), its momentum scaled with the water infiltration removes. */
 GR_INLINE float gr_sw_wet_q(float h, float q, float r, float s, float dt, float hw) {
-  float h1 = gr_rain_runoff_gain(h, r, s, dt);
-  return h1 > 0.0f ? q * (hw / h1) : 0.0f;
+  /* The share computed whether or not there is water (a dry cell's 0 / 0
+   * is never selected): a conditional share made NVIDIA's compiler load q
+   * only after the test. */
+  float h1 = gr_rain_runoff_gain(h, r, s, dt), share = hw / h1;
+  return h1 > 0.0f ? q * share : 0.0f;
 }
 
 /* The arguments every shallow-water step kernel takes (each uses those it
