@@ -4663,6 +4663,72 @@ static void give_inputs(gr_rain_runoff *sim, int bits, const float *r, const flo
     CHECK(gr_rain_runoff_set_manning_map(sim, nmap) == GR_OK);
 }
 
+/* The two forms of the expressions written apart for GPUs and CPUs
+ * (-DGR_RAIN_RUNOFF_GPU=1 or 0: the host picks by the device's type; see
+ * gr_sw_minmod) give the same bits. Each form is forced through
+ * GRAUPEL_CL_OPTIONS (read at each program build, the last -D winning), so
+ * both run on whatever device the test has: the shallow-water model on the
+ * 75 x 41 bumpy grid of the launch-path tests with every optional input, a
+ * wall, a transmissive, a level and an open edge, in each launch path;
+ * after 120 steps the whole state and the ledger are the same to the bit. */
+static void test_device_forms(void) {
+  gr_grid g = {75, 41, 2.0, 1.5, 0.0, 0.0, 0, 0};
+  size_t n = cells_of(&g);
+  float *b = alloc_field(&g, 1), *r = alloc_field(&g, 1), *k = alloc_field(&g, 1);
+  float *d = alloc_field(&g, 1);
+  double *nmap = malloc(n * sizeof(double));
+  paths_fields(&g, b, r, k, d, nmap, 6, 5);
+  gr_rain_runoff_params p = params_with(2e-5, 1e-6, GR_BOUNDARY_OPEN);
+  p.flow_model = GR_FLOW_SHALLOW_WATER;
+  p.no_data = GR_BOUNDARY_OPEN;
+  p.boundary[GR_RAIN_RUNOFF_WEST] = GR_BOUNDARY_LEVEL;
+  p.boundary_level[GR_RAIN_RUNOFF_WEST] = 0.5;
+  p.boundary[GR_RAIN_RUNOFF_EAST] = GR_BOUNDARY_TRANSMISSIVE;
+  p.boundary[GR_RAIN_RUNOFF_SOUTH] = GR_BOUNDARY_CLOSED;
+  const char *before = getenv("GRAUPEL_CL_OPTIONS");
+  char *kept = before ? strdup(before) : NULL;
+  for (int fused = 0; fused < 2; ++fused) {
+    gr_rain_runoff *sim[2] = {NULL, NULL}; /* the CPUs' form, the GPUs' */
+    for (int v = 0; v < 2; ++v) {
+      char opt[512];
+      snprintf(opt, sizeof(opt), "%s -DGR_RAIN_RUNOFF_GPU=%d", kept ? kept : "", v);
+      setenv("GRAUPEL_CL_OPTIONS", opt, 1);
+      sim[v] = make_sim(&g, &p, b, d);
+      if (sim[v]) {
+        gr_rain_runoff_set_sw_fused(sim[v], fused);
+        give_inputs(sim[v], GR_RAIN_RUNOFF_INPUT_ALL, r, k, nmap);
+        run_stable(sim[v], 4, 30); /* builds the program under this form */
+      }
+    }
+    if (kept)
+      setenv("GRAUPEL_CL_OPTIONS", kept, 1);
+    else
+      unsetenv("GRAUPEL_CL_OPTIONS");
+    if (sim[0] && sim[1]) {
+      size_t words = 0;
+      long diff = state_words_differ(sim[0], sim[1], &words);
+      gr_rain_runoff_ledger l0 = ledger(sim[0]), l1 = ledger(sim[1]);
+      CHECK_MSG(diff == 0 && memcmp(&l0, &l1, sizeof(l0)) == 0,
+                "%s: %ld words of the state of %zu differ between the forms; ledgers %s",
+                fused ? "fused" : "separate launches", diff, words,
+                memcmp(&l0, &l1, sizeof(l0)) == 0 ? "agree" : "differ");
+      CHECK_MSG(l0.steps == 120 && l0.outflow_volume > 0.0 && l0.infiltrated_volume > 0.0,
+                "%lld steps, outflow %g m^3, infiltrated %g m^3", l0.steps, l0.outflow_volume,
+                l0.infiltrated_volume);
+      printf("%s: %ld words of %zu differ between the forms; outflow %.4f m^3\n",
+             fused ? "fused" : "separate launches", diff, words, l0.outflow_volume);
+    }
+    gr_rain_runoff_destroy(sim[0]);
+    gr_rain_runoff_destroy(sim[1]);
+  }
+  free(kept);
+  free(b);
+  free(r);
+  free(k);
+  free(d);
+  free(nmap);
+}
+
 /* The step kernels compiled for the optional inputs in use
  * (gr_rain_runoff_set_specialised, the default) give the general kernels'
  * bits. Both models on the 75 x 41 bumpy grid of the launch-path tests,
@@ -4855,6 +4921,7 @@ static const gr_subtest tests[] = {
     {"no_data", test_no_data, 0},
     {"li_fused", test_li_fused, 0},
     {"specialised", test_specialised, 0},
+    {"device_forms", test_device_forms, 0},
     {"pieces_paths", test_pieces_paths, 0},
 };
 

@@ -160,6 +160,10 @@ struct gr_rain_runoff {
    * the program is built with at most GR_RAIN_RUNOFF_NV_REGISTERS
    * registers a work-item. */
   int nv_registers;
+  /* The device is a GPU: the program is built with -DGR_RAIN_RUNOFF_GPU=1
+   * (the forms of a few expressions SIMT devices run without branches,
+   * the same floats). */
+  int gpu;
   cl_mem h, h_c, b, k, inf, inf_c, out, out_c;
   cl_mem in, in_c; /* inflow (edges and sources), per cell (m), and its compensation */
   /* Sources (m/s of depth): the point inflows' field (pts, once set) and
@@ -952,11 +956,13 @@ static gr_status gr_rain_runoff_specialise(gr_rain_runoff *s) {
       &s->sw_edges, &s->sw_stage[0], &s->sw_stage[1], &s->reduce,       &s->derive,
       &s->sw_speed, &s->li_speed,    &s->maps,        &s->source,       &s->sw_inner[0],
       &s->sw_inner[1]};
-  char opt[128] = "";
+  char opt[160] = "";
   int len = 0;
   if (s->specialise)
     len = snprintf(opt, sizeof(opt), "-DGR_RAIN_RUNOFF_INPUTS=%d -DGR_RAIN_RUNOFF_SW=%d ", inputs,
                    sw);
+  if (s->gpu)
+    len += snprintf(opt + len, sizeof(opt) - (size_t)len, "-DGR_RAIN_RUNOFF_GPU=1 ");
   if (s->nv_registers)
     snprintf(opt + len, sizeof(opt) - (size_t)len, "-cl-nv-maxrregcount=%d",
              GR_RAIN_RUNOFF_NV_REGISTERS);
@@ -1090,6 +1096,10 @@ gr_status gr_rain_runoff_create(gr_context *ctx, const gr_grid *grid,
           CL_SUCCESS)
     s->nv_registers = strstr(ext, "cl_nv_compiler_options") != NULL;
   free(ext);
+  cl_device_type type = 0;
+  if (clGetDeviceInfo(gr_context_device(ctx), CL_DEVICE_TYPE, sizeof(type), &type, NULL) ==
+      CL_SUCCESS)
+    s->gpu = (type & CL_DEVICE_TYPE_GPU) != 0;
   st = gr_rain_runoff_specialise(s);
   if (st == GR_OK)
     st = gr_rain_runoff_sw_shape(s, 0, 0, 1);
