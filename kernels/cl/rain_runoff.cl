@@ -905,7 +905,7 @@ GR_INLINE float gr_sw_velocity(float h, float q) {
  * computed, since NVIDIA's compiler made the tests of each sign into
  * branches, eight a face, diverging wherever neighbouring slopes differ in
  * sign (the H200's shallow-water step at 4096^2 took 1.51 ms with them and
- * 1.40 without); on CPUs the tests of each sign, since PoCL pairs the
+ * the HLL speeds' branches, 1.40 without); on CPUs the tests of each sign, since PoCL pairs the
  * other form's fmin and fmax into a <2 x float> and then runs the stage
  * kernels scalar (1024^2: 28 ms a step became 90). */
 GR_INLINE float gr_sw_minmod(float a, float b) {
