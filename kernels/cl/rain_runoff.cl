@@ -1190,8 +1190,7 @@ GR_INLINE void gr_sw_inner_flux(gr_sw_pt q0, gr_sw_pt q1, gr_sw_pt q2, gr_sw_pt 
   gr_sw_cell R = gr_sw_recon(q1, q2, q3, true);
   *sh = R.sh;
   *se = R.se;
-  gr_sw_face(gr_sw_recon(q0, q1, q2, true), R, true, gr_sw_rise(q1, q2, 0.0f), g, fh, fmL, fmR,
-             ft);
+  gr_sw_face(gr_sw_recon(q0, q1, q2, true), R, true, gr_sw_rise(q1, q2, 0.0f), g, fh, fmL, fmR, ft);
 }
 
 /* gr_sw_line_flux's four values written to out[f] and the three planes
@@ -1234,8 +1233,8 @@ GR_INLINE void gr_sw_cell_slopes(gr_sw_pt p1, gr_sw_pt p2, gr_sw_pt p3, int i, i
  * fh, fmL, ft (gr_sw_line_flux): dh (mass in minus out), dqn and dqt
  * (momentum, with the bed's source), per unit of the axis' face length. */
 GR_INLINE void gr_sw_balance(float h, float sh, float se, float fh_lo, float fmR_lo, float ft_lo,
-                             float fh_hi, float fmL_hi, float ft_hi, float g, float *dh,
-                             float *dqn, float *dqt) {
+                             float fh_hi, float fmL_hi, float ft_hi, float g, float *dh, float *dqn,
+                             float *dqt) {
   float hw = h - 0.5f * sh, he = h + 0.5f * sh;
   *dh = fh_lo - fh_hi;
   /* (fmw + g hw^2 / 2) - (fme + g he^2 / 2) - g (hw + he) / 2 (bed slope)
@@ -1405,11 +1404,11 @@ __kernel void rain_runoff_sw_faces2(GR_SW_STEP_ARGS) {
  * momenta before the stage (suc, svc; stage 2's, stage 1 takes the wet
  * ones); with velocities, stage 1 also writes U1's velocities u1, v1. Both
  * launch paths call it, so they give the same floats. */
-GR_INLINE void gr_sw_update_cell(GR_SW_CELL_ARGS, int i, int j, gr_sw_pt x2, float shx,
-                                 float sex, float shy, float sey, float fh_w, float fm_w,
-                                 float ft_w, float fh_e, float fm_e, float ft_e, float fh_s,
-                                 float fm_s, float ft_s, float fh_n, float fm_n, float ft_n,
-                                 float suc, float svc, const int stage, const int velocities) {
+GR_INLINE void gr_sw_update_cell(GR_SW_CELL_ARGS, int i, int j, gr_sw_pt x2, float shx, float sex,
+                                 float shy, float sey, float fh_w, float fm_w, float ft_w,
+                                 float fh_e, float fm_e, float ft_e, float fh_s, float fm_s,
+                                 float ft_s, float fh_n, float fm_n, float ft_n, float suc,
+                                 float svc, const int stage, const int velocities) {
   int c = gr_idx(i, j, nx);
   float n2c = GR_RAIN_RUNOFF_USES(GR_RAIN_RUNOFF_IN_N2, use_n2)
                   ? n2map[c]
@@ -1561,11 +1560,11 @@ __kernel void rain_runoff_sw_edges(GR_SW_STEP_ARGS) {
  * qu1, qv1, the velocities as stage 1 would have stored them), computes its
  * tile's faces there (each face once: an x-face and a y-face per cell, one
  * more column and row; each face also keeps its high cell's slopes, which
- * the update takes instead of reconstructing the cell again), then updates its cells and books the rim's edge
- * flows. Points and faces never go to global memory: per cell a step reads
- * the state, bed and stage (h, qu, qv, b; h1, qu1, qv1, dh1, h_comp) and
- * writes the stage and the state. The local array `tile` holds four planes
- * of points ((tx + 4) (ty + 4) each: h, b, u, v) and six of x-faces
+ * the update takes instead of reconstructing the cell again), then updates its cells and books the
+ * rim's edge flows. Points and faces never go to global memory: per cell a step reads the state,
+ * bed and stage (h, qu, qv, b; h1, qu1, qv1, dh1, h_comp) and writes the stage and the state. The
+ * local array `tile` holds four planes of points ((tx + 4) (ty + 4) each: h, b, u, v) and six of
+ * x-faces
  * ((tx + 1) ty) and y-faces (tx (ty + 1)): fh, fmL, fmR, ft and the high
  * cell's sh, se. */
 
@@ -1587,7 +1586,9 @@ GR_INLINE gr_sw_pt gr_sw_tile_pt(__local const float *restrict th, __local const
  * error, so its floor is the quotient. An integer division by a number
  * known only at run time is some twenty instructions on GPUs; the tile's
  * loops take one per point and per face. */
-GR_INLINE int gr_sw_div(int t, float rw) { return (int)(((float)t + 0.5f) * rw); }
+GR_INLINE int gr_sw_div(int t, float rw) {
+  return (int)(((float)t + 0.5f) * rw);
+}
 
 /* The tile (*ti, *tj) of the rim's work-group r (rain_runoff_sw_stage*):
  * the tiles outside the interior ones (tiles: their columns x .. y - 1 and
@@ -1696,9 +1697,9 @@ GR_INLINE void gr_sw_fused(GR_SW_CELL_ARGS, float lvl_w, float lvl_e, float lvl_
   gr_sw_pt x2 = gr_sw_tile_pt(th, tb, tu, tv, p);
   int fw = ly * (tx + 1) + lx, fs = ly * tx + lx, fn = fs + tx;
   float suc = stage == 1 ? qu[c] : qu1[c], svc = stage == 1 ? qv[c] : qv1[c];
-  gr_sw_update_cell(GR_SW_CELL_PASS, i, j, x2, xsh[fw], xse[fw], ysh[fs], yse[fs], xh[fw], xr[fw], xt[fw], xh[fw + 1],
-                    xl[fw + 1], xt[fw + 1], yh[fs], yr[fs], yt[fs], yh[fn], yl[fn], yt[fn], suc,
-                    svc, stage, 0);
+  gr_sw_update_cell(GR_SW_CELL_PASS, i, j, x2, xsh[fw], xse[fw], ysh[fs], yse[fs], xh[fw], xr[fw],
+                    xt[fw], xh[fw + 1], xl[fw + 1], xt[fw + 1], yh[fs], yr[fs], yt[fs], yh[fn],
+                    yl[fn], yt[fn], suc, svc, stage, 0);
   /* Half of the stage's edge flows, as rain_runoff_sw_edges books them
    * after the update (the rim's tiles hold every edge cell). */
   if (!inner && (i == 0 || j == 0 || i == nx - 1 || j == ny - 1)) {
@@ -1719,7 +1720,7 @@ GR_INLINE void gr_sw_fused(GR_SW_CELL_ARGS, float lvl_w, float lvl_e, float lvl_
  * binds the same table), the tiles and the tile's local memory: 4 (tx + 4)
  * (ty + 4) + 6 (tx + 1) ty + 6 tx (ty + 1) floats. */
 #define GR_SW_FUSED_KERNEL(name, stage, inner)                                                     \
-  __kernel void name(GR_SW_STEP_ARGS, int4 tiles, __local float *restrict tile) {                 \
+  __kernel void name(GR_SW_STEP_ARGS, int4 tiles, __local float *restrict tile) {                  \
     gr_sw_fused(GR_SW_CELL_PASS, lvl_w, lvl_e, lvl_s, lvl_n, tile, tiles, stage, inner);           \
   }
 GR_SW_FUSED_KERNEL(rain_runoff_sw_stage1, 1, 0)

@@ -951,10 +951,10 @@ static gr_status gr_rain_runoff_specialise(gr_rain_runoff *s) {
   static const unsigned char sw_only[GR_RR_KERNELS] = {0, 0, 0, 0, 0, 1, 1, 1, 1, 1, 1,
                                                        1, 1, 0, 0, 1, 0, 0, 0, 1, 1};
   cl_kernel *slots[GR_RR_KERNELS] = {
-      &s->flux,     &s->flux_edges,  &s->limit,       &s->update,       &s->li_step,
-      &s->sw_prep,  &s->sw_faces[0], &s->sw_faces[1], &s->sw_update[0], &s->sw_update[1],
-      &s->sw_edges, &s->sw_stage[0], &s->sw_stage[1], &s->reduce,       &s->derive,
-      &s->sw_speed, &s->li_speed,    &s->maps,        &s->source,       &s->sw_inner[0],
+      &s->flux,       &s->flux_edges,  &s->limit,       &s->update,       &s->li_step,
+      &s->sw_prep,    &s->sw_faces[0], &s->sw_faces[1], &s->sw_update[0], &s->sw_update[1],
+      &s->sw_edges,   &s->sw_stage[0], &s->sw_stage[1], &s->reduce,       &s->derive,
+      &s->sw_speed,   &s->li_speed,    &s->maps,        &s->source,       &s->sw_inner[0],
       &s->sw_inner[1]};
   char opt[160] = "";
   int len = 0;
