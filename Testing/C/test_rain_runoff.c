@@ -12,9 +12,9 @@
 #include "graupel/cl_runtime.h"
 #include "graupel/rain_runoff.h"
 #include "gr_test.h"
+#include "gr_test_team.h"
 
 #include <math.h>
-#include <pthread.h>
 #include <stddef.h>
 #include <stdint.h>
 #include <stdlib.h>
@@ -2534,40 +2534,26 @@ static void test_pieces_x(void) {
 /* Two threads, one piece each (split in y), with a barrier-based allreduce
  * and a mailbox for the halo: the allreduce gives both the whole domain's
  * stable step and ledger. */
-typedef struct team {
-  pthread_barrier_t barrier;
-  double slot[2][32];
-  void *mail[2];
-  size_t mail_bytes[2];
-} team;
-
 typedef struct member {
-  team *t;
+  gr_test_team *t;
   int rank, steps;
   piece *p;
   gr_status st;
   gr_rain_runoff_ledger l;
 } member;
 
+static gr_status team_halo(void *s, int side, void *host, size_t bytes, int set) {
+  return set ? gr_rain_runoff_halo_set(s, side, host, bytes)
+             : gr_rain_runoff_halo_get(s, side, host, bytes);
+}
+
 static gr_status team_allreduce(void *user, double *values, int n, gr_reduce_op op) {
   member *m = user;
-  team *t = m->t;
-  if (n > 32)
-    return GR_ERR_INVALID_ARGUMENT;
-  memcpy(t->slot[m->rank], values, (size_t)n * sizeof(double));
-  pthread_barrier_wait(&t->barrier);
-  for (int q = 0; q < n; ++q) { /* in rank order: every member gets the same bits */
-    double a = t->slot[0][q], b = t->slot[1][q];
-    values[q] = op == GR_REDUCE_SUM ? a + b : op == GR_REDUCE_MAX ? fmax(a, b) : fmin(a, b);
-  }
-  pthread_barrier_wait(&t->barrier);
-  return GR_OK;
+  return gr_test_team_allreduce(m->t, m->rank, values, n, op);
 }
 
 static void *member_run(void *arg) {
   member *m = arg;
-  team *t = m->t;
-  int out = m->rank == 0 ? GR_RAIN_RUNOFF_NORTH : GR_RAIN_RUNOFF_SOUTH;
   gr_status st = GR_OK;
   for (int k = 0; k < m->steps; ++k) {
     double dt = 0.0;
@@ -2575,11 +2561,9 @@ static void *member_run(void *arg) {
     if (s1 == GR_OK)
       s1 = gr_rain_runoff_step(m->p->s, dt, 1);
     if (s1 == GR_OK)
-      s1 = gr_rain_runoff_halo_get(m->p->s, out, t->mail[m->rank], t->mail_bytes[m->rank]);
-    pthread_barrier_wait(&t->barrier);
-    if (s1 == GR_OK)
-      s1 = gr_rain_runoff_halo_set(m->p->s, out, t->mail[1 - m->rank], t->mail_bytes[1 - m->rank]);
-    pthread_barrier_wait(&t->barrier);
+      s1 = gr_test_team_exchange(m->t, m->rank, m->p->s, team_halo);
+    else
+      gr_test_team_pass(m->t);
     if (st == GR_OK)
       st = s1;
   }
@@ -2597,25 +2581,20 @@ static void *member_ledger(void *arg) {
 /* The global ledger of two pieces: gr_rain_runoff_ledger_get (collective)
  * on two threads with the team's allreduce, which is removed again. */
 static void team_ledger(piece *pc, gr_rain_runoff_ledger *out) {
-  team t;
-  memset(&t, 0, sizeof(t));
-  pthread_barrier_init(&t.barrier, NULL, 2);
+  gr_test_team t;
+  gr_test_team_init(&t, 2, 32);
   member m[2];
-  pthread_t th[2];
   for (int k = 0; k < 2; ++k) {
     m[k] = (member){&t, k, 0, &pc[k], GR_OK, {0}};
     gr_rain_runoff_set_allreduce(pc[k].s, team_allreduce, &m[k]);
   }
-  for (int k = 0; k < 2; ++k)
-    pthread_create(&th[k], NULL, member_ledger, &m[k]);
-  for (int k = 0; k < 2; ++k)
-    pthread_join(th[k], NULL);
+  gr_test_team_run(2, member_ledger, m, sizeof(m[0]));
   for (int k = 0; k < 2; ++k) {
     CHECK_MSG(m[k].st == GR_OK, "ledger of piece %d: %s", k, gr_rain_runoff_last_error(pc[k].s));
     gr_rain_runoff_set_allreduce(pc[k].s, NULL, NULL);
     out[k] = m[k].l;
   }
-  pthread_barrier_destroy(&t.barrier);
+  gr_test_team_destroy(&t);
 }
 
 static void test_pieces_y(void) {
@@ -2627,28 +2606,23 @@ static void test_pieces_y(void) {
       make_piece(&pc[0], &dm, &prm, 0, 0, 29, 20) && make_piece(&pc[1], &dm, &prm, 0, 20, 29, 21);
   const int steps = 150;
   if (ok && whole) {
-    team t;
-    memset(&t, 0, sizeof(t));
-    pthread_barrier_init(&t.barrier, NULL, 2);
+    gr_test_team t;
+    gr_test_team_init(&t, 2, 32);
     member m[2];
-    pthread_t th[2];
     for (int k = 0; k < 2; ++k) {
-      CHECK(gr_rain_runoff_halo_size(pc[k].s, k == 0 ? GR_RAIN_RUNOFF_NORTH : GR_RAIN_RUNOFF_SOUTH,
-                                     &t.mail_bytes[k]) == GR_OK);
-      t.mail[k] = malloc(t.mail_bytes[k]);
+      int side = k == 0 ? GR_RAIN_RUNOFF_NORTH : GR_RAIN_RUNOFF_SOUTH;
+      size_t bytes = 0;
+      CHECK(gr_rain_runoff_halo_size(pc[k].s, side, &bytes) == GR_OK);
+      gr_test_team_mail(&t, k, side, bytes);
       m[k] = (member){&t, k, steps, &pc[k], GR_OK, {0}};
       gr_rain_runoff_set_allreduce(pc[k].s, team_allreduce, &m[k]);
     }
-    for (int k = 0; k < 2; ++k)
-      pthread_create(&th[k], NULL, member_run, &m[k]);
-    for (int k = 0; k < 2; ++k)
-      pthread_join(th[k], NULL);
+    gr_test_team_run(2, member_run, m, sizeof(m[0]));
     for (int k = 0; k < 2; ++k) {
       CHECK_MSG(m[k].st == GR_OK, "member %d: %s", k, gr_rain_runoff_last_error(pc[k].s));
       gr_rain_runoff_set_allreduce(pc[k].s, NULL, NULL);
-      free(t.mail[k]);
     }
-    pthread_barrier_destroy(&t.barrier);
+    gr_test_team_destroy(&t);
     for (int k = 0; k < steps; ++k) {
       double dt = 0.0;
       CHECK(gr_rain_runoff_stable_dt(whole, &dt) == GR_OK);
@@ -2677,7 +2651,6 @@ static void test_pieces_y(void) {
  * the core calls after every step. */
 typedef struct advancer {
   member m; /* the allreduce's user: team and rank */
-  int side; /* the side toward the other piece */
   int mode; /* 0: advance by duration; 1: stable_dt, then nsteps steps */
   double duration;
   int nsteps, steps, exchanges;
@@ -2688,15 +2661,8 @@ typedef struct advancer {
 
 static gr_status team_exchange(void *user) {
   advancer *a = user;
-  team *t = a->m.t;
-  int r = a->m.rank;
-  gr_status st = gr_rain_runoff_halo_get(a->m.p->s, a->side, t->mail[r], t->mail_bytes[r]);
-  pthread_barrier_wait(&t->barrier);
-  if (st == GR_OK)
-    st = gr_rain_runoff_halo_set(a->m.p->s, a->side, t->mail[1 - r], t->mail_bytes[1 - r]);
-  pthread_barrier_wait(&t->barrier);
   ++a->exchanges;
-  return st;
+  return gr_test_team_exchange(a->m.t, a->m.rank, a->m.p->s, team_halo);
 }
 
 static void *advancer_run(void *arg) {
@@ -2723,17 +2689,15 @@ static void *advancer_run(void *arg) {
  * becomes piece k's progress callback. Returns the wall time. */
 static double run_team(piece pc[2], int side0, int mode, double duration, int nsteps,
                        progress_log *logs[2], advancer a[2]) {
-  team t;
-  memset(&t, 0, sizeof(t));
-  pthread_barrier_init(&t.barrier, NULL, 2);
-  pthread_t th[2];
+  gr_test_team t;
+  gr_test_team_init(&t, 2, 32);
   for (int k = 0; k < 2; ++k) {
     int side = k == 0 ? side0 : side0 ^ 1;
-    CHECK(gr_rain_runoff_halo_size(pc[k].s, side, &t.mail_bytes[k]) == GR_OK);
-    t.mail[k] = malloc(t.mail_bytes[k]);
+    size_t bytes = 0;
+    CHECK(gr_rain_runoff_halo_size(pc[k].s, side, &bytes) == GR_OK);
+    gr_test_team_mail(&t, k, side, bytes);
     memset(&a[k], 0, sizeof(a[k]));
     a[k].m = (member){&t, k, 0, &pc[k], GR_OK, {0}};
-    a[k].side = side;
     a[k].mode = mode;
     a[k].duration = duration;
     a[k].nsteps = nsteps;
@@ -2744,18 +2708,14 @@ static double run_team(piece pc[2], int side0, int mode, double duration, int ns
       gr_rain_runoff_set_progress(pc[k].s, on_progress, a[k].log);
   }
   double t0 = wall_now();
-  for (int k = 0; k < 2; ++k)
-    pthread_create(&th[k], NULL, advancer_run, &a[k]);
-  for (int k = 0; k < 2; ++k)
-    pthread_join(th[k], NULL);
+  gr_test_team_run(2, advancer_run, a, sizeof(a[0]));
   double wall = wall_now() - t0;
   for (int k = 0; k < 2; ++k) {
     gr_rain_runoff_set_allreduce(pc[k].s, NULL, NULL);
     gr_rain_runoff_set_halo_exchange(pc[k].s, NULL, NULL);
     gr_rain_runoff_set_progress(pc[k].s, NULL, NULL);
-    free(t.mail[k]);
   }
-  pthread_barrier_destroy(&t.barrier);
+  gr_test_team_destroy(&t);
   return wall;
 }
 

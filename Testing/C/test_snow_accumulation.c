@@ -7,11 +7,11 @@
  * paths. */
 #include "gr_test.h"
 #include "gr_test_mesh.h"
+#include "gr_test_team.h"
 
 #include "graupel/snow_accumulation.h"
 
 #include <math.h>
-#include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -1068,16 +1068,8 @@ static void pc_pose(pc_scene *sc, int k) {
 
 enum { PC_MAX = 3, PC_STEPS = 12 };
 
-typedef struct pc_team {
-  pthread_barrier_t barrier;
-  int n;
-  double *slot[PC_MAX];
-  void *mail[PC_MAX][4];
-  size_t bytes[PC_MAX][4];
-} pc_team;
-
 typedef struct pc_runner {
-  pc_team *t;
+  gr_test_team *t;
   int rank, exchanges, reductions;
   double values; /* reduced, over every call */
   /* Steps k0 .. k1 - 1 of the scene; the state saved after save_at steps
@@ -1097,45 +1089,23 @@ static int pc_stop(void *user, double time) {
   return ++r->calls >= r->stop_at;
 }
 
+static gr_status pc_halo(void *s, int side, void *host, size_t bytes, int set) {
+  return set ? gr_snow_accumulation_halo_set(s, side, host, bytes)
+             : gr_snow_accumulation_halo_get(s, side, host, bytes);
+}
+
 static gr_status pc_allreduce(void *user, double *values, int n, gr_reduce_op op) {
   pc_runner *r = user;
-  pc_team *t = r->t;
-  if (n > GR_SNOW_ACCUMULATION_REDUCE_CHUNK)
-    return GR_ERR_INVALID_ARGUMENT;
-  ++r->reductions;
-  r->values += n;
-  memcpy(t->slot[r->rank], values, (size_t)n * sizeof(double));
-  pthread_barrier_wait(&t->barrier);
-  for (int q = 0; q < n; ++q) {
-    double v = t->slot[0][q];
-    for (int k = 1; k < t->n; ++k) {
-      double w = t->slot[k][q];
-      v = op == GR_REDUCE_SUM ? v + w : op == GR_REDUCE_MAX ? fmax(v, w) : fmin(v, w);
-    }
-    values[q] = v;
-  }
-  pthread_barrier_wait(&t->barrier);
-  return GR_OK;
+  gr_status st = gr_test_team_allreduce(r->t, r->rank, values, n, op);
+  if (st == GR_OK)
+    ++r->reductions, r->values += n;
+  return st;
 }
 
 static gr_status pc_exchange(void *user) {
   pc_runner *r = user;
-  pc_team *t = r->t;
-  gr_status st = GR_OK;
   ++r->exchanges;
-  for (int side = 2; side < 4; ++side)
-    if (st == GR_OK && t->bytes[r->rank][side])
-      st = gr_snow_accumulation_halo_get(r->s, side, t->mail[r->rank][side],
-                                         t->bytes[r->rank][side]);
-  pthread_barrier_wait(&t->barrier);
-  for (int side = 2; side < 4; ++side) {
-    int other = side == 2 ? r->rank - 1 : r->rank + 1;
-    if (st == GR_OK && t->bytes[r->rank][side])
-      st = gr_snow_accumulation_halo_set(r->s, side, t->mail[other][side ^ 1],
-                                         t->bytes[r->rank][side]);
-  }
-  pthread_barrier_wait(&t->barrier);
-  return st;
+  return gr_test_team_exchange(r->t, r->rank, r->s, pc_halo);
 }
 
 /* The box's points along an edge of a face, less one: 6 (294 points), or
@@ -1235,14 +1205,6 @@ static void pc_check(const pc_domain *dm, int tilted, int n, pc_runner *rn,
   }
 }
 
-/* Runs the pieces on n threads. */
-static void pc_team_run(pc_runner *rn, pthread_t *th, int n) {
-  for (int k = 0; k < n; ++k)
-    pthread_create(&th[k], NULL, pc_run, &rn[k]);
-  for (int k = 0; k < n; ++k)
-    pthread_join(th[k], NULL);
-}
-
 /* The whole grid against n pieces (cut at rows cuts[0..n-2]) through the
  * same scene (pc_check); then each piece's checkpoint after half the steps
  * loaded back, and the second half again (pc_check); then a stop asked by
@@ -1254,12 +1216,9 @@ static void pc_split(const pc_domain *dm, int tilted, int n, const int *cuts,
   gr_snow_accumulation_params p;
   pc_params(&p, tilted);
   int ghost = gr_snow_accumulation_ghost(&p);
-  pc_team t;
-  memset(&t, 0, sizeof(t));
-  t.n = n;
-  pthread_barrier_init(&t.barrier, NULL, (unsigned)n);
+  gr_test_team t;
+  gr_test_team_init(&t, n, GR_SNOW_ACCUMULATION_REDUCE_CHUNK);
   pc_runner rn[PC_MAX];
-  pthread_t th[PC_MAX];
   int ok = 1;
   for (int k = 0; k < n; ++k) {
     memset(&rn[k], 0, sizeof(rn[k]));
@@ -1267,13 +1226,12 @@ static void pc_split(const pc_domain *dm, int tilted, int n, const int *cuts,
     rn[k].t = &t, rn[k].rank = k, rn[k].k1 = PC_STEPS, rn[k].save_at = PC_STEPS / 2;
     rn[k].s = pc_piece(dm, &p, j0, j1 - j0, ghost, &rn[k].g);
     ok = ok && rn[k].s;
-    t.slot[k] = malloc(GR_SNOW_ACCUMULATION_REDUCE_CHUNK * sizeof(double));
     for (int side = 2; ok && side < 4; ++side) {
-      CHECK(gr_snow_accumulation_halo_size(rn[k].s, side, &t.bytes[k][side]) == GR_OK);
+      size_t bytes = 0;
+      CHECK(gr_snow_accumulation_halo_size(rn[k].s, side, &bytes) == GR_OK);
       int has = side == 2 ? k > 0 : k + 1 < n;
-      CHECK(has ? t.bytes[k][side] == (size_t)ghost * dm->g.nx * sizeof(float)
-                : t.bytes[k][side] == 0);
-      t.mail[k][side] = t.bytes[k][side] ? malloc(t.bytes[k][side]) : NULL;
+      CHECK(has ? bytes == (size_t)ghost * dm->g.nx * sizeof(float) : bytes == 0);
+      gr_test_team_mail(&t, k, side, bytes);
     }
     if (ok) {
       gr_snow_accumulation_set_allreduce(rn[k].s, pc_allreduce, &rn[k]);
@@ -1281,7 +1239,7 @@ static void pc_split(const pc_domain *dm, int tilted, int n, const int *cuts,
     }
   }
   if (ok) {
-    pc_team_run(rn, th, n);
+    gr_test_team_run(n, pc_run, rn, sizeof(rn[0]));
     pc_check(dm, tilted, n, rn, lw, wf, wo, nv, "");
   }
   int exchanges = rn[0].exchanges, reductions = rn[0].reductions;
@@ -1309,7 +1267,7 @@ static void pc_split(const pc_domain *dm, int tilted, int n, const int *cuts,
   if (ok) {
     /* A piece's state loads into that piece only. */
     CHECK(gr_snow_accumulation_state_load(rn[1].s, rn[0].state, rn[0].state_bytes) != GR_OK);
-    pc_team_run(rn, th, n);
+    gr_test_team_run(n, pc_run, rn, sizeof(rn[0]));
     pc_check(dm, tilted, n, rn, lw, wf, wo, nv, " (from the checkpoints)");
   }
   for (int k = 0; ok && k < n; ++k) {
@@ -1318,7 +1276,7 @@ static void pc_split(const pc_domain *dm, int tilted, int n, const int *cuts,
     rn[k].stop_at = k == n - 1 ? 3 : 0;
   }
   if (ok) {
-    pc_team_run(rn, th, n);
+    gr_test_team_run(n, pc_run, rn, sizeof(rn[0]));
     for (int k = 0; k < n; ++k)
       CHECK_MSG(rn[k].taken == 3 && rn[k].last == GR_ERR_ABORTED && rn[k].l.steps == 3,
                 "%d pieces, piece %d: %d steps taken (%s) after a stop on piece %d's third", n, k,
@@ -1332,11 +1290,8 @@ static void pc_split(const pc_domain *dm, int tilted, int n, const int *cuts,
   for (int k = 0; k < n; ++k) {
     gr_snow_accumulation_destroy(rn[k].s);
     free(rn[k].state);
-    free(t.slot[k]);
-    for (int side = 2; side < 4; ++side)
-      free(t.mail[k][side]);
   }
-  pthread_barrier_destroy(&t.barrier);
+  gr_test_team_destroy(&t);
 }
 
 /* Two and three pieces in one process (threads) give the whole grid's bits:

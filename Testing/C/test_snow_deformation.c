@@ -5,11 +5,11 @@
  * error paths. */
 #include "gr_test.h"
 #include "gr_test_mesh.h"
+#include "gr_test_team.h"
 
 #include "graupel/snow_deformation.h"
 
 #include <math.h>
-#include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -1392,15 +1392,8 @@ static gr_snow_deformation *make_whole(const domain *dm, const gr_snow_deformati
 /* Two threads, one piece each: an allreduce through a barrier (combined in
  * rank order, so both get the same bits) and a halo exchange through a
  * mailbox, which the core calls inside its steps. */
-typedef struct team {
-  pthread_barrier_t barrier;
-  double slot[2][32];
-  void *mail[2];
-  size_t mail_bytes[2];
-} team;
-
 typedef struct runner {
-  team *t;
+  gr_test_team *t;
   int rank, side, steps, stop_at, calls, exchanges, taken, fail_exchange;
   piece *p;
   scene sc;
@@ -1409,32 +1402,22 @@ typedef struct runner {
   double force[6], area[2];
 } runner;
 
-static gr_status team_allreduce(void *user, double *values, int n, gr_reduce_op op) {
-  runner *r = user;
-  team *t = r->t;
-  if (n > 32)
-    return GR_ERR_INVALID_ARGUMENT;
-  memcpy(t->slot[r->rank], values, (size_t)n * sizeof(double));
-  pthread_barrier_wait(&t->barrier);
-  for (int q = 0; q < n; ++q) {
-    double a = t->slot[0][q], b = t->slot[1][q];
-    values[q] = op == GR_REDUCE_SUM ? a + b : op == GR_REDUCE_MAX ? fmax(a, b) : fmin(a, b);
-  }
-  pthread_barrier_wait(&t->barrier);
-  return GR_OK;
+static gr_status team_halo(void *s, int side, void *host, size_t bytes, int set) {
+  return set ? gr_snow_deformation_halo_set(s, side, host, bytes)
+             : gr_snow_deformation_halo_get(s, side, host, bytes);
 }
 
+static gr_status team_allreduce(void *user, double *values, int n, gr_reduce_op op) {
+  runner *r = user;
+  return gr_test_team_allreduce(r->t, r->rank, values, n, op);
+}
+
+/* From exchange fail_exchange on, every piece's exchange fails (after the
+ * strips went through, so no piece waits for ever). */
 static gr_status team_exchange(void *user) {
   runner *r = user;
-  team *t = r->t;
   ++r->exchanges;
-  gr_status st =
-      gr_snow_deformation_halo_get(r->p->s, r->side, t->mail[r->rank], t->mail_bytes[r->rank]);
-  pthread_barrier_wait(&t->barrier);
-  if (st == GR_OK)
-    st = gr_snow_deformation_halo_set(r->p->s, r->side, t->mail[1 - r->rank],
-                                      t->mail_bytes[1 - r->rank]);
-  pthread_barrier_wait(&t->barrier);
+  gr_status st = gr_test_team_exchange(r->t, r->rank, r->p->s, team_halo);
   if (r->fail_exchange && r->exchanges >= r->fail_exchange)
     return GR_ERR_IO;
   return st;
@@ -1475,10 +1458,8 @@ static void *runner_run(void *arg) {
 /* Runs both pieces on two threads; side0: piece 0's side toward piece 1. */
 static void run_team(piece pc[2], runner rn[2], int side0, int kind, int steps, int stop_rank,
                      int stop_at, int fail_exchange) {
-  team t;
-  memset(&t, 0, sizeof(t));
-  pthread_barrier_init(&t.barrier, NULL, 2);
-  pthread_t th[2];
+  gr_test_team t;
+  gr_test_team_init(&t, 2, 32);
   for (int k = 0; k < 2; ++k) {
     memset(&rn[k], 0, sizeof(rn[k]));
     rn[k].t = &t;
@@ -1488,9 +1469,10 @@ static void run_team(piece pc[2], runner rn[2], int side0, int kind, int steps, 
     rn[k].fail_exchange = fail_exchange;
     rn[k].p = &pc[k];
     scene_init(&rn[k].sc, kind);
-    CHECK(gr_snow_deformation_halo_size(pc[k].s, rn[k].side, &t.mail_bytes[k]) == GR_OK);
-    CHECK(t.mail_bytes[k] > 0);
-    t.mail[k] = malloc(t.mail_bytes[k]);
+    size_t bytes = 0;
+    CHECK(gr_snow_deformation_halo_size(pc[k].s, rn[k].side, &bytes) == GR_OK);
+    CHECK(bytes > 0);
+    gr_test_team_mail(&t, k, rn[k].side, bytes);
     gr_snow_deformation_set_allreduce(pc[k].s, team_allreduce, &rn[k]);
     gr_snow_deformation_set_halo_exchange(pc[k].s, team_exchange, &rn[k]);
     if (k == stop_rank) {
@@ -1498,17 +1480,13 @@ static void run_team(piece pc[2], runner rn[2], int side0, int kind, int steps, 
       gr_snow_deformation_set_progress(pc[k].s, stop_at_step, &rn[k]);
     }
   }
-  CHECK(t.mail_bytes[0] == t.mail_bytes[1]);
-  for (int k = 0; k < 2; ++k)
-    pthread_create(&th[k], NULL, runner_run, &rn[k]);
-  for (int k = 0; k < 2; ++k)
-    pthread_join(th[k], NULL);
+  CHECK(t.bytes[0][rn[0].side] == t.bytes[1][rn[1].side]);
+  gr_test_team_run(2, runner_run, rn, sizeof(rn[0]));
   for (int k = 0; k < 2; ++k) {
     gr_snow_deformation_set_progress(pc[k].s, NULL, NULL);
-    free(t.mail[k]);
     scene_free(&rn[k].sc);
   }
-  pthread_barrier_destroy(&t.barrier);
+  gr_test_team_destroy(&t);
 }
 
 /* The whole grid through the same scene. */

@@ -14,9 +14,9 @@
  *   test_water_surface memcheck   the host-code paths only, on tiny grids */
 #include "graupel/water_surface.h"
 #include "gr_test.h"
+#include "gr_test_team.h"
 
 #include <math.h>
-#include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -747,16 +747,8 @@ static void pc_params(gr_water_surface_params *p) {
   p->seed = 11;
 }
 
-typedef struct pc_team {
-  pthread_barrier_t barrier;
-  int n;
-  double slot[PC_MAX][16];
-  float *mail[PC_MAX][4];
-  size_t bytes[PC_MAX][4];
-} pc_team;
-
 typedef struct pc_runner {
-  pc_team *t;
+  gr_test_team *t;
   int rank, exchanges, reductions, skip_exchange;
   /* Steps k0 .. k1 - 1 of dt; the state saved after save_at of them (0:
    * none); or, with duration > 0, one advance by it, stopped by this
@@ -776,46 +768,24 @@ static int pc_stop(void *user, double time) {
   return 1;
 }
 
+static gr_status pc_halo(void *s, int side, void *host, size_t bytes, int set) {
+  return set ? gr_water_surface_halo_set(s, side, host, bytes)
+             : gr_water_surface_halo_get(s, side, host, bytes);
+}
+
 static gr_status pc_allreduce(void *user, double *values, int n, gr_reduce_op op) {
   pc_runner *r = user;
-  pc_team *t = r->t;
-  if (n > 16)
-    return GR_ERR_INVALID_ARGUMENT;
-  ++r->reductions;
-  memcpy(t->slot[r->rank], values, (size_t)n * sizeof(double));
-  pthread_barrier_wait(&t->barrier);
-  for (int q = 0; q < n; ++q) {
-    double v = t->slot[0][q];
-    for (int k = 1; k < t->n; ++k) {
-      double w = t->slot[k][q];
-      v = op == GR_REDUCE_SUM ? v + w : op == GR_REDUCE_MAX ? fmax(v, w) : fmin(v, w);
-    }
-    values[q] = v;
-  }
-  pthread_barrier_wait(&t->barrier);
-  return GR_OK;
+  gr_status st = gr_test_team_allreduce(r->t, r->rank, values, n, op);
+  r->reductions += st == GR_OK;
+  return st;
 }
 
 /* Each piece's strips out, then the neighbours' in; with skip_exchange,
  * nothing (the rings keep their first values). */
 static gr_status pc_exchange(void *user) {
   pc_runner *r = user;
-  pc_team *t = r->t;
-  gr_status st = GR_OK;
   ++r->exchanges;
-  if (r->skip_exchange)
-    return GR_OK;
-  for (int side = 2; side < 4; ++side)
-    if (st == GR_OK && t->bytes[r->rank][side])
-      st = gr_water_surface_halo_get(r->s, side, t->mail[r->rank][side], t->bytes[r->rank][side]);
-  pthread_barrier_wait(&t->barrier);
-  for (int side = 2; side < 4; ++side) {
-    int other = side == 2 ? r->rank - 1 : r->rank + 1;
-    if (st == GR_OK && t->bytes[r->rank][side])
-      st = gr_water_surface_halo_set(r->s, side, t->mail[other][side ^ 1], t->bytes[r->rank][side]);
-  }
-  pthread_barrier_wait(&t->barrier);
-  return st;
+  return r->skip_exchange ? GR_OK : gr_test_team_exchange(r->t, r->rank, r->s, pc_halo);
 }
 
 static void *pc_run(void *arg) {
@@ -838,14 +808,6 @@ static void *pc_run(void *arg) {
   r->st = st != GR_OK ? st : s2;
   gr_water_surface_set_progress(r->s, NULL, NULL);
   return NULL;
-}
-
-static void pc_team_run(pc_runner *rn, int n) {
-  pthread_t th[PC_MAX];
-  for (int k = 0; k < n; ++k)
-    pthread_create(&th[k], NULL, pc_run, &rn[k]);
-  for (int k = 0; k < n; ++k)
-    pthread_join(th[k], NULL);
 }
 
 /* A piece of rows j0 .. j0 + ny - 1 with rings of ghost rows: its local
@@ -925,10 +887,8 @@ static int pc_split(const pc_domain *dm, int n, const int *cuts, double dt, floa
   gr_water_surface_params p;
   pc_params(&p);
   int ghost = gr_water_surface_ghost(&p, dm->g.dy);
-  pc_team t;
-  memset(&t, 0, sizeof(t));
-  t.n = n;
-  pthread_barrier_init(&t.barrier, NULL, (unsigned)n);
+  gr_test_team t;
+  gr_test_team_init(&t, n, 16);
   pc_runner rn[PC_MAX];
   int ok = 1;
   for (int k = 0; k < n; ++k) {
@@ -939,10 +899,11 @@ static int pc_split(const pc_domain *dm, int n, const int *cuts, double dt, floa
     rn[k].s = pc_piece(dm, &p, j0, j1 - j0, ghost, &rn[k].g);
     ok = ok && rn[k].s;
     for (int side = 2; ok && side < 4; ++side) {
-      CHECK(gr_water_surface_halo_size(rn[k].s, side, &t.bytes[k][side]) == GR_OK);
+      size_t bytes = 0;
+      CHECK(gr_water_surface_halo_size(rn[k].s, side, &bytes) == GR_OK);
       int has = side == 2 ? k > 0 : k + 1 < n;
-      CHECK(t.bytes[k][side] == (has ? (size_t)PC_NX * sizeof(float) : 0));
-      t.mail[k][side] = t.bytes[k][side] ? malloc(t.bytes[k][side]) : NULL;
+      CHECK(bytes == (has ? (size_t)PC_NX * sizeof(float) : 0));
+      gr_test_team_mail(&t, k, side, bytes);
     }
     if (ok) {
       gr_water_surface_set_allreduce(rn[k].s, pc_allreduce, &rn[k]);
@@ -951,7 +912,7 @@ static int pc_split(const pc_domain *dm, int n, const int *cuts, double dt, floa
   }
   int exchanges = 0, reductions = 0;
   if (ok) {
-    pc_team_run(rn, n);
+    gr_test_team_run(n, pc_run, rn, sizeof(rn[0]));
     exchanges = rn[0].exchanges, reductions = rn[0].reductions;
     for (int k = 0; k < n; ++k) {
       CHECK_MSG(rn[k].st == GR_OK, "%d pieces, piece %d: %s", n, k,
@@ -978,7 +939,7 @@ static int pc_split(const pc_domain *dm, int n, const int *cuts, double dt, floa
   if (ok) {
     /* A piece's state loads into that piece only. */
     CHECK(gr_water_surface_state_load(rn[1].s, rn[0].state, rn[0].state_bytes) != GR_OK);
-    pc_team_run(rn, n);
+    gr_test_team_run(n, pc_run, rn, sizeof(rn[0]));
     for (int k = 0; k < n; ++k) {
       CHECK(rn[k].st == GR_OK);
       long d = pc_differ(rn[k].s, &rn[k].g, wf);
@@ -997,7 +958,7 @@ static int pc_split(const pc_domain *dm, int n, const int *cuts, double dt, floa
   }
   int stopped = 0;
   if (ok) {
-    pc_team_run(rn, n);
+    gr_test_team_run(n, pc_run, rn, sizeof(rn[0]));
     stopped = rn[0].taken;
     for (int k = 0; k < n; ++k)
       CHECK_MSG(rn[k].st == GR_ERR_ABORTED && rn[k].taken == stopped && rn[k].l.steps == stopped &&
@@ -1026,7 +987,7 @@ static int pc_split(const pc_domain *dm, int n, const int *cuts, double dt, floa
     rn[k].skip_exchange = 1;
   }
   if (ok) {
-    pc_team_run(rn, n);
+    gr_test_team_run(n, pc_run, rn, sizeof(rn[0]));
     for (int k = 0; k < n; ++k)
       wrong += pc_differ(rn[k].s, &rn[k].g, wf);
     CHECK_MSG(wrong > 0, "%d pieces without the exchange still give the whole grid", n);
@@ -1040,10 +1001,8 @@ static int pc_split(const pc_domain *dm, int n, const int *cuts, double dt, floa
   for (int k = 0; k < n; ++k) {
     gr_water_surface_destroy(rn[k].s);
     free(rn[k].state);
-    for (int side = 2; side < 4; ++side)
-      free(t.mail[k][side]);
   }
-  pthread_barrier_destroy(&t.barrier);
+  gr_test_team_destroy(&t);
   return exchanges;
 }
 
