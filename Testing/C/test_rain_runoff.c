@@ -3710,6 +3710,33 @@ static void paths_fields(const gr_grid *g, float *b, float *r, float *k, float *
     }
 }
 
+/* The launch-path tests' 75 x 41 grid and its inputs (paths_fields, the
+ * first hole hole_w x hole_h cells). */
+typedef struct paths_in {
+  gr_grid g;
+  float *b, *r, *k, *d;
+  double *nmap;
+} paths_in;
+
+static paths_in paths_make(int hole_w, int hole_h) {
+  paths_in in = {{75, 41, 2.0, 1.5, 0.0, 0.0, 0, 0}, NULL, NULL, NULL, NULL, NULL};
+  in.b = alloc_field(&in.g, 1);
+  in.r = alloc_field(&in.g, 1);
+  in.k = alloc_field(&in.g, 1);
+  in.d = alloc_field(&in.g, 1);
+  in.nmap = malloc(cells_of(&in.g) * sizeof(double));
+  paths_fields(&in.g, in.b, in.r, in.k, in.d, in.nmap, hole_w, hole_h);
+  return in;
+}
+
+static void paths_free(paths_in *in) {
+  free(in->b);
+  free(in->r);
+  free(in->k);
+  free(in->d);
+  free(in->nmap);
+}
+
 /* The 4-byte words in which the saved states of a and b differ (-1 where
  * either cannot be saved); *words gets the state's length in words. */
 static long state_words_differ(gr_rain_runoff *a, gr_rain_runoff *b, size_t *words) {
@@ -3801,12 +3828,11 @@ static void test_sw_pieces_paths(void) {
  * 8 x 4: 8 x 8 of 10 x 11). A tile that is no tile, or larger than the
  * device takes, is refused. */
 static void test_sw_fused(void) {
-  gr_grid g = {75, 41, 2.0, 1.5, 0.0, 0.0, 0, 0};
+  paths_in in = paths_make(8, 7); /* the first hole across tiles' corners */
+  gr_grid g = in.g;
   size_t n = cells_of(&g);
-  float *b = alloc_field(&g, 1), *r = alloc_field(&g, 1), *k = alloc_field(&g, 1);
-  float *d = alloc_field(&g, 1);
-  double *nmap = malloc(n * sizeof(double));
-  paths_fields(&g, b, r, k, d, nmap, 8, 7); /* the first hole across tiles' corners */
+  float *b = in.b, *r = in.r, *k = in.k, *d = in.d;
+  double *nmap = in.nmap;
   const double ht[3] = {0.0, 30.0, 90.0}, hq[3] = {0.0, 0.5, 0.1};
   const double hyt[3] = {0.0, 40.0, 200.0}, hyr[3] = {1e-5, 6e-5, 2e-5};
   const int ij[4] = {37, 20, 5, 38};
@@ -3885,11 +3911,7 @@ static void test_sw_fused(void) {
     for (int v = 0; v < 3; ++v)
       gr_rain_runoff_destroy(sim[v]);
   }
-  free(b);
-  free(r);
-  free(k);
-  free(d);
-  free(nmap);
+  paths_free(&in);
 }
 
 /* The local inertial pieces tests with each of the step's launch paths
@@ -4547,12 +4569,11 @@ static void test_no_data(void) {
  * outflow, inflow, flood maps, ledger) is the same to the bit, also for a
  * run that switches between the paths every 30 steps. */
 static void test_li_fused(void) {
-  gr_grid g = {75, 41, 2.0, 1.5, 0.0, 0.0, 0, 0};
+  paths_in in = paths_make(6, 5); /* the first hole across a tile's corner */
+  gr_grid g = in.g;
   size_t n = cells_of(&g);
-  float *b = alloc_field(&g, 1), *r = alloc_field(&g, 1), *k = alloc_field(&g, 1);
-  float *d = alloc_field(&g, 1);
-  double *nmap = malloc(n * sizeof(double));
-  paths_fields(&g, b, r, k, d, nmap, 6, 5); /* the first hole across a tile's corner */
+  float *b = in.b, *r = in.r, *k = in.k, *d = in.d;
+  double *nmap = in.nmap;
   const double ht[3] = {0.0, 30.0, 90.0}, hq[3] = {0.0, 0.5, 0.1};
   const double hyt[3] = {0.0, 40.0, 200.0}, hyr[3] = {1e-5, 6e-5, 2e-5};
   const int ij[4] = {37, 20, 5, 38};
@@ -4606,11 +4627,7 @@ static void test_li_fused(void) {
     for (int v = 0; v < 3; ++v)
       gr_rain_runoff_destroy(sim[v]);
   }
-  free(b);
-  free(r);
-  free(k);
-  free(d);
-  free(nmap);
+  paths_free(&in);
 }
 
 /* Gives sim the optional inputs of `bits` (GR_RAIN_RUNOFF_INPUT_*) from the
@@ -4638,12 +4655,11 @@ static void give_inputs(gr_rain_runoff *sim, int bits, const float *r, const flo
  * wall, a transmissive, a level and an open edge, in each launch path;
  * after 120 steps the whole state and the ledger are the same to the bit. */
 static void test_device_forms(void) {
-  gr_grid g = {75, 41, 2.0, 1.5, 0.0, 0.0, 0, 0};
+  paths_in in = paths_make(6, 5);
+  gr_grid g = in.g;
   size_t n = cells_of(&g);
-  float *b = alloc_field(&g, 1), *r = alloc_field(&g, 1), *k = alloc_field(&g, 1);
-  float *d = alloc_field(&g, 1);
-  double *nmap = malloc(n * sizeof(double));
-  paths_fields(&g, b, r, k, d, nmap, 6, 5);
+  float *b = in.b, *r = in.r, *k = in.k, *d = in.d;
+  double *nmap = in.nmap;
   gr_rain_runoff_params p = params_with(2e-5, 1e-6, GR_BOUNDARY_OPEN);
   p.flow_model = GR_FLOW_SHALLOW_WATER;
   p.no_data = GR_BOUNDARY_OPEN;
@@ -4689,11 +4705,7 @@ static void test_device_forms(void) {
     gr_rain_runoff_destroy(sim[1]);
   }
   free(kept);
-  free(b);
-  free(r);
-  free(k);
-  free(d);
-  free(nmap);
+  paths_free(&in);
 }
 
 /* The step kernels compiled for the optional inputs in use
@@ -4709,12 +4721,12 @@ static void test_device_forms(void) {
  * discharges, infiltration, outflow, inflow, flood maps) and the ledger are
  * the same to the bit; also after switching the model between steps. */
 static void test_specialised(void) {
-  gr_grid g = {75, 41, 2.0, 1.5, 0.0, 0.0, 0, 0};
+  paths_in in = paths_make(6, 5);
+  gr_grid g = in.g;
   size_t n = cells_of(&g);
-  float *b = alloc_field(&g, 1), *r = alloc_field(&g, 1), *k = alloc_field(&g, 1);
-  float *d = alloc_field(&g, 1), *solid = alloc_field(&g, 1);
-  double *nmap = malloc(n * sizeof(double));
-  paths_fields(&g, b, r, k, d, nmap, 6, 5);
+  float *b = in.b, *r = in.r, *k = in.k, *d = in.d;
+  double *nmap = in.nmap;
+  float *solid = alloc_field(&g, 1);
   for (size_t c = 0; c < n; ++c) /* the same bed without holes */
     solid[c] = isnan(b[c]) ? 0.5f : b[c];
   const int sets[] = {0,
@@ -4810,12 +4822,8 @@ static void test_specialised(void) {
   }
   gr_rain_runoff_destroy(sim[0]);
   gr_rain_runoff_destroy(sim[1]);
-  free(b);
-  free(r);
-  free(k);
-  free(d);
   free(solid);
-  free(nmap);
+  paths_free(&in);
 }
 
 static const gr_subtest tests[] = {
