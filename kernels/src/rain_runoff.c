@@ -813,8 +813,8 @@ static gr_status gr_rain_runoff_piece(const gr_grid *g, gr_flow_model model, int
 }
 
 /* The local memory of a fused shallow-water stage's tile of tx x ty cells
- * (gr_sw_fused): four planes of points with two cells either side, six
- * of x-faces and six of y-faces. */
+ * (gr_sw_fused): its points with two cells either side (a float4 each),
+ * six planes of x-faces and six of y-faces. */
 static size_t gr_rain_runoff_sw_tile_bytes(size_t tx, size_t ty) {
   return sizeof(cl_float) * (4 * (tx + 4) * (ty + 4) + 6 * ((tx + 1) * ty + tx * (ty + 1)));
 }
