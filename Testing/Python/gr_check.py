@@ -1,6 +1,7 @@
 """Small helpers shared by Graupel's Python tests: argument parsing, checks
 that count failures instead of stopping at the first, and error capture."""
 import argparse
+import os
 import sys
 
 _failures = []
@@ -112,3 +113,59 @@ class AbortOnce:
 
     def remove(self):
         self._algorithm.RemoveObserver(self._tag)
+
+
+# For a ProgrammableFilter's script: the lines that make gr_check importable
+# on every rank (pvbatch's other ranks run the script without the test's
+# sys.path).
+IMPORT = "import sys\nsys.path.insert(0, %r)\nimport gr_check\n" % (
+    os.path.dirname(os.path.abspath(__file__)))
+
+
+def piece_compare(algorithm, ref, fields, ledger, nx, ny, extra=()):
+    """In a ProgrammableFilter's script, on every rank of a split run: the
+    rank's piece (the filter's input, an image of the nx x ny grid's extent)
+    against ref, the whole grid computed in that rank by the wrapped classes.
+    Adds to the output (the piece) the point arrays `mismatch` (at each
+    point, how many of the point arrays `fields` differ from ref's in any
+    bit), `ledger_mismatch` (how many of the field-data values `ledger`
+    differ in any byte of their doubles, so that -0.0 against 0.0 or a NaN
+    counts; the same at every point), `piece_share` (the piece's
+    piece_cells over the grid, -1 without) and each (name, value) of extra:
+    a number, or a whole-grid array of nx * ny values cropped to the piece.
+    The ranks' arrays are then reduced by ParaView's data information
+    (Fetch brings only rank 0's piece in pvbatch)."""
+    import numpy as np
+    from vtkmodules.util.numpy_support import numpy_to_vtk, vtk_to_numpy
+    img = algorithm.GetInputDataObject(0, 0)
+    out = algorithm.GetOutputDataObject(0)
+    out.ShallowCopy(img)
+    e0, e1, f0, f1, _, _ = img.GetExtent()
+    rows, cols = f1 - f0 + 1, e1 - e0 + 1
+    bad = np.zeros(rows * cols, dtype=np.float32)
+    for name in fields:
+        r = vtk_to_numpy(ref.GetPointData().GetArray(name)).reshape(ny, nx, -1)
+        m = vtk_to_numpy(img.GetPointData().GetArray(name)).reshape(rows, cols, -1)
+        bad += (m.view(np.uint32) != r[f0:f1 + 1, e0:e1 + 1].view(np.uint32)).any(axis=2) \
+            .reshape(-1)
+    ledger_bad = 0
+    for name in ledger:
+        x, y = img.GetFieldData().GetArray(name), ref.GetFieldData().GetArray(name)
+        if x is None or y is None or \
+                np.float64(x.GetTuple1(0)).tobytes() != np.float64(y.GetTuple1(0)).tobytes():
+            ledger_bad += 1
+    cells = img.GetFieldData().GetArray("piece_cells")
+    share = cells.GetTuple1(0) / float(nx * ny) if cells else -1.0
+    n = bad.size
+    arrays = [("mismatch", bad), ("ledger_mismatch", np.full(n, ledger_bad, np.float32)),
+              ("piece_share", np.full(n, share, np.float32))]
+    for name, value in extra:
+        if np.ndim(value) == 0:
+            arrays.append((name, np.full(n, float(value), np.float32)))
+        else:
+            whole = np.asarray(value, dtype=np.float32).reshape(ny, nx)
+            arrays.append((name, whole[f0:f1 + 1, e0:e1 + 1].reshape(-1)))
+    for name, values in arrays:
+        arr = numpy_to_vtk(np.ascontiguousarray(values), deep=1)
+        arr.SetName(name)
+        out.GetPointData().AddArray(arr)

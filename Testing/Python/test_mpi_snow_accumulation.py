@@ -57,17 +57,14 @@ LEDGER = ["time", "steps", "initial_volume", "snowfall_volume", "stored_volume",
           "balance_error"]
 FIELDS = ["snow_depth", "snow_surface", "snow_density", "exposure", "elevation"]
 
-# Each rank compares its piece with the whole grid computed there; the
-# per-point mismatch counts are then reduced over the ranks by ParaView's
-# data information (Fetch brings only rank 0's piece in pvbatch).
-COMPARE = SCENARIO + """
+# Each rank compares its piece with the whole grid computed there
+# (gr_check.piece_compare); the per-point mismatch counts are then reduced
+# over the ranks by ParaView's data information.
+COMPARE = SCENARIO + T.IMPORT + """
 import numpy as np
-from vtkmodules.util.numpy_support import vtk_to_numpy, numpy_to_vtk
+from vtkmodules.util.numpy_support import vtk_to_numpy
 from vtkmodules.vtkFiltersSources import vtkCubeSource
 from graupel import vtkProceduralTerrainSource, vtkSnowAccumulationFilter
-img = self.GetInputDataObject(0, 0)
-out = self.GetOutputDataObject(0)
-out.ShallowCopy(img)
 _, _, whole = scenario(vtkProceduralTerrainSource, vtkCubeSource, vtkSnowAccumulationFilter)
 whole.UpdateTimeStep(%(end)r)
 ref = whole.GetOutput()
@@ -76,31 +73,11 @@ ref = whole.GetOutput()
 _, _, bare = scenario(vtkProceduralTerrainSource, vtkCubeSource, vtkSnowAccumulationFilter,
                       with_box=False)
 bare.UpdateTimeStep(%(dt)r)
-hidden = float(np.count_nonzero(vtk_to_numpy(bare.GetOutput().GetPointData()
-                                             .GetArray("exposure")) == 0.0))
-e0, e1, f0, f1, _, _ = img.GetExtent()
-bad = np.zeros((f1 - f0 + 1) * (e1 - e0 + 1), dtype=np.float32)
-for name in %(fields)r:
-    r = vtk_to_numpy(ref.GetPointData().GetArray(name)).reshape(%(ny)d, %(nx)d)
-    m = vtk_to_numpy(img.GetPointData().GetArray(name)).reshape(f1 - f0 + 1, e1 - e0 + 1)
-    bad += (m.view(np.uint32) != r[f0:f1 + 1, e0:e1 + 1].view(np.uint32)).reshape(-1)
-ledger_bad = 0
-for name in %(ledger)r:
-    x, y = img.GetFieldData().GetArray(name), ref.GetFieldData().GetArray(name)
-    if x is None or y is None or x.GetTuple1(0) != y.GetTuple1(0):
-        ledger_bad += 1
-cells = img.GetFieldData().GetArray("piece_cells")
-share = cells.GetTuple1(0) / (%(nx)d * %(ny)d) if cells else -1.0
-n = bad.size
-for arr_name, values in (("mismatch", bad), ("ledger_mismatch", np.full(n, ledger_bad, np.float32)),
-                         ("piece_share", np.full(n, share, np.float32)),
-                         ("ridge_hidden", np.full(n, hidden, np.float32)),
-                         ("ref_objects", np.full(n, ref.GetFieldData()
-                                                 .GetArray("stored_volume_objects").GetTuple1(0),
-                                                 np.float32))):
-    arr = numpy_to_vtk(np.ascontiguousarray(values), deep=1)
-    arr.SetName(arr_name)
-    out.GetPointData().AddArray(arr)
+hidden = np.count_nonzero(vtk_to_numpy(bare.GetOutput().GetPointData().GetArray("exposure")) == 0.0)
+gr_check.piece_compare(self, ref, %(fields)r, %(ledger)r, %(nx)d, %(ny)d,
+                       [("ridge_hidden", hidden),
+                        ("ref_objects",
+                         ref.GetFieldData().GetArray("stored_volume_objects").GetTuple1(0))])
 """ % {"end": END, "dt": STEP, "fields": FIELDS, "ledger": LEDGER, "nx": NX, "ny": NY}
 
 # The box's output (on the rank that carries it): its snow per point against the whole grid's.

@@ -47,44 +47,18 @@ LEDGER = ["time", "steps", "initial_volume", "initial_mass", "snow_volume", "sno
           "relax_iterations"]
 FIELDS = ["snow_depth", "snow_surface", "snow_density", "overlap", "contact", "elevation"]
 
-# Each rank compares its piece with the whole grid computed there; the
-# per-point mismatch counts are then reduced over the ranks by ParaView's
-# data information (Fetch brings only rank 0's piece in pvbatch).
-COMPARE = SCENARIO + """
-import numpy as np
-from vtkmodules.util.numpy_support import vtk_to_numpy, numpy_to_vtk
+# Each rank compares its piece with the whole grid computed there
+# (gr_check.piece_compare); the per-point mismatch counts are then reduced
+# over the ranks by ParaView's data information.
+COMPARE = SCENARIO + T.IMPORT + """
+from vtkmodules.util.numpy_support import vtk_to_numpy
 from vtkmodules.vtkFiltersSources import vtkSphereSource
 from graupel import vtkProceduralTerrainSource, vtkSnowDeformationFilter
-img = self.GetInputDataObject(0, 0)
-out = self.GetOutputDataObject(0)
-out.ShallowCopy(img)
 _, _, whole = scenario(vtkProceduralTerrainSource, vtkSphereSource, vtkSnowDeformationFilter)
 whole.UpdateTimeStep(%(end)r)
 ref = whole.GetOutput()
-e0, e1, f0, f1, _, _ = img.GetExtent()
-bad = np.zeros((f1 - f0 + 1) * (e1 - e0 + 1), dtype=np.float32)
-for name in %(fields)r:
-    r = vtk_to_numpy(ref.GetPointData().GetArray(name)).reshape(%(ny)d, %(nx)d)
-    m = vtk_to_numpy(img.GetPointData().GetArray(name)).reshape(f1 - f0 + 1, e1 - e0 + 1)
-    bad += (m.view(np.uint32) != r[f0:f1 + 1, e0:e1 + 1].view(np.uint32)).reshape(-1)
-# Bit for bit: the bytes, so that -0.0 against 0.0 or a NaN would count.
-ledger_bad = 0
-for name in %(ledger)r:
-    x, y = img.GetFieldData().GetArray(name), ref.GetFieldData().GetArray(name)
-    if x is None or y is None or \
-            np.float64(x.GetTuple1(0)).tobytes() != np.float64(y.GetTuple1(0)).tobytes():
-        ledger_bad += 1
-cells = img.GetFieldData().GetArray("piece_cells")
-share = cells.GetTuple1(0) / (%(nx)d * %(ny)d) if cells else -1.0
-n = bad.size
-for arr_name, values in (("mismatch", bad), ("ledger_mismatch", np.full(n, ledger_bad, np.float32)),
-                         ("piece_share", np.full(n, share, np.float32)),
-                         ("ref_overlap", vtk_to_numpy(ref.GetPointData().GetArray("overlap"))
-                          .reshape(%(ny)d, %(nx)d)[f0:f1 + 1, e0:e1 + 1].reshape(-1)
-                          .astype(np.float32))):
-    arr = numpy_to_vtk(np.ascontiguousarray(values), deep=1)
-    arr.SetName(arr_name)
-    out.GetPointData().AddArray(arr)
+gr_check.piece_compare(self, ref, %(fields)r, %(ledger)r, %(nx)d, %(ny)d,
+                       [("ref_overlap", vtk_to_numpy(ref.GetPointData().GetArray("overlap")))])
 """ % {"end": END, "fields": FIELDS, "ledger": LEDGER, "nx": NX, "ny": NY}
 
 # The sphere's output (on the ranks that carry it): its force against the whole grid's.

@@ -48,43 +48,20 @@ def scenario(terrain_cls, water_cls):
 LEDGER = ["time", "steps", "wet_points", "wave_volume", "initial_volume", "energy", "max_wave"]
 FIELDS = ["wave_height", "water_surface", "normal", "wet", "elevation", "water_depth"]
 
-# Each rank compares its piece with the whole grid computed there; the
-# per-point mismatch counts are then reduced over the ranks by ParaView's
-# data information (Fetch brings only rank 0's piece in pvbatch).
-COMPARE = SCENARIO + """
+# Each rank compares its piece with the whole grid computed there
+# (gr_check.piece_compare); the per-point mismatch counts are then reduced
+# over the ranks by ParaView's data information.
+COMPARE = SCENARIO + T.IMPORT + """
 import numpy as np
-from vtkmodules.util.numpy_support import vtk_to_numpy, numpy_to_vtk
+from vtkmodules.util.numpy_support import vtk_to_numpy
 from graupel import vtkProceduralTerrainSource, vtkWaterSurfaceFilter
-img = self.GetInputDataObject(0, 0)
-out = self.GetOutputDataObject(0)
-out.ShallowCopy(img)
 _, whole = scenario(vtkProceduralTerrainSource, vtkWaterSurfaceFilter)
 whole.UpdateTimeStep(%(end)r)
 ref = whole.GetOutput()
-e0, e1, f0, f1, _, _ = img.GetExtent()
-bad = np.zeros((f1 - f0 + 1) * (e1 - e0 + 1), dtype=np.float32)
-for name in %(fields)r:
-    r = vtk_to_numpy(ref.GetPointData().GetArray(name)).reshape(%(ny)d, %(nx)d, -1)
-    m = vtk_to_numpy(img.GetPointData().GetArray(name)).reshape(f1 - f0 + 1, e1 - e0 + 1, -1)
-    bad += (m.view(np.uint32) != r[f0:f1 + 1, e0:e1 + 1].view(np.uint32)).any(axis=2).reshape(-1)
-ledger_bad = 0
-for name in %(ledger)r:
-    x, y = img.GetFieldData().GetArray(name), ref.GetFieldData().GetArray(name)
-    if x is None or y is None or x.GetTuple1(0) != y.GetTuple1(0):
-        ledger_bad += 1
-cells = img.GetFieldData().GetArray("piece_cells")
-share = cells.GetTuple1(0) / (%(nx)d * %(ny)d) if cells else -1.0
-fd = ref.GetFieldData()
-n = bad.size
-for arr_name, values in (("mismatch", bad), ("ledger_mismatch", np.full(n, ledger_bad, np.float32)),
-                         ("piece_share", np.full(n, share, np.float32)),
-                         ("ref_max_wave", np.full(n, fd.GetArray("max_wave").GetTuple1(0),
-                                                  np.float32)),
-                         ("ref_dry", np.full(n, float(np.count_nonzero(vtk_to_numpy(
-                             ref.GetPointData().GetArray("wet")) == 0.0)), np.float32))):
-    arr = numpy_to_vtk(np.ascontiguousarray(values), deep=1)
-    arr.SetName(arr_name)
-    out.GetPointData().AddArray(arr)
+dry = np.count_nonzero(vtk_to_numpy(ref.GetPointData().GetArray("wet")) == 0.0)
+gr_check.piece_compare(self, ref, %(fields)r, %(ledger)r, %(nx)d, %(ny)d,
+                       [("ref_max_wave", ref.GetFieldData().GetArray("max_wave").GetTuple1(0)),
+                        ("ref_dry", dry)])
 """ % {"end": END, "fields": FIELDS, "ledger": LEDGER, "nx": NX, "ny": NY}
 
 water = WaterSurface(Input=terrain, UseLakeLevel=1, LakeLevel=LEVEL, DropRate=0.05,
