@@ -1130,8 +1130,9 @@ GR_INLINE void gr_sw_continue(gr_sw_pt *q0, gr_sw_pt *q1, gr_sw_pt *q2, gr_sw_pt
 /* Face k of a line of n cells (between cells k - 1 and k; 0 and n are the
  * grid's edge faces), from the cells k - 2 .. k + 1: the depth flux fh,
  * the normal momentum flux as seen by the low cell (fmL) and by the high
- * cell (fmR) (gr_sw_face), and the tangential flux ft; and the slopes sh, se
- * of cell k (gr_sw_cell_slopes' floats, where k < n). kind_lo, kind_hi, lvl_lo, lvl_hi: the kinds
+ * cell (fmR) (gr_sw_face), and the tangential flux ft; and cell k's depth
+ * and surface slopes sh, se (its reconstruction R, where k < n: the
+ * slopes its update takes, gr_sw_balance). kind_lo, kind_hi, lvl_lo, lvl_hi: the kinds
  * and levels of the line's low and high edges. A transmissive edge continues the line
  * (gr_sw_continue), so its face is computed as an inner one; the other
  * edges' faces have a ghost (gr_sw_ghost): a wall passes no water, an open
@@ -1193,8 +1194,8 @@ GR_INLINE void gr_sw_inner_flux(gr_sw_pt q0, gr_sw_pt q1, gr_sw_pt q2, gr_sw_pt 
   gr_sw_face(gr_sw_recon(q0, q1, q2, true), R, true, gr_sw_rise(q1, q2, 0.0f), g, fh, fmL, fmR, ft);
 }
 
-/* gr_sw_line_flux's four values written to out[f] and the three planes
- * after it (plane floats apart). */
+/* gr_sw_line_flux's six values written to out[f] and the five planes
+ * after it (plane floats apart): fh, fmL, fmR, ft, sh, se. */
 GR_INLINE void gr_sw_line_face(gr_sw_pt q0, gr_sw_pt q1, gr_sw_pt q2, gr_sw_pt q3, int k, int n,
                                int kind_lo, int kind_hi, float lvl_lo, float lvl_hi, float g,
                                __global float *restrict out, int f, int plane) {
@@ -1205,31 +1206,12 @@ GR_INLINE void gr_sw_line_face(gr_sw_pt q0, gr_sw_pt q1, gr_sw_pt q2, gr_sw_pt q
   out[f + plane] = fmL;
   out[f + 2 * plane] = fmR;
   out[f + 3 * plane] = ft;
-}
-
-/* The depth and surface slopes (sh, se: gr_sw_recon's) of cell i (p2,
- * between p1 and p3) of a line of n cells along one axis, its line
- * continued beyond a transmissive edge as gr_sw_continue continues it: the
- * same floats as the reconstruction of that cell on either side of its
- * faces (gr_sw_line_flux's R), which the fused stages keep from their
- * faces instead (gr_sw_fused). */
-GR_INLINE void gr_sw_cell_slopes(gr_sw_pt p1, gr_sw_pt p2, gr_sw_pt p3, int i, int n, int kind_lo,
-                                 int kind_hi, float *sh, float *se) {
-  bool tlo = kind_lo == GR_RAIN_RUNOFF_B_TRANSMISSIVE,
-       thi = kind_hi == GR_RAIN_RUNOFF_B_TRANSMISSIVE;
-  if (tlo || thi) {
-    /* The edge cell's inner neighbour, where the edge is this cell's. */
-    gr_sw_pt in_lo = gr_sw_pick_pt(i + 1 < n, p3, p2), in_hi = gr_sw_pick_pt(i > 0, p1, p2);
-    p1 = gr_sw_pick_pt(tlo && i == 0, gr_sw_extend(p2, in_lo, 1.0f), p1);
-    p3 = gr_sw_pick_pt(thi && i == n - 1, gr_sw_extend(p2, in_hi, 1.0f), p3);
-  }
-  gr_sw_cell C = gr_sw_recon(p1, p2, p3, (i > 0 || tlo) && (i < n - 1 || thi));
-  *sh = C.sh;
-  *se = C.se;
+  out[f + 4 * plane] = sh;
+  out[f + 5 * plane] = se;
 }
 
 /* The flux balance along one axis of a cell of depth h and slopes sh, se
- * (gr_sw_cell_slopes), from its low face's fh, fmR, ft and its high face's
+ * (its low face's, gr_sw_line_flux), from its low face's fh, fmR, ft and its high face's
  * fh, fmL, ft (gr_sw_line_flux): dh (mass in minus out), dqn and dqt
  * (momentum, with the bed's source), per unit of the axis' face length. */
 GR_INLINE void gr_sw_balance(float h, float sh, float se, float fh_lo, float fmR_lo, float ft_lo,
@@ -1273,8 +1255,8 @@ GR_INLINE float gr_sw_wet_q(float h, float q, float r, float s, float dt, float 
  * the points the faces read (stage 1: wh, wu, wv, the depth after rain and
  * infiltration and the velocities; stage 2: h1, u1, v1), the faces (fx:
  * (nx+1) x ny x-faces, row stride nx+1; fy: nx x (ny+1) y-faces, numbered
- * like cells with one more row; four planes each, fh, fmL, fmR and ft of
- * gr_sw_line_face: separate planes, not float4s, which CPU compilers do
+ * like cells with one more row; six planes each, fh, fmL, fmR, ft, sh and se
+ * of gr_sw_line_face: separate planes, not float4s, which CPU compilers do
  * not vectorise across work-items), the inputs and the ledger's per-cell sums. */
 #define GR_SW_STEP_ARGS                                                                            \
   __global float *restrict h, __global float *restrict qu, __global float *restrict qv,            \
@@ -1399,7 +1381,7 @@ __kernel void rain_runoff_sw_faces2(GR_SW_STEP_ARGS) {
       wetting_depth, debris_factor, map_time
 
 /* Cell (i, j)'s update in a stage (see gr_sw_update) from its point x2
- * (along x), its slopes along x (shx, sex) and y (shy, sey) (gr_sw_cell_slopes),
+ * (along x), its slopes along x (shx, sex) and y (shy, sey) (its west and south faces' sh, se),
  * its four faces' values as gr_sw_balance takes them (west, east, south, north) and its
  * momenta before the stage (suc, svc; stage 2's, stage 1 takes the wet
  * ones); with velocities, stage 1 also writes U1's velocities u1, v1. Both
@@ -1493,20 +1475,16 @@ GR_INLINE void gr_sw_update(GR_SW_CELL_ARGS, __global const float *restrict fx,
   if (!gr_inside(i, j, nx, ny))
     return;
   int c = gr_idx(i, j, nx);
-  gr_sw_pt x1 = gr_sw_point(ph, pu, pv, b, i >= 1, c - 1);
   gr_sw_pt x2 = gr_sw_point(ph, pu, pv, b, true, c);
-  gr_sw_pt x3 = gr_sw_point(ph, pu, pv, b, i + 1 < nx, c + 1);
-  gr_sw_pt y1 = gr_sw_point(ph, pv, pu, b, j >= 1, c - nx);
-  gr_sw_pt y3 = gr_sw_point(ph, pv, pu, b, j + 1 < ny, c + nx);
-  float shx, sex, shy, sey;
-  gr_sw_cell_slopes(x1, x2, x3, i, nx, bnd_w, bnd_e, &shx, &sex);
-  gr_sw_cell_slopes(y1, x2, y3, j, ny, bnd_s, bnd_n, &shy, &sey);
-  /* The planes of gr_sw_line_face: fh, fmL, fmR, ft. */
+  /* The planes of gr_sw_line_face: fh, fmL, fmR, ft, sh, se; the cell's
+   * slopes are those its west and south faces kept (on PoCL at 1024^2 the
+   * step took 24-25 ms reconstructing the cell again here, and 22-23
+   * reading them). */
   int f = j * (nx + 1) + i, px = (nx + 1) * ny, py = nx * (ny + 1);
-  gr_sw_update_cell(GR_SW_CELL_PASS, i, j, x2, shx, sex, shy, sey, fx[f], fx[f + 2 * px],
-                    fx[f + 3 * px], fx[f + 1], fx[f + 1 + px], fx[f + 1 + 3 * px], fy[c],
-                    fy[c + 2 * py], fy[c + 3 * py], fy[c + nx], fy[c + nx + py],
-                    fy[c + nx + 3 * py], su[c], sv[c], stage, 1);
+  gr_sw_update_cell(GR_SW_CELL_PASS, i, j, x2, fx[f + 4 * px], fx[f + 5 * px], fy[c + 4 * py],
+                    fy[c + 5 * py], fx[f], fx[f + 2 * px], fx[f + 3 * px], fx[f + 1],
+                    fx[f + 1 + px], fx[f + 1 + 3 * px], fy[c], fy[c + 2 * py], fy[c + 3 * py],
+                    fy[c + nx], fy[c + nx + py], fy[c + nx + 3 * py], su[c], sv[c], stage, 1);
 }
 
 /* The two stages' updates as two kernels, each reading one state and

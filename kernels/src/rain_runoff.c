@@ -1120,10 +1120,10 @@ gr_status gr_rain_runoff_create(gr_context *ctx, const gr_grid *grid,
                             &s->qy[a]);
   }
   if (st == GR_OK)
-    st = gr_buffer_create(ctx, CL_MEM_READ_WRITE, (nx + 1) * ny * 4 * sizeof(cl_float), NULL,
+    st = gr_buffer_create(ctx, CL_MEM_READ_WRITE, (nx + 1) * ny * 6 * sizeof(cl_float), NULL,
                           &s->fx);
   if (st == GR_OK)
-    st = gr_buffer_create(ctx, CL_MEM_READ_WRITE, nx * (ny + 1) * 4 * sizeof(cl_float), NULL,
+    st = gr_buffer_create(ctx, CL_MEM_READ_WRITE, nx * (ny + 1) * 6 * sizeof(cl_float), NULL,
                           &s->fy);
   if (st == GR_OK)
     st = gr_buffer_create(ctx, CL_MEM_READ_ONLY, sizeof(cl_float), NULL, &s->dummy);
