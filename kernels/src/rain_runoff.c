@@ -1120,12 +1120,6 @@ gr_status gr_rain_runoff_create(gr_context *ctx, const gr_grid *grid,
                             &s->qy[a]);
   }
   if (st == GR_OK)
-    st = gr_buffer_create(ctx, CL_MEM_READ_WRITE, (nx + 1) * ny * 6 * sizeof(cl_float), NULL,
-                          &s->fx);
-  if (st == GR_OK)
-    st = gr_buffer_create(ctx, CL_MEM_READ_WRITE, nx * (ny + 1) * 6 * sizeof(cl_float), NULL,
-                          &s->fy);
-  if (st == GR_OK)
     st = gr_buffer_create(ctx, CL_MEM_READ_ONLY, sizeof(cl_float), NULL, &s->dummy);
   if (st == GR_OK)
     st = gr_rain_runoff_reductions(s);
@@ -2248,6 +2242,9 @@ static gr_status gr_rain_runoff_bind(gr_rain_runoff *s, cl_float dt) {
       {"inflow_comp", m, &s->in_c},
   };
   if (p->flow_model == GR_FLOW_SHALLOW_WATER) {
+    /* The face arrays, or the one-float dummy until a step takes the
+     * separate launches (gr_rain_runoff_face_arrays). */
+    cl_mem fx = s->fx ? s->fx : s->dummy, fy = s->fy ? s->fy : s->dummy;
     const gr_rain_runoff_arg sw[] = {
         {"h", m, &s->h},
         {"qu", m, &s->qu},
@@ -2258,8 +2255,8 @@ static gr_status gr_rain_runoff_bind(gr_rain_runoff *s, cl_float dt) {
         {"wv", m, &s->wv},
         {"u1", m, &s->u1},
         {"v1", m, &s->v1},
-        {"fx", m, &s->fx},
-        {"fy", m, &s->fy},
+        {"fx", m, &fx},
+        {"fy", m, &fy},
         {"h_comp", m, &s->h_c},
         {"dh1", m, &s->dh1},
         {"qu1", m, &s->qu1},
@@ -2359,6 +2356,28 @@ static gr_status gr_rain_runoff_bind(gr_rain_runoff *s, cl_float dt) {
   return st;
 }
 
+/* The separate shallow-water launches' face arrays (six planes of x-faces
+ * and of y-faces, gr_sw_line_face), made the first time a step takes that
+ * path: the fused stages, the default on GPUs, keep their faces in local
+ * memory, and the arrays would take 805 MB at 4096^2 (12.9 GB at 16384^2)
+ * for nothing. Until then the kernels get the one-float dummy for them. */
+static gr_status gr_rain_runoff_face_arrays(gr_rain_runoff *s) {
+  if (s->fx)
+    return GR_OK;
+  size_t nx = (size_t)s->nxl, ny = (size_t)s->nyl;
+  gr_status st = gr_buffer_create(s->ctx, CL_MEM_READ_WRITE, (nx + 1) * ny * 6 * sizeof(cl_float),
+                                  NULL, &s->fx);
+  if (st == GR_OK)
+    st = gr_buffer_create(s->ctx, CL_MEM_READ_WRITE, nx * (ny + 1) * 6 * sizeof(cl_float), NULL,
+                          &s->fy);
+  if (st != GR_OK) {
+    gr_buffer_release(&s->fx);
+    gr_buffer_release(&s->fy);
+  }
+  s->args_set = 0;
+  return st;
+}
+
 /* Enqueues up to nsteps steps of dt; *done gets the steps enqueued. With a
  * watch (advance with a progress callback) it may stop early at a step
  * boundary: *stop becomes 1. */
@@ -2367,6 +2386,8 @@ static gr_status gr_rain_runoff_enqueue(gr_rain_runoff *s, double dt, int nsteps
   cl_float dtf = (cl_float)dt;
   const size_t m = sizeof(cl_mem);
   gr_status st = gr_rain_runoff_specialise(s);
+  if (st == GR_OK && s->params.flow_model == GR_FLOW_SHALLOW_WATER && !s->sw_fused)
+    st = gr_rain_runoff_face_arrays(s);
   if (st == GR_OK)
     st = gr_rain_runoff_bind(s, dtf);
   int done = 0, exchange = s->halo_exchange && gr_rain_runoff_has_ring(s);
