@@ -1119,8 +1119,11 @@ gr_status gr_rain_runoff_create(gr_context *ctx, const gr_grid *grid,
       st = gr_buffer_create(ctx, CL_MEM_READ_WRITE, nx * (ny + 1) * sizeof(cl_float), NULL,
                             &s->qy[a]);
   }
+  /* Bound where an input is absent, and for the face arrays before they
+   * exist (gr_rain_runoff_face_arrays, arguments the kernels may write):
+   * read-write, though nothing reads or writes it. */
   if (st == GR_OK)
-    st = gr_buffer_create(ctx, CL_MEM_READ_ONLY, sizeof(cl_float), NULL, &s->dummy);
+    st = gr_buffer_create(ctx, CL_MEM_READ_WRITE, sizeof(cl_float), NULL, &s->dummy);
   if (st == GR_OK)
     st = gr_rain_runoff_reductions(s);
   /* Dry, flat ground; nothing infiltrated or gone. */
