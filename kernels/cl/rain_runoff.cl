@@ -521,12 +521,8 @@ GR_INLINE void gr_rain_runoff_map_cell(int c, float d, float u, float v, GR_RAIN
     max_hazard[c] = hazard;
   if (wet && ar < 0.0f)
     arrival[c] = time;
-  if (wet && dt > 0.0f) {
-    /* gr_kahan_add on the values read. */
-    float y = dt - wc, t = wt + y;
-    wet_time_comp[c] = (t - wt) - y;
-    wet_time[c] = t;
-  }
+  if (wet && dt > 0.0f)
+    gr_kahan_store(wet_time, wet_time_comp, c, wt, wc, dt);
 }
 
 /* The new depth of cell c = (i, j) from its depth h0 before the step, its
@@ -1211,9 +1207,9 @@ GR_INLINE void gr_sw_line_face(gr_sw_pt q0, gr_sw_pt q1, gr_sw_pt q2, gr_sw_pt q
 }
 
 /* The flux balance along one axis of a cell of depth h and slopes sh, se
- * (its low face's, gr_sw_line_flux), from its low face's fh, fmR, ft and its high face's
- * fh, fmL, ft (gr_sw_line_flux): dh (mass in minus out), dqn and dqt
- * (momentum, with the bed's source), per unit of the axis' face length. */
+ * (as its low face keeps them, gr_sw_line_flux), from its low face's fh, fmR, ft and its high
+ * face's fh, fmL, ft (gr_sw_line_flux): dh (mass in minus out), dqn and dqt (momentum, with the
+ * bed's source), per unit of the axis' face length. */
 GR_INLINE void gr_sw_balance(float h, float sh, float se, float fh_lo, float fmR_lo, float ft_lo,
                              float fh_hi, float fmL_hi, float ft_hi, float g, float *dh, float *dqn,
                              float *dqt) {

@@ -15,13 +15,19 @@
 
 /* Kahan summation into per-cell arrays: sum[c] - comp[c] carries a running
  * total to about twice float precision over 10^5 steps and more. */
-GR_INLINE void gr_kahan_add(__global float *restrict sum, __global float *restrict comp, int c,
-                            float x) {
-  float s = sum[c];
-  float y = x - comp[c];
+/* x added to the sum s and compensation k already read from sum[c],
+ * comp[c] (a caller that reads them before it knows whether it adds). */
+GR_INLINE void gr_kahan_store(__global float *restrict sum, __global float *restrict comp, int c,
+                              float s, float k, float x) {
+  float y = x - k;
   float t = s + y;
   comp[c] = (t - s) - y;
   sum[c] = t;
+}
+
+GR_INLINE void gr_kahan_add(__global float *restrict sum, __global float *restrict comp, int c,
+                            float x) {
+  gr_kahan_store(sum, comp, c, sum[c], comp[c], x);
 }
 
 /* Double-float arithmetic (Knuth's TwoSum): hi + lo holds a sum to about
