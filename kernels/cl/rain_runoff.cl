@@ -1386,7 +1386,8 @@ GR_INLINE void gr_sw_update_cell(GR_SW_CELL_ARGS, int i, int j, gr_sw_pt x2, flo
                                  float shy, float sey, float fh_w, float fm_w, float ft_w,
                                  float fh_e, float fm_e, float ft_e, float fh_s, float fm_s,
                                  float ft_s, float fh_n, float fm_n, float ft_n, float suc,
-                                 float svc, const int stage, const int velocities) {
+                                 float svc, float h0, float q0u, float q0v, float hcomp, float dh1c,
+                                 const int stage, const int velocities) {
   int c = gr_idx(i, j, nx);
   float n2c = GR_RAIN_RUNOFF_USES(GR_RAIN_RUNOFF_IN_N2, use_n2)
                   ? n2map[c]
@@ -1403,8 +1404,8 @@ GR_INLINE void gr_sw_update_cell(GR_SW_CELL_ARGS, int i, int j, gr_sw_pt x2, flo
     float r = GR_RAIN_RUNOFF_RAIN(c);
     float sc = GR_RAIN_RUNOFF_SRC(c);
     float hw = x2.h;
-    qun = gr_sw_wet_q(h[c], qu[c], r, sc, dt, hw) + dt * (dqx_x * inv_dx + dqx_y * inv_dy);
-    qvn = gr_sw_wet_q(h[c], qv[c], r, sc, dt, hw) + dt * (dqy_x * inv_dx + dqy_y * inv_dy);
+    qun = gr_sw_wet_q(h0, q0u, r, sc, dt, hw) + dt * (dqx_x * inv_dx + dqx_y * inv_dy);
+    qvn = gr_sw_wet_q(h0, q0v, r, sc, dt, hw) + dt * (dqy_x * inv_dx + dqy_y * inv_dy);
     /* Friction in each stage: without it a film on a steep slope would
      * gather g S dt of speed in the first stage and empty its cell in the
      * second. */
@@ -1421,7 +1422,6 @@ GR_INLINE void gr_sw_update_cell(GR_SW_CELL_ARGS, int i, int j, gr_sw_pt x2, flo
       v1[c] = gr_sw_velocity(hs, qvs);
     }
   } else {
-    float h0 = h[c];
     float r = GR_RAIN_RUNOFF_RAIN(c);
     float k = GR_RAIN_RUNOFF_PERM(c);
     float sc = GR_RAIN_RUNOFF_SRC(c);
@@ -1430,13 +1430,13 @@ GR_INLINE void gr_sw_update_cell(GR_SW_CELL_ARGS, int i, int j, gr_sw_pt x2, flo
     /* The new depth h0 + (r dt - i) + (dh1 + dh) / 2, Kahan-summed as the
      * local inertial model's (h - h_comp is the water): without it the
      * rounding of the depth would show in the ledger after 10^3 steps. */
-    float delta = ((r * dt - inf) + sc * dt) + 0.5f * (dh1[c] + dh);
-    float y = delta - h_comp[c];
+    float delta = ((r * dt - inf) + sc * dt) + 0.5f * (dh1c + dh);
+    float y = delta - hcomp;
     float hf = h0 + y;
     float comp = (hf - h0) - y;
     gr_sw_friction(hn, dt, g, n2c, &qun, &qvn);
-    float qx = 0.5f * (gr_sw_wet_q(h0, qu[c], r, sc, dt, hw) + qun);
-    float qy = 0.5f * (gr_sw_wet_q(h0, qv[c], r, sc, dt, hw) + qvn);
+    float qx = 0.5f * (gr_sw_wet_q(h0, q0u, r, sc, dt, hw) + qun);
+    float qy = 0.5f * (gr_sw_wet_q(h0, q0v, r, sc, dt, hw) + qvn);
     /* An outfall no-data cell drains (its water is outflow). */
     float gone = gr_rain_runoff_drain(nodata, use_nodata, c, hf, comp);
     bool keep = hf > 0.0f && gone == 0.0f;
@@ -1480,7 +1480,8 @@ GR_INLINE void gr_sw_update(GR_SW_CELL_ARGS, __global const float *restrict fx,
   gr_sw_update_cell(GR_SW_CELL_PASS, i, j, x2, fx[f + 4 * px], fx[f + 5 * px], fy[c + 4 * py],
                     fy[c + 5 * py], fx[f], fx[f + 2 * px], fx[f + 3 * px], fx[f + 1],
                     fx[f + 1 + px], fx[f + 1 + 3 * px], fy[c], fy[c + 2 * py], fy[c + 3 * py],
-                    fy[c + nx], fy[c + nx + py], fy[c + nx + 3 * py], su[c], sv[c], stage, 1);
+                    fy[c + nx], fy[c + nx + py], fy[c + nx + 3 * py], su[c], sv[c], h[c], qu[c],
+                    qv[c], stage == 2 ? h_comp[c] : 0.0f, stage == 2 ? dh1[c] : 0.0f, stage, 1);
 }
 
 /* The two stages' updates as two kernels, each reading one state and
@@ -1556,15 +1557,6 @@ GR_INLINE gr_sw_pt gr_sw_tile_pt(__local const float4 *restrict tp, int p, bool 
   return q;
 }
 
-/* t / w for 0 <= t < 2^20 and w >= 1, from rw = 1 / w: (t + 1/2) / w lies
- * at least 1 / (2 w) from any integer, far more than the float product's
- * error, so its floor is the quotient. An integer division by a number
- * known only at run time is some twenty instructions on GPUs; the tile's
- * loops take one per point and per face. */
-GR_INLINE int gr_sw_div(int t, float rw) {
-  return (int)(((float)t + 0.5f) * rw);
-}
-
 /* The tile (*ti, *tj) of the rim's work-group r (rain_runoff_sw_stage*):
  * the tiles outside the interior ones (tiles: their columns x .. y - 1 and
  * rows z .. w - 1) of a grid of nti x ntj tiles, row by row: the rows
@@ -1580,9 +1572,79 @@ GR_INLINE void gr_sw_rim_tile(int r, int nti, int ntj, int4 tiles, int *ti, int 
   *ti = r < south + north || a < tiles.x ? a : tiles.y + (a - tiles.x);
 }
 
+/* Point (a, e) of the tile's local array (pw points a row; its cell
+ * (i0 - 2 + a, j0 - 2 + e)), 0 beyond the grid as gr_sw_point masks them:
+ * stage 1 makes it from the state, rain and infiltration as sw_prep does,
+ * stage 2 takes U1's velocities as stage 1 would have stored them. */
+GR_INLINE void gr_sw_tile_point(GR_SW_CELL_ARGS, __local float4 *restrict tp, int pw, int i0,
+                                int j0, int a, int e, const int stage) {
+  int pi = i0 - 2 + a, pj = j0 - 2 + e;
+  bool in = pi >= 0 && pi < nx && pj >= 0 && pj < ny;
+  float ph = 0.0f, pb = 0.0f, pu = 0.0f, pv = 0.0f;
+  if (in) {
+    int q = pj * nx + pi;
+    pb = b[q];
+    if (stage == 1) {
+      float h0 = h[q], r = GR_RAIN_RUNOFF_RAIN(q), k = GR_RAIN_RUNOFF_PERM(q);
+      float sc = GR_RAIN_RUNOFF_SRC(q);
+      float hw = gr_rain_runoff_wet(h0, r, sc, k, dt);
+      ph = hw;
+      pu = gr_sw_velocity(hw, gr_sw_wet_q(h0, qu[q], r, sc, dt, hw));
+      pv = gr_sw_velocity(hw, gr_sw_wet_q(h0, qv[q], r, sc, dt, hw));
+    } else {
+      ph = h1[q];
+      pu = gr_sw_velocity(ph, qu1[q]);
+      pv = gr_sw_velocity(ph, qv1[q]);
+    }
+  }
+  tp[e * pw + a] = (float4)(ph, pb, pu, pv);
+}
+
+/* The tile's face (a, e) along x (xs: between cells a - 1 and a of row e)
+ * or along y (between rows e - 1 and e of column a), from the points, its
+ * six values (gr_sw_line_face's fh, fmL, fmR, ft, sh, se) written to out
+ * and the five planes after it (plane floats apart), at a + e (tx + 1) for
+ * an x-face, a + e tx for a y-face. An interior tile (inner: its faces all
+ * two cells or more inside the grid) takes the face's expression without
+ * the edges' cases (gr_sw_inner_flux); a rim tile's face beyond the grid
+ * is computed from zeros and never read. */
+GR_INLINE void gr_sw_tile_face(__local const float4 *restrict tp, __local float *restrict out,
+                               int plane, int tx, int pw, int i0, int j0, int a, int e, int nx,
+                               int ny, int bnd_w, int bnd_e, int bnd_s, int bnd_n, float lvl_w,
+                               float lvl_e, float lvl_s, float lvl_n, float g, const bool xs,
+                               const int inner) {
+  int p = (e + 2) * pw + a + 2, step = xs ? 1 : pw; /* the high cell's point */
+  gr_sw_pt q0 = gr_sw_tile_pt(tp, p - 2 * step, xs);
+  gr_sw_pt q1 = gr_sw_tile_pt(tp, p - step, xs);
+  gr_sw_pt q2 = gr_sw_tile_pt(tp, p, xs);
+  gr_sw_pt q3 = gr_sw_tile_pt(tp, p + step, xs);
+  float fh, fmL, fmR, ft, sh, se;
+  if (inner)
+    gr_sw_inner_flux(q0, q1, q2, q3, g, &fh, &fmL, &fmR, &ft, &sh, &se);
+  else
+    gr_sw_line_flux(q0, q1, q2, q3, xs ? i0 + a : j0 + e, xs ? nx : ny, xs ? bnd_w : bnd_s,
+                    xs ? bnd_e : bnd_n, xs ? lvl_w : lvl_s, xs ? lvl_e : lvl_n, g, &fh, &fmL, &fmR,
+                    &ft, &sh, &se);
+  int u = a + e * (xs ? tx + 1 : tx);
+  out[u] = fh;
+  out[u + plane] = fmL;
+  out[u + 2 * plane] = fmR;
+  out[u + 3 * plane] = ft;
+  out[u + 4 * plane] = sh;
+  out[u + 5 * plane] = se;
+}
+
 /* One stage for the tiles of the interior (inner: its tile columns tiles.x
  * .. tiles.y - 1 and rows tiles.z .. tiles.w - 1, one work-group each), or
- * for those of the rim (a line of work-groups, gr_sw_rim_tile). */
+ * for those of the rim (a line of work-groups, gr_sw_rim_tile). Each
+ * work-item makes its own cell's point and computes its cell's west and
+ * south faces; the rest of the tile's points (the two rows below and above
+ * it, the two columns left and right; the corners are never read) and
+ * faces (the east column and the north row) go to work-items from both
+ * ends of the work-group, so that few warps take them. Every index follows
+ * from the work-item's own (on the H200 the loops over a flat index,
+ * divided by the tile's run-time width, took a fifth of the faces'
+ * instructions in index arithmetic and selections of planes). */
 GR_INLINE void gr_sw_fused(GR_SW_CELL_ARGS, float lvl_w, float lvl_e, float lvl_s, float lvl_n,
                            __local float4 *restrict tile, int4 tiles, const int stage,
                            const int inner) {
@@ -1601,68 +1663,28 @@ GR_INLINE void gr_sw_fused(GR_SW_CELL_ARGS, float lvl_w, float lvl_e, float lvl_
   __local float *xsh = xt + nfx, *xse = xsh + nfx;
   __local float *yh = xse + nfx, *yl = yh + nfy, *yr = yl + nfy, *yt = yr + nfy;
   __local float *ysh = yt + nfy, *yse = ysh + nfy;
-  /* The points: 0 beyond the local array, as gr_sw_point masks them. */
-  float rpw = 1.0f / (float)pw, rx1 = 1.0f / (float)(tx + 1), rx = 1.0f / (float)tx;
-  for (int t = lid; t < np; t += wg) {
-    int e = gr_sw_div(t, rpw), a = t - e * pw, pi = i0 - 2 + a, pj = j0 - 2 + e;
-    bool corner = (a < 2 || a >= tx + 2) && (e < 2 || e >= ty + 2);
-    bool in = !corner && pi >= 0 && pi < nx && pj >= 0 && pj < ny;
-    float ph = 0.0f, pb = 0.0f, pu = 0.0f, pv = 0.0f;
-    if (in) {
-      int q = pj * nx + pi;
-      pb = b[q];
-      if (stage == 1) {
-        /* rain_runoff_sw_prep's points. */
-        float h0 = h[q], r = GR_RAIN_RUNOFF_RAIN(q), k = GR_RAIN_RUNOFF_PERM(q);
-        float sc = GR_RAIN_RUNOFF_SRC(q);
-        float hw = gr_rain_runoff_wet(h0, r, sc, k, dt);
-        ph = hw;
-        pu = gr_sw_velocity(hw, gr_sw_wet_q(h0, qu[q], r, sc, dt, hw));
-        pv = gr_sw_velocity(hw, gr_sw_wet_q(h0, qv[q], r, sc, dt, hw));
-      } else {
-        /* Stage 1's u1, v1. */
-        ph = h1[q];
-        pu = gr_sw_velocity(ph, qu1[q]);
-        pv = gr_sw_velocity(ph, qv1[q]);
-      }
-    }
-    tp[t] = (float4)(ph, pb, pu, pv);
+  gr_sw_tile_point(GR_SW_CELL_PASS, tp, pw, i0, j0, lx + 2, ly + 2, stage);
+  for (int t = lid; t < 2 * tx; t += wg) {
+    int k = t >= tx ? 1 : 0, a = 2 + t - k * tx;
+    gr_sw_tile_point(GR_SW_CELL_PASS, tp, pw, i0, j0, a, k, stage);
+    gr_sw_tile_point(GR_SW_CELL_PASS, tp, pw, i0, j0, a, ty + 2 + k, stage);
+  }
+  for (int t = wg - 1 - lid; t < 2 * ty; t += wg) {
+    int k = t >= ty ? 1 : 0, e = 2 + t - k * ty;
+    gr_sw_tile_point(GR_SW_CELL_PASS, tp, pw, i0, j0, k, e, stage);
+    gr_sw_tile_point(GR_SW_CELL_PASS, tp, pw, i0, j0, tx + 2 + k, e, stage);
   }
   barrier(CLK_LOCAL_MEM_FENCE);
-  /* The tile's faces, x-faces then y-faces in one index space: one call
-   * of the face's expression, its inputs selected. A face beyond the local
-   * array's is computed from zeros and never read. An interior tile (its
-   * faces all two cells or more inside the grid: nearly every tile of a
-   * large grid) takes the face's expression without the edges' cases:
-   * each face is inner, both its cells have both neighbours, no line is
-   * continued, no ghost is picked and no edge stops a flux, as
-   * gr_sw_line_flux finds face by face in the rim's tiles; the same floats
-   * in fewer instructions. */
-  for (int t = lid; t < nfx + nfy; t += wg) {
-    bool xs = t < nfx;
-    int u = xs ? t : t - nfx, w = xs ? tx + 1 : tx;
-    int e = gr_sw_div(u, xs ? rx1 : rx), a = u - e * w;
-    int p = (e + 2) * pw + a + 2, step = xs ? 1 : pw; /* the high cell's point */
-    gr_sw_pt q0 = gr_sw_tile_pt(tp, p - 2 * step, xs);
-    gr_sw_pt q1 = gr_sw_tile_pt(tp, p - step, xs);
-    gr_sw_pt q2 = gr_sw_tile_pt(tp, p, xs);
-    gr_sw_pt q3 = gr_sw_tile_pt(tp, p + step, xs);
-    float fh, fmL, fmR, ft, sh, se;
-    if (inner)
-      gr_sw_inner_flux(q0, q1, q2, q3, g, &fh, &fmL, &fmR, &ft, &sh, &se);
-    else
-      gr_sw_line_flux(q0, q1, q2, q3, xs ? i0 + a : j0 + e, xs ? nx : ny, xs ? bnd_w : bnd_s,
-                      xs ? bnd_e : bnd_n, xs ? lvl_w : lvl_s, xs ? lvl_e : lvl_n, g, &fh, &fmL,
-                      &fmR, &ft, &sh, &se);
-    __local float *oh = xs ? xh : yh, *ol = xs ? xl : yl, *orr = xs ? xr : yr, *ot = xs ? xt : yt;
-    __local float *osh = xs ? xsh : ysh, *ose = xs ? xse : yse;
-    oh[u] = fh;
-    ol[u] = fmL;
-    orr[u] = fmR;
-    ot[u] = ft;
-    osh[u] = sh;
-    ose[u] = se;
-  }
+#define GR_SW_TILE_FACE(a, e, xs)                                                                  \
+  gr_sw_tile_face(tp, xs ? xh : yh, xs ? nfx : nfy, tx, pw, i0, j0, a, e, nx, ny, bnd_w, bnd_e,    \
+                  bnd_s, bnd_n, lvl_w, lvl_e, lvl_s, lvl_n, g, xs, inner)
+  GR_SW_TILE_FACE(lx, ly, true);
+  GR_SW_TILE_FACE(lx, ly, false);
+  for (int t = lid; t < ty; t += wg)
+    GR_SW_TILE_FACE(tx, t, true);
+  for (int t = wg - 1 - lid; t < tx; t += wg)
+    GR_SW_TILE_FACE(t, ty, false);
+#undef GR_SW_TILE_FACE
   barrier(CLK_LOCAL_MEM_FENCE);
   if (i >= nx || j >= ny)
     return;
@@ -1672,7 +1694,8 @@ GR_INLINE void gr_sw_fused(GR_SW_CELL_ARGS, float lvl_w, float lvl_e, float lvl_
   float suc = stage == 1 ? qu[c] : qu1[c], svc = stage == 1 ? qv[c] : qv1[c];
   gr_sw_update_cell(GR_SW_CELL_PASS, i, j, x2, xsh[fw], xse[fw], ysh[fs], yse[fs], xh[fw], xr[fw],
                     xt[fw], xh[fw + 1], xl[fw + 1], xt[fw + 1], yh[fs], yr[fs], yt[fs], yh[fn],
-                    yl[fn], yt[fn], suc, svc, stage, 0);
+                    yl[fn], yt[fn], suc, svc, h[c], qu[c], qv[c], stage == 2 ? h_comp[c] : 0.0f,
+                    stage == 2 ? dh1[c] : 0.0f, stage, 0);
   /* Half of the stage's edge flows, as rain_runoff_sw_edges books them
    * after the update (the rim's tiles hold every edge cell). */
   if (!inner && (i == 0 || j == 0 || i == nx - 1 || j == ny - 1)) {
