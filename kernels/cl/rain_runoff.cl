@@ -946,11 +946,17 @@ typedef struct gr_sw_cell {
 #define GR_RAIN_RUNOFF_SW_FLAT (2.0f * FLT_EPSILON)
 
 GR_INLINE float gr_sw_rise(gr_sw_pt m, gr_sw_pt p, float after) {
-  /* + 0 after: the flat depth waits for another rise (after is finite, the
-   * sum exact), so that CPU compilers do not pair two rises into a
-   * <2 x float> before vectorising across work-items (see gr_sw_hll). */
+  /* On CPUs + 0 after: the flat depth waits for another rise (after is
+   * finite, the sum exact), so that CPU compilers do not pair two rises
+   * into a <2 x float> before vectorising across work-items (see
+   * gr_sw_hll); GPUs have no vectoriser to steer, and the same floats cost
+   * them two instructions fewer a rise. */
   float d = (p.b - m.b) + (p.h - m.h);
+#if GR_RAIN_RUNOFF_GPU
+  float flat = GR_RAIN_RUNOFF_SW_FLAT * (m.h + p.h);
+#else
   float flat = GR_RAIN_RUNOFF_SW_FLAT * (m.h + p.h) + 0.0f * fabs(after);
+#endif
   return fabs(d) <= flat ? 0.0f : d;
 }
 
@@ -986,7 +992,11 @@ GR_INLINE void gr_sw_hll(float hL, float uL, float vL, float hR, float uR, float
    * but for the sign of a zero, and cR is never read where hR is 0), so
    * that CPU compilers do not pair the two square roots into a <2 x float>
    * before vectorising across work-items, which such values prevent. */
+#if GR_RAIN_RUNOFF_GPU
+  float cL = sqrt(g * hL), cR = sqrt(g * hR); /* GPUs: as gr_sw_rise */
+#else
   float cL = sqrt(g * hL), cR = sqrt(g * hR + 0.0f * cL);
+#endif
   /* Each speed's three cases computed, then selected (nested conditionals
    * of expressions compiled to branches on NVIDIA devices). */
   float lo_dl = uR - 2.0f * cR, lo_dr = uL - cL, lo_w = fmin(uL - cL, uR - cR);
