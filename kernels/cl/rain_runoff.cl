@@ -1659,7 +1659,15 @@ GR_INLINE void gr_sw_fused(GR_SW_CELL_ARGS, float lvl_w, float lvl_e, float lvl_
                            __local float4 *restrict tile, int4 tiles, const int stage,
                            const int inner) {
   int lx = get_local_id(0), ly = get_local_id(1);
+  /* The tile's size, a constant where the program is built for it (GPUs:
+   * GR_SW_TILE_X, GR_SW_TILE_Y), so that every index and loop bound of the
+   * tile is one: on the H200 at 4096^2 1.12 -> 1.07 ms a step, and the
+   * interior's kernels no longer spill. */
+#ifdef GR_SW_TILE_X
+  const int tx = GR_SW_TILE_X, ty = GR_SW_TILE_Y;
+#else
   int tx = get_local_size(0), ty = get_local_size(1);
+#endif
   int ti = tiles.x + get_group_id(0), tj = tiles.z + get_group_id(1);
   if (!inner)
     gr_sw_rim_tile(get_group_id(0), (nx + tx - 1) / tx, (ny + ty - 1) / ty, tiles, &ti, &tj);
@@ -1725,8 +1733,13 @@ GR_INLINE void gr_sw_fused(GR_SW_CELL_ARGS, float lvl_w, float lvl_e, float lvl_
  * 1.55 ms a step with one kernel, 1.51 with two). All take GR_SW_STEP_ARGS (the host
  * binds the same table), the tiles and the tile's local memory: 4 (tx + 4)
  * (ty + 4) + 6 (tx + 1) ty + 6 tx (ty + 1) floats. */
+#ifdef GR_SW_TILE_X
+#define GR_SW_TILE_ATTR __attribute__((reqd_work_group_size(GR_SW_TILE_X, GR_SW_TILE_Y, 1)))
+#else
+#define GR_SW_TILE_ATTR
+#endif
 #define GR_SW_FUSED_KERNEL(name, stage, inner)                                                     \
-  __kernel void name(GR_SW_STEP_ARGS, int4 tiles, __local float4 *restrict tile) {                 \
+  __kernel GR_SW_TILE_ATTR void name(GR_SW_STEP_ARGS, int4 tiles, __local float4 *restrict tile) { \
     gr_sw_fused(GR_SW_CELL_PASS, lvl_w, lvl_e, lvl_s, lvl_n, tile, tiles, stage, inner);           \
   }
 GR_SW_FUSED_KERNEL(rain_runoff_sw_stage1, 1, 0)

@@ -149,6 +149,9 @@ struct gr_rain_runoff {
   int sw_fused;
   size_t sw_local[2], sw_tile_bytes, sw_rim;
   cl_int sw_tiles[4];
+  /* The tile the program's fused stages were built for (GPUs: its size a
+   * constant of the kernels, gr_rain_runoff_specialise); 0 x 0: any. */
+  size_t sw_built[2];
   /* Every kernel comes from the program built for `inputs`: the optional
    * inputs' GR_RAIN_RUNOFF_IN_* bits, and GR_RAIN_RUNOFF_IN_ALL + 1 where it
    * has the shallow-water model's kernels (-1 before the first build;
@@ -830,6 +833,22 @@ static size_t gr_rain_runoff_sw_tile_bytes(size_t tx, size_t ty) {
  * launches' time (512^2: 32-35 ms against 7.7-8.5; 1024^2: 160-250 ms
  * against 36), where the caches hide most of what the separate launches
  * store and read again. */
+/* The default tile of a device whose work-groups take at most `most`
+ * work-items and local_mem bytes: 32 x 8, halved until it fits. Measured
+ * on the H200 at 4096^2 (ms a step): 32 x 8 1.51, 64 x 4 1.59, 32 x 4 1.63
+ * (and before the interior's kernel and the register cap, 16 x 8 2.48,
+ * 16 x 16 2.50 against 32 x 8 2.16); with the tile's size built into the
+ * kernels, 32 x 8 1.12, 16 x 16 1.76. */
+static void gr_rain_runoff_sw_default_tile(size_t most, cl_ulong local_mem, size_t *tx,
+                                           size_t *ty) {
+  *tx = 32;
+  *ty = 8;
+  while (*ty > 1 && (*tx * *ty > most || gr_rain_runoff_sw_tile_bytes(*tx, *ty) > local_mem))
+    *ty /= 2;
+  while (*tx > 1 && (*tx * *ty > most || gr_rain_runoff_sw_tile_bytes(*tx, *ty) > local_mem))
+    *tx /= 2;
+}
+
 static gr_status gr_rain_runoff_sw_shape(gr_rain_runoff *s, size_t tx, size_t ty, int set_default) {
   cl_device_id dev = gr_context_device(s->ctx);
   cl_device_type type = 0;
@@ -855,17 +874,8 @@ static gr_status gr_rain_runoff_sw_shape(gr_rain_runoff *s, size_t tx, size_t ty
   if (err != CL_SUCCESS)
     return gr_cl_check(s->ctx, err, "Querying the device for the shallow-water stages' work-group");
   int gpu = (type & CL_DEVICE_TYPE_GPU) != 0;
-  if (tx == 0 && ty == 0) {
-    /* 32 x 8 on GPUs, measured on the H200 at 4096^2 (ms a step): 32 x 8
-     * 1.51, 64 x 4 1.59, 32 x 4 1.63 (and before the interior's kernel and
-     * the register cap, 16 x 8 2.48, 16 x 16 2.50 against 32 x 8 2.16). */
-    tx = 32;
-    ty = 8;
-    while (ty > 1 && (tx * ty > most || gr_rain_runoff_sw_tile_bytes(tx, ty) > local_mem))
-      ty /= 2;
-    while (tx > 1 && (tx * ty > most || gr_rain_runoff_sw_tile_bytes(tx, ty) > local_mem))
-      tx /= 2;
-  }
+  if (tx == 0 && ty == 0)
+    gr_rain_runoff_sw_default_tile(most, local_mem, &tx, &ty);
   size_t bytes = gr_rain_runoff_sw_tile_bytes(tx, ty);
   if (tx == 0 || ty == 0 || tx * ty > most || bytes > local_mem)
     return gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
@@ -936,7 +946,24 @@ static gr_status gr_rain_runoff_specialise(gr_rain_runoff *s) {
   int sw = !s->specialise || s->params.flow_model == GR_FLOW_SHALLOW_WATER;
   int inputs = s->specialise ? gr_rain_runoff_inputs_used(s) : GR_RAIN_RUNOFF_IN_ALL;
   int want = inputs | (sw ? GR_RAIN_RUNOFF_IN_ALL + 1 : 0);
-  if (want == s->inputs)
+  /* A GPU's shallow-water program is built for its tile (GR_SW_TILE_X, Y:
+   * the one set, or before one is the device's default): the fused stages
+   * then take only that work-group. */
+  size_t tile[2] = {0, 0};
+  if (s->gpu && sw) {
+    tile[0] = s->sw_local[0];
+    tile[1] = s->sw_local[1];
+    cl_ulong local_mem = 0;
+    size_t most = 0;
+    cl_device_id dev = gr_context_device(s->ctx);
+    if (tile[0] == 0 &&
+        clGetDeviceInfo(dev, CL_DEVICE_LOCAL_MEM_SIZE, sizeof(local_mem), &local_mem, NULL) ==
+            CL_SUCCESS &&
+        clGetDeviceInfo(dev, CL_DEVICE_MAX_WORK_GROUP_SIZE, sizeof(most), &most, NULL) ==
+            CL_SUCCESS)
+      gr_rain_runoff_sw_default_tile(most, local_mem, &tile[0], &tile[1]);
+  }
+  if (want == s->inputs && tile[0] == s->sw_built[0] && tile[1] == s->sw_built[1])
     return GR_OK;
   static const char *const names[] = {
       "rain_runoff_flux",       "rain_runoff_flux_edges", "rain_runoff_limit",
@@ -956,13 +983,16 @@ static gr_status gr_rain_runoff_specialise(gr_rain_runoff *s) {
       &s->sw_edges,   &s->sw_stage[0], &s->sw_stage[1], &s->reduce,       &s->derive,
       &s->sw_speed,   &s->li_speed,    &s->maps,        &s->source,       &s->sw_inner[0],
       &s->sw_inner[1]};
-  char opt[160] = "";
+  char opt[224] = "";
   int len = 0;
   if (s->specialise)
     len = snprintf(opt, sizeof(opt), "-DGR_RAIN_RUNOFF_INPUTS=%d -DGR_RAIN_RUNOFF_SW=%d ", inputs,
                    sw);
   if (s->gpu)
     len += snprintf(opt + len, sizeof(opt) - (size_t)len, "-DGR_RAIN_RUNOFF_GPU=1 ");
+  if (tile[0] > 0)
+    len += snprintf(opt + len, sizeof(opt) - (size_t)len, "-DGR_SW_TILE_X=%zu -DGR_SW_TILE_Y=%zu ",
+                    tile[0], tile[1]);
   if (s->nv_registers)
     snprintf(opt + len, sizeof(opt) - (size_t)len, "-cl-nv-maxrregcount=%d",
              GR_RAIN_RUNOFF_NV_REGISTERS);
@@ -986,6 +1016,8 @@ static gr_status gr_rain_runoff_specialise(gr_rain_runoff *s) {
   }
   /* Until all that follows holds, the next call builds them again. */
   s->inputs = -1;
+  s->sw_built[0] = tile[0];
+  s->sw_built[1] = tile[1];
   s->args_set = 0;
   s->maps_bound = 0;
   st = gr_rain_runoff_step_indices(s);
@@ -1001,6 +1033,10 @@ static gr_status gr_rain_runoff_specialise(gr_rain_runoff *s) {
     st = gr_rain_runoff_reductions(s);
   if (st == GR_OK)
     s->inputs = want;
+  /* A tile that had to change (it no longer fitted): built for the new one. */
+  if (st == GR_OK && !first && tile[0] > 0 &&
+      (s->sw_local[0] != tile[0] || s->sw_local[1] != tile[1]))
+    st = gr_rain_runoff_specialise(s);
   return st;
 }
 
