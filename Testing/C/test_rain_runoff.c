@@ -4653,7 +4653,11 @@ static void give_inputs(gr_rain_runoff *sim, int bits, const float *r, const flo
  * both run on whatever device the test has: the shallow-water model on the
  * 75 x 41 bumpy grid of the launch-path tests with every optional input, a
  * wall, a transmissive, a level and an open edge, in each launch path;
- * after 120 steps the whole state and the ledger are the same to the bit. */
+ * after 120 steps the whole state and the ledger are the same to the bit.
+ * A third run takes the GPUs' form with the fused stages built for their
+ * tile (-DGR_SW_TILE_X, Y, as the host builds them on GPUs: every index of
+ * the tile a constant), a tile of 8 x 4 that has interior and rim tiles on
+ * this grid; it too gives the CPUs' form's bits. */
 static void test_device_forms(void) {
   paths_in in = paths_make(6, 5);
   gr_grid g = in.g;
@@ -4670,13 +4674,17 @@ static void test_device_forms(void) {
   const char *before = getenv("GRAUPEL_CL_OPTIONS");
   char *kept = before ? strdup(before) : NULL;
   for (int fused = 0; fused < 2; ++fused) {
-    gr_rain_runoff *sim[2] = {NULL, NULL}; /* the CPUs' form, the GPUs' */
-    for (int v = 0; v < 2; ++v) {
+    /* the CPUs' form, the GPUs', the GPUs' built for an 8 x 4 tile */
+    gr_rain_runoff *sim[3] = {NULL, NULL, NULL};
+    for (int v = 0; v < 3; ++v) {
       char opt[512];
-      snprintf(opt, sizeof(opt), "%s -DGR_RAIN_RUNOFF_GPU=%d", kept ? kept : "", v);
+      snprintf(opt, sizeof(opt), "%s -DGR_RAIN_RUNOFF_GPU=%d%s", kept ? kept : "", v > 0,
+               v == 2 ? " -DGR_SW_TILE_X=8 -DGR_SW_TILE_Y=4" : "");
       setenv("GRAUPEL_CL_OPTIONS", opt, 1);
       sim[v] = make_sim(&g, &p, b, d);
       if (sim[v]) {
+        if (v == 2)
+          CHECK(gr_rain_runoff_set_sw_tile(sim[v], 8, 4) == GR_OK);
         gr_rain_runoff_set_sw_fused(sim[v], fused);
         give_inputs(sim[v], GR_RAIN_RUNOFF_INPUT_ALL, r, k, nmap);
         run_stable(sim[v], 4, 30); /* builds the program under this form */
@@ -4686,23 +4694,26 @@ static void test_device_forms(void) {
       setenv("GRAUPEL_CL_OPTIONS", kept, 1);
     else
       unsetenv("GRAUPEL_CL_OPTIONS");
-    if (sim[0] && sim[1]) {
+    for (int v = 1; v < 3; ++v) {
+      if (!sim[0] || !sim[v])
+        continue;
       size_t words = 0;
-      long diff = state_words_differ(sim[0], sim[1], &words);
+      long diff = state_words_differ(sim[0], sim[v], &words);
       gr_rain_runoff_ledger l0 = ledger(sim[0]);
-      int same_ledger = ledgers_same(sim[0], sim[1]);
+      int same_ledger = ledgers_same(sim[0], sim[v]);
+      const char *what = v == 2 ? "the GPUs' form built for its tile" : "the GPUs' form";
       CHECK_MSG(diff == 0 && same_ledger,
-                "%s: %ld words of the state of %zu differ between the forms; ledgers %s",
-                fused ? "fused" : "separate launches", diff, words,
+                "%s, %s: %ld words of the state of %zu differ from the CPUs' form; ledgers %s",
+                fused ? "fused" : "separate launches", what, diff, words,
                 same_ledger ? "agree" : "differ");
       CHECK_MSG(l0.steps == 120 && l0.outflow_volume > 0.0 && l0.infiltrated_volume > 0.0,
                 "%lld steps, outflow %g m^3, infiltrated %g m^3", l0.steps, l0.outflow_volume,
                 l0.infiltrated_volume);
-      printf("%s: %ld words of %zu differ between the forms; outflow %.4f m^3\n",
-             fused ? "fused" : "separate launches", diff, words, l0.outflow_volume);
+      printf("%s, %s: %ld words of %zu differ from the CPUs' form; outflow %.4f m^3\n",
+             fused ? "fused" : "separate launches", what, diff, words, l0.outflow_volume);
     }
-    gr_rain_runoff_destroy(sim[0]);
-    gr_rain_runoff_destroy(sim[1]);
+    for (int v = 0; v < 3; ++v)
+      gr_rain_runoff_destroy(sim[v]);
   }
   free(kept);
   paths_free(&in);
