@@ -1200,6 +1200,20 @@ GR_INLINE void gr_sw_inner_flux(gr_sw_pt q0, gr_sw_pt q1, gr_sw_pt q2, gr_sw_pt 
   gr_sw_face(gr_sw_recon(q0, q1, q2, true), R, true, gr_sw_rise(q1, q2, 0.0f), g, fh, fmL, fmR, ft);
 }
 
+/* A face's six values stored at out[u] and the five planes after it
+ * (plane floats apart), in global memory (gr_sw_line_face) or a tile's local
+ * memory (gr_sw_tile_face): a macro, since OpenCL 1.2 has no pointer to
+ * either. */
+#define GR_SW_PUT_FACE(out, u, plane, fh, fmL, fmR, ft, sh, se)                                    \
+  do {                                                                                             \
+    (out)[(u)] = (fh);                                                                             \
+    (out)[(u) + (plane)] = (fmL);                                                                  \
+    (out)[(u) + 2 * (plane)] = (fmR);                                                              \
+    (out)[(u) + 3 * (plane)] = (ft);                                                               \
+    (out)[(u) + 4 * (plane)] = (sh);                                                               \
+    (out)[(u) + 5 * (plane)] = (se);                                                               \
+  } while (0)
+
 /* gr_sw_line_flux's six values written to out[f] and the five planes
  * after it (plane floats apart): fh, fmL, fmR, ft, sh, se. */
 GR_INLINE void gr_sw_line_face(gr_sw_pt q0, gr_sw_pt q1, gr_sw_pt q2, gr_sw_pt q3, int k, int n,
@@ -1208,12 +1222,7 @@ GR_INLINE void gr_sw_line_face(gr_sw_pt q0, gr_sw_pt q1, gr_sw_pt q2, gr_sw_pt q
   float fh, fmL, fmR, ft, sh, se;
   gr_sw_line_flux(q0, q1, q2, q3, k, n, kind_lo, kind_hi, lvl_lo, lvl_hi, g, &fh, &fmL, &fmR, &ft,
                   &sh, &se);
-  out[f] = fh;
-  out[f + plane] = fmL;
-  out[f + 2 * plane] = fmR;
-  out[f + 3 * plane] = ft;
-  out[f + 4 * plane] = sh;
-  out[f + 5 * plane] = se;
+  GR_SW_PUT_FACE(out, f, plane, fh, fmL, fmR, ft, sh, se);
 }
 
 /* The flux balance along one axis of a cell of depth h and slopes sh, se
@@ -1643,12 +1652,7 @@ GR_INLINE void gr_sw_tile_face(__local const float4 *restrict tp, __local float 
                     xs ? bnd_e : bnd_n, xs ? lvl_w : lvl_s, xs ? lvl_e : lvl_n, g, &fh, &fmL, &fmR,
                     &ft, &sh, &se);
   int u = a + e * (xs ? tx + 1 : tx);
-  out[u] = fh;
-  out[u + plane] = fmL;
-  out[u + 2 * plane] = fmR;
-  out[u + 3 * plane] = ft;
-  out[u + 4 * plane] = sh;
-  out[u + 5 * plane] = se;
+  GR_SW_PUT_FACE(out, u, plane, fh, fmL, fmR, ft, sh, se);
 }
 
 /* One stage for the tiles of the interior (inner: its tile columns tiles.x
