@@ -822,17 +822,6 @@ static size_t gr_rain_runoff_sw_tile_bytes(size_t tx, size_t ty) {
   return sizeof(cl_float) * (4 * (tx + 4) * (ty + 4) + 6 * ((tx + 1) * ty + tx * (ty + 1)));
 }
 
-/* The fused shallow-water stages' work-group (rain_runoff_sw_stage1, 2): a
- * tile of tx x ty cells (0 x 0: the device's default), refused where the
- * device's work-groups or local memory are too small for it; with
- * set_default also whether the fused path is the default. A GPU: fused by
- * default (a step moves the state twice instead of storing and reading
- * every face and point, see gr_sw_fused; the H200 at 4096^2: 2.16 ms a step
- * against 2.65). A CPU: not fused by default: with PoCL
- * on this project's 2-core machine a fused step took 4-7x the separate
- * launches' time (512^2: 32-35 ms against 7.7-8.5; 1024^2: 160-250 ms
- * against 36), where the caches hide most of what the separate launches
- * store and read again. */
 /* The default tile of a device whose work-groups take at most `most`
  * work-items and local_mem bytes: 32 x 8, halved until it fits. Measured
  * on the H200 at 4096^2 (ms a step): 32 x 8 1.51, 64 x 4 1.59, 32 x 4 1.63
@@ -849,6 +838,17 @@ static void gr_rain_runoff_sw_default_tile(size_t most, cl_ulong local_mem, size
     *tx /= 2;
 }
 
+/* The fused shallow-water stages' work-group (rain_runoff_sw_stage1, 2): a
+ * tile of tx x ty cells (0 x 0: the device's default), refused where the
+ * device's work-groups or local memory are too small for it; with
+ * set_default also whether the fused path is the default. A GPU: fused by
+ * default (a step moves the state twice instead of storing and reading
+ * every face and point, see gr_sw_fused; the H200 at 4096^2: 2.16 ms a step
+ * against 2.65). A CPU: not fused by default: with PoCL
+ * on this project's 2-core machine a fused step took 4-7x the separate
+ * launches' time (512^2: 32-35 ms against 7.7-8.5; 1024^2: 160-250 ms
+ * against 36), where the caches hide most of what the separate launches
+ * store and read again. */
 static gr_status gr_rain_runoff_sw_shape(gr_rain_runoff *s, size_t tx, size_t ty, int set_default) {
   cl_device_id dev = gr_context_device(s->ctx);
   cl_device_type type = 0;

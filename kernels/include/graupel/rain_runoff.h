@@ -575,7 +575,9 @@ GR_API void gr_rain_runoff_set_sw_fused(gr_rain_runoff *s, int on);
  * The fused shallow-water stages' tile, tx x ty cells (a work-group of as
  * many work-items); 0 x 0: the device's default. A tuning knob: the bits do
  * not depend on it. Refused (GR_ERR_INVALID_ARGUMENT, the tile kept) where
- * the device's work-groups or local memory are too small for it.
+ * the device's work-groups or local memory are too small for it. On GPUs
+ * the shallow-water program is built for its tile (its size a constant of
+ * the kernels), so a new tile builds it again before the next step.
  */
 GR_API gr_status gr_rain_runoff_set_sw_tile(gr_rain_runoff *s, int tx, int ty);
 
