@@ -1290,20 +1290,54 @@ GR_INLINE float gr_sw_wet_q(float h, float q, float r, float s, float dt, float 
       int bnd_n, float lvl_w, float lvl_e, float lvl_s, float lvl_n, GR_RAIN_RUNOFF_MAP_ARGS,      \
       float map_time
 
-/* Stage 1's points, once per cell: the depth after rain and infiltration
- * (as the local inertial model takes them) and the velocities of the
- * momentum scaled with the water infiltration removed. */
+/* The arguments of a stage's cell update (gr_sw_update_cell), the state,
+ * the stage and the ledger of GR_SW_STEP_ARGS. */
+#define GR_SW_CELL_ARGS                                                                            \
+  __global float *restrict h, __global float *restrict qu, __global float *restrict qv,            \
+      __global float *restrict h_comp, __global float *restrict h1, __global float *restrict qu1,  \
+      __global float *restrict qv1, __global float *restrict dh1, __global float *restrict u1,     \
+      __global float *restrict v1, __global const float *restrict b,                               \
+      __global const float *restrict rain, __global const float *restrict perm,                    \
+      __global const float *restrict src, int use_src, __global const float *restrict nodata,      \
+      int use_nodata, __global float *restrict infiltrated,                                        \
+      __global float *restrict infiltrated_comp, __global float *restrict outflow,                 \
+      __global float *restrict outflow_comp, __global float *restrict inflow,                      \
+      __global float *restrict inflow_comp, int nx, int ny, float dt, float inv_dx, float inv_dy,  \
+      float g, float n2, __global const float *restrict n2map, int use_n2, int use_rain,           \
+      float rain_uniform, int use_perm, float perm_uniform, int bnd_w, int bnd_e, int bnd_s,       \
+      int bnd_n, GR_RAIN_RUNOFF_MAP_ARGS, float map_time
+#define GR_SW_CELL_PASS                                                                            \
+  h, qu, qv, h_comp, h1, qu1, qv1, dh1, u1, v1, b, rain, perm, src, use_src, nodata, use_nodata,   \
+      infiltrated, infiltrated_comp, outflow, outflow_comp, inflow, inflow_comp, nx, ny, dt,       \
+      inv_dx, inv_dy, g, n2, n2map, use_n2, use_rain, rain_uniform, use_perm, perm_uniform, bnd_w, \
+      bnd_e, bnd_s, bnd_n, max_depth, max_speed, arrival, wet_time, wet_time_comp, max_hazard,     \
+      wetting_depth, debris_factor, map_time
+
+/* Cell q's point in stage 1: its depth after rain and infiltration (*hw)
+ * and the velocities (*u, *v) of its momentum scaled with the water
+ * infiltration removed (as the local inertial model takes rain and
+ * infiltration): rain_runoff_sw_prep's and the fused stages' tiles'. */
+GR_INLINE void gr_sw_wet_point(GR_SW_CELL_ARGS, int q, float *hw, float *u, float *v) {
+  float h0 = h[q], r = GR_RAIN_RUNOFF_RAIN(q), k = GR_RAIN_RUNOFF_PERM(q);
+  float sc = GR_RAIN_RUNOFF_SRC(q);
+  float w = gr_rain_runoff_wet(h0, r, sc, k, dt);
+  *hw = w;
+  *u = gr_sw_velocity(w, gr_sw_wet_q(h0, qu[q], r, sc, dt, w));
+  *v = gr_sw_velocity(w, gr_sw_wet_q(h0, qv[q], r, sc, dt, w));
+}
+
+/* Stage 1's points for the separate launches, once per cell
+ * (gr_sw_wet_point). */
 __kernel void rain_runoff_sw_prep(GR_SW_STEP_ARGS) {
   int i = get_global_id(0), j = get_global_id(1);
   if (!gr_inside(i, j, nx, ny))
     return;
   int c = gr_idx(i, j, nx);
-  float h0 = h[c], r = GR_RAIN_RUNOFF_RAIN(c), k = GR_RAIN_RUNOFF_PERM(c);
-  float sc = GR_RAIN_RUNOFF_SRC(c);
-  float hw = gr_rain_runoff_wet(h0, r, sc, k, dt);
+  float hw, u, v;
+  gr_sw_wet_point(GR_SW_CELL_PASS, c, &hw, &u, &v);
   wh[c] = hw;
-  wu[c] = gr_sw_velocity(hw, gr_sw_wet_q(h0, qu[c], r, sc, dt, hw));
-  wv[c] = gr_sw_velocity(hw, gr_sw_wet_q(h0, qv[c], r, sc, dt, hw));
+  wu[c] = u;
+  wv[c] = v;
 }
 
 /* One point of a line (in: inside the local array; q its index): depth,
@@ -1372,28 +1406,6 @@ __kernel void rain_runoff_sw_faces2(GR_SW_STEP_ARGS) {
  *            h, qu, qv (each cell reads its own old values only), with the
  *            infiltration and half of each stage's edge outflow booked in
  *            Kahan sums. */
-/* The arguments of a stage's cell update (gr_sw_update_cell), the state,
- * the stage and the ledger of GR_SW_STEP_ARGS. */
-#define GR_SW_CELL_ARGS                                                                            \
-  __global float *restrict h, __global float *restrict qu, __global float *restrict qv,            \
-      __global float *restrict h_comp, __global float *restrict h1, __global float *restrict qu1,  \
-      __global float *restrict qv1, __global float *restrict dh1, __global float *restrict u1,     \
-      __global float *restrict v1, __global const float *restrict b,                               \
-      __global const float *restrict rain, __global const float *restrict perm,                    \
-      __global const float *restrict src, int use_src, __global const float *restrict nodata,      \
-      int use_nodata, __global float *restrict infiltrated,                                        \
-      __global float *restrict infiltrated_comp, __global float *restrict outflow,                 \
-      __global float *restrict outflow_comp, __global float *restrict inflow,                      \
-      __global float *restrict inflow_comp, int nx, int ny, float dt, float inv_dx, float inv_dy,  \
-      float g, float n2, __global const float *restrict n2map, int use_n2, int use_rain,           \
-      float rain_uniform, int use_perm, float perm_uniform, int bnd_w, int bnd_e, int bnd_s,       \
-      int bnd_n, GR_RAIN_RUNOFF_MAP_ARGS, float map_time
-#define GR_SW_CELL_PASS                                                                            \
-  h, qu, qv, h_comp, h1, qu1, qv1, dh1, u1, v1, b, rain, perm, src, use_src, nodata, use_nodata,   \
-      infiltrated, infiltrated_comp, outflow, outflow_comp, inflow, inflow_comp, nx, ny, dt,       \
-      inv_dx, inv_dy, g, n2, n2map, use_n2, use_rain, rain_uniform, use_perm, perm_uniform, bnd_w, \
-      bnd_e, bnd_s, bnd_n, max_depth, max_speed, arrival, wet_time, wet_time_comp, max_hazard,     \
-      wetting_depth, debris_factor, map_time
 
 /* Cell (i, j)'s update in a stage (see gr_sw_update) from its point x2
  * (along x), its slopes along x (shx, sex) and y (shy, sey) (its west and south faces' sh, se),
@@ -1611,12 +1623,7 @@ GR_INLINE void gr_sw_tile_point(GR_SW_CELL_ARGS, __local float4 *restrict tp, in
     int q = pj * nx + pi;
     pb = b[q];
     if (stage == 1) {
-      float h0 = h[q], r = GR_RAIN_RUNOFF_RAIN(q), k = GR_RAIN_RUNOFF_PERM(q);
-      float sc = GR_RAIN_RUNOFF_SRC(q);
-      float hw = gr_rain_runoff_wet(h0, r, sc, k, dt);
-      ph = hw;
-      pu = gr_sw_velocity(hw, gr_sw_wet_q(h0, qu[q], r, sc, dt, hw));
-      pv = gr_sw_velocity(hw, gr_sw_wet_q(h0, qv[q], r, sc, dt, hw));
+      gr_sw_wet_point(GR_SW_CELL_PASS, q, &ph, &pu, &pv);
     } else {
       ph = h1[q];
       pu = gr_sw_velocity(ph, qu1[q]);
