@@ -489,6 +489,8 @@ GR_INLINE void gr_rain_runoff_book_edges(__global float *restrict outflow,
       __global float *restrict arrival, __global float *restrict wet_time,                         \
       __global float *restrict wet_time_comp, __global float *restrict max_hazard,                 \
       float wetting_depth, float debris_factor
+#define GR_RAIN_RUNOFF_MAP_PASS                                                                    \
+  max_depth, max_speed, arrival, wet_time, wet_time_comp, max_hazard, wetting_depth, debris_factor
 
 /* Cell c's flood maps as they stand (gr_rain_runoff_map_fold folds a new
  * state into them; the shallow-water stages read them early, see
@@ -547,12 +549,8 @@ GR_INLINE void gr_rain_runoff_map_fold(int c, float d, float u, float v, gr_rain
  * local inertial update on the H200 4 % of its time. */
 GR_INLINE void gr_rain_runoff_map_cell(int c, float d, float u, float v, GR_RAIN_RUNOFF_MAP_ARGS,
                                        float time, float dt) {
-  gr_rain_runoff_map_fold(c, d, u, v,
-                          gr_rain_runoff_maps_read(c, max_depth, max_speed, arrival, wet_time,
-                                                   wet_time_comp, max_hazard, wetting_depth,
-                                                   debris_factor),
-                          max_depth, max_speed, arrival, wet_time, wet_time_comp, max_hazard,
-                          wetting_depth, debris_factor, time, dt);
+  gr_rain_runoff_map_fold(c, d, u, v, gr_rain_runoff_maps_read(c, GR_RAIN_RUNOFF_MAP_PASS),
+                          GR_RAIN_RUNOFF_MAP_PASS, time, dt);
 }
 
 /* The new depth of cell c = (i, j) from its depth h0 before the step, its
@@ -755,8 +753,7 @@ __kernel void rain_runoff_li_step(
         GR_RAIN_RUNOFF_SRC(c2), kc, GR_LI_K(l2 - 1), GR_LI_K(l2 + 1), GR_LI_K(l2 - lx),
         GR_LI_K(l2 + lx), fxl[l2], fxl[l2 + 1], fyl[l2], fyl[l2 + lx], h_out, h_comp, nodata,
         use_nodata, infiltrated, infiltrated_comp, outflow, outflow_comp, inflow, inflow_comp, dt,
-        inv_dx, inv_dy, max_depth, max_speed, arrival, wet_time, wet_time_comp, max_hazard,
-        wetting_depth, debris_factor, map_time);
+        inv_dx, inv_dy, GR_RAIN_RUNOFF_MAP_PASS, map_time);
 #undef GR_LI_K
   }
 }
@@ -1340,8 +1337,7 @@ GR_INLINE float gr_sw_wet_q(float h, float q, float r, float s, float dt, float 
   h, qu, qv, h_comp, h1, qu1, qv1, dh1, u1, v1, b, rain, perm, src, use_src, nodata, use_nodata,   \
       infiltrated, infiltrated_comp, outflow, outflow_comp, inflow, inflow_comp, nx, ny, dt,       \
       inv_dx, inv_dy, g, n2, n2map, use_n2, use_rain, rain_uniform, use_perm, perm_uniform, bnd_w, \
-      bnd_e, bnd_s, bnd_n, max_depth, max_speed, arrival, wet_time, wet_time_comp, max_hazard,     \
-      wetting_depth, debris_factor, map_time
+      bnd_e, bnd_s, bnd_n, GR_RAIN_RUNOFF_MAP_PASS, map_time
 
 /* Cell q's point in stage 1: its depth after rain and infiltration (*hw)
  * and the velocities (*u, *v) of its momentum scaled with the water
@@ -1452,17 +1448,14 @@ typedef struct gr_sw_cell_in {
 } gr_sw_cell_in;
 
 GR_INLINE gr_sw_cell_in gr_sw_cell_read(GR_SW_CELL_ARGS, int c, const int stage) {
-  gr_sw_cell_in in;
+  gr_sw_cell_in in = {0.0f};
   in.h0 = h[c];
   in.qu0 = qu[c];
   in.qv0 = qv[c];
-  in.hc = in.dh1 = in.is = in.ic = 0.0f;
-  in.m.md = in.m.msp = in.m.mh = in.m.ar = in.m.wt = in.m.wc = 0.0f;
   if (stage == 2) {
     in.hc = h_comp[c];
     in.dh1 = dh1[c];
-    in.m = gr_rain_runoff_maps_read(c, max_depth, max_speed, arrival, wet_time, wet_time_comp,
-                                    max_hazard, wetting_depth, debris_factor);
+    in.m = gr_rain_runoff_maps_read(c, GR_RAIN_RUNOFF_MAP_PASS);
     float inf = gr_rain_runoff_infiltration(in.h0, GR_RAIN_RUNOFF_RAIN(c), GR_RAIN_RUNOFF_SRC(c),
                                             GR_RAIN_RUNOFF_PERM(c), dt);
     if (inf != 0.0f) {
@@ -1550,12 +1543,8 @@ GR_INLINE void gr_sw_update_cell(GR_SW_CELL_ARGS, int i, int j, gr_sw_pt x2, flo
     qv[c] = v;
     /* The flood maps from the new state. */
     gr_rain_runoff_map_fold(c, d, u, v,
-                            given ? in.m
-                                  : gr_rain_runoff_maps_read(c, max_depth, max_speed, arrival,
-                                                             wet_time, wet_time_comp, max_hazard,
-                                                             wetting_depth, debris_factor),
-                            max_depth, max_speed, arrival, wet_time, wet_time_comp, max_hazard,
-                            wetting_depth, debris_factor, map_time, dt);
+                            given ? in.m : gr_rain_runoff_maps_read(c, GR_RAIN_RUNOFF_MAP_PASS),
+                            GR_RAIN_RUNOFF_MAP_PASS, map_time, dt);
     if (gone != 0.0f)
       gr_kahan_add(outflow, outflow_comp, c, gone);
     if (inf != 0.0f)
@@ -1925,6 +1914,5 @@ __kernel void rain_runoff_maps(__global const float *restrict h, __global const 
     u = 0.5f * (fw + fe);
     v = 0.5f * (fs + fn);
   }
-  gr_rain_runoff_map_cell(c, d, u, v, max_depth, max_speed, arrival, wet_time, wet_time_comp,
-                          max_hazard, wetting_depth, debris_factor, time, dt);
+  gr_rain_runoff_map_cell(c, d, u, v, GR_RAIN_RUNOFF_MAP_PASS, time, dt);
 }

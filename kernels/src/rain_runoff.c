@@ -556,6 +556,16 @@ static gr_status gr_rain_runoff_step_indices(gr_rain_runoff *s) {
   return st;
 }
 
+/* The device's largest work-group and its local memory (bytes). */
+static cl_int gr_rain_runoff_group_limits(const gr_rain_runoff *s, size_t *most,
+                                          cl_ulong *local_mem) {
+  cl_device_id dev = gr_context_device(s->ctx);
+  cl_int err = clGetDeviceInfo(dev, CL_DEVICE_MAX_WORK_GROUP_SIZE, sizeof(*most), most, NULL);
+  if (err == CL_SUCCESS)
+    err = clGetDeviceInfo(dev, CL_DEVICE_LOCAL_MEM_SIZE, sizeof(*local_mem), local_mem, NULL);
+  return err;
+}
+
 /* The fused local inertial step's work-group (rain_runoff_li_step: a tile
  * 3 cells smaller each way, whose faces it computes again for the ring
  * around the tile) and whether it is the default. A GPU: the largest of 32
@@ -567,22 +577,17 @@ static gr_status gr_rain_runoff_step_indices(gr_rain_runoff *s) {
  * the three at 256^2 to 1024^2 (its ring's faces again, every cell's limiter five times, and LLVM's
  * code for its two regions), where the caches hide most of what the three launches read again. */
 static gr_status gr_rain_runoff_li_shape(gr_rain_runoff *s) {
-  cl_device_id dev = gr_context_device(s->ctx);
-  cl_device_type type = 0;
   cl_ulong local_mem = 0;
-  size_t wg = 0;
-  cl_int err = clGetDeviceInfo(dev, CL_DEVICE_TYPE, sizeof(type), &type, NULL);
+  size_t most = 0, wg = 0;
+  cl_int err = gr_rain_runoff_group_limits(s, &most, &local_mem);
   if (err == CL_SUCCESS)
-    err = clGetDeviceInfo(dev, CL_DEVICE_LOCAL_MEM_SIZE, sizeof(local_mem), &local_mem, NULL);
-  if (err == CL_SUCCESS)
-    err =
-        clGetKernelWorkGroupInfo(s->li_step, dev, CL_KERNEL_WORK_GROUP_SIZE, sizeof(wg), &wg, NULL);
+    err = clGetKernelWorkGroupInfo(s->li_step, gr_context_device(s->ctx), CL_KERNEL_WORK_GROUP_SIZE,
+                                   sizeof(wg), &wg, NULL);
   if (err != CL_SUCCESS)
     return gr_cl_check(s->ctx, err, "Querying the device for the local inertial step's work-group");
-  int gpu = (type & CL_DEVICE_TYPE_GPU) != 0;
   static const size_t gpu_shapes[][2] = {{32, 16}, {16, 16}, {16, 8}, {8, 8}, {8, 8}};
   static const size_t cpu_shapes[][2] = {{64, 16}, {32, 16}, {16, 16}, {16, 8}, {8, 8}};
-  const size_t(*shapes)[2] = gpu ? gpu_shapes : cpu_shapes;
+  const size_t(*shapes)[2] = s->gpu ? gpu_shapes : cpu_shapes;
   int fits = 0;
   for (int k = 0; k < 5 && !fits; ++k) {
     s->li_local[0] = shapes[k][0];
@@ -598,7 +603,6 @@ static gr_status gr_rain_runoff_li_shape(gr_rain_runoff *s) {
    * measured slower on both kinds of device (the H200 at 4096^2: 1.34 ms a
    * step against 1.14; PoCL here about 1.5x). gr_rain_runoff_set_fused
    * picks it, where the device allows its work-group. */
-  (void)gpu;
   s->fused = s->fused && s->li_local[0] > 0;
   return GR_OK;
 }
@@ -851,14 +855,9 @@ static void gr_rain_runoff_sw_default_tile(size_t most, cl_ulong local_mem, size
  * store and read again. */
 static gr_status gr_rain_runoff_sw_shape(gr_rain_runoff *s, size_t tx, size_t ty, int set_default) {
   cl_device_id dev = gr_context_device(s->ctx);
-  cl_device_type type = 0;
   cl_ulong local_mem = 0;
   size_t most = 0;
-  cl_int err = clGetDeviceInfo(dev, CL_DEVICE_TYPE, sizeof(type), &type, NULL);
-  if (err == CL_SUCCESS)
-    err = clGetDeviceInfo(dev, CL_DEVICE_LOCAL_MEM_SIZE, sizeof(local_mem), &local_mem, NULL);
-  if (err == CL_SUCCESS)
-    err = clGetDeviceInfo(dev, CL_DEVICE_MAX_WORK_GROUP_SIZE, sizeof(most), &most, NULL);
+  cl_int err = gr_rain_runoff_group_limits(s, &most, &local_mem);
   /* The smallest work-group any of the four kernels takes. A local
    * inertial program has no stages: the device's largest work-group until
    * the model changes, when the tile is checked again
@@ -873,7 +872,6 @@ static gr_status gr_rain_runoff_sw_shape(gr_rain_runoff *s, size_t tx, size_t ty
   }
   if (err != CL_SUCCESS)
     return gr_cl_check(s->ctx, err, "Querying the device for the shallow-water stages' work-group");
-  int gpu = (type & CL_DEVICE_TYPE_GPU) != 0;
   if (tx == 0 && ty == 0)
     gr_rain_runoff_sw_default_tile(most, local_mem, &tx, &ty);
   size_t bytes = gr_rain_runoff_sw_tile_bytes(tx, ty);
@@ -903,7 +901,7 @@ static gr_status gr_rain_runoff_sw_shape(gr_rain_runoff *s, size_t tx, size_t ty
   s->sw_tiles[3] = (cl_int)jhi;
   s->sw_rim = nti * ntj - (ihi - ilo) * (jhi - jlo);
   if (set_default)
-    s->sw_fused = gpu;
+    s->sw_fused = s->gpu;
   s->args_set = 0;
   return GR_OK;
 }
@@ -955,12 +953,7 @@ static gr_status gr_rain_runoff_specialise(gr_rain_runoff *s) {
     tile[1] = s->sw_local[1];
     cl_ulong local_mem = 0;
     size_t most = 0;
-    cl_device_id dev = gr_context_device(s->ctx);
-    if (tile[0] == 0 &&
-        clGetDeviceInfo(dev, CL_DEVICE_LOCAL_MEM_SIZE, sizeof(local_mem), &local_mem, NULL) ==
-            CL_SUCCESS &&
-        clGetDeviceInfo(dev, CL_DEVICE_MAX_WORK_GROUP_SIZE, sizeof(most), &most, NULL) ==
-            CL_SUCCESS)
+    if (tile[0] == 0 && gr_rain_runoff_group_limits(s, &most, &local_mem) == CL_SUCCESS)
       gr_rain_runoff_sw_default_tile(most, local_mem, &tile[0], &tile[1]);
   }
   if (want == s->inputs && tile[0] == s->sw_built[0] && tile[1] == s->sw_built[1])
