@@ -28,7 +28,12 @@
  * registers (from 45 and 48) the H200's step at 4096^2 took 1.65 ms
  * against 1.87 (24: 1.77, 28: 1.69, 40: 1.73, 64: 1.94); the local
  * inertial step is the same either way (1.06 ms). Register allocation
- * changes no arithmetic: the same bits. */
+ * changes no arithmetic: the same bits. NVIDIA's compiler applies the cap
+ * only to kernels without reqd_work_group_size: since the fused stages
+ * are built for their tile (GR_SW_TILE_ATTR) it bounds their registers by
+ * itself (on the H200 32 for the interior's tiles, 47 for the rim's), so
+ * the cap now binds the separate launches and the local inertial kernels
+ * (RESULTS.md, "2026-12-01, fourth session"). */
 #define GR_RAIN_RUNOFF_NV_REGISTERS 32
 /* advance re-reads the stable step after 1 to 64 steps (see
  * gr_rain_runoff_advance_impl). */
