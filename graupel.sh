@@ -40,6 +40,8 @@ TEST_PACKAGES=(
   libvtk9.1 libvtk9.1-qt
   # the real DEM in Data/ is checked against its source, shipped here
   python-matplotlib-data
+  # the GUI tests drive the mouse and read the screen
+  xdotool imagemagick
 )
 
 as_root() { if [ "$(id -u)" = 0 ]; then "$@"; else sudo "$@"; fi; }

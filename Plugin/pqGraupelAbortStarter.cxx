@@ -189,6 +189,16 @@ void pqGraupelAbortStarter::onProgress(const QString &text, int percent) {
   if (!this->Active || this->Processing || percent <= 0) {
     return;
   }
+  // Only inside a Graupel algorithm's own update: the long ones, which
+  // honour the abort. A representation or any other filter updating inside
+  // a Qt handler (a render on resize, the look's timer) must not have the
+  // event loop run under it: processing events inside the representation's
+  // update that the look's render starts left QMainWindow's dock animator
+  // with a deleted animation, and the next drag of a dock's separator
+  // crashed (Testing/Python/check_gui_docks.py).
+  if (!LastProgressing || !LastProgressing->IsA("vtkGraupelAlgorithm")) {
+    return;
+  }
   if (!this->TestArmed && text.contains(QLatin1String(" s of "))) {
     this->TestArmed = true;
     ArmTestClick();
