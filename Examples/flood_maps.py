@@ -67,7 +67,7 @@ for name, arr, title, rng, preset in (
 chart = CreateView("XYChartView")
 chart.ViewTime = end
 c = Show(OutputPort(rain, 1), chart)
-c.SeriesVisibility = ["rain_rate", "outflow_rate", "infiltration_rate"]
+c.SeriesVisibility = ["rain_volume_rate", "outflow_rate", "infiltration_rate"]
 chart.LeftAxisTitle = "m^3/s"
 chart.BottomAxisTitle = "time (s)"
 SaveScreenshot(os.path.join(args.out, "flood_hydrograph.png"), chart, ImageResolution=[900, 500])

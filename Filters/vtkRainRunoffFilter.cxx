@@ -781,8 +781,10 @@ int vtkRainRunoffFilter::FillHydrograph(vtkDataObject *tableObject) {
                   << this->GetStateTime() << " s; this is a bug: please report it.");
     return 0;
   }
-  const char *names[] = {"time",         "rain_rate",     "inflow_rate",    "infiltration_rate",
-                         "outflow_rate", "stored_volume", "outflow_volume", "balance_error"};
+  // rain_volume_rate, not rain_rate: the volume a second on the domain (m^3/s),
+  // not the RainRate property (mm/h) nor the rain_rate input array (m/s).
+  const char *names[] = {"time",         "rain_volume_rate", "inflow_rate",    "infiltration_rate",
+                         "outflow_rate", "stored_volume",    "outflow_volume", "balance_error"};
   const int columns = static_cast<int>(sizeof(names) / sizeof(names[0]));
   std::vector<vtkSmartPointer<vtkDoubleArray>> c(static_cast<size_t>(columns));
   for (int k = 0; k < columns; ++k) {

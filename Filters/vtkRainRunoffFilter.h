@@ -33,7 +33,7 @@
  * whatever the order in which times are requested.
  *
  * Output 1 (`Hydrograph`) is a vtkTable with one row per output time up to
- * the requested one: `time` (s), `rain_rate`, `inflow_rate`,
+ * the requested one: `time` (s), `rain_volume_rate`, `inflow_rate`,
  * `infiltration_rate` and `outflow_rate` (m^3/s over the domain: row k's is
  * the mean over the output interval that ends at its time, the ledger's
  * volume difference over the interval, so rate times interval sums to the

@@ -9,6 +9,8 @@
 #include "pqRenderView.h"
 #include "pqServer.h"
 #include "pqServerManagerModel.h"
+#include "pqRepresentation.h"
+#include "pqView.h"
 #include "vtkPVDataInformation.h"
 #include "vtkPVXMLElement.h"
 #include "vtkSMPVRepresentationProxy.h"
@@ -20,8 +22,11 @@
 #include "vtkSMSourceProxy.h"
 #include "vtkSMTransferFunctionProxy.h"
 #include "vtkSmartPointer.h"
+#include "vtkSMViewProxy.h"
 
 #include <QTimer>
+
+#include <cmath>
 
 #include <algorithm>
 #include <cstring>
@@ -75,6 +80,58 @@ void LookAt(vtkSMRenderViewProxy *view, const double b[6]) {
   vtkSMPropertyHelper(view, "CameraPosition").Set(fitted, 3);
   view->UpdateVTKObjects();
 }
+
+// The x and y bounds of a port's data; empty when it has no points.
+QVector<double> Extent(pqOutputPort *port) {
+  vtkPVDataInformation *info = port ? port->getDataInformation() : nullptr;
+  if (!info || info->GetNumberOfPoints() <= 0) {
+    return QVector<double>();
+  }
+  double b[6];
+  info->GetBounds(b);
+  return QVector<double>{b[0], b[1], b[2], b[3]};
+}
+
+// Whether two x-y extents differ by more than 1 % of the larger span.
+bool ExtentChanged(const QVector<double> &a, const QVector<double> &b) {
+  if (a.size() != 4 || b.size() != 4) {
+    return a.size() != b.size();
+  }
+  const double span = std::max({a[1] - a[0], a[3] - a[2], b[1] - b[0], b[3] - b[2]});
+  for (int i = 0; i < 4; ++i) {
+    if (std::fabs(a[i] - b[i]) > 0.01 * span) {
+      return true;
+    }
+  }
+  return false;
+}
+
+// The legend's title: the array's name in words and units, and the
+// vertical exaggeration where the heights are not drawn true.
+QString LegendTitle(const char *array, double exaggeration) {
+  QString title = QString::fromUtf8(pqGraupelApplyLook::legendTitle(array));
+  if (exaggeration != 1.0) {
+    title += QString::fromUtf8(", heights \xc3\x97") + QString::number(exaggeration, 'g', 3);
+  }
+  return title;
+}
+
+// Rain Runoff's Hydrograph columns in a line chart: label, shown by
+// default, on the right axis (the volumes, m^3).
+struct HydrographSeries {
+  const char *name, *label;
+  bool shown, right;
+};
+const HydrographSeries Hydrograph[] = {
+    {"rain_volume_rate", "rain", true, false},
+    {"inflow_rate", "inflow through the edges", true, false},
+    {"infiltration_rate", "infiltration", true, false},
+    {"outflow_rate", "outflow", true, false},
+    {"stored_volume", "stored (m\xc2\xb3)", false, true},
+    {"outflow_volume", "outflow so far (m\xc2\xb3)", false, true},
+    {"balance_error", "balance error (m\xc2\xb3)", false, true},
+    {"time", "time", false, false},
+};
 } // namespace
 
 const char *pqGraupelApplyLook::legendTitle(const char *array) {
@@ -114,7 +171,17 @@ void pqGraupelApplyLook::onStartup() {
   QObject::connect(smm, &pqServerManagerModel::sourceAdded, this,
                    [this](pqPipelineSource *source) { this->onSourceAdded(source); });
   QObject::connect(smm, &pqServerManagerModel::sourceRemoved, this,
-                   [this](pqPipelineSource *source) { this->Pending.remove(source); });
+                   [this](pqPipelineSource *source) {
+                     this->Pending.remove(source);
+                     this->Waiting.remove(source);
+                     this->Extents.remove(source);
+                   });
+  // A representation joins its view after it is registered: the view's
+  // signal is the one that knows both.
+  QObject::connect(smm, &pqServerManagerModel::viewAdded, this, [this](pqView *view) {
+    QObject::connect(view, &pqView::representationAdded, this,
+                     [this](pqRepresentation *repr) { this->onRepresentationAdded(repr); });
+  });
 }
 
 void pqGraupelApplyLook::onSourceAdded(pqPipelineSource *source) {
@@ -123,6 +190,34 @@ void pqGraupelApplyLook::onSourceAdded(pqPipelineSource *source) {
   }
   QObject::connect(source, &pqProxy::modifiedStateChanged, this,
                    [this, source]() { this->onModifiedStateChanged(source); });
+  QObject::connect(source, QOverload<pqPipelineSource *>::of(&pqPipelineSource::dataUpdated), this,
+                   [this](pqPipelineSource *updated) { this->onDataUpdated(updated); });
+}
+
+void pqGraupelApplyLook::onDataUpdated(pqPipelineSource *source) {
+  // An Apply whose update failed (no points): the look comes with the first
+  // update that gives points, once that update has returned.
+  if (this->Waiting.contains(source) && !Extent(source->getOutputPort(0)).isEmpty()) {
+    this->Waiting.remove(source);
+    QPointer<pqPipelineSource> later(source);
+    QTimer::singleShot(0, this, [this, later]() { this->showSurfaceLater(later, 1200); });
+  }
+}
+
+void pqGraupelApplyLook::onSurfaceUpdated(pqPipelineSource *surface) {
+  // Another extent (a reader's spacing or origin changed): look again.
+  const QVector<double> now = Extent(surface->getOutputPort(0));
+  if (now.isEmpty() || !ExtentChanged(this->Extents.value(surface), now)) {
+    return;
+  }
+  this->Extents[surface] = now;
+  pqRenderView *view = ShownIn(surface);
+  if (view && view->getNumberOfVisibleDataRepresentations() == 1) {
+    double bounds[6];
+    surface->getOutputPort(0)->getDataInformation()->GetBounds(bounds);
+    LookAt(view->getRenderViewProxy(), bounds);
+    view->render();
+  }
 }
 
 void pqGraupelApplyLook::onModifiedStateChanged(pqPipelineSource *source) {
@@ -154,6 +249,10 @@ void pqGraupelApplyLook::showSurfaceLater(QPointer<pqPipelineSource> source, int
 }
 
 void pqGraupelApplyLook::showSurface(pqPipelineSource *source) {
+  if (Extent(source->getOutputPort(0)).isEmpty()) {
+    this->Waiting.insert(source); // refused, or nothing yet: wait for points
+    return;
+  }
   pqRenderView *view = ShownIn(source);
   pqServer *server = source->getServer();
   if (!view || !server) {
@@ -179,6 +278,7 @@ void pqGraupelApplyLook::showSurface(pqPipelineSource *source) {
   }
 
   vtkSMViewProxy *viewProxy = view->getViewProxy();
+  const bool objects = this->showObjects(source, surface, viewProxy);
   vtkSMProxy *repr = controller->Show(surfaceSource, 0, viewProxy);
   if (!repr) {
     return;
@@ -201,12 +301,24 @@ void pqGraupelApplyLook::showSurface(pqPipelineSource *source) {
     const char *array = vtkSMPropertyHelper(repr, "ColorArrayName").GetInputArrayNameToProcess();
     vtkSMProxy *lut = vtkSMPropertyHelper(repr, "LookupTable", true).GetAsProxy();
     if (vtkSMProxy *bar = vtkSMTransferFunctionProxy::FindScalarBarRepresentation(lut, viewProxy)) {
-      vtkSMPropertyHelper(bar, "Title").Set(legendTitle(array));
+      const double exaggeration =
+          vtkSMPropertyHelper(surface, "VerticalExaggeration").GetAsDouble();
+      vtkSMPropertyHelper(bar, "Title").Set(LegendTitle(array, exaggeration).toUtf8().constData());
       vtkSMPropertyHelper(bar, "ComponentTitle").Set("");
+      // 120 and 0.01, not 1.2e+02 and 1.0e-02.
+      vtkSMPropertyHelper(bar, "RangeLabelFormat").Set("%.4g");
       bar->UpdateVTKObjects();
     }
   }
-  if (view->getNumberOfVisibleDataRepresentations() == 1) {
+  const int shown = view->getNumberOfVisibleDataRepresentations();
+  pqServerManagerModel *smm = pqApplicationCore::instance()->getServerManagerModel();
+  if (auto *added = smm->findItem<pqPipelineSource *>(surface.GetPointer())) {
+    this->Extents[added] = Extent(added->getOutputPort(0));
+    QObject::connect(added, QOverload<pqPipelineSource *>::of(&pqPipelineSource::dataUpdated), this,
+                     [this](pqPipelineSource *updated) { this->onSurfaceUpdated(updated); });
+  }
+  // The surface alone, or with the objects' port beside it.
+  if (shown == 1 || (shown == 2 && objects)) {
     double bounds[6];
     surfaceSource->GetDataInformation(0)->GetBounds(bounds);
     if (bounds[0] <= bounds[1]) {
@@ -214,4 +326,83 @@ void pqGraupelApplyLook::showSurface(pqPipelineSource *source) {
     }
   }
   view->render();
+}
+
+bool pqGraupelApplyLook::showObjects(pqPipelineSource *source, vtkSMProxy *surface,
+                                     vtkSMViewProxy *view) {
+  vtkSMProxy *proxy = source->getProxy();
+  auto *producer = vtkSMSourceProxy::SafeDownCast(proxy);
+  if (!producer || !proxy->GetProperty("Objects") || producer->GetNumberOfOutputPorts() < 2) {
+    return false;
+  }
+  vtkSMPropertyHelper objects(proxy, "Objects");
+  auto *input = objects.GetNumberOfElements() > 0
+                    ? vtkSMSourceProxy::SafeDownCast(objects.GetAsProxy(0))
+                    : nullptr;
+  if (!input) {
+    return false;
+  }
+  // True heights: the objects are drawn at their pose, so the snow must be too.
+  vtkSMPropertyHelper(surface, "VerticalExaggeration").Set(1.0);
+  surface->UpdateVTKObjects();
+  vtkNew<vtkSMParaViewPipelineControllerWithRendering> controller;
+  // The objects at their pose (output port 1), and not the mesh they came
+  // from at its start as well.
+  controller->Hide(input, objects.GetOutputPort(0), view);
+  vtkSMProxy *repr = controller->Show(producer, 1, view);
+  if (!repr) {
+    return false;
+  }
+  // A brick red that reads against white snow and the terrain's greens.
+  const double red[3] = {0.78, 0.30, 0.20};
+  vtkSMPropertyHelper(repr, "DiffuseColor").Set(red, 3);
+  vtkSMPropertyHelper(repr, "AmbientColor").Set(red, 3);
+  vtkSMPVRepresentationProxy::SetScalarColoring(repr, nullptr, 0);
+  repr->UpdateVTKObjects();
+  return true;
+}
+
+void pqGraupelApplyLook::onRepresentationAdded(pqRepresentation *added) {
+  // Rain Runoff's Hydrograph (output port 1) in a line chart: the discharge
+  // series on the left axis with units, the volumes on the right one,
+  // hidden until chosen (they are 10^4 to 10^7 times the rates).
+  // A state file keeps the chart it saved.
+  if (pqApplicationCore::instance()->isLoadingState()) {
+    return;
+  }
+  auto *repr = qobject_cast<pqDataRepresentation *>(added);
+  pqView *view = repr ? repr->getView() : nullptr;
+  pqOutputPort *port = repr ? repr->getOutputPortFromInput() : nullptr;
+  vtkSMProxy *producer = port && port->getSource() ? port->getSource()->getProxy() : nullptr;
+  if (!view || view->getViewType() != QLatin1String("XYChartView") || !producer ||
+      !producer->GetXMLName() || strcmp(producer->GetXMLName(), "RainRunoff") != 0 ||
+      port->getPortNumber() != 1) {
+    return;
+  }
+  vtkSMProxy *proxy = repr->getProxy();
+  vtkSMPropertyHelper visibility(proxy, "SeriesVisibility");
+  vtkSMPropertyHelper labels(proxy, "SeriesLabel");
+  vtkSMPropertyHelper corners(proxy, "SeriesPlotCorner");
+  visibility.SetNumberOfElements(0);
+  labels.SetNumberOfElements(0);
+  corners.SetNumberOfElements(0);
+  unsigned int k = 0;
+  for (const auto &series : Hydrograph) {
+    visibility.Set(2 * k, series.name);
+    visibility.Set(2 * k + 1, series.shown ? "1" : "0");
+    labels.Set(2 * k, series.name);
+    labels.Set(2 * k + 1, series.label);
+    corners.Set(2 * k, series.name);
+    corners.Set(2 * k + 1, series.right ? "1" : "0");
+    ++k;
+  }
+  vtkSMPropertyHelper(proxy, "UseIndexForXAxis").Set(0);
+  vtkSMPropertyHelper(proxy, "XArrayName").Set("time");
+  proxy->UpdateVTKObjects();
+  vtkSMProxy *chart = view->getProxy();
+  vtkSMPropertyHelper(chart, "ChartTitle").Set("Rain Runoff: hydrograph");
+  vtkSMPropertyHelper(chart, "LeftAxisTitle").Set("discharge (m\xc2\xb3/s)");
+  vtkSMPropertyHelper(chart, "RightAxisTitle").Set("volume (m\xc2\xb3)");
+  vtkSMPropertyHelper(chart, "BottomAxisTitle").Set("time (s)");
+  chart->UpdateVTKObjects();
 }

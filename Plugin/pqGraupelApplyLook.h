@@ -15,7 +15,23 @@
  * ("water depth (m)") is shown, and when the surface is all the view shows,
  * the camera looks at it from the south-east and above.
  *
- * Only the GUI's Apply path triggers it: ParaView's pqObjectBuilder marks a
+ * The look waits for the first update that gives the output points: an
+ * Apply that failed (a wrong input, then Change Input) gets the look on the
+ * first one that works. With objects attached (Snow Deformation, Snow
+ * Accumulation), the heights are drawn true (no exaggeration, so the
+ * objects sit on the snow as they are), the objects' output port is shown at
+ * its pose in a colour that stands out from snow, and the source the
+ * objects came from is hidden; otherwise the legend says the exaggeration
+ * ("snow depth (m), heights x2"). Legends' range labels are plain numbers.
+ * When a surface this component added changes its extent (a reader given
+ * another spacing), the camera looks at it again.
+ *
+ * Rain Runoff's Hydrograph shown in a line chart (from the GUI or its
+ * Python shell; not from a state file) plots the discharge series (m^3/s)
+ * on the left axis and the volumes (m^3) on the right one, hidden until
+ * chosen, with axis titles in units.
+ *
+ * Only the GUI's Apply path triggers the surface: ParaView's pqObjectBuilder marks a
  * source made from a menu UNINITIALIZED until its first Apply
  * (pqApplyBehavior sets it UNMODIFIED after showing it). Sources made by
  * Python (the GUI's shell, pvpython, pvbatch) or by loading a state file
@@ -30,11 +46,16 @@
 #ifndef pqGraupelApplyLook_h
 #define pqGraupelApplyLook_h
 
+#include <QMap>
 #include <QObject>
 #include <QPointer>
 #include <QSet>
+#include <QVector>
 
 class pqPipelineSource;
+class pqRepresentation;
+class vtkSMProxy;
+class vtkSMViewProxy;
 
 class pqGraupelApplyLook : public QObject {
   typedef QObject Superclass;
@@ -53,10 +74,16 @@ private:
   void onModifiedStateChanged(pqPipelineSource *source);
   void showSurfaceLater(QPointer<pqPipelineSource> source, int tries);
   void showSurface(pqPipelineSource *source);
+  bool showObjects(pqPipelineSource *source, vtkSMProxy *surface, vtkSMViewProxy *view);
+  void onDataUpdated(pqPipelineSource *source);
+  void onSurfaceUpdated(pqPipelineSource *surface);
+  void onRepresentationAdded(pqRepresentation *repr);
 
   Q_DISABLE_COPY(pqGraupelApplyLook)
-  QSet<pqPipelineSource *> Pending; // made from a menu, not applied yet
-  bool Updating = false;            // between progress start and end
+  QSet<pqPipelineSource *> Pending;                  // made from a menu, not applied yet
+  QSet<pqPipelineSource *> Waiting;                  // applied, but no update has given points yet
+  QMap<pqPipelineSource *, QVector<double>> Extents; // surfaces added: x and y bounds
+  bool Updating = false;                             // between progress start and end
 };
 
 #endif

@@ -5,7 +5,8 @@ QtTesting XML script that plays what a user does: Sources > Graupel >
 Procedural Terrain, Apply; Filters > Graupel > Rain Runoff, Apply; File > Save
 State. Then checks the saved state: one Terrain Surface below each output,
 shown in the render view and coloured by the right array, the flat images
-and the terrain's surface hidden, the legends visible with titles in units.
+and the terrain's surface hidden, the legends visible with titles in units
+and the vertical exaggeration.
 (QtTesting's Python scripts cannot be used: their thread waits forever for
 the Python lock the GUI holds.)"""
 import os
@@ -89,8 +90,9 @@ print("sources: %s" % sorted(names.values()))
 checks = [len(terrain) == 1, len(rain) == 1, len(surfaces) == 2]
 expected = {}
 if len(terrain) == 1 and len(rain) == 1:
-    expected = {terrain[0]: ("elevation", "elevation (m)", "0"),
-                rain[0]: ("water_depth_display", "water depth (m)", "1")}
+    # The legends say the surfaces' vertical exaggeration (2, the default).
+    expected = {terrain[0]: ("elevation", "elevation (m), heights \u00d72", "0"),
+                rain[0]: ("water_depth_display", "water depth (m), heights \u00d72", "1")}
 for source, (array, title, visible) in expected.items():
     below = [s for s in surfaces if prop(proxies[s], "Input")[1] == [source]]
     flat = render_repr(source)

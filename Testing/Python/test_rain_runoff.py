@@ -391,12 +391,12 @@ dt_rows = np.diff(h["time"])
 out_int = float(np.sum(h["outflow_rate"][1:] * dt_rows))
 T.check(fwd_out[60.0] > 0.0 and abs(out_int - fwd_out[60.0]) <= 1e-6 * fwd_out[60.0],
         "outflow_rate integrates to outflow_volume: %.9g vs %.9g m^3" % (out_int, fwd_out[60.0]))
-rain_int = float(np.sum(h["rain_rate"][1:] * dt_rows))
+rain_int = float(np.sum(h["rain_volume_rate"][1:] * dt_rows))
 rain_q = 80.0 * MM_PER_H * NX * NY * DX * DX
 T.check(abs(rain_int - rain_q * 60.0) <= 1e-6 * rain_q * 60.0 and
-        np.allclose(h["rain_rate"][1:], rain_q, rtol=1e-6),
-        "rain_rate %g m^3/s = rate x area, integrating to the rain (%g m^3)" % (h["rain_rate"][1], rain_int))
-T.check(all(np.isnan(h[c][0]) for c in ("rain_rate", "inflow_rate", "infiltration_rate",
+        np.allclose(h["rain_volume_rate"][1:], rain_q, rtol=1e-6),
+        "rain_volume_rate %g m^3/s = rate x area, integrating to the rain (%g m^3)" % (h["rain_volume_rate"][1], rain_int))
+T.check(all(np.isnan(h[c][0]) for c in ("rain_volume_rate", "inflow_rate", "infiltration_rate",
                                           "outflow_rate")) and np.all(h["inflow_rate"][1:] == 0.0),
         "row 0 ends no interval: its rates are NaN; no inflow through open edges")
 T.check(np.all(np.abs(h["balance_error"]) <= 1e-5 * rain_q * 60.0)
@@ -598,7 +598,7 @@ expect = 0.5 * 50.0 * 72.0 * MM_PER_H * area
 h = hydrograph(hy)
 T.check(hy.GetNumberOfHyetographRows() == 3 and d is not None
         and abs(field(out, "rain_volume") - expect) <= 1e-6 * expect
-        and abs(float(np.sum(h["rain_rate"][1:] * np.diff(h["time"]))) - expect) <= 1e-6 * expect
+        and abs(float(np.sum(h["rain_volume_rate"][1:] * np.diff(h["time"]))) - expect) <= 1e-6 * expect
         and np.allclose(d, expect / area, rtol=1e-5),
         "the hyetograph rains its integral: %.9g m^3 (expected %.9g), every point %.6g m deep"
         % (field(out, "rain_volume") if d is not None else -1, expect, expect / area))
