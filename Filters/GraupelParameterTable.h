@@ -39,13 +39,39 @@ inline std::string OutOfRange(const char *filter, const char *name, const gr_par
 }
 } // namespace graupel
 
-/** Defines cls::Set<name>(type), clamped by the table that bounds returns. */
+/**
+ * Defines cls::Set<name>(type), clamped by the table that bounds returns; a
+ * value moved into the range is noted (vtkGraupelAlgorithm::NoteSetting) so
+ * that the next update says so in one warning.
+ */
 #define GRAUPEL_TABLE_SETTER(cls, name, type, bounds)                                              \
   void cls::Set##name(type value) {                                                                \
     const type v =                                                                                 \
         static_cast<type>(graupel::ClampToTable(bounds, #name, static_cast<double>(value)));       \
+    int count_ = 0;                                                                                \
+    const gr_param_bound *table_ = bounds(&count_);                                                \
+    if (const gr_param_bound *row_ = gr_param_find(table_, count_, #name)) {                       \
+      this->NoteSetting(#name, static_cast<double>(value), static_cast<double>(v),                 \
+                        static_cast<double>(this->name), row_->unit, row_->min, row_->max);        \
+    }                                                                                              \
     if (!(this->name == v) ||                                                                      \
         std::isnan(static_cast<double>(this->name)) != std::isnan(static_cast<double>(v))) {       \
+      this->name = v;                                                                              \
+      this->Modified();                                                                            \
+    }                                                                                              \
+  }
+
+/**
+ * Defines cls::Set<name>(type), clamped to [lo, hi] (for properties without
+ * a core table row), noted as GRAUPEL_TABLE_SETTER notes.
+ */
+#define GRAUPEL_CLAMP_SETTER(cls, name, type, lo, hi, unit)                                        \
+  void cls::Set##name(type value) {                                                                \
+    const type v = value < (lo) ? (lo) : (value > (hi) ? (hi) : value);                            \
+    this->NoteSetting(#name, static_cast<double>(value), static_cast<double>(v),                   \
+                      static_cast<double>(this->name), unit, static_cast<double>(lo),              \
+                      static_cast<double>(hi));                                                    \
+    if (!(this->name == v)) {                                                                      \
       this->name = v;                                                                              \
       this->Modified();                                                                            \
     }                                                                                              \

@@ -2,6 +2,7 @@
 
 #include "vtkDataObject.h"
 #include "vtkDemandDrivenPipeline.h"
+#include "vtkDoubleArray.h"
 #include "vtkFieldData.h"
 #include "vtkInformation.h"
 #include "vtkInformationVector.h"
@@ -14,7 +15,10 @@
 
 #include "GraupelPieces.h"
 
+#include <cctype>
+#include <cmath>
 #include <cstring>
+#include <sstream>
 #include <string>
 
 namespace {
@@ -91,6 +95,42 @@ int vtkGraupelAlgorithm::ReportFailure(int status, const char *what, const char 
   return 0;
 }
 
+void vtkGraupelAlgorithm::NoteSetting(const char *property, double value, double used,
+                                      double current, const char *unit, double min, double max) {
+  if (value == used || (std::isnan(value) && std::isnan(used))) {
+    if (used != current) {
+      this->Clamped.erase(property); // a new value in range
+    }
+    return;
+  }
+  const std::string u = unit && *unit ? std::string(" ") + unit : std::string();
+  std::ostringstream msg;
+  msg << property << " must be from " << min << " to " << max << u << "; it was set to " << value
+      << u << ", so " << used << u << " is used. Set it within that range.";
+  this->Clamped[property] = {msg.str(), false, used};
+}
+
+std::string vtkGraupelAlgorithm::Label() const {
+  std::string name = this->GetClassName();
+  if (name.rfind("vtk", 0) == 0) {
+    name = name.substr(3);
+  }
+  for (const char *suffix : {"Filter", "Source"}) {
+    const size_t n = strlen(suffix);
+    if (name.size() > n && name.compare(name.size() - n, n, suffix) == 0) {
+      name.resize(name.size() - n);
+    }
+  }
+  std::string label;
+  for (size_t i = 0; i < name.size(); ++i) {
+    if (i > 0 && isupper(static_cast<unsigned char>(name[i]))) {
+      label += ' ';
+    }
+    label += name[i];
+  }
+  return label;
+}
+
 int vtkGraupelAlgorithm::ReportError(const std::string &sentence) {
   if (sentence.empty()) {
     return 1;
@@ -161,10 +201,25 @@ vtkTypeBool vtkGraupelAlgorithm::ProcessRequest(vtkInformation *request,
     return this->InformationFailed ? 1 : this->RequestUpdateExtent(request, inInfo, outInfo);
   }
   if (request->Has(vtkDemandDrivenPipeline::REQUEST_DATA())) {
+    for (auto &note : this->Clamped) {
+      if (!note.second.said) {
+        vtkWarningMacro(<< this->Label() << ": " << note.second.sentence);
+        note.second.said = true;
+      }
+    }
     if (this->InformationFailed || !this->RequestData(request, inInfo, outInfo)) {
       // The sentence was reported where the failure happened; see the header
       // for why this is not returned as 0.
       this->EmptyOutputs(outInfo);
+    } else if (vtkDataObject *out = outInfo->GetNumberOfInformationObjects() > 0
+                                        ? vtkDataObject::GetData(outInfo, 0)
+                                        : nullptr) {
+      for (const auto &note : this->Clamped) {
+        vtkNew<vtkDoubleArray> used;
+        used->SetName(("graupel_used_" + note.first).c_str());
+        used->InsertNextValue(note.second.used);
+        out->GetFieldData()->AddArray(used);
+      }
     }
     return 1;
   }

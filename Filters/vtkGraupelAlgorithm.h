@@ -37,7 +37,9 @@
 #include "GraupelFiltersModule.h"
 #include "vtkAlgorithm.h"
 
+#include <map>
 #include <string>
+#include <utility>
 
 struct gr_context;
 class vtkDataObject;
@@ -117,6 +119,22 @@ protected:
    */
   int ReportError(const std::string &sentence);
 
+public:
+  /**
+   * Called by the setters that clamp (GraupelParameterTable.h): value was
+   * asked for property, used is what the setter keeps. A value moved into
+   * the range is remembered, and the next update warns once, in one
+   * sentence, what was asked and what is used ("Rain Runoff: RainRate must
+   * be from 0 to 3600 mm/h; it was set to -5 mm/h, so 0 mm/h is used.").
+   * Setting the same used value again (the GUI writing back what is used)
+   * keeps the note; any other value in range drops it. While a note is
+   * kept, output 0's field data holds graupel_used_<property> (the value
+   * used), which the GUI reads to show that value in the panel.
+   */
+  void NoteSetting(const char *property, double value, double used, double current,
+                   const char *unit, double min, double max);
+
+protected:
   /** Adds the `graupel_device` string to the output's field data. */
   void AddDeviceFieldData(vtkDataObject *output);
 
@@ -132,6 +150,16 @@ private:
   gr_context *Context = nullptr;
   // RequestInformation failed (and said why): the data pass is skipped.
   bool InformationFailed = false;
+  // Values moved into their range: property -> the sentence, whether it
+  // was said, and the value used.
+  struct ClampNote {
+    std::string sentence;
+    bool said;
+    double used;
+  };
+  std::map<std::string, ClampNote> Clamped;
+  // "Rain Runoff" from vtkRainRunoffFilter: the name users see.
+  std::string Label() const;
 };
 
 #endif

@@ -25,6 +25,7 @@
 
 #include "graupel/graupel.h"
 
+#include "GraupelParameterTable.h"
 #include "GraupelPieces.h"
 
 #include <algorithm>
@@ -80,6 +81,10 @@ std::string ProgressTimes(double t, double goal) {
 } // namespace
 
 vtkGraupelSimulation::vtkGraupelSimulation() : PieceLayout(new graupel::Pieces) {}
+
+GRAUPEL_CLAMP_SETTER(vtkGraupelSimulation, CheckpointInterval, int, 0, MaximumOutputSteps,
+                     "outputs")
+GRAUPEL_CLAMP_SETTER(vtkGraupelSimulation, CheckpointMemoryLimit, double, 0.0, 1.0e9, "MiB")
 
 vtkGraupelSimulation::~vtkGraupelSimulation() {
   delete this->PieceLayout;

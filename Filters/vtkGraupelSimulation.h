@@ -193,7 +193,7 @@ public:
 
   ///@{
   /** A checkpoint every this many outputs (default 10; 0: none). */
-  vtkSetClampMacro(CheckpointInterval, int, 0, MaximumOutputSteps);
+  virtual void SetCheckpointInterval(int value);
   vtkGetMacro(CheckpointInterval, int);
   ///@}
 
@@ -202,7 +202,7 @@ public:
    * Most host memory the checkpoints may hold, MiB (default 1024); a quarter
    * of the host's physical memory applies when that is less.
    */
-  vtkSetClampMacro(CheckpointMemoryLimit, double, 0.0, 1.0e9);
+  virtual void SetCheckpointMemoryLimit(double value);
   vtkGetMacro(CheckpointMemoryLimit, double);
   ///@}
 

@@ -84,6 +84,7 @@ vtkSnowAccumulationFilter::~vtkSnowAccumulationFilter() {
   this->ReleaseState();
 }
 
+GRAUPEL_CLAMP_SETTER(vtkSnowAccumulationFilter, TimeStep, double, 1.0e-6, 86400.0, "s")
 GRAUPEL_TABLE_SETTER(vtkSnowAccumulationFilter, Flutter, double, gr_snow_accumulation_param_bounds)
 GRAUPEL_TABLE_SETTER(vtkSnowAccumulationFilter, SnowfallRate, double,
                      gr_snow_accumulation_param_bounds)

@@ -92,7 +92,7 @@ public:
 
   ///@{
   /** Length of one simulation step, s (default 300; from 1e-6 to 86400). */
-  vtkSetClampMacro(TimeStep, double, 1.0e-6, 86400.0);
+  virtual void SetTimeStep(double value);
   vtkGetMacro(TimeStep, double);
   ///@}
 

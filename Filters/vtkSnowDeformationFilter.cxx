@@ -90,6 +90,7 @@ vtkSnowDeformationFilter::~vtkSnowDeformationFilter() {
   this->ReleaseState();
 }
 
+GRAUPEL_CLAMP_SETTER(vtkSnowDeformationFilter, TimeStep, double, 1.0e-6, 60.0, "s")
 GRAUPEL_TABLE_SETTER(vtkSnowDeformationFilter, InitialSnowDepth, double,
                      gr_snow_deformation_param_bounds)
 GRAUPEL_TABLE_SETTER(vtkSnowDeformationFilter, InitialDensity, double,

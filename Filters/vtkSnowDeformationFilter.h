@@ -99,7 +99,7 @@ public:
 
   ///@{
   /** Length of one simulation step, s (default 1/60; from 1e-6 to 60). */
-  vtkSetClampMacro(TimeStep, double, 1.0e-6, 60.0);
+  virtual void SetTimeStep(double value);
   vtkGetMacro(TimeStep, double);
   ///@}
 

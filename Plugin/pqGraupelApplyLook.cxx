@@ -11,9 +11,12 @@
 #include "pqServerManagerModel.h"
 #include "pqRepresentation.h"
 #include "pqView.h"
+#include "vtkPVArrayInformation.h"
 #include "vtkPVDataInformation.h"
+#include "vtkPVDataSetAttributesInformation.h"
 #include "vtkPVXMLElement.h"
 #include "vtkSMPVRepresentationProxy.h"
+#include "vtkSMProperty.h"
 #include "vtkSMParaViewPipelineControllerWithRendering.h"
 #include "vtkSMPropertyHelper.h"
 #include "vtkSMProxySelectionModel.h"
@@ -35,6 +38,14 @@ namespace {
 bool WantsSurface(vtkSMProxy *proxy) {
   vtkPVXMLElement *hints = proxy ? proxy->GetHints() : nullptr;
   return hints && hints->FindNestedElementByName("GraupelSurface");
+}
+
+// A proxy of the plugin: its menu category is Graupel.
+bool IsGraupel(vtkSMProxy *proxy) {
+  vtkPVXMLElement *hints = proxy ? proxy->GetHints() : nullptr;
+  vtkPVXMLElement *menu = hints ? hints->FindNestedElementByName("ShowInMenu") : nullptr;
+  const char *category = menu ? menu->GetAttribute("category") : nullptr;
+  return category && strcmp(category, "Graupel") == 0;
 }
 
 bool IsTerrainSurface(pqPipelineSource *source) {
@@ -185,16 +196,56 @@ void pqGraupelApplyLook::onStartup() {
 }
 
 void pqGraupelApplyLook::onSourceAdded(pqPipelineSource *source) {
-  if (!source || !WantsSurface(source->getProxy())) {
+  if (!source || !IsGraupel(source->getProxy())) {
     return;
   }
-  QObject::connect(source, &pqProxy::modifiedStateChanged, this,
-                   [this, source]() { this->onModifiedStateChanged(source); });
   QObject::connect(source, QOverload<pqPipelineSource *>::of(&pqPipelineSource::dataUpdated), this,
                    [this](pqPipelineSource *updated) { this->onDataUpdated(updated); });
+  if (WantsSurface(source->getProxy())) {
+    QObject::connect(source, &pqProxy::modifiedStateChanged, this,
+                     [this, source]() { this->onModifiedStateChanged(source); });
+  }
+}
+
+void pqGraupelApplyLook::showUsedValues(pqPipelineSource *source) {
+  // A value the filter moved into its range (it warned once): the panel
+  // shows the value used, which the output's field data carries as
+  // graupel_used_<property> (vtkGraupelAlgorithm::NoteSetting).
+  pqOutputPort *port = source->getOutputPort(0);
+  vtkPVDataInformation *info = port ? port->getDataInformation() : nullptr;
+  vtkPVDataSetAttributesInformation *fields = info ? info->GetFieldDataInformation() : nullptr;
+  vtkSMProxy *proxy = source->getProxy();
+  bool changed = false;
+  for (int i = 0; fields && i < fields->GetNumberOfArrays(); ++i) {
+    vtkPVArrayInformation *array = fields->GetArrayInformation(i);
+    const char *name = array ? array->GetName() : nullptr;
+    const size_t prefix = strlen("graupel_used_");
+    if (!name || strncmp(name, "graupel_used_", prefix) != 0) {
+      continue;
+    }
+    vtkSMProperty *property = proxy->GetProperty(name + prefix);
+    if (!property || property->GetInformationOnly()) {
+      continue;
+    }
+    const double used = array->GetComponentRange(0)[0];
+    vtkSMPropertyHelper helper(property);
+    if (helper.GetNumberOfElements() == 1 && helper.GetAsDouble(0) != used) {
+      helper.Set(0, used);
+      changed = true;
+    }
+  }
+  if (changed) {
+    proxy->UpdateVTKObjects();
+  }
 }
 
 void pqGraupelApplyLook::onDataUpdated(pqPipelineSource *source) {
+  QPointer<pqPipelineSource> shown(source);
+  QTimer::singleShot(0, this, [this, shown]() {
+    if (shown) {
+      this->showUsedValues(shown);
+    }
+  });
   // An Apply whose update failed (no points): the look comes with the first
   // update that gives points, once that update has returned.
   if (this->Waiting.contains(source) && !Extent(source->getOutputPort(0)).isEmpty()) {

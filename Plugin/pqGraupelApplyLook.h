@@ -23,6 +23,8 @@
  * its pose in a colour that stands out from snow, and the source the
  * objects came from is hidden; otherwise the legend says the exaggeration
  * ("snow depth (m), heights x2"). Legends' range labels are plain numbers.
+ * A property value a Graupel filter moved into its range (it warns once)
+ * is shown in the panel as the value used, after the update.
  * When a surface this component added changes its extent (a reader given
  * another spacing), the camera looks at it again.
  *
@@ -76,6 +78,7 @@ private:
   void showSurface(pqPipelineSource *source);
   bool showObjects(pqPipelineSource *source, vtkSMProxy *surface, vtkSMViewProxy *view);
   void onDataUpdated(pqPipelineSource *source);
+  void showUsedValues(pqPipelineSource *source);
   void onSurfaceUpdated(pqPipelineSource *surface);
   void onRepresentationAdded(pqRepresentation *repr);
 

@@ -7,7 +7,8 @@ the panel by QtTesting as a user does:
   Filters > Graupel > Snow Deformation, Objects: Sphere1 picked in the
   panel's list, Apply;
   Wavelet1 selected, Filters > Graupel > Rain Runoff, Apply (refused: the
-  Wavelet has no elevation); Edit > Change Input: ProceduralTerrain1, Apply;
+  Wavelet has no elevation); Edit > Change Input: ProceduralTerrain1, Rain
+  Rate -5 mm/h (out of range), Apply;
   the Hydrograph shown in a new line chart from the Python shell;
   File > Save State.
 
@@ -19,6 +20,8 @@ Then checks the saved state:
   * Rain Runoff, refused on its first Apply, got the look on the first update
     that worked: a Terrain Surface coloured by water depth with a legend that
     states the exaggeration ("heights x2"), range labels as plain numbers;
+  * the rain rate out of range was said once, in one sentence, and the panel
+    shows the value used (0);
   * the Hydrograph shown in a line chart (made in the Python shell) has the
     discharge series shown, the volumes hidden and on the right axis, and the
     axes titled in units."""
@@ -78,6 +81,8 @@ events = [
     (change, "mousePress", "1,1,0,40,8,/0:0/2:0"),
     (change, "mouseRelease", "1,0,0,40,8,/0:0/2:0"),
     ("pqClientMainWindow/ChangeInputDialog/buttonBox/1QPushButton0", "activate", ""),
+    # Out of range (0-3600 mm/h): the filter warns once and uses 0.
+    (panel + "RainRate/DoubleRangeWidget/DoubleLineEdit", "set_string", "-5"),
     (apply_button, "activate", ""),
     ("pqClientMainWindow", "process_events", "2000"),
     # A line chart of the Hydrograph, made as the Python shell makes it.
@@ -98,7 +103,8 @@ with open(script, "w") as f:
 
 env = dict(os.environ, PV_PLUGIN_PATH=plugin_dir)
 proc = subprocess.run(["paraview", "--dr", "--test-script=" + script, "--exit"], env=env,
-                      timeout=240)
+                      timeout=240, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+print(proc.stdout[-4000:])
 print("paraview exit code %d" % proc.returncode)
 if not os.path.exists(state):
     print("no state saved: the GUI script did not get through")
@@ -189,6 +195,13 @@ title = prop(bar, "Title")[0] if bar is not None else []
 check(title == ["water depth (m), heights \u00d72"], "its legend %r states the exaggeration" % title)
 check(bar is not None and prop(bar, "RangeLabelFormat")[0] == ["%.4g"], "plain range labels")
 check(bar is not None and prop(bar, "Visibility")[0] == ["1"], "its legend visible")
+
+# 5: a value out of range said once, and the panel shows the value used.
+warning = ("Rain Runoff: RainRate must be from 0 to 3600 mm/h; it was set to -5 mm/h, so 0 mm/h "
+           "is used.")
+check(proc.stdout.count(warning) == 1, "the warning said once (%d times)" % proc.stdout.count(warning))
+check(prop(proxies[rain], "RainRate")[0] == ["0"],
+      "the panel's RainRate is the value used: %s" % prop(proxies[rain], "RainRate")[0])
 
 # 9: the hydrograph in a line chart, discharge only, volumes on the right.
 charts = [r for r in reprs(rain, "1") if r.get("type") == "XYChartRepresentation"]
