@@ -43,9 +43,9 @@ view = graupel_scene.show_terrain(terrain)
 SaveScreenshot(os.path.join(args.out, "terrain.png"), view, ImageResolution=[1024, 768])
 Delete(view)
 
-# 2. The real DEM: 3 arc-second cells (74.5 m east-west, 92.1 m north-south).
+# 2. The real DEM: 3 arc-second cells (74.5 m east-west, 92.1 m north-south),
+# a spacing the file holds, so the reader needs no property.
 dem = OpenDataFile(os.path.join(here, "..", "Data", "jacksboro_fault_dem.exr"))
-dem.Spacing = [74.5, 92.1]
 dem.UpdatePipeline()
 lo, hi = dem.PointData["elevation"].GetRange()
 print("Jacksboro Fault DEM: elevation %.0f..%.0f m" % (lo, hi))

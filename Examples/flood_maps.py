@@ -1,5 +1,5 @@
 """Rain Runoff's flood maps on the real DEM in Data/: 1 h of 50 mm/h on the
-Jacksboro fault DEM (344 x 403 points, 74.5 x 92.1 m), then the largest depth
+Jacksboro fault DEM (403 x 344 points, 74.5 x 92.1 m), then the largest depth
 and the flood-hazard class (FD2321's h (v + 0.5) + DF) seen from above, and the
 hydrograph (output port 1) as a line chart. About 80 s on PoCL on two cores.
 
@@ -25,8 +25,8 @@ if "RainRunoff" not in globals():
     LoadPlugin(os.path.abspath(args.plugin), ns=globals())
 
 end = 3600.0 * args.hours
+# The DEM's spacing (74.5 x 92.1 m) and origin are in the file.
 dem = OpenDataFile(os.path.join(here, "..", "Data", "jacksboro_fault_dem.exr"))
-dem.Spacing = [74.5, 92.1]
 rain = RainRunoff(Input=dem, RainRate=50.0, EndTime=end, OutputInterval=300.0, MaxTimeStep=10.0)
 rain.UpdatePipeline(end)
 for m in ("max_depth", "max_speed", "arrival_time", "hazard_class"):

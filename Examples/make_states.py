@@ -92,7 +92,6 @@ if args.scene == "terrain":
 elif args.scene == "rain_jacksboro":
     dem = pvs.EXRHeightFieldReader(
         FileName=os.path.realpath(os.path.join(here, "..", "Data", "jacksboro_fault_dem.exr")))
-    dem.Spacing = [74.5, 92.1]
     rain = pvs.RainRunoff(Input=dem, RainRate=50.0, EndTime=1800.0, OutputInterval=300.0,
                           MaxTimeStep=10.0)
     at_time(1800.0)

@@ -47,8 +47,7 @@ def build(data, sample=2, seconds=3600.0 * HOURS, drops=20000):
     of its proxies."""
     from paraview.simple import ExtractSubset, OpenDataFile
     P = L.constructor
-    dem = OpenDataFile(os.path.join(data, "jacksboro_fault_dem.exr"))
-    dem.Spacing = [74.5, 92.1]
+    dem = OpenDataFile(os.path.join(data, "jacksboro_fault_dem.exr"))  # spacing in the file
     dem.UpdatePipeline()
     ext = dem.GetDataInformation().GetExtent()
     terrain = ExtractSubset(Input=dem, VOI=list(ext),

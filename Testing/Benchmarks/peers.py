@@ -52,7 +52,6 @@ import time
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
 DEM = os.path.join(ROOT, "Data", "jacksboro_fault_dem.exr")
-SPACING = (74.5, 92.1)  # m, east-west and north-south (Data/README.md)
 MM_PER_H = 1.0 / 3.6e6  # m/s
 
 
@@ -89,12 +88,13 @@ def worker_dem(a):
     from graupel import vtkEXRHeightFieldReader
     import numpy as np
     r = vtkEXRHeightFieldReader()
-    r.SetFileName(DEM)
-    r.SetSpacing(*SPACING)
+    r.SetFileName(DEM)  # the file holds the spacing, 74.5 x 92.1 m (Data/README.md)
     r.Update()
     img = r.GetOutput()
     nx, ny, _ = img.GetDimensions()
     sp = img.GetSpacing()
+    if sp[:2] == (1.0, 1.0):
+        sys.exit("dem: %s holds no spacing (an old copy of Data/?)" % DEM)
     z = vtk_to_numpy(img.GetPointData().GetArray("elevation")).reshape(ny, nx).astype(np.float64)
     np.savez(os.path.join(a.work, "dem.npz"), elevation=z, dx=sp[0], dy=sp[1])
     log("dem: %d x %d points, spacing %.1f x %.1f m, %.0f..%.0f m"
@@ -110,8 +110,7 @@ def worker_graupel(a):
 
     t0 = time.perf_counter()
     r = vtkEXRHeightFieldReader()
-    r.SetFileName(DEM)
-    r.SetSpacing(*SPACING)
+    r.SetFileName(DEM)  # spacing and origin from the file
     r.Update()
     t_read = time.perf_counter() - t0
 

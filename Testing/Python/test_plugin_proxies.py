@@ -111,10 +111,15 @@ T.check(r.GetDataInformation().GetNumberOfPoints() == 128 * 96, "reader output s
 T.check(r.PointData["elevation"].GetRange() == t.PointData["elevation"].GetRange(),
         "reader range equals source range")
 
+# File > Open on the real DEM, no property set: its spacing and origin come
+# from the file (3 arc-seconds, 74.5 m east-west and 92.1 m north-south, the
+# south-west point at 0 0), so it opens at its real size, 30 x 31.6 km.
 dem = OpenDataFile(os.path.join(a.data, "jacksboro_fault_dem.exr"))
-dem.Spacing = [74.5, 92.1]
 dem.UpdatePipeline()
 T.check(dem.PointData["elevation"].GetRange() == (236.0, 1076.0), "real DEM range")
+b = dem.GetDataInformation().GetBounds()
+T.check(max(abs(x - y) for x, y in zip(b, (0.0, 402 * 74.5, 0.0, 343 * 92.1, 0.0, 0.0))) < 1e-6,
+        "the real DEM opens at its real size: bounds %s" % (b,))
 
 # Rain Runoff on the DEM: a time source whose times the animation scene sees.
 rr = RainRunoff(Input=dem)

@@ -70,6 +70,17 @@ for name in found:
     T.check(not missing, "%s: every data file found (%s)" % (name, missing))
     T.check(not empty, "%s: every one of %d sources has data at t = %g s (empty: %s)"
             % (name, len(sources), t, empty))
+    # The DEM's spacing comes from its file (the state sets none), so the
+    # state's camera, placed for the real 30 x 31.6 km, sees the terrain.
+    dems = [(label, proxy) for (label, _), proxy in sources.items()
+            if proxy.GetXMLName() == "EXRHeightFieldReader"
+            and "jacksboro" in "".join(file_names(proxy))]
+    T.check(len(dems) == (1 if name == "rain_jacksboro" else 0),
+            "%s: %d readers of the DEM" % (name, len(dems)))
+    for label, proxy in dems:
+        b = proxy.GetDataInformation().GetBounds()
+        T.check(abs(b[1] - 402 * 74.5) < 1e-6 and abs(b[3] - 343 * 92.1) < 1e-6,
+                "%s: %s opens at the DEM's real size (bounds %s)" % (name, label, b))
     png = os.path.join(a.scratch, "state_%s.png" % name)
     pvs.SaveScreenshot(png, view, ImageResolution=[400, 300])
     r = vtkPNGReader()

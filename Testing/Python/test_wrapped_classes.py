@@ -328,6 +328,19 @@ out = r.GetOutput()
 T.check(tuple(out.GetDimensions()) == (403, 344, 1), "DEM is 403 x 344")
 z = vtk_to_numpy(out.GetPointData().GetArray("elevation")).reshape(344, 403)
 T.check(z.min() == 236.0 and z.max() == 1076.0, "DEM elevation 236..1076 m")
+# Its geometry is in the file (graupel.spacing, graupel.origin): the reader's
+# defaults give the real size, 3 arc-seconds as Data/README.md states them
+# (74.5 m east-west, 92.1 m north-south), the south-west point at the origin;
+# with GeometryFromFile off the reader's own 1 m applies, so the file is what
+# gives it.
+T.check(out.GetSpacing() == (74.5, 92.1, 1.0) and out.GetOrigin() == (0.0, 0.0, 0.0),
+        "DEM spacing %s and origin %s from the file" % (out.GetSpacing(), out.GetOrigin()))
+r1 = vtkEXRHeightFieldReader()
+r1.SetFileName(dem)
+r1.SetGeometryFromFile(0)
+r1.Update()
+T.check(r1.GetOutput().GetSpacing() == (1.0, 1.0, 1.0), "DEM without the file's geometry: %s"
+        % (r1.GetOutput().GetSpacing(),))
 src = "/usr/share/matplotlib/mpl-data/sample_data/jacksboro_fault_dem.npz"
 if os.path.exists(src):
     ref = np.load(src)["elevation"].astype(np.float32)
