@@ -488,9 +488,13 @@ void vtkGraupelSimulation::KeepCheckpoint() {
 }
 
 int vtkGraupelSimulation::ReportProgress(double t) {
+  // The bar says how far the simulated time is along the run to the goal,
+  // as the text does ("t = 1000 s of 3600 s"), also when an update resumes
+  // from a kept state.
   const double goal = this->GetOutputTime(this->Target);
-  const double span = goal - this->ProgressStart;
-  const double fraction = span > 0.0 ? (t - this->ProgressStart) / span : 1.0;
+  const double start = this->GetOutputTime(0);
+  const double span = goal - start;
+  const double fraction = span > 0.0 ? (t - start) / span : 1.0;
   const std::string text = std::string(this->GetSimulationLabel()) + ": " + ProgressTimes(t, goal);
   this->SetProgressText(text.c_str());
   this->UpdateProgress(std::max(0.0, std::min(1.0, fraction)));
@@ -669,7 +673,6 @@ int vtkGraupelSimulation::UpdateState(vtkInformation *request, vtkInformationVec
       this->HasFailed = true;
       return 0;
     }
-    this->ProgressStart = this->StateTime;
     this->ReportProgress(this->StateTime);
   }
 

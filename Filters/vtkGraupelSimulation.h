@@ -488,7 +488,6 @@ private:
   int ExtraPassCount = 0;
   bool Continuing = false;
   int Target = 0;
-  double ProgressStart = 0.0;
   double LastProgressWall = 0.0; // s, steady clock: ThrottledProgress's last report
   Key StateKey;
   Key FailedKey;

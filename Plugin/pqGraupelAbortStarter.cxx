@@ -14,6 +14,8 @@
 #include "vtkWeakPointer.h"
 
 #include <QAbstractButton>
+#include <QAction>
+#include <QToolButton>
 #include <QApplication>
 #include <QDateTime>
 #include <QFile>
@@ -86,6 +88,23 @@ bool IsAbortButton(QObject *obj) {
   for (QObject *o = obj; o; o = o->parent()) {
     if (o->objectName() == QLatin1String("AbortButton")) {
       return true;
+    }
+  }
+  return false;
+}
+
+// The VCR toolbar's Play (or Reverse) button while an animation plays: it
+// says Pause then (pqVCRToolbar::onPlaying) and only stops the scene. Any
+// other button could start a second update inside this one.
+bool IsPauseButton(QObject *obj) {
+  for (QObject *o = obj; o; o = o->parent()) {
+    auto *button = qobject_cast<QToolButton *>(o);
+    QAction *action = button ? button->defaultAction() : nullptr;
+    if (action) {
+      const QString name = action->objectName();
+      return (name == QLatin1String("actionVCRPlay") ||
+              name == QLatin1String("actionVCRReverse")) &&
+             action->text() == QLatin1String("Pa&use");
     }
   }
   return false;
@@ -227,11 +246,12 @@ bool pqGraupelAbortStarter::eventFilter(QObject *obj, QEvent *event) {
     case QEvent::MouseButtonRelease:
     case QEvent::MouseButtonDblClick:
     case QEvent::MouseMove: {
-      // The abort button alone takes clicks during an update. A click
+      // The abort button alone takes clicks during an update, and Pause
+      // while an animation plays (one click, not one between two updates). A click
       // reaches the top-level QWindow first: look at what lies under it.
       auto *mouse = static_cast<QMouseEvent *>(event);
       QObject *target = obj->isWidgetType() ? obj : QApplication::widgetAt(mouse->globalPos());
-      if (IsAbortButton(target)) {
+      if (IsAbortButton(target) || IsPauseButton(target)) {
         break;
       }
       return true;

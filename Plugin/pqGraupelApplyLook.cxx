@@ -324,11 +324,12 @@ void pqGraupelApplyLook::showSurface(pqPipelineSource *source) {
   // stays active instead: its panel stays open and the Filters menu (Rain
   // Runoff below a terrain) applies to its image, not to the surface.
   controller->RegisterPipelineProxy(surface);
+  vtkSMViewProxy *viewProxy = view->getViewProxy();
+  this->showTime(source, viewProxy);
   if (vtkSMProxySelectionModel *active = pxm->GetSelectionModel("ActiveSources")) {
     active->SetCurrentProxy(source->getProxy(), vtkSMProxySelectionModel::CLEAR_AND_SELECT);
   }
 
-  vtkSMViewProxy *viewProxy = view->getViewProxy();
   const bool objects = this->showObjects(source, surface, viewProxy);
   vtkSMProxy *repr = controller->Show(surfaceSource, 0, viewProxy);
   if (!repr) {
@@ -337,6 +338,13 @@ void pqGraupelApplyLook::showSurface(pqPipelineSource *source) {
   // The flat image, and the surfaces of this output's inputs (as ParaView
   // hides a filter's input): one surface, not two drawn in one place.
   controller->Hide(vtkSMSourceProxy::SafeDownCast(source->getProxy()), 0, viewProxy);
+  // The representation toolbar shows the active source's: say Surface, what
+  // is drawn, not Slice.
+  if (vtkSMProxy *image =
+          viewProxy->FindRepresentation(vtkSMSourceProxy::SafeDownCast(source->getProxy()), 0)) {
+    vtkSMPropertyHelper(image, "Representation").Set("Surface");
+    image->UpdateVTKObjects();
+  }
   if (auto *filter = qobject_cast<pqPipelineFilter *>(source)) {
     for (pqOutputPort *input : filter->getAllInputs()) {
       for (pqPipelineSource *sibling : input->getConsumers()) {
@@ -456,4 +464,37 @@ void pqGraupelApplyLook::onRepresentationAdded(pqRepresentation *added) {
   vtkSMPropertyHelper(chart, "RightAxisTitle").Set("volume (m\xc2\xb3)");
   vtkSMPropertyHelper(chart, "BottomAxisTitle").Set("time (s)");
   chart->UpdateVTKObjects();
+}
+
+void pqGraupelApplyLook::showTime(pqPipelineSource *source, vtkSMViewProxy *view) {
+  // A simulation (a time source: it has an EndTime) gets the simulated time
+  // in the view's upper left corner, once a view.
+  vtkSMProxy *proxy = source->getProxy();
+  if (!proxy->GetProperty("EndTime")) {
+    return;
+  }
+  pqServerManagerModel *smm = pqApplicationCore::instance()->getServerManagerModel();
+  for (pqPipelineSource *other : smm->findItems<pqPipelineSource *>(source->getServer())) {
+    vtkSMProxy *p = other->getProxy();
+    if (p && p->GetXMLName() && strcmp(p->GetXMLName(), "TimeToTextConvertorSource") == 0 &&
+        ShownIn(other)) {
+      return;
+    }
+  }
+  vtkSMSessionProxyManager *pxm = source->getServer()->proxyManager();
+  vtkSmartPointer<vtkSMProxy> text;
+  text.TakeReference(pxm->NewProxy("sources", "TimeToTextConvertorSource"));
+  auto *textSource = vtkSMSourceProxy::SafeDownCast(text);
+  if (!textSource) {
+    return;
+  }
+  vtkNew<vtkSMParaViewPipelineControllerWithRendering> controller;
+  controller->PreInitializeProxy(text);
+  vtkSMPropertyHelper(text, "Format").Set("t = {time:.0f} s");
+  controller->PostInitializeProxy(text);
+  controller->RegisterPipelineProxy(text, "Simulated Time");
+  if (vtkSMProxy *repr = controller->Show(textSource, 0, view)) {
+    vtkSMPropertyHelper(repr, "WindowLocation").Set("Upper Left Corner");
+    repr->UpdateVTKObjects();
+  }
 }

@@ -25,6 +25,8 @@
  * ("snow depth (m), heights x2"). Legends' range labels are plain numbers.
  * A property value a Graupel filter moved into its range (it warns once)
  * is shown in the panel as the value used, after the update.
+ * A simulation's view gets the simulated time in its upper left corner
+ * (an Annotate Time source, "t = 600 s"), once a view.
  * When a surface this component added changes its extent (a reader given
  * another spacing), the camera looks at it again.
  *
@@ -79,6 +81,7 @@ private:
   bool showObjects(pqPipelineSource *source, vtkSMProxy *surface, vtkSMViewProxy *view);
   void onDataUpdated(pqPipelineSource *source);
   void showUsedValues(pqPipelineSource *source);
+  void showTime(pqPipelineSource *source, vtkSMViewProxy *view);
   void onSurfaceUpdated(pqPipelineSource *surface);
   void onRepresentationAdded(pqRepresentation *repr);
 

@@ -19,7 +19,9 @@ Then checks the saved state:
     the snow's surface has no vertical exaggeration;
   * Rain Runoff, refused on its first Apply, got the look on the first update
     that worked: a Terrain Surface coloured by water depth with a legend that
-    states the exaggeration ("heights x2"), range labels as plain numbers;
+    states the exaggeration ("heights x2"), range labels as plain numbers, the
+    hidden image's representation named as what is drawn (Surface), and one
+    time annotation in the view (Snow Deformation added it; not a second);
   * the rain rate out of range was said once, in one sentence, and the panel
     shows the value used (0);
   * the Hydrograph shown in a line chart (made in the Python shell) has the
@@ -195,6 +197,16 @@ title = prop(bar, "Title")[0] if bar is not None else []
 check(title == ["water depth (m), heights \u00d72"], "its legend %r states the exaggeration" % title)
 check(bar is not None and prop(bar, "RangeLabelFormat")[0] == ["%.4g"], "plain range labels")
 check(bar is not None and prop(bar, "Visibility")[0] == ["1"], "its legend visible")
+image = reprs(rain)
+check(len(image) == 1 and prop(image[0], "Representation")[0] == ["Surface"],
+      "the hidden image's representation says Surface, not Slice")
+# The simulated time in the view, once.
+clocks = by_type("TimeToTextConvertorSource")
+shown_clock = [p for p in proxies.values() if p.get("group") == "representations"
+               and clocks and prop(p, "Input")[1] == [(clocks[0], "0")]
+               and prop(p, "Visibility")[0] == ["1"]]
+check(len(clocks) == 1 and len(shown_clock) >= 1,
+      "one time annotation shown (%d)" % len(clocks))
 
 # 5: a value out of range said once, and the panel shows the value used.
 warning = ("Rain Runoff: RainRate must be from 0 to 3600 mm/h; it was set to -5 mm/h, so 0 mm/h "

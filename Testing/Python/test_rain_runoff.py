@@ -214,12 +214,21 @@ T.check(d is not None and np.array_equal(d, ref[60.0]), "the next update finishe
 T.check(ab.GetRestartCount() == 1, "going on after an abort needs no restart")
 
 # ---- progress names the simulated time ---------------------------------------
-pr = rain(slope + bowl, RainRate=50.0)
+pr = rain(slope + bowl, RainRate=50.0, EndTime=120.0)
 texts = []
 pr.AddObserver("ProgressEvent", lambda o, e: texts.append(o.GetProgressText()))
 at(pr, 60.0)
 T.check("Rain Runoff: t = 30 s of 60 s" in texts,
         "progress text names the time: %r" % texts[:8])
+# The bar agrees with the text, also when the update resumes from the state
+# kept at 60 s (before, a resumed update's bar counted from 0 % again).
+bars = []
+pr.AddObserver("ProgressEvent", lambda o, e: bars.append((o.GetProgressText(), o.GetProgress())))
+at(pr, 120.0)
+inside = [(t, p) for t, p in bars if " s of " in t and 0.0 < p < 1.0]
+agree = [abs(p - float(t.split("t = ")[1].split(" s")[0]) / 120.0) < 0.02 for t, p in inside]
+T.check(len(inside) > 0 and all(agree) and min(p for _, p in inside) >= 0.45,
+        "progress from 60 to 120 s is t/120: %r" % inside[:4])
 
 # ---- checkpoints: going back restores the nearest one, same bits --------------
 ck = rain(slope + bowl, RainRate=50.0, CheckpointInterval=2)
