@@ -6,13 +6,12 @@ Procedural Terrain, Apply; Filters > Graupel > Rain Runoff, Apply; File > Save
 State. Then checks the saved state: one Terrain Surface below each output,
 shown in the render view and coloured by the right array, the flat images
 and the terrain's surface hidden, the legends visible with titles in units
-and the vertical exaggeration.
-(QtTesting's Python scripts cannot be used: their thread waits forever for
-the Python lock the GUI holds.)"""
+and the vertical exaggeration."""
 import os
-import subprocess
 import sys
-import xml.etree.ElementTree as ET
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from gr_gui import APPLY, State, paraview, write_events  # noqa: E402
 
 scratch = sys.argv[sys.argv.index("--scratch") + 1]
 plugin_dir = sys.argv[sys.argv.index("--plugin-dir") + 1]
@@ -21,65 +20,34 @@ script = os.path.join(scratch, "gui_apply.xml")
 if os.path.exists(state):
     os.remove(state)
 
-apply_button = "pqClientMainWindow/propertiesDock/propertiesPanel/Accept"
-events = [
+write_events(script, [
     ("pqClientMainWindow/menubar/menuSources/Graupel", "activate", "ProceduralTerrain"),
-    (apply_button, "activate", ""),
+    (APPLY, "activate", ""),
     # The surface is added once the Apply has returned (a zero-time timer).
     ("pqClientMainWindow", "process_events", "1000"),
     # Enabled only if Procedural Terrain is still the active source.
     ("pqClientMainWindow/menubar/menuFilters/Graupel", "activate", "RainRunoff"),
-    (apply_button, "activate", ""),
+    (APPLY, "activate", ""),
     ("pqClientMainWindow", "process_events", "1000"),
     ("pqClientMainWindow/menubar/menu_File", "activate", "actionFileSaveServerState"),
     ("pqClientMainWindow/FileSaveServerStateDialog", "filesSelected", state),
-]
-with open(script, "w") as f:
-    f.write('<?xml version="1.0" ?>\n<pqevents>\n')
-    for obj, command, arguments in events:
-        f.write('  <pqevent object="%s" command="%s" arguments="%s"/>\n' % (obj, command, arguments))
-    f.write("</pqevents>\n")
-
-env = dict(os.environ, PV_PLUGIN_PATH=plugin_dir)
-proc = subprocess.run(["paraview", "--dr", "--test-script=" + script, "--exit"], env=env,
-                      timeout=240)
+])
+proc = paraview(script, plugin_dir)
 print("paraview exit code %d" % proc.returncode)
 if not os.path.exists(state):
     print("no state saved: the GUI script did not get through")
     sys.exit(1)
 
-root = ET.parse(state).getroot().find("ServerManagerState")
-names = {i.get("id"): i.get("name") for c in root.findall("ProxyCollection")
-         if c.get("name") == "sources" for i in c.findall("Item")}
-proxies = {p.get("id"): p for p in root.findall("Proxy")}
-
-
-def prop(proxy, name):
-    for q in proxy.findall("Property"):
-        if q.get("name") == name:
-            return ([e.get("value") for e in q.findall("Element")],
-                    [d.get("value") for d in q.findall("Proxy")])
-    return [], []
-
-
-def by_type(xml_name):
-    return [i for i, p in proxies.items() if p.get("type") == xml_name and i in names]
+S = State(state)
+names, proxies, prop, by_type, bar_for = S.names, S.proxies, S.prop, S.by_type, S.bar_for
 
 
 def render_repr(source_id):
     """The representation of `source_id`'s first port in the render view."""
     for p in proxies.values():
         # Its helper proxies (selection, ...) have no Representation type.
-        if (p.get("group") == "representations" and prop(p, "Input")[1] == [source_id]
+        if (p.get("group") == "representations" and prop(p, "Input")[1] == [(source_id, "0")]
                 and prop(p, "Representation")[0]):
-            return p
-    return None
-
-
-def bar_for(repr_proxy):
-    lut = prop(repr_proxy, "LookupTable")[1]
-    for p in proxies.values():
-        if p.get("type") == "ScalarBarWidgetRepresentation" and prop(p, "LookupTable")[1] == lut:
             return p
     return None
 
@@ -94,7 +62,7 @@ if len(terrain) == 1 and len(rain) == 1:
     expected = {terrain[0]: ("elevation", "elevation (m), heights \u00d72", "0"),
                 rain[0]: ("water_depth_display", "water depth (m), heights \u00d72", "1")}
 for source, (array, title, visible) in expected.items():
-    below = [s for s in surfaces if prop(proxies[s], "Input")[1] == [source]]
+    below = [s for s in surfaces if prop(proxies[s], "Input")[1] == [(source, "0")]]
     flat = render_repr(source)
     print("%s: surfaces below %s, flat image visible %s" % (
         names[source], [names[s] for s in below], flat is not None and prop(flat, "Visibility")[0]))

@@ -17,14 +17,15 @@ import subprocess
 import sys
 import time
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from gr_gui import APPLY, PANEL, paraview, write_events  # noqa: E402
+
 scratch = sys.argv[sys.argv.index("--scratch") + 1]
 plugin_dir = sys.argv[sys.argv.index("--plugin-dir") + 1]
 script = os.path.join(scratch, "gui_docks.xml")
 log = os.path.join(scratch, "gui_docks.log")
 
-apply_button = "pqClientMainWindow/propertiesDock/propertiesPanel/Accept"
-panel = ("pqClientMainWindow/propertiesDock/propertiesPanel/scrollArea/qt_scrollarea_viewport/"
-         "scrollAreaWidgetContents/PropertiesFrame/ProxyPanel/")
+apply_button, panel = APPLY, PANEL
 # A grid large enough that the surface's representation takes several
 # tenths of a second on any machine: progress is reported during it (the
 # condition the crash needed; at 512 x 512 only on a loaded machine).
@@ -35,11 +36,7 @@ events = [
     (apply_button, "activate", ""),
     ("pqClientMainWindow", "process_events", "1000"),
 ]
-with open(script, "w") as f:
-    f.write('<?xml version="1.0" ?>\n<pqevents>\n')
-    for obj, command, arguments in events:
-        f.write('  <pqevent object="%s" command="%s" arguments="%s"/>\n' % (obj, command, arguments))
-    f.write("</pqevents>\n")
+write_events(script, events)
 
 
 def xdotool(*args):
@@ -65,10 +62,8 @@ def view_left(line):
     return None
 
 
-env = dict(os.environ, PV_PLUGIN_PATH=plugin_dir)
 with open(log, "w") as out:
-    proc = subprocess.Popen(["paraview", "--dr", "--test-script=" + script], env=env,
-                            stdout=out, stderr=subprocess.STDOUT)
+    proc = paraview(script, plugin_dir, exit=False, stdout=out, stderr=subprocess.STDOUT)
 checks = []
 try:
     deadline = time.time() + 180

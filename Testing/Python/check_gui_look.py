@@ -30,7 +30,9 @@ Then checks the saved state:
 import os
 import subprocess
 import sys
-import xml.etree.ElementTree as ET
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from gr_gui import APPLY, PANEL, State, paraview, write_events  # noqa: E402
 
 scratch = sys.argv[sys.argv.index("--scratch") + 1]
 plugin_dir = sys.argv[sys.argv.index("--plugin-dir") + 1]
@@ -48,9 +50,7 @@ with open(chart_script, "w") as f:
             "Show(OutputPort(rain, 1), chart)\n"
             "Render(chart)\n")
 
-apply_button = "pqClientMainWindow/propertiesDock/propertiesPanel/Accept"
-panel = ("pqClientMainWindow/propertiesDock/propertiesPanel/scrollArea/qt_scrollarea_viewport/"
-         "scrollAreaWidgetContents/PropertiesFrame/ProxyPanel/")
+apply_button, panel = APPLY, PANEL
 browser = "pqClientMainWindow/pipelineBrowserDock/pipelineBrowser"
 change = "pqClientMainWindow/ChangeInputDialog/pipelineView"
 events = [
@@ -97,37 +97,16 @@ events = [
     ("pqClientMainWindow/menubar/menu_File", "activate", "actionFileSaveServerState"),
     ("pqClientMainWindow/FileSaveServerStateDialog", "filesSelected", state),
 ]
-with open(script, "w") as f:
-    f.write('<?xml version="1.0" ?>\n<pqevents>\n')
-    for obj, command, arguments in events:
-        f.write('  <pqevent object="%s" command="%s" arguments="%s"/>\n' % (obj, command, arguments))
-    f.write("</pqevents>\n")
-
-env = dict(os.environ, PV_PLUGIN_PATH=plugin_dir)
-proc = subprocess.run(["paraview", "--dr", "--test-script=" + script, "--exit"], env=env,
-                      timeout=240, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+write_events(script, events)
+proc = paraview(script, plugin_dir, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
 print(proc.stdout[-4000:])
 print("paraview exit code %d" % proc.returncode)
 if not os.path.exists(state):
     print("no state saved: the GUI script did not get through")
     sys.exit(1)
 
-root = ET.parse(state).getroot().find("ServerManagerState")
-names = {i.get("id"): i.get("name") for c in root.findall("ProxyCollection")
-         if c.get("name") == "sources" for i in c.findall("Item")}
-proxies = {p.get("id"): p for p in root.findall("Proxy")}
-
-
-def prop(proxy, name):
-    for q in proxy.findall("Property"):
-        if q.get("name") == name:
-            return ([e.get("value") for e in q.findall("Element")],
-                    [(d.get("value"), d.get("output_port")) for d in q.findall("Proxy")])
-    return [], []
-
-
-def by_type(xml_name):
-    return [i for i, p in proxies.items() if p.get("type") == xml_name and i in names]
+S = State(state)
+names, proxies, prop, by_type, bar_for = S.names, S.proxies, S.prop, S.by_type, S.bar_for
 
 
 def reprs(source_id, port="0"):
@@ -176,14 +155,6 @@ rain_surface = [s for s, src in below.items() if src == rain]
 check(len(snow_surface) == 1 and
       prop(proxies[snow_surface[0]], "VerticalExaggeration")[0] == ["1"],
       "the snow's surface drawn without exaggeration")
-
-
-def bar_for(repr_proxy):
-    lut = prop(repr_proxy, "LookupTable")[1]
-    for p in proxies.values():
-        if p.get("type") == "ScalarBarWidgetRepresentation" and prop(p, "LookupTable")[1] == lut:
-            return p
-    return None
 
 
 # 8: Rain Runoff refused first, then the look on the first update that worked.
