@@ -106,6 +106,16 @@ def _legend(sb, title, fmt, x=0.30, length=0.40):
     sb.Position = [x, 0.03]
     sb.ScalarBarLength = length
     sb.RangeLabelFormat = sb.LabelFormat = fmt
+    # White letters on a dark band: the legend lies over white snow.
+    sb.DrawBackground = 1
+    sb.BackgroundColor = [0.12, 0.13, 0.17, 0.65]
+
+
+def _readable(text):
+    """White text on a dark, half-clear band, readable over snow."""
+    text.ShowBorder = "Always"
+    text.BackgroundColor = [0.12, 0.13, 0.17, 0.65]
+    text.BorderThickness = 0
 
 
 def _note(view, exaggeration):
@@ -115,6 +125,7 @@ def _note(view, exaggeration):
     text.WindowLocation = "Upper Right Corner"
     text.FontSize = 14
     text.Color = [1.0, 1.0, 1.0]
+    _readable(text)
 
 
 def show(snow, time, size=(1024, 768), bar=True, label=True, close=False):
@@ -156,6 +167,7 @@ def show(snow, time, size=(1024, 768), bar=True, label=True, close=False):
         text.Justification = "Left"
         text.FontSize = 15
         text.Color = [1.0, 1.0, 1.0]
+        _readable(text)
     wheel = Show(OutputPort(snow, 1), view)
     wheel.Representation = "Surface"
     wheel.ColorArrayName = ["POINTS", ""]
@@ -498,6 +510,7 @@ def show_accumulation(acc, end, snow=None, crossing=None, size=(1024, 768), bar=
         key.WindowLocation = "Lower Left Corner"
         key.FontSize = 14
         key.Color = [1.0, 0.84, 0.66]
+        _readable(key)
     _note(view, 1.0)
     if label:
         words = ("Snow Accumulation: %g h of %g cm/h snow, driven by a west wind %g\u00b0 off "
@@ -508,6 +521,7 @@ def show_accumulation(acc, end, snow=None, crossing=None, size=(1024, 768), bar=
         text.WindowLocation = "Upper Left Corner"
         text.FontSize = 16
         text.Color = [1.0, 1.0, 1.0]
+        _readable(text)
 
     # The objects as they stand at the end of the snowfall, whatever the
     # view's time (the sledge's seconds are no time for the snowfall).
