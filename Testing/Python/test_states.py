@@ -12,7 +12,12 @@ import sys
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import gr_check as T  # noqa: E402
 
-a = T.args(lambda p: p.add_argument("--states", required=True))
+def extra(p):
+    p.add_argument("--states", required=True)
+    p.add_argument("--built-states", default=None)
+
+
+a = T.args(extra)
 
 import numpy as np  # noqa: E402
 from paraview import servermanager  # noqa: E402
@@ -92,4 +97,25 @@ for name in found:
     print("%s: %d sources at t = %g s, %.0f%% of the picture drawn" % (
         name, len(sources), t, 100 * drawn))
     T.check(drawn > 0.2, "%s: the view draws the scene (%.2f of the pixels)" % (name, drawn))
+
+# The build tree's copies (Plugin/CMakeLists.txt) load with the dialog's
+# defaults (Use File Names From State), from any folder: every reader finds
+# its file and reads it.
+if a.built_states:
+    built = sorted(os.path.basename(p)[:-5]
+                   for p in glob.glob(os.path.join(a.built_states, "*.pvsm")))
+    T.check(built == expected, "the built states are %s (found %s)" % (expected, built))
+    for name in built:
+        pvs.ResetSession()
+        pvs.LoadState(os.path.join(a.built_states, name + ".pvsm"))
+        readers = [(label, proxy) for (label, _), proxy in pvs.GetSources().items()
+                   if file_names(proxy)]
+        bad = []
+        for label, proxy in readers:
+            proxy.UpdatePipeline()
+            if (not all(os.path.isfile(f) for f in file_names(proxy))
+                    or proxy.GetDataInformation().GetNumberOfPoints() == 0):
+                bad.append(label)
+        T.check(not bad, "%s, loaded with the defaults: %d readers, all read (not: %s)"
+                % (name, len(readers), bad))
 T.finish()
