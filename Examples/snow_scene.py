@@ -447,10 +447,10 @@ def build_accumulation(cells=288, spacing=0.05, time_step=300.0, resolution=768,
     length = float(np.sum(np.hypot(np.hypot(np.diff(x), np.diff(y)), np.diff(z))))
 
     crossing = round(0.95 * length / SLEDGE_SPEED, 2)
-    # The snow as it lies at the end of the snowfall, whatever time the
-    # sledge's own seconds ask it for (a state loaded at the crossing's time).
-    fallen = pvs.ForceTime(Input=acc, IgnorePipelineTime=1, ForcedTime=end)
-    snow = _constructor("SnowDeformation")(Input=fallen, Objects=_producer(_sledge()), Path=path)
+    # The sledge starts from the snow as it lies at the end of the snowfall
+    # (a simulation reads another's output at its end: InputTime), whatever
+    # time its own seconds ask for.
+    snow = _constructor("SnowDeformation")(Input=acc, Objects=_producer(_sledge()), Path=path)
     snow.TimeStep = sledge_step
     snow.EndTime = crossing
     snow.OutputInterval = crossing

@@ -284,8 +284,12 @@ int vtkGraupelSimulation::AdvertiseTimes(vtkInformationVector **inputVector,
   this->DeliveredTime.resize(static_cast<size_t>(nports), 0.0);
   this->PendingTime.resize(static_cast<size_t>(nports), 0.0);
   for (int port = 0; port < nports; ++port) {
-    const bool temporal = static_cast<size_t>(port) < this->Policies.size() &&
-                          this->Policies[static_cast<size_t>(port)] == TEMPORAL_INPUT;
+    // The Input follows the simulated time only when asked (FollowInputTime);
+    // other ports by their policy (objects in motion, inflows in time).
+    const bool temporal = port == 0
+                              ? this->FollowInputTime != 0
+                              : static_cast<size_t>(port) < this->Policies.size() &&
+                                    this->Policies[static_cast<size_t>(port)] == TEMPORAL_INPUT;
     vtkInformation *inInfo = inputVector[port]->GetInformationObject(0);
     if (!temporal || !inInfo || !inInfo->Has(vtkStreamingDemandDrivenPipeline::TIME_STEPS())) {
       continue;
@@ -392,14 +396,33 @@ int vtkGraupelSimulation::RequestUpdateExtent(vtkInformation *, vtkInformationVe
         const double t = this->PendingTime[static_cast<size_t>(port)];
         inInfo->Set(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP(), t);
         this->DeliveredTime[static_cast<size_t>(port)] = t;
+      } else if (inInfo->Has(vtkStreamingDemandDrivenPipeline::TIME_STEPS()) ||
+                 inInfo->Has(vtkStreamingDemandDrivenPipeline::TIME_RANGE())) {
+        // A static input with times of its own (another simulation's
+        // output) at InputTime, by default its end: a time request for this
+        // simulation is not one for its input, and no earlier request
+        // decides what it starts from.
+        inInfo->Set(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP(),
+                    this->StaticInputTime(inInfo));
       } else {
-        // A static input at its first time: a time request for the
-        // simulation is not one for the terrain.
         inInfo->Remove(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP());
       }
     }
   }
   return 1;
+}
+
+double vtkGraupelSimulation::StaticInputTime(vtkInformation *inInfo) const {
+  if (this->InputTime >= 0.0) {
+    return this->InputTime;
+  }
+  if (inInfo->Has(vtkStreamingDemandDrivenPipeline::TIME_STEPS())) {
+    const int n = inInfo->Length(vtkStreamingDemandDrivenPipeline::TIME_STEPS());
+    if (n > 0) {
+      return inInfo->Get(vtkStreamingDemandDrivenPipeline::TIME_STEPS())[n - 1];
+    }
+  }
+  return inInfo->Get(vtkStreamingDemandDrivenPipeline::TIME_RANGE())[1];
 }
 
 vtkGraupelSimulation::Key vtkGraupelSimulation::CurrentKey() {

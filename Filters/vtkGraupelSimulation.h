@@ -17,8 +17,10 @@
  * static input sets the simulation up again.
  *
  * **Inputs in time.** Each input port has a policy (SetInputPortPolicy):
- * - STATIC: read once, at its first time (a terrain). A change of its data
- *   sets the simulation up again.
+ * - STATIC: read once (a terrain). An input with times of its own (another
+ *   simulation's output) is read at InputTime, by default its last time;
+ *   one without at no time. A change of its data sets the simulation up
+ *   again. The Input (port 0) is static unless FollowInputTime is on.
  * - TEMPORAL: read at the simulated time while stepping (a moving object,
  *   rain that varies). Its data at input time step tau_i holds from tau_i
  *   until the next input time step (sample and hold; before the first step
@@ -181,6 +183,32 @@ public:
 
   ///@{
   /**
+   * The time at which a static input that has times of its own (another
+   * simulation's output: the snow of a Snow Accumulation, the water of a
+   * Rain Runoff) is read, seconds of that input's time; negative (the
+   * default, -1): its last time, the upstream's EndTime. Whatever time this
+   * simulation is asked for and whatever was updated before: two
+   * simulations on their own time axes (hours of snowfall, seconds of a
+   * vehicle) chain end to start.
+   */
+  vtkSetMacro(InputTime, double);
+  vtkGetMacro(InputTime, double);
+  ///@}
+
+  ///@{
+  /**
+   * 1: the Input (port 0) follows the simulated time instead: read at each
+   * of its time steps while stepping (sample and hold; Water Surface's
+   * ripples on Rain Runoff's changing water). 0 (default): read once, at
+   * InputTime.
+   */
+  vtkSetClampMacro(FollowInputTime, int, 0, 1);
+  vtkGetMacro(FollowInputTime, int);
+  vtkBooleanMacro(FollowInputTime, int);
+  ///@}
+
+  ///@{
+  /**
    * The EndTime and OutputInterval a new object of this class starts with,
    * seconds: a simulation whose time scale differs sets its own in its
    * constructor (SetTimeDefaults). ParaView's EndTime and OutputInterval
@@ -288,6 +316,9 @@ protected:
 
   /** Results of AdvanceState. */
   enum AdvanceResult { ADVANCE_FAILED = 0, ADVANCE_DONE = 1, ADVANCE_ABORTED = 2 };
+
+  /** The time a static input with times of its own is read at (InputTime, else its last). */
+  double StaticInputTime(vtkInformation *inInfo) const;
 
   /** Sets a port's policy (STATIC_INPUT by default); call in the constructor. */
   void SetInputPortPolicy(int port, int policy);
@@ -420,6 +451,8 @@ public:
 protected:
   double EndTime = 600.0;
   double OutputInterval = 10.0;
+  double InputTime = -1.0;
+  int FollowInputTime = 0;
   int CheckpointInterval = 10;
   double CheckpointMemoryLimit = 1024.0;
 

@@ -46,8 +46,8 @@ int Ring(double dropRadius, double dy) {
 } // namespace
 
 vtkWaterSurfaceFilter::vtkWaterSurfaceFilter() {
-  // Rain Runoff's water changes in time: read it at the simulated time.
-  this->SetInputPortPolicy(0, TEMPORAL_INPUT);
+  // Rain Runoff's water is read at its end (InputTime); FollowInputTime
+  // makes the ripples follow it in time.
   // Ripples live for seconds: a minute in half-second frames.
   this->SetTimeDefaults(60.0, 0.5);
   // The core runs as pieces of a split domain (an MPI run's strips); its

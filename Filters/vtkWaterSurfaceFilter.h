@@ -7,10 +7,10 @@
  * (m) and, optionally, `water_depth` (m): Rain Runoff's output, or a
  * terrain. The water is where water_depth exceeds WetDepth, or, with
  * UseLakeLevel on, where the elevation lies below LakeLevel (a lake replaces
- * any water_depth). An input with neither is refused with one sentence. The
- * input is read in time: connected to Rain Runoff (a time source), the
- * water follows its depth at each of its time steps (sample and hold, see
- * vtkGraupelSimulation); a terrain without time is read once.
+ * any water_depth). An input with neither is refused with one sentence.
+ * Connected to Rain Runoff (a time source), the water is Rain Runoff's at
+ * its end (InputTime, see vtkGraupelSimulation); with FollowInputTime on it
+ * follows the depth at each of Rain Runoff's time steps (sample and hold).
  *
  * The output has the input's geometry and the point arrays `wave_height`
  * (m above the still water, 0 on dry points; active scalars),

@@ -158,6 +158,7 @@ ws.SetEndTime(120.0)
 ws.SetOutputInterval(30.0)
 ws.SetWetDepth(0.003)
 ws.SetDropRate(0.2)
+ws.SetFollowInputTime(1)
 errors = T.ErrorCatcher(ws)
 wet_counts = []
 for t in (30.0, 60.0, 120.0):
