@@ -107,7 +107,7 @@ public:
   enum FlowModels { SHALLOW_WATER = 0, LOCAL_INERTIAL = 1 };
 
   ///@{
-  /** Rain intensity, mm/h (default 10). */
+  /** Rain intensity, mm/h (default 100: a cloudburst that shows on real terrain in 600 s). */
   virtual void SetRainRate(double value);
   vtkGetMacro(RainRate, double);
   ///@}
@@ -257,7 +257,7 @@ protected:
   int LoadState(const std::vector<unsigned char> &bytes) override;
   const char *GetSimulationLabel() override { return "Rain Runoff"; }
 
-  double RainRate = 10.0;
+  double RainRate = 100.0;
   double Permeability = 0.0;
   double ManningN = 0.03;
   int BoundaryWest = OPEN;

@@ -1059,7 +1059,7 @@ static void test_errors(void) {
   gr_rain_runoff_params p;
   gr_rain_runoff_params_init(&p);
   CHECK(gr_rain_runoff_params_validate(&p, msg, sizeof(msg)) == GR_OK);
-  CHECK_NEAR(p.rain_rate, 10.0 / 3.6e6, 1e-15);
+  CHECK_NEAR(p.rain_rate, 100.0 / 3.6e6, 1e-15);
   CHECK(p.permeability == 0.0 && p.manning_n == 0.03 && p.cfl == 0.7 && p.max_dt == 3600.0 &&
         p.boundary[0] == GR_BOUNDARY_OPEN && p.boundary[3] == GR_BOUNDARY_OPEN &&
         p.boundary_level[2] == 0.0 && p.flow_model == GR_FLOW_SHALLOW_WATER);
@@ -1420,7 +1420,7 @@ static void test_param_table(void) {
   gr_rain_runoff_params p, q;
   gr_rain_runoff_params_init(&p);
   /* The defaults are the table's. */
-  CHECK(p.rain_rate == t[0].default_value * t[0].to_core && t[0].default_value == 10.0);
+  CHECK(p.rain_rate == t[0].default_value * t[0].to_core && t[0].default_value == 100.0);
   CHECK(p.permeability == t[1].default_value * t[1].to_core && p.manning_n == t[2].default_value);
   CHECK(p.max_dt == t[3].default_value && p.cfl == t[4].default_value &&
         (double)p.flow_model == t[13].default_value);
@@ -1848,6 +1848,7 @@ static void test_maps_reset(void) {
     d0[c] = (c % (size_t)g.nx) < 5 ? 0.6f : 0.0f;
   gr_rain_runoff_params p;
   gr_rain_runoff_params_init(&p);
+  p.rain_rate = 10.0 / 3.6e6; /* 10 mm/h, this test's rain (the default's before 100) */
   gr_rain_runoff *a = make_sim(&g, &p, NULL, d0), *b = make_sim(&g, &p, NULL, d0);
   if (!a || !b) {
     gr_rain_runoff_destroy(a);

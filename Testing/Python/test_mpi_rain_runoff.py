@@ -95,6 +95,7 @@ def reference(model, level):
     f.SetInputDataObject(2, gauges())
     f.SetInputDataObject(3, inflows())
     f.SetFlowModel(model)
+    f.SetRainRate(10.0)
     f.SetBoundaryWest(1)
     f.SetBoundaryNorth(3)
     f.SetLevelNorth(level)
@@ -209,7 +210,7 @@ gauge_points = ProgrammableSource(OutputDataSetType="vtkPolyData", Script=GAUGES
 
 for model, label in ((0, "shallow water"), (1, "local inertial")):
     rain = RainRunoff(Input=deco, PermeabilityMap=deco, Gauges=gauge_points, Inflows=flows,
-                      FlowModel=model, BoundaryWest="Closed", BoundaryNorth="Level",
+                      FlowModel=model, RainRate=10.0, BoundaryWest="Closed", BoundaryNorth="Level",
                       LevelNorth=LEVEL, EndTime=END, OutputInterval=EVERY)
     pid = ProcessIdScalars(Input=rain)
     cmp = ProgrammableFilter(Input=[pid, OutputPort(rain, 1)])

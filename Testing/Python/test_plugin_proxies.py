@@ -123,9 +123,10 @@ T.check(max(abs(x - y) for x, y in zip(b, (0.0, 402 * 74.5, 0.0, 343 * 92.1, 0.0
 
 # Rain Runoff on the DEM: a time source whose times the animation scene sees.
 rr = RainRunoff(Input=dem)
-T.check(rr.RainRate == 10.0 and rr.Permeability == 0.0 and rr.ManningN == 0.03
-        and rr.BoundaryWest == "Open" and rr.BoundaryNorth == "Open" and rr.LevelEast == 0.0,
-        "Rain Runoff defaults")
+T.check(rr.RainRate == 100.0 and rr.Permeability == 0.0 and rr.ManningN == 0.03
+        and rr.BoundaryWest == "Open" and rr.BoundaryNorth == "Open" and rr.LevelEast == 0.0
+        and rr.EndTime == 600.0 and rr.OutputInterval == 10.0, "Rain Runoff defaults")
+rr.RainRate = 10.0  # the rain the volume below is written for
 rr.EndTime = 40.0
 rr.OutputInterval = 20.0
 rr.UpdatePipelineInformation()

@@ -64,6 +64,9 @@ def rain(terrain, **kw):
     f.SetInputConnection(producer(image({"elevation": terrain})).GetOutputPort())
     f.SetEndTime(kw.pop("EndTime", 60.0))
     f.SetOutputInterval(kw.pop("OutputInterval", 10.0))
+    # 10 mm/h unless a test says otherwise: the rain these tests were written
+    # with (the default before it became 100), not whatever the default is.
+    f.SetRainRate(kw.pop("RainRate", 10.0))
     for k, v in kw.items():
         getattr(f, "Set" + k)(v)
     return f
@@ -85,8 +88,8 @@ def field(out, name):
 
 # ---- defaults and advertised times ---------------------------------------------
 f = vtkRainRunoffFilter()
-T.check(f.GetRainRate() == 10.0 and f.GetPermeability() == 0.0 and f.GetManningN() == 0.03,
-        "defaults RainRate 10 mm/h, Permeability 0, ManningN 0.03")
+T.check(f.GetRainRate() == 100.0 and f.GetPermeability() == 0.0 and f.GetManningN() == 0.03,
+        "defaults RainRate 100 mm/h, Permeability 0, ManningN 0.03")
 T.check(f.GetBoundary() == 0 and f.GetEndTime() == 600.0 and f.GetOutputInterval() == 10.0,
         "defaults Boundary open, EndTime 600 s, OutputInterval 10 s")
 T.check(f.GetFlowModel() == 0, "default FlowModel 0 (shallow water)")
@@ -313,6 +316,7 @@ def started(arrays, **kw):
     g = vtkRainRunoffFilter()
     g.SetInputConnection(producer(image(arrays)).GetOutputPort())
     g.SetEndTime(20.0)
+    g.SetRainRate(kw.pop("RainRate", 10.0))  # as rain(): 10 mm/h unless said
     for k, v in kw.items():
         getattr(g, "Set" + k)(v)
     return g
@@ -813,6 +817,7 @@ tall = image({"elevation": 300.0 * i / (NX - 1.0)}, spacing=1.0)
 g = vtkRainRunoffFilter()
 g.SetInputConnection(producer(tall).GetOutputPort())
 g.SetEndTime(20.0)
+g.SetRainRate(10.0)
 warns = T.ErrorCatcher(g, event="WarningEvent")
 at(g, 10.0)
 g.SetRainRate(20.0)  # set up again on the same terrain: no second warning

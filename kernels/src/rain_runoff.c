@@ -88,7 +88,7 @@ enum {
 /* The one place each range is written: the validator, the field checks, the
  * filter's clamps, the XML domains and the README follow it. */
 static const gr_param_bound gr_rain_runoff_bounds[GR_RAIN_RUNOFF_P_COUNT] = {
-    {"RainRate", "mm/h", 0.0, 3600.0, 10.0, 1.0 / 3.6e6, 0, 0},
+    {"RainRate", "mm/h", 0.0, 3600.0, 100.0, 1.0 / 3.6e6, 0, 0},
     {"Permeability", "mm/h", 0.0, 36000.0, 0.0, 1.0 / 3.6e6, 0, 0},
     {"ManningN", "s/m^(1/3)", 0.0, 1.0, 0.03, 1.0, 0, 0},
     {"MaxTimeStep", "s", 0.0, 3600.0, 3600.0, 1.0, 1, 0},
