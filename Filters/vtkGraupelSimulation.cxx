@@ -198,6 +198,22 @@ double vtkGraupelSimulation::GetOutputTime(int k) const {
   return std::min(k * this->OutputInterval, this->EndTime);
 }
 
+bool vtkGraupelSimulation::IsOutputTime(double t) const {
+  const int n = this->GetNumberOfOutputTimes();
+  if (n <= 0 || !(this->OutputInterval > 0.0)) {
+    return false;
+  }
+  const double slack = 1e-9 * std::max(1.0, std::fabs(t));
+  const int k = static_cast<int>(
+      std::max(0.0, std::min(n - 1.0, std::floor(t / this->OutputInterval + 0.5))));
+  for (int i = std::max(0, k - 1); i <= std::min(n - 1, k + 1); ++i) {
+    if (std::fabs(this->GetOutputTime(i) - t) <= slack) {
+      return true;
+    }
+  }
+  return false;
+}
+
 int vtkGraupelSimulation::CheckTimes() {
   if (!(this->OutputInterval > 0.0) || !std::isfinite(this->OutputInterval)) {
     vtkErrorMacro(<< this->GetClassName() << ": OutputInterval must be above 0 s; it is "

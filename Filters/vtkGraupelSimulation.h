@@ -272,6 +272,8 @@ public:
   int GetNumberOfOutputTimes() const;
   /** Output time k (0 <= k < GetNumberOfOutputTimes()), seconds. */
   double GetOutputTime(int k) const;
+  /** Whether t (s) is one of the output times (an AdvanceState's t0 or t1 may be). */
+  bool IsOutputTime(double t) const;
 
   /** Output index at or before the state kept on the device; -1 when there is none. */
   vtkGetMacro(StateIndex, int);

@@ -60,12 +60,13 @@ double TableDefault(const char *property, double fallback) {
   return b ? b->default_value : fallback;
 }
 
-void AddForce(vtkFieldData *fd, const double force[3], double area) {
+void AddForce(vtkFieldData *fd, const double force[3], double peak, double area) {
   vtkNew<vtkDoubleArray> f;
   f->SetName("force");
   f->SetNumberOfComponents(3);
   f->InsertNextTuple(force);
   fd->AddArray(f);
+  AddValue(fd, "peak_force", peak);
   AddValue(fd, "contact_area", area);
 }
 
@@ -424,6 +425,11 @@ int vtkSnowDeformationFilter::AdvanceState(double t0, double t1) {
   // until it is set again; an abort consumed since must not stop this call.
   gr_snow_deformation_set_progress(this->Simulation, &vtkGraupelSimulation::ThrottledProgress,
                                    this);
+  // An output interval starts: the mean force reported at the next output
+  // is over it alone.
+  if (this->IsOutputTime(t0)) {
+    gr_snow_deformation_clear_impulses(this->Simulation);
+  }
   // Steps of TimeStep from t0, the last one ending on t1.
   const double dt = this->TimeStep;
   const long long n = CountSteps(t0, t1, dt);
@@ -468,20 +474,27 @@ int vtkSnowDeformationFilter::FillObjectOutput(int, vtkDataObject *output, doubl
     return 1;
   }
   const size_t n = this->Objects.size();
-  std::vector<double> force(3 * n + 3, 0.0), area(n + 1, 0.0);
+  // The force is the mean over the output interval that ends here (the
+  // impulse since the last output over its time: AdvanceState clears it at
+  // each output), not the last step's, which aliases with the step.
+  std::vector<double> force(3 * n + 3, 0.0), peak(n + 1, 0.0), area(n + 1, 0.0);
   if (n > 0) {
-    const gr_status st = gr_snow_deformation_object_forces(this->Simulation, force.data(),
-                                                           area.data(), static_cast<int>(n));
+    gr_status st = gr_snow_deformation_object_mean_forces(
+        this->Simulation, force.data(), peak.data(), nullptr, static_cast<int>(n));
+    if (st == GR_OK) {
+      st = gr_snow_deformation_object_forces(this->Simulation, nullptr, area.data(),
+                                             static_cast<int>(n));
+    }
     if (st != GR_OK) {
       return this->ReportFailure(st, "Snow Deformation could not read the objects' forces",
                                  gr_snow_deformation_last_error(this->Simulation));
     }
   }
-  auto posed = [this, t, &force, &area](size_t k, vtkPolyData *leaf) {
+  auto posed = [this, t, &force, &peak, &area](size_t k, vtkPolyData *leaf) {
     double matrix[16];
     this->Pose(k, t, matrix);
     vtkSmartPointer<vtkPolyData> one = Posed(leaf, this->Objects[k].centre, matrix);
-    AddForce(one->GetFieldData(), &force[3 * k], area[k]);
+    AddForce(one->GetFieldData(), &force[3 * k], peak[k], area[k]);
     return one;
   };
   vtkMultiBlockDataSet *blocks = nullptr;
@@ -490,14 +503,15 @@ int vtkSnowDeformationFilter::FillObjectOutput(int, vtkDataObject *output, doubl
   }
   if (blocks) {
     // The whole: every object's force and contact area summed.
-    double total[3] = {0.0, 0.0, 0.0}, totalArea = 0.0;
+    double total[3] = {0.0, 0.0, 0.0}, totalArea = 0.0, totalPeak = 0.0;
     for (size_t k = 0; k < n; ++k) {
       for (int c = 0; c < 3; ++c) {
         total[c] += force[3 * k + c];
       }
       totalArea += area[k];
+      totalPeak = std::max(totalPeak, peak[k]);
     }
-    AddForce(blocks->GetFieldData(), total, totalArea);
+    AddForce(blocks->GetFieldData(), total, totalPeak, totalArea);
   }
   return 1;
 }

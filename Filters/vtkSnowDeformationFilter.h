@@ -40,8 +40,11 @@
  * `volume_error` (m^3) and `relax_iterations`. Output 1 is the objects at
  * their pose at the output time (vtkPolyData, or a multiblock of the same
  * structure as the input), each with field data `force` (3 components, N:
- * the snow's resistance in the last step) and `contact_area` (m^2); a
- * multiblock's own field data holds their sums.
+ * the snow's resistance, the mean over the output interval that ends at
+ * the output: the impulse of its steps over its time, which does not alias
+ * with the step as one step's force does), `peak_force` (N, the largest
+ * step force's magnitude in that interval) and `contact_area` (m^2); a
+ * multiblock's own field data holds the sums (the largest peak).
  *
  * The snow type: DensityRange (rho min, rho max) and InitialDensity, or a
  * DensityPreset (the thesis' Table 3.1 snow types, and sand), which then

@@ -22,8 +22,8 @@
 /* Checkpoints: "GSD1". */
 #define GR_SNOW_STATE_MAGIC 0x31445347u
 #define GR_SNOW_STATE_VERSION                                                                      \
-  4u /* 4: the piece's i0, j0, the ledger's start in fixed                                         \
-         point, the relaxation's rest box */
+  5u /* 5: the impulses since the last output; 4: the piece's i0,                                  \
+         j0, the ledger's start in fixed point, the relaxation's rest box */
 /* Per-point arrays of a checkpoint: depth, density, overlap sum, contact. */
 #define GR_SNOW_STATE_ARRAYS 4
 /* Per point of a halo strip: depth and density. */
@@ -102,6 +102,10 @@ struct gr_snow_deformation {
   gr_mesh_memo memo[GR_SNOW_DEFORMATION_MAX_OBJECTS]; /* each object's mesh as last checked */
   int nobjects;
   double force[GR_SNOW_DEFORMATION_MAX_OBJECTS][3], area[GR_SNOW_DEFORMATION_MAX_OBJECTS];
+  /* Since the last clear_impulses: each object's impulse (N s), its largest
+   * step force (N) and the time the steps took (s). */
+  double impulse[GR_SNOW_DEFORMATION_MAX_OBJECTS][3], peak[GR_SNOW_DEFORMATION_MAX_OBJECTS];
+  double impulse_time;
   double time, compressed, displaced;
   /* The snow at the start over the piece's own points: quanta, and
    * 2^-24 kg/m^2 (snow_ledger_reduce's fixed point). */
@@ -355,6 +359,7 @@ static gr_status gr_snow_initial_state(gr_snow_deformation *s) {
   s->aborted = 0;
   memset(s->force, 0, sizeof(s->force));
   memset(s->area, 0, sizeof(s->area));
+  gr_snow_deformation_clear_impulses(s);
   if (st == GR_OK)
     st = gr_snow_ledger_sums(s, &s->initial_q, &s->initial_m);
   return st;
@@ -996,6 +1001,7 @@ static gr_status gr_snow_set_objects_impl(gr_snow_deformation *s, const gr_mesh 
   if (n != s->nobjects) {
     memset(s->force, 0, sizeof(s->force));
     memset(s->area, 0, sizeof(s->area));
+    gr_snow_deformation_clear_impulses(s);
   }
   s->nobjects = n;
   return GR_OK;
@@ -1834,6 +1840,14 @@ gr_status gr_snow_deformation_step(gr_snow_deformation *s, double dt) {
     return GR_SNOW_KEEP_ERROR(s, st);
   s->time += dt;
   s->steps++;
+  /* The impulse: the force of a step acts over the step. */
+  for (int o = 0; o < s->nobjects; ++o) {
+    const double *f = s->force[o];
+    for (int a = 0; a < 3; ++a)
+      s->impulse[o][a] += f[a] * dt;
+    s->peak[o] = fmax(s->peak[o], sqrt(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]));
+  }
+  s->impulse_time += dt;
   int stop = s->progress && s->progress(s->progress_user, s->time) != 0;
   /* Pieces: a stop asked on any piece stops every piece after this step
    * (every piece makes this call at every step, callback or not). */
@@ -1958,6 +1972,38 @@ gr_status gr_snow_deformation_object_forces(gr_snow_deformation *s, double *forc
   return GR_OK;
 }
 
+gr_status gr_snow_deformation_object_mean_forces(gr_snow_deformation *s, double *force3,
+                                                 double *peak, double *seconds, int n) {
+  if (!s)
+    return gr_set_error(NULL, GR_ERR_INVALID_ARGUMENT,
+                        "gr_snow_deformation_object_mean_forces needs a simulation.");
+  if (n != s->nobjects)
+    return GR_SNOW_KEEP_ERROR(
+        s, gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
+                        "gr_snow_deformation_object_mean_forces was asked for %d objects but %d "
+                        "are set; pass the number given to set_objects.",
+                        n, s->nobjects));
+  const double span = s->impulse_time;
+  for (int o = 0; o < n; ++o) {
+    if (force3)
+      for (int a = 0; a < 3; ++a)
+        force3[3 * o + a] = span > 0.0 ? s->impulse[o][a] / span : 0.0;
+    if (peak)
+      peak[o] = s->peak[o];
+  }
+  if (seconds)
+    *seconds = span;
+  return GR_OK;
+}
+
+void gr_snow_deformation_clear_impulses(gr_snow_deformation *s) {
+  if (!s)
+    return;
+  memset(s->impulse, 0, sizeof(s->impulse));
+  memset(s->peak, 0, sizeof(s->peak));
+  s->impulse_time = 0.0;
+}
+
 void gr_snow_deformation_set_progress(gr_snow_deformation *s, gr_progress_fn fn, void *user) {
   if (!s)
     return;
@@ -1975,6 +2021,8 @@ typedef struct gr_snow_state_header {
   int64_t steps, initial_q, initial_m;
   double time, compressed, displaced, pending, pending_mass;
   double force[GR_SNOW_DEFORMATION_MAX_OBJECTS][3], area[GR_SNOW_DEFORMATION_MAX_OBJECTS];
+  double impulse[GR_SNOW_DEFORMATION_MAX_OBJECTS][3], peak[GR_SNOW_DEFORMATION_MAX_OBJECTS];
+  double impulse_time;
 } gr_snow_state_header;
 
 static size_t gr_snow_state_bytes(const gr_snow_deformation *s) {
@@ -2028,6 +2076,9 @@ gr_status gr_snow_deformation_state_save(gr_snow_deformation *s, void *host, siz
   hd.pending = s->pending;
   hd.pending_mass = s->pending_mass;
   memcpy(hd.force, s->force, sizeof(hd.force));
+  memcpy(hd.impulse, s->impulse, sizeof(hd.impulse));
+  memcpy(hd.peak, s->peak, sizeof(hd.peak));
+  hd.impulse_time = s->impulse_time;
   memcpy(hd.area, s->area, sizeof(hd.area));
   memcpy(host, &hd, sizeof(hd));
   size_t ab = gr_snow_cells(s) * sizeof(float);
@@ -2097,6 +2148,9 @@ gr_status gr_snow_deformation_state_load(gr_snow_deformation *s, const void *hos
   s->pending = hd.pending;
   s->pending_mass = hd.pending_mass;
   memcpy(s->force, hd.force, sizeof(hd.force));
+  memcpy(s->impulse, hd.impulse, sizeof(hd.impulse));
+  memcpy(s->peak, hd.peak, sizeof(hd.peak));
+  s->impulse_time = hd.impulse_time;
   memcpy(s->area, hd.area, sizeof(hd.area));
   return GR_OK;
 }

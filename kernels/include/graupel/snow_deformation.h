@@ -283,6 +283,24 @@ GR_API gr_status gr_snow_deformation_object_forces(gr_snow_deformation *s, doubl
                                                    double *area, int n);
 
 /**
+ * The mean resistance since the last gr_snow_deformation_clear_impulses (or
+ * set-up, reset, a new number of objects): each object's impulse, the sum
+ * of its step forces times their steps, over the time those steps took (N,
+ * world: force3 gets 3 doubles per object), the largest step force's
+ * magnitude (N, peak one per object) and that time (s, *seconds); any may
+ * be NULL. Zeros before a step. The force of one step aliases with the
+ * step (a step that moves no snow reports 0, the next one twice the mean):
+ * a caller that clears at each output reports the interval's force,
+ * the same for any step short enough. The impulses are part of the
+ * checkpoint state.
+ */
+GR_API gr_status gr_snow_deformation_object_mean_forces(gr_snow_deformation *s, double *force3,
+                                                        double *peak, double *seconds, int n);
+
+/** Starts the impulses of gr_snow_deformation_object_mean_forces anew. NULL is fine. */
+GR_API void gr_snow_deformation_clear_impulses(gr_snow_deformation *s);
+
+/**
  * Progress (see gr_progress_fn): called after each step with the time
  * reached; a non-zero return makes the next gr_snow_deformation_step
  * refuse with GR_ERR_ABORTED until set_progress or reset is called. NULL
