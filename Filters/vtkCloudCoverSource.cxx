@@ -15,6 +15,7 @@
 #include "graupel/cl_runtime.h"
 #include "graupel/sky.h"
 
+#include "GraupelMemory.h"
 #include "GraupelParameterTable.h"
 
 #include <algorithm>
@@ -97,6 +98,9 @@ int vtkCloudCoverSource::RequestData(vtkInformation *, vtkInformationVector **,
   vtkInformation *outInfo = outputVector->GetInformationObject(0);
   vtkImageData *output = vtkImageData::GetData(outInfo);
   output->Initialize();
+  if (this->AbortRequested("Cloud Cover", false)) {
+    return 1;
+  }
   const double t = outInfo->Has(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP())
                        ? outInfo->Get(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP())
                        : 0.0;
@@ -108,6 +112,15 @@ int vtkCloudCoverSource::RequestData(vtkInformation *, vtkInformationVector **,
   }
   gr_context *ctx = this->GetContext();
   if (!ctx) {
+    return 0;
+  }
+  // The core's buffers and the output's cloud (a float) and sky_rgb (3 bytes).
+  gr_memory_need need;
+  gr_cloud_cover_memory(&p, &need);
+  const double pixels = static_cast<double>(p.resolution) * p.resolution;
+  if (!this->ReportError(graupel::MemoryRefusal(
+          ctx, "Cloud Cover", graupel::GridSubject(p.resolution, p.resolution, "image"),
+          graupel::WithHostArrays(need, pixels, 4.0 + 3.0), "lower Resolution"))) {
     return 0;
   }
   gr_cloud_cover *clouds = nullptr;
@@ -134,6 +147,9 @@ int vtkCloudCoverSource::RequestData(vtkInformation *, vtkInformationVector **,
   rgb->SetNumberOfTuples(npoints);
   // Band by band (about 4 million pixels each): progress and abort between.
   const int band = std::max(1, (1 << 22) / g.nx);
+  const std::string text =
+      "Cloud Cover: " + std::to_string(g.nx) + " x " + std::to_string(g.ny) + " pixels";
+  this->SetProgressText(text.c_str());
   this->UpdateProgress(0.0);
   for (int row = 0; row < g.ny && st == GR_OK; row += band) {
     const int rows = std::min(band, g.ny - row);
@@ -142,11 +158,8 @@ int vtkCloudCoverSource::RequestData(vtkInformation *, vtkInformationVector **,
       st = gr_finish(ctx);
     }
     this->UpdateProgress(static_cast<double>(row + rows) / g.ny);
-    if (st == GR_OK && this->GetAbortExecute()) {
+    if (st == GR_OK && this->AbortRequested("Cloud Cover", true)) {
       gr_cloud_cover_destroy(clouds);
-      vtkWarningMacro("Cloud Cover: the update was aborted; the output is empty.");
-      this->SetAbortExecute(0);
-      this->Modified();
       return 1;
     }
   }

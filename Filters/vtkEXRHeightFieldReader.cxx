@@ -14,6 +14,8 @@
 
 #include "graupel/exr_io.h"
 
+#include "GraupelMemory.h"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -158,6 +160,20 @@ int vtkEXRHeightFieldReader::RequestData(vtkInformation *, vtkInformationVector 
   }
   const gr_exr_image &img = this->Loaded->image;
   const vtkIdType n = static_cast<vtkIdType>(img.width) * img.height;
+  // The reader checked its own planes before decoding; the output's arrays
+  // copy them, a float a channel a point, from what is left.
+  gr_memory_need need = {};
+  need.points = static_cast<double>(n);
+  need.host = need.points * img.nchannels * sizeof(float);
+  const std::string refusal =
+      graupel::MemoryRefusal(nullptr, "EXR Height Field Reader",
+                             graupel::GridSubject(img.width, img.height, "image") + " of " +
+                                 std::to_string(img.nchannels) + " channels",
+                             need, "read a smaller file or free memory");
+  if (!refusal.empty()) {
+    vtkErrorMacro(<< refusal);
+    return 0;
+  }
 
   std::vector<vtkSmartPointer<vtkFloatArray>> arrays;
   std::vector<bool> used(img.nchannels, false);

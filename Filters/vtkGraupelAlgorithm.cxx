@@ -139,6 +139,25 @@ int vtkGraupelAlgorithm::ReportError(const std::string &sentence) {
   return 0;
 }
 
+bool vtkGraupelAlgorithm::AbortRequested(const char *label, bool started) {
+  if (!this->GetAbortExecute()) {
+    return false;
+  }
+  if (started) {
+    vtkWarningMacro(<< label << ": the update was aborted; the output is empty.");
+  }
+#if GRAUPEL_VTK_ABORT_OUTPUT
+  // Consumed, and the output marked aborted: the executive empties it and
+  // the next request computes again.
+  this->AbortExecute = 0;
+  this->SetAbortOutput(true);
+#else
+  this->SetAbortExecute(0);
+  this->Modified();
+#endif
+  return true;
+}
+
 void vtkGraupelAlgorithm::AddDeviceFieldData(vtkDataObject *output) {
   vtkNew<vtkStringArray> device;
   device->SetName("graupel_device");

@@ -36,6 +36,15 @@
 
 #include "GraupelFiltersModule.h"
 #include "vtkAlgorithm.h"
+#include "vtkVersionMacros.h"
+
+// VTK's aborted-output protocol (AbortOutput, vtkAlgorithm::ABORTED) came
+// after 9.2.x: ParaView 5.11's VTK has it, Debian's VTK 9.1 does not.
+#if VTK_VERSION_NUMBER >= VTK_VERSION_CHECK(9, 2, 20220614)
+#define GRAUPEL_VTK_ABORT_OUTPUT 1
+#else
+#define GRAUPEL_VTK_ABORT_OUTPUT 0
+#endif
 
 #include <map>
 #include <string>
@@ -140,6 +149,20 @@ protected:
 
   /** Empties every output and stamps it with its requested time. */
   void EmptyOutputs(vtkInformationVector *outInfo);
+
+  /**
+   * The abort of a source or filter that computes in bands (Procedural
+   * Terrain, Cloud Cover, Terrain Analysis), by vtkGraupelSimulation's
+   * protocol: call it as RequestData starts (started false: an update that
+   * begins with AbortExecute set, as pqGraupelAbortStarter sets it again
+   * while the aborted Render lasts, returns its empty output at once and
+   * silently) and after each band (started true: warns "<label>: the update
+   * was aborted; the output is empty."). When an abort was asked for, it is
+   * consumed, the output is marked aborted (AbortOutput: the executive
+   * empties it and the next request computes again; on VTK 9.1, Modified())
+   * and true is returned: RequestData then returns 1.
+   */
+  bool AbortRequested(const char *label, bool started);
 
   char *Device = nullptr;
 

@@ -16,6 +16,7 @@
 
 #include "graupel/particles.h"
 
+#include "GraupelMemory.h"
 #include "GraupelParameterTable.h"
 
 #include <cmath>
@@ -137,6 +138,20 @@ int vtkGraupelParticlesSource::RequestData(vtkInformation *, vtkInformationVecto
 
   gr_context *ctx = this->GetContext();
   if (!ctx) {
+    return 0;
+  }
+  // The core's outputs (unless a core of this Count holds them already), their
+  // host copies and one vertex cell a particle (offset and connectivity).
+  gr_memory_need need;
+  gr_particles_memory(&p, &need);
+  const double copies = need.device;
+  if (this->Core && this->CoreContext == ctx && gr_particles_count(this->Core) == p.count) {
+    need.device = need.largest = 0.0;
+  }
+  need.host += copies;
+  if (!this->ReportError(graupel::MemoryRefusal(
+          ctx, label, "a set of " + std::to_string(p.count) + " particles",
+          graupel::WithHostArrays(need, p.count, 2.0 * sizeof(vtkIdType)), "lower Count"))) {
     return 0;
   }
   gr_status st = GR_OK;

@@ -25,6 +25,7 @@
 
 #include "graupel/graupel.h"
 
+#include "GraupelMemory.h"
 #include "GraupelParameterTable.h"
 #include "GraupelPieces.h"
 
@@ -589,6 +590,24 @@ int vtkGraupelSimulation::CheckTerrain(vtkImageData *terrain) {
     return 0;
   }
   return 1;
+}
+
+int vtkGraupelSimulation::CheckMemory(const gr_grid &grid, const gr_memory_need &core,
+                                      double hostBytes) {
+  const std::string fix = this->GetPieces().IsSplit()
+                              ? "resample the terrain to fewer points (Resample To Image) or "
+                                "split it over more MPI ranks"
+                              : "resample the terrain to fewer points (Resample To Image) or "
+                                "split it over MPI ranks (mpiexec ... pvbatch)";
+  // A checkpoint is one copy of the state on the host while it is made (the
+  // ones kept are capped by CheckpointMemoryLimit).
+  gr_memory_need need = core;
+  if (this->CheckpointInterval > 0 || (this->CheckpointFile && *this->CheckpointFile)) {
+    need.host += core.state;
+  }
+  return this->ReportError(graupel::MemoryRefusal(
+      this->GetContext(), this->GetSimulationLabel(), graupel::GridSubject(grid.nx, grid.ny),
+      graupel::WithHostArrays(need, static_cast<double>(grid.nx) * grid.ny, hostBytes), fix));
 }
 
 vtkDataArray *vtkGraupelSimulation::GetElevation(vtkImageData *terrain, const char *inputName) {

@@ -135,16 +135,7 @@
 #define vtkGraupelSimulation_h
 
 #include "GraupelFiltersModule.h"
-#include "vtkGraupelAlgorithm.h"
-#include "vtkVersionMacros.h"
-
-// VTK's aborted-output protocol (AbortOutput, vtkAlgorithm::ABORTED) came
-// after 9.2.x: ParaView 5.11's VTK has it, Debian's VTK 9.1 does not.
-#if VTK_VERSION_NUMBER >= VTK_VERSION_CHECK(9, 2, 20220614)
-#define GRAUPEL_VTK_ABORT_OUTPUT 1
-#else
-#define GRAUPEL_VTK_ABORT_OUTPUT 0
-#endif
+#include "vtkGraupelAlgorithm.h" // GRAUPEL_VTK_ABORT_OUTPUT
 
 #include <deque>
 #include <functional>
@@ -158,6 +149,7 @@ class Pieces;
 }
 
 struct gr_grid;
+struct gr_memory_need;
 class GRAUPELFILTERS_EXPORT vtkGraupelSimulation : public vtkGraupelAlgorithm {
 public:
   vtkTypeMacro(vtkGraupelSimulation, vtkGraupelAlgorithm);
@@ -432,6 +424,18 @@ protected:
    * simulation, what it got and the fix). 0 after the error.
    */
   int CheckTerrain(vtkImageData *terrain);
+
+  /**
+   * For SetUpState, before it copies or allocates anything: refuses a
+   * set-up that would not fit in memory with one sentence ("Rain Runoff: a
+   * 20000 x 20000 grid needs 75.2 GB (188 bytes a point) but this process
+   * can use 21.9 GB; ...") and returns 0; else 1. core is the core's need
+   * (gr_<core>_memory) on grid, the piece this rank simulates (PieceGrid of
+   * the terrain's grid); hostBytes is what the filter adds a point of that
+   * piece: its output's fields, the uploads' float copies. A checkpoint's
+   * copy of the state (core.state) is added when checkpoints are made.
+   */
+  int CheckMemory(const gr_grid &grid, const gr_memory_need &core, double hostBytes);
 
   /** Forgets the state, so the next update sets it up again. */
   void InvalidateState();

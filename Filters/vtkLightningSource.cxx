@@ -19,10 +19,12 @@
 
 #include "graupel/sky.h"
 
+#include "GraupelMemory.h"
 #include "GraupelParameterTable.h"
 
 #include <algorithm>
 #include <cmath>
+#include <string>
 #include <vector>
 
 vtkStandardNewMacro(vtkLightningSource);
@@ -138,6 +140,16 @@ int vtkLightningSource::RequestData(vtkInformation *, vtkInformationVector **inp
     return 0;
   }
   const long npoints = gr_lightning_point_count(&p);
+  // Host memory only (the bolt is made on the host): per point its position
+  // (3 doubles), intensity, strand and connectivity; at most 510 050 points.
+  gr_memory_need need = {};
+  need.points = static_cast<double>(npoints);
+  need.host = need.points * (3 * sizeof(double) + sizeof(float) + sizeof(int) + sizeof(vtkIdType));
+  if (!this->ReportError(graupel::MemoryRefusal(nullptr, "Lightning",
+                                                "a bolt of " + std::to_string(npoints) + " points",
+                                                need, "lower ControlPoints or Strands"))) {
+    return 0;
+  }
   vtkNew<vtkDoubleArray> xyz;
   xyz->SetNumberOfComponents(3);
   xyz->SetNumberOfTuples(npoints);

@@ -12,6 +12,7 @@
 #include "graupel/cl_runtime.h"
 #include "graupel/procedural_terrain.h"
 
+#include "GraupelMemory.h"
 #include "GraupelParameterTable.h"
 
 #include <algorithm>
@@ -82,6 +83,9 @@ int vtkProceduralTerrainSource::RequestData(vtkInformation *, vtkInformationVect
   int extent[6];
   outInfo->Get(vtkStreamingDemandDrivenPipeline::UPDATE_EXTENT(), extent);
   output->Initialize();
+  if (this->AbortRequested("Procedural Terrain", false)) {
+    return 1;
+  }
 
   gr_procedural_terrain_params p;
   gr_procedural_terrain_params_init(&p);
@@ -118,8 +122,17 @@ int vtkProceduralTerrainSource::RequestData(vtkInformation *, vtkInformationVect
   if (!ctx) {
     return 0;
   }
-  // The generator checks the grid against the device's limits before any
-  // host memory is taken for the result.
+  // The elevation buffer and its host copy, checked against the device and
+  // what this process can get before either is allocated.
+  gr_memory_need need;
+  gr_procedural_terrain_memory(&grid, &need);
+  const vtkIdType npoints = static_cast<vtkIdType>(grid.nx) * grid.ny;
+  if (!this->ReportError(graupel::MemoryRefusal(
+          ctx, "Procedural Terrain", graupel::GridSubject(grid.nx, grid.ny),
+          graupel::WithHostArrays(need, static_cast<double>(npoints), sizeof(float)),
+          "choose smaller Dimensions (a larger Spacing keeps the extent)"))) {
+    return 0;
+  }
   gr_procedural_terrain *noise = nullptr;
   gr_status st = gr_procedural_terrain_create(ctx, &grid, &p, &noise);
   if (st != GR_OK) {
@@ -129,7 +142,6 @@ int vtkProceduralTerrainSource::RequestData(vtkInformation *, vtkInformationVect
   }
   vtkNew<vtkFloatArray> elevation;
   elevation->SetName("elevation");
-  const vtkIdType npoints = static_cast<vtkIdType>(grid.nx) * grid.ny;
   if (!elevation->Allocate(npoints)) {
     gr_procedural_terrain_destroy(noise);
     vtkErrorMacro("Procedural Terrain: out of host memory for "
@@ -140,6 +152,9 @@ int vtkProceduralTerrainSource::RequestData(vtkInformation *, vtkInformationVect
   // Band by band (about 4 million points each), so that a large terrain
   // reports progress and can be aborted between bands.
   const int band = std::max(1, (1 << 22) / grid.nx);
+  const std::string text = "Procedural Terrain: " + std::to_string(grid.nx) + " x " +
+                           std::to_string(grid.ny) + " points";
+  this->SetProgressText(text.c_str());
   this->UpdateProgress(0.0);
   for (int row = 0; row < grid.ny && st == GR_OK; row += band) {
     const int rows = std::min(band, grid.ny - row);
@@ -148,14 +163,8 @@ int vtkProceduralTerrainSource::RequestData(vtkInformation *, vtkInformationVect
       st = gr_finish(ctx);
     }
     this->UpdateProgress(static_cast<double>(row + rows) / grid.ny);
-    if (st == GR_OK && this->GetAbortExecute()) {
+    if (st == GR_OK && this->AbortRequested("Procedural Terrain", true)) {
       gr_procedural_terrain_destroy(noise);
-      vtkWarningMacro("Procedural Terrain: the update was aborted; the output is empty.");
-      // The abort is honoured: clear it, and mark the source modified so that
-      // the next update computes the terrain again instead of keeping the
-      // empty output.
-      this->SetAbortExecute(0);
-      this->Modified();
       return 1;
     }
   }

@@ -221,6 +221,9 @@ int vtkRainRunoffFilter::SetUpState(vtkInformationVector **inputVector) {
   if (!elevationArray || !this->CheckParameters()) {
     return 0;
   }
+  if (!this->CheckStateMemory(terrain, map, inputVector)) {
+    return 0;
+  }
 
   struct Upload {
     gr_field field;
@@ -435,6 +438,36 @@ int vtkRainRunoffFilter::SetUpState(vtkInformationVector **inputVector) {
   this->Ledgers.clear();
   this->GaugeRows.clear();
   return this->RecordLedger(0);
+}
+
+int vtkRainRunoffFilter::CheckStateMemory(vtkImageData *terrain, vtkImageData *map,
+                                          vtkInformationVector **inputVector) {
+  vtkPointData *pd = terrain->GetPointData();
+  vtkPointData *md = map ? map->GetPointData() : nullptr;
+  int inputs = GR_RAIN_RUNOFF_INPUT_NO_DATA; // NaN elevations are found later
+  inputs |= pd->GetArray("rain_rate") ? GR_RAIN_RUNOFF_INPUT_RAIN : 0;
+  inputs |= md && md->GetArray("permeability") ? GR_RAIN_RUNOFF_INPUT_PERMEABILITY : 0;
+  const bool manning = pd->GetArray("manning_n") || (md && md->GetArray("manning_n"));
+  inputs |= manning ? GR_RAIN_RUNOFF_INPUT_MANNING : 0;
+  bool inflows = inputVector[3]->GetNumberOfInformationObjects() > 0;
+  for (const std::vector<double> &times : this->InflowTimes) {
+    inflows = inflows || !times.empty();
+  }
+  inputs |= inflows ? GR_RAIN_RUNOFF_INPUT_INFLOWS : 0;
+  gr_rain_runoff_params p;
+  gr_rain_runoff_params_init(&p);
+  p.flow_model = this->FlowModel == LOCAL_INERTIAL ? GR_FLOW_LOCAL_INERTIAL : GR_FLOW_SHALLOW_WATER;
+  gr_grid grid;
+  TerrainGrid(terrain, &grid);
+  this->GetPieces().PieceGrid(&grid);
+  gr_memory_need need;
+  gr_rain_runoff_memory(this->GetContext(), &grid, &p, inputs, &need);
+  // The output's fields (water depth and surface, velocity, discharge,
+  // infiltrated, elevation: 8 floats) and flood maps, with the maps' staging
+  // plane; the uploads' staging (3 floats) and the Manning map in double.
+  const double output = 4.0 * (8 + GR_RAIN_RUNOFF_MAP_COUNT + 1);
+  const double staging = 4.0 * 3 + (manning ? 8.0 : 0.0);
+  return this->CheckMemory(grid, need, output + staging);
 }
 
 int vtkRainRunoffFilter::SetPointInflows(vtkPointSet *points, vtkImageData *terrain) {

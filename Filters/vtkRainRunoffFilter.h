@@ -289,6 +289,12 @@ private:
   /** Adds the flood maps to the image output, on its extent. */
   int AddMaps(vtkDataObject *output);
 
+  /**
+   * Refuses (one sentence, 0) a terrain whose simulation would not fit in
+   * memory, with the optional inputs it has: before anything is copied.
+   */
+  int CheckStateMemory(vtkImageData *terrain, vtkImageData *map,
+                       vtkInformationVector **inputVector);
   /** Gives the core the Inflows points (snapped to the terrain; none: nothing); 0 with a sentence.
    */
   int SetPointInflows(vtkPointSet *points, vtkImageData *terrain);

@@ -301,6 +301,14 @@ int vtkSnowAccumulationFilter::SetUpState(vtkInformationVector **inputVector) {
   // snow and ledger are the whole grid's.
   graupel::Pieces &pieces = this->GetPieces();
   pieces.PieceGrid(&grid);
+  // Before the device: the core's state on this rank's piece with the
+  // exposure view (checked against the device above, for its own
+  // sentence), the output's five fields and an upload's staging plane.
+  gr_memory_need need;
+  gr_snow_accumulation_memory(&grid, &p, &need);
+  if (!this->CheckMemory(grid, need, 4.0 * (5 + 1))) {
+    return 0;
+  }
   st = gr_snow_accumulation_create(ctx, &grid, &p, &this->Simulation);
   if (st != GR_OK) {
     return this->ReportFailure(st, "Snow Accumulation could not set up the simulation");

@@ -317,6 +317,18 @@ int vtkSnowDeformationFilter::SetUpState(vtkInformationVector **inputVector) {
   if (!elevationArray || !this->CheckParameters()) {
     return 0;
   }
+  {
+    // Before anything is copied: the core's state on this rank's piece, the
+    // output's six fields and an upload's staging plane.
+    gr_grid grid;
+    TerrainGrid(terrain, &grid);
+    this->GetPieces().PieceGrid(&grid);
+    gr_memory_need need;
+    gr_snow_deformation_memory(&grid, &need);
+    if (!this->CheckMemory(grid, need, 4.0 * (6 + 1))) {
+      return 0;
+    }
+  }
   const size_t npoints = static_cast<size_t>(dims[0]) * static_cast<size_t>(dims[1]);
   std::vector<graupel::Upload> uploads;
   uploads.push_back({GR_FIELD_ELEVATION, AsFloat(elevationArray)});

@@ -15,6 +15,7 @@
 #include "graupel/terrain_analysis.h"
 
 #include "GraupelArrays.h"
+#include "GraupelMemory.h"
 #include "GraupelParameterTable.h"
 
 #include <algorithm>
@@ -89,6 +90,9 @@ int vtkTerrainAnalysisFilter::RequestData(vtkInformation *, vtkInformationVector
   vtkImageData *input = vtkImageData::GetData(inputVector[0]);
   vtkImageData *output = vtkImageData::GetData(outputVector);
   output->Initialize();
+  if (this->AbortRequested(label, false)) {
+    return 1;
+  }
   if (!input) {
     vtkErrorMacro(<< label << " needs a terrain image on its Input.");
     return 0;
@@ -155,6 +159,22 @@ int vtkTerrainAnalysisFilter::RequestData(vtkInformation *, vtkInformationVector
   if (!ctx) {
     return 0;
   }
+  // The core's buffers, the output arrays (the shadow's float, or every
+  // output: 33 bytes a point) and a float copy of heights stored otherwise.
+  gr_memory_need need;
+  gr_terrain_analysis_memory(&grid, &need);
+  const double points = static_cast<double>(grid.nx) * grid.ny;
+  const double outputBytes = this->GetShadowOnly() ? 4.0 : 4.0 * (1 + 3 + 4) + 1.0;
+  const double copyBytes = vtkFloatArray::SafeDownCast(heights) ? 0.0 : 4.0;
+  if (!this->ReportError(graupel::MemoryRefusal(
+          ctx, label, graupel::GridSubject(grid.nx, grid.ny),
+          graupel::WithHostArrays(need, points, outputBytes + copyBytes),
+          "resample the terrain to fewer points (e.g. with Resample To Image)"))) {
+    return 0;
+  }
+  this->SetProgressText((std::string(label) + ": " + std::to_string(grid.nx) + " x " +
+                         std::to_string(grid.ny) + " points")
+                            .c_str());
   gr_terrain_analysis *t = nullptr;
   gr_status st = gr_terrain_analysis_create(ctx, &grid, &p, &t);
   if (st != GR_OK) {
@@ -182,13 +202,8 @@ int vtkTerrainAnalysisFilter::RequestData(vtkInformation *, vtkInformationVector
       st = gr_finish(ctx);
     }
     this->UpdateProgress(0.9 * (row + rows) / grid.ny);
-    if (st == GR_OK && this->GetAbortExecute()) {
+    if (st == GR_OK && this->AbortRequested(label, true)) {
       gr_terrain_analysis_destroy(t);
-      vtkWarningMacro(<< label << ": the update was aborted; the output is empty.");
-      // Honoured: cleared, and the filter marked modified so that the next
-      // update computes again instead of keeping the empty output.
-      this->SetAbortExecute(0);
-      this->Modified();
       return 1;
     }
   }

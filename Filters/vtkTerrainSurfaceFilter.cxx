@@ -1,5 +1,6 @@
 #include "vtkTerrainSurfaceFilter.h"
 
+#include "vtkAbstractArray.h"
 #include "vtkCellArray.h"
 #include "vtkDataArray.h"
 #include "vtkDoubleArray.h"
@@ -16,9 +17,13 @@
 #include "vtkPolyData.h"
 #include "vtkStreamingDemandDrivenPipeline.h"
 
+#include "GraupelMemory.h"
+#include "vtkGraupelAlgorithm.h" // GRAUPEL_VTK_ABORT_OUTPUT
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <string>
 #include <vector>
 
 vtkStandardNewMacro(vtkTerrainSurfaceFilter);
@@ -111,6 +116,12 @@ int vtkTerrainSurfaceFilter::RequestData(vtkInformation *, vtkInformationVector 
   if (!input || !output) {
     return 1;
   }
+  if (this->GetAbortExecute()) {
+    // Aborted while the Render that asked for it lasts (see ConsumeAbort).
+    output->Initialize();
+    this->ConsumeAbort();
+    return 1;
+  }
   int dims[3];
   input->GetDimensions(dims);
   if (input->GetNumberOfPoints() == 0) {
@@ -138,6 +149,31 @@ int vtkTerrainSurfaceFilter::RequestData(vtkInformation *, vtkInformationVector 
   vtkDataArray *height = input->GetPointData()->GetArray(heightName);
   const vtkIdType n = input->GetNumberOfPoints();
   const int nx = dims[0], ny = dims[1];
+  // Host memory only: a point's position (3 doubles) and normal (3 floats),
+  // its quad's offset and four point ids, a copy of every input point array
+  // and the water's display copy. Refused before anything is allocated: a
+  // terrain of 20000 x 20000 points would take 34 GB.
+  gr_memory_need need = {};
+  need.points = static_cast<double>(n);
+  double perPoint = 3 * sizeof(double) + 3 * sizeof(float) + 5 * sizeof(vtkIdType) + sizeof(float);
+  vtkPointData *inArrays = input->GetPointData();
+  for (int a = 0; a < inArrays->GetNumberOfArrays(); ++a) {
+    if (vtkAbstractArray *array = inArrays->GetAbstractArray(a)) {
+      perPoint += static_cast<double>(array->GetDataTypeSize()) * array->GetNumberOfComponents();
+    }
+  }
+  need.host = need.points * perPoint;
+  const std::string refusal = graupel::MemoryRefusal(
+      nullptr, "Terrain Surface", graupel::GridSubject(nx, ny, "terrain"), need,
+      "resample the terrain to fewer points first (Resample To Image) or show its image instead");
+  if (!refusal.empty()) {
+    vtkErrorMacro(<< refusal);
+    return 1;
+  }
+  const std::string text =
+      "Terrain Surface: " + std::to_string(nx) + " x " + std::to_string(ny) + " points";
+  this->SetProgressText(text.c_str());
+  this->UpdateProgress(0.0);
   double lowest = VTK_DOUBLE_MAX;
   for (vtkIdType id = 0; id < n; ++id) {
     const double h = height->GetComponent(id, 0);
@@ -169,8 +205,27 @@ int vtkTerrainSurfaceFilter::RequestData(vtkInformation *, vtkInformationVector 
   outPD->CopyAllocate(inPD, n + wallPoints);
 
   auto z = [&](int i, int j) { return s * height->GetComponent(i + j * nx, 0); };
+  // Progress every band of rows (about a million points) and the abort
+  // looked at there: a large terrain takes seconds.
+  const int band = std::max(1, (1 << 20) / nx);
+  auto aborted = [&](int row, double share, double done) {
+    if (row % band != 0) {
+      return false;
+    }
+    this->UpdateProgress(done + share * row / ny);
+    if (!this->GetAbortExecute()) {
+      return false;
+    }
+    output->Initialize();
+    vtkWarningMacro("Terrain Surface: the update was aborted; the output is empty.");
+    this->ConsumeAbort();
+    return true;
+  };
   double p[3];
   for (int j = 0; j < ny; ++j) {
+    if (aborted(j, 0.7, 0.0)) {
+      return 1;
+    }
     for (int i = 0; i < nx; ++i) {
       const vtkIdType id = i + static_cast<vtkIdType>(j) * nx;
       input->GetPoint(id, p);
@@ -203,6 +258,9 @@ int vtkTerrainSurfaceFilter::RequestData(vtkInformation *, vtkInformationVector 
     ++q;
   };
   for (int j = 0; j + 1 < ny; ++j) {
+    if (aborted(j, 0.3, 0.7)) {
+      return 1;
+    }
     for (int i = 0; i + 1 < nx; ++i) {
       const vtkIdType a = i + static_cast<vtkIdType>(j) * nx;
       quad(a, a + 1, a + 1 + nx, a + nx); // counter-clockwise seen from above
@@ -276,7 +334,21 @@ int vtkTerrainSurfaceFilter::RequestData(vtkInformation *, vtkInformationVector 
   factor->SetName("vertical_exaggeration");
   factor->InsertNextValue(s);
   output->GetFieldData()->AddArray(factor);
+  this->UpdateProgress(1.0);
   return 1;
+}
+
+void vtkTerrainSurfaceFilter::ConsumeAbort() {
+  // vtkGraupelAlgorithm::AbortRequested's protocol: the abort consumed, the
+  // output marked aborted, so that the executive empties it and the next
+  // request builds the surface again (on VTK 9.1, Modified()).
+#if GRAUPEL_VTK_ABORT_OUTPUT
+  this->AbortExecute = 0;
+  this->SetAbortOutput(true);
+#else
+  this->SetAbortExecute(0);
+  this->Modified();
+#endif
 }
 
 void vtkTerrainSurfaceFilter::PrintSelf(ostream &os, vtkIndent indent) {

@@ -26,7 +26,10 @@
  * (Plugin/GraupelColorMaps.json) are the defaults for those arrays.
  *
  * Bad input (not an image, 3-D, no height array, non-finite heights) gives
- * one error sentence and an empty output.
+ * one error sentence and an empty output, as does a terrain whose surface
+ * would not fit in the memory the process can get (about 84 bytes a point:
+ * 34 GB for 20000 x 20000), refused before anything is allocated. A large
+ * terrain reports progress and honours an abort every million points.
  */
 #ifndef vtkTerrainSurfaceFilter_h
 #define vtkTerrainSurfaceFilter_h
@@ -96,6 +99,8 @@ protected:
   int RequestUpdateExtent(vtkInformation *, vtkInformationVector **,
                           vtkInformationVector *) override;
   int RequestData(vtkInformation *, vtkInformationVector **, vtkInformationVector *) override;
+  /** Consumes an abort and marks the output aborted (RequestData returns 1 then). */
+  void ConsumeAbort();
 
   double VerticalExaggeration = 2.0;
   std::string HeightArray;

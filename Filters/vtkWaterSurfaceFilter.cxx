@@ -210,6 +210,14 @@ int vtkWaterSurfaceFilter::SetUpState(vtkInformationVector **inputVector) {
   if (!ctx) {
     return 0;
   }
+  // The core's state on this rank's piece, the output's fields (wave height,
+  // surface, normal, wet, elevation, depth: 8 floats) and the water's two
+  // staging planes.
+  gr_memory_need need;
+  gr_water_surface_memory(&grid, &need);
+  if (!this->CheckMemory(grid, need, 4.0 * (8 + 2))) {
+    return 0;
+  }
   gr_status st = gr_water_surface_create(ctx, &grid, &p, &this->Simulation);
   if (st != GR_OK) {
     return this->ReportFailure(st, "Water Surface could not set up the simulation");

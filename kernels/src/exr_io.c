@@ -23,6 +23,7 @@
  * no global state.
  */
 #include "graupel/exr_io.h"
+#include "graupel/memory.h"
 
 #include <openexr.h>
 
@@ -861,6 +862,22 @@ static gr_status read_exr(const char *label, read_source *src, gr_exr_image *out
             label, (long long)L.width, (long long)L.height, chlist->num_channels,
             (unsigned long long)GR_EXR_MAX_SAMPLES);
     goto cleanup;
+  }
+  {
+    /* The planes, before anything is decoded: a file that does not fit is
+     * refused at once, not after minutes of decoding or by a failed malloc
+     * under the kernel's overcommit. */
+    gr_memory_need need;
+    char why[200];
+    memset(&need, 0, sizeof(need));
+    need.points = (double)npix;
+    need.host = (double)npix * (double)chlist->num_channels * sizeof(float);
+    if (gr_memory_check(NULL, &need, why, sizeof(why)) != GR_OK) {
+      st = GR_ERR_TOO_LARGE;
+      set_err(err, err_len, "Cannot read '%s': the image of %lld by %lld pixels in %d channels %s.",
+              label, (long long)L.width, (long long)L.height, chlist->num_channels, why);
+      goto cleanup;
+    }
   }
   for (c = 0; c < (size_t)chlist->num_channels; ++c) {
     const exr_attr_chlist_entry_t *e = &chlist->entries[c];

@@ -182,6 +182,20 @@ static gr_status gr_pa_allocate(gr_particles *s, int count) {
   return st;
 }
 
+gr_status gr_particles_memory(const gr_particles_params *p, gr_memory_need *out) {
+  if (!p || !out)
+    return gr_set_error(NULL, GR_ERR_INVALID_ARGUMENT,
+                        "gr_particles_memory needs parameters and a place for the answer.");
+  memset(out, 0, sizeof(*out));
+  out->points = p->count > 0 ? (double)p->count : 0.0;
+  for (int o = 0; o < GR_PARTICLES_OUTPUT_COUNT; ++o) {
+    double bytes = out->points * gr_particles_output_components(o) * sizeof(float);
+    out->device += bytes; /* gr_pa_allocate */
+    out->largest = bytes > out->largest ? bytes : out->largest;
+  }
+  return GR_OK;
+}
+
 gr_status gr_particles_create(gr_context *ctx, const gr_particles_params *p, gr_particles **out) {
   char msg[256];
   if (!ctx || !out)
@@ -190,6 +204,11 @@ gr_status gr_particles_create(gr_context *ctx, const gr_particles_params *p, gr_
   *out = NULL;
   if (gr_particles_params_validate(p, msg, sizeof(msg)) != GR_OK)
     return gr_set_error(ctx, GR_ERR_INVALID_ARGUMENT, "%s", msg);
+  gr_memory_need need;
+  gr_particles_memory(p, &need);
+  if (gr_memory_check(ctx, &need, msg, sizeof(msg)) != GR_OK)
+    return gr_set_error(ctx, GR_ERR_TOO_LARGE, "A set of %d particles %s: lower Count.", p->count,
+                        msg);
   gr_particles *s = calloc(1, sizeof(*s));
   if (!s)
     return gr_set_error(ctx, GR_ERR_OUT_OF_MEMORY, "Out of host memory.");

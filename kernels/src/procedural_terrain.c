@@ -222,6 +222,23 @@ static gr_status gr_pt_kernel(gr_context *ctx, const gr_procedural_terrain_param
   return st;
 }
 
+/* The octave tables' bytes (three small read-only buffers). */
+#define GR_PT_TABLE_BYTES                                                                          \
+  (GR_PROCEDURAL_TERRAIN_OCTAVES_MAX *                                                             \
+   (sizeof(cl_float) * (GR_PT_TABLE_STRIDE + 1) + sizeof(cl_int) * GR_PT_LATTICE_STRIDE))
+
+gr_status gr_procedural_terrain_memory(const gr_grid *grid, gr_memory_need *out) {
+  if (!grid || !out)
+    return gr_set_error(NULL, GR_ERR_INVALID_ARGUMENT,
+                        "gr_procedural_terrain_memory needs a grid and a place for the answer.");
+  double points = (double)grid->nx * (double)grid->ny;
+  memset(out, 0, sizeof(*out));
+  out->points = points;
+  out->largest = sizeof(cl_float) * points;
+  out->device = out->largest + (double)GR_PT_TABLE_BYTES;
+  return GR_OK;
+}
+
 gr_status gr_procedural_terrain_create(gr_context *ctx, const gr_grid *grid,
                                        const gr_procedural_terrain_params *p,
                                        gr_procedural_terrain **out) {
@@ -235,6 +252,13 @@ gr_status gr_procedural_terrain_create(gr_context *ctx, const gr_grid *grid,
     return gr_set_error(ctx, GR_ERR_INVALID_ARGUMENT, "%s", msg);
   if (gr_procedural_terrain_params_validate(p, msg, sizeof(msg)) != GR_OK)
     return gr_set_error(ctx, GR_ERR_INVALID_ARGUMENT, "%s", msg);
+  gr_memory_need need;
+  gr_procedural_terrain_memory(grid, &need);
+  if (gr_memory_check(ctx, &need, msg, sizeof(msg)) != GR_OK)
+    return gr_set_error(ctx, GR_ERR_TOO_LARGE,
+                        "The procedural terrain of a %d x %d grid %s: use a smaller grid or "
+                        "another device.",
+                        grid->nx, grid->ny, msg);
 
   gr_procedural_terrain *t = calloc(1, sizeof(*t));
   if (!t)

@@ -1067,6 +1067,39 @@ int gr_rain_runoff_specialised_for(const gr_rain_runoff *s) {
   return s && s->inputs >= 0 ? s->inputs & GR_RAIN_RUNOFF_IN_ALL : -1;
 }
 
+gr_status gr_rain_runoff_memory(const gr_context *ctx, const gr_grid *grid,
+                                const gr_rain_runoff_params *p, int inputs, gr_memory_need *out) {
+  if (!grid || !p || !out)
+    return gr_set_error(ctx, GR_ERR_INVALID_ARGUMENT,
+                        "gr_rain_runoff_memory needs a grid, parameters and a place for the "
+                        "answer.");
+  /* A piece's ring (at most grid->ghost cells each way). */
+  int ring = grid->ghost > 0 ? grid->ghost : 0;
+  double nx = (double)grid->nx + 2.0 * ring, ny = (double)grid->ny + 2.0 * ring, cells = nx * ny;
+  double faces = (nx + 1.0) * ny + nx * (ny + 1.0);
+  /* gr_rain_runoff_create's per_cell (21) and flood maps, the derive
+   * kernel's scratch (3), the initial water h0 (1). */
+  double planes = 21.0 + GR_RAIN_RUNOFF_MAP_ARRAYS + 3.0 + 1.0;
+  planes += (inputs & GR_RAIN_RUNOFF_INPUT_RAIN) ? 1.0 : 0.0;
+  planes += (inputs & GR_RAIN_RUNOFF_INPUT_PERMEABILITY) ? 1.0 : 0.0;
+  planes += (inputs & GR_RAIN_RUNOFF_INPUT_INFLOWS) ? 2.0 : 0.0; /* src, pts */
+  planes += (inputs & GR_RAIN_RUNOFF_INPUT_NO_DATA) ? 1.0 : 0.0;
+  planes += (inputs & GR_RAIN_RUNOFF_INPUT_MANNING) ? 1.0 : 0.0;
+  double face_planes = 2.0; /* qx[2] and qy[2]: two sets of x- and y-faces */
+  /* The separate shallow-water launches' x- and y-face arrays
+   * (gr_rain_runoff_face_arrays): where the stages are not fused. */
+  int separate = p->flow_model == GR_FLOW_SHALLOW_WATER && !(ctx && gr_context_is_gpu(ctx));
+  face_planes += separate ? 6.0 : 0.0;
+  memset(out, 0, sizeof(*out));
+  out->points = (double)grid->nx * (double)grid->ny;
+  out->device = sizeof(cl_float) * (planes * cells + face_planes * faces);
+  out->largest = sizeof(cl_float) * (separate ? 6.0 * (nx + 1.0) * ny : 3.0 * cells);
+  out->host = ((inputs & GR_RAIN_RUNOFF_INPUT_NO_DATA) ? 1.0 : 0.0) * cells + 8.0 * cells;
+  /* gr_rain_runoff_state_bytes, the header aside */
+  out->state = sizeof(float) * (GR_RAIN_RUNOFF_STATE_CELL_ARRAYS * cells + faces);
+  return GR_OK;
+}
+
 gr_status gr_rain_runoff_create(gr_context *ctx, const gr_grid *grid,
                                 const gr_rain_runoff_params *p, gr_rain_runoff **out) {
   char msg[256];
@@ -1089,24 +1122,14 @@ gr_status gr_rain_runoff_create(gr_context *ctx, const gr_grid *grid,
                         "The rain runoff grid of %zu x %zu points is too large: the kernels "
                         "address at most about 2.1e9 faces; split the domain or coarsen it.",
                         nx, ny);
-  /* The state that is always there: depth, elevation, limiter, infiltrated
-   * outflow and inflow with their compensations, the shallow-water discharges,
-   * stage and points (21 per cell), the flood maps (6), two sets of face arrays
-   * and the shallow-water faces (4 floats each). Refuse before
-   * allocating when the device cannot hold it. */
-  gr_device_info info;
-  gr_status st = gr_context_device_info(ctx, &info);
-  if (st != GR_OK)
-    return st;
-  double need = 4.0 * ((21.0 + GR_RAIN_RUNOFF_MAP_ARRAYS) * (double)cells +
-                       6.0 * ((double)(nx + 1) * ny + (double)nx * (ny + 1)));
-  if (need > (double)info.global_mem_bytes)
+  gr_memory_need need;
+  gr_rain_runoff_memory(ctx, grid, p, 0, &need);
+  if (gr_memory_check(ctx, &need, msg, sizeof(msg)) != GR_OK)
     return gr_set_error(ctx, GR_ERR_TOO_LARGE,
-                        "The rain runoff state of a %zu x %zu grid needs %.1f MiB but the device "
-                        "'%s' has %.1f MiB: use a smaller grid or another device.",
-                        nx, ny, need / 1048576.0, info.name,
-                        (double)info.global_mem_bytes / 1048576.0);
-
+                        "The rain runoff state of a %zu x %zu grid %s: use a smaller grid or "
+                        "another device.",
+                        nx, ny, msg);
+  gr_status st = GR_OK;
   gr_rain_runoff *s = calloc(1, sizeof(*s));
   if (!s)
     return gr_set_error(ctx, GR_ERR_OUT_OF_MEMORY, "Out of host memory.");

@@ -1,6 +1,7 @@
 /* OpenCL runtime of the Graupel core: device choice, the shared context,
  * checked program/kernel/buffer helpers, and error reporting. */
 #include "graupel/cl_runtime.h"
+#include "graupel/memory.h"
 
 #include <ctype.h>
 #include <math.h>
@@ -16,6 +17,9 @@
  * entry is reused, so a long session that creates kernels without end keeps
  * a fixed amount of memory. */
 #define GR_ARG_CACHE 64
+/* Buffers from this size on are checked against the memory the process can
+ * get (two /proc reads); smaller ones cannot matter. */
+#define GR_BUFFER_CHECKED ((size_t)1 << 20)
 
 typedef struct gr_program_entry {
   char *key; /* name + '\n' + options */
@@ -41,6 +45,7 @@ struct gr_context {
   char device_name[128];
   char platform_name[128];
   int is_gpu;
+  int host_memory; /* the device's buffers are host memory (gr_device_info) */
   cl_ulong max_alloc, global_mem;
   size_t local2d[2]; /* default work-group shape for 2-D kernels */
   gr_log_fn log;
@@ -713,6 +718,11 @@ static void gr_fill_device_info(cl_platform_id p, cl_device_id d, gr_device_info
   info->compute_units = (int)cu;
   info->global_mem_bytes = mem;
   info->max_alloc_bytes = alloc;
+  cl_bool unified = CL_FALSE;
+  if (clGetDeviceInfo(d, CL_DEVICE_HOST_UNIFIED_MEMORY, sizeof(unified), &unified, NULL) !=
+      CL_SUCCESS)
+    unified = CL_FALSE;
+  info->host_memory = info->is_cpu || unified == CL_TRUE;
 }
 
 /* Visits every device of every platform; stops when visit returns nonzero. */
@@ -934,6 +944,7 @@ static gr_status gr_context_open(const gr_context_options *opt, cl_platform_id p
   snprintf(ctx->device_name, sizeof(ctx->device_name), "%s", info.name);
   snprintf(ctx->platform_name, sizeof(ctx->platform_name), "%s", info.platform);
   ctx->is_gpu = info.is_gpu;
+  ctx->host_memory = info.host_memory;
   ctx->max_alloc = info.max_alloc_bytes;
   /* A fixed work-group shape for every 2-D launch. Left to the driver, PoCL
    * picks one per global size and JIT-compiles and caches a work-group
@@ -1433,9 +1444,32 @@ gr_status gr_buffer_create(gr_context *ctx, cl_mem_flags flags, size_t size, con
                         "most %.1f MiB per buffer: use a smaller grid or another device.",
                         (double)size / 1048576.0, ctx->device_name,
                         (double)ctx->max_alloc / 1048576.0);
+  if (ctx->host_memory && size >= GR_BUFFER_CHECKED) {
+    /* The buffer is host memory: refuse what the process cannot get rather
+     * than let the kernel's overcommit hand out pages that are not there. */
+    gr_memory_info mem;
+    if (gr_memory_query(NULL, &mem) == GR_OK && (double)size > (double)mem.host_available) {
+      char need[32], have[32];
+      gr_memory_format((double)size, need, sizeof(need));
+      gr_memory_format((double)mem.host_available, have, sizeof(have));
+      return gr_set_error(ctx, GR_ERR_OUT_OF_MEMORY,
+                          "A device buffer of %s does not fit: the device '%s' keeps its "
+                          "buffers in host memory and this process can use %s; use a smaller "
+                          "grid.",
+                          need, ctx->device_name, have);
+    }
+  }
   cl_int err = CL_SUCCESS;
   if (host)
     flags |= CL_MEM_COPY_HOST_PTR;
+  /* Where buffers are host memory, allocate them now: PoCL otherwise
+   * allocates at the buffer's first use and, when that fails, asserts
+   * (pocl_create_migration_commands: p->mem_ptr != NULL) and aborts the
+   * process; with CL_MEM_ALLOC_HOST_PTR clCreateBuffer itself fails with
+   * CL_OUT_OF_HOST_MEMORY. The buffer is the same one allocation either
+   * way (4 x 2 GB filled take 8.3 GB resident). */
+  if (ctx->host_memory && !(flags & CL_MEM_USE_HOST_PTR))
+    flags |= CL_MEM_ALLOC_HOST_PTR;
   *out = clCreateBuffer(ctx->cl, flags, size, (void *)host, &err);
   if (err != CL_SUCCESS) {
     *out = NULL;

@@ -509,6 +509,20 @@ static gr_status gr_cloud_allocate(gr_cloud_cover *c) {
   return st;
 }
 
+gr_status gr_cloud_cover_memory(const gr_cloud_cover_params *p, gr_memory_need *out) {
+  if (!p || !out)
+    return gr_set_error(NULL, GR_ERR_INVALID_ARGUMENT,
+                        "gr_cloud_cover_memory needs parameters and a place for the answer.");
+  double n = (double)p->resolution * (double)p->resolution;
+  double sample = sizeof(cl_float) * (double)GR_SKY_SAMPLE_SIDE * GR_SKY_SAMPLE_SIDE;
+  memset(out, 0, sizeof(*out));
+  out->points = n;
+  out->device = (4.0 + 4.0 + 3.0) * n + sample; /* gr_cloud_allocate, gr_cloud_measure */
+  out->largest = 4.0 * n > sample ? 4.0 * n : sample;
+  out->host = sample; /* the sorted sample */
+  return GR_OK;
+}
+
 gr_status gr_cloud_cover_create(gr_context *ctx, const gr_cloud_cover_params *p,
                                 gr_cloud_cover **out) {
   char msg[256];
@@ -522,6 +536,13 @@ gr_status gr_cloud_cover_create(gr_context *ctx, const gr_cloud_cover_params *p,
   gr_cloud_cover_grid(p, &grid);
   if (gr_grid_validate(&grid, msg, sizeof(msg)) != GR_OK)
     return gr_set_error(ctx, GR_ERR_INVALID_ARGUMENT, "%s", msg);
+  gr_memory_need need;
+  gr_cloud_cover_memory(p, &need);
+  if (gr_memory_check(ctx, &need, msg, sizeof(msg)) != GR_OK)
+    return gr_set_error(ctx, GR_ERR_TOO_LARGE,
+                        "The cloud image of %d x %d pixels %s: lower Resolution or use another "
+                        "device.",
+                        grid.nx, grid.ny, msg);
   gr_cloud_cover *c = calloc(1, sizeof(*c));
   float *sorted = malloc(sizeof(float) * GR_SKY_SAMPLE_SIDE * GR_SKY_SAMPLE_SIDE);
   if (!c || !sorted) {

@@ -610,6 +610,28 @@ static gr_status gr_snac_initial_state(gr_snow_accumulation *s) {
   return st;
 }
 
+gr_status gr_snow_accumulation_memory(const gr_grid *grid, const gr_snow_accumulation_params *p,
+                                      gr_memory_need *out) {
+  if (!grid || !p || !out)
+    return gr_set_error(NULL, GR_ERR_INVALID_ARGUMENT,
+                        "gr_snow_accumulation_memory needs a grid, parameters and a place for "
+                        "the answer.");
+  /* A piece's ring (at most grid->ghost rows each way). */
+  double rows = (double)grid->ny + 2.0 * (grid->ghost > 0 ? grid->ghost : 0);
+  double n = (double)grid->nx * rows;
+  double side = (double)p->exposure_resolution + 2.0 * GR_SNAC_VIEW_MARGIN + 1.0;
+  double view = sizeof(cl_int) * side * side;
+  memset(out, 0, sizeof(*out));
+  out->points = (double)grid->nx * (double)grid->ny;
+  /* The buffers gr_snow_accumulation_create makes, and the view (gr_snac_prepare). */
+  out->device =
+      sizeof(float) * (5.0 + GR_SNAC_ARRAYS) * n + view + sizeof(float) * 2.0 * GR_SNAC_SUMS * rows;
+  out->largest = sizeof(float) * n > view ? sizeof(float) * n : view;
+  out->host = sizeof(double) * (1.0 + GR_SNAC_SUMS) * rows; /* init_rows, the rows' sums */
+  out->state = sizeof(float) * GR_SNAC_ARRAYS * n + sizeof(double) * rows; /* gr_snac_state_bytes */
+  return GR_OK;
+}
+
 gr_status gr_snow_accumulation_create(gr_context *ctx, const gr_grid *grid,
                                       const gr_snow_accumulation_params *p,
                                       gr_snow_accumulation **out) {
@@ -631,6 +653,13 @@ gr_status gr_snow_accumulation_create(gr_context *ctx, const gr_grid *grid,
                         "The snow accumulation grid of %d x %d points is too large: the kernels "
                         "address at most about 1e9 points; coarsen it.",
                         grid->nx, grid->ny);
+  gr_memory_need need;
+  gr_snow_accumulation_memory(grid, p, &need);
+  if (gr_memory_check(ctx, &need, msg, sizeof(msg)) != GR_OK)
+    return gr_set_error(ctx, GR_ERR_TOO_LARGE,
+                        "The snow accumulation of a %d x %d grid %s: use a smaller grid, a "
+                        "lower ExposureResolution or another device.",
+                        grid->nx, grid->ny, msg);
   gr_snow_accumulation *s = calloc(1, sizeof(*s));
   if (!s)
     return gr_set_error(ctx, GR_ERR_OUT_OF_MEMORY, "Out of host memory.");

@@ -668,6 +668,24 @@ static const char *gr_snow_build_options(gr_context *ctx) {
   return "";
 }
 
+/* The planes of a point that gr_snow_deformation_create allocates. */
+#define GR_SNOW_PLANES 17
+
+gr_status gr_snow_deformation_memory(const gr_grid *grid, gr_memory_need *out) {
+  if (!grid || !out)
+    return gr_set_error(NULL, GR_ERR_INVALID_ARGUMENT,
+                        "gr_snow_deformation_memory needs a grid and a place for the answer.");
+  /* A piece's ring (at most grid->ghost points each way). */
+  int ring = grid->ghost > 0 ? grid->ghost : 0;
+  double n = ((double)grid->nx + 2.0 * ring) * ((double)grid->ny + 2.0 * ring);
+  memset(out, 0, sizeof(*out));
+  out->points = (double)grid->nx * (double)grid->ny;
+  out->device = sizeof(float) * GR_SNOW_PLANES * n;
+  out->largest = sizeof(float) * n;
+  out->state = sizeof(float) * GR_SNOW_STATE_ARRAYS * n; /* gr_snow_state_bytes */
+  return GR_OK;
+}
+
 gr_status gr_snow_deformation_create(gr_context *ctx, const gr_grid *grid,
                                      const gr_snow_deformation_params *p,
                                      gr_snow_deformation **out) {
@@ -691,6 +709,13 @@ gr_status gr_snow_deformation_create(gr_context *ctx, const gr_grid *grid,
                         "The snow deformation grid of %d x %d points is too large: the kernels "
                         "address at most about 1e9 points; coarsen it.",
                         grid->nx, grid->ny);
+  gr_memory_need need;
+  gr_snow_deformation_memory(grid, &need);
+  if (gr_memory_check(ctx, &need, msg, sizeof(msg)) != GR_OK)
+    return gr_set_error(ctx, GR_ERR_TOO_LARGE,
+                        "The snow deformation of a %d x %d grid %s: use a smaller grid or "
+                        "another device.",
+                        grid->nx, grid->ny, msg);
   gr_snow_deformation *s = calloc(1, sizeof(*s));
   if (!s)
     return gr_set_error(ctx, GR_ERR_OUT_OF_MEMORY, "Out of host memory.");
@@ -734,6 +759,8 @@ gr_status gr_snow_deformation_create(gr_context *ctx, const gr_grid *grid,
                     &s->depth0,      &s->density0, &s->under,      &s->overlap,    &s->weight,
                     &s->overlap_sum, &s->contact,  &s->under_min,  &s->rate,       &s->rate_in,
                     &s->movable,     &s->scratch};
+  _Static_assert(sizeof(bufs) / sizeof(bufs[0]) == GR_SNOW_PLANES,
+                 "gr_snow_deformation_memory counts every plane");
   for (size_t i = 0; st == GR_OK && i < sizeof(bufs) / sizeof(bufs[0]); ++i)
     st = gr_buffer_create(ctx, CL_MEM_READ_WRITE, bytes, NULL, bufs[i]);
   if (st == GR_OK)

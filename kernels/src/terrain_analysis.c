@@ -182,6 +182,19 @@ static void gr_ta_forget(gr_terrain_analysis *t, int shadow_only) {
   memset(t->shadow_done, 0, (size_t)t->grid.ny);
 }
 
+gr_status gr_terrain_analysis_memory(const gr_grid *grid, gr_memory_need *out) {
+  if (!grid || !out)
+    return gr_set_error(NULL, GR_ERR_INVALID_ARGUMENT,
+                        "gr_terrain_analysis_memory needs a grid and a place for the answer.");
+  double n = (double)grid->nx * (double)grid->ny;
+  memset(out, 0, sizeof(*out));
+  out->points = n;
+  out->device = (4.0 * (1 + 3 + 5) + 1.0) * n; /* the buffers gr_terrain_analysis_create makes */
+  out->largest = 3.0 * 4.0 * n;                /* the normal */
+  out->host = (double)grid->ny;                /* shadow_done */
+  return GR_OK;
+}
+
 gr_status gr_terrain_analysis_create(gr_context *ctx, const gr_grid *grid,
                                      const gr_terrain_analysis_params *p,
                                      gr_terrain_analysis **out) {
@@ -202,6 +215,13 @@ gr_status gr_terrain_analysis_create(gr_context *ctx, const gr_grid *grid,
                         grid->nx, grid->ny, grid->global_nx, grid->global_ny, grid->ghost);
   if (gr_terrain_analysis_params_validate(p, msg, sizeof(msg)) != GR_OK)
     return gr_set_error(ctx, GR_ERR_INVALID_ARGUMENT, "%s", msg);
+  gr_memory_need need;
+  gr_terrain_analysis_memory(grid, &need);
+  if (gr_memory_check(ctx, &need, msg, sizeof(msg)) != GR_OK)
+    return gr_set_error(ctx, GR_ERR_TOO_LARGE,
+                        "The terrain analysis of a %d x %d grid %s: use a smaller grid or "
+                        "another device.",
+                        grid->nx, grid->ny, msg);
 
   gr_terrain_analysis *t = calloc(1, sizeof(*t));
   if (!t)

@@ -348,6 +348,22 @@ gr_status gr_water_surface_halo_set(gr_water_surface *s, int side, const void *h
   return GR_WS_KEEP(s, gr_ws_halo_copy(s, side, (void *)host, bytes, 1));
 }
 
+gr_status gr_water_surface_memory(const gr_grid *grid, gr_memory_need *out) {
+  if (!grid || !out)
+    return gr_set_error(NULL, GR_ERR_INVALID_ARGUMENT,
+                        "gr_water_surface_memory needs a grid and a place for the answer.");
+  /* A piece's ring (at most grid->ghost rows each way). */
+  double n = (double)grid->nx * ((double)grid->ny + 2.0 * (grid->ghost > 0 ? grid->ghost : 0));
+  memset(out, 0, sizeof(*out));
+  out->points = (double)grid->nx * (double)grid->ny;
+  /* h twice, v, base, g, h0 and the scratch's 3: 9 floats and a byte a point. */
+  out->device = (9.0 * 4.0 + 1.0) * n;
+  out->largest = 3.0 * 4.0 * n; /* the scratch */
+  out->host = (4.0 + 4.0 + 4.0 + 1.0) * n;
+  out->state = 2.0 * sizeof(float) * n; /* gr_ws_state_bytes */
+  return GR_OK;
+}
+
 gr_status gr_water_surface_create(gr_context *ctx, const gr_grid *grid,
                                   const gr_water_surface_params *p, gr_water_surface **out) {
   char msg[256];
@@ -368,18 +384,13 @@ gr_status gr_water_surface_create(gr_context *ctx, const gr_grid *grid,
                         "The water surface grid of %d x %d points is too large: the kernels "
                         "address at most about 2.1e9 points; coarsen it.",
                         grid->nx, grid->ny);
-  /* h twice, v, base, g, h0 and the scratch's 3: 9 floats and a byte a point. */
-  gr_device_info info;
-  gr_status st = gr_context_device_info(ctx, &info);
-  if (st != GR_OK)
-    return st;
-  double need = 37.0 * (double)n;
-  if (need > (double)info.global_mem_bytes)
+  gr_memory_need need;
+  gr_water_surface_memory(grid, &need);
+  if (gr_memory_check(ctx, &need, msg, sizeof(msg)) != GR_OK)
     return gr_set_error(ctx, GR_ERR_TOO_LARGE,
-                        "The water surface of a %d x %d grid needs %.1f MiB but the device '%s' "
-                        "has %.1f MiB: use a smaller grid or another device.",
-                        grid->nx, grid->ny, need / 1048576.0, info.name,
-                        (double)info.global_mem_bytes / 1048576.0);
+                        "The water surface of a %d x %d grid %s: use a smaller grid or another "
+                        "device.",
+                        grid->nx, grid->ny, msg);
   gr_water_surface *s = calloc(1, sizeof(*s));
   if (!s)
     return gr_set_error(ctx, GR_ERR_OUT_OF_MEMORY, "Out of host memory.");
@@ -398,7 +409,7 @@ gr_status gr_water_surface_create(gr_context *ctx, const gr_grid *grid,
   }
   size_t fb = n * sizeof(cl_float);
   cl_program prog = NULL;
-  st = gr_program_get(ctx, "water_surface", NULL, &prog);
+  gr_status st = gr_program_get(ctx, "water_surface", NULL, &prog);
   if (st == GR_OK)
     st = gr_kernel_create(ctx, prog, "water_surface_drops", &s->drops);
   if (st == GR_OK)

@@ -108,8 +108,14 @@ GR_API gr_status gr_kernel_create(gr_context *ctx, cl_program prog, const char *
 
 /**
  * A device buffer of size bytes, checked against the device's largest
- * allocation and global memory. host may be NULL; when given, the buffer is
- * initialised from it (CL_MEM_COPY_HOST_PTR).
+ * allocation and global memory (GR_ERR_TOO_LARGE). host may be NULL; when
+ * given, the buffer is initialised from it (CL_MEM_COPY_HOST_PTR). On a
+ * device whose buffers are host memory (gr_device_info.host_memory) the
+ * buffer is allocated at once (CL_MEM_ALLOC_HOST_PTR), so that a failed
+ * allocation is this call's GR_ERR_OUT_OF_MEMORY and not an abort inside the
+ * driver at the buffer's first use, and one of 1 MiB or more that exceeds
+ * what the process can get (gr_memory_query) is refused with a sentence.
+ * A core checks its whole grid first (memory.h); this is the backstop.
  */
 GR_API gr_status gr_buffer_create(gr_context *ctx, cl_mem_flags flags, size_t size,
                                   const void *host, cl_mem *out);

@@ -66,6 +66,7 @@
 #ifndef GRAUPEL_PARTICLES_H
 #define GRAUPEL_PARTICLES_H
 
+#include "graupel/memory.h"
 #include "graupel/runtime.h"
 
 #ifdef __cplusplus
@@ -136,7 +137,18 @@ GR_API double gr_particles_rain_fall_speed(double diameter_mm);
 
 typedef struct gr_particles gr_particles;
 
-/** Validates the parameters, builds the kernels and allocates the outputs. */
+/**
+ * What p's Count of particles needs (memory.h): their outputs on the
+ * device, 4 bytes a component (points here are particles).
+ * GR_ERR_INVALID_ARGUMENT without p or out.
+ */
+GR_API gr_status gr_particles_memory(const gr_particles_params *p, gr_memory_need *out);
+
+/**
+ * Validates the parameters, refuses a Count that gr_particles_memory says
+ * does not fit (GR_ERR_TOO_LARGE, before anything is allocated), builds the
+ * kernels and allocates the outputs.
+ */
 GR_API gr_status gr_particles_create(gr_context *ctx, const gr_particles_params *p,
                                      gr_particles **out);
 

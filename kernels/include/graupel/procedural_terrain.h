@@ -26,6 +26,7 @@
 #ifndef GRAUPEL_PROCEDURAL_TERRAIN_H
 #define GRAUPEL_PROCEDURAL_TERRAIN_H
 
+#include "graupel/memory.h"
 #include "graupel/runtime.h"
 
 #ifdef __cplusplus
@@ -75,8 +76,16 @@ GR_API gr_status gr_procedural_terrain_params_validate(const gr_procedural_terra
 typedef struct gr_procedural_terrain gr_procedural_terrain;
 
 /**
+ * What a generator for grid needs (memory.h): its elevation buffer, 4 bytes
+ * a point, and the octave tables. GR_ERR_INVALID_ARGUMENT without grid or out.
+ */
+GR_API gr_status gr_procedural_terrain_memory(const gr_grid *grid, gr_memory_need *out);
+
+/**
  * A terrain generator for one grid: validates the grid and the parameters,
- * builds the kernel and allocates the elevation buffer on the device.
+ * checks gr_procedural_terrain_memory against what there is (a grid that
+ * does not fit is GR_ERR_TOO_LARGE, before anything is allocated), builds
+ * the kernel and allocates the elevation buffer on the device.
  */
 GR_API gr_status gr_procedural_terrain_create(gr_context *ctx, const gr_grid *grid,
                                               const gr_procedural_terrain_params *p,

@@ -121,6 +121,7 @@
 #ifndef GRAUPEL_RAIN_RUNOFF_H
 #define GRAUPEL_RAIN_RUNOFF_H
 
+#include "graupel/memory.h"
 #include "graupel/runtime.h"
 
 #ifdef __cplusplus
@@ -239,7 +240,27 @@ typedef struct gr_rain_runoff_ledger {
 typedef struct gr_rain_runoff gr_rain_runoff;
 
 /**
- * A simulation on one grid: validates grid and parameters, builds the
+ * What a simulation on grid needs on ctx's device (memory.h), its ring
+ * included, with the optional inputs of `inputs` (GR_RAIN_RUNOFF_INPUT_*
+ * bits, below; GR_RAIN_RUNOFF_INPUT_ALL for the most): on the device 27
+ * floats a cell of state and flood maps, the two sets of face discharges,
+ * the derived fields' three floats, the initial water, a float a cell per
+ * input (two for inflows), and on a device that runs the shallow-water
+ * stages as separate launches (not a GPU; ctx NULL counts them) their six
+ * planes of x- and y-faces, about 48 bytes a cell; on the host the no-data
+ * mask's byte and the copies made while inputs are set (8 bytes a cell).
+ * Initial velocities (2 floats a cell) and the fused local inertial step's
+ * two planes (gr_rain_runoff_set_li_fused) are not counted.
+ * GR_ERR_INVALID_ARGUMENT without grid, p or out.
+ */
+GR_API gr_status gr_rain_runoff_memory(const gr_context *ctx, const gr_grid *grid,
+                                       const gr_rain_runoff_params *p, int inputs,
+                                       gr_memory_need *out);
+
+/**
+ * A simulation on one grid: validates grid and parameters, refuses a grid
+ * whose state (gr_rain_runoff_memory without optional inputs) does not fit
+ * (GR_ERR_TOO_LARGE, before anything is allocated), builds the
  * kernels and allocates the device state (dry, flat ground until
  * ELEVATION is set).
  */

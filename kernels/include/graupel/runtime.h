@@ -83,6 +83,8 @@ typedef struct gr_device_info {
   int compute_units;
   unsigned long long global_mem_bytes;
   unsigned long long max_alloc_bytes;
+  /** 1 when its buffers are host memory (a CPU device, or CL_DEVICE_HOST_UNIFIED_MEMORY). */
+  int host_memory;
 } gr_device_info;
 
 /**

@@ -70,6 +70,7 @@
 #ifndef GRAUPEL_SKY_H
 #define GRAUPEL_SKY_H
 
+#include "graupel/memory.h"
 #include "graupel/runtime.h"
 
 #ifdef __cplusplus
@@ -176,9 +177,18 @@ GR_API const gr_param_bound *gr_sky_param_bounds(int *count);
 typedef struct gr_cloud_cover gr_cloud_cover;
 
 /**
- * A cloud image: validates the parameters and the grid against the device,
- * builds the kernels, allocates the buffers and measures the Seed's noise
- * distribution (one small launch, waited for).
+ * What a cloud image of p's Resolution needs (memory.h): 11 bytes a pixel
+ * on the device (the noise and the cloud's floats, the colour's three
+ * bytes) and the Seed's noise sample on both sides. GR_ERR_INVALID_ARGUMENT
+ * without p or out.
+ */
+GR_API gr_status gr_cloud_cover_memory(const gr_cloud_cover_params *p, gr_memory_need *out);
+
+/**
+ * A cloud image: validates the parameters and the grid against the device
+ * and its memory (gr_cloud_cover_memory; GR_ERR_TOO_LARGE before anything
+ * is allocated), builds the kernels, allocates the buffers and measures the
+ * Seed's noise distribution (one small launch, waited for).
  */
 GR_API gr_status gr_cloud_cover_create(gr_context *ctx, const gr_cloud_cover_params *p,
                                        gr_cloud_cover **out);

@@ -80,6 +80,7 @@
 #ifndef GRAUPEL_SNOW_ACCUMULATION_H
 #define GRAUPEL_SNOW_ACCUMULATION_H
 
+#include "graupel/memory.h"
 #include "graupel/runtime.h"
 
 #ifdef __cplusplus
@@ -161,12 +162,26 @@ typedef struct gr_snow_accumulation_ledger {
 typedef struct gr_snow_accumulation gr_snow_accumulation;
 
 /**
+ * What a simulation on grid with p's ExposureResolution needs (memory.h),
+ * its ring included and its objects not (they add their mesh points'
+ * arrays): 48 bytes a point on the device (ground, initial depth, growth,
+ * scratch, noise and the seven snow arrays), the exposure view's int a
+ * texel, and 8 bytes a row on the host. GR_ERR_INVALID_ARGUMENT without
+ * grid, p or out.
+ */
+GR_API gr_status gr_snow_accumulation_memory(const gr_grid *grid,
+                                             const gr_snow_accumulation_params *p,
+                                             gr_memory_need *out);
+
+/**
  * A simulation on a whole grid or a piece of one (see "Pieces of a split
  * domain" below): validates grid and parameters, checks
  * that the exposure view fits the device (no wider than its largest 2-D
  * image where it has images, and within its largest buffer:
- * GR_ERR_TOO_LARGE with a sentence otherwise), builds the kernels, and
- * starts with flat ground at 0, no snow and no objects.
+ * GR_ERR_TOO_LARGE with a sentence otherwise) and that the grid fits in
+ * memory (gr_snow_accumulation_memory; GR_ERR_TOO_LARGE before anything is
+ * allocated), builds the kernels, and starts with flat ground at 0, no
+ * snow and no objects.
  */
 GR_API gr_status gr_snow_accumulation_create(gr_context *ctx, const gr_grid *grid,
                                              const gr_snow_accumulation_params *p,

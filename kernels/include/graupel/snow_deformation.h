@@ -123,6 +123,7 @@
 #ifndef GRAUPEL_SNOW_DEFORMATION_H
 #define GRAUPEL_SNOW_DEFORMATION_H
 
+#include "graupel/memory.h"
 #include "graupel/runtime.h"
 
 #ifdef __cplusplus
@@ -213,9 +214,21 @@ typedef struct gr_snow_deformation_ledger {
 typedef struct gr_snow_deformation gr_snow_deformation;
 
 /**
+ * What a simulation on grid needs (memory.h), its ring included and its
+ * objects not (they add 36 bytes a triangle): 68 bytes a point on the
+ * device (depth and density twice, ground, the initial depth and density,
+ * the underside, overlap, weight, overlap sum, contact, underside minimum,
+ * the talus rates in and out, the movable snow and a scratch plane).
+ * GR_ERR_INVALID_ARGUMENT without grid or out.
+ */
+GR_API gr_status gr_snow_deformation_memory(const gr_grid *grid, gr_memory_need *out);
+
+/**
  * A simulation on a whole grid or a piece of one (see "Pieces of a split
  * domain" below): validates grid and
- * parameters, builds the kernels, allocates the state: flat ground at 0,
+ * parameters, refuses a grid that gr_snow_deformation_memory says does not
+ * fit (GR_ERR_TOO_LARGE, before anything is allocated), builds the kernels,
+ * allocates the state: flat ground at 0,
  * snow of initial_snow_depth and initial_density, no objects.
  */
 GR_API gr_status gr_snow_deformation_create(gr_context *ctx, const gr_grid *grid,

@@ -58,6 +58,7 @@
 #ifndef GRAUPEL_TERRAIN_ANALYSIS_H
 #define GRAUPEL_TERRAIN_ANALYSIS_H
 
+#include "graupel/memory.h"
 #include "graupel/runtime.h"
 
 #ifdef __cplusplus
@@ -124,8 +125,18 @@ GR_API const gr_param_bound *gr_terrain_analysis_param_bounds(int *count);
 typedef struct gr_terrain_analysis gr_terrain_analysis;
 
 /**
+ * What an analysis of grid needs (memory.h): 37 bytes a point on the device
+ * (the heights, the normal's three floats, slope, aspect, hillshade, snow
+ * cover, shadow and the cover class's byte) and a byte a row on the host.
+ * GR_ERR_INVALID_ARGUMENT without grid or out.
+ */
+GR_API gr_status gr_terrain_analysis_memory(const gr_grid *grid, gr_memory_need *out);
+
+/**
  * An analysis of one whole grid: validates the grid and the parameters,
- * builds the kernels and allocates the device buffers.
+ * refuses one that gr_terrain_analysis_memory says does not fit
+ * (GR_ERR_TOO_LARGE, before anything is allocated), builds the kernels and
+ * allocates the device buffers.
  */
 GR_API gr_status gr_terrain_analysis_create(gr_context *ctx, const gr_grid *grid,
                                             const gr_terrain_analysis_params *p,

@@ -80,6 +80,7 @@
 #ifndef GRAUPEL_WATER_SURFACE_H
 #define GRAUPEL_WATER_SURFACE_H
 
+#include "graupel/memory.h"
 #include "graupel/runtime.h"
 
 #ifdef __cplusplus
@@ -151,8 +152,19 @@ typedef struct gr_water_surface_ledger {
 typedef struct gr_water_surface gr_water_surface;
 
 /**
+ * What a simulation on grid needs (memory.h), its ring included: 37 bytes a
+ * point on the device (h twice, v, base, the drops' g, the initial h and
+ * the derived fields' three floats, the wet mask's byte) and 13 on the host
+ * (the elevation, the depth, and the wet mask and still surface made when
+ * the water is prepared). GR_ERR_INVALID_ARGUMENT without grid or out.
+ */
+GR_API gr_status gr_water_surface_memory(const gr_grid *grid, gr_memory_need *out);
+
+/**
  * A simulation on a whole grid or a piece of one (see "Pieces of a split
- * domain"), at rest, with flat ground at 0 and no water yet.
+ * domain"), at rest, with flat ground at 0 and no water yet. A grid that
+ * gr_water_surface_memory says does not fit is GR_ERR_TOO_LARGE, before
+ * anything is allocated.
  */
 GR_API gr_status gr_water_surface_create(gr_context *ctx, const gr_grid *grid,
                                          const gr_water_surface_params *p, gr_water_surface **out);
