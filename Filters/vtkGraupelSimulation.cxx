@@ -301,12 +301,11 @@ int vtkGraupelSimulation::AdvertiseTimes(vtkInformationVector **inputVector,
   this->DeliveredTime.resize(static_cast<size_t>(nports), 0.0);
   this->PendingTime.resize(static_cast<size_t>(nports), 0.0);
   for (int port = 0; port < nports; ++port) {
-    // The Input follows the simulated time only when asked (FollowInputTime);
-    // other ports by their policy (objects in motion, inflows in time).
-    const bool temporal = port == 0
-                              ? this->FollowInputTime != 0
-                              : static_cast<size_t>(port) < this->Policies.size() &&
-                                    this->Policies[static_cast<size_t>(port)] == TEMPORAL_INPUT;
+    // A port follows the simulated time by its policy (objects in motion,
+    // inflows in time), the Input also when asked (FollowInputTime).
+    const bool temporal = (static_cast<size_t>(port) < this->Policies.size() &&
+                           this->Policies[static_cast<size_t>(port)] == TEMPORAL_INPUT) ||
+                          (port == 0 && this->FollowInputTime != 0);
     vtkInformation *inInfo = inputVector[port]->GetInformationObject(0);
     if (!temporal || !inInfo || !inInfo->Has(vtkStreamingDemandDrivenPipeline::TIME_STEPS())) {
       continue;

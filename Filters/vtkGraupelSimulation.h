@@ -20,7 +20,8 @@
  * - STATIC: read once (a terrain). An input with times of its own (another
  *   simulation's output) is read at InputTime, by default its last time;
  *   one without at no time. A change of its data sets the simulation up
- *   again. The Input (port 0) is static unless FollowInputTime is on.
+ *   again. The Input (port 0) is static unless its class declares it
+ *   temporal or FollowInputTime is on.
  * - TEMPORAL: read at the simulated time while stepping (a moving object,
  *   rain that varies). Its data at input time step tau_i holds from tau_i
  *   until the next input time step (sample and hold; before the first step
