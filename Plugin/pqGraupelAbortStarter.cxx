@@ -195,8 +195,10 @@ void pqGraupelAbortStarter::onProgressEnd() {
   }
   this->Active = false;
   if (Aborted) {
-    Aborted->SetAbortExecute(0);
-    Aborted = nullptr;
+    // A Render updates in several passes, each with its own progress: the
+    // abort holds until the event loop is idle again (no progress shown),
+    // or the next pass would run the aborted algorithm again.
+    QTimer::singleShot(0, this, [this]() { this->releaseAbort(); });
   }
   QApplication::instance()->removeEventFilter(this);
   pqApplicationCore::instance()->getProgressManager()->setEnableAbort(false);
@@ -215,7 +217,12 @@ void pqGraupelAbortStarter::onProgress(const QString &text, int percent) {
   // update that the look's render starts left QMainWindow's dock animator
   // with a deleted animation, and the next drag of a dock's separator
   // crashed (Testing/Python/check_gui_docks.py).
-  if (!LastProgressing || !LastProgressing->IsA("vtkGraupelAlgorithm")) {
+  // Terrain Surface (a polydata filter of the plugin) too, except while the
+  // look adds one: that update runs inside a timer's handler.
+  if (!LastProgressing ||
+      !(LastProgressing->IsA("vtkGraupelAlgorithm") ||
+        LastProgressing->IsA("vtkTerrainSurfaceFilter")) ||
+      pqGraupelApplyLook::busy()) {
     return;
   }
   if (!this->TestArmed && text.contains(QLatin1String(" s of "))) {
@@ -230,6 +237,16 @@ void pqGraupelAbortStarter::onProgress(const QString &text, int percent) {
   QApplication::processEvents();
   this->Processing = false;
   pm->unblockEvents(wasUnblocked);
+}
+
+void pqGraupelAbortStarter::releaseAbort() {
+  if (this->Active) {
+    return; // a pass is running: its own end posts this again
+  }
+  if (Aborted) {
+    Aborted->SetAbortExecute(0);
+    Aborted = nullptr;
+  }
 }
 
 void pqGraupelAbortStarter::onAbort() {

@@ -11,17 +11,23 @@
  * plugin, for builtin sessions only:
  * - while progress is shown, the abort button is enabled;
  * - on each progress event the GUI forwards (vtkPVProgressHandler lets one
- *   through every 0.1 s at most) Qt processes pending events, with all user
- *   input except the abort button's held back, so the click is delivered
- *   but nothing else can start a second update inside this one;
+ *   through every 0.1 s at most) from a Graupel algorithm or Terrain
+ *   Surface, Qt processes pending events, with all user input except the
+ *   abort button's (and Pause's while an animation plays) held back, so the
+ *   click is delivered but nothing else can start a second update inside
+ *   this one; never under a representation's update, nor while the look
+ *   adds a surface from its timer (events processed there broke QMainWindow's
+ *   dock animation);
  * - a click sets AbortExecute on the algorithm that reported progress last
  *   in this update (the one running), as ParaView 6.1 does;
  * - that algorithm gets AbortExecute again each time it starts to execute
- *   until the progress ends: ParaView's Render asks for the data more than
+ *   until the event loop is idle again: ParaView's Render asks for the data more than
  *   once, and an aborted output (VTK's ABORTED flag) makes the next request
  *   execute again. A Graupel simulation then returns its empty output at
- *   once; the next Render (a new time, Apply) runs it. When the progress
- *   ends the flag is cleared, for filters that do not clear it themselves.
+ *   once; the next Render (a new time, Apply) runs it. The flag is cleared
+ *   once the event loop is idle again after the progress ended (a Render's
+ *   later passes would run the algorithm again), for filters that do not
+ *   clear it themselves.
  * An algorithm honours an abort at its next abort check: a Graupel
  * simulation within about 0.1 s of simulated stepping.
  *
@@ -65,6 +71,7 @@ private:
   void onProgressEnd();
   void onProgress(const QString &text, int percent);
   void onAbort();
+  void releaseAbort();
 
   Q_DISABLE_COPY(pqGraupelAbortStarter)
   bool Active = false;     // a builtin update shows progress now

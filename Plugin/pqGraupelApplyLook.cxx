@@ -296,7 +296,17 @@ void pqGraupelApplyLook::showSurfaceLater(QPointer<pqPipelineSource> source, int
     }
     return;
   }
+  // The surface's update runs inside this timer's handler: no events are
+  // processed under it (pqGraupelAbortStarter asks busy()).
+  Busy = true;
   this->showSurface(source);
+  Busy = false;
+}
+
+bool pqGraupelApplyLook::Busy = false;
+
+bool pqGraupelApplyLook::busy() {
+  return Busy;
 }
 
 void pqGraupelApplyLook::showSurface(pqPipelineSource *source) {

@@ -73,6 +73,9 @@ public:
   /** The legend title of a colour array: "water depth (m)"; the name itself when unknown. */
   static const char *legendTitle(const char *array);
 
+  /** Whether the look is adding a surface now (its updates run inside a timer's handler). */
+  static bool busy();
+
 private:
   void onSourceAdded(pqPipelineSource *source);
   void onModifiedStateChanged(pqPipelineSource *source);
@@ -89,7 +92,8 @@ private:
   QSet<pqPipelineSource *> Pending;                  // made from a menu, not applied yet
   QSet<pqPipelineSource *> Waiting;                  // applied, but no update has given points yet
   QMap<pqPipelineSource *, QVector<double>> Extents; // surfaces added: x and y bounds
-  bool Updating = false;                             // between progress start and end
+  bool Updating = false;
+  static bool Busy; // between progress start and end
 };
 
 #endif
