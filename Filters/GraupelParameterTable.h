@@ -10,6 +10,24 @@
 #include <string>
 
 namespace graupel {
+/** The row of property in the table that bounds returns; nullptr when it has none. */
+inline const gr_param_bound *TableRow(const gr_param_bound *(*bounds)(int *),
+                                      const char *property) {
+  int count = 0;
+  const gr_param_bound *table = bounds(&count);
+  return gr_param_find(table, count, property);
+}
+
+/**
+ * The default of property from its table row: the one place a default is
+ * written (py.param_bounds checks that the row exists and that the XML and
+ * README agree with it).
+ */
+inline double TableDefault(const gr_param_bound *(*bounds)(int *), const char *property) {
+  const gr_param_bound *row = TableRow(bounds, property);
+  return row ? row->default_value : std::nan("");
+}
+
 /** value clamped by the table row of property (unchanged when the table has no such row). */
 inline double ClampToTable(const gr_param_bound *(*bounds)(int *), const char *property,
                            double value) {

@@ -36,9 +36,7 @@ constexpr double MillimetresPerHour = 1.0 / 3.6e6;
 
 // The core's parameter table row for a property, or nullptr.
 const gr_param_bound *Bound(const char *property) {
-  int count = 0;
-  const gr_param_bound *table = gr_rain_runoff_param_bounds(&count);
-  return gr_param_find(table, count, property);
+  return graupel::TableRow(gr_rain_runoff_param_bounds, property);
 }
 
 } // namespace

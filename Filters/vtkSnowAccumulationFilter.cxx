@@ -35,14 +35,11 @@ using graupel::AddValue;
 using graupel::AsFloat;
 using graupel::Posed;
 const gr_param_bound *Bound(const char *property) {
-  int count = 0;
-  const gr_param_bound *table = gr_snow_accumulation_param_bounds(&count);
-  return gr_param_find(table, count, property);
+  return graupel::TableRow(gr_snow_accumulation_param_bounds, property);
 }
 
-double TableDefault(const char *property, double fallback) {
-  const gr_param_bound *b = Bound(property);
-  return b ? b->default_value : fallback;
+double TableDefault(const char *property) {
+  return graupel::TableDefault(gr_snow_accumulation_param_bounds, property);
 }
 
 double TableToCore(const char *property) {
@@ -60,18 +57,18 @@ vtkSnowAccumulationFilter::vtkSnowAccumulationFilter()
   // each (72 exposure views). Growth is a rate times dt, so longer steps
   // give the same snow; they only see the exposure change less often.
   this->SetTimeDefaults(21600.0, 900.0);
-  this->Flutter = TableDefault("Flutter", 0.0);
-  this->SnowfallRate = TableDefault("SnowfallRate", 2.0);
-  this->NoiseAmplitude = TableDefault("NoiseAmplitude", 0.2);
-  this->NoiseScale = TableDefault("NoiseScale", 1.0);
-  this->Seed = static_cast<int>(TableDefault("Seed", 0.0));
-  this->ExposureResolution = static_cast<int>(TableDefault("ExposureResolution", 1024.0));
-  this->BlurRadius = static_cast<int>(TableDefault("BlurRadius", 1.0));
-  this->Dilation = static_cast<int>(TableDefault("Dilation", 0.0));
-  this->MaxDepth = TableDefault("MaxDepth", 1.0);
-  this->StabilityFactor = TableDefault("StabilityFactor", 1.0);
-  this->SnowDensity = TableDefault("SnowDensity", 100.0);
-  this->AccumulationTextureSize = static_cast<int>(TableDefault("AccumulationTextureSize", 256.0));
+  this->Flutter = TableDefault("Flutter");
+  this->SnowfallRate = TableDefault("SnowfallRate");
+  this->NoiseAmplitude = TableDefault("NoiseAmplitude");
+  this->NoiseScale = TableDefault("NoiseScale");
+  this->Seed = static_cast<int>(TableDefault("Seed"));
+  this->ExposureResolution = static_cast<int>(TableDefault("ExposureResolution"));
+  this->BlurRadius = static_cast<int>(TableDefault("BlurRadius"));
+  this->Dilation = static_cast<int>(TableDefault("Dilation"));
+  this->MaxDepth = TableDefault("MaxDepth");
+  this->StabilityFactor = TableDefault("StabilityFactor");
+  this->SnowDensity = TableDefault("SnowDensity");
+  this->AccumulationTextureSize = static_cast<int>(TableDefault("AccumulationTextureSize"));
   // The core runs as pieces of a split domain (an MPI run's strips); its
   // ring follows BlurRadius (RequestInformation sets it again).
   gr_snow_accumulation_params ring;

@@ -32,9 +32,7 @@ using graupel::AddValue;
 using graupel::AsFloat;
 using graupel::Posed;
 const gr_param_bound *Bound(const char *property) {
-  int count = 0;
-  const gr_param_bound *table = gr_snow_deformation_param_bounds(&count);
-  return gr_param_find(table, count, property);
+  return graupel::TableRow(gr_snow_deformation_param_bounds, property);
 }
 
 // rho min and rho max (kg/m^3) per DensityPresets value from 1 on. The snow
@@ -55,9 +53,8 @@ const double DensityPresetTable[][2] = {
     {1500.0, 1700.0} // SAND
 };
 
-double TableDefault(const char *property, double fallback) {
-  const gr_param_bound *b = Bound(property);
-  return b ? b->default_value : fallback;
+double TableDefault(const char *property) {
+  return graupel::TableDefault(gr_snow_deformation_param_bounds, property);
 }
 
 void AddForce(vtkFieldData *fd, const double force[3], double peak, double area) {
@@ -82,9 +79,9 @@ vtkSnowDeformationFilter::vtkSnowDeformationFilter()
   this->SetTimeDefaults(10.0, 0.25);
   // The core runs as pieces of a split domain (an MPI run's strips).
   this->SetPieceRing(GR_SNOW_DEFORMATION_GHOST);
-  this->MaxRelaxIterations = static_cast<int>(TableDefault("MaxRelaxIterations", 64));
-  this->RelaxTolerance = TableDefault("RelaxTolerance", 1e-4);
-  this->SlumpSpeed = TableDefault("SlumpSpeed", 2.0);
+  this->MaxRelaxIterations = static_cast<int>(TableDefault("MaxRelaxIterations"));
+  this->RelaxTolerance = TableDefault("RelaxTolerance");
+  this->SlumpSpeed = TableDefault("SlumpSpeed");
 }
 
 vtkSnowDeformationFilter::~vtkSnowDeformationFilter() {
