@@ -31,8 +31,6 @@ vtkStandardNewMacro(vtkRainRunoffFilter);
 namespace {
 using graupel::AddValue;
 using graupel::AsFloat;
-// User-facing intensities are in mm/h; the core speaks m/s.
-constexpr double MillimetresPerHour = 1.0 / 3.6e6;
 
 // The core's parameter table row for a property, or nullptr.
 const gr_param_bound *Bound(const char *property) {
@@ -295,8 +293,9 @@ int vtkRainRunoffFilter::SetUpState(vtkInformationVector **inputVector) {
 
   gr_rain_runoff_params p;
   gr_rain_runoff_params_init(&p);
-  p.rain_rate = this->RainRate * MillimetresPerHour;
-  p.permeability = this->Permeability * MillimetresPerHour;
+  // The user's units (mm/h) to the core's (m/s): each row's to_core.
+  p.rain_rate = this->RainRate * Bound("RainRate")->to_core;
+  p.permeability = this->Permeability * Bound("Permeability")->to_core;
   p.manning_n = this->ManningN;
   p.cfl = this->CourantNumber;
   p.max_dt = this->MaxTimeStep;
@@ -404,8 +403,9 @@ int vtkRainRunoffFilter::SetUpState(vtkInformationVector **inputVector) {
   // The hyetograph, in m/s.
   if (!this->HyetographTimes.empty()) {
     std::vector<double> rates(this->HyetographRates);
+    const double toCore = Bound("RainRate")->to_core; // mm/h, as RainRate
     for (double &r : rates) {
-      r *= MillimetresPerHour;
+      r *= toCore;
     }
     if (gr_rain_runoff_set_hyetograph(this->Simulation, this->HyetographTimes.data(), rates.data(),
                                       static_cast<int>(this->HyetographTimes.size())) != GR_OK) {
