@@ -11,14 +11,9 @@ import os
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from gr_gui import APPLY, State, paraview, write_events  # noqa: E402
+from gr_gui import APPLY, State, paraview, setup, write_events  # noqa: E402
 
-scratch = sys.argv[sys.argv.index("--scratch") + 1]
-plugin_dir = sys.argv[sys.argv.index("--plugin-dir") + 1]
-state = os.path.join(scratch, "gui_apply.pvsm")
-script = os.path.join(scratch, "gui_apply.xml")
-if os.path.exists(state):
-    os.remove(state)
+scratch, plugin_dir, state, script = setup("gui_apply")
 
 write_events(script, [
     ("pqClientMainWindow/menubar/menuSources/Graupel", "activate", "ProceduralTerrain"),

@@ -32,14 +32,9 @@ import subprocess
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from gr_gui import APPLY, PANEL, State, paraview, write_events  # noqa: E402
+from gr_gui import APPLY, PANEL, State, paraview, setup, write_events  # noqa: E402
 
-scratch = sys.argv[sys.argv.index("--scratch") + 1]
-plugin_dir = sys.argv[sys.argv.index("--plugin-dir") + 1]
-state = os.path.join(scratch, "gui_look.pvsm")
-script = os.path.join(scratch, "gui_look.xml")
-if os.path.exists(state):
-    os.remove(state)
+scratch, plugin_dir, state, script = setup("gui_look")
 
 chart_script = os.path.join(scratch, "gui_look_chart.py")
 with open(chart_script, "w") as f:

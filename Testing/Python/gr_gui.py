@@ -5,11 +5,24 @@ plugin on PV_PLUGIN_PATH, and the state file it saved read back.
 the Python lock the GUI holds.)"""
 import os
 import subprocess
+import sys
 import xml.etree.ElementTree as ET
 
 APPLY = "pqClientMainWindow/propertiesDock/propertiesPanel/Accept"
 PANEL = ("pqClientMainWindow/propertiesDock/propertiesPanel/scrollArea/qt_scrollarea_viewport/"
          "scrollAreaWidgetContents/PropertiesFrame/ProxyPanel/")
+
+
+def setup(name):
+    """The test's arguments and files: (scratch, plugin_dir, state, script),
+    the state NAME.pvsm (removed if an earlier run left one) and the script
+    NAME.xml in the scratch folder."""
+    scratch = sys.argv[sys.argv.index("--scratch") + 1]
+    plugin_dir = sys.argv[sys.argv.index("--plugin-dir") + 1]
+    state = os.path.join(scratch, name + ".pvsm")
+    if os.path.exists(state):
+        os.remove(state)
+    return scratch, plugin_dir, state, os.path.join(scratch, name + ".xml")
 
 
 def write_events(path, events):

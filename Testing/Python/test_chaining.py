@@ -89,19 +89,22 @@ terrain = graupel.vtkProceduralTerrainSource()
 terrain.SetDimensions(32, 32)
 terrain.SetSpacing(2.0)
 terrain.SetHeightScale(4.0)
-rain = graupel.vtkRainRunoffFilter()
-rain.SetInputConnection(terrain.GetOutputPort())
-rain.SetRainRate(100.0)
-rain.SetEndTime(600.0)
-rain.SetOutputInterval(300.0)
+
+
+def storm():
+    rain = graupel.vtkRainRunoffFilter()
+    rain.SetInputConnection(terrain.GetOutputPort())
+    rain.SetRainRate(100.0)
+    rain.SetEndTime(600.0)
+    rain.SetOutputInterval(300.0)
+    return rain
+
+
+rain = storm()
 rain.UpdateTimeStep(600.0)
 from vtkmodules.util.numpy_support import vtk_to_numpy  # noqa: E402
 depth = vtk_to_numpy(rain.GetOutputDataObject(0).GetPointData().GetArray("water_depth"))
-rain2 = graupel.vtkRainRunoffFilter()
-rain2.SetInputConnection(terrain.GetOutputPort())
-rain2.SetRainRate(100.0)
-rain2.SetEndTime(600.0)
-rain2.SetOutputInterval(300.0)
+rain2 = storm()
 ws = graupel.vtkWaterSurfaceFilter()
 ws.SetInputConnection(rain2.GetOutputPort(0))
 ws.SetEndTime(2.0)
