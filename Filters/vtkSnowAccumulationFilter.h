@@ -9,9 +9,11 @@
  * Input 1 (`Objects`, optional) is triangle meshes (vtkPolyData, whose
  * polygons and strips are split into triangles here; open surfaces such as
  * a roof are fine) or a multiblock of them, one object per non-empty leaf.
- * They shadow the terrain and each other and keep their own snow, one
- * depth per point of the polydata (so the output's point arrays match the
- * input's points). Polygons wound counter-clockwise seen from outside (VTK's
+ * They shadow the terrain and each other and keep their own snow on their
+ * faces (each triangle exposed, growing and shedding with its own normal),
+ * shown as one depth per point of the polydata (so the output's point
+ * arrays match the input's points): the mean of the point's faces weighted
+ * by the area each turns to the sky. Polygons wound counter-clockwise seen from outside (VTK's
  * sources are) receive snow on their outer side. Each object is handed to
  * the core in its own frame, about the centre of its bounds, with a pose
  * that puts it in the world.
@@ -44,8 +46,9 @@
  * `balance_error` (m^3: initial + snowfall - shed - dropped - stored).
  * Output 1 is the objects at their pose at the output time (vtkPolyData, or
  * a multiblock of the same structure as the input) with the point arrays
- * `snow_depth` (m, along the point's normal) and `snow_offset` (3
- * components, m: the world normal times the depth, for Warp By Vector).
+ * `snow_depth` (m, along the faces' normals) and `snow_offset` (3
+ * components, m: the faces' mean world normal times the depth, for Warp By
+ * Vector).
  * Output 2, Textures, is a multiblock with one vtkImageData per object:
  * for an object whose polydata has texture coordinates (its point data's
  * TCoords), its accumulation texture (the thesis' per-object texture:
@@ -54,7 +57,7 @@
  * 0 on texels no triangle covers); an empty image for the others, or for
  * all with AccumulationTextureSize 0. See
  * gr_snow_accumulation_set_object_texture: the texels are samples on the
- * surface stepped like the mesh points, a finer picture of the same snow
+ * surface stepped like the faces, a finer picture of the same snow
  * kept out of the ledger.
  *
  * Time defaults (SetTimeDefaults): EndTime 6 h (21600 s), OutputInterval

@@ -35,6 +35,7 @@ from vtkmodules.vtkCommonDataModel import (  # noqa: E402
 )
 from vtkmodules.vtkCommonExecutionModel import vtkTrivialProducer  # noqa: E402
 from vtkmodules.vtkFiltersGeneral import vtkOBBTree  # noqa: E402
+from vtkmodules.vtkFiltersCore import vtkTriangleFilter  # noqa: E402
 from vtkmodules.vtkFiltersSources import vtkConeSource, vtkCubeSource  # noqa: E402
 
 from graupel import vtkSnowAccumulationFilter, vtkSnowDeformationFilter  # noqa: E402
@@ -564,6 +565,92 @@ t1 = vtk_to_numpy(single.GetOutputDataObject(2).GetBlock(0).GetPointData()
                   .GetArray("snow_depth")).copy()
 T.check(t1.size == 256 and np.allclose(t1, want / 2, rtol=1e-5),
         "a single polydata at 1 h: 16 x 16 texels of %g m (%g..%g)" % (want / 2, t1.min(), t1.max()))
+
+# ---- growth and shedding together: the same snow in 10 steps or 100 ---------------
+# "Snow physics, checked from outside", defect 4: 20 cm/h for 4 h over MaxDepth 0.3 m
+# with StabilityFactor 0.001/s stored 7.8 % less in 10 steps than in 100 (growth added,
+# then a step's worth of shedding). Now each step is the exact solution of
+# dS/dt = r - k max(0, S - c), k = -ln(1 - f): the ground in the open and the box's top
+# sit at it, whatever the TimeStep.
+R20, T4 = 0.2 / HOUR, 4 * HOUR
+for factor in (0.001, 0.01):
+    k = -math.log1p(-factor)
+    exact = 0.3 + R20 / k * -math.expm1(-k * (T4 - 0.3 / R20))
+    vols = []
+    for steps in (10, 100):
+        g = snow(box(B), SnowfallRate=20.0, MaxDepth=0.3, StabilityFactor=factor,
+                 NoiseAmplitude=0.0, BlurRadius=0, EndTime=T4, OutputInterval=T4,
+                 TimeStep=T4 / steps)
+        d, out = at(g, T4)
+        vols.append(field(out, "stored_volume"))
+        objs = g.GetOutputDataObject(1)
+        od = vtk_to_numpy(objs.GetPointData().GetArray("snow_depth"))
+        top = vtk_to_numpy(objs.GetPointData().GetNormals())[:, 2] > 0.5
+        print("stability %g/s, %d steps: open ground %.6f m, box top %.6f m, exact %.6f m; "
+              "stored %.6f m^3" % (factor, steps, d[far].mean(), od[top].mean(), exact, vols[-1]))
+        T.check(np.allclose(d[far], exact, atol=0.01 * (exact - 0.3))
+                and np.allclose(od[top], exact, atol=0.01 * (exact - 0.3)),
+                "StabilityFactor %g, %d steps: the open ground and the box's top at the continuous "
+                "solution %.6f m (excess within 1 %%): %.6f, %.6f"
+                % (factor, steps, exact, d[far].mean(), od[top].mean()))
+    T.check(abs(vols[1] - vols[0]) <= 0.01 * vols[1],
+            "StabilityFactor %g: 10 and 100 steps store %.6f and %.6f m^3 (within 1 %%)"
+            % (factor, vols[0], vols[1]))
+
+# ---- snow from the faces: a capped cone, its flat-shaded copy, a box of 8 corners ----
+# Defect 5: snow followed the points' averaged normals, so a capped cone got the flat
+# ground's snow at its apex and none on its base ring. Now the faces grow and the points
+# show their faces' snow weighted by the area each turns to the sky.
+ALPHA, RC = math.radians(70.0), 1.0
+HC = RC * math.tan(ALPHA)
+smooth = cone((3.0, 3.0, 0.2 + HC / 2), HC, RC, res=32)
+tri = vtkTriangleFilter()
+tri.SetInputData(smooth)
+tri.Update()
+tris = tri.GetOutput()
+tp = vtk_to_numpy(tris.GetPoints().GetData())
+cells = [[tris.GetCell(c).GetPointId(q) for q in range(3)] for c in range(tris.GetNumberOfCells())]
+flat_pts = [tuple(tp[v] + np.array([5.5, 0.0, 0.0])) for c in cells for v in c]
+flat = polys(flat_pts, [(3 * c, 3 * c + 1, 3 * c + 2) for c in range(len(cells))])
+corners = [(x, y, z) for z in (0.2, 1.2) for y in (7.5, 9.5) for x in (2.0, 4.0)]
+box8 = polys(corners, [(0, 2, 3, 1), (4, 5, 7, 6), (0, 1, 5, 4), (2, 6, 7, 3), (0, 4, 6, 2),
+                       (1, 3, 7, 5)])
+g = snow(blocks(smooth, flat, box8), NoiseAmplitude=0.0)
+d, out = at(g, 2 * HOUR)
+want = RATE * 0.01 * 2.0
+chord = RC * math.cos(math.pi / 32)
+side = want * chord / math.hypot(chord, HC)  # a side face's rate x t x cos(slope)
+clear = (X > 5.0) & (X < 7.0) & (Y > 5.0) & (Y < 7.0)  # ground away from the three
+res_out = g.GetOutputDataObject(1)
+for b, name in ((0, "capped cone"), (1, "flat-shaded cone")):
+    leaf = res_out.GetBlock(b)
+    od = vtk_to_numpy(leaf.GetPointData().GetArray("snow_depth"))
+    pz = vtk_to_numpy(leaf.GetPoints().GetData())[:, 2]
+    off = vtk_to_numpy(leaf.GetPointData().GetArray("snow_offset"))
+    ring = np.abs(pz - 0.2) < 1e-4
+    apex = pz > 1.0
+    if b == 1:  # the base's own points face down and hold nothing
+        base = np.array([c for c in range(len(cells)) for _ in range(3)])
+        on_base = np.array([tris.GetCell(c).GetNumberOfPoints() == 3 and
+                            np.all(tp[cells[c]][:, 2] < 0.2 + 1e-4) for c in base])
+        T.check(np.all(od[on_base] == 0.0), "%s: the base's faces hold nothing" % name)
+        ring &= ~on_base
+    print("%s: %d base ring points %.6f..%.6f m, apex %.6f m; the sides' %.6f m (rate t cos 70 "
+          "%.6f), flat ground %.6f m" % (name, ring.sum(), od[ring].min(), od[ring].max(),
+                                          od[apex].mean(), side, want * math.cos(ALPHA),
+                                          d[clear].mean()))
+    T.check(ring.sum() >= 32 and np.allclose(od[ring], side, rtol=5e-3)
+            and np.allclose(od[apex], side, rtol=5e-3),
+            "%s: base ring and apex carry the sides' %.6f m (ring %.6f..%.6f, apex %.6f)"
+            % (name, side, od[ring].min(), od[ring].max(), od[apex].mean()))
+    T.check(np.all(off[ring][:, 2] > 0.3 * od[ring]),
+            "%s: the ring's snow_offset points up and out" % name)
+top8 = vtk_to_numpy(res_out.GetBlock(2).GetPoints().GetData())[:, 2] > 1.0
+od8 = vtk_to_numpy(res_out.GetBlock(2).GetPointData().GetArray("snow_depth"))
+T.check(np.allclose(od8[top8], want, rtol=1e-5) and np.all(od8[~top8] == 0.0)
+        and np.allclose(d[clear], want, rtol=1e-5),
+        "a box of 8 shared corners: its top corners carry the flat ground's %g m: %r"
+        % (want, od8))
 
 # ---- bad input: one sentence, empty outputs, the next good update works ------------
 nan_ground = np.zeros((N, N))

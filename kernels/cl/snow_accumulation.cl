@@ -265,29 +265,49 @@ __kernel void snow_accumulation_dilate(__global const float *restrict in, int nx
   out[gr_idx(i, j, nx)] = m;
 }
 
-/* Increment and stability of one point: the growth g lands, then the
- * excess over the capacity c is shed but for the fraction keep. Depth,
- * fallen and shed snow are pairs, so depth - fallen + shed stays what it
- * was. */
-GR_INLINE void snac_settle(float g, float c, float keep, __global float *restrict d,
+/* phi(z) = (1 - e^-z) / z: the share of a step's growth that a point
+ * above capacity keeps at the step's end (z = k dt); 1 - z / 2 + z^2 / 6
+ * for small z, 1 / z for large. */
+GR_INLINE float snac_phi(float z) {
+  if (z < 1.0e-3f)
+    return 1.0f - z * (0.5f - z * (1.0f / 6.0f));
+  return -expm1(-z) / z;
+}
+
+/* Increment and stability of one point over a step, integrated together
+ * (graupel/snow_accumulation.h, step 5): the growth g arrives at a
+ * constant rate through the step while the excess over the capacity c
+ * relaxes at rate k, and the excess at the step's end is the exact
+ * solution's: from x0 >= 0 at the start, x0 e^-kdt + g phi(kdt); from
+ * below capacity (reaching it within the step, with an excess E at the
+ * end had nothing been shed), E phi(kdt E / g). keep = e^-kdt; kdt >=
+ * 1e30 (StabilityFactor 1) sheds all the excess. Depth, fallen and shed
+ * snow are pairs, and what is shed leaves the depth's pair exactly as it
+ * joins the shed pair, so depth - fallen + shed stays what it was. */
+GR_INLINE void snac_settle(float g, float c, float keep, float kdt, __global float *restrict d,
                            __global float *restrict dl, __global float *restrict f,
                            __global float *restrict fl, __global float *restrict sh,
                            __global float *restrict sl, int k) {
   float dh = d[k], dlo = dl[k];
+  /* The excess before the growth (negative below capacity). */
+  float x0 = (dh - c) + dlo;
   if (g > 0.0f) {
     float fh = f[k], flo = fl[k];
     snac_df_add(&dh, &dlo, g);
     snac_df_add(&fh, &flo, g);
     f[k] = fh, fl[k] = flo;
   }
-  if ((dh - c) + dlo > 0.0f) {
-    /* The excess as a pair: (dh - c) exactly by TwoSum, plus dlo. */
+  if ((dh - c) + dlo > 0.0f && kdt > 0.0f) {
+    /* The excess as a pair: (dh - c) exactly by TwoSum, plus dlo; what is
+     * shed is that less the excess kept, x1. */
     float s = dh - c, bb = s - dh;
     float err = (dh - (s - bb)) + (-c - bb);
     float rh = s, rl = err + dlo;
-    if (keep > 0.0f) {
-      rh *= 1.0f - keep;
-      rl *= 1.0f - keep;
+    if (kdt < 1.0e30f) {
+      float e = rh + rl;
+      float x1 = x0 >= 0.0f ? x0 * keep + g * snac_phi(kdt) : e * snac_phi(kdt * fmin(e / g, 1.0f));
+      x1 = fmin(fmax(x1, 0.0f), e);
+      snac_df_add(&rh, &rl, -x1);
     }
     float shh = sh[k], shl = sl[k];
     snac_df_add(&dh, &dlo, -rh);
@@ -302,19 +322,21 @@ GR_INLINE void snac_settle(float g, float c, float keep, __global float *restric
 __kernel void
 snow_accumulation_apply(__global const float *restrict ground, int nx, int ny, float dx, float dy,
                         __global const float *restrict growth, float max_depth, float keep,
-                        __global float *restrict depth, __global float *restrict depth_lo,
-                        __global float *restrict fall, __global float *restrict fall_lo,
-                        __global float *restrict shed, __global float *restrict shed_lo) {
+                        float kdt, __global float *restrict depth,
+                        __global float *restrict depth_lo, __global float *restrict fall,
+                        __global float *restrict fall_lo, __global float *restrict shed,
+                        __global float *restrict shed_lo) {
   int i = get_global_id(0), j = get_global_id(1);
   if (!gr_inside(i, j, nx, ny))
     return;
   int c = gr_idx(i, j, nx);
   float3 nb = snac_normal(ground, (__global const float *)0, i, j, nx, ny, dx, dy);
-  snac_settle(growth[c], max_depth * fmax(0.0f, nb.z), keep, depth, depth_lo, fall, fall_lo, shed,
-              shed_lo, c);
+  snac_settle(growth[c], max_depth * fmax(0.0f, nb.z), keep, kdt, depth, depth_lo, fall, fall_lo,
+              shed, shed_lo, c);
 }
 
-/* A mesh point's test position: half a texel out along its normal. One
+/* An object's sample point (a face's centroid with the face's normal, or
+ * a texel's sample): its test position half a texel out along its normal. One
  * expression for snow_accumulation_objects and
  * snow_accumulation_object_surface, so both see the same floats. */
 GR_INLINE float3 snac_mesh_point(__global const float *restrict pos, float3 n, int v, float texel) {
@@ -393,7 +415,8 @@ __kernel void snow_accumulation_object_exposure(__global const float *restrict p
       snac_exposed(view, vw, vh, p.x, p.y, p.z, n, d, tau_x, tau_y, qx0, qy0, inv_texel, texel);
 }
 
-/* The mesh points: exposure (half a texel out along the normal), growth,
+/* The objects' faces (pos the centroid, nrm the face's normal) or the
+ * textures' samples: exposure (half a texel out along the normal), growth,
  * increment and stability, like the grid's but without blur. pos and nrm
  * are world (pos relative to grid point (0, 0) and zref), lattice the
  * object's own frame in noise lattice units. */
@@ -402,7 +425,7 @@ __kernel void snow_accumulation_objects(
     __global const float *restrict lattice, int nv, float dir_x, float dir_y, float dir_z,
     float tau_x, float tau_y, float qx0, float qy0, float inv_texel, float texel, int vw, int vh,
     __global const int *restrict view, float rate_dt, float amplitude, uint seed, float max_depth,
-    float keep, int terrain_drawn, __global const float *restrict ground,
+    float keep, float kdt, int terrain_drawn, __global const float *restrict ground,
     __global const float *restrict gdepth, int gnx, int gny, float gdx, float gdy, float zref,
     int have_surface, int have_exposure, __global const float *restrict surface,
     __global float *restrict exposure, __global float *restrict depth,
@@ -434,8 +457,8 @@ __kernel void snow_accumulation_objects(
   float noise = snac_noise(lattice[3 * v], lattice[3 * v + 1], lattice[3 * v + 2], seed);
   float g = rate_dt * e * fmax(0.0f, -dot(n, d)) * (1.0f + amplitude * noise);
   exposure[v] = e;
-  snac_settle(g, max_depth * fmax(0.0f, n.z), keep, depth, depth_lo, fall, fall_lo, shed, shed_lo,
-              v);
+  snac_settle(g, max_depth * fmax(0.0f, n.z), keep, kdt, depth, depth_lo, fall, fall_lo, shed,
+              shed_lo, v);
 }
 
 /* x w as a pair (TwoProduct), added to the sum hi + lo. */
@@ -446,7 +469,7 @@ GR_INLINE void snac_add_product(float *hi, float *lo, float x, float w) {
 }
 
 /* The ledger: stored, fallen and shed snow over the points first ..
- * first + n - 1, each weighted by area[] when weighted (mesh points), else
+ * first + n - 1, each weighted by area[] when weighted (faces), else
  * 1 (grid points: the host multiplies by dx dy). */
 __kernel void snow_accumulation_reduce(
     __global const float *restrict depth, __global const float *restrict depth_lo,

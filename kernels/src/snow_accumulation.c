@@ -22,7 +22,7 @@
 #define GR_SNAC_PI 3.14159265358979323846
 /* Checkpoints: "GSA1". */
 #define GR_SNAC_STATE_MAGIC 0x31415347u
-#define GR_SNAC_STATE_VERSION 3u /* 3: a piece's j0 and the initial snow per row */
+#define GR_SNAC_STATE_VERSION 4u /* 3: a piece's j0 and the initial snow per row; 4: per face */
 /* Per-point arrays of the state: depth, its low part, fallen and shed
  * snow (pairs) and the exposure. */
 #define GR_SNAC_ARRAYS 7
@@ -84,7 +84,7 @@ struct gr_snow_accumulation {
   /* The ledger's initial grid snow per own row (m, per unit area), and the
    * objects' (m^3): see "Pieces" in the header for why per row. */
   double *init_rows, initial_objects;
-  /* Per local row, the row sums' 6 floats; per mesh point or sample, the
+  /* Per local row, the row sums' 6 floats; per face or sample, the
    * snow surface under it or its exposure (pieces only). */
   cl_mem rows_buf, o_surface;
   size_t o_surface_cap;
@@ -105,8 +105,10 @@ struct gr_snow_accumulation {
   cl_uint noise_seed;
   float noise_key[4];
   size_t view_cap; /* ints */
-  /* The objects: world triangles, per mesh point the world position and
-   * normal, the noise coordinates, the area and the state arrays. */
+  /* The objects: world triangles, per face (triangle) the world position
+   * of its centroid and its normal, the noise coordinates, the area and
+   * the state arrays: snow lives on the faces (object o's are trifirst[o]
+   * .. trifirst[o + 1] - 1), the mesh points show it (gr_snac_points). */
   int nobjects, nv, ntri;
   int first[GR_SNOW_ACCUMULATION_MAX_OBJECTS + 1], nverts[GR_SNOW_ACCUMULATION_MAX_OBJECTS];
   gr_mesh_memo memo[GR_SNOW_ACCUMULATION_MAX_OBJECTS]; /* each object's mesh as last checked */
@@ -125,7 +127,8 @@ struct gr_snow_accumulation {
   cl_mem t_pos, t_nrm, t_local, t_arr[GR_SNAC_ARRAYS];
   double *hv;                /* world vertices, 3 per mesh point, absolute */
   int *ht;                   /* triangles, indices into hv */
-  float *hnrm;               /* world normals, 3 per mesh point */
+  float *hnrm;               /* world normals, 3 per face */
+  float *harea;              /* face areas (the object's own frame) */
   double ob_lo[3], ob_hi[3]; /* the objects' world box */
   gr_reduction red, red_slope;
   double zref, bmin, bmax, init_max, snow_bound;
@@ -590,8 +593,8 @@ static gr_status gr_snac_initial_state(gr_snow_accumulation *s) {
                              "Copying the initial snow");
   for (int a = 1; st == GR_OK && a < GR_SNAC_ARRAYS; ++a)
     st = gr_snac_fill(s, s->arr[a], cells, 0.0f);
-  for (int a = 0; st == GR_OK && a < GR_SNAC_ARRAYS && s->nv > 0; ++a)
-    st = gr_snac_fill(s, s->o_arr[a], (size_t)s->nv, 0.0f);
+  for (int a = 0; st == GR_OK && a < GR_SNAC_ARRAYS && s->ntri > 0; ++a)
+    st = gr_snac_fill(s, s->o_arr[a], (size_t)s->ntri, 0.0f);
   for (int a = 0; st == GR_OK && a < GR_SNAC_ARRAYS && s->ns > 0; ++a)
     st = gr_snac_fill(s, s->t_arr[a], (size_t)s->ns, 0.0f);
   s->time = s->retired_fall = s->retired_shed = s->dropped = 0.0;
@@ -712,7 +715,7 @@ gr_status gr_snow_accumulation_create(gr_context *ctx, const gr_grid *grid,
   if (st == GR_OK)
     st = gr_snac_prepare(s, p);
   /* The objects' sums: a launch chosen for the domain's size, so that
-   * every piece of it adds the mesh points in the same groups. */
+   * every piece of it adds the faces in the same groups. */
   if (st == GR_OK)
     st = gr_reduction_init(ctx, s->reduce, (size_t)s->gnx * (size_t)s->gny, GR_SNAC_SUMS, 0,
                            &s->red);
@@ -768,6 +771,7 @@ void gr_snow_accumulation_destroy(gr_snow_accumulation *s) {
   free(s->hv);
   free(s->ht);
   free(s->hnrm);
+  free(s->harea);
   free(s->view_rows), free(s->view_cover);
   free(s->init_rows);
   for (int o = 0; o < GR_SNOW_ACCUMULATION_MAX_OBJECTS; ++o)
@@ -800,27 +804,36 @@ gr_status gr_snow_accumulation_set_params(gr_snow_accumulation *s,
 }
 
 /* Uploads the objects' world geometry relative to grid point (0, 0) and
- * zref (again whenever zref moves). */
+ * zref (again whenever zref moves): the triangles, and the faces' centroids
+ * (where a face is exposed and grows). */
 static gr_status gr_snac_upload_geometry(gr_snow_accumulation *s) {
-  if (s->nv == 0)
+  if (s->nv == 0 || s->ntri == 0)
     return GR_OK;
   size_t nv = (size_t)s->nv, nt = (size_t)s->ntri;
-  float *pos = malloc(nv * 3 * sizeof(float)), *tri = malloc((nt ? nt : 1) * 9 * sizeof(float));
-  if (!pos || !tri) {
-    free(pos), free(tri);
+  float *pos = malloc(nv * 3 * sizeof(float)), *tri = malloc(nt * 9 * sizeof(float));
+  float *cen = malloc(nt * 3 * sizeof(float));
+  if (!pos || !tri || !cen) {
+    free(pos), free(tri), free(cen);
     return gr_set_error(s->ctx, GR_ERR_OUT_OF_MEMORY, "Out of host memory.");
   }
   double off[3] = {s->grid.x0, s->grid.y0, s->zref};
   for (size_t v = 0; v < nv; ++v)
     for (int a = 0; a < 3; ++a)
       pos[3 * v + a] = (float)(s->hv[3 * v + a] - off[a]);
-  for (size_t t = 0; t < nt; ++t)
+  for (size_t t = 0; t < nt; ++t) {
+    const int *ix = s->ht + 3 * t;
     for (int k = 0; k < 3; ++k)
-      memcpy(tri + 9 * t + 3 * k, pos + 3 * (size_t)s->ht[3 * t + k], 3 * sizeof(float));
-  gr_status st = gr_buffer_write(s->ctx, s->o_pos, 0, nv * 3 * sizeof(float), pos);
-  if (st == GR_OK && nt)
+      memcpy(tri + 9 * t + 3 * k, pos + 3 * (size_t)ix[k], 3 * sizeof(float));
+    for (int a = 0; a < 3; ++a)
+      cen[3 * t + a] = (float)((s->hv[3 * (size_t)ix[0] + a] + s->hv[3 * (size_t)ix[1] + a] +
+                                s->hv[3 * (size_t)ix[2] + a]) /
+                                   3.0 -
+                               off[a]);
+  }
+  gr_status st = gr_buffer_write(s->ctx, s->o_pos, 0, nt * 3 * sizeof(float), cen);
+  if (st == GR_OK)
     st = gr_buffer_write(s->ctx, s->o_tri, 0, nt * 9 * sizeof(float), tri);
-  free(pos), free(tri);
+  free(pos), free(tri), free(cen);
   if (st != GR_OK || s->ns == 0)
     return st;
   size_t ns = (size_t)s->ns;
@@ -894,8 +907,9 @@ gr_status gr_snow_accumulation_set_field(gr_snow_accumulation *s, gr_field f, co
 }
 
 /* The new objects' geometry on the host: world vertices, triangles with
- * global indices, world normals (area-weighted), noise coordinates and
- * areas (in the object's own frame). */
+ * global indices, and per face its world normal, noise coordinates (its
+ * centroid in the object's own frame) and area (in the object's own
+ * frame); hlocal: the mesh points in their objects' frames. */
 typedef struct gr_snac_geometry {
   double *hv;
   int *ht;
@@ -912,15 +926,12 @@ static gr_status gr_snac_build_geometry(gr_snow_accumulation *s, const gr_mesh *
   size_t V = nv ? (size_t)nv : 1, T = nt ? (size_t)nt : 1;
   g->hv = malloc(V * 3 * sizeof(double));
   g->ht = malloc(T * 3 * sizeof(int));
-  g->nrm = calloc(V * 3, sizeof(float));
-  g->local = malloc(V * 3 * sizeof(float));
-  g->area = calloc(V, sizeof(float));
+  g->nrm = calloc(T * 3, sizeof(float));
+  g->local = malloc(T * 3 * sizeof(float));
+  g->area = calloc(T, sizeof(float));
   g->hlocal = malloc(V * 3 * sizeof(float));
-  double *acc = calloc(V * 3, sizeof(double)), *area = calloc(V, sizeof(double));
-  if (!g->hv || !g->ht || !g->nrm || !g->local || !g->area || !g->hlocal || !acc || !area) {
-    free(acc), free(area);
+  if (!g->hv || !g->ht || !g->nrm || !g->local || !g->area || !g->hlocal)
     return gr_set_error(s->ctx, GR_ERR_OUT_OF_MEMORY, "Out of host memory.");
-  }
   for (int a = 0; a < 3; ++a)
     g->lo[a] = HUGE_VAL, g->hi[a] = -HUGE_VAL;
   double inv_scale = 1.0 / s->params.noise_scale;
@@ -937,9 +948,6 @@ static gr_status gr_snac_build_geometry(gr_snow_accumulation *s, const gr_mesh *
         g->hv[3 * k + a] = w;
         g->lo[a] = fmin(g->lo[a], w);
         g->hi[a] = fmax(g->hi[a], w);
-        /* Per object a different stretch of the noise lattice. */
-        g->local[3 * k + a] =
-            (float)fmod(p[a] * inv_scale + 97.0 * (double)o, GR_SNAC_NOISE_PERIOD);
       }
     }
     for (int t = 0; t < m->ntriangles; ++t, ++at) {
@@ -954,6 +962,7 @@ static gr_status gr_snac_build_geometry(gr_snow_accumulation *s, const gr_mesh *
       double w[3] = {C[0] - A[0], C[1] - A[1], C[2] - A[2]};
       double cr[3] = {u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2],
                       u[0] * w[1] - u[1] * w[0]};
+      double len = sqrt(cr[0] * cr[0] + cr[1] * cr[1] + cr[2] * cr[2]);
       const float *a = m->vertices + 3 * m->triangles[3 * t],
                   *b = m->vertices + 3 * m->triangles[3 * t + 1],
                   *c = m->vertices + 3 * m->triangles[3 * t + 2];
@@ -961,23 +970,65 @@ static gr_status gr_snac_build_geometry(gr_snow_accumulation *s, const gr_mesh *
       double lw[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
       double lc[3] = {lu[1] * lw[2] - lu[2] * lw[1], lu[2] * lw[0] - lu[0] * lw[2],
                       lu[0] * lw[1] - lu[1] * lw[0]};
-      double la = 0.5 * sqrt(lc[0] * lc[0] + lc[1] * lc[1] + lc[2] * lc[2]);
-      for (int q = 0; q < 3; ++q) {
-        for (int e = 0; e < 3; ++e)
-          acc[3 * (size_t)idx[q] + e] += cr[e];
-        area[idx[q]] += la / 3.0;
+      g->area[at] = (float)(0.5 * sqrt(lc[0] * lc[0] + lc[1] * lc[1] + lc[2] * lc[2]));
+      for (int e = 0; e < 3; ++e) {
+        g->nrm[3 * at + e] = len > 0.0 ? (float)(cr[e] / len) : 0.0f;
+        /* Per object a different stretch of the noise lattice. */
+        double cen = ((double)a[e] + b[e] + c[e]) / 3.0;
+        g->local[3 * at + e] =
+            (float)fmod(cen * inv_scale + 97.0 * (double)o, GR_SNAC_NOISE_PERIOD);
       }
     }
   }
-  for (size_t v = 0; v < (size_t)nv; ++v) {
-    double *c = acc + 3 * v;
-    double len = sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
-    for (int e = 0; e < 3 && len > 0.0; ++e)
-      g->nrm[3 * v + e] = (float)(c[e] / len);
-    g->area[v] = (float)area[v];
-  }
-  free(acc), free(area);
   return GR_OK;
+}
+
+/* What object o's mesh points show of its faces' snow (the state lives on
+ * the faces): per point the mean of its faces' values (which = 0 the
+ * depth, 6 the exposure) weighted by the area each turns to the sky, A
+ * max(0, n . up), so that an edge between a roof and a wall or a cone's
+ * side and its base shows the snow of the face that holds it; a point
+ * whose faces all face sideways or down takes their plain area-weighted
+ * mean. With offsets (3 floats a point), the same mean of the faces' unit
+ * normals, made unit, times the depth. Waits. */
+static gr_status gr_snac_points(gr_snow_accumulation *s, int o, int which, float *host, int n,
+                                float *offsets) {
+  int t0 = s->trifirst[o], nt = s->trifirst[o + 1] - t0, v0 = s->first[o];
+  size_t N = n > 0 ? (size_t)n : 1;
+  float *f = malloc((nt > 0 ? (size_t)nt : 1) * sizeof(float));
+  double *acc = calloc(N * 10, sizeof(double));
+  gr_status st = GR_OK;
+  if (!f || !acc)
+    st = gr_set_error(s->ctx, GR_ERR_OUT_OF_MEMORY, "Out of host memory.");
+  if (st == GR_OK && nt > 0)
+    st = gr_buffer_read(s->ctx, s->o_arr[which], (size_t)t0 * sizeof(float),
+                        (size_t)nt * sizeof(float), f);
+  /* Per point: the sky-weighted sums (weight, value, normal) and the plain
+   * ones (weight, value, normal). */
+  for (int t = 0; st == GR_OK && t < nt; ++t) {
+    const float *nr = s->hnrm + 3 * (size_t)(t0 + t);
+    double area = s->harea[t0 + t], sky = area * fmax(0.0, (double)nr[2]);
+    for (int q = 0; q < 3; ++q) {
+      double *a = acc + 10 * (size_t)(s->ht[3 * (size_t)(t0 + t) + q] - v0);
+      a[0] += sky, a[1] += sky * f[t];
+      a[5] += area, a[6] += area * f[t];
+      for (int e = 0; e < 3; ++e)
+        a[2 + e] += sky * nr[e], a[7 + e] += area * nr[e];
+    }
+  }
+  for (int v = 0; st == GR_OK && v < n; ++v) {
+    const double *a = acc + 10 * (size_t)v;
+    int k = a[0] > 0.0 ? 0 : 5;
+    double value = a[k] > 0.0 ? a[k + 1] / a[k] : 0.0;
+    host[v] = (float)value;
+    if (offsets) {
+      double len = sqrt(a[k + 2] * a[k + 2] + a[k + 3] * a[k + 3] + a[k + 4] * a[k + 4]);
+      for (int e = 0; e < 3; ++e)
+        offsets[3 * v + e] = len > 0.0 ? (float)(a[k + 2 + e] / len * value) : 0.0f;
+    }
+  }
+  free(f), free(acc);
+  return st;
 }
 
 /* ------------------------------------------------- accumulation textures */
@@ -1196,52 +1247,54 @@ static gr_status gr_snac_set_objects_impl(gr_snow_accumulation *s, const gr_mesh
                           INT_MAX / 4, INT_MAX / 16);
   }
   first[n] = (int)nv;
-  /* Which objects keep their snow: the same index with as many points. */
-  int same = n == s->nobjects;
-  for (int o = 0; same && o < n; ++o)
-    same = meshes[o].nvertices == s->nverts[o];
+  /* Which objects keep their snow: the same index with as many points and
+   * faces (the snow lives on the faces). */
   unsigned char kept[GR_SNOW_ACCUMULATION_MAX_OBJECTS];
   int trifirst[GR_SNOW_ACCUMULATION_MAX_OBJECTS + 1];
   trifirst[0] = 0;
   for (int o = 0; o < n; ++o) {
-    kept[o] = (unsigned char)(o < s->nobjects && meshes[o].nvertices == s->nverts[o]);
+    kept[o] = (unsigned char)(o < s->nobjects && meshes[o].nvertices == s->nverts[o] &&
+                              meshes[o].ntriangles == s->trifirst[o + 1] - s->trifirst[o]);
     trifirst[o + 1] = trifirst[o] + meshes[o].ntriangles;
   }
+  int same = n == s->nobjects;
+  for (int o = 0; same && o < n; ++o)
+    same = kept[o];
   gr_snac_geometry g;
   memset(&g, 0, sizeof(g));
   gr_status st = gr_snac_build_geometry(s, meshes, n, first, (int)nv, (int)nt, &g);
   cl_mem nb[5] = {NULL, NULL, NULL, NULL, NULL}, na[GR_SNAC_ARRAYS];
   memset(na, 0, sizeof(na));
-  size_t V = nv ? (size_t)nv : 1, T = nt ? (size_t)nt : 1;
+  size_t T = nt ? (size_t)nt : 1;
   if (!same) {
-    size_t sizes[5] = {T * 9, V * 3, V * 3, V * 3, V};
+    size_t sizes[5] = {T * 9, T * 3, T * 3, T * 3, T};
     for (int b = 0; st == GR_OK && b < 5; ++b)
       st = gr_buffer_create(s->ctx, CL_MEM_READ_WRITE, sizes[b] * sizeof(float), NULL, &nb[b]);
     for (int a = 0; st == GR_OK && a < GR_SNAC_ARRAYS; ++a)
-      st = gr_buffer_create(s->ctx, CL_MEM_READ_WRITE, V * sizeof(float), NULL, &na[a]);
+      st = gr_buffer_create(s->ctx, CL_MEM_READ_WRITE, T * sizeof(float), NULL, &na[a]);
     /* Kept objects' state to their new place, the rest zero; the snow of
      * objects that go is dropped (counted). */
     for (int a = 0; st == GR_OK && a < GR_SNAC_ARRAYS; ++a) {
       float zero = 0.0f;
       st = gr_cl_check(s->ctx,
                        clEnqueueFillBuffer(gr_context_queue(s->ctx), na[a], &zero, sizeof(zero), 0,
-                                           V * sizeof(float), 0, NULL, NULL),
+                                           T * sizeof(float), 0, NULL, NULL),
                        "Clearing the objects' snow");
     }
     double fall = 0.0, shed = 0.0, stored = 0.0;
     for (int o = 0; st == GR_OK && o < s->nobjects; ++o) {
-      int keep = o < n && meshes[o].nvertices == s->nverts[o];
-      if (keep && s->nverts[o] > 0) {
+      int keep = o < n && kept[o], faces = s->trifirst[o + 1] - s->trifirst[o];
+      if (keep && faces > 0) {
         for (int a = 0; st == GR_OK && a < GR_SNAC_ARRAYS; ++a)
           st = gr_cl_check(s->ctx,
                            clEnqueueCopyBuffer(gr_context_queue(s->ctx), s->o_arr[a], na[a],
-                                               (size_t)s->first[o] * sizeof(float),
-                                               (size_t)first[o] * sizeof(float),
-                                               (size_t)s->nverts[o] * sizeof(float), 0, NULL, NULL),
+                                               (size_t)s->trifirst[o] * sizeof(float),
+                                               (size_t)trifirst[o] * sizeof(float),
+                                               (size_t)faces * sizeof(float), 0, NULL, NULL),
                            "Copying an object's snow");
       } else if (!keep) {
         double sums[GR_SNAC_SUMS];
-        st = gr_snac_sums(s, 1, s->first[o], s->nverts[o], sums);
+        st = gr_snac_sums(s, 1, s->trifirst[o], faces, sums);
         stored += sums[0], fall += sums[1], shed += sums[2];
       }
     }
@@ -1264,8 +1317,8 @@ static gr_status gr_snac_set_objects_impl(gr_snow_accumulation *s, const gr_mesh
     s->o_tri = nb[0], s->o_pos = nb[1], s->o_nrm = nb[2], s->o_local = nb[3], s->o_area = nb[4];
     memcpy(s->o_arr, na, sizeof(na));
   }
-  free(s->hv), free(s->ht), free(s->hnrm), free(s->hlocal);
-  s->hv = g.hv, s->ht = g.ht, s->hnrm = g.nrm, s->hlocal = g.hlocal;
+  free(s->hv), free(s->ht), free(s->hnrm), free(s->harea), free(s->hlocal);
+  s->hv = g.hv, s->ht = g.ht, s->hnrm = g.nrm, s->harea = g.area, s->hlocal = g.hlocal;
   s->nobjects = n;
   s->nv = (int)nv;
   s->ntri = (int)nt;
@@ -1284,16 +1337,16 @@ static gr_status gr_snac_set_objects_impl(gr_snow_accumulation *s, const gr_mesh
       s->tsize[o] = 0;
     }
   st = gr_snac_textures(s, kept);
-  if (st == GR_OK && nv > 0) {
-    st = gr_buffer_write(s->ctx, s->o_nrm, 0, (size_t)nv * 3 * sizeof(float), g.nrm);
+  if (st == GR_OK && nt > 0) {
+    st = gr_buffer_write(s->ctx, s->o_nrm, 0, (size_t)nt * 3 * sizeof(float), g.nrm);
     if (st == GR_OK)
-      st = gr_buffer_write(s->ctx, s->o_local, 0, (size_t)nv * 3 * sizeof(float), g.local);
+      st = gr_buffer_write(s->ctx, s->o_local, 0, (size_t)nt * 3 * sizeof(float), g.local);
     if (st == GR_OK)
-      st = gr_buffer_write(s->ctx, s->o_area, 0, (size_t)nv * sizeof(float), g.area);
+      st = gr_buffer_write(s->ctx, s->o_area, 0, (size_t)nt * sizeof(float), g.area);
     if (st == GR_OK)
       st = gr_snac_upload_geometry(s);
   }
-  free(g.local), free(g.area);
+  free(g.local);
   return st;
 }
 
@@ -1332,8 +1385,7 @@ gr_status gr_snow_accumulation_get_object_field(gr_snow_accumulation *s, int o, 
                       name ? name : "(unknown field)");
   }
   if (st == GR_OK && n > 0)
-    st = gr_buffer_read(s->ctx, s->o_arr[f == GR_FIELD_SNOW_DEPTH ? 0 : 6],
-                        (size_t)s->first[o] * sizeof(float), (size_t)n * sizeof(float), host);
+    st = gr_snac_points(s, o, f == GR_FIELD_SNOW_DEPTH ? 0 : 6, host, n, NULL);
   return st == GR_OK ? GR_OK : GR_SNAC_KEEP_ERROR(s, st);
 }
 
@@ -1343,19 +1395,13 @@ gr_status gr_snow_accumulation_get_object_offsets(gr_snow_accumulation *s, int o
     return gr_set_error(NULL, GR_ERR_INVALID_ARGUMENT,
                         "gr_snow_accumulation_get_object_offsets needs a simulation.");
   gr_status st = gr_snac_check_object(s, "gr_snow_accumulation_get_object_offsets", o, n, xyz);
+  float *depth = st == GR_OK && n > 0 ? malloc((size_t)n * sizeof(float)) : NULL;
+  if (st == GR_OK && n > 0 && !depth)
+    st = gr_set_error(s->ctx, GR_ERR_OUT_OF_MEMORY, "Out of host memory.");
   if (st == GR_OK && n > 0)
-    st = gr_buffer_read(s->ctx, s->o_arr[0], (size_t)s->first[o] * sizeof(float),
-                        (size_t)n * sizeof(float), xyz);
-  if (st != GR_OK)
-    return GR_SNAC_KEEP_ERROR(s, st);
-  /* In place, from the back: depth k sits at xyz[k]. */
-  for (int k = n - 1; k >= 0; --k) {
-    float d = xyz[k];
-    const float *nr = s->hnrm + 3 * (size_t)(s->first[o] + k);
-    for (int a = 2; a >= 0; --a)
-      xyz[3 * k + a] = nr[a] * d;
-  }
-  return GR_OK;
+    st = gr_snac_points(s, o, 0, depth, n, xyz);
+  free(depth);
+  return st == GR_OK ? GR_OK : GR_SNAC_KEEP_ERROR(s, st);
 }
 
 gr_status gr_snow_accumulation_set_object_snow(gr_snow_accumulation *s, int o, const float *depth,
@@ -1370,19 +1416,33 @@ gr_status gr_snow_accumulation_set_object_snow(gr_snow_accumulation *s, int o, c
     st = gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT, "Object %d: %s", o, msg);
   if (st != GR_OK || n == 0)
     return st == GR_OK ? GR_OK : GR_SNAC_KEEP_ERROR(s, st);
+  /* The snow lives on the faces: each gets the mean of its corners'. */
+  int t0 = s->trifirst[o], nt = s->trifirst[o + 1] - t0;
+  if (nt == 0)
+    return GR_OK;
+  float *faces = malloc((size_t)nt * sizeof(float));
+  if (!faces)
+    return GR_SNAC_KEEP_ERROR(s, gr_set_error(s->ctx, GR_ERR_OUT_OF_MEMORY, "Out of host memory."));
+  for (int t = 0; t < nt; ++t) {
+    const int *ix = s->ht + 3 * (size_t)(t0 + t);
+    faces[t] = (float)(((double)depth[ix[0] - s->first[o]] + depth[ix[1] - s->first[o]] +
+                        depth[ix[2] - s->first[o]]) /
+                       3.0);
+  }
   double before[GR_SNAC_SUMS], after[GR_SNAC_SUMS];
-  size_t off = (size_t)s->first[o] * sizeof(float), bytes = (size_t)n * sizeof(float);
+  size_t off = (size_t)t0 * sizeof(float), bytes = (size_t)nt * sizeof(float);
   float zero = 0.0f;
-  st = gr_snac_sums(s, 1, s->first[o], n, before);
+  st = gr_snac_sums(s, 1, t0, nt, before);
   if (st == GR_OK)
-    st = gr_buffer_write(s->ctx, s->o_arr[0], off, bytes, depth);
+    st = gr_buffer_write(s->ctx, s->o_arr[0], off, bytes, faces);
   if (st == GR_OK)
     st = gr_cl_check(s->ctx,
                      clEnqueueFillBuffer(gr_context_queue(s->ctx), s->o_arr[1], &zero, sizeof(zero),
                                          off, bytes, 0, NULL, NULL),
                      "Clearing an object's snow");
   if (st == GR_OK)
-    st = gr_snac_sums(s, 1, s->first[o], n, after);
+    st = gr_snac_sums(s, 1, t0, nt, after);
+  free(faces);
   if (st == GR_OK)
     s->initial_objects += after[0] - before[0];
   return st == GR_OK ? GR_OK : GR_SNAC_KEEP_ERROR(s, st);
@@ -1631,11 +1691,11 @@ static gr_status gr_snac_view_reduce(gr_snow_accumulation *s, const gr_snac_view
   for (size_t r = 0; r < vh; ++r)
     rows[r] = cover[2 * r] > -HUGE_VAL && cover[2 * r] != -cover[2 * r + 1];
   /* The objects: the rows under their box (the same on every piece), or a
-   * value per mesh point and sample, whichever is fewer values. */
+   * value per face and sample, whichever is fewer values. */
   s->objects_by_point = 0;
-  size_t points = (size_t)s->nv + (size_t)s->ns;
+  size_t points = (size_t)s->ntri + (size_t)s->ns;
   if (points > 0) {
-    double half = GR_SNAC_NORMAL_OFFSET * v->texel; /* a mesh point's test position */
+    double half = GR_SNAC_NORMAL_OFFSET * v->texel; /* a face's test position */
     gr_snac_band(v, s->ob_lo[1] - s->grid.y0 - half, s->ob_hi[1] - s->grid.y0 + half,
                  s->ob_lo[2] - s->zref - half, s->ob_hi[2] - s->zref + half, &lo, &hi);
     size_t extra = 0;
@@ -1682,7 +1742,7 @@ static gr_status gr_snac_view_reduce(gr_snow_accumulation *s, const gr_snac_view
   return st;
 }
 
-/* Room for n values per mesh point or sample in s->o_surface. */
+/* Room for n values per face or sample in s->o_surface. */
 static gr_status gr_snac_point_buffer(gr_snow_accumulation *s, size_t n) {
   if (n <= s->o_surface_cap)
     return GR_OK;
@@ -1695,7 +1755,7 @@ static gr_status gr_snac_point_buffer(gr_snow_accumulation *s, size_t n) {
   return st;
 }
 
-/* The exposure of n mesh points (or samples) at pos, nrm in the pieces'
+/* The exposure of n faces (or samples) at pos, nrm in the pieces'
  * combined view into s->o_surface: each piece's from its own view, the
  * minimum over the pieces (snow_accumulation_object_exposure). Waits. */
 static gr_status gr_snac_object_exposure(gr_snow_accumulation *s, cl_mem pos, cl_mem nrm, cl_int nv,
@@ -1741,7 +1801,7 @@ static gr_status gr_snac_object_exposure(gr_snow_accumulation *s, cl_mem pos, cl
   return st;
 }
 
-/* The snow surface under n mesh points (or samples) at pos, nrm into
+/* The snow surface under n faces (or samples) at pos, nrm into
  * s->o_surface: each piece gives the points over its own cells, the
  * allreduce the rest (snow_accumulation_object_surface). Waits. */
 static gr_status gr_snac_object_surface(gr_snow_accumulation *s, cl_mem pos, cl_mem nrm, cl_int nv,
@@ -1863,7 +1923,13 @@ static gr_status gr_snac_step_impl(gr_snow_accumulation *s, double dt) {
   const gr_snow_accumulation_params *p = &s->params;
   float rate_dt = (float)(p->snowfall_rate * dt), amplitude = (float)p->noise_amplitude;
   float max_depth = (float)p->max_depth;
-  float keep = (float)pow(1.0 - p->stability_factor, dt);
+  /* Stability as a relaxation rate: k = -ln(1 - f), so that an excess
+   * alone keeps (1 - f)^t after t seconds; the step integrates it with the
+   * growth (snac_settle) from keep = e^-k dt and k dt. f = 1: k infinite
+   * (kdt 1e30), all the excess goes. */
+  double krate = p->stability_factor >= 1.0 ? HUGE_VAL : -log1p(-p->stability_factor);
+  float kdt = (float)fmin(krate * dt, 1.0e30);
+  float keep = (float)exp(-krate * dt);
   cl_uint seed = (cl_uint)p->seed;
   double inv_scale = 1.0 / p->noise_scale;
   float noise_x0 = (float)fmod(g->x0 * inv_scale, GR_SNAC_NOISE_PERIOD);
@@ -2020,6 +2086,7 @@ static gr_status gr_snac_step_impl(gr_snow_accumulation *s, double dt) {
                             GR_SNAC_MEM("growth", cur),
                             GR_SNAC_VAL("max_depth", max_depth),
                             GR_SNAC_VAL("keep", keep),
+                            GR_SNAC_VAL("kdt", kdt),
                             GR_SNAC_MEM("depth", s->arr[0]),
                             GR_SNAC_MEM("depth_lo", s->arr[1]),
                             GR_SNAC_MEM("fall", s->arr[2]),
@@ -2044,11 +2111,10 @@ static gr_status gr_snac_step_impl(gr_snow_accumulation *s, double dt) {
                         s->steps + 1, gr_status_string(st));
   }
 
-  /* the mesh points */
-  /* the mesh points, then the accumulation textures' samples: the same
-   * exposure, growth and stability, on their own arrays */
+  /* the objects' faces (their centroids), then the accumulation textures'
+   * samples: the same exposure, growth and stability, on their own arrays */
   for (int pass = 0; pass < 2; ++pass) {
-    cl_int nv = pass ? s->ns : s->nv;
+    cl_int nv = pass ? s->ns : s->ntri;
     if (st != GR_OK || nv == 0)
       continue;
     const cl_mem *A = pass ? s->t_arr : s->o_arr;
@@ -2075,6 +2141,7 @@ static gr_status gr_snac_step_impl(gr_snow_accumulation *s, double dt) {
                               GR_SNAC_VAL("seed", seed),
                               GR_SNAC_VAL("max_depth", max_depth),
                               GR_SNAC_VAL("keep", keep),
+                              GR_SNAC_VAL("kdt", kdt),
                               GR_SNAC_VAL("terrain_drawn", terrain_drawn),
                               GR_SNAC_MEM("ground", s->ground),
                               GR_SNAC_MEM("gdepth", s->arr[0]),
@@ -2225,7 +2292,7 @@ gr_status gr_snow_accumulation_ledger_get(gr_snow_accumulation *s,
   double gs[4], os[GR_SNAC_SUMS];
   gr_status st = gr_snac_grid_sums(s, gs);
   if (st == GR_OK)
-    st = gr_snac_sums(s, 1, 0, s->nv, os);
+    st = gr_snac_sums(s, 1, 0, s->ntri, os);
   if (st != GR_OK)
     return GR_SNAC_KEEP_ERROR(s, st);
   double a = s->grid.dx * s->grid.dy;
@@ -2256,14 +2323,14 @@ void gr_snow_accumulation_set_progress(gr_snow_accumulation *s, gr_progress_fn f
 
 typedef struct gr_snac_state_header {
   uint32_t magic, version;
-  int32_t nx, ny, nobjects, nv, ns, j0;
+  int32_t nx, ny, nobjects, nv, ns, j0, ntri, pad;
   int64_t steps;
   double time, initial_objects, retired_fall, retired_shed, dropped, snow_bound;
 } gr_snac_state_header;
 
 static size_t gr_snac_state_bytes(const gr_snow_accumulation *s) {
   return sizeof(gr_snac_state_header) +
-         GR_SNAC_ARRAYS * (gr_snac_cells(s) + (size_t)s->nv + (size_t)s->ns) * sizeof(float) +
+         GR_SNAC_ARRAYS * (gr_snac_cells(s) + (size_t)s->ntri + (size_t)s->ns) * sizeof(float) +
          (size_t)s->own_ny * sizeof(double);
 }
 
@@ -2295,6 +2362,7 @@ gr_status gr_snow_accumulation_state_save(gr_snow_accumulation *s, void *host, s
   hd.nx = s->grid.nx, hd.ny = s->grid.ny, hd.nobjects = s->nobjects, hd.nv = s->nv;
   hd.ns = s->ns;
   hd.j0 = s->grid.j0;
+  hd.ntri = s->ntri;
   hd.steps = s->steps;
   hd.time = s->time;
   hd.initial_objects = s->initial_objects;
@@ -2304,12 +2372,12 @@ gr_status gr_snow_accumulation_state_save(gr_snow_accumulation *s, void *host, s
   hd.snow_bound = s->snow_bound;
   memcpy(host, &hd, sizeof(hd));
   char *at = (char *)host + sizeof(hd);
-  size_t gb = gr_snac_cells(s) * sizeof(float), ob = (size_t)s->nv * sizeof(float);
+  size_t gb = gr_snac_cells(s) * sizeof(float), ob = (size_t)s->ntri * sizeof(float);
   size_t tb = (size_t)s->ns * sizeof(float);
   gr_status st = GR_OK;
   for (int a = 0; st == GR_OK && a < GR_SNAC_ARRAYS; ++a, at += gb)
     st = gr_buffer_read(s->ctx, s->arr[a], 0, gb, at);
-  /* Per array the mesh points, then the textures' samples. */
+  /* Per array the faces, then the textures' samples. */
   for (int a = 0; st == GR_OK && ob + tb > 0 && a < GR_SNAC_ARRAYS; ++a, at += ob + tb) {
     if (ob > 0)
       st = gr_buffer_read(s->ctx, s->o_arr[a], 0, ob, at);
@@ -2338,7 +2406,7 @@ gr_status gr_snow_accumulation_state_load(gr_snow_accumulation *s, const void *h
   memcpy(&hd, host, sizeof(hd));
   if (hd.magic != GR_SNAC_STATE_MAGIC || hd.version != GR_SNAC_STATE_VERSION ||
       hd.nx != s->grid.nx || hd.ny != s->grid.ny || hd.nobjects != s->nobjects || hd.nv != s->nv ||
-      hd.ns != s->ns || hd.j0 != s->grid.j0)
+      hd.ns != s->ns || hd.j0 != s->grid.j0 || hd.ntri != s->ntri)
     return GR_SNAC_KEEP_ERROR(
         s, gr_set_error(s->ctx, GR_ERR_FORMAT,
                         "The bytes are not a snow accumulation state of a %d x %d grid (a piece "
@@ -2347,12 +2415,13 @@ gr_status gr_snow_accumulation_state_load(gr_snow_accumulation *s, const void *h
                         "set.",
                         s->grid.nx, s->grid.ny, s->grid.j0, s->nobjects, GR_SNAC_STATE_VERSION));
   const char *base = (const char *)host + sizeof(hd);
-  size_t gcells = gr_snac_cells(s), gb = gcells * sizeof(float), ob = (size_t)s->nv * sizeof(float);
+  size_t gcells = gr_snac_cells(s), gb = gcells * sizeof(float),
+         ob = (size_t)s->ntri * sizeof(float);
   size_t tb = (size_t)s->ns * sizeof(float);
   /* Depths (the hi parts) must be finite and not negative. */
   for (int part = 0; part < 2; ++part) {
     const char *p = part ? base + GR_SNAC_ARRAYS * gb : base;
-    size_t n = part ? (size_t)s->nv + (size_t)s->ns : gcells;
+    size_t n = part ? (size_t)s->ntri + (size_t)s->ns : gcells;
     for (size_t c = 0; c < n; ++c) {
       float v;
       memcpy(&v, p + c * sizeof(float), sizeof(v));

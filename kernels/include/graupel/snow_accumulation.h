@@ -6,8 +6,9 @@
  * the device.
  *
  * State: snow depth S per grid point over a ground B (the snow surface is
- * H = B + S), and snow depth per mesh point of every object (it lives in the
- * object's own frame, so it moves with the object).
+ * H = B + S), and snow depth per face (triangle) of every object (it lives
+ * in the object's own frame, so it moves with the object; the mesh points
+ * show it, see Objects below).
  *
  * One step of dt seconds (gr_snow_accumulation_step), with d the unit snow
  * direction (SnowDirection, turned by up to Flutter at random each step,
@@ -20,15 +21,17 @@
  *     texel keeps the highest crossing of its centre's ray, by an integer
  *     atomic_max on the float's ordered bits: order-independent, so reruns
  *     are bit-identical (no float atomics).
- *  2. exposure: a grid point, or a mesh point moved half a texel along its
- *     normal, is exposed (1) when nothing in the view lies above it on its
- *     ray by more than a depth bias (a quarter texel plus the surface's
- *     slope in the view times 0.75 texel: a surface does not shadow
- *     itself), else 0. Binary, like the thesis' occlusion render.
+ *  2. exposure: a grid point, or an object face's centroid (or a texture
+ *     sample) moved half a texel along the face's normal, is exposed (1) when nothing in the view
+ * lies above it on its ray by more than a depth bias (a quarter texel plus the surface's slope in
+ * the view times 0.75 texel: a surface does not shadow itself), else 0. Binary, like the thesis'
+ * occlusion render.
  *  3. growth: g = SnowfallRate x exposure x max(0, n . -d) x (1 + A N) x dt,
- *     n the ground's normal (grid) or the mesh point's normal (objects), N a
- *     seeded value noise in [-1, 1] of the position (world xy on the
- *     terrain, the object's own frame on objects) with a lattice of
+ *     n the ground's normal (grid) or the face's own normal (objects: each
+ *     triangle faces the snow as it is, not as its points' averaged
+ *     normals would), N a seeded value noise in [-1, 1] of the position
+ *     (world xy on the terrain, the face's centroid in the object's own
+ *     frame on objects) with a lattice of
  *     NoiseScale metres, A = NoiseAmplitude. SnowfallRate is the fall per
  *     area across the snow direction: what an exposed surface facing the
  *     snow receives (a horizontal one, for vertical snow).
@@ -37,31 +40,49 @@
  *     is the thesis' 9-tap kernel, notes/002.md 2.4; near the grid's edge
  *     the weights are renormalised) and, with Dilation, replaced by its
  *     maximum over the 3 x 3 neighbourhood (the thesis' dilation).
- *  5. increment and stability: S += g, then with the capacity
- *     c = MaxDepth x max(0, n . up) the excess over it is shed:
- *     S -= (1 - (1 - f)^dt) (S - c) where S > c, f = StabilityFactor (the
- *     fraction of the excess shed per second; f = 1 keeps S at c whatever
- *     dt). Shed snow leaves the simulation and is counted (shed_volume).
+ *  5. increment and stability, integrated together over the step: with
+ *     the capacity c = MaxDepth x max(0, n . up) and k = -ln(1 - f),
+ *     f = StabilityFactor (so that an excess alone keeps (1 - f)^t after t
+ *     seconds: f is the fraction of the excess shed per second), the depth
+ *     follows dS/dt = r - k max(0, S - c) through the step, the growth g
+ *     arriving at the constant rate r = g / dt. Its exact solution: from
+ *     an excess x0 = S - c >= 0, x(t) = r / k + (x0 - r / k) e^-kt, so
+ *       x1 = x0 e^-k dt + g phi(k dt),  phi(z) = (1 - e^-z) / z;
+ *     from below capacity, S grows freely until it reaches c at
+ *     t* = (c - S) / r, and relaxes the remaining tau = dt - t* =
+ *     dt E / g (E = S + g - c, the excess had nothing been shed):
+ *       x1 = E phi(k dt E / g)   (S + g when E <= 0: never reaches c).
+ *     The snow shed is what fell and is no longer stored, S + g - (c + x1),
+ *     taken from the depth's double-float pair as it is added to the shed
+ *     pair. A constant rate then gives the same snow in 10 steps as in 100
+ *     (and as the continuous solution) to float rounding, whatever f; f = 1
+ *     (k infinite) keeps S at c, f = 0 never sheds. Shed snow leaves the
+ *     simulation and is counted (shed_volume). (Before, the step added g
+ *     and then shed 1 - (1 - f)^dt of the excess: a step of dt shed the
+ *     whole step's growth as if it had all come at its start, and
+ *     StabilityFactor 0.001/s stored 7.6 % less in 10 steps than in 100.)
  *
  * Deviations from the thesis, on purpose (notes/002.md 2.2, 2.5, 7): its
  * stability branch sets every point below capacity to 0 (flat surfaces
  * could never hold snow): here snow below capacity stays. Its growth is a
  * noise value per frame: here it is a rate times dt, and the noise is a
  * fixed pattern in space (not re-drawn per step), so the same simulated
- * time gives the same snow whether it is taken in 10 steps or 100 (exactly
- * with f = 1 while the exposure does not change). Its "5x5" blur is the 9-tap
- * kernel above. Its per-object UV textures are here per-mesh-point depths
- * (no UV unwrap needed) and, for objects given texture coordinates, an
- * accumulation texture whose texels are samples like the mesh points
- * (gr_snow_accumulation_set_object_texture).
+ * time gives the same snow whether it is taken in 10 steps or 100 (to
+ * float rounding for any f while the exposure does not change, step 5).
+ * Its "5x5" blur is the 9-tap kernel above. Its per-object UV textures are
+ * here per-face depths (no UV unwrap needed) and, for objects given
+ * texture coordinates, an accumulation texture whose texels are samples
+ * like the faces (gr_snow_accumulation_set_object_texture): both from the
+ * faces, as the thesis' texels lie on one face each.
  *
- * Book-keeping: every grid point and mesh point keeps its depth, the snow
+ * Book-keeping: every grid point and object face keeps its depth, the snow
  * that fell on it and the snow it shed as double-float pairs, so
  *   stored = initial + snowfall - shed - dropped
  * holds to about 1e-12 over any number of steps (dropped: the snow of
  * objects that set_objects removed). Volumes: grid points count dx dy each;
- * a mesh point counts a third of the area of its triangles (in the object's
- * own frame: poses are rigid).
+ * a face its area (in the object's own frame: poses are rigid), so an
+ * exposed object below capacity under vertical snow holds rate x t times
+ * the area its snow-facing faces cover seen from above, as the ground does.
  *
  * Fields (gr_field): set ELEVATION (required, m; within +-1e6 m, finite)
  * and optionally SNOW_DEPTH (m, 0 to 1e4, the initial snow). Read
@@ -71,7 +92,15 @@
  * Objects: triangle meshes (gr_mesh; open surfaces such as a roof plane
  * are fine, triangles wound counter-clockwise seen from the side that
  * receives snow), at the pose of their transform; set them before each
- * step that moves them.
+ * step that moves them. The snow lives on the faces (steps 2, 3 and 5 per
+ * triangle, with its own normal and capacity). A mesh point shows the mean
+ * of its faces' snow weighted by the area each turns to the sky, A max(0,
+ * n . up) (the plain area where all its faces face sideways or down): so a
+ * cone's base ring and apex carry what its sloped sides do (not the flat
+ * ground's snow at the apex and none on the ring, as the averaged point
+ * normals gave), a roof's ridge what its planes do, the top corners of a
+ * box what its top does, and a flat-shaded mesh (its own points per face)
+ * the same as a smooth one.
  *
  * Pieces of a split domain: see "Pieces of a split domain" below; a piece
  * computes bit for bit what the whole grid computes at its points, its
@@ -152,7 +181,7 @@ typedef struct gr_snow_accumulation_ledger {
   double snowfall_volume;       /**< all that fell (the growth after blur and dilation) */
   double stored_volume;         /**< terrain + objects now */
   double stored_volume_terrain; /**< sum S dx dy */
-  double stored_volume_objects; /**< sum over mesh points of depth x area */
+  double stored_volume_objects; /**< sum over the objects' faces of depth x area */
   double shed_volume;           /**< removed by the stability cap */
   double dropped_volume;        /**< on objects that set_objects removed */
   /** initial + snowfall - shed - dropped - stored: rounding only */
@@ -163,10 +192,10 @@ typedef struct gr_snow_accumulation gr_snow_accumulation;
 
 /**
  * What a simulation on grid with p's ExposureResolution needs (memory.h),
- * its ring included and its objects not (they add their mesh points'
- * arrays): 48 bytes a point on the device (ground, initial depth, growth,
- * scratch, noise and the seven snow arrays), the exposure view's int a
- * texel, and 8 bytes a row on the host. GR_ERR_INVALID_ARGUMENT without
+ * its ring included and its objects not (they add their faces' arrays):
+ * 48 bytes a point on the device (ground, initial depth, growth, scratch,
+ * noise and the seven snow arrays), the exposure view's int a texel, and 8
+ * bytes a row on the host. GR_ERR_INVALID_ARGUMENT without
  * grid, p or out.
  */
 GR_API gr_status gr_snow_accumulation_memory(const gr_grid *grid,
@@ -205,8 +234,8 @@ GR_API gr_status gr_snow_accumulation_set_field(gr_snow_accumulation *s, gr_fiel
  * The objects for the next steps (copied; 0 to
  * GR_SNOW_ACCUMULATION_MAX_OBJECTS), each passing gr_mesh_validate(mesh, 0)
  * (open surfaces allowed), at the pose of its transform. Object o keeps its
- * snow when the previous call had an object o with as many vertices (the
- * same mesh at a new pose: its snow moves with it); otherwise its snow
+ * snow when the previous call had an object o with as many vertices and
+ * triangles (the same mesh at a new pose: its snow moves with it); otherwise its snow
  * starts at 0 and the snow of an object that is gone counts as dropped. A
  * refusal names the object and keeps the objects set before.
  */
@@ -214,17 +243,26 @@ GR_API gr_status gr_snow_accumulation_set_objects(gr_snow_accumulation *s, const
                                                   int n);
 
 /**
- * Object o's snow per mesh point (n must be its vertex count): SNOW_DEPTH
- * (m, along the point's normal) or EXPOSURE (0 or 1, the last step's).
+ * Object o's snow per mesh point (n must be its vertex count), from its
+ * faces (see Objects above): SNOW_DEPTH (m, along the faces' normals) or
+ * EXPOSURE (0 to 1, the last step's: the sky-weighted share of the point's
+ * faces that were exposed).
  */
 GR_API gr_status gr_snow_accumulation_get_object_field(gr_snow_accumulation *s, int o, gr_field f,
                                                        float *host, int n);
 
-/** Object o's snow cap as offsets: 3 floats per mesh point, world normal x depth (m). */
+/**
+ * Object o's snow cap as offsets: 3 floats per mesh point, the point's
+ * SNOW_DEPTH (m) along the unit mean of its faces' world normals, weighted
+ * as the depth is (a cone's base ring moves up and out with its sides).
+ */
 GR_API gr_status gr_snow_accumulation_get_object_offsets(gr_snow_accumulation *s, int o, float *xyz,
                                                          int n);
 
-/** Sets object o's snow per mesh point (m, 0 to 1e4); the initial volume moves by the change. */
+/**
+ * Sets object o's snow per mesh point (m, 0 to 1e4): each face gets the
+ * mean of its three points' depths; the initial volume moves by the change.
+ */
 GR_API gr_status gr_snow_accumulation_set_object_snow(gr_snow_accumulation *s, int o,
                                                       const float *depth, int n);
 
@@ -236,10 +274,10 @@ GR_API gr_status gr_snow_accumulation_set_object_snow(gr_snow_accumulation *s, i
  * the object's triangles becomes a sample on that triangle (barycentric;
  * the first triangle in mesh order wins where UV triangles overlap) with
  * the triangle's own normal, and goes through the same exposure, growth,
- * noise (the object's frame) and stability as the mesh points each step,
+ * noise (the object's frame) and stability as the faces each step,
  * moving with the object. Texels on no triangle stay 0. The samples are a
  * finer picture of the same snow, not more of it: they stay out of the
- * ledger (the mesh points carry the object's volume), set_object_snow and
+ * ledger (the faces carry the object's volume), set_object_snow and
  * reset leave them at / bring them to 0, checkpoints include them. The
  * same size and coordinates again keep the texture's snow; set_objects
  * keeps a kept object's texture (its samples move with it) and drops the
@@ -289,7 +327,7 @@ GR_API void gr_snow_accumulation_set_progress(gr_snow_accumulation *s, gr_progre
  * Checkpoints: the grid's and the objects' snow, fallen and shed snow,
  * exposures, time, steps and ledger as bytes. Loading into a simulation of
  * the same grid with the same objects set (as many, with as many mesh
- * points) makes every later step bit-identical. Elevation, parameters and
+ * points and triangles) makes every later step bit-identical. Elevation, parameters and
  * object poses are not part of it. A piece's state holds its local arrays,
  * rings included, and its j0; it loads only into the same piece.
  */
@@ -344,7 +382,7 @@ GR_API gr_status gr_snow_accumulation_reset(gr_snow_accumulation *s);
  * most GR_SNOW_ACCUMULATION_REDUCE_CHUNK values); every other row a piece
  * reads is already the maximum. The objects' points read rows anywhere:
  * their exposure (a point is exposed when every piece's view leaves it
- * exposed) is combined per mesh point and sample, GR_REDUCE_MAX of minus
+ * exposed) is combined per face and sample, GR_REDUCE_MAX of minus
  * the exposure, or, where that is more values, the view rows under the
  * objects are combined too. At 1024^2 with ExposureResolution 1024 and two
  * pieces, graupel-bench's scene reduces about 0.37 MB a step per piece
@@ -353,13 +391,13 @@ GR_API gr_status gr_snow_accumulation_reset(gr_snow_accumulation *s);
  * falls (snow straight down always) the view holds the objects alone,
  * which every piece draws the same, and nothing is reduced.
  *
- * Objects: every piece keeps every object and its snow (mesh points and
+ * Objects: every piece keeps every object and its snow (faces and
  * textures are small beside the grid), takes the same steps on them from
  * the same view, and so holds the same bits. The one grid value an object
- * reads is the snow surface under a mesh point (whether it is buried, in
+ * reads is the snow surface under a face's centroid (whether it is buried, in
  * the steps without terrain in the view): the piece that owns the grid
  * cell under the point gives it, the others -inf, reduced with
- * GR_REDUCE_MAX (a value per mesh point). An object across the cut thus
+ * GR_REDUCE_MAX (a value per face). An object across the cut thus
  * sees both pieces' snow. The objects' volumes are the same on every piece
  * and enter the ledger once.
  *
@@ -433,7 +471,7 @@ typedef struct gr_snow_accumulation_timing {
   double exposure_ms; /**< exposure and growth of the grid points */
   double blur_ms;     /**< blur and dilation */
   double apply_ms;    /**< increment and stability on the grid */
-  double objects_ms;  /**< exposure, growth and stability of the mesh points */
+  double objects_ms;  /**< exposure, growth and stability of the faces and samples */
   double host_ms;     /**< the view's extent and the direction, on the host */
 } gr_snow_accumulation_timing;
 
