@@ -477,6 +477,13 @@ static void test_estimates(void) {
 static void test_refusals(void) {
   if (!limits_usable())
     return;
+  /* On a GPU the cores' buffers are the device's memory: an address-space
+   * limit bounds only the host's copies (and the driver's own mappings,
+   * which then fail cleanly but without the estimate's sentence). */
+  if (!uses_host_memory()) {
+    printf("refusals: skipped, the device's buffers are not host memory\n");
+    return;
+  }
   /* The programs first: building them takes memory of its own. */
   gr_grid small = {64, 64, 1.0, 1.0, 0.0, 0.0, 0, 0};
   drop_terrain(make_terrain(&small));
