@@ -99,15 +99,28 @@ __kernel void snow_overlap(__global const float *restrict ground,
   overlap[c] = snow_overlap_of(ground[c], depth[c], u);
 }
 
-/* Contour weight: -1 off the contour (overlapped or touched, or no
- * overlapped 8-neighbour); on it s_w = max(0, v^ . w^) + r / K with w^ the outward
- * direction, minus the sum of the overlapped neighbours' offsets. */
+/* The room a deposit may fill at a point, in whole quanta: up to its
+ * ceiling, the lowest underside above it (this object's u, an earlier
+ * object's umin) less the clearance (twice GR_SNOW_DEFORMATION_CONTACT_GAP,
+ * as the talus'); +inf where no object covers the point. */
+GR_INLINE float snow_room(float b, float s, float u, float umin, float clearance) {
+  return snow_q(fmax(0.0f, (fmin(u, umin) - clearance) - (b + s)));
+}
+
+/* Contour weight: -1 off the contour; on it s_w = max(0, v^ . w^) + r / K
+ * with w^ the outward direction, minus the sum of the offsets of the
+ * neighbours it borders. Ring 0 (the thesis' contour): the points not
+ * overlapped nor touched with an overlapped neighbour. Ring 1, 2, ...: what
+ * did not fit under an overhang goes on outward: the points with room
+ * (snow_room) that border a full one (overlapped, or no room left: filled
+ * by the ring before, or touched). */
 __kernel void snow_contour(__global const float *restrict ground,
                            __global const float *restrict depth,
                            __global const float *restrict under,
+                           __global const float *restrict under_min,
                            __global const float *restrict overlap, int nx, int ny, float vx,
-                           float vy, float rest, float gap, int x_end, int y_end,
-                           __global float *restrict weight) {
+                           float vy, float rest, float gap, float clearance, int ring, int x_end,
+                           int y_end, __global float *restrict weight) {
   int i = get_global_id(0), j = get_global_id(1);
   if (!gr_inside(i, j, nx, ny) || i >= x_end || j >= y_end)
     return;
@@ -116,14 +129,18 @@ __kernel void snow_contour(__global const float *restrict ground,
   /* A point the object touches without pressing it (pressed before: its
    * surface at the underside) lies under the object, not on its contour:
    * snow is never put under an object. */
-  if (overlap[c] <= 0.0f && ground[c] + depth[c] < under[c] - gap) {
+  int open = ring == 0 ? ground[c] + depth[c] < under[c] - gap
+                       : snow_room(ground[c], depth[c], under[c], under_min[c], clearance) > 0.0f;
+  if (overlap[c] <= 0.0f && open) {
     int any = 0, ox = 0, oy = 0;
     for (int dj = -1; dj <= 1; ++dj)
       for (int di = -1; di <= 1; ++di) {
         int a = i + di, b = j + dj;
         if ((di | dj) == 0 || a < 0 || b < 0 || a >= nx || b >= ny)
           continue;
-        if (overlap[gr_idx(a, b, nx)] > 0.0f) {
+        int m = gr_idx(a, b, nx);
+        if (overlap[m] > 0.0f || (ring > 0 && snow_room(ground[m], depth[m], under[m], under_min[m],
+                                                        clearance) <= 0.0f)) {
           any = 1;
           ox += di;
           oy += dj;
@@ -195,67 +212,86 @@ snow_object_reduce(__global const float *restrict ground, __global const float *
 }
 
 /* Press and deposit: an overlapped point drops to the underside keeping the
- * mass (S - e) rho; a contour point gains cw * add_depth of depth and
- * cw * add_mass of mass per unit area (add_* = 0 when the object deforms
- * nothing this step) of density add_rho, the mean density of the displaced
- * snow. Also the step's overlap sum, contact flag and lowest
- * underside. */
+ * mass (S - e) rho; a contour point gains cw * add_depth of depth, at most
+ * its room (snow_room: never up to an underside), of density add_rho, the
+ * mean density of the displaced snow (add_depth = 0 when the object deforms
+ * nothing this step). Ring 0 also keeps the step's overlap sum, contact flag
+ * and lowest underside; a later ring (snow_contour) only deposits. Every
+ * point of the window writes its deposit to got and 1 to full where the
+ * room held less than its share (for snow_ring_reduce). */
 __kernel void snow_apply(__global const float *restrict ground, __global float *restrict depth,
                          __global float *restrict density, __global const float *restrict under,
                          __global const float *restrict overlap,
                          __global const float *restrict weight, float rho_min, float rho_max,
-                         float w_const, float gap, float add_depth, float add_rho, int press,
-                         int nx, int ny, int x_end, int y_end, __global float *restrict overlap_sum,
-                         __global float *restrict contact, __global float *restrict under_min) {
+                         float w_const, float gap, float clearance, float add_depth, float add_rho,
+                         int press, int ring, int nx, int ny, int x_end, int y_end,
+                         __global float *restrict overlap_sum, __global float *restrict contact,
+                         __global float *restrict under_min, __global float *restrict got,
+                         __global float *restrict full) {
   int i = get_global_id(0), j = get_global_id(1);
   if (!gr_inside(i, j, nx, ny) || i >= x_end || j >= y_end)
     return;
   int c = gr_idx(i, j, nx);
   float s = depth[c], rho = density[c], d = overlap[c], cw = weight[c], u = under[c];
-  if (ground[c] + s >= u - gap)
-    contact[c] = 1.0f;
-  under_min[c] = fmin(under_min[c], u);
-  if (!press)
-    return;
-  if (d > 0.0f) {
-    float e = snow_displaced(s, rho, d, rho_min, rho_max, w_const);
-    float s1 = s - d;
-    depth[c] = s1;
-    /* rho (S - e) / (S - D) written as rho + rho (D - e) / (S - D): when
-     * nothing is compressed (e = D) the density stays bit for bit. */
-    if (s1 > 0.0f)
-      density[c] = fmin(rho_max, rho + rho * ((d - e) / s1));
-    overlap_sum[c] += d;
-  } else if (cw > 0.0f) {
+  float umin = under_min[c], add = 0.0f, over = 0.0f;
+  if (ring == 0) {
+    if (ground[c] + s >= u - gap)
+      contact[c] = 1.0f;
+    under_min[c] = fmin(umin, u);
+    if (press && d > 0.0f) {
+      float e = snow_displaced(s, rho, d, rho_min, rho_max, w_const);
+      float s1 = s - d;
+      depth[c] = s1;
+      /* rho (S - e) / (S - D) written as rho + rho (D - e) / (S - D): when
+       * nothing is compressed (e = D) the density stays bit for bit. */
+      if (s1 > 0.0f)
+        density[c] = fmin(rho_max, rho + rho * ((d - e) / s1));
+      overlap_sum[c] += d;
+    }
+  }
+  if (press && d <= 0.0f && cw > 0.0f) {
+    float share = snow_q(cw * add_depth), room = snow_room(ground[c], s, u, umin, clearance);
+    add = fmin(share, room);
+    over = share > room ? 1.0f : 0.0f;
     /* The mass-weighted mean written as a change, so that snow of the same
      * density leaves the density bit for bit as it was. */
-    float add = snow_q(cw * add_depth), s1 = s + add;
+    float s1 = s + add;
     depth[c] = s1;
     /* A share below one quantum rounds to nothing: bare ground stays bare
      * (and its density is not 0/0). */
     if (add > 0.0f)
       density[c] = rho + add * ((add_rho - rho) / s1);
   }
+  got[c] = add;
+  full[c] = over;
 }
 
-/* What the contour of the window [x0, x0 + w) x [y0, y0 + n / w) received
- * in snow_apply (the same floats), in quanta. */
-__kernel void snow_added_reduce(__global const float *restrict overlap,
-                                __global const float *restrict weight, float add_depth, int nx,
-                                int x0, int y0, int w, int n, __global long *restrict partial,
-                                __local long *restrict scratch) {
+/* After a ring's deposit and the next ring's weights, over the window [x0,
+ * x0 + w) x [y0, y0 + n / w): what the ring received (quanta), its points
+ * that got less than their share (their rest goes on to the next ring),
+ * the next ring's weights (units of 2^-20) and its points. */
+__kernel void snow_ring_reduce(__global const float *restrict got,
+                               __global const float *restrict full,
+                               __global const float *restrict weight, int nx, int x0, int y0, int w,
+                               int n, __global long *restrict partial,
+                               __local long *restrict scratch) {
   int lid = get_local_id(0), wg = get_local_size(0), start, end;
   gr_reduce_block(n, &start, &end);
-  long acc = 0;
+  long acc[4] = {0, 0, 0, 0};
   for (int q = start + lid; q < end; q += wg) {
     int c = gr_idx(x0 + q % w, y0 + q / w, nx);
     float cw = weight[c];
-    if (overlap[c] <= 0.0f && cw > 0.0f)
-      acc += (long)rint(snow_q(cw * add_depth) * GR_SNOW_QUANTUM_INV);
+    acc[0] += (long)rint(got[c] * GR_SNOW_QUANTUM_INV);
+    acc[1] += full[c] > 0.0f;
+    if (cw >= 0.0f) {
+      acc[2] += (long)rint(cw * GR_SNOW_WEIGHT_INV);
+      acc[3] += 1;
+    }
   }
-  __local long *mine = gr_reduce_slots_long(scratch, 1);
-  mine[0] = acc;
-  gr_reduce_group_long(scratch, 1, partial);
+  __local long *mine = gr_reduce_slots_long(scratch, 4);
+  for (int q = 0; q < 4; ++q)
+    mine[q] = acc[q];
+  gr_reduce_group_long(scratch, 4, partial);
 }
 
 /* Depths to the nearest whole quantum. */
@@ -335,7 +371,8 @@ GR_INLINE void snow_rate_at(float s, float g, float u, const float *sn, const fl
       big_in = fmax(big_in, y);
     }
   }
-  float m = giver && s > 0.0f ? fmin(s, big) : 0.0f, k = 0.0f;
+  /* u = -inf: out of the step's reach (snow_ceiling) */
+  float m = giver && s > 0.0f && u > -INFINITY ? fmin(s, big) : 0.0f, k = 0.0f;
   if (m > tol && sum > 0.0f)
     k = fmin(snow_share(big, fmin(tx, ty)) * (big / sum), GR_SNOW_KEEP * s / sum);
   *k_out = k;
@@ -651,6 +688,78 @@ __kernel void snow_relax_group(__global const float *restrict ground, __global f
     result[4] = x1;
     result[5] = y1;
   }
+}
+
+/* The reach: the points within h (8-neighbour steps) of a point of src
+ * above thr in the box [sx0, sx1] x [sy0, sy1] (0 beyond it), a max filter
+ * in two passes over the window [its offset, x_end) x [.., y_end): rows
+ * (src to out, on the rows of the box) then columns (src, the rows'
+ * result, to out). Integer logic on 0/1 floats: exact, whatever the split. */
+__kernel void snow_reach_rows(__global const float *restrict src, float thr, int sx0, int sy0,
+                              int sx1, int sy1, int h, int nx, int ny, int x_end, int y_end,
+                              __global float *restrict out) {
+  int i = get_global_id(0), j = get_global_id(1);
+  if (!gr_inside(i, j, nx, ny) || i >= x_end || j >= y_end)
+    return;
+  float v = 0.0f;
+  if (j >= sy0 && j <= sy1)
+    for (int a = max(i - h, sx0); a <= min(i + h, sx1); ++a)
+      v = src[gr_idx(a, j, nx)] > thr ? 1.0f : v;
+  out[gr_idx(i, j, nx)] = v;
+}
+
+__kernel void snow_reach_cols(__global const float *restrict src, int sy0, int sy1, int h, int nx,
+                              int ny, int x_end, int y_end, __global float *restrict out) {
+  int i = get_global_id(0), j = get_global_id(1);
+  if (!gr_inside(i, j, nx, ny) || i >= x_end || j >= y_end)
+    return;
+  float v = 0.0f;
+  for (int b = max(j - h, sy0); b <= min(j + h, sy1); ++b)
+    v = src[gr_idx(i, b, nx)] > 0.5f ? 1.0f : v;
+  out[gr_idx(i, j, nx)] = v;
+}
+
+/* The reach's seeds on the window [its offset, x_end) x [.., y_end): the
+ * movers (movable above tol, on the box [ax0, ax1] x [ay0, ay1] where it
+ * was computed) and the points on a slope, those standing at least half
+ * their talus threshold above a neighbour: the face of a heap, or a slope
+ * at the talus angle, which what slides runs down as far as it goes; only
+ * the flat snow beyond waits for the front. */
+__kernel void snow_reach_seed(__global const float *restrict ground,
+                              __global const float *restrict depth,
+                              __global const float *restrict movable, float tol, int ax0, int ay0,
+                              int ax1, int ay1, float tx, float ty, float td, int nx, int ny,
+                              int x_end, int y_end, __global float *restrict reach) {
+  int i = get_global_id(0), j = get_global_id(1);
+  if (!gr_inside(i, j, nx, ny) || i >= x_end || j >= y_end)
+    return;
+  int c = gr_idx(i, j, nx);
+  float v = (i >= ax0 && i <= ax1 && j >= ay0 && j <= ay1 && movable[c] > tol) ? 1.0f : 0.0f;
+  float h = ground[c] + depth[c];
+  for (int q = 0; q < 8 && v == 0.0f; ++q) {
+    int m = snow_neighbour(i, j, q, nx, ny);
+    float thr = snow_threshold(GR_SNOW_NEIGHBOUR_DI(q), GR_SNOW_NEIGHBOUR_DJ(q), tx, ty, td);
+    if (h - (ground[m] + depth[m]) >= 0.5f * thr)
+      v = 1.0f;
+  }
+  reach[c] = v;
+}
+
+/* The talus' ceilings under a reach (gr_snow_relax), on the window [its
+ * offset, x_end) x [.., y_end): the lowest underside in the reach (the box
+ * [bx0, bx1] x [by0, by1] and its mask), -inf out of it, where nothing fits
+ * and snow_rate_at gives nothing: the talus kernels take this plane for
+ * under_min. */
+__kernel void snow_reach_ceiling(__global const float *restrict under_min,
+                                 __global const float *restrict reach, int bx0, int by0, int bx1,
+                                 int by1, int nx, int ny, int x_end, int y_end,
+                                 __global float *restrict ceiling) {
+  int i = get_global_id(0), j = get_global_id(1);
+  if (!gr_inside(i, j, nx, ny) || i >= x_end || j >= y_end)
+    return;
+  int c = gr_idx(i, j, nx);
+  int in = i >= bx0 && i <= bx1 && j >= by0 && j <= by1 && reach[c] > 0.5f;
+  ceiling[c] = in ? under_min[c] : -INFINITY;
 }
 
 /* The largest movable amount on the window [x0, x0 + w) x [y0, y0 + h)

@@ -83,7 +83,8 @@ struct gr_snow_deformation {
   void *halo_user;
   gr_snow_deformation_params params;
   cl_kernel raster, raster_clear, overlap_k, contour, obj_reduce, apply, relax_rate, relax_move,
-      relax_block, relax_group, check_reduce, ledger_reduce, surface, reset, added_reduce, quantize;
+      relax_block, relax_group, check_reduce, ledger_reduce, surface, reset, ring_reduce, quantize,
+      reach_rows, reach_cols, reach_seed, reach_ceiling;
   cl_mem depth[2], density[2]; /* [cur] is the state */
   int cur;
   cl_mem ground, depth0, density0, under, overlap, weight, overlap_sum, contact, under_min, rate,
@@ -97,7 +98,7 @@ struct gr_snow_deformation {
   cl_mem tri;          /* world triangles, 9 floats each */
   size_t tri_cap;
   gr_reduction red_check[GR_SNOW_CHECK_LAG + 1];
-  gr_reduction_i64 red_obj, red_ledger, red_added;
+  gr_reduction_i64 red_obj, red_ledger, red_ring;
   gr_snow_object objects[GR_SNOW_DEFORMATION_MAX_OBJECTS];
   gr_mesh_memo memo[GR_SNOW_DEFORMATION_MAX_OBJECTS]; /* each object's mesh as last checked */
   int nobjects;
@@ -120,7 +121,12 @@ struct gr_snow_deformation {
    * snow still able to move (x0 > x1: nowhere); the next one starts there
    * too, so that no window ever leaves out a point that can move. */
   int rest[4];
-  int sync_full;  /* the state's other buffer may differ anywhere */
+  int sync_full; /* the state's other buffer may differ anywhere */
+  /* The talus' reach this step (gr_snow_relax_reach): on, its box (x0 y0
+   * x1 y1, local) cut to the local arrays and whole (the domain's box, the
+   * same on every piece), the mask in `weight`, the ceilings in `scratch`;
+   * halo_reach: the exchange carries the mask. */
+  int reach_on, reach_box[4], reach_all[4], halo_reach;
   int dirty[4];   /* x0 y0 x1 y1: where the last step's objects wrote */
   int reset_full; /* the next step clears the per-step arrays everywhere */
   gr_progress_fn progress;
@@ -578,6 +584,14 @@ static gr_status gr_snow_halo_copy(gr_snow_deformation *s, int side, void *host,
   gr_status st = GR_OK;
   for (int a = 0; st == GR_OK && a < GR_SNOW_HALO_ARRAYS; ++a) {
     cl_mem *pair = a ? s->density : s->depth;
+    if (s->halo_reach) { /* the talus' reach mask in the depth's place (gr_snow_relax_reach) */
+      if (a == 0)
+        st = gr_snow_rect(s, s->weight, x0, y0, w, h, at, set);
+      else if (!set)
+        memset(at, 0, cells * sizeof(cl_float));
+      at += cells * sizeof(cl_float);
+      continue;
+    }
     st = gr_snow_rect(s, pair[s->cur], x0, y0, w, h, at, set);
     if (st == GR_OK && set)
       st = gr_snow_rect(s, pair[1 - s->cur], x0, y0, w, h, at, set);
@@ -751,8 +765,12 @@ gr_status gr_snow_deformation_create(gr_context *ctx, const gr_grid *grid,
             {"snow_ledger_reduce", &s->ledger_reduce},
             {"snow_surface", &s->surface},
             {"snow_reset", &s->reset},
-            {"snow_added_reduce", &s->added_reduce},
-            {"snow_quantize", &s->quantize}};
+            {"snow_ring_reduce", &s->ring_reduce},
+            {"snow_quantize", &s->quantize},
+            {"snow_reach_rows", &s->reach_rows},
+            {"snow_reach_cols", &s->reach_cols},
+            {"snow_reach_seed", &s->reach_seed},
+            {"snow_reach_ceiling", &s->reach_ceiling}};
   for (size_t i = 0; st == GR_OK && i < sizeof(ks) / sizeof(ks[0]); ++i)
     st = gr_kernel_create(ctx, prog, ks[i].name, ks[i].k);
   cl_mem *bufs[] = {&s->depth[0],    &s->depth[1], &s->density[0], &s->density[1], &s->ground,
@@ -775,7 +793,7 @@ gr_status gr_snow_deformation_create(gr_context *ctx, const gr_grid *grid,
   if (st == GR_OK)
     st = gr_reduction_i64_init(ctx, s->ledger_reduce, cells, GR_SNOW_LEDGER_SUMS, &s->red_ledger);
   if (st == GR_OK)
-    st = gr_reduction_i64_init(ctx, s->added_reduce, cells, 1, &s->red_added);
+    st = gr_reduction_i64_init(ctx, s->ring_reduce, cells, 4, &s->red_ring);
   if (st == GR_OK)
     st = gr_snow_fill(s, s->ground, 0.0f);
   if (st == GR_OK)
@@ -802,7 +820,8 @@ void gr_snow_deformation_destroy(gr_snow_deformation *s) {
   cl_kernel ks[] = {s->raster,      s->raster_clear, s->overlap_k,    s->contour,
                     s->obj_reduce,  s->apply,        s->relax_rate,   s->relax_move,
                     s->relax_block, s->relax_group,  s->check_reduce, s->ledger_reduce,
-                    s->surface,     s->reset,        s->added_reduce, s->quantize};
+                    s->surface,     s->reset,        s->ring_reduce,  s->quantize,
+                    s->reach_rows,  s->reach_cols,   s->reach_seed,   s->reach_ceiling};
   for (size_t i = 0; i < sizeof(ks) / sizeof(ks[0]); ++i)
     if (ks[i])
       clReleaseKernel(ks[i]);
@@ -816,7 +835,7 @@ void gr_snow_deformation_destroy(gr_snow_deformation *s) {
   for (int q = 0; q <= GR_SNOW_CHECK_LAG; ++q)
     gr_reduction_release(&s->red_check[q]);
   gr_reduction_i64_release(&s->red_ledger);
-  gr_reduction_i64_release(&s->red_added);
+  gr_reduction_i64_release(&s->red_ring);
   for (int o = 0; o < GR_SNOW_DEFORMATION_MAX_OBJECTS; ++o)
     gr_mesh_memo_free(&s->memo[o]);
   gr_context_release(s->ctx);
@@ -1136,6 +1155,151 @@ static gr_status gr_snow_reset(gr_snow_deformation *s) {
   return st;
 }
 
+/* The contour window of an object's step: [x0, x0 + w) x [y0, y0 + h) of
+ * the local arrays (on: not empty), and the piece's own points of it for
+ * the sums: from (rx0, ry0), rw wide, rn in all. */
+typedef struct gr_snow_cwin {
+  size_t x0, y0, w, h;
+  cl_int x_end, y_end, rx0, ry0, rw, rn;
+  int on;
+} gr_snow_cwin;
+
+/* Rings a deposit goes out at most (gr_snow_deposit); what is left after
+ * them waits for the next press, as the rounding's rest does. */
+#define GR_SNOW_DEPOSIT_RINGS 64
+
+/* The contour weights of ring `ring` (snow_contour) on the window. */
+static gr_status gr_snow_contour_ring(gr_snow_deformation *s, const gr_snow_cwin *win, cl_int ring,
+                                      float vx, float vy, float rest) {
+  cl_int nx = s->grid.nx, ny = s->grid.ny;
+  float gap = (float)GR_SNOW_DEFORMATION_CONTACT_GAP, clearance = 2.0f * gap;
+  const gr_snow_arg args[] = {{"ground", sizeof(cl_mem), &s->ground},
+                              {"depth", sizeof(cl_mem), &s->depth[s->cur]},
+                              {"under", sizeof(cl_mem), &s->under},
+                              {"under_min", sizeof(cl_mem), &s->under_min},
+                              {"overlap", sizeof(cl_mem), &s->overlap},
+                              {"nx", sizeof(nx), &nx},
+                              {"ny", sizeof(ny), &ny},
+                              {"vx", sizeof(vx), &vx},
+                              {"vy", sizeof(vy), &vy},
+                              {"rest", sizeof(rest), &rest},
+                              {"gap", sizeof(gap), &gap},
+                              {"clearance", sizeof(clearance), &clearance},
+                              {"ring", sizeof(ring), &ring},
+                              {"x_end", sizeof(cl_int), &win->x_end},
+                              {"y_end", sizeof(cl_int), &win->y_end},
+                              {"weight", sizeof(cl_mem), &s->weight}};
+  gr_status st = gr_snow_args(s, s->contour, args, sizeof(args) / sizeof(args[0]));
+  if (st == GR_OK)
+    st = gr_enqueue_2d(s->ctx, s->contour, win->x0, win->y0, win->w, win->h, NULL);
+  return st;
+}
+
+/* After a ring's deposit (and the next ring's weights), over the domain
+ * (snow_ring_reduce): q[0] the quanta the ring received, q[1] its points
+ * that got less than their share, q[2] the next ring's weights (units of
+ * 2^-20), q[3] its points. */
+static gr_status gr_snow_ring_sums(gr_snow_deformation *s, const gr_snow_cwin *win,
+                                   long long q[4]) {
+  cl_int nx = s->grid.nx;
+  const gr_snow_arg args[] = {
+      {"got", sizeof(cl_mem), &s->scratch},   {"full", sizeof(cl_mem), &s->movable},
+      {"weight", sizeof(cl_mem), &s->weight}, {"nx", sizeof(nx), &nx},
+      {"x0", sizeof(cl_int), &win->rx0},      {"y0", sizeof(cl_int), &win->ry0},
+      {"w", sizeof(cl_int), &win->rw},        {"n", sizeof(cl_int), &win->rn}};
+  gr_status st = gr_snow_args(s, s->ring_reduce, args, sizeof(args) / sizeof(args[0]));
+  if (st == GR_OK)
+    st = gr_reduction_i64_run(s->ctx, &s->red_ring, s->ring_reduce, q);
+  if (st == GR_OK)
+    st = gr_snow_allreduce_i64(s, q, 4);
+  return st;
+}
+
+/* snow_apply on the window: ring 0 presses (press) and deposits, a later
+ * ring only deposits; each point's deposit to scratch, its lack of room to
+ * movable (for gr_snow_ring_sums). */
+static gr_status gr_snow_apply_ring(gr_snow_deformation *s, const gr_snow_cwin *win, cl_int ring,
+                                    cl_int press, float add_depth, float add_rho) {
+  cl_int nx = s->grid.nx, ny = s->grid.ny;
+  float clearance = (float)(2.0 * GR_SNOW_DEFORMATION_CONTACT_GAP);
+  const gr_snow_arg args[] = {{"clearance", sizeof(clearance), &clearance},
+                              {"add_depth", sizeof(add_depth), &add_depth},
+                              {"add_rho", sizeof(add_rho), &add_rho},
+                              {"press", sizeof(press), &press},
+                              {"ring", sizeof(ring), &ring},
+                              {"nx", sizeof(nx), &nx},
+                              {"ny", sizeof(ny), &ny},
+                              {"x_end", sizeof(cl_int), &win->x_end},
+                              {"y_end", sizeof(cl_int), &win->y_end},
+                              {"overlap_sum", sizeof(cl_mem), &s->overlap_sum},
+                              {"contact", sizeof(cl_mem), &s->contact},
+                              {"under_min", sizeof(cl_mem), &s->under_min},
+                              {"got", sizeof(cl_mem), &s->scratch},
+                              {"full", sizeof(cl_mem), &s->movable}};
+  gr_status st = gr_snow_press_args(s, s->apply);
+  if (st == GR_OK)
+    st = gr_snow_args(s, s->apply, args, sizeof(args) / sizeof(args[0]));
+  if (st == GR_OK)
+    st = gr_enqueue_2d(s->ctx, s->apply, win->x0, win->y0, win->w, win->h, NULL);
+  return st;
+}
+
+/* An object's press and deposit (header, steps 4 to 6): give (per unit
+ * cell area: the displaced snow and what waited) goes to the contour at
+ * add_depth per unit weight, each point taking at most its room under the
+ * objects (snow_room: snow is never put under an object up to its
+ * underside). What did not fit under an overhang goes on to the next ring
+ * out, the points bordering the full ones, with the same direction
+ * weights (or evenly, where none faces the motion), ring by ring until it
+ * is placed: at most GR_SNOW_DEPOSIT_RINGS rings, and what is left (the
+ * rounding to whole quanta, less than a quantum a point) waits for the
+ * next press. One read-back a ring: its deposit and the next ring's
+ * weights together. Every decision is on global integer sums: the same on
+ * every split. */
+static gr_status gr_snow_deposit(gr_snow_deformation *s, const gr_snow_cwin *win, cl_int press,
+                                 float add_depth, float add_rho, double give, float vx, float vy,
+                                 float rest) {
+  const double quantum = 1.0 / GR_SNOW_QUANTUM_INV;
+  long long q[4] = {0, 0, 0, 0};
+  gr_status st = GR_OK;
+  double left = give;
+  for (cl_int ring = 0; st == GR_OK; ++ring) {
+    if (win->on)
+      st = gr_snow_apply_ring(s, win, ring, press, add_depth, add_rho);
+    /* A piece's ring: the contour and the deposits beside its outer edge
+     * lacked their neighbours; the neighbours' own points replace them. */
+    if (st == GR_OK)
+      st = gr_snow_piece_sync(s);
+    if (st != GR_OK || add_depth <= 0.0f)
+      return st; /* nothing deposited: what waits still waits */
+    if (win->on)
+      st = gr_snow_contour_ring(s, win, ring + 1, vx, vy, rest);
+    if (st == GR_OK)
+      st = gr_snow_ring_sums(s, win, q);
+    if (st != GR_OK)
+      break;
+    left -= (double)q[0] * quantum;
+    if (q[1] == 0 || ring == GR_SNOW_DEPOSIT_RINGS)
+      break;                     /* all placed but the rounding's rest, or the last ring */
+    if (q[3] > 0 && q[2] == 0) { /* no point of the next ring faces the motion: evenly */
+      if (win->on)
+        st = gr_snow_contour_ring(s, win, ring + 1, vx, vy, 1.0f);
+      if (st == GR_OK)
+        st = gr_snow_ring_sums(s, win, q);
+    }
+    if (st != GR_OK || q[2] <= 0)
+      break; /* no ring left on the grid */
+    double per = left / ((double)q[2] / GR_SNOW_WEIGHT_INV);
+    add_depth = (float)per;
+    if ((double)add_depth > per)
+      add_depth = nextafterf(add_depth, 0.0f);
+  }
+  /* The rest waits for the next press (and counts in the ledger). */
+  s->pending_mass = left > 0.0 ? left * add_rho : 0.0;
+  s->pending = left > 0.0 ? left : 0.0;
+  return st;
+}
+
 static gr_status gr_snow_object_step(gr_snow_deformation *s, int o, double dt) {
   const gr_snow_object *ob = &s->objects[o];
   gr_context *ctx = s->ctx;
@@ -1234,36 +1398,9 @@ static gr_status gr_snow_object_step(gr_snow_deformation *s, int o, double dt) {
     uz = ob->v[2] / vn;
   }
   float vx = (float)ux, vy = (float)uy, rest = (float)(uz * uz / s->params.direction_falloff);
-  float gap = (float)GR_SNOW_DEFORMATION_CONTACT_GAP;
-  if (st == GR_OK && c_on) {
-    st = GR_SNOW_ARG(s, s->contour, "ground", s->ground);
-    if (st == GR_OK)
-      st = GR_SNOW_ARG(s, s->contour, "depth", s->depth[s->cur]);
-    if (st == GR_OK)
-      st = GR_SNOW_ARG(s, s->contour, "under", s->under);
-    if (st == GR_OK)
-      st = GR_SNOW_ARG(s, s->contour, "gap", gap);
-    if (st == GR_OK)
-      st = GR_SNOW_ARG(s, s->contour, "overlap", s->overlap);
-    if (st == GR_OK)
-      st = GR_SNOW_ARG(s, s->contour, "nx", nx);
-    if (st == GR_OK)
-      st = GR_SNOW_ARG(s, s->contour, "ny", ny);
-    if (st == GR_OK)
-      st = GR_SNOW_ARG(s, s->contour, "vx", vx);
-    if (st == GR_OK)
-      st = GR_SNOW_ARG(s, s->contour, "vy", vy);
-    if (st == GR_OK)
-      st = GR_SNOW_ARG(s, s->contour, "rest", rest);
-    if (st == GR_OK)
-      st = GR_SNOW_ARG(s, s->contour, "weight", s->weight);
-    if (st == GR_OK)
-      st = GR_SNOW_ARG(s, s->contour, "x_end", cx_end);
-    if (st == GR_OK)
-      st = GR_SNOW_ARG(s, s->contour, "y_end", cy_end);
-    if (st == GR_OK)
-      st = gr_enqueue_2d(ctx, s->contour, CX0, CY0, CW, CH, NULL);
-  }
+  gr_snow_cwin win = {CX0, CY0, CW, CH, cx_end, cy_end, 0, 0, 1, 0, c_on};
+  if (st == GR_OK && c_on)
+    st = gr_snow_contour_ring(s, &win, 0, vx, vy, rest);
   if (st == GR_OK)
     st = gr_snow_mark(s, &s->tm.contour_ms);
   /* Totals over the piece's own points of the contour window (fixed point:
@@ -1274,6 +1411,7 @@ static gr_status gr_snow_object_step(gr_snow_deformation *s, int o, double dt) {
   gr_snow_own_clip(s, &rx0, &ry0, &rx1, &ry1);
   cl_int cw = rx1 - rx0 + 1, cn = rx0 <= rx1 && ry0 <= ry1 ? cw * (ry1 - ry0 + 1) : 0;
   cw = cw > 0 ? cw : 1;
+  win.rx0 = rx0, win.ry0 = ry0, win.rw = cw, win.rn = cn;
   if (st == GR_OK)
     st = gr_snow_press_args(s, s->obj_reduce);
   if (st == GR_OK)
@@ -1328,65 +1466,8 @@ static gr_status gr_snow_object_step(gr_snow_deformation *s, int o, double dt) {
       s->force[o][a] += -m * ob->v[a] / dt;
   }
   s->area[o] = sums[6] * area;
-  if (st == GR_OK && c_on) {
-    st = gr_snow_press_args(s, s->apply);
-    if (st == GR_OK)
-      st = GR_SNOW_ARG(s, s->apply, "add_depth", add_depth);
-    if (st == GR_OK)
-      st = GR_SNOW_ARG(s, s->apply, "add_rho", add_rho);
-    if (st == GR_OK)
-      st = GR_SNOW_ARG(s, s->apply, "press", press);
-    if (st == GR_OK)
-      st = GR_SNOW_ARG(s, s->apply, "nx", nx);
-    if (st == GR_OK)
-      st = GR_SNOW_ARG(s, s->apply, "ny", ny);
-    if (st == GR_OK)
-      st = GR_SNOW_ARG(s, s->apply, "overlap_sum", s->overlap_sum);
-    if (st == GR_OK)
-      st = GR_SNOW_ARG(s, s->apply, "contact", s->contact);
-    if (st == GR_OK)
-      st = GR_SNOW_ARG(s, s->apply, "under_min", s->under_min);
-    if (st == GR_OK)
-      st = GR_SNOW_ARG(s, s->apply, "x_end", cx_end);
-    if (st == GR_OK)
-      st = GR_SNOW_ARG(s, s->apply, "y_end", cy_end);
-    if (st == GR_OK)
-      st = gr_enqueue_2d(ctx, s->apply, CX0, CY0, CW, CH, NULL);
-  }
-  /* The contour received whole quanta, a little less than given: the rest
-   * waits for the next press (and counts in the ledger meanwhile). */
-  if (st == GR_OK && add_depth > 0.0f) {
-    cl_kernel k = s->added_reduce;
-    long long got = 0;
-    st = GR_SNOW_ARG(s, k, "overlap", s->overlap);
-    if (st == GR_OK)
-      st = GR_SNOW_ARG(s, k, "weight", s->weight);
-    if (st == GR_OK)
-      st = GR_SNOW_ARG(s, k, "add_depth", add_depth);
-    if (st == GR_OK)
-      st = GR_SNOW_ARG(s, k, "nx", nx);
-    if (st == GR_OK)
-      st = GR_SNOW_ARG(s, k, "x0", rx0);
-    if (st == GR_OK)
-      st = GR_SNOW_ARG(s, k, "y0", ry0);
-    if (st == GR_OK)
-      st = GR_SNOW_ARG(s, k, "w", cw);
-    if (st == GR_OK)
-      st = GR_SNOW_ARG(s, k, "n", cn);
-    if (st == GR_OK)
-      st = gr_reduction_i64_run(ctx, &s->red_added, k, &got);
-    if (st == GR_OK)
-      st = gr_snow_allreduce_i64(s, &got, 1);
-    if (st == GR_OK) {
-      double rest = give - (double)got * quantum;
-      s->pending_mass = rest > 0.0 ? rest * add_rho : 0.0;
-      s->pending = rest > 0.0 ? rest : 0.0;
-    }
-  }
-  /* A piece's ring: the contour and the deposits beside its outer edge
-   * lacked their neighbours; the neighbours' own points replace them. */
   if (st == GR_OK)
-    st = gr_snow_piece_sync(s);
+    st = gr_snow_deposit(s, &win, press, add_depth, add_rho, give, vx, vy, rest);
   if (st == GR_OK)
     st = gr_snow_mark(s, &s->tm.distribution_ms);
   return st;
@@ -1470,14 +1551,17 @@ static void gr_snow_thresholds(const gr_snow_deformation *s, float thr[3]) {
 }
 
 /* The arguments every talus kernel shares: the ground, the lowest
- * underside and its clearance (snow_excess), the grid and the thresholds. */
+ * underside (or the reach's ceilings) and its clearance (snow_excess), the
+ * grid and the thresholds. */
 static gr_status gr_snow_talus_args(gr_snow_deformation *s, cl_kernel k) {
   cl_int nx = s->grid.nx, ny = s->grid.ny;
   float thr[3];
   gr_snow_thresholds(s, thr);
   float clearance = (float)(2.0 * GR_SNOW_DEFORMATION_CONTACT_GAP);
+  /* Under a reach the ceilings are its plane (snow_reach_ceiling). */
+  cl_mem ceiling = s->reach_on ? s->scratch : s->under_min;
   const gr_snow_arg args[] = {{"ground", sizeof(cl_mem), &s->ground},
-                              {"under_min", sizeof(cl_mem), &s->under_min},
+                              {"under_min", sizeof(cl_mem), &ceiling},
                               {"clearance", sizeof(clearance), &clearance},
                               {"nx", sizeof(nx), &nx},
                               {"ny", sizeof(ny), &ny},
@@ -1618,24 +1702,205 @@ static gr_status gr_snow_relax_group(gr_snow_deformation *s, int *x0, int *y0, i
   return st;
 }
 
-/* The talus iterations a step of dt may run: MaxRelaxIterations, and with a
- * SlumpSpeed c no more than a front moving at c crosses, ceil(c dt / d)
- * for the finer spacing d (at least one). A talus iteration moves snow one
- * point, so without that bound the snow would slide as fast as the
- * iterations allow (about 60 m/s at 4096 points over 20 m with 200 a
- * step): the slump's speed, and the shape of a trail, would change with
- * the resolution. With it a pile collapses at the same speed in metres per
- * second on every grid, and a relaxation that needs longer goes on in the
- * next steps (the rest box). The same on every piece: dt and the spacing are
- * the domain's. */
-static int gr_snow_relax_cap(const gr_snow_deformation_params *p, const gr_grid *g, double dt) {
-  int cap = p->max_relax_iterations;
-  if (p->slump_speed > 0.0 && cap > 0) {
-    double d = g->dx < g->dy ? g->dx : g->dy, n = ceil(p->slump_speed * dt / d - 1e-9);
-    if (n < (double)cap)
-      cap = n < 1.0 ? 1 : (int)n;
+/* The reach of a step's talus in points (8-neighbour steps): with a
+ * SlumpSpeed c, ceil(c dt / d) for the finer spacing d (at least one); 0
+ * (no bound) for c = 0 or where it spans the whole domain anyway. A talus
+ * iteration moves snow one point, so without a bound the snow would slide
+ * as far as the iterations reach (about 60 m/s at 4096 points over 20 m
+ * with 200 a step): the slump's speed, and the shape of a trail, would
+ * change with the resolution. The same on every piece: dt and the spacing
+ * are the domain's. */
+static int gr_snow_reach_hops(const gr_snow_deformation *s, double dt) {
+  const gr_snow_deformation_params *p = &s->params;
+  if (!(p->slump_speed > 0.0))
+    return 0;
+  double d = s->grid.dx < s->grid.dy ? s->grid.dx : s->grid.dy;
+  double n = ceil(p->slump_speed * dt / d - 1e-9), all = s->gnx > s->gny ? s->gnx : s->gny;
+  return n >= all ? 0 : (n < 1.0 ? 1 : (int)n);
+}
+
+/* One pass of the reach's max filter (snow_reach_rows, snow_reach_cols):
+ * the points within h of a point of src above thr in the box src_box
+ * (local, inclusive, cut to the arrays; empty: none) into `weight`, on
+ * out_box. */
+static gr_status gr_snow_reach_dilate(gr_snow_deformation *s, cl_mem src, float thr,
+                                      const int src_box[4], const int out_box[4], cl_int h) {
+  cl_int nx = s->grid.nx, ny = s->grid.ny, sx0 = src_box[0], sy0 = src_box[1], sx1 = src_box[2],
+         sy1 = src_box[3];
+  cl_int x_end = out_box[2] + 1, y_end = sy1 + 1;
+  const gr_snow_arg rows[] = {{"src", sizeof(cl_mem), &src},
+                              {"thr", sizeof(thr), &thr},
+                              {"sx0", sizeof(sx0), &sx0},
+                              {"sy0", sizeof(sy0), &sy0},
+                              {"sx1", sizeof(sx1), &sx1},
+                              {"sy1", sizeof(sy1), &sy1},
+                              {"h", sizeof(h), &h},
+                              {"nx", sizeof(nx), &nx},
+                              {"ny", sizeof(ny), &ny},
+                              {"x_end", sizeof(x_end), &x_end},
+                              {"y_end", sizeof(y_end), &y_end},
+                              {"out", sizeof(cl_mem), &s->scratch}};
+  gr_status st = gr_snow_args(s, s->reach_rows, rows, sizeof(rows) / sizeof(rows[0]));
+  if (st == GR_OK && sy0 <= sy1) /* no rows: the columns read none */
+    st = gr_enqueue_2d(s->ctx, s->reach_rows, (size_t)out_box[0], (size_t)sy0,
+                       (size_t)(out_box[2] - out_box[0] + 1), (size_t)(sy1 - sy0 + 1), NULL);
+  cl_int y_end2 = out_box[3] + 1;
+  const gr_snow_arg cols[] = {{"src", sizeof(cl_mem), &s->scratch},
+                              {"sy0", sizeof(sy0), &sy0},
+                              {"sy1", sizeof(sy1), &sy1},
+                              {"h", sizeof(h), &h},
+                              {"nx", sizeof(nx), &nx},
+                              {"ny", sizeof(ny), &ny},
+                              {"x_end", sizeof(x_end), &x_end},
+                              {"y_end", sizeof(y_end2), &y_end2},
+                              {"out", sizeof(cl_mem), &s->weight}};
+  if (st == GR_OK)
+    st = gr_snow_args(s, s->reach_cols, cols, sizeof(cols) / sizeof(cols[0]));
+  if (st == GR_OK)
+    st = gr_enqueue_2d(s->ctx, s->reach_cols, (size_t)out_box[0], (size_t)out_box[1],
+                       (size_t)(out_box[2] - out_box[0] + 1), (size_t)(out_box[3] - out_box[1] + 1),
+                       NULL);
+  return st;
+}
+
+/* A box (x0 y0 x1 y1) cut to the local arrays; 0 when nothing is left. */
+static int gr_snow_clip_box(const gr_snow_deformation *s, const int in[4], int out[4]) {
+  out[0] = in[0] > 0 ? in[0] : 0;
+  out[1] = in[1] > 0 ? in[1] : 0;
+  out[2] = in[2] < s->grid.nx - 1 ? in[2] : s->grid.nx - 1;
+  out[3] = in[3] < s->grid.ny - 1 ? in[3] : s->grid.ny - 1;
+  return out[0] <= out[2] && out[1] <= out[3];
+}
+
+/* The reach of this step's talus (SlumpSpeed; header): the points within
+ * hops of a seed, a point that can move more than the tolerance at the
+ * step's start (a mover, found on the window [*x0, *x1] x [*y0, *y1],
+ * where every point that can move lies) or one on a slope
+ * (snow_reach_seed), as far as the talus can reach in the step (the cap's
+ * iterations from the movers). Only those points give or receive (their
+ * ceilings, snow_reach_ceiling, are -inf elsewhere), and within them the
+ * snow settles: a slide spreads over flat snow at SlumpSpeed, and what an
+ * object feeds becomes a heap at MaxSlope on every grid (a talus cut to a
+ * number of iterations carries a flux that shrinks with the spacing, and
+ * piled a wall). The mask is a max filter of the seeds in passes of at
+ * most GR_SNOW_DEFORMATION_GHOST - 1 points, each exchanged on a piece (a
+ * seed reads its neighbours: the ring gives 7 points), so a piece's mask is
+ * the whole grid's. Leaves the movers' box in *x0.. (the givers' window)
+ * and the reach's box in s->reach_box and s->reach_all; *any = 0 when
+ * nothing can move. */
+static gr_status gr_snow_relax_reach(gr_snow_deformation *s, int hops, float tol, int *x0, int *y0,
+                                     int *x1, int *y1, int *any) {
+  cl_int gx0 = *x0, gy0 = *y0, gx_end = *x1 + 1, gy_end = *y1 + 1, t = 0;
+  s->reach_on = 0;
+  *any = 0;
+  /* The movers: snow_relax_rate's movable amounts at t = 0, everyone a giver. */
+  const gr_snow_arg seed[] = {{"depth", sizeof(cl_mem), &s->depth[s->cur]},
+                              {"tol", sizeof(tol), &tol},
+                              {"gx0", sizeof(gx0), &gx0},
+                              {"gy0", sizeof(gy0), &gy0},
+                              {"gx_end", sizeof(gx_end), &gx_end},
+                              {"gy_end", sizeof(gy_end), &gy_end},
+                              {"t", sizeof(t), &t},
+                              {"x_end", sizeof(gx_end), &gx_end},
+                              {"y_end", sizeof(gy_end), &gy_end},
+                              {"rate", sizeof(cl_mem), &s->rate},
+                              {"rate_in", sizeof(cl_mem), &s->rate_in},
+                              {"movable", sizeof(cl_mem), &s->movable}};
+  gr_status st = gr_snow_talus_args(s, s->relax_rate);
+  if (st == GR_OK)
+    st = gr_snow_args(s, s->relax_rate, seed, sizeof(seed) / sizeof(seed[0]));
+  if (st == GR_OK)
+    st = gr_enqueue_2d(s->ctx, s->relax_rate, (size_t)gx0, (size_t)gy0, (size_t)(gx_end - gx0),
+                       (size_t)(gy_end - gy0), NULL);
+  double m[GR_SNOW_CHECK_MAXES];
+  int empty = 0;
+  if (st == GR_OK)
+    st = gr_snow_relax_check_start(s, &s->red_check[0], *x0, *y0, *x1, *y1, &empty);
+  if (st == GR_OK)
+    st = gr_snow_relax_check_finish(s, &s->red_check[0], empty, m);
+  if (st != GR_OK || m[0] <= tol)
+    return st;
+  *any = 1;
+  /* The boxes in the local arrays' indices, not cut: the same box of the
+   * domain on every piece. The seeds: wherever this step's talus can
+   * reach, snow moving a point an iteration, so within the cap of the
+   * movers. */
+  int movers[4] = {(int)-m[1], (int)-m[3], (int)m[2], (int)m[4]}, src[4], out[4], cut[4],
+      cut_out[4];
+  int far = s->params.max_relax_iterations;
+  src[0] = movers[0] - far, src[1] = movers[1] - far, src[2] = movers[2] + far,
+  src[3] = movers[3] + far;
+  *x0 = movers[0], *y0 = movers[1], *x1 = movers[2], *y1 = movers[3];
+  float t3[3];
+  gr_snow_thresholds(s, t3);
+  if (gr_snow_clip_box(s, src, cut)) {
+    cl_int nx = s->grid.nx, ny = s->grid.ny, x_end = cut[2] + 1, y_end = cut[3] + 1;
+    const gr_snow_arg args[] = {{"ground", sizeof(cl_mem), &s->ground},
+                                {"depth", sizeof(cl_mem), &s->depth[s->cur]},
+                                {"movable", sizeof(cl_mem), &s->movable},
+                                {"tol", sizeof(tol), &tol},
+                                {"ax0", sizeof(cl_int), &movers[0]},
+                                {"ay0", sizeof(cl_int), &movers[1]},
+                                {"ax1", sizeof(cl_int), &movers[2]},
+                                {"ay1", sizeof(cl_int), &movers[3]},
+                                {"tx", sizeof(float), &t3[0]},
+                                {"ty", sizeof(float), &t3[1]},
+                                {"td", sizeof(float), &t3[2]},
+                                {"nx", sizeof(nx), &nx},
+                                {"ny", sizeof(ny), &ny},
+                                {"x_end", sizeof(x_end), &x_end},
+                                {"y_end", sizeof(y_end), &y_end},
+                                {"reach", sizeof(cl_mem), &s->weight}};
+    st = gr_snow_args(s, s->reach_seed, args, sizeof(args) / sizeof(args[0]));
+    if (st == GR_OK)
+      st = gr_enqueue_2d(s->ctx, s->reach_seed, (size_t)cut[0], (size_t)cut[1],
+                         (size_t)(cut[2] - cut[0] + 1), (size_t)(cut[3] - cut[1] + 1), NULL);
   }
-  return cap;
+  /* The max filter, hops points, in passes a piece's ring can feed. */
+  for (int left = hops; st == GR_OK && left > 0;) {
+    int h = left < GR_SNOW_DEFORMATION_GHOST - 1 ? left : GR_SNOW_DEFORMATION_GHOST - 1;
+    out[0] = src[0] - h, out[1] = src[1] - h, out[2] = src[2] + h, out[3] = src[3] + h;
+    if (!gr_snow_clip_box(s, src, cut)) /* no seeds here */
+      cut[0] = cut[1] = 0, cut[2] = cut[3] = -1;
+    if (gr_snow_clip_box(s, out, cut_out))
+      st = gr_snow_reach_dilate(s, s->weight, 0.5f, cut, cut_out, h);
+    if (st == GR_OK) {
+      s->halo_reach = 1; /* pieces: the ring's mask from its own piece */
+      st = gr_snow_piece_sync(s);
+      s->halo_reach = 0;
+    }
+    memcpy(src, out, sizeof(src));
+    left -= h;
+  }
+  memcpy(s->reach_all, src, sizeof(src));
+  if (st == GR_OK && !gr_snow_clip_box(s, src, s->reach_box))
+    s->reach_box[0] = s->reach_box[1] = 0, s->reach_box[2] = s->reach_box[3] = -1;
+  /* The ceilings, as far as a talus launch on the reach reads: a blocked
+   * launch's moves reach GR_SNOW_BLOCK_ITERATIONS beyond its givers and read
+   * twice that farther. */
+  const int pad = 3 * GR_SNOW_BLOCK_ITERATIONS;
+  int wide[4] = {src[0] - pad, src[1] - pad, src[2] + pad, src[3] + pad};
+  if (st == GR_OK && gr_snow_clip_box(s, wide, cut)) {
+    cl_int nx = s->grid.nx, ny = s->grid.ny, x_end = cut[2] + 1, y_end = cut[3] + 1;
+    const gr_snow_arg args[] = {{"under_min", sizeof(cl_mem), &s->under_min},
+                                {"reach", sizeof(cl_mem), &s->weight},
+                                {"bx0", sizeof(cl_int), &s->reach_box[0]},
+                                {"by0", sizeof(cl_int), &s->reach_box[1]},
+                                {"bx1", sizeof(cl_int), &s->reach_box[2]},
+                                {"by1", sizeof(cl_int), &s->reach_box[3]},
+                                {"nx", sizeof(nx), &nx},
+                                {"ny", sizeof(ny), &ny},
+                                {"x_end", sizeof(x_end), &x_end},
+                                {"y_end", sizeof(y_end), &y_end},
+                                {"ceiling", sizeof(cl_mem), &s->scratch}};
+    st = gr_snow_args(s, s->reach_ceiling, args, sizeof(args) / sizeof(args[0]));
+    if (st == GR_OK)
+      st = gr_enqueue_2d(s->ctx, s->reach_ceiling, (size_t)cut[0], (size_t)cut[1],
+                         (size_t)(cut[2] - cut[0] + 1), (size_t)(cut[3] - cut[1] + 1), NULL);
+  }
+  if (st == GR_OK)
+    s->reach_on = 1;
+  return st;
 }
 
 /* Talus relaxation on a window that follows the snow that can move.
@@ -1706,6 +1971,22 @@ static gr_status gr_snow_relax(gr_snow_deformation *s, double dt) {
   else
     st = gr_snow_sync_rect(s, x0, y0, x1, y1);
   s->relax_full = s->sync_full = 0;
+  /* SlumpSpeed: the talus runs on the step's reach only (the givers'
+   * window from the movers on). */
+  const int hops = gr_snow_reach_hops(s, dt);
+  int movers[4] = {0, 0, -1, -1}; /* under a reach: the box of the points that could move */
+  s->reach_on = 0;
+  if (st == GR_OK && hops > 0) {
+    int any = 0;
+    st = gr_snow_relax_reach(s, hops, tol, &x0, &y0, &x1, &y1, &any);
+    movers[0] = x0, movers[1] = y0, movers[2] = x1, movers[3] = y1;
+    if (st != GR_OK || !any) {
+      s->reach_on = 0;
+      s->rest[0] = s->rest[1] = 0;
+      s->rest[2] = s->rest[3] = -1;
+      return st; /* nothing can move: the snow is as relaxed as it was */
+    }
+  }
   int lx0 = 0, ly0 = 0, lx1 = -1, ly1 = -1; /* the last launch's window */
   /* Launches in flight: on GPUs, where a read-back between launches costs
    * more than the launch, only every GR_SNOW_CHECK_EVERY-th launch is
@@ -1715,14 +1996,18 @@ static gr_status gr_snow_relax(gr_snow_deformation *s, double dt) {
    * one whose check says nothing could move changes nothing (no point
    * gives), so the lag changes what is computed, never the result or the
    * iteration count. */
-  const int lag = s->blocked ? GR_SNOW_CHECK_LAG : 0,
-            cap = gr_snow_relax_cap(&s->params, &s->grid, dt);
+  const int lag = s->blocked ? GR_SNOW_CHECK_LAG : 0, cap = s->params.max_relax_iterations;
   const int every = s->blocked ? GR_SNOW_CHECK_EVERY : 1;
   /* per check in flight: the iterations launched before its launch, and
    * whether it is empty (a piece with none of the window) */
   int before[GR_SNOW_CHECK_LAG + 1], empty[GR_SNOW_CHECK_LAG + 1];
   int launched = 0, started = 0, read = 0, it_launched = 0, done = 0;
   while (st == GR_OK && !done) {
+    if (s->reach_on) { /* no giver beyond the reach (and no read beyond its ceilings) */
+      const int *b = s->reach_box;
+      x0 = x0 > b[0] ? x0 : b[0], y0 = y0 > b[1] ? y0 : b[1];
+      x1 = x1 < b[2] ? x1 : b[2], y1 = y1 < b[3] ? y1 : b[3];
+    }
     /* The tail: once the givers' window grown by two is small, in one
      * work-group (not on a piece with a ring: it would need an exchange
      * every iteration), after every check in flight is read. */
@@ -1814,6 +2099,24 @@ static gr_status gr_snow_relax(gr_snow_deformation *s, double dt) {
     s->rest[0] = x0 > 0 ? x0 : 0, s->rest[1] = y0 > 0 ? y0 : 0;
     s->rest[2] = x1 < nx - 1 ? x1 : nx - 1, s->rest[3] = y1 < ny - 1 ? y1 : ny - 1;
   }
+  /* Under a reach: snow moved a point an iteration from the points that
+   * could move, within the reach, so only there, and next to it, may a
+   * point have an excess now (the edge of the reach, where the front
+   * slides on next step). Not cut to the local arrays: the domain's box,
+   * so that every piece goes on with the next step's talus alike. */
+  if (st == GR_OK && s->reach_on) {
+    const int *b = s->reach_all, g = it_launched + 1;
+    int e[4] = {movers[0] - g, movers[1] - g, movers[2] + g, movers[3] + g};
+    e[0] = e[0] > b[0] - 1 ? e[0] : b[0] - 1, e[1] = e[1] > b[1] - 1 ? e[1] : b[1] - 1;
+    e[2] = e[2] < b[2] + 1 ? e[2] : b[2] + 1, e[3] = e[3] < b[3] + 1 ? e[3] : b[3] + 1;
+    if (s->rest[0] > s->rest[2] || s->rest[1] > s->rest[3])
+      memcpy(s->rest, e, sizeof(e));
+    s->rest[0] = s->rest[0] < e[0] ? s->rest[0] : e[0];
+    s->rest[1] = s->rest[1] < e[1] ? s->rest[1] : e[1];
+    s->rest[2] = s->rest[2] > e[2] ? s->rest[2] : e[2];
+    s->rest[3] = s->rest[3] > e[3] ? s->rest[3] : e[3];
+  }
+  s->reach_on = 0;
   /* Both buffers equal again: the last window from the state. */
   if (st == GR_OK)
     st = gr_snow_sync_rect(s, lx0, ly0, lx1, ly1);

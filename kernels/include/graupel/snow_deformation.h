@@ -44,12 +44,24 @@
  *     fraction s_w(c) / sum s_w, s_w = max(0, v^ . (w_x, w_y, 0)) + r / K,
  *     v^ the object's unit velocity (3-D), r = v^_z^2 (the code form of Eq.
  *     3.19, notes section 2.8; zero velocity counts as straight down: a uniform
- *     ring), K = DirectionFalloff. The point's volume grows by its share of
- *     V and its mass by its share of M (rho mixes), so both are conserved.
- *     The totals are device reductions (reduce.h): no atomics, no append
- *     buffers. An object whose overlap leaves no contour point on the grid
- *     (it covers the whole grid) or whose weights sum to 0 (none ahead, the
- *     rest off the grid) deforms nothing that step.
+ *     ring), K = DirectionFalloff, but never more than its room: up to its
+ *     ceiling, the lowest underside above it (this object's, or an earlier
+ *     one's this step) less twice GR_SNOW_DEFORMATION_CONTACT_GAP, so snow
+ *     is never put under an object up to it. What the room under an
+ *     overhang (a sphere's, a wheel's) does not hold goes on outward, ring
+ *     by ring: the next ring is the points with room that border a full one
+ *     (overlapped, touched, or filled by the ring before), weighted the
+ *     same way (w from their full neighbours; evenly where no point faces
+ *     the motion), until all is placed or 64 rings are filled (the rest
+ *     waits, as the rounding's does). (A contour that took its share
+ *     whatever the room put snow up to 11 mm inside a sphere pressed into
+ *     dense snow, where neither contact nor overlap showed it.) The point's
+ *     volume grows by its share of V and its mass by its share of M (rho
+ *     mixes), so both are conserved. The totals are device reductions
+ *     (reduce.h): no atomics, no append buffers. An object whose overlap
+ *     leaves no contour point on the grid (it covers the whole grid) or
+ *     whose weights sum to 0 (none ahead, the rest off the grid) deforms
+ *     nothing that step.
  * Then, after all objects, talus relaxation (Eqs. 3.29-3.33, with Alg.
  * 4.11's loss fixed): Jacobi iterations with gather (each point computes
  * what it gives and what it receives from the same floats, so volume and
@@ -80,12 +92,22 @@
  * (mass mixes). Only a point that can move more than RelaxTolerance gives
  * (min(S_a, largest x_ab)), and the relaxation stops when none can (read
  * every 4 iterations, with the box of those points, which bounds the next
- * iterations' window) or after MaxRelaxIterations, or after the iterations
- * a front moving at SlumpSpeed crosses in the step (ceil(c dt / d): a talus
- * iteration moves snow one point; the rest goes on in the next steps, so a
- * pile collapses at the same speed on every grid). A RelaxTolerance below
- * 16 quanta (1.5e-5 m) acts as 16 quanta, so that an iteration always moves
- * something.
+ * iterations' window) or after MaxRelaxIterations (the rest goes on in the
+ * next steps). With a SlumpSpeed c the talus of a step runs on its reach
+ * only: the points within n = ceil(c dt / d) points (8-neighbour steps, d
+ * the finer spacing) of a point that can move at the step's start or of a
+ * point on a slope (one standing at least half its threshold above a
+ * neighbour: moving snow runs down a slope, or a heap's face, as far as
+ * it goes); the other points neither give nor receive. Within its reach
+ * the snow settles; the front into flat snow advances n points a step. So
+ * a pile collapses, and the heap an object feeds spreads, at c on every
+ * grid, steeper than MaxSlope only within about c dt of where snow arrived
+ * that step (a talus cut to n iterations a step instead carries a flux that
+ * shrinks with the spacing: a box pushed through snow built a wall one
+ * point thick ahead of it, 1.3 m over the snow at 2.5 cm spacing, taller on
+ * finer grids). c = 0 (or a reach that spans the domain) relaxes each step
+ * to the end. A RelaxTolerance below 16 quanta (1.5e-5 m) acts as 16
+ * quanta, so that an iteration always moves something.
  *
  * Exact volume: depths and every amount that moves (D rounded down, e to
  * the nearest, each contour point's deposit and each talus transfer rounded
@@ -93,8 +115,8 @@
  * difference of such floats is exact, so what leaves one point arrives at
  * another to the bit, and the volume closes to the ledger's own rounding
  * over any number of steps. What the rounding of the deposits keeps back
- * (less than a quantum per contour point) waits for the next press and
- * counts in the ledger meanwhile. The mass is depth times a float density:
+ * (less than a quantum per contour point and ring) waits for the next press
+ * and counts in the ledger meanwhile. The mass is depth times a float density:
  * it closes to the densities' rounding (about 6e-7 of the mass after 10^4
  * steps of the constant compression model, the worst case tested).
  *
@@ -356,8 +378,12 @@ GR_API gr_status gr_snow_deformation_reset(gr_snow_deformation *s);
  * GR_SNOW_BLOCK_ITERATIONS (4) iterations per launch (or per group of
  * one-launch iterations) on the local arrays, ring included: after a launch
  * the outer 2 x 4 points of the ring are stale, every own point is the
- * whole grid's. So the ring is refreshed after every launch, and after each
- * object's press (whose contour reads one point away).
+ * whole grid's. So the ring is refreshed after every launch, after each
+ * object's press and each further ring of its deposit (whose contour reads
+ * one point away), and after each pass of the talus' reach (its mask, a
+ * max filter of at most 7 points a pass, travels in the strips' depth
+ * slot: a point's mover status reads its neighbours, so a ring of 8 feeds
+ * 7 points).
  *
  * The exchange is the caller's (gr_snow_deformation_set_halo_exchange),
  * called by the core at those stages, so a step makes several: per ring
