@@ -1,7 +1,10 @@
 #!/usr/bin/env bash
-# On an NVIDIA GPU machine (../shared/gpu/README.md): unpack the OpenCL and
-# OpenEXR packages carried in .gpu/, build kernels/ alone, run the core tests
-# on the GPU, benchmark every core, and soak the simulations.
+# On an NVIDIA GPU machine without ParaView or OpenCL packages: unpack the
+# Debian 12 .deb files carried in .gpu/ (ignored by git; put there beforehand:
+# clinfo, ocl-icd-libopencl1, ocl-icd-opencl-dev, opencl-c-headers, libimath
+# and libopenexr with their -dev) into /tmp/ocl, register NVIDIA's OpenCL
+# driver, build kernels/ alone, run the core tests on the GPU, benchmark
+# every core, and soak the simulations.
 #   Testing/Benchmarks/gpu_run.sh [OUT]      (OUT: where logs go, default ./gpu-out)
 # DEVICES=K (on a machine with K GPUs, e.g. nvidia-h200-x2): also the cores that
 # run as pieces (marked * in graupel-bench --help) with --devices 1 and K at

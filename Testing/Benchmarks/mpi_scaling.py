@@ -1,4 +1,4 @@
-"""Strong scaling of the simulations over MPI ranks (issue 11), for
+"""Strong scaling of the simulations over MPI ranks, for
 RESULTS.md, not a test:
 
   PYTHONPATH=build/lib/python3/site-packages \\

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Rain Runoff side by side with its peers on the real DEM (issue 10, section 4).
+"""Rain Runoff side by side with its peers on the real DEM.
 
 The scenario, the same for all three: Data/jacksboro_fault_dem.exr (403 x 344
 points, 74.5 m east-west, 92.1 m north-south), 3 h of 50 mm/h rain on sealed

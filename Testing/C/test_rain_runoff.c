@@ -1,5 +1,5 @@
-/* Rain runoff tests (graupel/rain_runoff.h; seed 004, notes/004.md 9 items
- * 14-25 with the conservative deviation of item 17): rain gain, infiltration,
+/* Rain runoff tests (graupel/rain_runoff.h; seed 004, RainCL, its water
+ * height map with its flow made conservative): rain gain, infiltration,
  * the water balance, pooling in a bowl, runoff down a plane, mirror symmetry,
  * determinism, the lake at rest, a spreading column, advance, reset, long
  * runs, and every error path.
@@ -135,7 +135,7 @@ static double sum_of(const float *v, size_t n) {
 
 /* ------------------------------------------------------------------ tests */
 
-/* Item 15: on flat, impermeable ground nothing flows and every cell rises by
+/* On flat, impermeable ground nothing flows and every cell rises by
  * r dt per step; the ledger's rain is r t area. */
 static void test_rain_gain(void) {
   gr_grid g = {40, 32, 2.0, 1.5, 0.0, 0.0, 0, 0};
@@ -218,7 +218,7 @@ static void test_rain_gain(void) {
   gr_rain_runoff_destroy(s);
 }
 
-/* Item 16: with no rain, cells lose k t until dry and never go below 0;
+/* With no rain, cells lose k t until dry and never go below 0;
  * the infiltrated field is the loss; k = 0 loses nothing. Two flat basins
  * of equal depth (k = 2e-5 m/s and k = 0) split by a dry wall, so that
  * nothing flows. */
@@ -324,9 +324,10 @@ static gr_rain_runoff *make_bumpy(const gr_grid *g, gr_boundary boundary) {
   return s;
 }
 
-/* Item 17: initial + rain = infiltrated + outflow + stored, to float
- * rounding: |balance_error| <= 1e-7 (initial + rain) after 400 steps on a
- * bumpy open terrain (the brief asks 1e-5; the Kahan-summed depth gives
+/* The seed's flow makes and loses water; here initial + rain =
+ * infiltrated + outflow + stored, to float rounding: |balance_error| <=
+ * 1e-7 (initial + rain) after 400 steps on a bumpy open terrain (the
+ * target is 1e-5; the Kahan-summed depth gives
  * about 1e-10 on PoCL); the device's sums agree with the fields read back. */
 static void test_conservation(void) {
   gr_grid g = {64, 48, 2.0, 2.5, 0.0, 0.0, 0, 0};
@@ -449,7 +450,7 @@ static void test_bowl(void) {
   gr_rain_runoff_destroy(s);
 }
 
-/* Item 19: rain on a tilted plane with an open boundary runs off through the
+/* Rain on a tilted plane with an open boundary runs off through the
  * low edge: the depth grows downslope, the water flows downslope, and the
  * discharge at the low edge far exceeds that at the high edge. */
 static void test_tilted_plane(void) {
@@ -2953,7 +2954,7 @@ static void test_memcheck_subset(void) {
 /* ------------------------------------------------------- shallow water */
 
 /* The shallow-water model (FlowModel 0) against analytic solutions, with
- * its errors measured and bounded by issue 10's targets. */
+ * its errors measured and bounded by the targets below. */
 static gr_rain_runoff_params sw_params(double manning_n, gr_boundary boundary) {
   gr_rain_runoff_params p;
   gr_rain_runoff_params_init(&p);
@@ -3021,7 +3022,7 @@ static double strip_crossing(const float *h, const gr_grid *g, double x_from, do
 
 /* Ritter's dry dam break: h0 = 1 m at rest behind the dam at x0, dry ground
  * beyond, frictionless; after t the rarefaction h = (2 c0 - (x - x0) / t)^2
- * / (9 g) spans x0 - c0 t to the front x0 + 2 c0 t. Issue 10: depth L1 <
+ * / (9 g) spans x0 - c0 t to the front x0 + 2 c0 t. Target: depth L1 <
  * 5%. The front: where the depth falls below 1 cm (1% of h0), analytically
  * at x0 + (2 c0 - 3 sqrt(g 0.01)) t, within 4 cells (the thin tip of the
  * rarefaction, below 1 cm, lags by more: its 1 mm point is printed). */
@@ -3078,7 +3079,7 @@ static double stoker_middle(double h0, double h1) {
 
 /* Stoker's wet dam break, h0 = 1 m behind the dam and h1 = 0.1 m ahead:
  * a rarefaction, a plateau hm and a bore moving at S = hm um / (hm - h1).
- * Issue 10: depth L1 < 5%, the bore (where the depth crosses (hm + h1) / 2)
+ * Target: depth L1 < 5%, the bore (where the depth crosses (hm + h1) / 2)
  * within 2 cells of x0 + S t. */
 static void test_sw_stoker(void) {
   const double h0 = 1.0, h1 = 0.1, x0 = 200.0, t = 30.0, g0 = GR_GRAVITY;
@@ -3120,7 +3121,7 @@ static void test_sw_stoker(void) {
 
 /* The lake at rest with a dry rim and an island (well-balanced at wet/dry
  * fronts): a still lake at 1 m in a closed, bumpy bowl whose rim and a
- * central island rise above it, frictionless, for 10^4 s; issue 10's goal:
+ * central island rise above it, frictionless, for 10^4 s; the target:
  * below 1e-6 m/s. With elevations on a 2^-10 m lattice the depths and
  * their surface are exact floats. With arbitrary elevations the depths
  * level - b are rounded wherever b < level / 2 (102 of the wet cells here),
@@ -3307,7 +3308,7 @@ static void test_sw_determinism(void) {
  * the surface a tilted plane whose water sloshes round the bowl at
  * omega = sqrt(2 g h0) / a, the velocity (-eta omega sin wt, eta omega cos
  * wt), eta = 0.5, given as the initial velocity. Frictionless, 80 x 80
- * cells. Issue 10: depth L2 < 5% after one period, the moving shoreline
+ * cells. Target: depth L2 < 5% after one period, the moving shoreline
  * included (every cell of the square is counted). */
 static double thacker_depth(double x, double y, double t) {
   const double a = 1.0, h0 = 0.1, eta = 0.5, L = 4.0;

@@ -448,7 +448,7 @@ static gr_snow_accumulation *scene(gr_snow_accumulation_params *p, test_mesh *m,
   return s;
 }
 
-/* Issue 9: snowfall = stored + shed to 1e-6 relative over 10^4 steps. */
+/* The target: snowfall = stored + shed to 1e-6 relative over 10^4 steps. */
 static void test_ledger(void) {
   gr_snow_accumulation_params p;
   test_mesh m[2];

@@ -161,10 +161,10 @@ static void plough(gr_snow_deformation *s, int steps, double speed, double dt) {
   mesh_free(&box);
 }
 
-/* Issue 8: 10^4 steps. The talus gets 8 iterations a step (the snow need
- * not settle for the books to close, and the test stays quick); every
- * amount that moves is whole quanta (snow_deformation_shared.h), so the
- * volume closes to the rounding of the ledger's own double sums. */
+/* The target: volume kept to 1e-6 over 10^4 steps. The talus gets 8 iterations a step (the snow
+ * need not settle for the books to close, and the test stays quick); every amount that moves is
+ * whole quanta (snow_deformation_shared.h), so the volume closes to the rounding of the ledger's
+ * own double sums. */
 #define MASS_STEPS 10000
 
 static void test_mass_no_compression(void) {
@@ -183,7 +183,7 @@ static void test_mass_no_compression(void) {
          "compressed %.3g\n",
          l.steps, l.snow_volume, l.initial_volume, rel, l.displaced_volume, l.compressed_volume);
   CHECK(l.steps == MASS_STEPS);
-  CHECK(rel < 1e-12); /* issue 8 asks for 1e-6 */
+  CHECK(rel < 1e-12); /* the target is 1e-6 */
   CHECK(l.compressed_volume == 0.0);
   CHECK(l.displaced_volume > 1.0); /* the box did move snow */
   CHECK(fabs(l.balance_error) / l.initial_mass < 1e-6);
@@ -470,7 +470,7 @@ static void test_talus_resumes(void) {
   gr_snow_deformation_destroy(s);
 }
 
-/* The thesis' Alg. 4.11 (notes/000.md section 2.9) on the host: it removes
+/* Seed 000's Alg. 4.11 (its talus flattening) on the host: it removes
  * the total excess s but hands out only s/m. */
 /* SlumpSpeed: a pile (0.5 m^3 on a block 0.3 m wide, 5.6 m high)
  * collapses at c = 2 m/s. A talus iteration moves snow one point, and a step
@@ -1419,7 +1419,7 @@ static void test_berm(void) {
 
 /* Every OpenCL device here ploughs the same trail (the box drag of the
  * trail test, 40 steps, the talus converged each step): surfaces within
- * 1e-5 m of the first device's (issue 8). Measured on the H200 against
+ * 1e-5 m of the first device's. Measured on the H200 against
  * PoCL: the same bits (divisions correctly rounded; 7.4e-5 m apart
  * without). On a machine with one device this says so and checks nothing. */
 static void test_devices_agree(void) {

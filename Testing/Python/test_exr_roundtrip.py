@@ -43,7 +43,7 @@ for pixel, tol in (("Float", 0.0), ("Half", 2.0 ** -11)):
     Delete(r)
 
 # Geometry and field data: a DEM saved with spacing 74.5 x 92.1, origin
-# (100, 200, 0) and a ledger comes back with them (issue 7).
+# (100, 200, 0) and a ledger comes back with them.
 from vtkmodules.vtkCommonCore import vtkDoubleArray, vtkStringArray  # noqa: E402
 from vtkmodules.vtkCommonDataModel import vtkImageData  # noqa: E402
 

@@ -1,5 +1,5 @@
 """pvbatch: `import graupel` works whether it comes before or after Graupel
-objects were wrapped for Python through a proxy (issue 7: after
+objects were wrapped for Python through a proxy (the bug fixed: after
 GetClientSideObject() on a Graupel proxy, VTK's wrapping had recorded each
 class as its nearest wrapped base, and `import graupel` then gave abstract
 base classes that could not be instantiated).

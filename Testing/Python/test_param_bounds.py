@@ -44,7 +44,7 @@ def extra(p):
 a = T.args(extra)
 
 # The wrapped classes first: importing graupel after a proxy exists is the
-# order issue 7 fixes elsewhere (py.wrapped_classes tests both orders).
+# order py.import_order_* pins (py.wrapped_classes tests both orders).
 import graupel  # noqa: E402
 from paraview import servermanager  # noqa: E402
 from paraview.simple import LoadPlugin  # noqa: E402

@@ -3,7 +3,7 @@ interval (the impulse since the last output over its time), the same for a
 step and its half, and `peak_force` is the largest step's. Before, `force`
 was the last step's: a box ploughing at 1 m/s moves whole cells of snow only
 every few steps, so the last step's force was 0 or twice the mean by the
-phase of the step (the issue's 33 N at dt 1/60 s against 67 N at 1/120 s).
+phase of the step (33 N at dt 1/60 s against 67 N at 1/120 s, before the fix).
 Also: the force does not depend on the order times are asked in (the
 impulse is part of the checkpoint state)."""
 import os

@@ -133,8 +133,8 @@ static gr_status rain_runoff_step(void *state) {
 /* What a caller pays besides the steps: the ledger (one reduction and its
  * read-back) and the stable step (the same reduction, reading only the
  * depth in the local inertial model); and a step against
- * plain 5-point stencil passes measured in the same run (issue 10: steps
- * and passes timed back to back, so that a busy machine slows both). */
+ * plain 5-point stencil passes measured in the same run (steps and
+ * passes timed back to back, so that a busy machine slows both). */
 static gr_status rain_runoff_report(void *state, gr_context *ctx) {
   rain_runoff_bench *r = state;
   gr_rain_runoff_ledger l;
@@ -151,7 +151,7 @@ static gr_status rain_runoff_report(void *state, gr_context *ctx) {
     st = gr_bench_stencil_ms(ctx, r->nx, r->ny, &stencil);
   if (st == GR_OK)
     printf("rain_runoff: %s step %.4f ms, 5-point stencil pass %.4f ms at %d x %d: a step costs "
-           "%.1f passes (issue 10's target for the local inertial step at 1024^2: 30 or fewer)\n",
+           "%.1f passes (the target for the local inertial step at 1024^2: 30 passes or fewer)\n",
            bench_flow_model() == GR_FLOW_SHALLOW_WATER ? "shallow-water" : "local inertial", step,
            stencil, r->nx, r->ny, stencil > 0.0 ? step / stencil : 0.0);
   if (st == GR_OK)

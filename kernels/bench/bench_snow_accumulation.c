@@ -1,10 +1,10 @@
 /* graupel-bench --core snow_accumulation: the exposure view plus one step
  * of snowfall, one minute, on a 50 m square whatever the grid's size, with
  * a field of boxes as occluders, 12 triangles each, about 10^4 triangles
- * in all (issue 9). Two scenes:
+ * in all. Two scenes:
  *  - one grid (no --devices): snowfall tilted 20 degrees over gently
  *    rolling ground, which then never rises above another point's ray, so
- *    the view holds the boxes alone (issue 9's scene, RESULTS.md's figures);
+ *    the view holds the boxes alone (the scene of RESULTS.md's figures);
  *  - --devices K (1 included, and --verify's whole grid), or
  *    GRAUPEL_BENCH_RIDGES=1: snowfall tilted 35 degrees and 20 degrees off
  *    x over ridges that rise 2 m per m, so the terrain is drawn into the

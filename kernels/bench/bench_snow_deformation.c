@@ -1,11 +1,11 @@
 /* graupel-bench --core snow_deformation: a closed sphere of radius 1 m
- * (SPHERE_STACKS x SPHERE_SLICES, 9936 triangles, issue 8's "one object of
- * 10^4 triangles") ploughs at 2 m/s through 0.5 m of snow on flat ground,
+ * (SPHERE_STACKS x SPHERE_SLICES, 9936 triangles, the target's "one object
+ * of 10^4 triangles") ploughs at 2 m/s through 0.5 m of snow on flat ground,
  * its lowest point 0.2 m above the ground, 1/60 s steps; the grid spans 20 m
  * whatever its size (SlumpSpeed the default, 2 m/s, unless
  * GRAUPEL_BENCH_SLUMP_SPEED says otherwise). The report times the stages of ten more steps
  * separately and, in the same run, plain 5-point stencil passes over the
- * grid (issue 8's yardstick). */
+ * grid (the yardstick of the target). */
 #include "bench.h"
 
 #include <math.h>
@@ -197,7 +197,7 @@ static gr_status snow_deformation_report(void *state, gr_context *ctx) {
            tm.relax_ms * q, (double)tm.relax_iterations * q,
            tm.relax_iterations ? tm.relax_ms / (double)tm.relax_iterations : 0.0, total, place_ms);
     printf("snow_deformation: 5-point stencil pass %.4f ms at %d x %d: a step costs %.1f passes "
-           "(issue 8's target at 1024^2: under 30)\n",
+           "(the target at 1024^2: under 30)\n",
            stencil, b->n, b->n, stencil > 0.0 ? total / stencil : 0.0);
   }
   return st;

@@ -4,8 +4,8 @@
 #ifndef GRAUPEL_CL_PARTICLES_SHARED_H
 #define GRAUPEL_CL_PARTICLES_SHARED_H
 
-/* Drop diameters, mm: real drops span about 0.1 to 6 mm (notes/004.md
- * 3.2), so Marshall-Palmer's exponential is truncated there. */
+/* Drop diameters, mm: real drops span about 0.1 to 6 mm (seed 004's drop
+ * physics), so Marshall-Palmer's exponential is truncated there. */
 #define GR_PA_DROP_MIN_MM 0.1
 #define GR_PA_DROP_MAX_MM 6.0
 

@@ -1,4 +1,4 @@
-/* Procedural terrain (seed 001, notes/001_003.md A.2.1): 2-D gradient noise
+/* Procedural terrain (seed 001's terrain, after libnoise): 2-D gradient noise
  * summed over octaves as fBm, billow or (inverted) ridged multifractal. The
  * normalisation is documented in graupel/procedural_terrain.h. */
 #include "common.h"

@@ -1,8 +1,7 @@
-/* Rain on terrain (seed 004, notes/004.md 2.4-2.7 with the conservative
- * deviation of item 17): rain gain, infiltration, and runoff by the local
- * inertial approximation of the shallow water equations (Bates, Horritt &
- * Fewtrell 2010) on a staggered grid. The model is documented in
- * graupel/rain_runoff.h.
+/* Rain on terrain (seed 004's water height map, rain and infiltration,
+ * with a conservative flow in place of its tangential flow): rain gain, infiltration, and runoff by
+ * the local inertial approximation of the shallow water equations (Bates, Horritt & Fewtrell 2010)
+ * on a staggered grid. The model is documented in graupel/rain_runoff.h.
  *
  * State: depth h (cells) with a Kahan compensation, discharges qx ((nx+1) x
  * ny faces, row stride nx+1) and qy (nx x (ny+1) faces, numbered like cells

@@ -1,4 +1,4 @@
-/* The cloud cover of seed 001's sky (notes/001_003.md A.2.6): fBm of the
+/* The cloud cover of seed 001's sky: fBm of the
  * terrain's gradient noise drifting with the wind, thresholded at the
  * Cover's quantile and shaped by Elias's density curve. The model is
  * documented in graupel/sky.h; the lightning is host code (kernels/src/sky.c). */

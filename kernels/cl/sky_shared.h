@@ -4,7 +4,7 @@
 #ifndef GRAUPEL_CL_SKY_SHARED_H
 #define GRAUPEL_CL_SKY_SHARED_H
 
-/* The cloud noise: libnoise's fBm defaults (notes/001_003.md A.2.1; seed 001
+/* The cloud noise: libnoise's fBm defaults (seed 001 names libnoise and
  * gives no octaves, persistence or lacunarity). */
 #define GR_SKY_OCTAVES 6
 #define GR_SKY_LACUNARITY 2.0

@@ -1,5 +1,5 @@
-/* Snow accumulation from a direction (seed 002, notes/002.md with the errata
- * of its sections 2.2, 2.5 and 7 fixed). The model is documented in
+/* Snow accumulation from a direction (seed 002, with its stability
+ * branch and per-frame noise corrected; README's Sources). The model is documented in
  * graupel/snow_accumulation.h.
  *
  * The exposure view is a scatter (each triangle writes the texels whose

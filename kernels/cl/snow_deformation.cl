@@ -1,5 +1,6 @@
-/* Snow deformation by objects (seed 000, notes/000.md section 2 with the errata
- * of section 9 fixed). The model is documented in graupel/snow_deformation.h.
+/* Snow deformation by objects (seed 000, with its errors
+ * corrected as the header says; README's Sources). The model is documented in
+ * graupel/snow_deformation.h.
  *
  * State: snow depth S and density rho per point (two sets, alternating
  * between talus iterations), the ground B; per object and step the underside

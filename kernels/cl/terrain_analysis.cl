@@ -1,4 +1,4 @@
-/* Terrain analysis (seed 001, notes/001_003.md A.2.3 and A.2.5): derivatives,
+/* Terrain analysis (seed 001's snow/ice cover and shadows): derivatives,
  * hillshade, snow cover and classes, and the ray-marched shadow mask. The
  * definitions are in graupel/terrain_analysis.h. */
 #include "common.h"

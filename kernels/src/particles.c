@@ -23,7 +23,7 @@ struct gr_particles {
 enum { GR_PA_COUNT, GR_PA_RAIN_RATE, GR_PA_EXPOSURE_TIME, GR_PA_SEED, GR_PA_FLUTTER, GR_PA_ROWS };
 
 /* The one place the ranges are written. Count: the seed's slider spans
- * 2^10 .. 2^20 and its benchmark 2^24 (notes/004.md 2.1, 4.6); the default
+ * 2^10 .. 2^20 and its benchmark 2^24 (seed 004); the default
  * is the seed's 2^17. RainRate: Marshall-Palmer's Lambda needs a rate above
  * 0; 500 mm/h is beyond the heaviest cloudburst recorded for an hour.
  * ExposureTime 1/50 s, a film camera's (the seed's streaks stand for

@@ -22,14 +22,14 @@
  * uniform point shifted on a periodic box is uniform, so respawned
  * particles appear anywhere, and within a life every particle moves by
  * exactly the wind times the time, however slowly it falls.
- * Drops and flakes fall through terrain (as in RainCL, notes/004.md 2.1):
+ * Drops and flakes fall through terrain (as in RainCL, seed 004):
  * the box's bottom is the ground plane.
  *
- * Rain (GR_PARTICLES_RAIN), notes/004.md 2.1 and 3.2:
+ * Rain (GR_PARTICLES_RAIN), after seed 004's particles and drop physics:
  * - Drop diameters D follow Marshall and Palmer (1948),
  *   N(D) = N0 exp(-Lambda D), N0 = 8000 m^-3 mm^-1, Lambda = 4.1 R^-0.21
  *   mm^-1 for a rain rate R in mm/h, truncated to the 0.1 .. 6 mm of real
- *   drops (notes/004.md 3.2: drops above about 5-6 mm break up), sampled
+ *   drops (drops above about 5-6 mm break up), sampled
  *   by the inverse of the truncated distribution's CDF:
  *   D = 0.1 - ln(1 - u (1 - exp(-Lambda 5.9))) / Lambda, u uniform in [0, 1).
  *   Its mean is 0.1 + 1/Lambda - 5.9 e / (1 - e), e = exp(-Lambda 5.9).
@@ -38,12 +38,12 @@
  * - Terminal fall speed by diameter, Gunn and Kinzer's (1949) data as fitted
  *   by Atlas, Srivastava and Sekhon (1973): v = 9.65 - 10.3 exp(-0.6 D),
  *   m/s, D in mm, clamped at 0 (the fit goes negative below 0.09 mm).
- *   The seed draws speeds at random and ignores size (notes/004.md 2.1);
+ *   The seed draws speeds at random and ignores size;
  *   here speed follows size, as its physics section says it should.
  * - velocity = (wind_x, wind_y, wind_z - v): the drops move with the wind
  *   (the seed's pos += (velocity + wind) dt).
  *
- * Snowfall (GR_PARTICLES_SNOW), notes/001_003.md A.2.8 and 9 (the seed
+ * Snowfall (GR_PARTICLES_SNOW), after seed 001's snowfall (the seed
  * leaves the jitter open; these are the choices):
  * - fall speed uniform in [0.5, 1.5] m/s per flake (dry snowflakes,
  *   Locatelli and Hobbs 1974), size uniform in [2, 10] mm;

@@ -12,7 +12,7 @@
  *   sqrt(2)/2; g is multiplied by sqrt(2) and clamped against rounding);
  * - fBm: n = (sum_o p^o g_o / sum_o p^o + 1) / 2;
  * - billow: as fBm with g_o replaced by 2|g_o| - 1;
- * - ridged multifractal (libnoise's recurrence, notes/001_003.md A.2.1):
+ * - ridged multifractal (libnoise's recurrence):
  *   s_o = (offset - |g_o|)^2 * w_o,  w_0 = 1,  w_{o+1} = clamp(s_o*gain, 0, 1),
  *   r = sum_o s_o lambda^(-o H) / sum_o offset^2 lambda^(-o H)  in [0, 1];
  *   inverted (seed 001's choice: rounded hills and river valleys instead of

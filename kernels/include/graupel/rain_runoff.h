@@ -4,7 +4,7 @@
  * infiltration through a permeability map, runoff and pooling, as a
  * conservative, deterministic height-field flow on the device.
  *
- * Per step of length dt, in this order (seed 004, notes/004.md 1.2):
+ * Per step of length dt, in this order (seed 004's per-frame order):
  *  1. rain gain:     h += r dt                       (r: rain rate, m/s)
  *  2. infiltration:  i = min(k dt, h),  h -= i        (k: permeability, m/s)
  *  3. flow: face discharges q (m^2/s) by the local inertial approximation of
@@ -28,7 +28,7 @@
  *     depth), and
  *        h    += dt (sum of inflows - sum of outflows) / (dx dy).
  *
- * Deviation from the seed, on purpose (notes/004.md 10 and item 17): the
+ * Deviation from the seed, on purpose: the
  * seed's tangential flow and its Algorithm 1 "distribution" create and
  * destroy water (and its released code races); here every face discharge is
  * computed once from both sides' identical inputs, so what leaves one cell

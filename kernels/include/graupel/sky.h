@@ -1,6 +1,6 @@
 /**
  * @file sky.h
- * @brief The sky of seed 001 (notes/001_003.md A.2.6, A.2.9): branching
+ * @brief The sky of seed 001 (its clouds and lightning): branching
  * lightning bolts as polylines, and a drifting cloud cover image.
  *
  * Lightning (gr_lightning_*, host C, no device). A bolt is a few hundred

@@ -2,7 +2,7 @@
  * @file snow_accumulation.h
  * @brief Snowfall from a direction onto terrain and objects (seed 002: the
  * occlusion-based accumulation of Reynolds, Laycock & Day as a CTU thesis
- * implements it; notes/002.md), as a deterministic, volume-keeping model on
+ * implements it), as a deterministic, volume-keeping model on
  * the device.
  *
  * State: snow depth S per grid point over a ground B (the snow surface is
@@ -37,7 +37,7 @@
  *     snow receives (a horizontal one, for vertical snow).
  *  4. on the grid only: the growth is blurred (a separable binomial kernel
  *     of radius r = BlurRadius points, weights C(2r + 4, r + 2 + k); r = 4
- *     is the thesis' 9-tap kernel, notes/002.md 2.4; near the grid's edge
+ *     is the thesis' 9-tap kernel; near the grid's edge
  *     the weights are renormalised) and, with Dilation, replaced by its
  *     maximum over the 3 x 3 neighbourhood (the thesis' dilation).
  *  5. increment and stability, integrated together over the step: with
@@ -62,7 +62,7 @@
  *     whole step's growth as if it had all come at its start, and
  *     StabilityFactor 0.001/s stored 7.6 % less in 10 steps than in 100.)
  *
- * Deviations from the thesis, on purpose (notes/002.md 2.2, 2.5, 7): its
+ * Deviations from the thesis, on purpose: its
  * stability branch sets every point below capacity to 0 (flat surfaces
  * could never hold snow): here snow below capacity stays. Its growth is a
  * noise value per frame: here it is a rate times dt, and the noise is a
@@ -268,7 +268,7 @@ GR_API gr_status gr_snow_accumulation_set_object_snow(gr_snow_accumulation *s, i
 
 /**
  * Gives object o an accumulation texture of size x size texels (the thesis'
- * per-object texture, notes/002.md 2.3; size 0 removes it; the row
+ * per-object texture; size 0 removes it; the row
  * AccumulationTextureSize bounds it), uv holding 2 texture coordinates per
  * mesh point. Every texel whose centre falls in the UV triangle of one of
  * the object's triangles becomes a sample on that triangle (barycentric;

@@ -1,7 +1,7 @@
 /**
  * @file snow_deformation.h
  * @brief Objects pressing into and ploughing through snow (seed 000's
- * thesis, notes/000.md section 2), as a mass-conserving, deterministic height-field
+ * thesis), as a mass-conserving, deterministic height-field
  * model on the device.
  *
  * State per grid point: snow depth S (m) over a rigid ground B (m) and the
@@ -83,7 +83,7 @@
  * slope relaxes like a diffusion of its excess, and the share is its speed.
  * The room: snow slides in under an object (the gap behind a ploughing
  * sphere fills as the trench walls collapse) but never rises to touch it,
- * so the imprint holds and talus never makes contact. (notes/000.md's rule,
+ * so the imprint holds and talus never makes contact. (the seed's rule,
  * never into a cell an object occupies, would leave the space under any
  * overhang empty; a bare "not where U_b <= H_a", this core's first rule,
  * hid an excess whole until a small change revealed it, and trench walls

@@ -26,7 +26,7 @@
  *   scaling to 0..255: a flat field gives sin E. With ModelShadows on,
  *   hillshade is multiplied by the shadow mask (ESRI's "model shadows").
  *
- * Cover (seed 001, notes/001_003.md A.2.3; the seed gives neither the
+ * Cover (seed 001's snow/ice blend by slope; the seed gives neither the
  * exponent nor the threshold, so both are parameters):
  * - snow_cover = clamp(n_z, 0, 1)^SnowExponent (CoverMode 0, the seed's
  *   smooth snow/ice blend), or 1 where slope <= RockSlope and 0 elsewhere

@@ -16,9 +16,9 @@
  * sentence. Water with no wet point is not refused (runoff early in a
  * storm is dry): nothing moves then; the ledger's wet_points says so.
  *
- * Model (seed 003 leaves its solver to Klein's thesis, notes/001_003.md
- * B.2.1; this is the Gomez / Kass-Miller wave-equation height field those
- * notes name as the substitute). The wave height h (m, above the still
+ * Model (seed 003 leaves its solver to Klein's thesis, which is not
+ * at hand; this is the Gomez / Kass-Miller wave-equation height field in
+ * its place). The wave height h (m, above the still
  * surface) obeys
  *    h_tt = c^2 (h_xx + h_yy) - gamma h_t
  * with c = WaveSpeed (m/s) and gamma = Damping (1/s), each grid point a
@@ -54,7 +54,7 @@
  * metres a step too short to be worth taking. Set sqrt(9.81 d) for depth d
  * where the physical speed matters.
  *
- * Raindrops (seed 004's ripples, notes/004.md 2.9): a drop falls on wet
+ * Raindrops (seed 004's ripples): a drop falls on wet
  * point (a, b) during step k with the chance p = DropRate dx dy dt (at most
  * one per point per step: p is capped at 1), decided by a hash of (Seed, k,
  * a, b), at a position hashed uniformly within the point's cell. So drops
