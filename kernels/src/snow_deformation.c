@@ -1571,6 +1571,33 @@ static gr_status gr_snow_talus_args(gr_snow_deformation *s, cl_kernel k) {
   return gr_snow_args(s, k, args, sizeof(args) / sizeof(args[0]));
 }
 
+/* snow_relax_rate over [x0, x_end) x [y0, y_end) (nothing when that is
+ * empty, as a piece's cut may be): the rates of iteration t of a launch
+ * whose givers' window at t = 0 is [gx0, gx_end) x [gy0, gy_end). */
+static gr_status gr_snow_relax_rate(gr_snow_deformation *s, float tol, cl_int gx0, cl_int gy0,
+                                    cl_int gx_end, cl_int gy_end, cl_int t, cl_int x0, cl_int y0,
+                                    cl_int x_end, cl_int y_end) {
+  const gr_snow_arg rate[] = {{"depth", sizeof(cl_mem), &s->depth[s->cur]},
+                              {"tol", sizeof(tol), &tol},
+                              {"gx0", sizeof(gx0), &gx0},
+                              {"gy0", sizeof(gy0), &gy0},
+                              {"gx_end", sizeof(gx_end), &gx_end},
+                              {"gy_end", sizeof(gy_end), &gy_end},
+                              {"t", sizeof(t), &t},
+                              {"x_end", sizeof(x_end), &x_end},
+                              {"y_end", sizeof(y_end), &y_end},
+                              {"rate", sizeof(cl_mem), &s->rate},
+                              {"rate_in", sizeof(cl_mem), &s->rate_in},
+                              {"movable", sizeof(cl_mem), &s->movable}};
+  gr_status st = gr_snow_talus_args(s, s->relax_rate);
+  if (st == GR_OK)
+    st = gr_snow_args(s, s->relax_rate, rate, sizeof(rate) / sizeof(rate[0]));
+  if (st == GR_OK && x_end > x0 && y_end > y0)
+    st = gr_enqueue_2d(s->ctx, s->relax_rate, (size_t)x0, (size_t)y0, (size_t)(x_end - x0),
+                       (size_t)(y_end - y0), NULL);
+  return st;
+}
+
 /* Iteration t of a launch whose givers' window at t = 0 is [gx0, gx_end) x
  * [gy0, gy_end), in two launches: the rates on the window grown by t + 2,
  * the moves on it grown by t + 1; the state flips buffers. */
@@ -1583,24 +1610,7 @@ static gr_status gr_snow_relax_once(gr_snow_deformation *s, cl_int gx0, cl_int g
   cl_int mx0 = gx0 - t - 1 > 0 ? gx0 - t - 1 : 0, my0 = gy0 - t - 1 > 0 ? gy0 - t - 1 : 0;
   cl_int mx_end = gx_end + t + 1 < nx ? gx_end + t + 1 : nx,
          my_end = gy_end + t + 1 < ny ? gy_end + t + 1 : ny;
-  const gr_snow_arg rate[] = {{"depth", sizeof(cl_mem), &s->depth[s->cur]},
-                              {"tol", sizeof(tol), &tol},
-                              {"gx0", sizeof(gx0), &gx0},
-                              {"gy0", sizeof(gy0), &gy0},
-                              {"gx_end", sizeof(gx_end), &gx_end},
-                              {"gy_end", sizeof(gy_end), &gy_end},
-                              {"t", sizeof(t), &t},
-                              {"x_end", sizeof(rx_end), &rx_end},
-                              {"y_end", sizeof(ry_end), &ry_end},
-                              {"rate", sizeof(cl_mem), &s->rate},
-                              {"rate_in", sizeof(cl_mem), &s->rate_in},
-                              {"movable", sizeof(cl_mem), &s->movable}};
-  gr_status st = gr_snow_talus_args(s, s->relax_rate);
-  if (st == GR_OK)
-    st = gr_snow_args(s, s->relax_rate, rate, sizeof(rate) / sizeof(rate[0]));
-  if (st == GR_OK && rx_end > rx0 && ry_end > ry0) /* a piece's cut may be empty */
-    st = gr_enqueue_2d(s->ctx, s->relax_rate, (size_t)rx0, (size_t)ry0, (size_t)(rx_end - rx0),
-                       (size_t)(ry_end - ry0), NULL);
+  gr_status st = gr_snow_relax_rate(s, tol, gx0, gy0, gx_end, gy_end, t, rx0, ry0, rx_end, ry_end);
   const gr_snow_arg move[] = {{"depth", sizeof(cl_mem), &s->depth[s->cur]},
                               {"density", sizeof(cl_mem), &s->density[s->cur]},
                               {"rate", sizeof(cl_mem), &s->rate},
@@ -1794,24 +1804,7 @@ static gr_status gr_snow_relax_reach(gr_snow_deformation *s, int hops, float tol
   s->reach_on = 0;
   *any = 0;
   /* The movers: snow_relax_rate's movable amounts at t = 0, everyone a giver. */
-  const gr_snow_arg seed[] = {{"depth", sizeof(cl_mem), &s->depth[s->cur]},
-                              {"tol", sizeof(tol), &tol},
-                              {"gx0", sizeof(gx0), &gx0},
-                              {"gy0", sizeof(gy0), &gy0},
-                              {"gx_end", sizeof(gx_end), &gx_end},
-                              {"gy_end", sizeof(gy_end), &gy_end},
-                              {"t", sizeof(t), &t},
-                              {"x_end", sizeof(gx_end), &gx_end},
-                              {"y_end", sizeof(gy_end), &gy_end},
-                              {"rate", sizeof(cl_mem), &s->rate},
-                              {"rate_in", sizeof(cl_mem), &s->rate_in},
-                              {"movable", sizeof(cl_mem), &s->movable}};
-  gr_status st = gr_snow_talus_args(s, s->relax_rate);
-  if (st == GR_OK)
-    st = gr_snow_args(s, s->relax_rate, seed, sizeof(seed) / sizeof(seed[0]));
-  if (st == GR_OK)
-    st = gr_enqueue_2d(s->ctx, s->relax_rate, (size_t)gx0, (size_t)gy0, (size_t)(gx_end - gx0),
-                       (size_t)(gy_end - gy0), NULL);
+  gr_status st = gr_snow_relax_rate(s, tol, gx0, gy0, gx_end, gy_end, t, gx0, gy0, gx_end, gy_end);
   double m[GR_SNOW_CHECK_MAXES];
   int empty = 0;
   if (st == GR_OK)
