@@ -11,7 +11,7 @@ import os
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from gr_gui import APPLY, State, paraview, setup, write_events  # noqa: E402
+from gr_gui import APPLY, play_to_state, setup, write_events  # noqa: E402
 
 scratch, plugin_dir, state, script = setup("gui_apply")
 
@@ -27,13 +27,7 @@ write_events(script, [
     ("pqClientMainWindow/menubar/menu_File", "activate", "actionFileSaveServerState"),
     ("pqClientMainWindow/FileSaveServerStateDialog", "filesSelected", state),
 ])
-proc = paraview(script, plugin_dir)
-print("paraview exit code %d" % proc.returncode)
-if not os.path.exists(state):
-    print("no state saved: the GUI script did not get through")
-    sys.exit(1)
-
-S = State(state)
+proc, S = play_to_state(script, plugin_dir, state)
 names, proxies, prop, by_type, bar_for = S.names, S.proxies, S.prop, S.by_type, S.bar_for
 
 

@@ -32,7 +32,7 @@ import subprocess
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from gr_gui import APPLY, PANEL, State, paraview, setup, write_events  # noqa: E402
+from gr_gui import APPLY, PANEL, play_to_state, setup, write_events  # noqa: E402
 
 scratch, plugin_dir, state, script = setup("gui_look")
 
@@ -93,14 +93,8 @@ events = [
     ("pqClientMainWindow/FileSaveServerStateDialog", "filesSelected", state),
 ]
 write_events(script, events)
-proc = paraview(script, plugin_dir, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
-print(proc.stdout[-4000:])
-print("paraview exit code %d" % proc.returncode)
-if not os.path.exists(state):
-    print("no state saved: the GUI script did not get through")
-    sys.exit(1)
-
-S = State(state)
+proc, S = play_to_state(script, plugin_dir, state, stdout=subprocess.PIPE,
+                        stderr=subprocess.STDOUT, text=True)
 names, proxies, prop, by_type, bar_for = S.names, S.proxies, S.prop, S.by_type, S.bar_for
 
 

@@ -44,6 +44,20 @@ def paraview(script, plugin_dir, exit=True, **popen):
     return subprocess.Popen(cmd, env=env, **popen)
 
 
+def play_to_state(script, plugin_dir, state, **popen):
+    """Plays script in the GUI to its end and reads the state it saved;
+    exits the test (status 1) when it saved none. Returns (the finished
+    process, the State)."""
+    proc = paraview(script, plugin_dir, **popen)
+    if isinstance(proc.stdout, str):
+        print(proc.stdout[-4000:])
+    print("paraview exit code %d" % proc.returncode)
+    if not os.path.exists(state):
+        print("no state saved: the GUI script did not get through")
+        sys.exit(1)
+    return proc, State(state)
+
+
 class State:
     """A saved state: its pipeline sources' names and every proxy by id."""
 
