@@ -1,5 +1,7 @@
 #include "vtkEXRHeightFieldReader.h"
 
+#include "GraupelRanges.h"
+
 #include "vtkDoubleArray.h"
 #include "vtkFieldData.h"
 #include "vtkFloatArray.h"
@@ -262,6 +264,7 @@ int vtkEXRHeightFieldReader::RequestData(vtkInformation *, vtkInformationVector 
                                                     " NoDataBoundary), the other simulations"
                                                     " refuse them.");
   }
+  graupel::CacheRanges(output);
   return 1;
 }
 

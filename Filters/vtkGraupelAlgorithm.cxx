@@ -1,5 +1,7 @@
 #include "vtkGraupelAlgorithm.h"
 
+#include "GraupelRanges.h"
+
 #include "vtkDataObject.h"
 #include "vtkDemandDrivenPipeline.h"
 #include "vtkDoubleArray.h"
@@ -238,6 +240,9 @@ vtkTypeBool vtkGraupelAlgorithm::ProcessRequest(vtkInformation *request,
         used->SetName(("graupel_used_" + note.first).c_str());
         used->InsertNextValue(note.second.used);
         out->GetFieldData()->AddArray(used);
+      }
+      for (int i = 0; i < outInfo->GetNumberOfInformationObjects(); ++i) {
+        graupel::CacheRanges(vtkDataObject::GetData(outInfo, i));
       }
     }
     return 1;
