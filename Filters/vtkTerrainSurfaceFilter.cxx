@@ -7,6 +7,7 @@
 #include "vtkFieldData.h"
 #include "vtkFloatArray.h"
 #include "vtkIdTypeArray.h"
+#include "vtkIntArray.h"
 #include "vtkImageData.h"
 #include "vtkInformation.h"
 #include "vtkInformationVector.h"
@@ -34,6 +35,32 @@ namespace {
 const char *const HeightChoices[] = {"water_surface", "snow_surface", "elevation"};
 const char *const ColorChoices[] = {"water_depth", "snow_depth", "cover_class", "shadow",
                                     "elevation"};
+
+// The stride that draws at most `most` points of an nx x ny grid (every
+// point for 0, or when they are no more).
+int SurfaceStride(int nx, int ny, vtkIdType most) {
+  const double points = static_cast<double>(nx) * ny;
+  if (most <= 0 || points <= static_cast<double>(most)) {
+    return 1;
+  }
+  int stride = static_cast<int>(std::ceil(std::sqrt(points / static_cast<double>(most))));
+  auto drawn = [&](int k) { return (static_cast<double>((nx - 1 + k - 1) / k) + 1.0) *
+                                   (static_cast<double>((ny - 1 + k - 1) / k) + 1.0); };
+  while (drawn(stride) > static_cast<double>(most)) {
+    ++stride;
+  }
+  return stride;
+}
+
+// 0, stride, 2 stride, ... and n - 1: the drawn indices along one axis.
+std::vector<int> Samples(int n, int stride) {
+  std::vector<int> at;
+  for (int k = 0; k < n - 1; k += stride) {
+    at.push_back(k);
+  }
+  at.push_back(n - 1);
+  return at;
+}
 
 vtkPointData *InputPointData(vtkDataObject *input) {
   auto *image = vtkImageData::SafeDownCast(input);
@@ -147,8 +174,14 @@ int vtkTerrainSurfaceFilter::RequestData(vtkInformation *, vtkInformationVector 
     return 1;
   }
   vtkDataArray *height = input->GetPointData()->GetArray(heightName);
-  const vtkIdType n = input->GetNumberOfPoints();
   const int nx = dims[0], ny = dims[1];
+  // The points drawn: every stride-th row and column and the last ones, so
+  // that the surface keeps the terrain's extent with at most MaximumPoints.
+  const int stride = SurfaceStride(nx, ny, this->MaximumPoints);
+  const std::vector<int> xs = Samples(nx, stride), ys = Samples(ny, stride);
+  const int mx = static_cast<int>(xs.size()), my = static_cast<int>(ys.size());
+  const vtkIdType n = static_cast<vtkIdType>(mx) * my;
+  auto source = [&](int a, int b) { return xs[a] + static_cast<vtkIdType>(ys[b]) * nx; };
   // Host memory only: a point's position (3 doubles) and normal (3 floats),
   // its quad's offset and four point ids, a copy of every input point array
   // and the water's display copy. Refused before anything is allocated: a
@@ -170,20 +203,26 @@ int vtkTerrainSurfaceFilter::RequestData(vtkInformation *, vtkInformationVector 
     vtkErrorMacro(<< refusal);
     return 1;
   }
-  const std::string text =
+  std::string text =
       "Terrain Surface: " + std::to_string(nx) + " x " + std::to_string(ny) + " points";
+  if (stride > 1) {
+    text += ", every " + std::to_string(stride) + "th drawn";
+  }
   this->SetProgressText(text.c_str());
   this->UpdateProgress(0.0);
   double lowest = VTK_DOUBLE_MAX;
-  for (vtkIdType id = 0; id < n; ++id) {
-    const double h = height->GetComponent(id, 0);
-    if (!std::isfinite(h)) {
-      vtkErrorMacro("Terrain Surface: the height array " << heightName << " is " << h
-                                                         << " at point " << id
-                                                         << "; fill the holes first.");
-      return 1;
+  for (int b = 0; b < my; ++b) {
+    for (int a = 0; a < mx; ++a) {
+      const vtkIdType id = source(a, b);
+      const double h = height->GetComponent(id, 0);
+      if (!std::isfinite(h)) {
+        vtkErrorMacro("Terrain Surface: the height array " << heightName << " is " << h
+                                                           << " at point " << id
+                                                           << "; fill the holes first.");
+        return 1;
+      }
+      lowest = std::min(lowest, h);
     }
-    lowest = std::min(lowest, h);
   }
 
   const double s = this->VerticalExaggeration;
@@ -192,7 +231,7 @@ int vtkTerrainSurfaceFilter::RequestData(vtkInformation *, vtkInformationVector 
   const bool skirt = this->Skirt;
   // Each wall has its own copies of the edge points: a crisp edge between
   // the lit top and the walls, whose normals point outwards.
-  const vtkIdType wallPoints = skirt ? 4 * (nx + ny) : 0;
+  const vtkIdType wallPoints = skirt ? 4 * (mx + my) : 0;
   vtkNew<vtkPoints> points;
   points->SetDataTypeToDouble();
   points->SetNumberOfPoints(n + wallPoints);
@@ -204,15 +243,15 @@ int vtkTerrainSurfaceFilter::RequestData(vtkInformation *, vtkInformationVector 
   vtkPointData *outPD = output->GetPointData();
   outPD->CopyAllocate(inPD, n + wallPoints);
 
-  auto z = [&](int i, int j) { return s * height->GetComponent(i + j * nx, 0); };
+  auto z = [&](int a, int b) { return s * height->GetComponent(source(a, b), 0); };
   // Progress every band of rows (about a million points) and the abort
   // looked at there: a large terrain takes seconds.
-  const int band = std::max(1, (1 << 20) / nx);
+  const int band = std::max(1, (1 << 20) / mx);
   auto aborted = [&](int row, double share, double done) {
     if (row % band != 0) {
       return false;
     }
-    this->UpdateProgress(done + share * row / ny);
+    this->UpdateProgress(done + share * row / my);
     if (!this->GetAbortExecute()) {
       return false;
     }
@@ -222,29 +261,29 @@ int vtkTerrainSurfaceFilter::RequestData(vtkInformation *, vtkInformationVector 
     return true;
   };
   double p[3];
-  for (int j = 0; j < ny; ++j) {
+  for (int j = 0; j < my; ++j) {
     if (aborted(j, 0.7, 0.0)) {
       return 1;
     }
-    for (int i = 0; i < nx; ++i) {
-      const vtkIdType id = i + static_cast<vtkIdType>(j) * nx;
-      input->GetPoint(id, p);
+    for (int i = 0; i < mx; ++i) {
+      const vtkIdType id = i + static_cast<vtkIdType>(j) * mx;
+      input->GetPoint(source(i, j), p);
       p[2] += z(i, j);
       points->SetPoint(id, p);
       // Central differences inside, one-sided on the edges: a one-sided edge
       // normal is the slope of the edge cell, not half of it.
-      const int i0 = i > 0 ? i - 1 : i, i1 = i < nx - 1 ? i + 1 : i;
-      const int j0 = j > 0 ? j - 1 : j, j1 = j < ny - 1 ? j + 1 : j;
-      const double gx = (z(i1, j) - z(i0, j)) / ((i1 - i0) * spacing[0]);
-      const double gy = (z(i, j1) - z(i, j0)) / ((j1 - j0) * spacing[1]);
+      const int i0 = i > 0 ? i - 1 : i, i1 = i < mx - 1 ? i + 1 : i;
+      const int j0 = j > 0 ? j - 1 : j, j1 = j < my - 1 ? j + 1 : j;
+      const double gx = (z(i1, j) - z(i0, j)) / ((xs[i1] - xs[i0]) * spacing[0]);
+      const double gy = (z(i, j1) - z(i, j0)) / ((ys[j1] - ys[j0]) * spacing[1]);
       const double len = std::sqrt(gx * gx + gy * gy + 1.0);
       normals->SetTuple3(id, -gx / len, -gy / len, 1.0 / len);
-      outPD->CopyData(inPD, id, id);
+      outPD->CopyData(inPD, source(i, j), id);
     }
   }
 
   const vtkIdType quads =
-      static_cast<vtkIdType>(nx - 1) * (ny - 1) + (skirt ? 2 * (nx + ny - 2) : 0);
+      static_cast<vtkIdType>(mx - 1) * (my - 1) + (skirt ? 2 * (mx + my - 2) : 0);
   vtkNew<vtkIdTypeArray> offsets, conn;
   offsets->SetNumberOfValues(quads + 1);
   conn->SetNumberOfValues(4 * quads);
@@ -257,13 +296,13 @@ int vtkTerrainSurfaceFilter::RequestData(vtkInformation *, vtkInformationVector 
     conn->SetValue(4 * q + 3, d);
     ++q;
   };
-  for (int j = 0; j + 1 < ny; ++j) {
+  for (int j = 0; j + 1 < my; ++j) {
     if (aborted(j, 0.3, 0.7)) {
       return 1;
     }
-    for (int i = 0; i + 1 < nx; ++i) {
-      const vtkIdType a = i + static_cast<vtkIdType>(j) * nx;
-      quad(a, a + 1, a + 1 + nx, a + nx); // counter-clockwise seen from above
+    for (int i = 0; i + 1 < mx; ++i) {
+      const vtkIdType a = i + static_cast<vtkIdType>(j) * mx;
+      quad(a, a + 1, a + 1 + mx, a + mx); // counter-clockwise seen from above
     }
   }
 
@@ -273,19 +312,20 @@ int vtkTerrainSurfaceFilter::RequestData(vtkInformation *, vtkInformationVector 
     struct Edge {
       int i0, j0, di, dj, count;
     };
-    const Edge edges[4] = {{0, 0, 1, 0, nx},
-                           {nx - 1, 0, 0, 1, ny},
-                           {nx - 1, ny - 1, -1, 0, nx},
-                           {0, ny - 1, 0, -1, ny}};
+    const Edge edges[4] = {{0, 0, 1, 0, mx},
+                           {mx - 1, 0, 0, 1, my},
+                           {mx - 1, my - 1, -1, 0, mx},
+                           {0, my - 1, 0, -1, my}};
     input->GetPoint(0, p);
     const double base = p[2] + s * (lowest - this->SkirtDepth);
     vtkIdType next = n;
     for (const Edge &e : edges) {
       const double nxw = e.dj, nyw = -e.di;
       for (int k = 0; k < e.count; ++k) {
-        const vtkIdType src = (e.i0 + k * e.di) + static_cast<vtkIdType>(e.j0 + k * e.dj) * nx;
+        const int a = e.i0 + k * e.di, b = e.j0 + k * e.dj;
+        const vtkIdType drawn = a + static_cast<vtkIdType>(b) * mx, src = source(a, b);
         const vtkIdType top = next + 2 * k, bottom = top + 1;
-        points->GetPoint(src, p);
+        points->GetPoint(drawn, p);
         points->SetPoint(top, p);
         p[2] = base;
         points->SetPoint(bottom, p);
@@ -334,6 +374,10 @@ int vtkTerrainSurfaceFilter::RequestData(vtkInformation *, vtkInformationVector 
   factor->SetName("vertical_exaggeration");
   factor->InsertNextValue(s);
   output->GetFieldData()->AddArray(factor);
+  vtkNew<vtkIntArray> drawn;
+  drawn->SetName("surface_stride");
+  drawn->InsertNextValue(stride);
+  output->GetFieldData()->AddArray(drawn);
   this->UpdateProgress(1.0);
   return 1;
 }
@@ -359,4 +403,5 @@ void vtkTerrainSurfaceFilter::PrintSelf(ostream &os, vtkIndent indent) {
   os << indent << "Skirt: " << this->Skirt << "\n";
   os << indent << "SkirtDepth: " << this->SkirtDepth << "\n";
   os << indent << "WettingDepth: " << this->WettingDepth << "\n";
+  os << indent << "MaximumPoints: " << this->MaximumPoints << "\n";
 }

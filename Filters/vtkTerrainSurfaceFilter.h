@@ -25,6 +25,9 @@
  * `water_depth_display` (NaN where drier than WettingDepth). The plugin's colour maps
  * (Plugin/GraupelColorMaps.json) are the defaults for those arrays.
  *
+ * A grid of more than MaximumPoints points (default 2048 x 2048) is drawn at
+ * every k-th row and column, k in the field data `surface_stride`.
+ *
  * Bad input (not an image, 3-D, no height array, non-finite heights) gives
  * one error sentence and an empty output, as does a terrain whose surface
  * would not fit in the memory the process can get (about 84 bytes a point:
@@ -86,6 +89,18 @@ public:
   vtkGetMacro(WettingDepth, double);
   ///@}
 
+  ///@{
+  /**
+   * The most points the surface draws (default 4194304, a 2048 x 2048
+   * grid; 0 draws every point). A larger grid is drawn at every k-th row
+   * and column (and its last ones, keeping its extent), k the smallest
+   * stride that fits; the field data `surface_stride` holds k. A 20000 x
+   * 20000 terrain would otherwise take 34 GB and minutes to render.
+   */
+  vtkSetClampMacro(MaximumPoints, vtkIdType, 0, VTK_ID_MAX);
+  vtkGetMacro(MaximumPoints, vtkIdType);
+  ///@}
+
   /** The height array chosen for `input` (HeightArray, or by the data); nullptr if none. */
   static const char *ChooseHeightArray(vtkDataObject *input, const std::string &wanted);
   /** The colour array chosen for `input` (ColorArray, or by the data); nullptr if none. */
@@ -108,6 +123,7 @@ protected:
   bool Skirt = true;
   double SkirtDepth = 0.0;
   double WettingDepth = 0.01;
+  vtkIdType MaximumPoints = 4194304;
 
 private:
   vtkTerrainSurfaceFilter(const vtkTerrainSurfaceFilter &) = delete;

@@ -212,9 +212,22 @@ analysis.SetInputConnection(mid.GetOutputPort())
 refused(analysis, "Terrain Analysis", "a 3000 x 3000 grid", 0.4 * GB, need="630.0 MB", per=70)
 surface = vtkTerrainSurfaceFilter()
 surface.SetInputConnection(mid.GetOutputPort())
+surface.SetMaximumPoints(0)  # every point
 # A position (24), normal (12), quad (40), the display copy (4) and the
 # input's elevation (4).
 refused(surface, "Terrain Surface", "a 3000 x 3000 terrain", 0.4 * GB, need="756.0 MB", per=84)
+# With the default MaximumPoints (2048 x 2048) it is drawn at every second
+# point, 1501 x 1501, under the same limit.
+surface.SetMaximumPoints(4194304)
+limit(0.4 * GB)
+surface.Update()
+unlimit()
+stride = surface.GetOutput().GetFieldData().GetArray("surface_stride")
+T.check(stride is not None and stride.GetValue(0) == 2
+        and surface.GetOutput().GetNumberOfPoints() == 1501 * 1501 + 4 * (1501 + 1501),
+        "Terrain Surface draws the 3000 x 3000 terrain at every second point under the limit "
+        "(%d points)" % surface.GetOutput().GetNumberOfPoints())
+surface.SetMaximumPoints(0)
 surface.SetInputConnection(terrain_image(100).GetOutputPort())
 limit(0.4 * GB)
 surface.Update()
