@@ -6,7 +6,8 @@ ground) over a good part of the DEM and gathered into hollows and valleys,
 not a film under 1 cm everywhere. The defaults before (10 mm/h for 600 s,
 1.7 mm of rain) left 7 mm at most and no point wet: every water check
 below failed. The optional inputs get ParaView's input selector, so the panel can
-pick them."""
+pick them. On a fresh Procedural Terrain the first minute of Play shows
+water in the valleys."""
 import os
 import sys
 
@@ -73,4 +74,22 @@ T.check(gathered > 0.03, "%.3f of the DEM holds more than 3 x the rain (%.0f mm)
 T.check(abs(ledger("balance_error")) <= 1e-6 * ledger("rain_volume"),
         "the ledger closes: %.3g m^3 of %.4g m^3" % (ledger("balance_error"),
                                                       ledger("rain_volume")))
+
+# A fresh Procedural Terrain (512 x 512 points, 2 m): Play's first minute of
+# rain (six frames) already shows water in its valleys, in few steps; the
+# whole 600 s takes about 7 600 steps, as the pits fill and deepen.
+terrain = ProceduralTerrain()
+rain2 = RainRunoff(Input=terrain)
+rain2.UpdatePipeline(60.0)
+out2 = servermanager.Fetch(rain2)
+h2 = vtk_to_numpy(out2.GetPointData().GetArray("water_depth"))
+steps2 = out2.GetFieldData().GetArray("steps").GetValue(0)
+wet2 = float(np.mean(h2 > rain2.WettingDepth))
+print("default Rain Runoff on a default Procedural Terrain at 60 s: %d steps, deepest %.3f m, "
+      "wet %.4f" % (steps2, h2.max(), wet2))
+# Measured: 114 steps, 0.209 m, 0.0187 (PoCL).
+T.check(steps2 <= 200, "the first minute takes %d steps, at most 200" % steps2)
+T.check(h2.max() > 0.1 and wet2 > 0.01,
+        "after a minute the valleys hold water: deepest %.3f m (> 0.1), %.4f wet (> 0.01)"
+        % (h2.max(), wet2))
 T.finish()
