@@ -44,8 +44,10 @@ int SurfaceStride(int nx, int ny, vtkIdType most) {
     return 1;
   }
   int stride = static_cast<int>(std::ceil(std::sqrt(points / static_cast<double>(most))));
-  auto drawn = [&](int k) { return (static_cast<double>((nx - 1 + k - 1) / k) + 1.0) *
-                                   (static_cast<double>((ny - 1 + k - 1) / k) + 1.0); };
+  auto drawn = [&](int k) {
+    return (static_cast<double>((nx - 1 + k - 1) / k) + 1.0) *
+           (static_cast<double>((ny - 1 + k - 1) / k) + 1.0);
+  };
   while (drawn(stride) > static_cast<double>(most)) {
     ++stride;
   }
