@@ -21,7 +21,7 @@ inline const gr_param_bound *TableRow(const gr_param_bound *(*bounds)(int *),
 /**
  * The default of property from its table row: the one place a default is
  * written (py.param_bounds checks that the row exists and that the XML and
- * README agree with it).
+ * docs pages agree with it).
  */
 inline double TableDefault(const gr_param_bound *(*bounds)(int *), const char *property) {
   const gr_param_bound *row = TableRow(bounds, property);

@@ -478,7 +478,7 @@ static void test_ledger(void) {
 }
 
 /* The same simulated time in 10 steps or 100: the same stored volume
- * within 1% (README's claim), on the scene with everything on (tilted
+ * within 1% (docs/SnowAccumulation.md's claim), on the scene with everything on (tilted
  * snow, rough ground, noise, blur, dilation, two objects), for a hard cap
  * and for soft ones (before growth and shedding were integrated together,
  * 10 steps stored 3.8 % less than 100 at StabilityFactor 0.01/s, 2.9 %

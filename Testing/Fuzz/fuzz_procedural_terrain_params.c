@@ -15,7 +15,7 @@
  * Checks: the status is GR_OK or GR_ERR_INVALID_ARGUMENT; a failure comes
  * with a non-empty message ending in '.'; accepted parameters lie in the
  * ranges of the parameter table (gr_procedural_terrain_param_bounds, which
- * the XML, the VTK clamps and the README follow), and parameters in those
+ * the XML, the VTK clamps and the docs pages follow), and parameters in those
  * ranges are accepted; an accepted grid has the documented dimensions,
  * spacing, origin and offsets; a short message buffer is never overrun and is
  * always terminated; the answer does not depend on the buffer. */

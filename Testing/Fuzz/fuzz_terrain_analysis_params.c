@@ -15,7 +15,7 @@
  * with a non-empty message ending in '.'; parameters are accepted exactly
  * when every one lies in its row of the parameter table
  * (gr_terrain_analysis_param_bounds, which the XML, the VTK clamps and the
- * README follow); a short message buffer is never overrun and is always
+ * docs pages follow); a short message buffer is never overrun and is always
  * terminated; the answer does not depend on the buffer. */
 #include "fuzz_common.h"
 #include "graupel/terrain_analysis.h"

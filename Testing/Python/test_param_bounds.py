@@ -11,7 +11,7 @@ core's validators follow, gr_<core>_param_bounds):
   * the VTK class: its default, and its clamp: a value just above max reads
     back as max, just below a closed min as min, and just below an open min is
     not moved inside the range (the validator refuses it at the next update).
-  * the README: every row once in a property table, in this format (columns
+  * the filter's page docs/<Proxy>.md: every row once in a property table, in this format (columns
     property | default | unit, range | meaning):
 
         | `RainRate` | 10 | mm/h, 0–3600 | rain intensity ... |
@@ -38,7 +38,7 @@ import gr_check as T  # noqa: E402
 
 def extra(p):
     p.add_argument("--params-tool", required=True)
-    p.add_argument("--readme", required=True)
+    p.add_argument("--docs", required=True)
 
 
 a = T.args(extra)
@@ -80,8 +80,8 @@ def fmt(row):
 # ------------------------------------------------------------------ the XML
 # A core lands before its filter (the VTK-free layer first); until the
 # filter comes it is named here, so that a core without a proxy is a
-# decision, not an oversight. Its table is checked against the README
-# when the filter brings the README's table.
+# decision, not an oversight. Its table is checked against its page
+# when the filter brings its page in docs/.
 CORE_ONLY = set()
 LoadPlugin(a.plugin, ns=globals())
 pxm = servermanager.ProxyManager()
@@ -116,7 +116,7 @@ for core in tables:
 
 # A property of several values (DensityRange) stands for several rows: its
 # hint <GraupelTableRows rows="MinDensity MaxDensity"/> names the row of each
-# value. ELEMENT maps (core, row) -> (property, value index); the README row
+# value. ELEMENT maps (core, row) -> (property, value index); the docs row
 # is the property's, its default cell the values in order.
 ELEMENT = {}
 for core, (group, name, _) in ((c, x) for c, xs in CORES.items() for x in xs):
@@ -218,7 +218,7 @@ def check_class(core, row, proxy):
         T.check(same(float(get()), row["min"]), "%s: min - %g reads back %r" % (where, step, get()))
 
 
-# --------------------------------------------------------------- the README
+# --------------------------------------------------------------- the docs pages
 NUM = r"-?[0-9][0-9  ]*(?:\.[0-9]+)?(?:e[+-]?[0-9]+)?"
 
 
@@ -226,11 +226,18 @@ def number(text):
     return float(re.sub(r"[  ]", "", text))
 
 
-def readme_rows(path):
-    """(proxy, property) -> list of (default cell, unit-range cell) of README table
-    rows, each under its section's heading "### Label (`Proxy`, `vtkClass`)" (two
-    filters may both have a `Seed`)."""
+def doc_rows(folder):
+    """(proxy, property) -> list of (default cell, unit-range cell) of the table
+    rows of the pages in docs/, each under its heading "# Label (`Proxy`,
+    `vtkClass`)" (two filters may both have a `Seed`)."""
     rows = {}
+    for page in sorted(os.listdir(folder)):
+        if page.endswith(".md"):
+            doc_page_rows(os.path.join(folder, page), rows)
+    return rows
+
+
+def doc_page_rows(path, rows):
     proxy = None
     with open(path, encoding="utf-8") as f:
         for line in f:
@@ -257,33 +264,33 @@ def parse_range(cell):
     return unit, number(m.group(5)), number(m.group(6)), False
 
 
-readme = readme_rows(a.readme)
+readme = doc_rows(a.docs)
 
 
 def check_readme(core, row, proxy):
     p, index = ELEMENT.get((core, row["property"]), (row["property"], -1))
     found = readme.get((proxy[1], p), [])
-    T.check(len(found) == 1, "README: one table row for `%s` in the section of %s (found %d)"
+    T.check(len(found) == 1, "docs: one table row for `%s` on the page of %s (found %d)"
             % (p, proxy[1], len(found)))
     if len(found) != 1:
         return
     default_cell, range_cell = found[0]
     nums = re.findall(NUM, default_cell)
     T.check(len(nums) > max(index, 0) and same(number(nums[index]), row["default"]),
-            "README `%s`: default '%s', table %r" % (p, default_cell, row["default"]))
+            "docs `%s`: default '%s', table %r" % (p, default_cell, row["default"]))
     r = parse_range(range_cell)
-    T.check(r is not None, "README `%s`: '%s' is not 'unit, min–max', 'unit, (min, max]' or 'any'"
+    T.check(r is not None, "docs `%s`: '%s' is not 'unit, min–max', 'unit, (min, max]' or 'any'"
             % (p, range_cell))
     if r is None:
         return
     unit, lo, hi, open_ = r
-    T.check(unit == row["unit"], "README `%s`: unit '%s', table '%s'" % (p, unit, row["unit"]))
+    T.check(unit == row["unit"], "docs `%s`: unit '%s', table '%s'" % (p, unit, row["unit"]))
     if lo is None:
         T.check(row["integer"] and row["min"] <= INT_MIN and row["max"] >= INT_MAX,
-                "README `%s`: 'any', but the table has %s" % (p, fmt(row)))
+                "docs `%s`: 'any', but the table has %s" % (p, fmt(row)))
     else:
         T.check(same(lo, row["min"]) and same(hi, row["max"]) and open_ == bool(row["min_open"]),
-                "README `%s`: '%s', table %s" % (p, range_cell, fmt(row)))
+                "docs `%s`: '%s', table %s" % (p, range_cell, fmt(row)))
 
 
 for core, rows in sorted(tables.items()):
@@ -304,5 +311,37 @@ for core, rows in sorted(tables.items()):
             check_xml(core, row, proxy)
             check_class(core, row, proxy)
             check_readme(core, row, proxy)
+
+# ------------------------------------------------- every proxy has its page
+# Every proxy the plugin adds (its VTK class is one of graupel's) has its
+# page docs/<Proxy>.md under a heading "# Label (`Proxy`, `vtkClass`)", and
+# every property the panel can show (all but Input) is named there in
+# backticks, or, for what every simulation shares, in docs/Simulations.md.
+shared = open(os.path.join(a.docs, "Simulations.md"), encoding="utf-8").read()
+pages = 0
+for group in ("sources", "filters", "writers"):
+    it = pxm.GetProxyDefinitionManager().NewSingleGroupIterator(group)
+    it.GoToFirstItem()
+    while not it.IsDoneWithTraversal():
+        name = it.GetProxyName()
+        proto = pxm.GetPrototypeProxy(group, name)
+        it.GoToNextItem()
+        if proto is None or not hasattr(graupel, proto.GetVTKClassName() or ""):
+            continue
+        pages += 1
+        path = os.path.join(a.docs, name + ".md")
+        page = open(path, encoding="utf-8").read() if os.path.exists(path) else ""
+        T.check(re.search(r"^# .*\(`%s`, `%s`\)" % (name, proto.GetVTKClassName()), page, re.M)
+                is not None, "docs/%s.md exists with its heading" % name)
+        props = proto.NewPropertyIterator()
+        props.Begin()
+        while not props.IsAtEnd():
+            key, prop = props.GetKey(), props.GetProperty()
+            props.Next()
+            if key == "Input" or prop.GetInformationOnly() or prop.GetPanelVisibility() == "never":
+                continue
+            T.check("`%s`" % key in page or "`%s`" % key in shared,
+                    "docs/%s.md names the property `%s`" % (name, key))
+T.check(pages >= 14, "%d Graupel proxies have pages" % pages)
 
 T.finish()

@@ -249,7 +249,7 @@ if plugin is not None:
     view = pv.CreateRenderView()
     rep = pv.Show(wsp, view)
     T.check(rep.Representation == "Surface", "shown as %r" % rep.Representation)
-    # The water look the README describes: physically based shading, low
+    # The water look docs/Scenes.md describes: physically based shading, low
     # roughness, one teal colour, lit by the water's own normals.
     pv.ColorBy(rep, None)
     rep.DiffuseColor = [0.05, 0.35, 0.4]

@@ -101,7 +101,7 @@ const char *gr_version_string(void) {
 }
 
 /* The field vocabulary: array name, components and SI unit of every
- * gr_field, in enum order. VTK arrays, EXR channels and the README use these
+ * gr_field, in enum order. VTK arrays, EXR channels and the docs pages use these
  * names and units; "1" is dimensionless. */
 static const struct gr_field_row {
   gr_field field; /* checked against the row's index by the tests */

@@ -146,7 +146,7 @@ typedef gr_status (*gr_halo_exchange_fn)(void *user);
 /**
  * One row of a core's parameter table: the single source of a parameter's
  * range that the core's validator, the filter's clamp, the XML domain and the
- * README all follow (a ctest checks that they agree). Values are in the
+ * docs pages all follow (a ctest checks that they agree). Values are in the
  * user's unit; the core's value is the user's times to_core.
  */
 typedef struct gr_param_bound {

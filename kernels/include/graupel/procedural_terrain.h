@@ -45,7 +45,7 @@ typedef enum gr_noise_type {
 /**
  * The noise parameters. Ranges and defaults are the rows of
  * gr_procedural_terrain_param_bounds (named after the filter's properties),
- * the one place they are written; the README, the XML domains and the VTK
+ * the one place they are written; the docs pages, the XML domains and the VTK
  * clamps follow that table.
  */
 typedef struct gr_procedural_terrain_params {
