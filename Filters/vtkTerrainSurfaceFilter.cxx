@@ -212,19 +212,29 @@ int vtkTerrainSurfaceFilter::RequestData(vtkInformation *, vtkInformationVector 
   }
   this->SetProgressText(text.c_str());
   this->UpdateProgress(0.0);
+  // NaN heights are no-data points (a raster's no-data, Rain Runoff outside
+  // its domain): no quad or wall touches them. An infinity is an error.
   double lowest = VTK_DOUBLE_MAX;
   for (int b = 0; b < my; ++b) {
     for (int a = 0; a < mx; ++a) {
       const vtkIdType id = source(a, b);
       const double h = height->GetComponent(id, 0);
-      if (!std::isfinite(h)) {
+      if (std::isinf(h)) {
         vtkErrorMacro("Terrain Surface: the height array " << heightName << " is " << h
                                                            << " at point " << id
                                                            << "; fill the holes first.");
         return 1;
       }
-      lowest = std::min(lowest, h);
+      if (!std::isnan(h)) {
+        lowest = std::min(lowest, h);
+      }
     }
+  }
+  if (lowest == VTK_DOUBLE_MAX) {
+    vtkErrorMacro("Terrain Surface: the height array " << heightName
+                                                       << " has no value at all (every point is"
+                                                          " NaN, no data).");
+    return 1;
   }
 
   const double s = this->VerticalExaggeration;
@@ -246,6 +256,7 @@ int vtkTerrainSurfaceFilter::RequestData(vtkInformation *, vtkInformationVector 
   outPD->CopyAllocate(inPD, n + wallPoints);
 
   auto z = [&](int a, int b) { return s * height->GetComponent(source(a, b), 0); };
+  auto hole = [&](int a, int b) { return std::isnan(height->GetComponent(source(a, b), 0)); };
   // Progress every band of rows (about a million points) and the abort
   // looked at there: a large terrain takes seconds.
   const int band = std::max(1, (1 << 20) / mx);
@@ -270,20 +281,27 @@ int vtkTerrainSurfaceFilter::RequestData(vtkInformation *, vtkInformationVector 
     for (int i = 0; i < mx; ++i) {
       const vtkIdType id = i + static_cast<vtkIdType>(j) * mx;
       input->GetPoint(source(i, j), p);
-      p[2] += z(i, j);
+      // A no-data point stays at the lowest height: drawn by no quad, it
+      // keeps the bounds those of the data.
+      p[2] += hole(i, j) ? s * lowest : z(i, j);
       points->SetPoint(id, p);
-      // Central differences inside, one-sided on the edges: a one-sided edge
-      // normal is the slope of the edge cell, not half of it.
-      const int i0 = i > 0 ? i - 1 : i, i1 = i < mx - 1 ? i + 1 : i;
-      const int j0 = j > 0 ? j - 1 : j, j1 = j < my - 1 ? j + 1 : j;
-      const double gx = (z(i1, j) - z(i0, j)) / ((xs[i1] - xs[i0]) * spacing[0]);
-      const double gy = (z(i, j1) - z(i, j0)) / ((ys[j1] - ys[j0]) * spacing[1]);
+      // Central differences inside, one-sided on the edges and beside
+      // no-data points: a one-sided normal is the slope of its cell, not
+      // half of it.
+      const bool here = !hole(i, j);
+      const int i0 = i > 0 && here && !hole(i - 1, j) ? i - 1 : i;
+      const int i1 = i < mx - 1 && here && !hole(i + 1, j) ? i + 1 : i;
+      const int j0 = j > 0 && here && !hole(i, j - 1) ? j - 1 : j;
+      const int j1 = j < my - 1 && here && !hole(i, j + 1) ? j + 1 : j;
+      const double gx = i1 > i0 ? (z(i1, j) - z(i0, j)) / ((xs[i1] - xs[i0]) * spacing[0]) : 0.0;
+      const double gy = j1 > j0 ? (z(i, j1) - z(i, j0)) / ((ys[j1] - ys[j0]) * spacing[1]) : 0.0;
       const double len = std::sqrt(gx * gx + gy * gy + 1.0);
       normals->SetTuple3(id, -gx / len, -gy / len, 1.0 / len);
       outPD->CopyData(inPD, source(i, j), id);
     }
   }
 
+  // At most this many: quads touching a no-data point are left out.
   const vtkIdType quads =
       static_cast<vtkIdType>(mx - 1) * (my - 1) + (skirt ? 2 * (mx + my - 2) : 0);
   vtkNew<vtkIdTypeArray> offsets, conn;
@@ -303,6 +321,9 @@ int vtkTerrainSurfaceFilter::RequestData(vtkInformation *, vtkInformationVector 
       return 1;
     }
     for (int i = 0; i + 1 < mx; ++i) {
+      if (hole(i, j) || hole(i + 1, j) || hole(i, j + 1) || hole(i + 1, j + 1)) {
+        continue;
+      }
       const vtkIdType a = i + static_cast<vtkIdType>(j) * mx;
       quad(a, a + 1, a + 1 + mx, a + mx); // counter-clockwise seen from above
     }
@@ -335,14 +356,16 @@ int vtkTerrainSurfaceFilter::RequestData(vtkInformation *, vtkInformationVector 
         normals->SetTuple3(bottom, nxw, nyw, 0.0);
         outPD->CopyData(inPD, src, top);
         outPD->CopyData(inPD, src, bottom);
-        if (k > 0) {
+        if (k > 0 && !hole(a, b) && !hole(a - e.di, b - e.dj)) {
           quad(top - 2, top - 1, bottom, top);
         }
       }
       next += 2 * e.count;
     }
   }
-  offsets->SetValue(quads, 4 * quads);
+  offsets->SetValue(q, 4 * q);
+  offsets->SetNumberOfValues(q + 1);
+  conn->SetNumberOfValues(4 * q);
   vtkNew<vtkCellArray> polys;
   polys->SetData(offsets, conn);
 

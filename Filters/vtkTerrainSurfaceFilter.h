@@ -28,7 +28,12 @@
  * A grid of more than MaximumPoints points (default 2048 x 2048) is drawn at
  * every k-th row and column, k in the field data `surface_stride`.
  *
- * Bad input (not an image, 3-D, no height array, non-finite heights) gives
+ * NaN heights are no-data points (a raster's no-data, the outside of Rain
+ * Runoff's domain): no quad or wall touches them, so the surface ends at
+ * the data's edge.
+ *
+ * Bad input (not an image, 3-D, no height array, an infinite height, no
+ * height at all) gives
  * one error sentence and an empty output, as does a terrain whose surface
  * would not fit in the memory the process can get (about 84 bytes a point:
  * 34 GB for 20000 x 20000), refused before anything is allocated. A large

@@ -82,4 +82,34 @@ T.check(same.GetNumberOfPoints() == full.GetNumberOfPoints(), "MaximumPoints = t
 k = check_top(surface(100), "at most 100", list(range(0, nx - 1, 4)) + [nx - 1],
               list(range(0, ny - 1, 4)) + [ny - 1])
 T.check(k == 4, "at most 100: stride %d (4: 10 x 7; 3 gives 13 x 9 = 117)" % k)
+
+# No-data points: a NaN block of 3 x 2 points inside and a NaN corner point
+# on the edge. Every point stays (at its place, z0 + 2 lowest for the
+# holes); no quad touches a NaN point; the walls skip the corner's two
+# wall quads; the bounds are the data's.
+hn = h.copy()
+hn[10:12, 5:8] = np.nan
+hn[0, 0] = np.nan
+holey = numpy_to_vtk(hn.ravel(), deep=1)
+holey.SetName("elevation")
+img.GetPointData().SetScalars(holey)
+img.Modified()
+out = surface(0)
+top = nx * ny
+touching = set()
+for j in range(ny - 1):
+    for i in range(nx - 1):
+        if np.isnan(hn[j:j + 2, i:i + 2]).any():
+            touching.add((i, j))
+walls = 2 * (nx + ny - 2) - 2  # the corner point is on two edges
+T.check(out.GetNumberOfPoints() == top + 4 * (nx + ny), "no-data: every point kept")
+T.check(out.GetNumberOfPolys() == (nx - 1) * (ny - 1) - len(touching) + walls,
+        "no-data: %d quads (%d top quads touch a NaN point, %d walls)"
+        % (out.GetNumberOfPolys(), len(touching), walls))
+pts = vtk_to_numpy(out.GetPoints().GetData())
+conn = vtk_to_numpy(out.GetPolys().GetConnectivityArray())
+holes = np.flatnonzero(np.isnan(hn.ravel()))
+T.check(not np.isin(conn, holes).any(), "no quad uses a no-data point")
+T.check(np.isfinite(pts).all() and abs(out.GetBounds()[5] - (1.0 + 2.0 * np.nanmax(hn))) < 1e-9,
+        "finite points, the data's bounds")
 T.finish()
