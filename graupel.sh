@@ -25,6 +25,8 @@ PACKAGES=(
   paraview paraview-dev python3-paraview python3-numpy
   pocl-opencl-icd ocl-icd-opencl-dev opencl-headers clinfo
   libopenexr-dev libglm-dev xvfb xauth cmake g++ make
+  # GIS rasters (GeoTIFF, ASCII grids) in and GeoTIFF out
+  libgdal-dev
   qtbase5-dev libqt5svg5-dev qttools5-dev qtxmlpatterns5-dev-tools
   libqt5x11extras5-dev libqt5opengl5-dev
   # find_package(ParaView) also needs these development files:
@@ -40,6 +42,8 @@ TEST_PACKAGES=(
   libvtk9.1 libvtk9.1-qt
   # the real DEM in Data/ is checked against its source, shipped here
   python-matplotlib-data
+  # GIS files made and checked from outside Graupel (gdalwarp, gdalinfo, osgeo)
+  gdal-bin python3-gdal
   # the GUI tests drive the mouse and read the screen
   xdotool imagemagick
 )

@@ -54,22 +54,24 @@ int vtkEXRFieldWriter::FillInputPortInformation(int, vtkInformation *info) {
   return 1;
 }
 
-void vtkEXRFieldWriter::WriteData() {
-  vtkImageData *input = this->GetInput();
+const char *vtkEXRFieldWriter::Label() const {
+  return "EXR Field Writer";
+}
+
+bool vtkEXRFieldWriter::ChoosePlanes(vtkImageData *input, std::vector<std::string> &names,
+                                     std::vector<std::vector<float>> &planes) {
   if (!this->FileName || !*this->FileName) {
-    vtkErrorMacro("EXR Field Writer: no FileName was set; give the path of the .exr to write.");
+    vtkErrorMacro(<< this->Label() << ": no FileName was set; give the path of the file to write.");
     this->SetErrorCode(vtkErrorCode::NoFileNameError);
-    return;
+    return false;
   }
   int dims[3];
   input->GetDimensions(dims);
   if (dims[2] != 1 || dims[0] < 1 || dims[1] < 1) {
-    vtkErrorMacro("EXR Field Writer: the input image is " << dims[0] << " x " << dims[1] << " x "
-                                                          << dims[2]
-                                                          << "; only 2-D images (one point in z)"
-                                                             " can be written as EXR.");
+    vtkErrorMacro(<< this->Label() << ": the input image is " << dims[0] << " x " << dims[1]
+                  << " x " << dims[2] << "; only 2-D images (one point in z) can be written.");
     this->SetErrorCode(vtkErrorCode::UserError);
-    return;
+    return false;
   }
   vtkPointData *pd = input->GetPointData();
   std::vector<vtkDataArray *> chosen;
@@ -83,23 +85,21 @@ void vtkEXRFieldWriter::WriteData() {
     for (const std::string &name : this->ArrayNames) {
       vtkDataArray *arr = pd->GetArray(name.c_str());
       if (!arr) {
-        vtkErrorMacro("EXR Field Writer: the input has no numeric point array '"
-                      << name << "'; choose among the arrays the input has.");
+        vtkErrorMacro(<< this->Label() << ": the input has no numeric point array '" << name
+                      << "'; choose among the arrays the input has.");
         this->SetErrorCode(vtkErrorCode::UserError);
-        return;
+        return false;
       }
       chosen.push_back(arr);
     }
   }
   if (chosen.empty()) {
-    vtkErrorMacro("EXR Field Writer: the input has no numeric point arrays to write.");
+    vtkErrorMacro(<< this->Label() << ": the input has no numeric point arrays to write.");
     this->SetErrorCode(vtkErrorCode::UserError);
-    return;
+    return false;
   }
 
   const vtkIdType n = static_cast<vtkIdType>(dims[0]) * dims[1];
-  std::vector<std::string> names;
-  std::vector<std::vector<float>> planes;
   for (vtkDataArray *arr : chosen) {
     const int nc = arr->GetNumberOfComponents();
     const std::string base = arr->GetName() ? arr->GetName() : "unnamed";
@@ -118,6 +118,18 @@ void vtkEXRFieldWriter::WriteData() {
       planes.push_back(std::move(plane));
     }
   }
+  return true;
+}
+
+void vtkEXRFieldWriter::WriteData() {
+  vtkImageData *input = this->GetInput();
+  std::vector<std::string> names;
+  std::vector<std::vector<float>> planes;
+  if (!this->ChoosePlanes(input, names, planes)) {
+    return;
+  }
+  int dims[3];
+  input->GetDimensions(dims);
   std::vector<const char *> namePtrs;
   std::vector<const float *> dataPtrs;
   for (size_t c = 0; c < names.size(); ++c) {

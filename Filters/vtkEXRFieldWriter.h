@@ -65,6 +65,16 @@ protected:
 
   void WriteData() override;
   int FillInputPortInformation(int port, vtkInformation *info) override;
+  /** The writer's name in its error sentences. */
+  virtual const char *Label() const;
+  /**
+   * The chosen point arrays of a 2-D input as float planes, one per
+   * component (NAME.x/.y/.z for three, NAME.0, NAME.1, ... for others).
+   * False, with one error sentence and the error code set, when there is no
+   * FileName, the input is not 2-D, or an array asked for is missing.
+   */
+  bool ChoosePlanes(vtkImageData *input, std::vector<std::string> &names,
+                    std::vector<std::vector<float>> &planes);
 
   char *FileName = nullptr;
   int PixelType = FLOAT;

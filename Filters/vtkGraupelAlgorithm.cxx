@@ -241,8 +241,19 @@ vtkTypeBool vtkGraupelAlgorithm::ProcessRequest(vtkInformation *request,
         used->InsertNextValue(note.second.used);
         out->GetFieldData()->AddArray(used);
       }
+      // The CRS a GIS raster brought (vtkGISRasterReader) goes on with the
+      // data, for vtkGeoTIFFWriter to write it back.
+      vtkDataObject *in =
+          this->GetNumberOfInputPorts() > 0 && inInfo[0]->GetNumberOfInformationObjects() > 0
+              ? vtkDataObject::GetData(inInfo[0], 0)
+              : nullptr;
+      vtkAbstractArray *crs = in ? in->GetFieldData()->GetAbstractArray("graupel_crs") : nullptr;
       for (int i = 0; i < outInfo->GetNumberOfInformationObjects(); ++i) {
-        graupel::CacheRanges(vtkDataObject::GetData(outInfo, i));
+        vtkDataObject *data = vtkDataObject::GetData(outInfo, i);
+        graupel::CacheRanges(data);
+        if (crs && data && !data->GetFieldData()->GetAbstractArray("graupel_crs")) {
+          data->GetFieldData()->AddArray(crs);
+        }
       }
     }
     return 1;

@@ -1,0 +1,52 @@
+#include "vtkGeoTIFFWriter.h"
+
+#include "vtkErrorCode.h"
+#include "vtkFieldData.h"
+#include "vtkImageData.h"
+#include "vtkObjectFactory.h"
+#include "vtkStringArray.h"
+
+#include "graupel/raster_io.h"
+
+#include <string>
+#include <vector>
+
+vtkStandardNewMacro(vtkGeoTIFFWriter);
+
+const char *vtkGeoTIFFWriter::Label() const {
+  return "GeoTIFF Writer";
+}
+
+void vtkGeoTIFFWriter::WriteData() {
+  vtkImageData *input = this->GetInput();
+  std::vector<std::string> names;
+  std::vector<std::vector<float>> planes;
+  if (!this->ChoosePlanes(input, names, planes)) {
+    return;
+  }
+  int dims[3];
+  double spacing[3], origin[3];
+  input->GetDimensions(dims);
+  input->GetSpacing(spacing);
+  input->GetOrigin(origin);
+  std::vector<const char *> namePtrs;
+  std::vector<const float *> dataPtrs;
+  for (size_t c = 0; c < names.size(); ++c) {
+    namePtrs.push_back(names[c].c_str());
+    dataPtrs.push_back(planes[c].data());
+  }
+  std::string crs;
+  if (auto *a =
+          vtkStringArray::SafeDownCast(input->GetFieldData()->GetAbstractArray("graupel_crs"))) {
+    if (a->GetNumberOfValues() > 0) {
+      crs = a->GetValue(0);
+    }
+  }
+  char err[1024] = "";
+  if (gr_raster_write(this->FileName, dims[0], dims[1], static_cast<int>(names.size()),
+                      namePtrs.data(), dataPtrs.data(), spacing, origin, crs.c_str(), err,
+                      sizeof(err)) != GR_OK) {
+    vtkErrorMacro(<< this->Label() << ": " << err);
+    this->SetErrorCode(vtkErrorCode::CannotOpenFileError);
+  }
+}
