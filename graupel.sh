@@ -145,7 +145,10 @@ case "$cmd" in
   soak)
     ensure_packages "${PACKAGES[@]}"
     build_preset core
-    ctest --preset soak ${CTEST_ARGS:-}
+    ctest --preset soak ${CTEST_ARGS:-} || status=1
+    build_preset plugin
+    ctest --preset soak-plugin ${CTEST_ARGS:-} || status=1
+    exit ${status:-0}
     ;;
   *)
     sed -n '2,17p' "$0" | sed 's/^# \{0,1\}//'

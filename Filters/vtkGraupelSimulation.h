@@ -68,7 +68,7 @@
  *
  * **Checkpoint files.** With CheckpointFile set (a path ending in .json),
  * every update also writes the state it outputs: each rank writes
- * `<stem>.<rank>.vti` beside the manifest, its output (the requested piece,
+ * `<stem>.<output index>.<rank>.vti` beside the manifest, its output (the requested piece,
  * every array, viewable as it is) with the core's state as SaveState gives
  * it, byte for byte, in the field array `graupel_state` (an unsigned char
  * array; the .vti is written raw and zlib-compressed, which is lossless);
@@ -76,7 +76,10 @@
  * simulation's label, the output index, time and interval, the grid, the
  * number of ranks and whether they split the grid, and per rank its own
  * rows, its file and its state's bytes (plus `steps` where the output has
- * it). RestartFile names such a manifest: after the set-up each rank checks
+ * it). Each file is written under a temporary name, flushed and renamed,
+ * the manifest last, and the pieces of earlier outputs are removed only
+ * once it is in place: a kill at any moment leaves the previous checkpoint
+ * or the new one whole. RestartFile names such a manifest: after the set-up each rank checks
  * it against this run (simulation, grid, ranks, its own rows, the output
  * time), reads its piece and loads the state (LoadState), so the run goes on
  * from that output time; the loaded state is also kept as a checkpoint, so

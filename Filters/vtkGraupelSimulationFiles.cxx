@@ -2,6 +2,14 @@
 // RestartFile): a JSON manifest beside one XML piece per rank holding the
 // output and the core's state bytes. See "Checkpoint files" in the class
 // comment for the format and the rules a restart checks.
+//
+// Written so that a kill at any moment leaves a restart that is whole: each
+// checkpoint's pieces have names of their own (the output index in them),
+// each is written under a temporary name, flushed to the disk and renamed;
+// the manifest, which names them, is written the same way and last; only
+// then are the pieces of earlier checkpoints removed. A reader therefore
+// finds either the previous manifest with its pieces or the new one with
+// its own, never a piece torn or of another output.
 #include "vtkGraupelSimulation.h"
 
 #include "vtkDataArray.h"
@@ -18,14 +26,81 @@
 
 #include "GraupelPieces.h"
 
+#include <cerrno>
 #include <cstdio>
+#include <cstring>
+#include <dirent.h>
+#include <fcntl.h>
 #include <fstream>
 #include <memory>
 #include <sstream>
 #include <string>
+#include <unistd.h>
 #include <vector>
 
 namespace {
+// Flushes a written file to the disk (so that a rename after it never
+// names a file whose bytes are still only in memory when the machine
+// stops); false if it cannot be opened or synced.
+bool Sync(const std::string &path) {
+  const int fd = ::open(path.c_str(), O_RDONLY);
+  if (fd < 0) {
+    return false;
+  }
+  const bool ok = ::fsync(fd) == 0;
+  ::close(fd);
+  return ok;
+}
+
+// Puts a finished temporary file in place of path: synced, then renamed.
+bool Publish(const std::string &part, const std::string &path) {
+  if (Sync(part) && std::rename(part.c_str(), path.c_str()) == 0) {
+    return true;
+  }
+  std::remove(part.c_str());
+  return false;
+}
+
+// The piece of rank r for output index i: <stem>.<i>.<r>.<extension>.
+std::string PieceName(const std::string &stem, int index, int r, const std::string &extension) {
+  return stem + "." + std::to_string(index) + "." + std::to_string(r) + "." + extension;
+}
+
+// Removes this rank's pieces of other checkpoints (<stem>.<i>.<rank>.<ext>
+// with i not index) and temporary files a killed writer left, in folder.
+void RemoveStalePieces(const std::string &folder, const std::string &stem, int index, int rank,
+                       const std::string &extension) {
+  DIR *dir = ::opendir(folder.empty() ? "." : folder.c_str());
+  if (!dir) {
+    return;
+  }
+  const std::string head = stem + ".", tail = "." + std::to_string(rank) + "." + extension;
+  const std::string keep = PieceName(stem, index, rank, extension);
+  std::vector<std::string> stale;
+  while (const dirent *e = ::readdir(dir)) {
+    const std::string name = e->d_name;
+    std::string body = name;
+    const bool part = body.size() > 5 && body.compare(body.size() - 5, 5, ".part") == 0;
+    if (part) {
+      body.erase(body.size() - 5);
+    }
+    if (body == keep && !part) {
+      continue;
+    }
+    if (body.size() <= head.size() + tail.size() || body.compare(0, head.size(), head) != 0 ||
+        body.compare(body.size() - tail.size(), tail.size(), tail) != 0) {
+      continue;
+    }
+    const std::string middle = body.substr(head.size(), body.size() - head.size() - tail.size());
+    if (!middle.empty() && middle.find_first_not_of("0123456789") == std::string::npos) {
+      stale.push_back(name);
+    }
+  }
+  ::closedir(dir);
+  for (const std::string &name : stale) {
+    std::remove((folder + name).c_str());
+  }
+}
 // The manifest's folder (with its slash) and its name without ".json".
 void SplitManifestPath(const std::string &path, std::string &folder, std::string &stem) {
   const size_t slash = path.find_last_of('/');
@@ -65,7 +140,8 @@ int vtkGraupelSimulation::WriteCheckpointFile(vtkDataObject *output) {
   vtkSmartPointer<vtkXMLWriter> writer =
       vtk::TakeSmartPointer(vtkXMLDataObjectWriter::NewWriter(output->GetDataObjectType()));
   const std::string extension = writer ? writer->GetDefaultFileExtension() : "vtk";
-  const std::string file = stem + "." + std::to_string(split ? rank : 0) + "." + extension;
+  const int index = this->StateIndex;
+  const std::string file = PieceName(stem, index, split ? rank : 0, extension);
 
   // This rank's piece: its output with the core's state, byte for byte.
   // Unsplit, every rank holds the whole state: rank 0 writes it.
@@ -89,11 +165,16 @@ int vtkGraupelSimulation::WriteCheckpointFile(vtkDataObject *output) {
       fd->AddArray(state);
       copy->SetFieldData(fd);
       writer->SetInputData(copy);
-      writer->SetFileName((folder + file).c_str());
+      const std::string part = folder + file + ".part";
+      writer->SetFileName(part.c_str());
       writer->SetDataModeToAppended();
       writer->EncodeAppendedDataOff();
-      if (!writer->Write()) {
+      if (!writer->Write() || writer->GetErrorCode() != 0) {
+        std::remove(part.c_str());
         why = "its piece " + folder + file + " could not be written";
+      } else if (!Publish(part, folder + file)) {
+        why = "its piece " + folder + file + " could not be put in place (" + std::strerror(errno) +
+              ")";
       }
     }
   }
@@ -140,7 +221,7 @@ int vtkGraupelSimulation::WriteCheckpointFile(vtkDataObject *output) {
       piece["rank"] = r;
       piece["rows"].append(static_cast<Json::Int64>(table[q]));
       piece["rows"].append(static_cast<Json::Int64>(table[q + 1]));
-      piece["file"] = stem + "." + std::to_string(r) + "." + extension;
+      piece["file"] = PieceName(stem, index, r, extension);
       piece["bytes"] = static_cast<Json::Int64>(table[q + 2]);
       list.append(piece);
     }
@@ -149,14 +230,17 @@ int vtkGraupelSimulation::WriteCheckpointFile(vtkDataObject *output) {
     builder["indentation"] = "  ";
     builder["precision"] = 17;
     const std::string json = Json::writeString(builder, root) + "\n";
-    // Written whole, then renamed: a reader never sees half a manifest.
+    // Written whole, flushed, then renamed, after every piece it names: a
+    // reader never sees half a manifest, nor one whose pieces are missing.
     const std::string part = manifest + ".part";
     std::ofstream out(part, std::ios::binary | std::ios::trunc);
     out << json;
     out.close();
-    if (!out || std::rename(part.c_str(), manifest.c_str()) != 0) {
+    if (!out) {
       std::remove(part.c_str());
       why = "the manifest could not be written";
+    } else if (!Publish(part, manifest)) {
+      why = "the manifest could not be put in place";
     }
   }
   const bool failed = pieces.AnyRank(!why.empty());
@@ -165,6 +249,10 @@ int vtkGraupelSimulation::WriteCheckpointFile(vtkDataObject *output) {
                   << (why.empty() ? std::string("another rank could not write its part") : why)
                   << "; check that the folder exists and can be written to.");
     return 0;
+  }
+  // The new manifest is in place on every rank's word: earlier pieces go.
+  if (writes) {
+    RemoveStalePieces(folder, stem, index, split ? rank : 0, extension);
   }
   this->CheckpointFileCount += writes ? 1 : 0;
   this->WrittenIndex = this->StateIndex;
@@ -267,6 +355,12 @@ int vtkGraupelSimulation::ReadRestartFile() {
         if (!state || state->GetNumberOfComponents() != 1) {
           m << "names the piece " << file
             << ", which holds no state (field array graupel_state); write it again";
+        } else if (!piece["bytes"].isIntegral() ||
+                   piece["bytes"].asInt64() !=
+                       static_cast<Json::Int64>(state->GetNumberOfTuples())) {
+          m << "names the piece " << file << ", whose state holds " << state->GetNumberOfTuples()
+            << " bytes where the manifest says " << piece["bytes"].asString()
+            << "; it belongs to another checkpoint";
         } else {
           bytes.assign(state->GetPointer(0), state->GetPointer(0) + state->GetNumberOfTuples());
         }

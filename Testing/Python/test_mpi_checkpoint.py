@@ -207,6 +207,15 @@ missing = os.path.join(folder, "missing.json")
 with open(missing, "w") as f:
     json.dump(gone, f)
 refused("a missing piece", rain_runoff, missing, 80.0, ["RestartFile", "could not be opened"])
+# A manifest naming a piece whose state is not the size it gives (another
+# checkpoint's piece, or a tampered manifest).
+tampered = dict(rr)
+tampered["pieces"] = [dict(p, bytes=p["bytes"] + 8) for p in rr["pieces"]]
+sizes = os.path.join(folder, "sizes.json")
+with open(sizes, "w") as f:
+    json.dump(tampered, f)
+refused("a piece of another size", rain_runoff, sizes, 80.0,
+        ["RestartFile", "bytes where the manifest says", "another checkpoint"])
 refused("no manifest", rain_runoff, os.path.join(folder, "nothing.json"), 80.0,
         ["RestartFile", "could not be opened"])
 # A CheckpointFile in a folder that is not there: one sentence, an empty output.
