@@ -241,6 +241,7 @@ int vtkRainRunoffFilter::SetUpState(vtkInformationVector **inputVector) {
   if (velocity && this->FlowModel == SHALLOW_WATER) {
     uploads.push_back({GR_FIELD_VELOCITY, AsFloat(velocity), "Input"});
   }
+  this->RainFollowed = pd->GetArray("rain_rate") != nullptr;
   if (vtkDataArray *rain = pd->GetArray("rain_rate")) {
     uploads.push_back({GR_FIELD_RAIN_RATE, AsFloat(rain), "Input"});
   }
@@ -431,6 +432,7 @@ int vtkRainRunoffFilter::SetUpState(vtkInformationVector **inputVector) {
     return 0;
   }
   this->InflowsReadAt = this->GetTemporalInputTime(3);
+  this->RainReadAt = this->GetTemporalInputTime(0);
   // Progress with the simulated time, and an abort inside a long interval.
   gr_rain_runoff_set_progress(this->Simulation, &vtkGraupelSimulation::CoreProgress, this);
   this->Ledgers.clear();
@@ -585,8 +587,45 @@ int vtkRainRunoffFilter::RecordLedger(int index) {
   return 1;
 }
 
+int vtkRainRunoffFilter::SetRainFromInput(vtkImageData *terrain) {
+  vtkDataArray *rain = terrain ? terrain->GetPointData()->GetArray("rain_rate") : nullptr;
+  if (!rain) {
+    if (this->RainFollowed) {
+      vtkErrorMacro("Rain Runoff's Input has no point array 'rain_rate' at t = "
+                    << this->GetTemporalInputTime(0)
+                    << " s, though it had one before; give every time step its rain (m/s).");
+      return 0;
+    }
+    return 1; // no rain map: RainRate (or the Hyetograph) rains
+  }
+  int dims[3];
+  terrain->GetDimensions(dims);
+  const size_t npoints = static_cast<size_t>(dims[0]) * static_cast<size_t>(dims[1]);
+  vtkSmartPointer<vtkFloatArray> values = graupel::AsFloat(rain);
+  char msg[512];
+  if (values->GetNumberOfComponents() != 1 ||
+      static_cast<size_t>(values->GetNumberOfTuples()) != npoints) {
+    vtkErrorMacro("Rain Runoff's Input array 'rain_rate' must have one value per point.");
+    return 0;
+  }
+  if (gr_rain_runoff_field_validate(GR_FIELD_RAIN_RATE, values->GetPointer(0), npoints, msg,
+                                    sizeof(msg)) != GR_OK) {
+    vtkErrorMacro("Rain Runoff's Input at t = " << this->GetTemporalInputTime(0) << " s: " << msg);
+    return 0;
+  }
+  const std::vector<float> local = this->GetPieces().LocalField(values->GetPointer(0), dims[0], 1);
+  const gr_status st = gr_rain_runoff_set_field(this->Simulation, GR_FIELD_RAIN_RATE, local.data());
+  if (st != GR_OK) {
+    return this->ReportFailure(st, "Rain Runoff could not take the Input's rain",
+                               gr_rain_runoff_last_error(this->Simulation));
+  }
+  this->RainFollowed = true;
+  return 1;
+}
+
 int vtkRainRunoffFilter::ResetState() {
   this->InflowsReadAt = std::numeric_limits<double>::quiet_NaN();
+  this->RainReadAt = std::numeric_limits<double>::quiet_NaN();
   const gr_status st = gr_rain_runoff_reset(this->Simulation);
   return st == GR_OK ? this->RecordLedger(0)
                      : this->ReportFailure(st, "Rain Runoff could not restart",
@@ -602,6 +641,14 @@ int vtkRainRunoffFilter::AdvanceState(double t0, double t1) {
       return ADVANCE_FAILED;
     }
     this->InflowsReadAt = this->GetTemporalInputTime(3);
+  }
+  // A temporal Input followed in time (FollowInputTime): its rain_rate of
+  // the time step that holds over [t0, t1], e.g. a series of radar frames.
+  if (this->IsInputTemporal(0) && this->GetTemporalInputTime(0) != this->RainReadAt) {
+    if (!this->SetRainFromInput(vtkImageData::SafeDownCast(this->GetTemporalInput(0)))) {
+      return ADVANCE_FAILED;
+    }
+    this->RainReadAt = this->GetTemporalInputTime(0);
   }
   const gr_status st = gr_rain_runoff_advance(this->Simulation, t1 - t0, nullptr);
   if (st == GR_ERR_ABORTED) {
@@ -703,9 +750,10 @@ int vtkRainRunoffFilter::LoadState(const std::vector<unsigned char> &bytes) {
   }
   std::copy(ledgers.begin(), ledgers.end(), this->Ledgers.begin());
   std::copy(gaugeRows.begin(), gaugeRows.end(), this->GaugeRows.begin());
-  // The point inflows are not in the core's state: the next advance sets
-  // those of the Inflows input's time step again.
+  // The point inflows and a followed Input's rain are not in the core's
+  // state: the next advance sets those of the inputs' time steps again.
   this->InflowsReadAt = std::numeric_limits<double>::quiet_NaN();
+  this->RainReadAt = std::numeric_limits<double>::quiet_NaN();
   return 1;
 }
 

@@ -300,6 +300,15 @@ private:
   int SetPointInflows(vtkPointSet *points, vtkImageData *terrain);
   /** The Inflows input's time step the core's point inflows came from (NaN: set them again). */
   double InflowsReadAt = 0.0;
+  /**
+   * With FollowInputTime, the Input's `rain_rate` of its time step now, to
+   * the core (nothing when the Input has none); 0 with a sentence.
+   */
+  int SetRainFromInput(vtkImageData *terrain);
+  /** The Input's time step the core's rain field came from (NaN: set it again). */
+  double RainReadAt = 0.0;
+  /** Whether the set-up's Input had a rain_rate (then every time step must have one). */
+  bool RainFollowed = false;
   void AddInflow(int side, double time, double discharge);
   void RemoveAllInflow(int side);
 
