@@ -25,6 +25,19 @@ static void gr_raster_say(char *err, size_t len, const char *fmt, ...) {
   va_end(ap);
 }
 
+/* Ends the sentence in err with a period (GDAL's messages often have none). */
+static void gr_raster_end_sentence(char *err, size_t len) {
+  if (!err || len < 2)
+    return;
+  size_t n = strlen(err);
+  while (n > 0 && (err[n - 1] == ' ' || err[n - 1] == '\n'))
+    err[--n] = '\0';
+  if (n > 0 && err[n - 1] != '.' && n + 1 < len) {
+    err[n] = '.';
+    err[n + 1] = '\0';
+  }
+}
+
 /* GDAL's last message, or a fallback; never NULL. */
 static const char *gr_raster_gdal_message(const char *fallback) {
   const char *m = CPLGetLastErrorMsg();
@@ -198,6 +211,7 @@ gr_status gr_raster_read(const char *path, int band, gr_raster *out, char *err, 
   if (!ds) {
     gr_raster_say(err, err_len, "'%s' could not be opened as a raster: %s", path,
                   gr_raster_gdal_message("no GDAL driver reads it."));
+    gr_raster_end_sentence(err, err_len);
     CPLPopErrorHandler();
     return GR_ERR_IO;
   }
@@ -269,6 +283,7 @@ gr_status gr_raster_read(const char *path, int band, gr_raster *out, char *err, 
   CPLPopErrorHandler();
   if (st != GR_OK) {
     gr_raster_free(&r);
+    gr_raster_end_sentence(err, err_len);
     return st;
   }
   *out = r;
@@ -390,8 +405,10 @@ gr_status gr_raster_write(const char *path, int width, int height, int nbands,
                   path);
     st = GR_ERR_IO;
   }
-  if (st != GR_OK)
+  if (st != GR_OK) {
     VSIUnlink(tmp);
+    gr_raster_end_sentence(err, err_len);
+  }
   CPLPopErrorHandler();
   return st;
 }
