@@ -816,8 +816,10 @@ int vtkGraupelSimulation::UpdateState(vtkInformation *request, vtkInformationVec
   output->GetInformation()->Set(vtkDataObject::DATA_TIME_STEP(), goal);
   this->AddDeviceFieldData(output);
   if (this->CheckpointFile && *this->CheckpointFile && !this->WriteCheckpointFile(output)) {
+    // A file that could not be written (a full disk) is no fault of the
+    // state, which stays as it is: the next request tries again (HasFailed
+    // would hold every later time until a property changed).
     output->Initialize();
-    this->HasFailed = true;
     return 0;
   }
   return 1;
