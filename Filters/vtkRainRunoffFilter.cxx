@@ -853,9 +853,14 @@ int vtkRainRunoffFilter::FillHydrograph(vtkDataObject *tableObject) {
   if (!table) {
     return 1; // a pipeline that asked for the image only
   }
-  const int rows = this->GetStateIndex() + 1;
-  if (rows < 1 || this->Ledgers.size() < static_cast<size_t>(rows) ||
-      this->GaugeRows.size() < static_cast<size_t>(rows)) {
+  // One table for the whole run, on rank 0: every rank holds the same rows
+  // (the ledger is reduced over the ranks), and ParaView appends the ranks'
+  // tables when it delivers them (a client's chart and CSV would hold every
+  // row once per rank). The other ranks give the columns without rows.
+  const bool holder = this->GetPieces().GetRank() == 0;
+  const int rows = holder ? this->GetStateIndex() + 1 : 0;
+  if (holder && (rows < 1 || this->Ledgers.size() < static_cast<size_t>(rows) ||
+                 this->GaugeRows.size() < static_cast<size_t>(rows))) {
     vtkErrorMacro("Rain Runoff's hydrograph lacks the ledger of an output time before "
                   << this->GetStateTime() << " s; this is a bug: please report it.");
     return 0;
