@@ -137,6 +137,118 @@ void gr_rain_runoff_blank(const gr_rain_runoff *s, float *host, size_t comps) {
           host[k * comps + q] = NAN;
 }
 
+/* VELOCITY: the discharges h (u, v) of the water there now; they are also
+ * the initial ones that reset returns to. */
+static gr_status gr_rain_runoff_set_velocity(gr_rain_runoff *s, const float *host) {
+  size_t cells = gr_rain_runoff_cells(s);
+  float *q = malloc(3 * cells * sizeof(float));
+  if (!q)
+    return gr_set_error(s->ctx, GR_ERR_OUT_OF_MEMORY, "Out of host memory.");
+  float *qx = q + cells, *qy = q + 2 * cells;
+  gr_status st = gr_buffer_read(s->ctx, s->h, 0, cells * sizeof(cl_float), q);
+  for (size_t c = 0; st == GR_OK && c < cells; ++c) {
+    qx[c] = q[c] * host[3 * c];
+    qy[c] = q[c] * host[3 * c + 1];
+  }
+  if (st == GR_OK)
+    st = gr_rain_runoff_upload(s, &s->qu0, qx);
+  if (st == GR_OK)
+    st = gr_rain_runoff_upload(s, &s->qv0, qy);
+  if (st == GR_OK)
+    st = gr_buffer_write(s->ctx, s->qu, 0, cells * sizeof(cl_float), qx);
+  if (st == GR_OK)
+    st = gr_buffer_write(s->ctx, s->qv, 0, cells * sizeof(cl_float), qy);
+  /* The maps see the new speeds from now on. */
+  if (st == GR_OK)
+    st = gr_rain_runoff_maps_update(s, s->time, 0.0);
+  free(q);
+  return st;
+}
+
+/* ELEVATION: the bed (gr_rain_runoff_set_elevation), the fastest the bed's
+ * slope can speed water up (slope_rate) and the edges' lowest ground. */
+static gr_status gr_rain_runoff_set_ground(gr_rain_runoff *s, const float *host) {
+  gr_status st = gr_rain_runoff_set_elevation(s, host);
+  double worst = 0.0;
+  const int nx = s->nxl, ny = s->nyl;
+  for (int j = 0; j < ny; ++j)
+    for (int i = 0; i < nx; ++i) {
+      const float *z = host + (size_t)j * nx + i;
+      double sx = 0.0, sy = 0.0;
+      if (i > 0)
+        sx = fabs((double)z[0] - z[-1]);
+      if (i < nx - 1)
+        sx = fmax(sx, fabs((double)z[1] - z[0]));
+      if (j > 0)
+        sy = fabs((double)z[0] - z[-nx]);
+      if (j < ny - 1)
+        sy = fmax(sy, fabs((double)z[nx] - z[0]));
+      double rate = sx / (s->grid.dx * s->grid.dx) + sy / (s->grid.dy * s->grid.dy);
+      worst = rate > worst ? rate : worst;
+    }
+  if (st == GR_OK) {
+    s->slope_rate = GR_GRAVITY * worst;
+    gr_rain_runoff_edge_beds(s, host);
+  }
+  return st;
+}
+
+/* RAIN_RATE: the field, its sum over the owned domain cells and its
+ * largest value. */
+static gr_status gr_rain_runoff_set_rain_field(gr_rain_runoff *s, const float *host) {
+  size_t cells = gr_rain_runoff_cells(s);
+  gr_fixed sum = gr_rain_runoff_own_sum(s, host);
+  gr_status st = gr_rain_runoff_upload(s, &s->rain, host);
+  if (st == GR_OK) {
+    s->has_rain = 1;
+    s->rain_field_sum = sum;
+    s->rain_field_max = 0.0;
+    for (size_t c = 0; c < cells; ++c)
+      if (!s->has_nodata || !s->mask[c])
+        s->rain_field_max = host[c] > s->rain_field_max ? host[c] : s->rain_field_max;
+  }
+  return st;
+}
+
+/* WATER_DEPTH: the new water replaces what is there now: the ledger counts
+ * the difference as initial water, so the balance still closes. No-data
+ * cells hold none. */
+static gr_status gr_rain_runoff_set_water(gr_rain_runoff *s, const float *host) {
+  size_t cells = gr_rain_runoff_cells(s);
+  float *dry = NULL;
+  if (s->has_nodata) {
+    dry = malloc(cells * sizeof(float));
+    if (!dry)
+      return gr_set_error(s->ctx, GR_ERR_OUT_OF_MEMORY, "Out of host memory.");
+    for (size_t c = 0; c < cells; ++c)
+      dry[c] = s->mask[c] ? 0.0f : host[c];
+    host = dry;
+  }
+  gr_fixed now[GR_RAIN_RUNOFF_SUMS], sum = gr_rain_runoff_own_sum(s, host);
+  gr_status st = gr_rain_runoff_reduce_fixed(s, now, NULL);
+  if (st == GR_OK)
+    st = gr_rain_runoff_upload(s, &s->h0, host);
+  if (st == GR_OK)
+    st = gr_buffer_write(s->ctx, s->h, 0, cells * sizeof(cl_float), host);
+  if (st == GR_OK)
+    st = gr_rain_runoff_fill(s, s->h_c, 0.0f, cells * sizeof(cl_float));
+  if (st == GR_OK)
+    st = gr_rain_runoff_clear_flow(s);
+  /* No discharge: the initial velocity, if any, was of other water. */
+  gr_buffer_release(&s->qu0);
+  gr_buffer_release(&s->qv0);
+  if (st == GR_OK) { /* exact: the device's sum of the old water is in the same units */
+    s->initial_sum = sum;
+    s->initial.coarse += sum.coarse - now[0].coarse;
+    s->initial.fine += sum.fine - now[0].fine;
+  }
+  /* The maps count the new water from the time it is set. */
+  if (st == GR_OK)
+    st = gr_rain_runoff_maps_update(s, s->time, 0.0);
+  free(dry);
+  return st;
+}
+
 static gr_status gr_rain_runoff_set_field_impl(gr_rain_runoff *s, gr_field f, const float *host) {
   char msg[320];
   size_t cells = gr_rain_runoff_cells(s);
@@ -164,115 +276,25 @@ static gr_status gr_rain_runoff_set_field_impl(gr_rain_runoff *s, gr_field f, co
     free(d);
     return st;
   }
-  if (f == GR_FIELD_VELOCITY) {
-    /* The discharges h (u, v) of the water there now; they are also the
-     * initial ones that reset returns to. */
-    float *q = malloc(3 * cells * sizeof(float));
-    if (!q)
-      return gr_set_error(s->ctx, GR_ERR_OUT_OF_MEMORY, "Out of host memory.");
-    float *qx = q + cells, *qy = q + 2 * cells;
-    gr_status st = gr_buffer_read(s->ctx, s->h, 0, cells * sizeof(cl_float), q);
-    for (size_t c = 0; st == GR_OK && c < cells; ++c) {
-      qx[c] = q[c] * host[3 * c];
-      qy[c] = q[c] * host[3 * c + 1];
-    }
-    if (st == GR_OK)
-      st = gr_rain_runoff_upload(s, &s->qu0, qx);
-    if (st == GR_OK)
-      st = gr_rain_runoff_upload(s, &s->qv0, qy);
-    if (st == GR_OK)
-      st = gr_buffer_write(s->ctx, s->qu, 0, cells * sizeof(cl_float), qx);
-    if (st == GR_OK)
-      st = gr_buffer_write(s->ctx, s->qv, 0, cells * sizeof(cl_float), qy);
-    /* The maps see the new speeds from now on. */
-    if (st == GR_OK)
-      st = gr_rain_runoff_maps_update(s, s->time, 0.0);
-    free(q);
-    return st;
-  }
+  if (f == GR_FIELD_VELOCITY)
+    return gr_rain_runoff_set_velocity(s, host);
   gr_status st = GR_OK;
   s->args_set = 0; /* a field allocated now is bound at the next step */
   switch (f) {
-  case GR_FIELD_ELEVATION: {
-    st = gr_rain_runoff_set_elevation(s, host);
-    double worst = 0.0;
-    const int nx = s->nxl, ny = s->nyl;
-    for (int j = 0; j < ny; ++j)
-      for (int i = 0; i < nx; ++i) {
-        const float *z = host + (size_t)j * nx + i;
-        double sx = 0.0, sy = 0.0;
-        if (i > 0)
-          sx = fabs((double)z[0] - z[-1]);
-        if (i < nx - 1)
-          sx = fmax(sx, fabs((double)z[1] - z[0]));
-        if (j > 0)
-          sy = fabs((double)z[0] - z[-nx]);
-        if (j < ny - 1)
-          sy = fmax(sy, fabs((double)z[nx] - z[0]));
-        double rate = sx / (s->grid.dx * s->grid.dx) + sy / (s->grid.dy * s->grid.dy);
-        worst = rate > worst ? rate : worst;
-      }
-    if (st == GR_OK) {
-      s->slope_rate = GR_GRAVITY * worst;
-      gr_rain_runoff_edge_beds(s, host);
-    }
+  case GR_FIELD_ELEVATION:
+    st = gr_rain_runoff_set_ground(s, host);
     break;
-  }
   case GR_FIELD_PERMEABILITY:
     st = gr_rain_runoff_upload(s, &s->perm, host);
     if (st == GR_OK)
       s->has_perm = 1;
     break;
-  case GR_FIELD_RAIN_RATE: {
-    gr_fixed sum = gr_rain_runoff_own_sum(s, host);
-    st = gr_rain_runoff_upload(s, &s->rain, host);
-    if (st == GR_OK) {
-      s->has_rain = 1;
-      s->rain_field_sum = sum;
-      s->rain_field_max = 0.0;
-      for (size_t c = 0; c < cells; ++c)
-        if (!s->has_nodata || !s->mask[c])
-          s->rain_field_max = host[c] > s->rain_field_max ? host[c] : s->rain_field_max;
-    }
+  case GR_FIELD_RAIN_RATE:
+    st = gr_rain_runoff_set_rain_field(s, host);
     break;
-  }
-  case GR_FIELD_WATER_DEPTH: {
-    /* The new water replaces what is there now: the ledger counts the
-     * difference as initial water, so the balance still closes. No-data
-     * cells hold none. */
-    float *dry = NULL;
-    if (s->has_nodata) {
-      dry = malloc(cells * sizeof(float));
-      if (!dry)
-        return gr_set_error(s->ctx, GR_ERR_OUT_OF_MEMORY, "Out of host memory.");
-      for (size_t c = 0; c < cells; ++c)
-        dry[c] = s->mask[c] ? 0.0f : host[c];
-      host = dry;
-    }
-    gr_fixed now[GR_RAIN_RUNOFF_SUMS], sum = gr_rain_runoff_own_sum(s, host);
-    st = gr_rain_runoff_reduce_fixed(s, now, NULL);
-    if (st == GR_OK)
-      st = gr_rain_runoff_upload(s, &s->h0, host);
-    if (st == GR_OK)
-      st = gr_buffer_write(s->ctx, s->h, 0, cells * sizeof(cl_float), host);
-    if (st == GR_OK)
-      st = gr_rain_runoff_fill(s, s->h_c, 0.0f, cells * sizeof(cl_float));
-    if (st == GR_OK)
-      st = gr_rain_runoff_clear_flow(s);
-    /* No discharge: the initial velocity, if any, was of other water. */
-    gr_buffer_release(&s->qu0);
-    gr_buffer_release(&s->qv0);
-    if (st == GR_OK) { /* exact: the device's sum of the old water is in the same units */
-      s->initial_sum = sum;
-      s->initial.coarse += sum.coarse - now[0].coarse;
-      s->initial.fine += sum.fine - now[0].fine;
-    }
-    /* The maps count the new water from the time it is set. */
-    if (st == GR_OK)
-      st = gr_rain_runoff_maps_update(s, s->time, 0.0);
-    free(dry);
+  case GR_FIELD_WATER_DEPTH:
+    st = gr_rain_runoff_set_water(s, host);
     break;
-  }
   default:
     break; /* refused by gr_rain_runoff_field_check */
   }
