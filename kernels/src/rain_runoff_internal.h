@@ -309,6 +309,7 @@ gr_status gr_rain_runoff_watch_step(gr_rain_runoff *s, gr_rain_runoff_watch *w, 
 gr_status gr_rain_runoff_stable_dt_impl(gr_rain_runoff *s, double *dt);
 
 /* rain_runoff_outputs.c */
+gr_status gr_rain_runoff_map_args(gr_rain_runoff *s, cl_kernel k);
 gr_status gr_rain_runoff_maps_update(gr_rain_runoff *s, double time, double dt);
 gr_status gr_rain_runoff_maps_restart(gr_rain_runoff *s);
 

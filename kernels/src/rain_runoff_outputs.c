@@ -5,6 +5,22 @@
 
 /* ------------------------------------------------------------ flood maps */
 
+/* The flood maps' arguments of kernel k: the maps kernel's, and each
+ * model's last step kernel's, which folds the state it leaves into them
+ * (GR_RAIN_RUNOFF_MAP_ARGS in rain_runoff.cl): the six arrays, the wetting
+ * depth and the debris factor. */
+gr_status gr_rain_runoff_map_args(gr_rain_runoff *s, cl_kernel k) {
+  const size_t m = sizeof(cl_mem);
+  cl_float wd = (cl_float)s->params.wetting_depth, df = (cl_float)s->params.debris_factor;
+  const gr_rain_runoff_arg args[] = {
+      {"max_depth", m, &s->map[0]},       {"max_speed", m, &s->map[1]},
+      {"arrival", m, &s->map[2]},         {"wet_time", m, &s->map[3]},
+      {"max_hazard", m, &s->map[4]},      {"wet_time_comp", m, &s->map[5]},
+      {"wetting_depth", sizeof(wd), &wd}, {"debris_factor", sizeof(df), &df},
+  };
+  return GR_RAIN_RUNOFF_ARGS(s, k, args);
+}
+
 /* Folds the state now into the flood maps (rain_runoff_maps): `time` is the
  * state's time (s), dt the step that led to it (0: count no time). */
 gr_status gr_rain_runoff_maps_update(gr_rain_runoff *s, double time, double dt) {
@@ -12,23 +28,13 @@ gr_status gr_rain_runoff_maps_update(gr_rain_runoff *s, double time, double dt) 
   gr_status st = GR_OK;
   if (!s->maps_bound) {
     cl_int nx = s->nxl, ny = s->nyl, sw = s->params.flow_model == GR_FLOW_SHALLOW_WATER;
-    cl_float wd = (cl_float)s->params.wetting_depth, df = (cl_float)s->params.debris_factor;
     const gr_rain_runoff_arg args[] = {
-        {"qu", m, &s->qu},
-        {"qv", m, &s->qv},
-        {"max_depth", m, &s->map[0]},
-        {"max_speed", m, &s->map[1]},
-        {"arrival", m, &s->map[2]},
-        {"wet_time", m, &s->map[3]},
-        {"max_hazard", m, &s->map[4]},
-        {"wet_time_comp", m, &s->map[5]},
-        {"nx", sizeof(nx), &nx},
-        {"ny", sizeof(ny), &ny},
-        {"sw", sizeof(sw), &sw},
-        {"wetting_depth", sizeof(wd), &wd},
-        {"debris_factor", sizeof(df), &df},
+        {"qu", m, &s->qu},       {"qv", m, &s->qv},       {"nx", sizeof(nx), &nx},
+        {"ny", sizeof(ny), &ny}, {"sw", sizeof(sw), &sw},
     };
-    st = GR_RAIN_RUNOFF_ARGS(s, s->maps, args);
+    st = gr_rain_runoff_map_args(s, s->maps);
+    if (st == GR_OK)
+      st = GR_RAIN_RUNOFF_ARGS(s, s->maps, args);
     s->maps_bound = st == GR_OK;
   }
   cl_float t = (cl_float)time, dtf = (cl_float)dt;

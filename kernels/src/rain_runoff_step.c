@@ -19,7 +19,6 @@ typedef struct gr_rain_runoff_binding {
   /* The optional inputs, or the one-float dummy where one is absent. */
   cl_mem rain, perm, src, n2map, nodata;
   cl_int use_src, use_n2, use_nodata;
-  cl_float theta, wd, df, t0;
 } gr_rain_runoff_binding;
 
 static void gr_rain_runoff_binding_init(const gr_rain_runoff *s, cl_float dt,
@@ -51,29 +50,84 @@ static void gr_rain_runoff_binding_init(const gr_rain_runoff *s, cl_float dt,
   v->n2map = v->use_n2 ? s->n2map : s->dummy;
   v->use_nodata = s->has_nodata;
   v->nodata = v->use_nodata ? s->nodata : s->dummy;
-  v->theta = (cl_float)GR_RAIN_RUNOFF_THETA;
-  v->wd = (cl_float)p->wetting_depth;
-  v->df = (cl_float)p->debris_factor;
-  v->t0 = 0.0f;
+}
+
+/* The arguments every step kernel of either model takes: the grid, the
+ * step, and the rain, infiltration, sources and no-data cells. */
+static gr_status gr_rain_runoff_bind_inputs(gr_rain_runoff *s, cl_kernel k,
+                                            const gr_rain_runoff_binding *v) {
+  const size_t m = sizeof(cl_mem);
+  const gr_rain_runoff_arg inputs[] = {
+      {"rain", m, &v->rain},
+      {"perm", m, &v->perm},
+      {"src", m, &v->src},
+      {"use_src", sizeof(v->use_src), &v->use_src},
+      {"nodata", m, &v->nodata},
+      {"use_nodata", sizeof(v->use_nodata), &v->use_nodata},
+      {"nx", sizeof(v->nx), &v->nx},
+      {"ny", sizeof(v->ny), &v->ny},
+      {"dt", sizeof(v->dt), &v->dt},
+      {"inv_dx", sizeof(v->inv_dx), &v->inv_dx},
+      {"inv_dy", sizeof(v->inv_dy), &v->inv_dy},
+      {"use_rain", sizeof(v->use_rain), &v->use_rain},
+      {"rain_uniform", sizeof(v->rain_uniform), &v->rain_uniform},
+      {"use_perm", sizeof(v->use_perm), &v->use_perm},
+      {"perm_uniform", sizeof(v->perm_uniform), &v->perm_uniform},
+  };
+  return GR_RAIN_RUNOFF_ARGS(s, k, inputs);
+}
+
+/* The friction's arguments (the bed, gravity, the roughness) of the
+ * kernels that compute faces. */
+static gr_status gr_rain_runoff_bind_friction(gr_rain_runoff *s, cl_kernel k,
+                                              const gr_rain_runoff_binding *v) {
+  const size_t m = sizeof(cl_mem);
+  const gr_rain_runoff_arg friction[] = {
+      {"b", m, &s->b},
+      {"g", sizeof(v->g), &v->g},
+      {"n2", sizeof(v->n2), &v->n2},
+      {"n2map", m, &v->n2map},
+      {"use_n2", sizeof(v->use_n2), &v->use_n2},
+  };
+  return GR_RAIN_RUNOFF_ARGS(s, k, friction);
+}
+
+/* The domain's edges' kinds and levels, for the kernels that apply them. */
+static gr_status gr_rain_runoff_bind_edges(gr_rain_runoff *s, cl_kernel k,
+                                           const gr_rain_runoff_binding *v) {
+  const gr_rain_runoff_arg edges[] = {
+      {"bnd_w", sizeof(cl_int), &v->bnd[0]},   {"bnd_e", sizeof(cl_int), &v->bnd[1]},
+      {"bnd_s", sizeof(cl_int), &v->bnd[2]},   {"bnd_n", sizeof(cl_int), &v->bnd[3]},
+      {"lvl_w", sizeof(cl_float), &v->lvl[0]}, {"lvl_e", sizeof(cl_float), &v->lvl[1]},
+      {"lvl_s", sizeof(cl_float), &v->lvl[2]}, {"lvl_n", sizeof(cl_float), &v->lvl[3]},
+  };
+  return GR_RAIN_RUNOFF_ARGS(s, k, edges);
+}
+
+/* The Kahan sums the kernels that change the depth book into: the depth's
+ * compensation, the infiltration, the outflow and the inflow. */
+static gr_status gr_rain_runoff_bind_books(gr_rain_runoff *s, cl_kernel k) {
+  const size_t m = sizeof(cl_mem);
+  const gr_rain_runoff_arg books[] = {
+      {"h_comp", m, &s->h_c},
+      {"infiltrated", m, &s->inf},
+      {"infiltrated_comp", m, &s->inf_c},
+      {"outflow", m, &s->out},
+      {"outflow_comp", m, &s->out_c},
+      {"inflow", m, &s->in},
+      {"inflow_comp", m, &s->in_c},
+  };
+  return GR_RAIN_RUNOFF_ARGS(s, k, books);
 }
 
 /* The flood maps' arguments of kernel k, the last kernel of a step, which
  * folds its state into them (map_time is set before every launch). */
-static gr_status gr_rain_runoff_bind_maps(gr_rain_runoff *s, cl_kernel k,
-                                          const gr_rain_runoff_binding *v) {
-  const size_t m = sizeof(cl_mem);
-  const gr_rain_runoff_arg maps[] = {
-      {"max_depth", m, &s->map[0]},
-      {"max_speed", m, &s->map[1]},
-      {"arrival", m, &s->map[2]},
-      {"wet_time", m, &s->map[3]},
-      {"max_hazard", m, &s->map[4]},
-      {"wet_time_comp", m, &s->map[5]},
-      {"wetting_depth", sizeof(v->wd), &v->wd},
-      {"debris_factor", sizeof(v->df), &v->df},
-      {"map_time", sizeof(v->t0), &v->t0},
-  };
-  return GR_RAIN_RUNOFF_ARGS(s, k, maps);
+static gr_status gr_rain_runoff_bind_maps(gr_rain_runoff *s, cl_kernel k) {
+  cl_float t0 = 0.0f;
+  gr_status st = gr_rain_runoff_map_args(s, k);
+  if (st == GR_OK)
+    st = gr_kernel_arg(s->ctx, k, "map_time", sizeof(t0), &t0);
+  return st;
 }
 
 /* The shallow-water kernels' arguments: the separate launches' and the
@@ -85,74 +139,35 @@ static gr_status gr_rain_runoff_bind_sw(gr_rain_runoff *s, const gr_rain_runoff_
    * separate launches (gr_rain_runoff_face_arrays). */
   cl_mem fx = s->fx ? s->fx : s->dummy, fy = s->fy ? s->fy : s->dummy;
   const gr_rain_runoff_arg sw[] = {
-      {"h", m, &s->h},
-      {"qu", m, &s->qu},
-      {"qv", m, &s->qv},
-      {"h1", m, &s->h1},
-      {"wh", m, &s->wh},
-      {"wu", m, &s->wu},
-      {"wv", m, &s->wv},
-      {"u1", m, &s->u1},
-      {"v1", m, &s->v1},
-      {"fx", m, &fx},
-      {"fy", m, &fy},
-      {"h_comp", m, &s->h_c},
-      {"dh1", m, &s->dh1},
-      {"qu1", m, &s->qu1},
-      {"qv1", m, &s->qv1},
-      {"b", m, &s->b},
-      {"rain", m, &v->rain},
-      {"perm", m, &v->perm},
-      {"src", m, &v->src},
-      {"use_src", sizeof(v->use_src), &v->use_src},
-      {"nodata", m, &v->nodata},
-      {"use_nodata", sizeof(v->use_nodata), &v->use_nodata},
-      {"infiltrated", m, &s->inf},
-      {"infiltrated_comp", m, &s->inf_c},
-      {"outflow", m, &s->out},
-      {"outflow_comp", m, &s->out_c},
-      {"nx", sizeof(v->nx), &v->nx},
-      {"ny", sizeof(v->ny), &v->ny},
-      {"dt", sizeof(v->dt), &v->dt},
-      {"inv_dx", sizeof(v->inv_dx), &v->inv_dx},
-      {"inv_dy", sizeof(v->inv_dy), &v->inv_dy},
-      {"g", sizeof(v->g), &v->g},
-      {"n2", sizeof(v->n2), &v->n2},
-      {"n2map", m, &v->n2map},
-      {"use_n2", sizeof(v->use_n2), &v->use_n2},
-      {"use_rain", sizeof(v->use_rain), &v->use_rain},
-      {"rain_uniform", sizeof(v->rain_uniform), &v->rain_uniform},
-      {"use_perm", sizeof(v->use_perm), &v->use_perm},
-      {"perm_uniform", sizeof(v->perm_uniform), &v->perm_uniform},
-      {"inflow", m, &s->in},
-      {"inflow_comp", m, &s->in_c},
-      {"bnd_w", sizeof(cl_int), &v->bnd[0]},
-      {"bnd_e", sizeof(cl_int), &v->bnd[1]},
-      {"bnd_s", sizeof(cl_int), &v->bnd[2]},
-      {"bnd_n", sizeof(cl_int), &v->bnd[3]},
-      {"lvl_w", sizeof(cl_float), &v->lvl[0]},
-      {"lvl_e", sizeof(cl_float), &v->lvl[1]},
-      {"lvl_s", sizeof(cl_float), &v->lvl[2]},
-      {"lvl_n", sizeof(cl_float), &v->lvl[3]},
+      {"h", m, &s->h},     {"qu", m, &s->qu},   {"qv", m, &s->qv}, {"h1", m, &s->h1},
+      {"wh", m, &s->wh},   {"wu", m, &s->wu},   {"wv", m, &s->wv}, {"u1", m, &s->u1},
+      {"v1", m, &s->v1},   {"fx", m, &fx},      {"fy", m, &fy},    {"dh1", m, &s->dh1},
+      {"qu1", m, &s->qu1}, {"qv1", m, &s->qv1},
   };
-  cl_kernel swk[6] = {s->sw_prep,     s->sw_faces[0],  s->sw_update[0],
-                      s->sw_faces[1], s->sw_update[1], s->sw_edges};
+  /* The separate launches, then the fused stages, which take the same
+   * arguments. */
+  cl_kernel swk[10] = {s->sw_prep,      s->sw_faces[0], s->sw_update[0], s->sw_faces[1],
+                       s->sw_update[1], s->sw_edges,    s->sw_stage[0],  s->sw_stage[1],
+                       s->sw_inner[0],  s->sw_inner[1]};
   gr_status st = GR_OK;
-  for (int k = 0; st == GR_OK && k < 6; ++k)
+  for (int k = 0; st == GR_OK && k < 10; ++k) {
     st = GR_RAIN_RUNOFF_ARGS(s, swk[k], sw);
-  for (int k = 0; st == GR_OK && k < 6; ++k)
-    st = gr_rain_runoff_bind_maps(s, swk[k], v);
-  /* The fused stages take the same arguments, the interior's tiles and
-   * their tile's local memory. */
-  cl_kernel fused[4] = {s->sw_stage[0], s->sw_stage[1], s->sw_inner[0], s->sw_inner[1]};
-  for (int k = 0; st == GR_OK && k < 4; ++k)
-    st = GR_RAIN_RUNOFF_ARGS(s, fused[k], sw);
-  for (int k = 0; st == GR_OK && k < 4; ++k)
-    st = gr_rain_runoff_bind_maps(s, fused[k], v);
-  for (int k = 0; st == GR_OK && k < 4; ++k)
-    st = gr_kernel_arg(s->ctx, fused[k], "tiles", sizeof(s->sw_tiles), s->sw_tiles);
-  for (int k = 0; st == GR_OK && k < 4; ++k)
-    st = gr_kernel_arg(s->ctx, fused[k], "tile", s->sw_tile_bytes, NULL);
+    if (st == GR_OK)
+      st = gr_rain_runoff_bind_inputs(s, swk[k], v);
+    if (st == GR_OK)
+      st = gr_rain_runoff_bind_friction(s, swk[k], v);
+    if (st == GR_OK)
+      st = gr_rain_runoff_bind_edges(s, swk[k], v);
+    if (st == GR_OK)
+      st = gr_rain_runoff_bind_books(s, swk[k]);
+    if (st == GR_OK)
+      st = gr_rain_runoff_bind_maps(s, swk[k]);
+  }
+  /* The fused stages' interior tiles and their tile's local memory. */
+  for (int k = 6; st == GR_OK && k < 10; ++k)
+    st = gr_kernel_arg(s->ctx, swk[k], "tiles", sizeof(s->sw_tiles), s->sw_tiles);
+  for (int k = 6; st == GR_OK && k < 10; ++k)
+    st = gr_kernel_arg(s->ctx, swk[k], "tile", s->sw_tile_bytes, NULL);
   return st;
 }
 
@@ -160,72 +175,36 @@ static gr_status gr_rain_runoff_bind_sw(gr_rain_runoff *s, const gr_rain_runoff_
  * step's. */
 static gr_status gr_rain_runoff_bind_li(gr_rain_runoff *s, const gr_rain_runoff_binding *v) {
   const size_t m = sizeof(cl_mem);
-  /* Arguments the three step kernels share (each takes those it has). */
-  const gr_rain_runoff_arg common[] = {
-      {"h", m, &s->h},
-      {"rain", m, &v->rain},
-      {"perm", m, &v->perm},
-      {"src", m, &v->src},
-      {"use_src", sizeof(v->use_src), &v->use_src},
-      {"nodata", m, &v->nodata},
-      {"use_nodata", sizeof(v->use_nodata), &v->use_nodata},
-      {"limit", m, &s->k},
-      {"nx", sizeof(v->nx), &v->nx},
-      {"ny", sizeof(v->ny), &v->ny},
-      {"dt", sizeof(v->dt), &v->dt},
-      {"inv_dx", sizeof(v->inv_dx), &v->inv_dx},
-      {"inv_dy", sizeof(v->inv_dy), &v->inv_dy},
-      {"use_rain", sizeof(v->use_rain), &v->use_rain},
-      {"rain_uniform", sizeof(v->rain_uniform), &v->rain_uniform},
-      {"use_perm", sizeof(v->use_perm), &v->use_perm},
-      {"perm_uniform", sizeof(v->perm_uniform), &v->perm_uniform},
-  };
-  const gr_rain_runoff_arg flux[] = {
-      {"b", m, &s->b},
-      {"g", sizeof(v->g), &v->g},
-      {"n2", sizeof(v->n2), &v->n2},
-      {"n2map", m, &v->n2map},
-      {"use_n2", sizeof(v->use_n2), &v->use_n2},
-  };
-  const gr_rain_runoff_arg edges[] = {
-      {"bnd_w", sizeof(cl_int), &v->bnd[0]},   {"bnd_e", sizeof(cl_int), &v->bnd[1]},
-      {"bnd_s", sizeof(cl_int), &v->bnd[2]},   {"bnd_n", sizeof(cl_int), &v->bnd[3]},
-      {"lvl_w", sizeof(cl_float), &v->lvl[0]}, {"lvl_e", sizeof(cl_float), &v->lvl[1]},
-      {"lvl_s", sizeof(cl_float), &v->lvl[2]}, {"lvl_n", sizeof(cl_float), &v->lvl[3]},
-  };
-  const gr_rain_runoff_arg update[] = {
-      {"h_comp", m, &s->h_c},
-      {"infiltrated", m, &s->inf},
-      {"infiltrated_comp", m, &s->inf_c},
-      {"outflow", m, &s->out},
-      {"outflow_comp", m, &s->out_c},
-      {"inflow", m, &s->in},
-      {"inflow_comp", m, &s->in_c},
-  };
+  /* The depth and limiter the three step kernels share (each takes those
+   * it has). */
+  const gr_rain_runoff_arg state[] = {{"h", m, &s->h}, {"limit", m, &s->k}};
   cl_kernel kernels[] = {s->flux, s->flux_edges, s->limit, s->update, s->li_step};
   gr_status st = GR_OK;
   for (int i = 0; st == GR_OK && i < 5; ++i)
-    st = GR_RAIN_RUNOFF_ARGS(s, kernels[i], common);
+    st = GR_RAIN_RUNOFF_ARGS(s, kernels[i], state);
+  for (int i = 0; st == GR_OK && i < 5; ++i)
+    st = gr_rain_runoff_bind_inputs(s, kernels[i], v);
   if (st == GR_OK)
-    st = GR_RAIN_RUNOFF_ARGS(s, s->flux, flux);
+    st = gr_rain_runoff_bind_friction(s, s->flux, v);
   if (st == GR_OK)
-    st = GR_RAIN_RUNOFF_ARGS(s, s->flux_edges, flux);
+    st = gr_rain_runoff_bind_friction(s, s->flux_edges, v);
   if (st == GR_OK)
-    st = GR_RAIN_RUNOFF_ARGS(s, s->li_step, flux);
+    st = gr_rain_runoff_bind_friction(s, s->li_step, v);
+  cl_float theta = (cl_float)GR_RAIN_RUNOFF_THETA;
   if (st == GR_OK)
-    st = gr_kernel_arg(s->ctx, s->flux, "theta", sizeof(v->theta), &v->theta);
+    st = gr_kernel_arg(s->ctx, s->flux, "theta", sizeof(theta), &theta);
   if (st == GR_OK)
-    st = gr_kernel_arg(s->ctx, s->li_step, "theta", sizeof(v->theta), &v->theta);
+    st = gr_kernel_arg(s->ctx, s->li_step, "theta", sizeof(theta), &theta);
   if (st == GR_OK)
-    st = GR_RAIN_RUNOFF_ARGS(s, s->flux_edges, edges);
+    st = gr_rain_runoff_bind_edges(s, s->flux_edges, v);
   if (st == GR_OK)
-    st = GR_RAIN_RUNOFF_ARGS(s, s->update, update);
+    st = gr_rain_runoff_bind_books(s, s->update);
   if (st == GR_OK)
-    st = gr_rain_runoff_bind_maps(s, s->update, v);
+    st = gr_rain_runoff_bind_maps(s, s->update);
   if (st == GR_OK)
-    st = GR_RAIN_RUNOFF_ARGS(s, s->li_step, update);
+    st = gr_rain_runoff_bind_books(s, s->li_step);
   if (st == GR_OK)
-    st = gr_rain_runoff_bind_maps(s, s->li_step, v);
+    st = gr_rain_runoff_bind_maps(s, s->li_step);
   /* The edges rain_runoff_flux_edges writes, which the fused step reads. */
   cl_int fixed = 0;
   for (int e = 0; e < 4; ++e)
