@@ -91,7 +91,6 @@ void test_gauges(void);
  * (gr_rain_runoff_set_sw_fused, gr_rain_runoff_set_fused; -1: the
  * default). */
 extern int piece_sw_fused, piece_fused;
-float *cut(const float *global, int gnx, int x0, int y0, int w, int h);
 void test_pieces_x(void);
 void test_pieces_y(void);
 void test_advance_pieces_x(void);

@@ -130,7 +130,7 @@ typedef struct piece {
 
 static void team_ledger(piece *pc, gr_rain_runoff_ledger *out);
 
-float *cut(const float *global, int gnx, int x0, int y0, int w, int h) {
+static float *cut(const float *global, int gnx, int x0, int y0, int w, int h) {
   float *out = malloc((size_t)w * (size_t)h * sizeof(float));
   for (int j = 0; j < h; ++j)
     memcpy(out + (size_t)j * w, global + (size_t)(y0 + j) * gnx + x0, (size_t)w * sizeof(float));

@@ -196,7 +196,7 @@ static gr_status gr_rain_runoff_film_rate(gr_rain_runoff *s, double *rate) {
   return st;
 }
 
-gr_status gr_rain_runoff_stable_dt_impl(gr_rain_runoff *s, double *dt) {
+static gr_status gr_rain_runoff_stable_dt_impl(gr_rain_runoff *s, double *dt) {
   if (s->params.flow_model == GR_FLOW_SHALLOW_WATER)
     return gr_rain_runoff_sw_stable_dt(s, dt);
   /* li_speed reads the no-data cells and the Manning map. */

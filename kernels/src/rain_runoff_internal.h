@@ -299,14 +299,12 @@ double gr_rain_runoff_rain_max(const gr_rain_runoff *s);
 double gr_rain_runoff_min_n(const gr_rain_runoff *s);
 
 /* rain_runoff_step.c */
-gr_status gr_rain_runoff_face_arrays(gr_rain_runoff *s);
 gr_status gr_rain_runoff_enqueue(gr_rain_runoff *s, double dt, int nsteps, gr_rain_runoff_watch *w,
                                  int *done_out, int *stop);
 
 /* rain_runoff_advance.c */
 gr_status gr_rain_runoff_watch_step(gr_rain_runoff *s, gr_rain_runoff_watch *w, double time,
                                     int *stop);
-gr_status gr_rain_runoff_stable_dt_impl(gr_rain_runoff *s, double *dt);
 
 /* rain_runoff_outputs.c */
 gr_status gr_rain_runoff_map_args(gr_rain_runoff *s, cl_kernel k);
@@ -318,6 +316,5 @@ gr_status gr_rain_runoff_piece(const gr_grid *g, gr_flow_model model, int ring[4
                                size_t len);
 gr_status gr_rain_runoff_allreduce(gr_rain_runoff *s, double *values, int n, gr_reduce_op op);
 gr_status gr_rain_runoff_exchange(gr_rain_runoff *s, long long step);
-size_t gr_rain_runoff_state_bytes(const gr_rain_runoff *s);
 
 #endif

@@ -208,7 +208,7 @@ static size_t gr_rain_runoff_yfaces(const gr_rain_runoff *s) {
   return (size_t)s->nxl * ((size_t)s->nyl + 1);
 }
 
-size_t gr_rain_runoff_state_bytes(const gr_rain_runoff *s) {
+static size_t gr_rain_runoff_state_bytes(const gr_rain_runoff *s) {
   return sizeof(gr_rain_runoff_state_header) +
          sizeof(float) * (GR_RAIN_RUNOFF_STATE_CELL_ARRAYS * gr_rain_runoff_cells(s) +
                           gr_rain_runoff_xfaces(s) + gr_rain_runoff_yfaces(s));

@@ -241,7 +241,7 @@ static gr_status gr_rain_runoff_bind(gr_rain_runoff *s, cl_float dt) {
  * path: the fused stages, the default on GPUs, keep their faces in local
  * memory, and the arrays would take 805 MB at 4096^2 (12.9 GB at 16384^2)
  * for nothing. Until then the kernels get the one-float dummy for them. */
-gr_status gr_rain_runoff_face_arrays(gr_rain_runoff *s) {
+static gr_status gr_rain_runoff_face_arrays(gr_rain_runoff *s) {
   if (s->fx)
     return GR_OK;
   size_t nx = (size_t)s->nxl, ny = (size_t)s->nyl;
