@@ -1,7 +1,8 @@
 /* Rain runoff core (seed 004's water simulation): host side of
  * rain_runoff.cl. The model, the step order and the book-keeping are
  * documented in graupel/rain_runoff.h; the kernels' data layout in
- * rain_runoff.cl; the constants both sides share in rain_runoff_shared.h;
+ * rain_runoff_li.cl and rain_runoff_sw.cl (the two flow models' parts of
+ * rain_runoff.cl); the constants both sides share in rain_runoff_shared.h;
  * the handle and the helpers the host files share in
  * rain_runoff_internal.h. This file: the parameter table and its checks,
  * the field checks, and the handle's life cycle (memory, create, destroy,
