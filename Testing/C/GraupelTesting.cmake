@@ -3,7 +3,7 @@
 # no-platform variants.
 #
 #   graupel_add_core_test(<core>
-#     SOURCE <file.c>          the program test_<core>; its main is gr_test_main
+#     SOURCE <file.c>...       the program test_<core>; its main is gr_test_main
 #     [LIBS <lib>...]          linked besides graupel_core and m
 #     [TIMEOUT <s>]            per subtest (default 120)
 #     [ARGS <arg>...]          put before the subtest name (and --list) in every run
@@ -36,12 +36,12 @@ set(GRAUPEL_DISCOVER_SCRIPT "${CMAKE_CURRENT_LIST_DIR}/GraupelDiscoverTests.cmak
 set(GRAUPEL_SUPPRESSIONS_DIR "${CMAKE_CURRENT_LIST_DIR}/../sanitizers")
 
 function(graupel_add_core_test core)
-  cmake_parse_arguments(PARSE_ARGV 1 arg "" "SOURCE;TIMEOUT" "LIBS;ARGS;MEMCHECK;SOAK;NO_PLATFORM")
+  cmake_parse_arguments(PARSE_ARGV 1 arg "" "TIMEOUT" "SOURCE;LIBS;ARGS;MEMCHECK;SOAK;NO_PLATFORM")
   if(arg_UNPARSED_ARGUMENTS)
     message(FATAL_ERROR "graupel_add_core_test(${core}): unknown arguments ${arg_UNPARSED_ARGUMENTS}")
   endif()
   if(NOT arg_SOURCE)
-    message(FATAL_ERROR "graupel_add_core_test(${core}): SOURCE <file.c> is required")
+    message(FATAL_ERROR "graupel_add_core_test(${core}): SOURCE <file.c>... is required")
   endif()
   if(NOT arg_TIMEOUT)
     set(arg_TIMEOUT 120)

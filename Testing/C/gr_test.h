@@ -11,8 +11,17 @@
 #include <string.h>
 #include <time.h>
 
+/* The counts of checks and failures. A test program of several files
+ * defines GR_TEST_SHARED_COUNTERS before including this header in each, and
+ * defines gr_test_failures and gr_test_checks (0) in the one with main, so
+ * that every file's CHECKs count in the one pair GR_TEST_RESULT reads. */
+#ifdef GR_TEST_SHARED_COUNTERS
+extern int gr_test_failures;
+extern int gr_test_checks;
+#else
 static int gr_test_failures = 0;
 static int gr_test_checks = 0;
+#endif
 
 #define CHECK(cond)                                                                                \
   do {                                                                                             \

@@ -1,6 +1,7 @@
 # Turns the OpenCL sources into one C file of byte arrays, inlining every
-# `#include "X.h"` of a header in kernels/cl (recursively, each header once per
-# program), so the library never looks for kernel files at run time.
+# `#include "X"` of a file in kernels/cl (a header, or a part of a large
+# program such as rain_runoff_sw.cl; recursively, each once per program), so
+# the library never looks for kernel files at run time.
 # Run as: cmake -DOUTPUT=... -DCL_DIR=.../kernels/cl -DSOURCES="a.cl|b.cl" -P EmbedKernels.cmake
 string(REPLACE "|" ";" SOURCES "${SOURCES}")
 
