@@ -673,7 +673,7 @@ int vtkGraupelSimulation::UpdateState(vtkInformation *request, vtkInformationVec
 #if GRAUPEL_VTK_ABORT_OUTPUT
   if (!this->Continuing &&
       this->PieceLayout->AnyRank(this->GetAbortExecute() != 0 || this->GetAbortOutput())) {
-    // Aborted before it began (see the class comment): an empty output, no
+    // Aborted before it began (see "Progress and abort" in Filters/README.md): an empty output, no
     // warning, nothing touched (on every rank of a split run at once).
     this->AbortExecute = 0;
     this->SetAbortOutput(true);
@@ -772,7 +772,7 @@ int vtkGraupelSimulation::UpdateState(vtkInformation *request, vtkInformationVec
       return 0;
     }
     if (result == ADVANCE_ABORTED) {
-      // Stopped between the knots: see the class comment. The set-up and the
+      // Stopped between the knots: see Filters/README.md. The set-up and the
       // checkpoints stay; the device state is no longer one to go on from.
       this->StateLost = true;
     } else {
@@ -795,7 +795,7 @@ int vtkGraupelSimulation::UpdateState(vtkInformation *request, vtkInformationVec
                                                     : "goes on from there."));
       this->Finish(request);
       // Consume the abort; the executive empties the output and marks it
-      // ABORTED, so the next request runs again (see the class comment).
+      // ABORTED, so the next request runs again (see Filters/README.md).
       this->AbortExecute = 0;
 #if GRAUPEL_VTK_ABORT_OUTPUT
       this->SetAbortOutput(true);

@@ -2,138 +2,23 @@
  * @class   vtkGraupelSimulation
  * @brief   Base of every Graupel filter that steps a simulation through time.
  *
- * A simulation filter is a time source: it advertises `TIME_STEPS` (0,
- * OutputInterval, 2 OutputInterval, ..., EndTime) and `TIME_RANGE` [0,
- * EndTime]. A requested time is snapped to the last output time at or
- * before it. The output may be any data type (an image for a grid core,
- * vtkPolyData for particles): the subclass declares it in
- * FillOutputPortInformation and fills it in FillOutput; the time logic here
- * never looks at it.
+ * A simulation filter is a time source (TIME_STEPS 0, OutputInterval, ...,
+ * EndTime) whose state stays on the device between updates: a later time
+ * advances it, an earlier one restores the nearest checkpoint kept on the
+ * host (or starts again from time 0), and a changed property or static
+ * input sets it up again. Temporal inputs (moving objects, rain frames) are
+ * read at the simulated time, one input time step per pipeline pass, held
+ * until the next; the result at a time never depends on the order in which
+ * times were asked. It also writes and reads checkpoint files
+ * (CheckpointFile, RestartFile), reports progress and honours an abort,
+ * reports errors once, and splits the grid into strips over MPI ranks.
  *
- * **The state.** It stays on the device between updates, at an absolute
- * time. A request for a later time advances it; a request for an earlier
- * time goes back to the nearest kept checkpoint at or before that time (see
- * below), or to time 0 when there is none; a changed property or a changed
- * static input sets the simulation up again.
- *
- * **Inputs in time.** Each input port has a policy (SetInputPortPolicy):
- * - STATIC: read once (a terrain). An input with times of its own (another
- *   simulation's output) is read at InputTime, by default its last time;
- *   one without at no time. A change of its data sets the simulation up
- *   again. The Input (port 0) is static unless its class declares it
- *   temporal or FollowInputTime is on.
- * - TEMPORAL: read at the simulated time while stepping (a moving object,
- *   rain that varies). Its data at input time step tau_i holds from tau_i
- *   until the next input time step (sample and hold; before the first step
- *   the first holds). A temporal input that advertises fewer than 2 time
- *   steps is static. A change upstream of it (its pipeline MTime) or of its
- *   time steps sets the simulation up again; a new time of it does not.
- *
- * The simulation gets its temporal inputs through ParaView's own idiom for
- * filters that consume many input times, CONTINUE_EXECUTING (as
- * vtkTemporalStatistics does): one input time per pipeline pass.
- * RequestUpdateExtent asks each temporal input for the time step the state
- * needs next; RequestData advances the state up to the next input time step
- * or output time, whichever comes first, then asks the executive for
- * another pass until the requested output time is reached. Chosen over a
- * cache of the input's time steps because (a) memory stays one input time
- * step per port whatever the number of steps (a mesh sequence or rain maps
- * of hundreds of steps would not fit a cache), (b) the upstream pipeline
- * runs as ParaView expects (its own caching, progress and MPI pieces
- * apply), and (c) no filter calls Update() on its input from inside
- * RequestData, which breaks in client-server pipelines. The cost is one
- * upstream execution per input time step passed, paid again when going back
- * in time beyond a checkpoint.
- *
- * Every AdvanceState(t0, t1) call covers one piece between consecutive
- * "knots": output times and the temporal inputs' time steps. The knots
- * depend on properties and inputs only, so the calls made to reach a time
- * are the same whatever the order in which times were requested, and a
- * deterministic core gives the same bits (Testing/Cxx and
- * Testing/Python/test_rain_runoff.py check it).
- *
- * **Checkpoints.** Every CheckpointInterval (K, default 10) outputs, the
- * state is saved on the host through SaveState into a ring bounded by
- * CheckpointMemoryLimit (MiB, default 1024, never more than a quarter of the
- * host's physical memory): when a new snapshot would exceed it, the oldest
- * ones are dropped; a snapshot larger than the limit is not kept. Going
- * back restores the nearest snapshot at or before the requested time with
- * LoadState, so it re-steps at most K output intervals; going forward past
- * a snapshot that is ahead of the state uses it too. K = 10 keeps a
- * 60-output run (600 s at 10 s) to six snapshots and a replay to at most ten
- * intervals; a Rain Runoff snapshot is about 60 bytes per grid point (15 arrays with the flood
- * maps), so a 1024 x 1024 grid keeps 17 of them under 1 GiB. Snapshots are dropped when the
- * simulation is set up again. RestartCount counts set-ups and returns to time 0; RestoreCount
- * counts snapshot loads.
- *
- * **Checkpoint files.** With CheckpointFile set (a path ending in .json),
- * every update also writes the state it outputs: each rank writes
- * `<stem>.<output index>.<rank>.vti` beside the manifest, its output (the requested piece,
- * every array, viewable as it is) with the core's state as SaveState gives
- * it, byte for byte, in the field array `graupel_state` (an unsigned char
- * array; the .vti is written raw and zlib-compressed, which is lossless);
- * then rank 0 writes the manifest `<stem>.json`: the format, the
- * simulation's label, the output index, time and interval, the grid, the
- * number of ranks and whether they split the grid, and per rank its own
- * rows, its file and its state's bytes (plus `steps` where the output has
- * it). Each file is written under a temporary name, flushed and renamed,
- * the manifest last, and the pieces of earlier outputs are removed only
- * once it is in place: a kill at any moment leaves the previous checkpoint
- * or the new one whole. RestartFile names such a manifest: after the set-up each rank checks
- * it against this run (simulation, grid, ranks, its own rows, the output
- * time), reads its piece and loads the state (LoadState), so the run goes on
- * from that output time; the loaded state is also kept as a checkpoint, so
- * later times come from it and earlier ones from time 0. Every rank takes
- * the same decision (a piece that fails on one rank fails them all).
- *
- * **Progress and abort.** Progress text names what happens ("Rain Runoff:
- * t = 420 s of 1800 s", the second time being the requested one) and is
- * updated after every AdvanceState and, through CoreProgress, from inside a
- * core's long advance. An abort is honoured between AdvanceState calls and,
- * where the core supports it, inside one (CoreProgress returns nonzero when
- * GetAbortExecute()). An aborted update uses VTK's aborted-output protocol
- * rather than Modified(): RequestData consumes AbortExecute and sets
- * AbortOutput, so the executive empties the output, stamps it with the
- * requested time and marks the port ABORTED, and the next request executes
- * again although no parameter changed. An update that starts with
- * AbortExecute (or AbortOutput, from an aborted input) already set returns
- * that empty output at once. ParaView's Render asks for the data more than
- * once; in ParaView 5.11's GUI the plugin's pqGraupelAbortStarter sets
- * AbortExecute again whenever the aborted filter starts executing until
- * that Render ends, so the Render returns at once and the next one (a new
- * time, Apply) runs the simulation. An abort is execution state, not a
- * parameter: setting AbortExecute does not modify the filter, and setting
- * AbortOutput (whose vtkAlgorithm setter does) keeps the state. On VTK
- * without that protocol (9.1) the filter calls Modified() instead. After an
- * abort between calls the state is kept and the
- * next update goes on from it. After an abort inside a call the core stopped
- * at a step that is not a knot: going on from there would take other steps
- * than an uninterrupted run, so that state is dropped and the next update
- * restores the nearest checkpoint (or restarts), and results stay
- * bit-identical.
- *
- * **Errors** are reported once (see vtkGraupelAlgorithm): a failed set-up or
- * step gives one sentence and an empty output, and the same request is not
- * tried again (nor its sentence repeated) until a property or input changes.
- *
- * **Distributed runs.** A simulation whose core follows the piece/halo
- * contract declares its ring (SetPieceRing, the core's ghost width); in an
- * MPI run whose request is one piece per rank (pvbatch, pvserver) each rank
- * then simulates only its strip along y with that ring (graupel::Pieces,
- * Filters/GraupelPieces.h): SetUpState builds the core on GetPieces()'s
- * grid (PieceGrid) and local arrays (LocalField) and, when IsSplit(), binds
- * the core's halo calls (BindHalo) and sets Pieces::Exchange and
- * Pieces::Allreduce on the core, and FillImage outputs the requested extent, taking
- * the row a strip shares with the next from that rank. Field data
- * `piece_cells` gives the grid points the rank simulated, ring included.
- * Aborts between knots are agreed by every rank (the cores agree inside a
- * call), so no rank waits alone in a collective call; a failure on one rank
- * (a device error) leaves the others waiting in their next collective call,
- * as MPI programs do. A simulation without a ring (SetPieceRing(0), the
- * default), a request that is not one piece per rank, or strips narrower
- * than the ring: every rank simulates the whole domain and outputs the
- * requested piece, so pieces equal the whole. Subclasses implement the
- * hooks below; they translate, they do not compute.
+ * A subclass implements the hooks below (SetUpState, ResetState,
+ * AdvanceState, FillOutput, SaveState, LoadState): they translate between
+ * VTK data and a core, they do not compute. The rules each part follows
+ * (the knots an advance stops at, the checkpoint ring and files, the abort
+ * protocol, the piece contract) are in Filters/README.md; what a user sees
+ * is in docs/Simulations.md.
  */
 #ifndef vtkGraupelSimulation_h
 #define vtkGraupelSimulation_h
@@ -162,7 +47,7 @@ public:
   /** The most output times a simulation advertises. */
   static constexpr int MaximumOutputSteps = 100000;
 
-  /** Input port policies (see the class comment). */
+  /** Input port policies (see "Inputs in time" in Filters/README.md). */
   enum InputPolicy { STATIC_INPUT = 0, TEMPORAL_INPUT = 1 };
 
   ///@{
@@ -232,7 +117,7 @@ public:
 
   ///@{
   /**
-   * A checkpoint on disk (see "Checkpoint files" in the class comment): while
+   * A checkpoint on disk (see "Checkpoint files" in Filters/README.md): while
    * set, every update writes the state it outputs to this manifest (JSON)
    * and one .vti per rank beside it, replacing what was there. Setting it
    * does not set the simulation up again. Empty (the default): nothing is
@@ -452,7 +337,7 @@ protected:
 
 #if GRAUPEL_VTK_ABORT_OUTPUT
 public:
-  /** Without Modified(): see "Progress and abort" in the class comment. */
+  /** Without Modified(): see "Progress and abort" in Filters/README.md. */
   void SetAbortExecute(vtkTypeBool abort) override;
   /** Keeps the state: the executive resets it before every execution. */
   void SetAbortOutput(bool abort) override;

@@ -1,7 +1,7 @@
 // vtkGraupelSimulation's checkpoint and restart files (CheckpointFile,
 // RestartFile): a JSON manifest beside one XML piece per rank holding the
-// output and the core's state bytes. See "Checkpoint files" in the class
-// comment for the format and the rules a restart checks.
+// output and the core's state bytes. "Checkpoint files" in Filters/README.md
+// gives the format and the rules a restart checks.
 //
 // Written so that a kill at any moment leaves a restart that is whole: each
 // checkpoint's pieces have names of their own (the output index in them),

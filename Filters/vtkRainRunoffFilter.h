@@ -3,86 +3,23 @@
  * @brief   Rain on a terrain: rain gain, infiltration, runoff and pooling
  *          (seed 004's water simulation), stepped on OpenCL.
  *
- * Input 0 (`Input`) is the terrain: a 2-D vtkImageData with the point array
- * `elevation` (m; an input without it is refused: active scalars are not
- * guessed at). Optional point arrays on it: `water_depth` (m, the water present at
- * time 0) or `water_surface` (m: the depth is max(0, surface - elevation)),
- * `velocity` (m/s, 3 components, z ignored: the water's velocity at time 0;
- * the local inertial model starts from rest and leaves it out) and
- * `rain_rate` (m/s, replaces RainRate cell by cell). With both water_depth
- * and water_surface (a Rain Runoff output as the input) water_depth is
- * taken.
- * Input 1 (`PermeabilityMap`, optional) is an image with the same dimensions
- * whose point array `permeability` (m/s) replaces Permeability.
+ * Input 0 is the terrain (a 2-D image with the point array `elevation`, m,
+ * and optionally the water, its velocity and a `rain_rate` map at time 0),
+ * input 1 an optional PermeabilityMap (`permeability`, `manning_n`), input 2
+ * optional Gauges (points), input 3 optional Inflows (points with a
+ * `discharge`, static or temporal). Output 0 is the terrain's grid with the
+ * water (`water_depth`, `water_surface`, `velocity`, `discharge`,
+ * `infiltrated`), the flood maps and the ledger as field data; output 1 the
+ * Hydrograph, a table with a row per output time (rank 0's in an MPI run).
+ * The page docs/RainRunoff.md gives every array, property and unit; the
+ * model, its departures from the seed and its conservation are the core's
+ * header, kernels/include/graupel/rain_runoff.h.
  *
- * The output has the terrain's geometry and the point arrays `water_depth`
- * (m, active scalars), `water_surface` (m), `velocity` (m/s, 3 components),
- * `discharge` (m^2/s), `infiltrated` (m, cumulative) and `elevation`, and
- * the field data `time`, `steps`, `initial_volume`, `rain_volume`,
- * `infiltrated_volume`, `outflow_volume`, `stored_volume`, `balance_error`
- * (m^3, double) and `max_depth` (m). The model, its deviation from the seed
- * and its conservation are described in kernels/include/graupel/rain_runoff.h.
- *
- * Flood maps (point arrays of output 0, cumulative since time 0, the core's
- * gr_rain_runoff_get_map, documented in rain_runoff.h): `max_depth` (m),
- * `max_speed` (m/s), `arrival_time` (s, NaN where the depth never exceeded
- * WettingDepth), `wet_duration` (s), `hazard_rating` (the largest UK
- * Defra/EA FD2321 rating h (v + 0.5) + DF, DF = DebrisFactor where h > 0.25
- * m) and `hazard_class` (0 low, 1 moderate, 2 significant, 3 extreme).
- * They live in the core's checkpointed state, so they are the same
- * whatever the order in which times are requested.
- *
- * Output 1 (`Hydrograph`) is a vtkTable with one row per output time up to
- * the requested one: `time` (s), `rain_volume_rate`, `inflow_rate`,
- * `infiltration_rate` and `outflow_rate` (m^3/s over the domain: row k's is
- * the mean over the output interval that ends at its time, the ledger's
- * volume difference over the interval, so rate times interval sums to the
- * ledger's volume exactly; row 0's rates are NaN: no interval ends there),
- * `stored_volume`,
- * `outflow_volume` and `balance_error` (m^3, the ledger at that time).
- * inflow_rate is what enters through the edges (level boundaries). Every row is the ledger
- * recorded when the state passed that output time; a checkpoint restored
- * or a restart re-records the same values (the steps are the same), so the
- * table does not depend on the order of requests either.
- *
- * Input 2 (`Gauges`, optional) is a point set: each point is snapped to the
- * nearest terrain point (a point beyond the terrain is refused with a
- * sentence), and the hydrograph gets three columns per gauge k,
- * `gauge<k>_depth` (m), `gauge<k>_surface` (m) and `gauge<k>_discharge`
- * (m^2/s, |q|), the output fields' values there at each output time (read
- * with gr_rain_runoff_sample: a few floats per output, whatever the grid).
- * Gauges are a static input: moving them sets the simulation up again.
- *
- * Inflows: Input 3 (`Inflows`, optional) is a point set with the point
- * array `discharge` (m^3/s, 0 to 1e6; a temporal input's time steps each
- * hold until the next, read while stepping): each point is snapped to the nearest terrain point and
- * lets that much water in there (a river, a culvert; points on one terrain point add up); a point
- * off the terrain or a bad discharge is refused with a sentence. And per edge an inflow hydrograph
- * (InflowWest ... InflowNorth): rows of time (s) and discharge (m^3/s), times strictly increasing,
- * linear in between, held before the first and after the last row, spread evenly along the edge.
- * Both count as the ledger's inflow_volume.
- *
- * MPI (pvbatch, pvserver): each rank simulates its strip of the grid with
- * the core's ring (GR_RAIN_RUNOFF_GHOST rows for the local inertial model,
- * GR_RAIN_RUNOFF_GHOST_SW for shallow water; see vtkGraupelSimulation,
- * "Distributed runs"): every input array goes up as the strip's rows and
- * ring, point inflows and gauges keep the whole grid's points (a gauge is
- * read by the rank that owns its row and shared with the others), the core
- * reduces the stable step and the ledger over the ranks, so every rank's
- * field data and hydrograph are the whole grid's, bit for bit, and the flood
- * maps come per piece like the fields. Field data `piece_cells` gives the
- * grid points the rank simulated, ring included.
- *
- * Time is handled by vtkGraupelSimulation: request a time with
- * UpdateTimeStep(t) (ParaView's animation does it). Checkpoints are the
- * core's gr_rain_runoff_state_save/load; an abort is honoured inside an
- * output interval through the core's progress callback.
- *
- * The setters clamp to the core's parameter table
- * (gr_rain_runoff_param_bounds, in the user's units): a value beyond a
- * range becomes its end; a value that is not a number, or at the open end
- * of a range such as CourantNumber's 0, is refused at the next update with a
- * sentence in the user's unit.
+ * Time, checkpoints, temporal inputs, aborts and MPI pieces are
+ * vtkGraupelSimulation's (request a time with UpdateTimeStep). The setters
+ * clamp to the core's parameter table (gr_rain_runoff_param_bounds, in the
+ * user's units); a value that is not a number, or at the open end of a
+ * range, is refused at the next update with one sentence.
  */
 #ifndef vtkRainRunoffFilter_h
 #define vtkRainRunoffFilter_h

@@ -3,77 +3,21 @@
  * @brief   Snowfall from a direction onto terrain and objects (seed 002:
  *          occlusion-based accumulation), stepped on OpenCL.
  *
- * Input 0 (`Input`) is the terrain: a 2-D vtkImageData with the point array
- * `elevation` (m) and, optionally, `snow_depth` (m), the snow at time 0.
+ * Input 0 is the terrain (a 2-D image with `elevation`, m, and optionally
+ * the `snow_depth` at time 0); input 1 optional Objects (triangle meshes or
+ * a multiblock of them, open surfaces such as a roof included, standing
+ * still, moving with ObjectVelocity or along a Path, or following their own
+ * time steps); input 2 an optional Path. Output 0 is the terrain's grid with
+ * the snow (`snow_depth`, `snow_surface`, `exposure`, ...) and the ledger;
+ * output 1 the objects at their pose with the snow kept on their faces.
+ * Snow Deformation chains onto output 0. The page docs/SnowAccumulation.md
+ * gives every array, property and unit; the model and its departures from
+ * the seed are the core's header, kernels/include/graupel/snow_accumulation.h.
  *
- * Input 1 (`Objects`, optional) is triangle meshes (vtkPolyData, whose
- * polygons and strips are split into triangles here; open surfaces such as
- * a roof are fine) or a multiblock of them, one object per non-empty leaf.
- * They shadow the terrain and each other and keep their own snow on their
- * faces (each triangle exposed, growing and shedding with its own normal),
- * shown as one depth per point of the polydata (so the output's point
- * arrays match the input's points): the mean of the point's faces weighted
- * by the area each turns to the sky. Polygons wound counter-clockwise seen from outside (VTK's
- * sources are) receive snow on their outer side. Each object is handed to
- * the core in its own frame, about the centre of its bounds, with a pose
- * that puts it in the world.
- * - Objects that do not advertise time steps stand still, or move by the
- *   properties (vtkGraupelMotion): the centre moves at ObjectVelocity (m/s)
- *   and the object turns at ObjectAngularVelocity (deg/s) about
- *   RotationAxis through its centre; with a Path (input 2, a polyline) the
- *   centre follows the path at the speed |ObjectVelocity|, the object's +x
- *   turned along the path's tangent. A leaf's field data `velocity` (3
- *   values, m/s) replaces ObjectVelocity for that object. Their snow moves
- *   with them.
- * - Objects that advertise time steps are read at each (sample and hold,
- *   see vtkGraupelSimulation): their geometry is the pose. An object keeps
- *   its snow from one time step to the next while it keeps its number of
- *   points.
- *
- * Time: every interval between the simulation's knots (output times, the
- * objects' time steps) is stepped in TimeStep-sized steps, the last one
- * shortened to end on the knot; each step takes the objects at their pose at
- * the step's end. A request without a time (a consumer that reads this
- * output once, such as Snow Deformation's Input) gets the last output,
- * EndTime: the snow that has fallen, not the bare ground of time 0.
- *
- * Output 0 has the terrain's geometry and the point arrays `snow_depth` (m,
- * active scalars), `snow_surface` (m), `snow_density` (kg/m^3: SnowDensity),
- * `exposure` (0 or 1, the last step's) and `elevation`, the arrays Snow
- * Deformation reads; field data `time` (s), `steps`, `initial_volume`,
- * `snowfall_volume`, `stored_volume`, `stored_volume_terrain`,
- * `stored_volume_objects`, `shed_volume`, `dropped_volume` (m^3) and
- * `balance_error` (m^3: initial + snowfall - shed - dropped - stored).
- * Output 1 is the objects at their pose at the output time (vtkPolyData, or
- * a multiblock of the same structure as the input) with the point arrays
- * `snow_depth` (m, along the faces' normals) and `snow_offset` (3
- * components, m: the faces' mean world normal times the depth, for Warp By
- * Vector).
- * Output 2, Textures, is a multiblock with one vtkImageData per object:
- * for an object whose polydata has texture coordinates (its point data's
- * TCoords), its accumulation texture (the thesis' per-object texture:
- * AccumulationTextureSize x AccumulationTextureSize texels spanning UV
- * [0, 1]^2, origin and spacing in UV units, point array `snow_depth` in m,
- * 0 on texels no triangle covers); an empty image for the others, or for
- * all with AccumulationTextureSize 0. See
- * gr_snow_accumulation_set_object_texture: the texels are samples on the
- * surface stepped like the faces, a finer picture of the same snow
- * kept out of the ledger.
- *
- * Time defaults (SetTimeDefaults): EndTime 6 h (21600 s), OutputInterval
- * 15 min (900 s), in TimeSteps of 5 min: a snowfall of a few hours.
- *
- * MPI (pvbatch, pvserver): each rank simulates its strip of the grid with
- * the core's ring of BlurRadius + 2 rows (gr_snow_accumulation_ghost; see
- * vtkGraupelSimulation, "Distributed runs"); every rank keeps every object,
- * the core combines the ranks' exposure views and ledger rows over the
- * ranks, and every rank's snow, objects and ledger are the whole grid's,
- * bit for bit. Field data `piece_cells` gives the grid points the rank
- * simulated, ring included; outputs 1 and 2 come on piece 0 only.
- *
- * The model is described in kernels/include/graupel/snow_accumulation.h;
- * the setters clamp to its parameter table
- * (gr_snow_accumulation_param_bounds).
+ * Time, checkpoints, temporal objects, aborts and MPI pieces are
+ * vtkGraupelSimulation's and vtkGraupelObjectsSimulation's. The setters clamp
+ * to the core's parameter table; values it refuses give one sentence at the
+ * next update.
  */
 #ifndef vtkSnowAccumulationFilter_h
 #define vtkSnowAccumulationFilter_h

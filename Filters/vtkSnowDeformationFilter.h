@@ -3,69 +3,22 @@
  * @brief   Objects pressing into and ploughing through snow (seed 000's
  *          thesis), stepped on OpenCL.
  *
- * Input 0 (`Input`) is the terrain: a 2-D vtkImageData with the point array
- * `elevation` (m). Optional point arrays on it give the snow at time 0:
- * `snow_depth` (m) and `snow_density` (kg/m^3), so Snow Accumulation's output
- * chains in; without them InitialSnowDepth and InitialDensity apply.
+ * Input 0 is the terrain (a 2-D image with `elevation`, m, and optionally
+ * `snow_depth` and `snow_density` at time 0, so Snow Accumulation's output
+ * chains in; else InitialSnowDepth and InitialDensity); input 1 the Objects
+ * (closed triangle meshes or a multiblock of them, moving with
+ * ObjectVelocity, along a Path, or by their own time steps); input 2 an
+ * optional Path. Output 0 is the terrain's grid with the snow (`snow_depth`,
+ * `snow_density`, `snow_surface`, ...) and the mass ledger; output 1 the
+ * objects at their pose with the force on each. The page
+ * docs/SnowDeformation.md gives every array, property and unit; the model
+ * and its departures from the seed are the core's header,
+ * kernels/include/graupel/snow_deformation.h.
  *
- * Input 1 (`Objects`, optional) is a closed triangle mesh (vtkPolyData; its
- * polygons and strips are split into triangles here) or a multiblock of them,
- * one object per leaf. Each object is handed to the core in its own frame:
- * its vertices about the centre of its bounds, with a pose that puts it in
- * the world (float vertices stay exact far from the origin).
- * - Objects that do not advertise time steps move by the properties
- *   (vtkGraupelMotion): the centre moves at ObjectVelocity (m/s) and the
- *   object turns at ObjectAngularVelocity (deg/s) about RotationAxis
- *   through its centre; with a Path (input 2, a polyline) the centre follows
- *   the path at the speed |ObjectVelocity|, the object's +x turned along the
- *   path's tangent. A leaf's field data `velocity` (3 values, m/s) replaces
- *   ObjectVelocity for that object.
- * - Objects that advertise time steps are read at each (sample and hold,
- *   see vtkGraupelSimulation): their geometry is the pose, and their
- *   velocity (for the direction of the displaced snow and the resistance) is
- *   the leaf's field data `velocity`, else ObjectVelocity.
- *
- * Time: every interval between the simulation's knots (output times, the
- * objects' time steps) is stepped in TimeStep-sized steps, the last one
- * shortened to end on the knot; each step takes the objects at their pose at
- * the step's end. The knots depend on properties and inputs only, so a
- * result does not depend on the order in which times are requested.
- *
- * Output 0 has the terrain's geometry and the point arrays `snow_depth` (m,
- * active scalars), `snow_surface` (m), `snow_density` (kg/m^3), `overlap`
- * (m, last step), `contact` (1 under an object in the last step) and
- * `elevation`; field data `time` (s), `steps`, `snow_volume` (m^3),
- * `snow_mass` (kg), `compressed_volume` and `displaced_volume` (m^3,
- * cumulative), `balance_error` (kg: mass now minus mass at the start),
- * `volume_error` (m^3) and `relax_iterations`. Output 1 is the objects at
- * their pose at the output time (vtkPolyData, or a multiblock of the same
- * structure as the input), each with field data `force` (3 components, N:
- * the snow's resistance, the mean over the output interval that ends at
- * the output: the impulse of its steps over its time, which does not alias
- * with the step as one step's force does), `peak_force` (N, the largest
- * step force's magnitude in that interval) and `contact_area` (m^2); a
- * multiblock's own field data holds the sums (the largest peak).
- *
- * The snow type: DensityRange (rho min, rho max) and InitialDensity, or a
- * DensityPreset (the thesis' Table 3.1 snow types, and sand), which then
- * sets both: the range it names and an initial density at its loose end.
- *
- * An object that never comes over the grid (its bounds more than a grid
- * spacing beyond the terrain's at every step up to EndTime) is refused: it
- * is a misplaced object, not an idle one. Objects with time steps are taken
- * as they come.
- *
- * Time defaults (SetTimeDefaults): EndTime 10 s, OutputInterval 0.25 s,
- * the scale of a wheel crossing a few metres of snow in steps of 1/60 s.
- *
- * MPI (pvbatch, pvserver): each rank simulates its strip of the grid with
- * the core's ring of GR_SNOW_DEFORMATION_GHOST rows (see vtkGraupelSimulation,
- * "Distributed runs"); every rank takes every object, the core sums what
- * steers a step over the ranks, and every rank's ledger and forces are the
- * whole grid's, bit for bit. Field data `piece_cells` gives the grid points
- * the rank simulated, ring included.
- * The model is described in kernels/include/graupel/snow_deformation.h; the
- * setters clamp to its parameter table (gr_snow_deformation_param_bounds).
+ * Time, checkpoints, temporal objects, aborts and MPI pieces are
+ * vtkGraupelSimulation's and vtkGraupelObjectsSimulation's. The setters clamp
+ * to the core's parameter table; values it refuses give one sentence at the
+ * next update.
  */
 #ifndef vtkSnowDeformationFilter_h
 #define vtkSnowDeformationFilter_h
