@@ -200,54 +200,45 @@ int vtkRainRunoffFilter::FillInputPortInformation(int port, vtkInformation *info
   return 1;
 }
 
-int vtkRainRunoffFilter::SetUpState(vtkInformationVector **inputVector) {
-  vtkImageData *terrain = vtkImageData::GetData(inputVector[0]);
-  vtkImageData *map = inputVector[1]->GetNumberOfInformationObjects()
-                          ? vtkImageData::GetData(inputVector[1])
-                          : nullptr;
-  if (!this->CheckTerrain(terrain)) {
-    return 0;
-  }
+// What SetUpState hands the core: the input fields, each with where it
+// came from (for the sentences), and the Manning map.
+struct vtkRainRunoffFilter::Upload {
+  gr_field field;
+  vtkSmartPointer<vtkFloatArray> values;
+  const char *where;
+};
+struct vtkRainRunoffFilter::Inputs {
+  std::vector<Upload> uploads;
+  vtkDataArray *manning = nullptr;
+  const char *manningWhere = "Input";
+};
+
+int vtkRainRunoffFilter::CollectInputs(vtkImageData *terrain, vtkImageData *map,
+                                       vtkDataArray *elevationArray, Inputs &in) {
   int dims[3];
   terrain->GetDimensions(dims);
-  double spacing[3];
-  terrain->GetSpacing(spacing);
   vtkPointData *pd = terrain->GetPointData();
-  vtkDataArray *elevationArray = this->GetElevation(terrain, "Input");
-  if (!elevationArray || !this->CheckParameters()) {
-    return 0;
-  }
-  if (!this->CheckStateMemory(terrain, map, inputVector)) {
-    return 0;
-  }
-
-  struct Upload {
-    gr_field field;
-    vtkSmartPointer<vtkFloatArray> values;
-    const char *where;
-  };
-  std::vector<Upload> uploads;
-  uploads.push_back({GR_FIELD_ELEVATION, AsFloat(elevationArray), "Input"});
+  in.uploads.push_back({GR_FIELD_ELEVATION, AsFloat(elevationArray), "Input"});
   // The water: its depth, or its surface (a Rain Runoff output has both:
   // the depth is the one then).
   if (vtkDataArray *depth = pd->GetArray("water_depth")) {
-    uploads.push_back({GR_FIELD_WATER_DEPTH, AsFloat(depth), "Input"});
+    in.uploads.push_back({GR_FIELD_WATER_DEPTH, AsFloat(depth), "Input"});
   } else if (vtkDataArray *surface = pd->GetArray("water_surface")) {
-    uploads.push_back({GR_FIELD_WATER_SURFACE, AsFloat(surface), "Input"});
+    in.uploads.push_back({GR_FIELD_WATER_SURFACE, AsFloat(surface), "Input"});
   }
   // After the water, whose velocity it is; the local inertial model starts
   // from rest.
   vtkDataArray *velocity = pd->GetArray("velocity");
   if (velocity && this->FlowModel == SHALLOW_WATER) {
-    uploads.push_back({GR_FIELD_VELOCITY, AsFloat(velocity), "Input"});
+    in.uploads.push_back({GR_FIELD_VELOCITY, AsFloat(velocity), "Input"});
   }
   this->RainFollowed = pd->GetArray("rain_rate") != nullptr;
   if (vtkDataArray *rain = pd->GetArray("rain_rate")) {
-    uploads.push_back({GR_FIELD_RAIN_RATE, AsFloat(rain), "Input"});
+    in.uploads.push_back({GR_FIELD_RAIN_RATE, AsFloat(rain), "Input"});
   }
   // The Manning map: the terrain's manning_n, or the PermeabilityMap's.
-  vtkDataArray *manning = pd->GetArray("manning_n");
-  const char *manningWhere = "Input";
+  in.manning = pd->GetArray("manning_n");
+  in.manningWhere = "Input";
   if (map) {
     int mdims[3];
     map->GetDimensions(mdims);
@@ -260,8 +251,8 @@ int vtkRainRunoffFilter::SetUpState(vtkInformationVector **inputVector) {
       return 0;
     }
     if (mn) {
-      manning = mn;
-      manningWhere = "PermeabilityMap";
+      in.manning = mn;
+      in.manningWhere = "PermeabilityMap";
     }
     if (mdims[0] != dims[0] || mdims[1] != dims[1] || mdims[2] != dims[2]) {
       vtkErrorMacro("Rain Runoff's PermeabilityMap has "
@@ -271,12 +262,12 @@ int vtkRainRunoffFilter::SetUpState(vtkInformationVector **inputVector) {
       return 0;
     }
     if (k) {
-      uploads.push_back({GR_FIELD_PERMEABILITY, AsFloat(k), "PermeabilityMap"});
+      in.uploads.push_back({GR_FIELD_PERMEABILITY, AsFloat(k), "PermeabilityMap"});
     }
   }
   const size_t npoints = static_cast<size_t>(dims[0]) * static_cast<size_t>(dims[1]);
   char msg[512];
-  for (const Upload &u : uploads) {
+  for (const Upload &u : in.uploads) {
     const int comps = gr_field_components(u.field);
     if (u.values->GetNumberOfComponents() != comps ||
         static_cast<size_t>(u.values->GetNumberOfTuples()) != npoints) {
@@ -292,35 +283,45 @@ int vtkRainRunoffFilter::SetUpState(vtkInformationVector **inputVector) {
     }
   }
 
-  gr_rain_runoff_params p;
-  gr_rain_runoff_params_init(&p);
+  return 1;
+}
+
+int vtkRainRunoffFilter::CoreParams(gr_rain_runoff_params *p) {
+  gr_rain_runoff_params_init(p);
   // The user's units (mm/h) to the core's (m/s): each row's to_core.
-  p.rain_rate = this->RainRate * Bound("RainRate")->to_core;
-  p.permeability = this->Permeability * Bound("Permeability")->to_core;
-  p.manning_n = this->ManningN;
-  p.cfl = this->CourantNumber;
-  p.max_dt = this->MaxTimeStep;
+  p->rain_rate = this->RainRate * Bound("RainRate")->to_core;
+  p->permeability = this->Permeability * Bound("Permeability")->to_core;
+  p->manning_n = this->ManningN;
+  p->cfl = this->CourantNumber;
+  p->max_dt = this->MaxTimeStep;
   const int kinds[4] = {this->BoundaryWest, this->BoundaryEast, this->BoundarySouth,
                         this->BoundaryNorth};
   const double levels[4] = {this->LevelWest, this->LevelEast, this->LevelSouth, this->LevelNorth};
   for (int e = 0; e < 4; ++e) {
-    p.boundary[e] = static_cast<gr_boundary>(kinds[e]);
-    p.boundary_level[e] = levels[e];
+    p->boundary[e] = static_cast<gr_boundary>(kinds[e]);
+    p->boundary_level[e] = levels[e];
   }
-  p.flow_model = this->FlowModel == LOCAL_INERTIAL ? GR_FLOW_LOCAL_INERTIAL : GR_FLOW_SHALLOW_WATER;
-  p.wetting_depth = this->WettingDepth;
-  p.debris_factor = this->DebrisFactor;
-  p.no_data = this->NoDataBoundary == OPEN ? GR_BOUNDARY_OPEN : GR_BOUNDARY_CLOSED;
-  if (gr_rain_runoff_params_validate(&p, msg, sizeof(msg)) != GR_OK) {
+  p->flow_model =
+      this->FlowModel == LOCAL_INERTIAL ? GR_FLOW_LOCAL_INERTIAL : GR_FLOW_SHALLOW_WATER;
+  p->wetting_depth = this->WettingDepth;
+  p->debris_factor = this->DebrisFactor;
+  p->no_data = this->NoDataBoundary == OPEN ? GR_BOUNDARY_OPEN : GR_BOUNDARY_CLOSED;
+  char msg[512];
+  if (gr_rain_runoff_params_validate(p, msg, sizeof(msg)) != GR_OK) {
     vtkErrorMacro("Rain Runoff: " << msg);
     return 0;
   }
 
+  return 1;
+}
+
+int vtkRainRunoffFilter::SnapGauges(vtkImageData *terrain, vtkPointSet *gauges) {
+  int dims[3];
+  terrain->GetDimensions(dims);
+  double spacing[3];
+  terrain->GetSpacing(spacing);
   // Each gauge at its nearest terrain point.
   this->GaugeCells.clear();
-  vtkPointSet *gauges = inputVector[2]->GetNumberOfInformationObjects()
-                            ? vtkPointSet::GetData(inputVector[2])
-                            : nullptr;
   if (gauges) {
     int ext[6];
     terrain->GetExtent(ext);
@@ -346,6 +347,14 @@ int vtkRainRunoffFilter::SetUpState(vtkInformationVector **inputVector) {
     }
   }
 
+  return 1;
+}
+
+int vtkRainRunoffFilter::CreateCore(vtkImageData *terrain, const gr_rain_runoff_params &p,
+                                    const Inputs &in) {
+  int dims[3];
+  terrain->GetDimensions(dims);
+  const size_t npoints = static_cast<size_t>(dims[0]) * static_cast<size_t>(dims[1]);
   // A split run's strip: its rows, its ring and the whole domain around it.
   // Every input field goes up as the local array (own rows and ring); point
   // inflows stay in the whole domain's indices (the core keeps those in its
@@ -372,7 +381,7 @@ int vtkRainRunoffFilter::SetUpState(vtkInformationVector **inputVector) {
     gr_rain_runoff_set_allreduce(sim, graupel::Pieces::Allreduce, &pieces);
     gr_rain_runoff_set_halo_exchange(sim, graupel::Pieces::Exchange, &pieces);
   }
-  for (const Upload &u : uploads) {
+  for (const Upload &u : in.uploads) {
     const std::vector<float> local =
         pieces.LocalField(u.values->GetPointer(0), dims[0], gr_field_components(u.field));
     st = gr_rain_runoff_set_field(this->Simulation, u.field, local.data());
@@ -382,6 +391,8 @@ int vtkRainRunoffFilter::SetUpState(vtkInformationVector **inputVector) {
     }
   }
   // The Manning map, in double (n^2 then rounds as ManningN's does).
+  vtkDataArray *manning = in.manning;
+  const char *manningWhere = in.manningWhere;
   if (manning) {
     if (manning->GetNumberOfComponents() != 1 ||
         static_cast<size_t>(manning->GetNumberOfTuples()) != npoints) {
@@ -401,6 +412,10 @@ int vtkRainRunoffFilter::SetUpState(vtkInformationVector **inputVector) {
       return 0;
     }
   }
+  return 1;
+}
+
+int vtkRainRunoffFilter::SetTimeSeries() {
   // The hyetograph, in m/s.
   if (!this->HyetographTimes.empty()) {
     std::vector<double> rates(this->HyetographRates);
@@ -424,6 +439,35 @@ int vtkRainRunoffFilter::SetUpState(vtkInformationVector **inputVector) {
                                      << gr_rain_runoff_last_error(this->Simulation));
       return 0;
     }
+  }
+  return 1;
+}
+
+int vtkRainRunoffFilter::SetUpState(vtkInformationVector **inputVector) {
+  vtkImageData *terrain = vtkImageData::GetData(inputVector[0]);
+  vtkImageData *map = inputVector[1]->GetNumberOfInformationObjects()
+                          ? vtkImageData::GetData(inputVector[1])
+                          : nullptr;
+  if (!this->CheckTerrain(terrain)) {
+    return 0;
+  }
+  vtkDataArray *elevationArray = this->GetElevation(terrain, "Input");
+  if (!elevationArray || !this->CheckParameters()) {
+    return 0;
+  }
+  if (!this->CheckStateMemory(terrain, map, inputVector)) {
+    return 0;
+  }
+
+  Inputs in;
+  gr_rain_runoff_params p;
+  vtkPointSet *gauges = inputVector[2]->GetNumberOfInformationObjects()
+                            ? vtkPointSet::GetData(inputVector[2])
+                            : nullptr;
+  if (!this->CollectInputs(terrain, map, elevationArray, in) || !this->CoreParams(&p) ||
+      !this->SnapGauges(terrain, gauges) || !this->CreateCore(terrain, p, in) ||
+      !this->SetTimeSeries()) {
+    return 0;
   }
   vtkPointSet *inflows = inputVector[3]->GetNumberOfInformationObjects()
                              ? vtkPointSet::SafeDownCast(this->GetTemporalInput(3))

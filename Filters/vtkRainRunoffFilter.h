@@ -219,6 +219,18 @@ private:
   /** 0 with one sentence in the user's unit when a property is out of its range. */
   int CheckParameters();
 
+  // SetUpState's parts, each 0 after one sentence: the input fields and the
+  // Manning map, validated; the properties as the core's parameters; the
+  // gauges at their terrain points; the core with its pieces and inputs;
+  // the hyetograph and the edges' inflow hydrographs.
+  struct Upload;
+  struct Inputs;
+  int CollectInputs(vtkImageData *terrain, vtkImageData *map, vtkDataArray *elevation, Inputs &in);
+  int CoreParams(struct gr_rain_runoff_params *p);
+  int SnapGauges(vtkImageData *terrain, vtkPointSet *gauges);
+  int CreateCore(vtkImageData *terrain, const struct gr_rain_runoff_params &p, const Inputs &in);
+  int SetTimeSeries();
+
   /** Records the ledger as the hydrograph's row `index`; 0 with the core's sentence. */
   int RecordLedger(int index);
   /** Fills the hydrograph table with rows 0 to the state's output index. */
