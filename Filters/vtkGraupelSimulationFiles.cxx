@@ -66,6 +66,86 @@ std::string PieceName(const std::string &stem, int index, int r, const std::stri
   return stem + "." + std::to_string(index) + "." + std::to_string(r) + "." + extension;
 }
 
+// Writes path: the output with the state's bytes in the field array
+// graupel_state, under a temporary name, then put in place. "" or why not.
+std::string WritePiece(vtkXMLWriter *writer, vtkDataObject *output,
+                       const std::vector<unsigned char> &bytes, const std::string &path) {
+  vtkSmartPointer<vtkDataObject> copy = vtk::TakeSmartPointer(output->NewInstance());
+  copy->ShallowCopy(output);
+  vtkNew<vtkFieldData> fd;
+  fd->ShallowCopy(output->GetFieldData());
+  vtkNew<vtkUnsignedCharArray> state;
+  state->SetName("graupel_state");
+  state->SetNumberOfTuples(static_cast<vtkIdType>(bytes.size()));
+  std::copy(bytes.begin(), bytes.end(), state->GetPointer(0));
+  fd->AddArray(state);
+  copy->SetFieldData(fd);
+  writer->SetInputData(copy);
+  const std::string part = path + ".part";
+  writer->SetFileName(part.c_str());
+  writer->SetDataModeToAppended();
+  writer->EncodeAppendedDataOff();
+  if (!writer->Write() || writer->GetErrorCode() != 0) {
+    std::remove(part.c_str());
+    return "its piece " + path + " could not be written";
+  }
+  if (!Publish(part, path)) {
+    return "its piece " + path + " could not be put in place (" + std::strerror(errno) + ")";
+  }
+  return std::string();
+}
+
+// Writes the manifest's text whole, flushed, then renamed, after every
+// piece it names: a reader never sees half a manifest, nor one whose
+// pieces are missing. "" or why not.
+std::string WriteManifest(const Json::Value &root, const std::string &manifest) {
+  // Every double to the last bit (17 digits), as the restart compares them.
+  Json::StreamWriterBuilder builder;
+  builder["indentation"] = "  ";
+  builder["precision"] = 17;
+  const std::string part = manifest + ".part";
+  std::ofstream out(part, std::ios::binary | std::ios::trunc);
+  out << Json::writeString(builder, root) << "\n";
+  out.close();
+  if (!out) {
+    std::remove(part.c_str());
+    return "the manifest could not be written";
+  }
+  return Publish(part, manifest) ? std::string() : "the manifest could not be put in place";
+}
+
+// The state bytes of a manifest's piece (beside the manifest, holding as
+// many bytes as the manifest says): "" with bytes filled, or why not.
+std::string ReadPieceState(const Json::Value &piece, const std::string &folder,
+                           std::vector<unsigned char> &bytes) {
+  const std::string file = folder + piece["file"].asString();
+  std::ostringstream m;
+  if (piece["file"].asString().find('/') != std::string::npos || !std::ifstream(file).good()) {
+    m << "names the piece " << file << ", which could not be opened; keep the pieces "
+      << "beside the manifest";
+    return m.str();
+  }
+  vtkNew<vtkXMLGenericDataObjectReader> reader;
+  reader->SetFileName(file.c_str());
+  reader->Update();
+  vtkDataObject *data = reader->GetOutputDataObject(0);
+  vtkUnsignedCharArray *state = data ? vtkUnsignedCharArray::SafeDownCast(
+                                           data->GetFieldData()->GetAbstractArray("graupel_state"))
+                                     : nullptr;
+  if (!state || state->GetNumberOfComponents() != 1) {
+    m << "names the piece " << file
+      << ", which holds no state (field array graupel_state); write it again";
+  } else if (!piece["bytes"].isIntegral() ||
+             piece["bytes"].asInt64() != static_cast<Json::Int64>(state->GetNumberOfTuples())) {
+    m << "names the piece " << file << ", whose state holds " << state->GetNumberOfTuples()
+      << " bytes where the manifest says " << piece["bytes"].asString()
+      << "; it belongs to another checkpoint";
+  } else {
+    bytes.assign(state->GetPointer(0), state->GetPointer(0) + state->GetNumberOfTuples());
+  }
+  return m.str();
+}
+
 // Removes this rank's pieces of other checkpoints (<stem>.<i>.<rank>.<ext>
 // with i not index) and temporary files a killed writer left, in folder.
 void RemoveStalePieces(const std::string &folder, const std::string &stem, int index, int rank,
@@ -154,28 +234,7 @@ int vtkGraupelSimulation::WriteCheckpointFile(vtkDataObject *output) {
     } else if (!this->SaveState(bytes)) {
       why = label + " keeps no checkpoints of its state";
     } else {
-      vtkSmartPointer<vtkDataObject> copy = vtk::TakeSmartPointer(output->NewInstance());
-      copy->ShallowCopy(output);
-      vtkNew<vtkFieldData> fd;
-      fd->ShallowCopy(output->GetFieldData());
-      vtkNew<vtkUnsignedCharArray> state;
-      state->SetName("graupel_state");
-      state->SetNumberOfTuples(static_cast<vtkIdType>(bytes.size()));
-      std::copy(bytes.begin(), bytes.end(), state->GetPointer(0));
-      fd->AddArray(state);
-      copy->SetFieldData(fd);
-      writer->SetInputData(copy);
-      const std::string part = folder + file + ".part";
-      writer->SetFileName(part.c_str());
-      writer->SetDataModeToAppended();
-      writer->EncodeAppendedDataOff();
-      if (!writer->Write() || writer->GetErrorCode() != 0) {
-        std::remove(part.c_str());
-        why = "its piece " + folder + file + " could not be written";
-      } else if (!Publish(part, folder + file)) {
-        why = "its piece " + folder + file + " could not be put in place (" + std::strerror(errno) +
-              ")";
-      }
+      why = WritePiece(writer, output, bytes, folder + file);
     }
   }
   // Every rank's rows and bytes to rank 0 (sums of what each rank alone
@@ -225,23 +284,7 @@ int vtkGraupelSimulation::WriteCheckpointFile(vtkDataObject *output) {
       piece["bytes"] = static_cast<Json::Int64>(table[q + 2]);
       list.append(piece);
     }
-    // Every double to the last bit (17 digits), as the restart compares them.
-    Json::StreamWriterBuilder builder;
-    builder["indentation"] = "  ";
-    builder["precision"] = 17;
-    const std::string json = Json::writeString(builder, root) + "\n";
-    // Written whole, flushed, then renamed, after every piece it names: a
-    // reader never sees half a manifest, nor one whose pieces are missing.
-    const std::string part = manifest + ".part";
-    std::ofstream out(part, std::ios::binary | std::ios::trunc);
-    out << json;
-    out.close();
-    if (!out) {
-      std::remove(part.c_str());
-      why = "the manifest could not be written";
-    } else if (!Publish(part, manifest)) {
-      why = "the manifest could not be put in place";
-    }
+    why = WriteManifest(root, manifest);
   }
   const bool failed = pieces.AnyRank(!why.empty());
   if (failed) {
@@ -334,36 +377,12 @@ int vtkGraupelSimulation::ReadRestartFile() {
       const int lo = piece["rows"][0].asInt(), hi = piece["rows"][1].asInt();
       const int ownLo = split ? pieces.GetOwnFirstRow() : 0;
       const int ownHi = split ? ownLo + pieces.GetOwnRows() - 1 : points[1] - 1;
-      const std::string file = folder + piece["file"].asString();
-      vtkNew<vtkXMLGenericDataObjectReader> reader;
-      vtkUnsignedCharArray *state = nullptr;
       if (lo != ownLo || hi != ownHi) {
         m << "gives rank " << rank << " the rows " << lo << " to " << hi
           << ", and this run gives it " << ownLo << " to " << ownHi
           << "; restart with the terrain and ranks it was written with";
-      } else if (piece["file"].asString().find('/') != std::string::npos ||
-                 !std::ifstream(file).good()) {
-        m << "names the piece " << file << ", which could not be opened; keep the pieces "
-          << "beside the manifest";
       } else {
-        reader->SetFileName(file.c_str());
-        reader->Update();
-        vtkDataObject *data = reader->GetOutputDataObject(0);
-        state = data ? vtkUnsignedCharArray::SafeDownCast(
-                           data->GetFieldData()->GetAbstractArray("graupel_state"))
-                     : nullptr;
-        if (!state || state->GetNumberOfComponents() != 1) {
-          m << "names the piece " << file
-            << ", which holds no state (field array graupel_state); write it again";
-        } else if (!piece["bytes"].isIntegral() ||
-                   piece["bytes"].asInt64() !=
-                       static_cast<Json::Int64>(state->GetNumberOfTuples())) {
-          m << "names the piece " << file << ", whose state holds " << state->GetNumberOfTuples()
-            << " bytes where the manifest says " << piece["bytes"].asString()
-            << "; it belongs to another checkpoint";
-        } else {
-          bytes.assign(state->GetPointer(0), state->GetPointer(0) + state->GetNumberOfTuples());
-        }
+        m << ReadPieceState(piece, folder, bytes);
       }
     }
     why = m.str();
