@@ -121,6 +121,16 @@ bool vtkEXRFieldWriter::ChoosePlanes(vtkImageData *input, std::vector<std::strin
   return true;
 }
 
+void vtkEXRFieldWriter::PlanePointers(const std::vector<std::string> &names,
+                                      const std::vector<std::vector<float>> &planes,
+                                      std::vector<const char *> &namePtrs,
+                                      std::vector<const float *> &dataPtrs) {
+  for (size_t c = 0; c < names.size(); ++c) {
+    namePtrs.push_back(names[c].c_str());
+    dataPtrs.push_back(planes[c].data());
+  }
+}
+
 void vtkEXRFieldWriter::WriteData() {
   vtkImageData *input = this->GetInput();
   std::vector<std::string> names;
@@ -132,10 +142,7 @@ void vtkEXRFieldWriter::WriteData() {
   input->GetDimensions(dims);
   std::vector<const char *> namePtrs;
   std::vector<const float *> dataPtrs;
-  for (size_t c = 0; c < names.size(); ++c) {
-    namePtrs.push_back(names[c].c_str());
-    dataPtrs.push_back(planes[c].data());
-  }
+  PlanePointers(names, planes, namePtrs, dataPtrs);
   // Geometry and field data (the ledger, the device name) travel in the
   // header, so a reopened file is where it was and keeps its record.
   gr_exr_meta meta{};

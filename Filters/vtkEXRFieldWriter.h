@@ -75,6 +75,11 @@ protected:
    */
   bool ChoosePlanes(vtkImageData *input, std::vector<std::string> &names,
                     std::vector<std::vector<float>> &planes);
+  /** The C views of ChoosePlanes' names and planes, for the core's writers. */
+  static void PlanePointers(const std::vector<std::string> &names,
+                            const std::vector<std::vector<float>> &planes,
+                            std::vector<const char *> &namePtrs,
+                            std::vector<const float *> &dataPtrs);
 
   char *FileName = nullptr;
   int PixelType = FLOAT;

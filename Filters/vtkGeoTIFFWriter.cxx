@@ -31,10 +31,7 @@ void vtkGeoTIFFWriter::WriteData() {
   input->GetOrigin(origin);
   std::vector<const char *> namePtrs;
   std::vector<const float *> dataPtrs;
-  for (size_t c = 0; c < names.size(); ++c) {
-    namePtrs.push_back(names[c].c_str());
-    dataPtrs.push_back(planes[c].data());
-  }
+  PlanePointers(names, planes, namePtrs, dataPtrs);
   std::string crs;
   if (auto *a =
           vtkStringArray::SafeDownCast(input->GetFieldData()->GetAbstractArray("graupel_crs"))) {

@@ -169,3 +169,17 @@ def piece_compare(algorithm, ref, fields, ledger, nx, ny, extra=()):
         arr = numpy_to_vtk(np.ascontiguousarray(values), deep=1)
         arr.SetName(name)
         out.GetPointData().AddArray(arr)
+
+
+def digest(alg, time, names):
+    """SHA-256 of the named point arrays of alg's output at time (b"none" for
+    a missing one): one value to compare runs by, bit for bit."""
+    import hashlib
+    from vtkmodules.util.numpy_support import vtk_to_numpy
+    alg.UpdateTimeStep(time)
+    pd = alg.GetOutput().GetPointData()
+    h = hashlib.sha256()
+    for name in names:
+        arr = pd.GetArray(name)
+        h.update(vtk_to_numpy(arr).tobytes() if arr is not None else b"none")
+    return h.hexdigest()

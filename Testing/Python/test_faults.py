@@ -10,7 +10,6 @@
     order (Rain Runoff on two terrains, Snow Deformation beside them), give
     the same bits as each alone.
 """
-import hashlib
 import os
 import resource
 import signal
@@ -23,7 +22,6 @@ import gr_check as T  # noqa: E402
 
 a = T.args()
 
-from vtkmodules.util.numpy_support import vtk_to_numpy  # noqa: E402
 from vtkmodules.vtkFiltersSources import vtkSphereSource  # noqa: E402
 
 from graupel import (  # noqa: E402
@@ -58,13 +56,7 @@ def rain_runoff(t, **props):
 
 
 def digest(alg, time, names=("water_depth", "discharge")):
-    alg.UpdateTimeStep(time)
-    out = alg.GetOutput()
-    h = hashlib.sha256()
-    for name in names:
-        arr = out.GetPointData().GetArray(name)
-        h.update(vtk_to_numpy(arr).tobytes() if arr is not None else b"none")
-    return h.hexdigest()
+    return T.digest(alg, time, names)
 
 
 # ---- a full disk while checkpointing ---------------------------------------
