@@ -15,7 +15,6 @@ import resource
 import signal
 import sys
 
-import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import gr_check as T  # noqa: E402
