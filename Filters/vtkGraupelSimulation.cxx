@@ -1,5 +1,6 @@
 #include "vtkGraupelSimulation.h"
 
+#include "vtkCellData.h"
 #include "vtkDataArray.h"
 #include "vtkDataObject.h"
 #include "vtkDoubleArray.h"
@@ -605,6 +606,23 @@ int vtkGraupelSimulation::CheckMemory(const gr_grid &grid, const gr_memory_need 
 
 vtkDataArray *vtkGraupelSimulation::GetElevation(vtkImageData *terrain, const char *inputName) {
   vtkDataArray *a = terrain ? terrain->GetPointData()->GetArray("elevation") : nullptr;
+  vtkCellData *cells = terrain ? terrain->GetCellData() : nullptr;
+  vtkDataArray *cellHeights = nullptr;
+  for (int k = 0; !a && cells && k < cells->GetNumberOfArrays() && !cellHeights; ++k) {
+    vtkDataArray *c = cells->GetArray(k);
+    const char *name = c ? c->GetName() : nullptr;
+    if (name && strncmp(name, "vtk", 3) != 0 && c->GetNumberOfComponents() == 1) {
+      cellHeights = c; // e.g. ParaView's GDAL Raster Reader's 'Elevation'
+    }
+  }
+  if (!a && cellHeights) {
+    vtkErrorMacro(<< this->GetSimulationLabel() << "'s " << inputName
+                  << " holds its heights as cell data ('" << cellHeights->GetName()
+                  << "', as ParaView's GDAL Raster Reader gives a raster, in the raster's own "
+                     "units); open the file with Graupel's GIS Raster Reader instead, which "
+                     "gives the point array 'elevation' in metres.");
+    return nullptr;
+  }
   if (!a || a->GetNumberOfComponents() != 1) {
     vtkErrorMacro(<< this->GetSimulationLabel() << "'s " << inputName
                   << " has no one-component point array 'elevation'; name the terrain's "

@@ -36,6 +36,8 @@ from vtkmodules.util.numpy_support import vtk_to_numpy  # noqa: E402
 
 import graupel  # noqa: E402
 
+vtkRainRunoffFilter_cls = graupel.vtkRainRunoffFilter
+
 gdal.UseExceptions()
 scratch = os.path.join(a.scratch, "gis")
 os.makedirs(scratch, exist_ok=True)
@@ -285,4 +287,22 @@ T.check(not errs and len(warns) == 1 and "no coordinate reference system" in war
         and o.GetSpacing()[:2] == (5.0, 5.0) and o.GetOrigin()[:2] == (102.5, 152.5),
         "no CRS: one warning, the spacing taken as metres (%s, %s %s)"
         % (warns, o.GetSpacing(), o.GetOrigin()))
+
+# ---- ParaView's own GDAL reader: cells, refused with the way out ----------------
+try:
+    from vtkmodules.vtkIOGDAL import vtkGDALRasterReader
+except ImportError:  # the VTK-alone build's VTK 9.1 has no GDAL module
+    vtkGDALRasterReader = None
+if vtkGDALRasterReader is not None:
+    pv = vtkGDALRasterReader()
+    pv.SetFileName(utm_tif)
+    cells_rain = vtkRainRunoffFilter_cls()
+    cells_rain.SetInputConnection(pv.GetOutputPort())
+    caught = T.ErrorCatcher(cells_rain)
+    cells_rain.UpdateTimeStep(0.0)
+    T.check(cells_rain.GetOutput().GetNumberOfPoints() == 0 and len(caught.messages) == 1
+            and "as cell data ('Elevation'" in caught.messages[0]
+            and "GIS Raster Reader" in caught.messages[0],
+            "ParaView's GDAL reader (cells): one sentence naming the GIS Raster Reader (%s)"
+            % caught.messages)
 T.finish()
