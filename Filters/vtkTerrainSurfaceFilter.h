@@ -47,6 +47,12 @@
 
 #include <string>
 
+class vtkCellArray;
+class vtkFloatArray;
+class vtkImageData;
+class vtkPointData;
+class vtkPoints;
+
 class GRAUPELFILTERS_EXPORT vtkTerrainSurfaceFilter : public vtkPolyDataAlgorithm {
 public:
   static vtkTerrainSurfaceFilter *New();
@@ -121,6 +127,18 @@ protected:
   int RequestData(vtkInformation *, vtkInformationVector **, vtkInformationVector *) override;
   /** Consumes an abort and marks the output aborted (RequestData returns 1 then). */
   void ConsumeAbort();
+
+  // RequestData's parts: the input checked, the grid drawn and its memory;
+  // the lowest height; the top's points and normals; the quads and walls;
+  // the colour array. false after one sentence (or, Aborted, an abort).
+  struct Surface;
+  bool Prepare(vtkImageData *input, Surface &g);
+  bool Lowest(Surface &g);
+  bool Aborted(vtkPolyData *output, const Surface &g, int row, double share, double done);
+  bool TopPoints(const Surface &g, vtkPoints *points, vtkFloatArray *normals, vtkPolyData *output);
+  bool Quads(const Surface &g, vtkPoints *points, vtkFloatArray *normals, vtkPolyData *output,
+             vtkCellArray *polys);
+  void Colour(vtkImageData *input, vtkPointData *outPD);
 
   double VerticalExaggeration = 2.0;
   std::string HeightArray;
