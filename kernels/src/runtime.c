@@ -2,6 +2,7 @@
  * checked program/kernel/buffer helpers, and error reporting. */
 #include "graupel/cl_runtime.h"
 #include "graupel/memory.h"
+#include "runtime_internal.h"
 
 #include <ctype.h>
 #include <math.h>
@@ -555,6 +556,48 @@ void gr_param_explain(const gr_param_bound *b, double core_value, const char *wh
   else
     snprintf(msg, msg_len, "%s: %s must lie between %g and %g%s%s (got %g%s%s).", w, b->property,
              b->min, b->max, sp, b->unit, user, sp, b->unit);
+}
+
+/* The "is" wordings of gr_params_check_table for row b refusing v. */
+static void gr_param_explain_is(const gr_param_bound *b, const char *hint, double v,
+                                const char *what, gr_param_wording wording, char *msg,
+                                size_t msg_len) {
+  const char *sep = b->unit[0] ? " " : "";
+  int whole = b->integer && wording != GR_PARAM_SAY_IS_RANGE &&
+              !(wording == GR_PARAM_SAY_IS_OPEN_FIRST && b->min_open);
+  if (whole)
+    snprintf(msg, msg_len, "%s: %s%s is %.15g but must be a whole number from %.15g to %.15g.",
+             what, b->property, hint, v, b->min_open ? b->min + 1.0 : b->min, b->max);
+  else if (b->min_open)
+    snprintf(msg, msg_len, "%s: %s%s is %.15g but must be above %.15g and at most %.15g%s%s.", what,
+             b->property, hint, v, b->min, b->max, sep, b->unit);
+  else
+    snprintf(msg, msg_len, "%s: %s%s is %.15g but must lie between %.15g and %.15g%s%s.", what,
+             b->property, hint, v, b->min, b->max, sep, b->unit);
+}
+
+gr_status gr_params_check_table(const gr_param_bound *table, const int *rows, int n,
+                                const double *values, const char *what, const char *const *hints,
+                                gr_param_wording wording, char *msg, size_t msg_len) {
+  for (int k = 0; k < n; ++k) {
+    int row = rows ? rows[k] : k;
+    const gr_param_bound *b = &table[row];
+    if (gr_param_accepts(b, values[k]))
+      continue;
+    if (wording == GR_PARAM_SAY_GOT)
+      gr_param_explain(b, values[k], what, msg, msg_len);
+    else if (msg && msg_len)
+      gr_param_explain_is(b, hints && hints[row] ? hints[row] : "", values[k], what, wording, msg,
+                          msg_len);
+    return GR_ERR_INVALID_ARGUMENT;
+  }
+  return GR_OK;
+}
+
+gr_status gr_params_missing(const char *what, char *msg, size_t msg_len) {
+  if (msg && msg_len)
+    snprintf(msg, msg_len, "%s: no parameters were given.", what);
+  return GR_ERR_INVALID_ARGUMENT;
 }
 
 /* ------------------------------------------------------------------ errors */

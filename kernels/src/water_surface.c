@@ -6,6 +6,7 @@
 #include "graupel/cl_runtime.h"
 #include "graupel/reduce.h"
 #include "water_surface_shared.h"
+#include "runtime_internal.h"
 
 #include <float.h>
 #include <limits.h>
@@ -127,20 +128,14 @@ static double gr_ws_param_value(const gr_water_surface_params *p, int row) {
 
 gr_status gr_water_surface_params_validate(const gr_water_surface_params *p, char *msg,
                                            size_t msg_len) {
-  if (!p) {
-    if (msg && msg_len)
-      snprintf(msg, msg_len, "Invalid water surface parameters: no parameters were given.");
-    return GR_ERR_INVALID_ARGUMENT;
-  }
-  for (int row = 0; row < GR_WS_P_COUNT; ++row) {
-    const gr_param_bound *r = &gr_ws_bounds[row];
-    double v = gr_ws_param_value(p, row);
-    if (gr_param_accepts(r, v))
-      continue;
-    gr_param_explain(r, v, "Invalid water surface parameters", msg, msg_len);
-    return GR_ERR_INVALID_ARGUMENT;
-  }
-  return GR_OK;
+  const char *what = "Invalid water surface parameters";
+  if (!p)
+    return gr_params_missing(what, msg, msg_len);
+  double values[GR_WS_P_COUNT];
+  for (int row = 0; row < GR_WS_P_COUNT; ++row)
+    values[row] = gr_ws_param_value(p, row);
+  return gr_params_check_table(gr_ws_bounds, NULL, GR_WS_P_COUNT, values, what, NULL,
+                               GR_PARAM_SAY_GOT, msg, msg_len);
 }
 
 /* ------------------------------------------------------------- the handle */
