@@ -288,6 +288,52 @@ gr_status gr_grid_strip_check(const gr_grid *g, const char *core, const char *sp
   return GR_OK;
 }
 
+gr_status gr_grid_piece_check(const gr_grid *g, const char *core, int need, const char *need_for,
+                              int origin_checked, int ring[4], char *msg, size_t msg_len) {
+  long long gnx = g->global_nx > 0 ? g->global_nx : g->nx;
+  long long gny = g->global_ny > 0 ? g->global_ny : g->ny;
+  int whole_x = g->global_nx <= 0, whole_y = g->global_ny <= 0;
+  memset(ring, 0, 4 * sizeof(int));
+  if (!origin_checked && (g->global_nx < 0 || g->global_ny < 0 || g->ghost < 0))
+    return gr_invalid(
+        msg, msg_len,
+        "Invalid grid: global_nx, global_ny and ghost must be 0 or more (got %d, %d, %d).",
+        g->global_nx, g->global_ny, g->ghost);
+  if (origin_checked &&
+      (g->global_nx < 0 || g->global_ny < 0 || g->ghost < 0 || g->i0 < 0 || g->j0 < 0))
+    return gr_invalid(msg, msg_len,
+                      "Invalid grid: i0, j0, global_nx, global_ny and ghost must be 0 or more "
+                      "(got %d, %d, %d, %d, %d).",
+                      g->i0, g->j0, g->global_nx, g->global_ny, g->ghost);
+  if ((origin_checked && ((whole_x && g->i0 != 0) || (whole_y && g->j0 != 0))) ||
+      (!whole_x && (long long)g->i0 + g->nx > gnx) || (!whole_y && (long long)g->j0 + g->ny > gny))
+    return gr_invalid(msg, msg_len,
+                      "Invalid grid: the piece of %d x %d points at (%d, %d) reaches beyond the "
+                      "domain of %lld x %lld points; give global_nx and global_ny of the whole "
+                      "domain.",
+                      g->nx, g->ny, g->i0, g->j0, gnx, gny);
+  if (!whole_x) {
+    ring[0] = g->i0 > 0 ? need : 0;
+    ring[1] = (long long)g->i0 + g->nx < gnx ? need : 0;
+  }
+  if (!whole_y) {
+    ring[2] = g->j0 > 0 ? need : 0;
+    ring[3] = (long long)g->j0 + g->ny < gny ? need : 0;
+  }
+  int any = ring[0] || ring[1] || ring[2] || ring[3];
+  if (any && g->ghost != need)
+    return gr_invalid(msg, msg_len,
+                      "Invalid grid: a %s piece with neighbours needs a ghost ring of %d points%s "
+                      "(got ghost = %d); set grid.ghost to %d.",
+                      core, need, need_for, g->ghost, need);
+  if (((ring[0] || ring[1]) && g->nx < need) || ((ring[2] || ring[3]) && g->ny < need))
+    return gr_invalid(msg, msg_len,
+                      "Invalid grid: a %s piece of %d x %d points is narrower than its ghost ring "
+                      "of %d toward a neighbour; split the domain into fewer pieces.",
+                      core, g->nx, g->ny, need);
+  return GR_OK;
+}
+
 /* The transform's part of gr_mesh_validate. */
 static gr_status gr_mesh_transform_check(const double *T, char *msg, size_t msg_len) {
   for (int k = 0; k < 16; ++k)

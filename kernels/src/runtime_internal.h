@@ -4,6 +4,7 @@
 #define GRAUPEL_RUNTIME_INTERNAL_H
 
 #include "graupel/graupel.h"
+#include "graupel/runtime.h"
 
 #include <stddef.h>
 
@@ -33,5 +34,16 @@ gr_status gr_params_check_table(const gr_param_bound *table, const int *rows, in
 /* "<what>: no parameters were given." in msg (when msg and msg_len);
  * returns GR_ERR_INVALID_ARGUMENT. */
 gr_status gr_params_missing(const char *what, char *msg, size_t msg_len);
+
+/* The piece contract of the cores that split a domain along x and y
+ * (graupel.h): ring[4] (west, east, south, north) gets `need` toward each
+ * side with a neighbour, 0 elsewhere; a piece with any neighbour must have
+ * ghost == need and at least need points across each ring's axis. core
+ * names the simulation ("rain runoff"), need_for follows "a ghost ring of
+ * <need> points" (" for FlowModel 1", or ""). With origin_checked, i0 and
+ * j0 are also checked to be 0 or more, and 0 along an axis not split.
+ * Otherwise a sentence goes to msg (when msg and msg_len). */
+gr_status gr_grid_piece_check(const gr_grid *g, const char *core, int need, const char *need_for,
+                              int origin_checked, int ring[4], char *msg, size_t msg_len);
 
 #endif
