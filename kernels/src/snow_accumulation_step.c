@@ -308,44 +308,36 @@ static gr_status gr_snac_object_surface(gr_snow_accumulation *s, cl_mem pos, cl_
   return st;
 }
 
-static gr_status gr_snac_step_impl(gr_snow_accumulation *s, double dt) {
-  gr_context *ctx = s->ctx;
-  const gr_grid *g = &s->grid;
-  double t0 = gr_snac_now_ms();
-  if (s->timing) {
-    gr_status st = gr_finish(ctx);
-    if (st != GR_OK)
-      return st;
-    t0 = s->t_mark = gr_snac_now_ms();
-  }
-  double dd[3];
-  gr_snac_direction(s, dd);
-  cl_int nx = g->nx, ny = g->ny, gi0 = 0, gj0 = s->row0;
-  float dx = (float)g->dx, dy = (float)g->dy;
-  int pieced = gr_snac_pieced(s);
-  if (pieced && (!s->allreduce || !s->halo_exchange))
-    return gr_set_error(ctx, GR_ERR_INVALID_ARGUMENT,
-                        "A snow accumulation piece with neighbours steps only with an allreduce "
-                        "and a halo exchange set (gr_snow_accumulation_set_allreduce, "
-                        "gr_snow_accumulation_set_halo_exchange).");
+/* What the stages of one step pass their kernels: the grid, the view, the
+ * snowfall's direction and the step's rates, in the kernels' types. */
+typedef struct gr_snac_step_vars {
+  cl_int nx, ny, gi0, gj0;
+  float dx, dy, zref;
+  float dir_x, dir_y, dir_z;
+  float rate_dt, amplitude, max_depth, kdt, keep;
+  cl_uint seed;
+  cl_int terrain_drawn, pieced, vw, vh;
+  gr_snac_view v;
+} gr_snac_step_vars;
 
-  /* The terrain is drawn into the view only where it could hide itself:
-   * where a triangle of the snow surface rises faster than the snow falls
-   * steeply (snow_accumulation_slope_reduce). Snow straight down, or a
-   * surface gentler than the snow's descent, leaves a view of the objects
-   * alone, and a far cheaper step. A piece's cells (its local arrays, ring
-   * included, are all the domain's) give its share of the maximum. */
-  cl_int terrain_drawn = 1;
+/* Whether the terrain is drawn into the view: only where it could hide
+ * itself, where a triangle of the snow surface rises faster than the snow
+ * falls steeply (snow_accumulation_slope_reduce). Snow straight down, or a
+ * surface gentler than the snow's descent, leaves a view of the objects
+ * alone, and a far cheaper step. A piece's cells (its local arrays, ring
+ * included, are all the domain's) give its share of the maximum; the
+ * pieces then agree on it and on the view's box through the allreduce. */
+static gr_status gr_snac_terrain_drawn(gr_snow_accumulation *s, const double dd[3],
+                                       gr_snac_step_vars *sv) {
+  gr_context *ctx = s->ctx;
+  sv->terrain_drawn = 1;
   double horiz = hypot(dd[0], dd[1]);
   double g2[2] = {0.0, 0.0};
   {
-    cl_int cells = nx * ny;
-    const gr_snac_arg sa[] = {GR_SNAC_MEM("ground", s->ground),
-                              GR_SNAC_MEM("depth", s->arr[0]),
-                              GR_SNAC_VAL("nx", nx),
-                              GR_SNAC_VAL("ny", ny),
-                              GR_SNAC_VAL("dx", dx),
-                              GR_SNAC_VAL("dy", dy),
+    cl_int cells = sv->nx * sv->ny;
+    const gr_snac_arg sa[] = {GR_SNAC_MEM("ground", s->ground), GR_SNAC_MEM("depth", s->arr[0]),
+                              GR_SNAC_VAL("nx", sv->nx),        GR_SNAC_VAL("ny", sv->ny),
+                              GR_SNAC_VAL("dx", sv->dx),        GR_SNAC_VAL("dy", sv->dy),
                               GR_SNAC_VAL("n", cells)};
     /* Snow straight down cannot be hidden by the surface: no reduction
      * (and no read-back) that step. */
@@ -356,7 +348,7 @@ static gr_status gr_snac_step_impl(gr_snow_accumulation *s, double dt) {
     if (sst != GR_OK)
       return sst;
   }
-  if (pieced) {
+  if (sv->pieced) {
     /* What the view's box and the drawing decision rest on, over the
      * domain: every piece then sets up the same view as the whole grid. */
     double m[6] = {g2[0], g2[1], -s->bmin, s->bmax, s->init_max, s->snow_bound};
@@ -374,45 +366,50 @@ static gr_status gr_snac_step_impl(gr_snow_accumulation *s, double dt) {
   }
   double steepest = sqrt(g2[0] * g2[0] + g2[1] * g2[1]);
   if (horiz == 0.0 || steepest * (1.0 + GR_SNAC_SLOPE_MARGIN) * horiz < fabs(dd[2]))
-    terrain_drawn = 0;
-  gr_snac_view v;
-  gr_snac_view_of(s, dd, &v);
-  cl_int vw = v.vw, vh = v.vh;
-  float zref = (float)s->zref;
-  float dir_x = (float)dd[0], dir_y = (float)dd[1], dir_z = (float)dd[2];
+    sv->terrain_drawn = 0;
+  return GR_OK;
+}
+
+/* The step's view and rates, once the terrain decision is made. */
+static void gr_snac_step_rates(const gr_snow_accumulation *s, double dt, const double dd[3],
+                               gr_snac_step_vars *sv) {
+  gr_snac_view_of(s, dd, &sv->v);
+  sv->vw = sv->v.vw, sv->vh = sv->v.vh;
+  sv->zref = (float)s->zref;
+  sv->dir_x = (float)dd[0], sv->dir_y = (float)dd[1], sv->dir_z = (float)dd[2];
   const gr_snow_accumulation_params *p = &s->params;
-  float rate_dt = (float)(p->snowfall_rate * dt), amplitude = (float)p->noise_amplitude;
-  float max_depth = (float)p->max_depth;
+  sv->rate_dt = (float)(p->snowfall_rate * dt), sv->amplitude = (float)p->noise_amplitude;
+  sv->max_depth = (float)p->max_depth;
   /* Stability as a relaxation rate: k = -ln(1 - f), so that an excess
    * alone keeps (1 - f)^t after t seconds; the step integrates it with the
    * growth (snac_settle) from keep = e^-k dt and k dt. f = 1: k infinite
    * (kdt 1e30), all the excess goes. */
   double krate = p->stability_factor >= 1.0 ? HUGE_VAL : -log1p(-p->stability_factor);
-  float kdt = (float)fmin(krate * dt, 1.0e30);
-  float keep = (float)exp(-krate * dt);
-  cl_uint seed = (cl_uint)p->seed;
-  double inv_scale = 1.0 / p->noise_scale;
+  sv->kdt = (float)fmin(krate * dt, 1.0e30);
+  sv->keep = (float)exp(-krate * dt);
+  sv->seed = (cl_uint)p->seed;
+}
+
+/* The noise is fixed in space: made again only for another seed or
+ * scale. */
+static gr_status gr_snac_make_noise(gr_snow_accumulation *s, const gr_snac_step_vars *sv) {
+  const gr_grid *g = &s->grid;
+  double inv_scale = 1.0 / s->params.noise_scale;
   float noise_x0 = (float)fmod(g->x0 * inv_scale, GR_SNAC_NOISE_PERIOD);
   float noise_y0 = (float)fmod(g->y0 * inv_scale, GR_SNAC_NOISE_PERIOD);
   float noise_dx = (float)(g->dx * inv_scale), noise_dy = (float)(g->dy * inv_scale);
-  /* The noise is fixed in space: made again only for another seed or
-   * scale. */
+  cl_uint seed = sv->seed;
   gr_status nst = GR_OK;
   if (!s->noise_made || s->noise_seed != seed || s->noise_key[0] != noise_x0 ||
       s->noise_key[1] != noise_y0 || s->noise_key[2] != noise_dx || s->noise_key[3] != noise_dy) {
-    const gr_snac_arg na[] = {GR_SNAC_VAL("nx", nx),
-                              GR_SNAC_VAL("ny", ny),
-                              GR_SNAC_VAL("gi0", gi0),
-                              GR_SNAC_VAL("gj0", gj0),
-                              GR_SNAC_VAL("noise_x0", noise_x0),
-                              GR_SNAC_VAL("noise_y0", noise_y0),
-                              GR_SNAC_VAL("noise_dx", noise_dx),
-                              GR_SNAC_VAL("noise_dy", noise_dy),
-                              GR_SNAC_VAL("seed", seed),
-                              GR_SNAC_MEM("noise", s->noise)};
+    const gr_snac_arg na[] = {GR_SNAC_VAL("nx", sv->nx),         GR_SNAC_VAL("ny", sv->ny),
+                              GR_SNAC_VAL("gi0", sv->gi0),       GR_SNAC_VAL("gj0", sv->gj0),
+                              GR_SNAC_VAL("noise_x0", noise_x0), GR_SNAC_VAL("noise_y0", noise_y0),
+                              GR_SNAC_VAL("noise_dx", noise_dx), GR_SNAC_VAL("noise_dy", noise_dy),
+                              GR_SNAC_VAL("seed", seed),         GR_SNAC_MEM("noise", s->noise)};
     nst = gr_snac_args(s, s->noise_k, na, sizeof(na) / sizeof(na[0]));
     if (nst == GR_OK)
-      nst = gr_enqueue_2d(ctx, s->noise_k, 0, 0, (size_t)nx, (size_t)ny, NULL);
+      nst = gr_enqueue_2d(s->ctx, s->noise_k, 0, 0, (size_t)sv->nx, (size_t)sv->ny, NULL);
     if (nst == GR_OK) {
       s->noise_made = 1;
       s->noise_seed = seed;
@@ -420,50 +417,46 @@ static gr_status gr_snac_step_impl(gr_snow_accumulation *s, double dt) {
       s->noise_key[2] = noise_dx, s->noise_key[3] = noise_dy;
     }
   }
-  if (s->timing)
-    s->tm.host_ms += gr_snac_now_ms() - t0, s->t_mark = gr_snac_now_ms();
-  if (nst != GR_OK)
-    return nst;
+  return nst;
+}
 
-  /* 1. the view */
+/* 1. the view: the terrain (when drawn) and the objects' triangles; a
+ * piece's views are then merged over the pieces. */
+static gr_status gr_snac_draw_view(gr_snow_accumulation *s, gr_snac_step_vars *sv) {
+  gr_context *ctx = s->ctx;
+  const gr_snac_view *v = &sv->v;
   cl_int empty = GR_SNAC_EMPTY;
-  gr_status st =
-      gr_cl_check(ctx,
-                  clEnqueueFillBuffer(gr_context_queue(ctx), s->view, &empty, sizeof(empty), 0,
-                                      (size_t)vw * (size_t)vh * sizeof(cl_int), 0, NULL, NULL),
-                  "Clearing the exposure view");
-  const gr_snac_arg rt[] = {GR_SNAC_MEM("ground", s->ground),
-                            GR_SNAC_MEM("depth", s->arr[0]),
-                            GR_SNAC_VAL("nx", nx),
-                            GR_SNAC_VAL("ny", ny),
-                            GR_SNAC_VAL("gi0", gi0),
-                            GR_SNAC_VAL("gj0", gj0),
-                            GR_SNAC_VAL("dx", dx),
-                            GR_SNAC_VAL("dy", dy),
-                            GR_SNAC_VAL("zref", zref),
-                            GR_SNAC_VAL("tau_x", v.tau_x),
-                            GR_SNAC_VAL("tau_y", v.tau_y),
-                            GR_SNAC_VAL("qx0", v.qx0),
-                            GR_SNAC_VAL("qy0", v.qy0),
-                            GR_SNAC_VAL("inv_texel", v.inv_texel),
-                            GR_SNAC_VAL("vw", vw),
-                            GR_SNAC_VAL("vh", vh),
-                            GR_SNAC_MEM("view", s->view)};
+  gr_status st = gr_cl_check(
+      ctx,
+      clEnqueueFillBuffer(gr_context_queue(ctx), s->view, &empty, sizeof(empty), 0,
+                          (size_t)sv->vw * (size_t)sv->vh * sizeof(cl_int), 0, NULL, NULL),
+      "Clearing the exposure view");
+  const gr_snac_arg rt[] = {
+      GR_SNAC_MEM("ground", s->ground), GR_SNAC_MEM("depth", s->arr[0]),
+      GR_SNAC_VAL("nx", sv->nx),        GR_SNAC_VAL("ny", sv->ny),
+      GR_SNAC_VAL("gi0", sv->gi0),      GR_SNAC_VAL("gj0", sv->gj0),
+      GR_SNAC_VAL("dx", sv->dx),        GR_SNAC_VAL("dy", sv->dy),
+      GR_SNAC_VAL("zref", sv->zref),    GR_SNAC_VAL("tau_x", v->tau_x),
+      GR_SNAC_VAL("tau_y", v->tau_y),   GR_SNAC_VAL("qx0", v->qx0),
+      GR_SNAC_VAL("qy0", v->qy0),       GR_SNAC_VAL("inv_texel", v->inv_texel),
+      GR_SNAC_VAL("vw", sv->vw),        GR_SNAC_VAL("vh", sv->vh),
+      GR_SNAC_MEM("view", s->view)};
   if (st == GR_OK)
     st = gr_snac_args(s, s->raster_terrain, rt, sizeof(rt) / sizeof(rt[0]));
-  if (st == GR_OK && nx > 1 && ny > 1 && terrain_drawn)
-    st = gr_enqueue_2d(ctx, s->raster_terrain, 0, 0, (size_t)(nx - 1), (size_t)(ny - 1), NULL);
+  if (st == GR_OK && sv->nx > 1 && sv->ny > 1 && sv->terrain_drawn)
+    st = gr_enqueue_2d(ctx, s->raster_terrain, 0, 0, (size_t)(sv->nx - 1), (size_t)(sv->ny - 1),
+                       NULL);
   cl_int ntri = s->ntri;
   if (st == GR_OK && ntri > 0) {
     const gr_snac_arg ro[] = {GR_SNAC_MEM("tri", s->o_tri),
                               GR_SNAC_VAL("ntri", ntri),
-                              GR_SNAC_VAL("tau_x", v.tau_x),
-                              GR_SNAC_VAL("tau_y", v.tau_y),
-                              GR_SNAC_VAL("qx0", v.qx0),
-                              GR_SNAC_VAL("qy0", v.qy0),
-                              GR_SNAC_VAL("inv_texel", v.inv_texel),
-                              GR_SNAC_VAL("vw", vw),
-                              GR_SNAC_VAL("vh", vh),
+                              GR_SNAC_VAL("tau_x", v->tau_x),
+                              GR_SNAC_VAL("tau_y", v->tau_y),
+                              GR_SNAC_VAL("qx0", v->qx0),
+                              GR_SNAC_VAL("qy0", v->qy0),
+                              GR_SNAC_VAL("inv_texel", v->inv_texel),
+                              GR_SNAC_VAL("vw", sv->vw),
+                              GR_SNAC_VAL("vh", sv->vh),
                               GR_SNAC_MEM("view", s->view)};
     st = gr_snac_args(s, s->raster_objects, ro, sizeof(ro) / sizeof(ro[0]));
     if (st == GR_OK)
@@ -472,96 +465,110 @@ static gr_status gr_snac_step_impl(gr_snow_accumulation *s, double dt) {
   /* A piece drew its own cells: the views' maximum over the pieces, texel
    * by texel, is the whole grid's view (see "Pieces" in the header). */
   s->objects_by_point = 0;
-  if (st == GR_OK && pieced && terrain_drawn)
-    st = gr_snac_view_reduce(s, &v);
+  if (st == GR_OK && sv->pieced && sv->terrain_drawn)
+    st = gr_snac_view_reduce(s, v);
   if (st == GR_OK)
     st = gr_snac_mark(s, &s->tm.view_ms);
+  return st;
+}
 
-  /* 2-3. exposure and growth of the grid points */
+/* 2-3. exposure and growth of the grid points. */
+static gr_status gr_snac_grow_points(gr_snow_accumulation *s, gr_snac_step_vars *sv) {
+  const gr_snac_view *v = &sv->v;
   const gr_snac_arg ex[] = {GR_SNAC_MEM("ground", s->ground),
                             GR_SNAC_MEM("depth", s->arr[0]),
-                            GR_SNAC_VAL("nx", nx),
-                            GR_SNAC_VAL("ny", ny),
-                            GR_SNAC_VAL("gi0", gi0),
-                            GR_SNAC_VAL("gj0", gj0),
-                            GR_SNAC_VAL("dx", dx),
-                            GR_SNAC_VAL("dy", dy),
-                            GR_SNAC_VAL("zref", zref),
-                            GR_SNAC_VAL("dir_x", dir_x),
-                            GR_SNAC_VAL("dir_y", dir_y),
-                            GR_SNAC_VAL("dir_z", dir_z),
-                            GR_SNAC_VAL("tau_x", v.tau_x),
-                            GR_SNAC_VAL("tau_y", v.tau_y),
-                            GR_SNAC_VAL("qx0", v.qx0),
-                            GR_SNAC_VAL("qy0", v.qy0),
-                            GR_SNAC_VAL("inv_texel", v.inv_texel),
-                            GR_SNAC_VAL("texel", v.texel),
-                            GR_SNAC_VAL("vw", vw),
-                            GR_SNAC_VAL("vh", vh),
+                            GR_SNAC_VAL("nx", sv->nx),
+                            GR_SNAC_VAL("ny", sv->ny),
+                            GR_SNAC_VAL("gi0", sv->gi0),
+                            GR_SNAC_VAL("gj0", sv->gj0),
+                            GR_SNAC_VAL("dx", sv->dx),
+                            GR_SNAC_VAL("dy", sv->dy),
+                            GR_SNAC_VAL("zref", sv->zref),
+                            GR_SNAC_VAL("dir_x", sv->dir_x),
+                            GR_SNAC_VAL("dir_y", sv->dir_y),
+                            GR_SNAC_VAL("dir_z", sv->dir_z),
+                            GR_SNAC_VAL("tau_x", v->tau_x),
+                            GR_SNAC_VAL("tau_y", v->tau_y),
+                            GR_SNAC_VAL("qx0", v->qx0),
+                            GR_SNAC_VAL("qy0", v->qy0),
+                            GR_SNAC_VAL("inv_texel", v->inv_texel),
+                            GR_SNAC_VAL("texel", v->texel),
+                            GR_SNAC_VAL("vw", sv->vw),
+                            GR_SNAC_VAL("vh", sv->vh),
                             GR_SNAC_MEM("view", s->view),
-                            GR_SNAC_VAL("rate_dt", rate_dt),
-                            GR_SNAC_VAL("amplitude", amplitude),
+                            GR_SNAC_VAL("rate_dt", sv->rate_dt),
+                            GR_SNAC_VAL("amplitude", sv->amplitude),
                             GR_SNAC_MEM("noise", s->noise),
                             GR_SNAC_MEM("exposure", s->arr[6]),
                             GR_SNAC_MEM("growth", s->growth)};
+  gr_status st = gr_snac_args(s, s->exposure_k, ex, sizeof(ex) / sizeof(ex[0]));
   if (st == GR_OK)
-    st = gr_snac_args(s, s->exposure_k, ex, sizeof(ex) / sizeof(ex[0]));
-  if (st == GR_OK)
-    st = gr_enqueue_2d(ctx, s->exposure_k, 0, 0, (size_t)nx, (size_t)ny, NULL);
+    st = gr_enqueue_2d(s->ctx, s->exposure_k, 0, 0, (size_t)sv->nx, (size_t)sv->ny, NULL);
   if (st == GR_OK)
     st = gr_snac_mark(s, &s->tm.exposure_ms);
+  return st;
+}
 
-  /* 4. blur and dilation, between growth and scratch */
+/* 4. blur and dilation, between growth and scratch; *cur gets the buffer
+ * that holds the result. */
+static gr_status gr_snac_blur_growth(gr_snow_accumulation *s, gr_snac_step_vars *sv,
+                                     cl_mem *cur_out) {
+  gr_context *ctx = s->ctx;
+  gr_status st = GR_OK;
   cl_mem cur = s->growth, other = s->scratch;
-  cl_int radius = p->blur_radius;
+  cl_int radius = s->params.blur_radius;
   for (cl_int axis = 0; st == GR_OK && radius > 0 && axis < 2; ++axis) {
-    const gr_snac_arg bl[] = {GR_SNAC_MEM("in", cur),    GR_SNAC_VAL("nx", nx),
-                              GR_SNAC_VAL("ny", ny),     GR_SNAC_VAL("radius", radius),
+    const gr_snac_arg bl[] = {GR_SNAC_MEM("in", cur),    GR_SNAC_VAL("nx", sv->nx),
+                              GR_SNAC_VAL("ny", sv->ny), GR_SNAC_VAL("radius", radius),
                               GR_SNAC_VAL("axis", axis), GR_SNAC_MEM("w", s->weights),
                               GR_SNAC_MEM("out", other)};
     st = gr_snac_args(s, s->blur, bl, sizeof(bl) / sizeof(bl[0]));
     if (st == GR_OK)
-      st = gr_enqueue_2d(ctx, s->blur, 0, 0, (size_t)nx, (size_t)ny, NULL);
+      st = gr_enqueue_2d(ctx, s->blur, 0, 0, (size_t)sv->nx, (size_t)sv->ny, NULL);
     cl_mem t = cur;
     cur = other, other = t;
   }
-  if (st == GR_OK && p->dilation) {
-    const gr_snac_arg dl[] = {GR_SNAC_MEM("in", cur), GR_SNAC_VAL("nx", nx), GR_SNAC_VAL("ny", ny),
-                              GR_SNAC_MEM("out", other)};
+  if (st == GR_OK && s->params.dilation) {
+    const gr_snac_arg dl[] = {GR_SNAC_MEM("in", cur), GR_SNAC_VAL("nx", sv->nx),
+                              GR_SNAC_VAL("ny", sv->ny), GR_SNAC_MEM("out", other)};
     st = gr_snac_args(s, s->dilate, dl, sizeof(dl) / sizeof(dl[0]));
     if (st == GR_OK)
-      st = gr_enqueue_2d(ctx, s->dilate, 0, 0, (size_t)nx, (size_t)ny, NULL);
+      st = gr_enqueue_2d(ctx, s->dilate, 0, 0, (size_t)sv->nx, (size_t)sv->ny, NULL);
     cl_mem t = cur;
     cur = other, other = t;
   }
   if (st == GR_OK)
     st = gr_snac_mark(s, &s->tm.blur_ms);
+  *cur_out = cur;
+  return st;
+}
 
-  /* 5. increment and stability */
+/* 5. increment and stability of the grid points from the growth in cur;
+ * then a piece's ring: the snow depth the next step's normals, blur and
+ * view (and this step's objects) read beyond its own rows. */
+static gr_status gr_snac_apply_growth(gr_snow_accumulation *s, gr_snac_step_vars *sv, cl_mem cur) {
+  gr_context *ctx = s->ctx;
   const gr_snac_arg ap[] = {GR_SNAC_MEM("ground", s->ground),
-                            GR_SNAC_VAL("nx", nx),
-                            GR_SNAC_VAL("ny", ny),
-                            GR_SNAC_VAL("dx", dx),
-                            GR_SNAC_VAL("dy", dy),
+                            GR_SNAC_VAL("nx", sv->nx),
+                            GR_SNAC_VAL("ny", sv->ny),
+                            GR_SNAC_VAL("dx", sv->dx),
+                            GR_SNAC_VAL("dy", sv->dy),
                             GR_SNAC_MEM("growth", cur),
-                            GR_SNAC_VAL("max_depth", max_depth),
-                            GR_SNAC_VAL("keep", keep),
-                            GR_SNAC_VAL("kdt", kdt),
+                            GR_SNAC_VAL("max_depth", sv->max_depth),
+                            GR_SNAC_VAL("keep", sv->keep),
+                            GR_SNAC_VAL("kdt", sv->kdt),
                             GR_SNAC_MEM("depth", s->arr[0]),
                             GR_SNAC_MEM("depth_lo", s->arr[1]),
                             GR_SNAC_MEM("fall", s->arr[2]),
                             GR_SNAC_MEM("fall_lo", s->arr[3]),
                             GR_SNAC_MEM("shed", s->arr[4]),
                             GR_SNAC_MEM("shed_lo", s->arr[5])};
+  gr_status st = gr_snac_args(s, s->apply, ap, sizeof(ap) / sizeof(ap[0]));
   if (st == GR_OK)
-    st = gr_snac_args(s, s->apply, ap, sizeof(ap) / sizeof(ap[0]));
-  if (st == GR_OK)
-    st = gr_enqueue_2d(ctx, s->apply, 0, 0, (size_t)nx, (size_t)ny, NULL);
+    st = gr_enqueue_2d(ctx, s->apply, 0, 0, (size_t)sv->nx, (size_t)sv->ny, NULL);
   if (st == GR_OK)
     st = gr_snac_mark(s, &s->tm.apply_ms);
-  /* A piece's ring: the snow depth the next step's normals, blur and view
-   * (and this step's objects) read beyond its own rows. */
-  if (st == GR_OK && pieced) {
+  if (st == GR_OK && sv->pieced) {
     st = s->halo_exchange(s->halo_user);
     if (st != GR_OK)
       st = gr_set_error(ctx, st,
@@ -570,77 +577,127 @@ static gr_status gr_snac_step_impl(gr_snow_accumulation *s, double dt) {
                         "piece's ring is not fresh, so restore a checkpoint before stepping on.",
                         s->steps + 1, gr_status_string(st));
   }
+  return st;
+}
 
-  /* the objects' faces (their centroids), then the accumulation textures'
-   * samples: the same exposure, growth and stability, on their own arrays */
-  for (int pass = 0; pass < 2; ++pass) {
-    cl_int nv = pass ? s->ns : s->ntri;
-    if (st != GR_OK || nv == 0)
-      continue;
-    const cl_mem *A = pass ? s->t_arr : s->o_arr;
-    const cl_mem *P = pass ? &s->t_pos : &s->o_pos, *N = pass ? &s->t_nrm : &s->o_nrm,
-                 *L = pass ? &s->t_local : &s->o_local;
-    const gr_snac_arg ob[] = {GR_SNAC_MEM("pos", *P),
-                              GR_SNAC_MEM("nrm", *N),
-                              GR_SNAC_MEM("lattice", *L),
-                              GR_SNAC_VAL("nv", nv),
-                              GR_SNAC_VAL("dir_x", dir_x),
-                              GR_SNAC_VAL("dir_y", dir_y),
-                              GR_SNAC_VAL("dir_z", dir_z),
-                              GR_SNAC_VAL("tau_x", v.tau_x),
-                              GR_SNAC_VAL("tau_y", v.tau_y),
-                              GR_SNAC_VAL("qx0", v.qx0),
-                              GR_SNAC_VAL("qy0", v.qy0),
-                              GR_SNAC_VAL("inv_texel", v.inv_texel),
-                              GR_SNAC_VAL("texel", v.texel),
-                              GR_SNAC_VAL("vw", vw),
-                              GR_SNAC_VAL("vh", vh),
-                              GR_SNAC_MEM("view", s->view),
-                              GR_SNAC_VAL("rate_dt", rate_dt),
-                              GR_SNAC_VAL("amplitude", amplitude),
-                              GR_SNAC_VAL("seed", seed),
-                              GR_SNAC_VAL("max_depth", max_depth),
-                              GR_SNAC_VAL("keep", keep),
-                              GR_SNAC_VAL("kdt", kdt),
-                              GR_SNAC_VAL("terrain_drawn", terrain_drawn),
-                              GR_SNAC_MEM("ground", s->ground),
-                              GR_SNAC_MEM("gdepth", s->arr[0]),
-                              GR_SNAC_VAL("gnx", nx),
-                              GR_SNAC_VAL("gny", ny),
-                              GR_SNAC_VAL("gdx", dx),
-                              GR_SNAC_VAL("gdy", dy),
-                              GR_SNAC_VAL("zref", zref),
-                              GR_SNAC_MEM("exposure", A[6]),
-                              GR_SNAC_MEM("depth", A[0]),
-                              GR_SNAC_MEM("depth_lo", A[1]),
-                              GR_SNAC_MEM("fall", A[2]),
-                              GR_SNAC_MEM("fall_lo", A[3]),
-                              GR_SNAC_MEM("shed", A[4]),
-                              GR_SNAC_MEM("shed_lo", A[5])};
-    /* On a piece, the surface under the points when the objects kernel
-     * needs it (no terrain in the view) comes from the pieces that hold
-     * it. */
-    cl_int have_surface = pieced && !terrain_drawn;
-    cl_int have_exposure = pieced && terrain_drawn && s->objects_by_point;
-    if (have_surface)
-      st = gr_snac_object_surface(s, *P, *N, nv, v.texel);
-    if (have_exposure) {
-      const float dir[3] = {dir_x, dir_y, dir_z};
-      st = gr_snac_object_exposure(s, *P, *N, nv, &v, dir);
-    }
-    cl_mem surf = have_surface || have_exposure ? s->o_surface : s->ground;
-    const gr_snac_arg ob2[] = {GR_SNAC_VAL("have_surface", have_surface),
-                               GR_SNAC_VAL("have_exposure", have_exposure),
-                               GR_SNAC_MEM("surface", surf)};
-    if (st == GR_OK)
-      st = gr_snac_args(s, s->objects_k, ob, sizeof(ob) / sizeof(ob[0]));
-    if (st == GR_OK)
-      st = gr_snac_args(s, s->objects_k, ob2, sizeof(ob2) / sizeof(ob2[0]));
-    if (st == GR_OK)
-      st = gr_enqueue_1d(ctx, s->objects_k, (size_t)nv);
-    if (st == GR_OK)
-      st = gr_snac_mark(s, &s->tm.objects_ms);
+/* The same exposure, growth and stability on the objects' own arrays:
+ * pass 0 their faces (centroids), pass 1 the accumulation textures'
+ * samples. */
+static gr_status gr_snac_grow_objects(gr_snow_accumulation *s, gr_snac_step_vars *sv, int pass) {
+  gr_context *ctx = s->ctx;
+  const gr_snac_view *v = &sv->v;
+  gr_status st = GR_OK;
+  cl_int nv = pass ? s->ns : s->ntri;
+  if (nv == 0)
+    return GR_OK;
+  const cl_mem *A = pass ? s->t_arr : s->o_arr;
+  const cl_mem *P = pass ? &s->t_pos : &s->o_pos, *N = pass ? &s->t_nrm : &s->o_nrm,
+               *L = pass ? &s->t_local : &s->o_local;
+  const gr_snac_arg ob[] = {GR_SNAC_MEM("pos", *P),
+                            GR_SNAC_MEM("nrm", *N),
+                            GR_SNAC_MEM("lattice", *L),
+                            GR_SNAC_VAL("nv", nv),
+                            GR_SNAC_VAL("dir_x", sv->dir_x),
+                            GR_SNAC_VAL("dir_y", sv->dir_y),
+                            GR_SNAC_VAL("dir_z", sv->dir_z),
+                            GR_SNAC_VAL("tau_x", v->tau_x),
+                            GR_SNAC_VAL("tau_y", v->tau_y),
+                            GR_SNAC_VAL("qx0", v->qx0),
+                            GR_SNAC_VAL("qy0", v->qy0),
+                            GR_SNAC_VAL("inv_texel", v->inv_texel),
+                            GR_SNAC_VAL("texel", v->texel),
+                            GR_SNAC_VAL("vw", sv->vw),
+                            GR_SNAC_VAL("vh", sv->vh),
+                            GR_SNAC_MEM("view", s->view),
+                            GR_SNAC_VAL("rate_dt", sv->rate_dt),
+                            GR_SNAC_VAL("amplitude", sv->amplitude),
+                            GR_SNAC_VAL("seed", sv->seed),
+                            GR_SNAC_VAL("max_depth", sv->max_depth),
+                            GR_SNAC_VAL("keep", sv->keep),
+                            GR_SNAC_VAL("kdt", sv->kdt),
+                            GR_SNAC_VAL("terrain_drawn", sv->terrain_drawn),
+                            GR_SNAC_MEM("ground", s->ground),
+                            GR_SNAC_MEM("gdepth", s->arr[0]),
+                            GR_SNAC_VAL("gnx", sv->nx),
+                            GR_SNAC_VAL("gny", sv->ny),
+                            GR_SNAC_VAL("gdx", sv->dx),
+                            GR_SNAC_VAL("gdy", sv->dy),
+                            GR_SNAC_VAL("zref", sv->zref),
+                            GR_SNAC_MEM("exposure", A[6]),
+                            GR_SNAC_MEM("depth", A[0]),
+                            GR_SNAC_MEM("depth_lo", A[1]),
+                            GR_SNAC_MEM("fall", A[2]),
+                            GR_SNAC_MEM("fall_lo", A[3]),
+                            GR_SNAC_MEM("shed", A[4]),
+                            GR_SNAC_MEM("shed_lo", A[5])};
+  /* On a piece, the surface under the points when the objects kernel
+   * needs it (no terrain in the view) comes from the pieces that hold
+   * it. */
+  cl_int have_surface = sv->pieced && !sv->terrain_drawn;
+  cl_int have_exposure = sv->pieced && sv->terrain_drawn && s->objects_by_point;
+  if (have_surface)
+    st = gr_snac_object_surface(s, *P, *N, nv, v->texel);
+  if (have_exposure) {
+    const float dir[3] = {sv->dir_x, sv->dir_y, sv->dir_z};
+    st = gr_snac_object_exposure(s, *P, *N, nv, v, dir);
   }
+  cl_mem surf = have_surface || have_exposure ? s->o_surface : s->ground;
+  const gr_snac_arg ob2[] = {GR_SNAC_VAL("have_surface", have_surface),
+                             GR_SNAC_VAL("have_exposure", have_exposure),
+                             GR_SNAC_MEM("surface", surf)};
+  if (st == GR_OK)
+    st = gr_snac_args(s, s->objects_k, ob, sizeof(ob) / sizeof(ob[0]));
+  if (st == GR_OK)
+    st = gr_snac_args(s, s->objects_k, ob2, sizeof(ob2) / sizeof(ob2[0]));
+  if (st == GR_OK)
+    st = gr_enqueue_1d(ctx, s->objects_k, (size_t)nv);
+  if (st == GR_OK)
+    st = gr_snac_mark(s, &s->tm.objects_ms);
+  return st;
+}
+
+static gr_status gr_snac_step_impl(gr_snow_accumulation *s, double dt) {
+  gr_context *ctx = s->ctx;
+  const gr_grid *g = &s->grid;
+  double t0 = gr_snac_now_ms();
+  if (s->timing) {
+    gr_status st = gr_finish(ctx);
+    if (st != GR_OK)
+      return st;
+    t0 = s->t_mark = gr_snac_now_ms();
+  }
+  double dd[3];
+  gr_snac_direction(s, dd);
+  gr_snac_step_vars sv;
+  memset(&sv, 0, sizeof(sv));
+  sv.nx = g->nx, sv.ny = g->ny, sv.gi0 = 0, sv.gj0 = s->row0;
+  sv.dx = (float)g->dx, sv.dy = (float)g->dy;
+  sv.pieced = gr_snac_pieced(s);
+  if (sv.pieced && (!s->allreduce || !s->halo_exchange))
+    return gr_set_error(ctx, GR_ERR_INVALID_ARGUMENT,
+                        "A snow accumulation piece with neighbours steps only with an allreduce "
+                        "and a halo exchange set (gr_snow_accumulation_set_allreduce, "
+                        "gr_snow_accumulation_set_halo_exchange).");
+  gr_status st = gr_snac_terrain_drawn(s, dd, &sv);
+  if (st != GR_OK)
+    return st;
+  gr_snac_step_rates(s, dt, dd, &sv);
+  st = gr_snac_make_noise(s, &sv);
+  if (s->timing)
+    s->tm.host_ms += gr_snac_now_ms() - t0, s->t_mark = gr_snac_now_ms();
+  if (st != GR_OK)
+    return st;
+
+  st = gr_snac_draw_view(s, &sv);
+  if (st == GR_OK)
+    st = gr_snac_grow_points(s, &sv);
+  cl_mem cur = s->growth;
+  if (st == GR_OK)
+    st = gr_snac_blur_growth(s, &sv, &cur);
+  if (st == GR_OK)
+    st = gr_snac_apply_growth(s, &sv, cur);
+  for (int pass = 0; st == GR_OK && pass < 2; ++pass)
+    st = gr_snac_grow_objects(s, &sv, pass);
   if (st == GR_OK && s->timing)
     s->tm.steps++;
   if (st == GR_OK && (s->steps + 1) % GR_SNAC_SYNC_EVERY == 0)
