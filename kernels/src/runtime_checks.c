@@ -246,17 +246,8 @@ gr_status gr_mesh_check(gr_mesh_memo *memo, const gr_mesh *m, int closed, char *
   return GR_OK;
 }
 
-gr_status gr_mesh_validate(const gr_mesh *m, int closed, char *msg, size_t msg_len) {
-  if (!m)
-    return gr_invalid(msg, msg_len, "Invalid mesh: no mesh was given.");
-  if (m->ntriangles < 1 || !m->triangles)
-    return gr_invalid(msg, msg_len,
-                      "Invalid mesh: it has %d triangles; give at least one triangle.",
-                      m->ntriangles);
-  if (m->nvertices < 3 || !m->vertices)
-    return gr_invalid(msg, msg_len,
-                      "Invalid mesh: it has %d vertices; a triangle needs at least three.",
-                      m->nvertices);
+/* The vertices' part of gr_mesh_validate: every coordinate finite. */
+static gr_status gr_mesh_vertices_check(const gr_mesh *m, char *msg, size_t msg_len) {
   for (int v = 0; v < m->nvertices; ++v)
     for (int a = 0; a < 3; ++a)
       if (!isfinite(m->vertices[3 * v + a]))
@@ -264,53 +255,53 @@ gr_status gr_mesh_validate(const gr_mesh *m, int closed, char *msg, size_t msg_l
                           "Invalid mesh: vertex %d has %s = %g; vertex coordinates must be "
                           "finite metres.",
                           v, gr_axis[a], (double)m->vertices[3 * v + a]);
-  for (int t = 0; t < m->ntriangles; ++t) {
-    const int *tri = m->triangles + 3 * t;
-    for (int k = 0; k < 3; ++k)
-      if (tri[k] < 0 || tri[k] >= m->nvertices)
-        return gr_invalid(msg, msg_len,
-                          "Invalid mesh: triangle %d refers to vertex %d, but the vertices are "
-                          "0 to %d.",
-                          t, tri[k], m->nvertices - 1);
-    const float *p0 = m->vertices + 3 * tri[0], *p1 = m->vertices + 3 * tri[1],
-                *p2 = m->vertices + 3 * tri[2];
-    double e1[3], e2[3];
-    for (int a = 0; a < 3; ++a) {
-      e1[a] = (double)p1[a] - p0[a];
-      e2[a] = (double)p2[a] - p0[a];
-    }
-    double cx = e1[1] * e2[2] - e1[2] * e2[1], cy = e1[2] * e2[0] - e1[0] * e2[2],
-           cz = e1[0] * e2[1] - e1[1] * e2[0];
-    double cross = sqrt(cx * cx + cy * cy + cz * cz);
-    double l1 = sqrt(e1[0] * e1[0] + e1[1] * e1[1] + e1[2] * e1[2]);
-    double l2 = sqrt(e2[0] * e2[0] + e2[1] * e2[1] + e2[2] * e2[2]);
-    /* Relative to the edge lengths: collinear corners, not small ones. */
-    if (!(cross > 1e-12 * l1 * l2))
-      return gr_invalid(msg, msg_len,
-                        "Invalid mesh: triangle %d (vertices %d, %d, %d) has zero area; remove "
-                        "it or move its corners apart.",
-                        t, tri[0], tri[1], tri[2]);
-  }
-  gr_status st = gr_mesh_transform_check(m->transform, msg, msg_len);
-  if (st != GR_OK)
-    return st;
-  if (!closed)
-    return GR_OK;
+  return GR_OK;
+}
 
-  /* The edges in gr_edge_cmp's order: counted into buckets by their lower
-   * vertex in triangle order (a stable counting sort, linear: a simulation
-   * checks its objects every step), then each bucket, a vertex's few edges,
-   * sorted by the upper vertex, stably. */
+/* Triangle t's part of gr_mesh_validate: its indices in range and its
+ * corners not collinear. */
+static gr_status gr_mesh_triangle_check(const gr_mesh *m, int t, char *msg, size_t msg_len) {
+  const int *tri = m->triangles + 3 * t;
+  for (int k = 0; k < 3; ++k)
+    if (tri[k] < 0 || tri[k] >= m->nvertices)
+      return gr_invalid(msg, msg_len,
+                        "Invalid mesh: triangle %d refers to vertex %d, but the vertices are "
+                        "0 to %d.",
+                        t, tri[k], m->nvertices - 1);
+  const float *p0 = m->vertices + 3 * tri[0], *p1 = m->vertices + 3 * tri[1],
+              *p2 = m->vertices + 3 * tri[2];
+  double e1[3], e2[3];
+  for (int a = 0; a < 3; ++a) {
+    e1[a] = (double)p1[a] - p0[a];
+    e2[a] = (double)p2[a] - p0[a];
+  }
+  double cx = e1[1] * e2[2] - e1[2] * e2[1], cy = e1[2] * e2[0] - e1[0] * e2[2],
+         cz = e1[0] * e2[1] - e1[1] * e2[0];
+  double cross = sqrt(cx * cx + cy * cy + cz * cz);
+  double l1 = sqrt(e1[0] * e1[0] + e1[1] * e1[1] + e1[2] * e1[2]);
+  double l2 = sqrt(e2[0] * e2[0] + e2[1] * e2[1] + e2[2] * e2[2]);
+  /* Relative to the edge lengths: collinear corners, not small ones. */
+  if (!(cross > 1e-12 * l1 * l2))
+    return gr_invalid(msg, msg_len,
+                      "Invalid mesh: triangle %d (vertices %d, %d, %d) has zero area; remove "
+                      "it or move its corners apart.",
+                      t, tri[0], tri[1], tri[2]);
+  return GR_OK;
+}
+
+/* The 3 * ntriangles edges of m in gr_edge_cmp's order: counted into
+ * buckets by their lower vertex in triangle order (a stable counting sort,
+ * linear: a simulation checks its objects every step), then each bucket, a
+ * vertex's few edges, sorted by the upper vertex, stably. NULL when out of
+ * memory. */
+static gr_edge *gr_mesh_sorted_edges(const gr_mesh *m) {
   size_t ne = 3 * (size_t)m->ntriangles;
   gr_edge *edges = malloc(ne * sizeof(*edges));
   size_t *start = calloc((size_t)m->nvertices + 1, sizeof(*start));
   if (!edges || !start) {
     free(edges);
     free(start);
-    if (msg && msg_len)
-      snprintf(msg, msg_len, "Out of host memory while checking a mesh of %d triangles.",
-               m->ntriangles);
-    return GR_ERR_OUT_OF_MEMORY;
+    return NULL;
   }
   for (size_t q = 0; q < ne; ++q) {
     int a = m->triangles[q], b = m->triangles[q % 3 == 2 ? q - 2 : q + 1];
@@ -345,7 +336,13 @@ gr_status gr_mesh_validate(const gr_mesh *m, int closed, char *msg, size_t msg_l
     i += n;
   }
   free(start);
-  st = GR_OK;
+  return edges;
+}
+
+/* The closed surface's part of gr_mesh_validate, on the sorted edges:
+ * every edge shared by exactly two triangles, run in opposite ways. */
+static gr_status gr_mesh_edges_check(const gr_edge *edges, size_t ne, char *msg, size_t msg_len) {
+  gr_status st = GR_OK;
   for (size_t i = 0; i < ne && st == GR_OK;) {
     size_t n = 1;
     while (i + n < ne && edges[i + n].lo == edges[i].lo && edges[i + n].hi == edges[i].hi)
@@ -370,6 +367,35 @@ gr_status gr_mesh_validate(const gr_mesh *m, int closed, char *msg, size_t msg_l
                       e[0].triangle, e[1].triangle, e->lo, e->hi);
     i += n;
   }
+  return st;
+}
+
+gr_status gr_mesh_validate(const gr_mesh *m, int closed, char *msg, size_t msg_len) {
+  if (!m)
+    return gr_invalid(msg, msg_len, "Invalid mesh: no mesh was given.");
+  if (m->ntriangles < 1 || !m->triangles)
+    return gr_invalid(msg, msg_len,
+                      "Invalid mesh: it has %d triangles; give at least one triangle.",
+                      m->ntriangles);
+  if (m->nvertices < 3 || !m->vertices)
+    return gr_invalid(msg, msg_len,
+                      "Invalid mesh: it has %d vertices; a triangle needs at least three.",
+                      m->nvertices);
+  gr_status st = gr_mesh_vertices_check(m, msg, msg_len);
+  for (int t = 0; st == GR_OK && t < m->ntriangles; ++t)
+    st = gr_mesh_triangle_check(m, t, msg, msg_len);
+  if (st == GR_OK)
+    st = gr_mesh_transform_check(m->transform, msg, msg_len);
+  if (st != GR_OK || !closed)
+    return st;
+  gr_edge *edges = gr_mesh_sorted_edges(m);
+  if (!edges) {
+    if (msg && msg_len)
+      snprintf(msg, msg_len, "Out of host memory while checking a mesh of %d triangles.",
+               m->ntriangles);
+    return GR_ERR_OUT_OF_MEMORY;
+  }
+  st = gr_mesh_edges_check(edges, 3 * (size_t)m->ntriangles, msg, msg_len);
   free(edges);
   return st;
 }
