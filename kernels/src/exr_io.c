@@ -376,32 +376,10 @@ static int64_t memory_size(exr_const_context_t ctxt, void *userdata) {
   return (uint64_t)src->size > (uint64_t)INT64_MAX ? INT64_MAX : (int64_t)src->size;
 }
 
-/* gr_exr_read and gr_exr_read_memory: opens the file or the buffer of src
- * (label names it in every message: the path of a file), then parses, checks
- * and decodes part 0. The arguments are checked by the callers. */
-static gr_status read_exr(const char *label, read_source *src, gr_exr_image *out, char *err,
-                          size_t err_len) {
-  gr_status st = GR_OK;
-  exr_result_t rv;
-  exr_context_t ctxt = NULL;
+/* Opens the file or the buffer of src as *ctxt (label names it). */
+static gr_status read_open(const char *label, read_source *src, exr_context_t *ctxt, char *err,
+                           size_t err_len) {
   exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
-  exr_decode_pipeline_t dec;
-  int dec_live = 0;
-  gr_exr_msg *msg = &src->msg;
-  exr_storage_t storage = EXR_STORAGE_LAST_TYPE;
-  const exr_attr_chlist_t *chlist = NULL;
-  chunk_layout L;
-  chunk_fault fault;
-  size_t npix, c;
-  int nparts = 0, pass;
-  gr_exr_image img;
-
-  memset(&img, 0, sizeof img);
-  memset(&dec, 0, sizeof dec);
-  memset(msg, 0, sizeof *msg);
-  memset(&L, 0, sizeof L);
-  memset(&fault, 0, sizeof fault);
-
   init.error_handler_fn = &gr_exr_capture_error;
   init.user_data = src;
   init.max_image_width = GR_EXR_MAX_DIM;
@@ -412,247 +390,294 @@ static gr_status read_exr(const char *label, read_source *src, gr_exr_image *out
     init.read_fn = &memory_read;
     init.size_fn = &memory_size;
   }
+  exr_result_t rv = exr_start_read(ctxt, label, &init);
+  if (rv == EXR_ERR_SUCCESS)
+    return GR_OK;
+  if (rv == EXR_ERR_FILE_ACCESS)
+    gr_exr_set_err(err, err_len, "Cannot read '%s': the file cannot be opened (OpenEXR: %s).",
+                   label, gr_exr_detail(&src->msg, rv));
+  else
+    gr_exr_set_err(err, err_len, "Cannot read '%s': it is not a valid OpenEXR file (OpenEXR: %s).",
+                   label, gr_exr_detail(&src->msg, rv));
+  return read_status(rv);
+}
 
-  rv = exr_start_read(&ctxt, label, &init);
-  if (rv != EXR_ERR_SUCCESS) {
-    st = read_status(rv);
-    if (rv == EXR_ERR_FILE_ACCESS)
-      gr_exr_set_err(err, err_len, "Cannot read '%s': the file cannot be opened (OpenEXR: %s).",
-                     label, gr_exr_detail(msg, rv));
-    else
-      gr_exr_set_err(err, err_len,
-                     "Cannot read '%s': it is not a valid OpenEXR file (OpenEXR: %s).", label,
-                     gr_exr_detail(msg, rv));
-    goto cleanup;
-  }
-  L.ctxt = ctxt;
-
-  rv = exr_get_count(ctxt, &nparts);
+/* Part 0's header: its storage, data window (into L) and channels; deep
+ * data is refused. */
+static gr_status read_header(const char *label, const gr_exr_msg *msg, chunk_layout *L,
+                             exr_storage_t *storage, const exr_attr_chlist_t **chlist, char *err,
+                             size_t err_len) {
+  int nparts = 0;
+  exr_result_t rv = exr_get_count(L->ctxt, &nparts);
   if (rv == EXR_ERR_SUCCESS && nparts < 1)
     rv = EXR_ERR_FILE_BAD_HEADER;
   if (rv == EXR_ERR_SUCCESS)
-    rv = exr_get_storage(ctxt, 0, &storage);
+    rv = exr_get_storage(L->ctxt, 0, storage);
   if (rv == EXR_ERR_SUCCESS)
-    rv = exr_get_data_window(ctxt, 0, &L.dw);
+    rv = exr_get_data_window(L->ctxt, 0, &L->dw);
   if (rv == EXR_ERR_SUCCESS)
-    rv = exr_get_channels(ctxt, 0, &chlist);
-  if (rv == EXR_ERR_SUCCESS && chlist == NULL)
+    rv = exr_get_channels(L->ctxt, 0, chlist);
+  if (rv == EXR_ERR_SUCCESS && *chlist == NULL)
     rv = EXR_ERR_MISSING_REQ_ATTR;
   if (rv != EXR_ERR_SUCCESS) {
-    st = read_status(rv);
     gr_exr_set_err(err, err_len, "Cannot read '%s': its header is incomplete (OpenEXR: %s).", label,
                    gr_exr_detail(msg, rv));
-    goto cleanup;
+    return read_status(rv);
   }
-  if (storage != EXR_STORAGE_SCANLINE && storage != EXR_STORAGE_TILED) {
-    st = GR_ERR_FORMAT;
+  if (*storage != EXR_STORAGE_SCANLINE && *storage != EXR_STORAGE_TILED) {
     gr_exr_set_err(err, err_len, "Cannot read '%s': it holds deep data, which is not supported.",
                    label);
-    goto cleanup;
+    return GR_ERR_FORMAT;
   }
+  return GR_OK;
+}
 
-  /* Size guards, before anything is allocated. */
-  L.width = (int64_t)L.dw.max.x - (int64_t)L.dw.min.x + 1;
-  L.height = (int64_t)L.dw.max.y - (int64_t)L.dw.min.y + 1;
-  if (L.width < 1 || L.height < 1 || L.width > GR_EXR_MAX_DIM || L.height > GR_EXR_MAX_DIM) {
-    st = GR_ERR_FORMAT;
+/* Size guards, before anything is allocated: the data window, the samples
+ * (*npix pixels a channel) and the memory the planes take. */
+static gr_status read_size_guards(const char *label, chunk_layout *L,
+                                  const exr_attr_chlist_t *chlist, size_t *npix, char *err,
+                                  size_t err_len) {
+  L->width = (int64_t)L->dw.max.x - (int64_t)L->dw.min.x + 1;
+  L->height = (int64_t)L->dw.max.y - (int64_t)L->dw.min.y + 1;
+  if (L->width < 1 || L->height < 1 || L->width > GR_EXR_MAX_DIM || L->height > GR_EXR_MAX_DIM) {
     gr_exr_set_err(err, err_len,
                    "Cannot read '%s': its data window is %lld by %lld pixels, outside "
                    "1 to %d.",
-                   label, (long long)L.width, (long long)L.height, GR_EXR_MAX_DIM);
-    goto cleanup;
+                   label, (long long)L->width, (long long)L->height, GR_EXR_MAX_DIM);
+    return GR_ERR_FORMAT;
   }
   if (chlist->num_channels < 1 || chlist->entries == NULL) {
-    st = GR_ERR_FORMAT;
     gr_exr_set_err(err, err_len, "Cannot read '%s': it has no channels.", label);
-    goto cleanup;
+    return GR_ERR_FORMAT;
   }
-  npix = (size_t)L.width * (size_t)L.height;
-  if (npix > GR_EXR_MAX_SAMPLES / (size_t)chlist->num_channels || npix > SIZE_MAX / sizeof(float)) {
-    st = GR_ERR_FORMAT;
+  *npix = (size_t)L->width * (size_t)L->height;
+  if (*npix > GR_EXR_MAX_SAMPLES / (size_t)chlist->num_channels ||
+      *npix > SIZE_MAX / sizeof(float)) {
     gr_exr_set_err(err, err_len,
                    "Cannot read '%s': %lld by %lld pixels in %d channels is more than "
                    "the %llu samples allowed.",
-                   label, (long long)L.width, (long long)L.height, chlist->num_channels,
+                   label, (long long)L->width, (long long)L->height, chlist->num_channels,
                    (unsigned long long)GR_EXR_MAX_SAMPLES);
-    goto cleanup;
+    return GR_ERR_FORMAT;
   }
-  {
-    /* The planes, before anything is decoded: a file that does not fit is
-     * refused at once, not after minutes of decoding or by a failed malloc
-     * under the kernel's overcommit. */
-    gr_memory_need need;
-    char why[200];
-    memset(&need, 0, sizeof(need));
-    need.points = (double)npix;
-    need.host = (double)npix * (double)chlist->num_channels * sizeof(float);
-    if (gr_memory_check(NULL, &need, why, sizeof(why)) != GR_OK) {
-      st = GR_ERR_TOO_LARGE;
-      gr_exr_set_err(err, err_len,
-                     "Cannot read '%s': the image of %lld by %lld pixels in %d channels %s.", label,
-                     (long long)L.width, (long long)L.height, chlist->num_channels, why);
-      goto cleanup;
-    }
+  /* The planes, before anything is decoded: a file that does not fit is
+   * refused at once, not after minutes of decoding or by a failed malloc
+   * under the kernel's overcommit. */
+  gr_memory_need need;
+  char why[200];
+  memset(&need, 0, sizeof(need));
+  need.points = (double)*npix;
+  need.host = (double)*npix * (double)chlist->num_channels * sizeof(float);
+  if (gr_memory_check(NULL, &need, why, sizeof(why)) != GR_OK) {
+    gr_exr_set_err(err, err_len,
+                   "Cannot read '%s': the image of %lld by %lld pixels in %d channels %s.", label,
+                   (long long)L->width, (long long)L->height, chlist->num_channels, why);
+    return GR_ERR_TOO_LARGE;
   }
-  for (c = 0; c < (size_t)chlist->num_channels; ++c) {
+  return GR_OK;
+}
+
+/* Every channel HALF or FLOAT, not subsampled, with a name. */
+static gr_status read_check_channels(const char *label, const exr_attr_chlist_t *chlist, char *err,
+                                     size_t err_len) {
+  for (size_t c = 0; c < (size_t)chlist->num_channels; ++c) {
     const exr_attr_chlist_entry_t *e = &chlist->entries[c];
     const char *nm = e->name.str != NULL ? e->name.str : "";
     if (e->pixel_type != EXR_PIXEL_HALF && e->pixel_type != EXR_PIXEL_FLOAT) {
-      st = GR_ERR_FORMAT;
       gr_exr_set_err(err, err_len,
                      "Cannot read '%s': channel '%s' is %s, and only HALF and FLOAT "
                      "channels are supported.",
                      label, nm, pixel_type_name(e->pixel_type));
-      goto cleanup;
+      return GR_ERR_FORMAT;
     }
     if (e->x_sampling != 1 || e->y_sampling != 1) {
-      st = GR_ERR_FORMAT;
       gr_exr_set_err(err, err_len,
                      "Cannot read '%s': channel '%s' is subsampled (%d by %d), which "
                      "is not supported.",
                      label, nm, (int)e->x_sampling, (int)e->y_sampling);
-      goto cleanup;
+      return GR_ERR_FORMAT;
     }
     if (nm[0] == '\0' || strlen(nm) > GR_EXR_MAX_NAME) {
-      st = GR_ERR_FORMAT;
       gr_exr_set_err(err, err_len, "Cannot read '%s': channel %d has an empty or over-long name.",
                      label, (int)c);
-      goto cleanup;
+      return GR_ERR_FORMAT;
     }
   }
+  return GR_OK;
+}
 
-  st = gr_exr_meta_read(ctxt, label, &img.meta, err, err_len);
-  if (st != GR_OK)
-    goto cleanup;
-
-  /* Chunk layout: scanlines per chunk, or level-0 tiles. */
-  {
-    exr_compression_t comp = EXR_COMPRESSION_NONE;
-    rv = exr_get_compression(ctxt, 0, &comp);
-    if (rv != EXR_ERR_SUCCESS) {
-      st = GR_ERR_FORMAT;
-      gr_exr_set_err(err, err_len,
-                     "Cannot read '%s': its compression is not understood (OpenEXR: %s).", label,
-                     gr_exr_detail(msg, rv));
-      goto cleanup;
-    }
-    L.compression = comp;
-    L.expand = max_expansion(comp);
-    /* DWA the library cannot decode: allow only raw-stored chunks, so that a
-     * small hostile file cannot claim gigabytes (DWA packs about 66000:1)
-     * and be refused only after the image was allocated. */
-    L.undecodable =
-        (comp == EXR_COMPRESSION_DWAA || comp == EXR_COMPRESSION_DWAB) && !core_decodes_dwa();
-    if (L.undecodable)
-      L.expand = 1;
+/* The chunk layout into L: the compression (and the most a packed byte may
+ * unpack to), then scanlines per chunk or the level-0 tiles. */
+static gr_status read_chunk_layout(const char *label, const gr_exr_msg *msg, exr_storage_t storage,
+                                   chunk_layout *L, char *err, size_t err_len) {
+  exr_compression_t comp = EXR_COMPRESSION_NONE;
+  exr_result_t rv = exr_get_compression(L->ctxt, 0, &comp);
+  if (rv != EXR_ERR_SUCCESS) {
+    gr_exr_set_err(err, err_len,
+                   "Cannot read '%s': its compression is not understood (OpenEXR: %s).", label,
+                   gr_exr_detail(msg, rv));
+    return GR_ERR_FORMAT;
   }
+  L->compression = comp;
+  L->expand = max_expansion(comp);
+  /* DWA the library cannot decode: allow only raw-stored chunks, so that a
+   * small hostile file cannot claim gigabytes (DWA packs about 66000:1)
+   * and be refused only after the image was allocated. */
+  L->undecodable =
+      (comp == EXR_COMPRESSION_DWAA || comp == EXR_COMPRESSION_DWAB) && !core_decodes_dwa();
+  if (L->undecodable)
+    L->expand = 1;
   if (storage == EXR_STORAGE_SCANLINE) {
     int32_t lines = 0;
-    rv = exr_get_scanlines_per_chunk(ctxt, 0, &lines);
+    rv = exr_get_scanlines_per_chunk(L->ctxt, 0, &lines);
     if (rv != EXR_ERR_SUCCESS || lines < 1) {
-      st = GR_ERR_FORMAT;
       gr_exr_set_err(err, err_len,
                      "Cannot read '%s': its compression is not understood (OpenEXR: %s).", label,
                      gr_exr_detail(msg, rv));
-      goto cleanup;
+      return GR_ERR_FORMAT;
     }
-    L.lines = lines;
-  } else {
-    uint32_t tw = 0, th = 0;
-    exr_tile_level_mode_t lmode;
-    exr_tile_round_mode_t rmode;
-    rv = exr_get_tile_descriptor(ctxt, 0, &tw, &th, &lmode, &rmode);
-    if (rv != EXR_ERR_SUCCESS || tw < 1 || th < 1 || tw > INT32_MAX || th > INT32_MAX) {
-      st = GR_ERR_FORMAT;
-      gr_exr_set_err(err, err_len,
-                     "Cannot read '%s': its tile description is not valid (OpenEXR: %s).", label,
-                     gr_exr_detail(msg, rv));
-      goto cleanup;
-    }
-    L.tiled = 1;
-    L.tw = (int64_t)tw;
-    L.th = (int64_t)th;
-    L.ntx = (L.width + L.tw - 1) / L.tw;
-    L.nty = (L.height + L.th - 1) / L.th;
+    L->lines = lines;
+    return GR_OK;
   }
+  uint32_t tw = 0, th = 0;
+  exr_tile_level_mode_t lmode;
+  exr_tile_round_mode_t rmode;
+  rv = exr_get_tile_descriptor(L->ctxt, 0, &tw, &th, &lmode, &rmode);
+  if (rv != EXR_ERR_SUCCESS || tw < 1 || th < 1 || tw > INT32_MAX || th > INT32_MAX) {
+    gr_exr_set_err(err, err_len,
+                   "Cannot read '%s': its tile description is not valid (OpenEXR: %s).", label,
+                   gr_exr_detail(msg, rv));
+    return GR_ERR_FORMAT;
+  }
+  L->tiled = 1;
+  L->tw = (int64_t)tw;
+  L->th = (int64_t)th;
+  L->ntx = (L->width + L->tw - 1) / L->tw;
+  L->nty = (L->height + L->th - 1) / L->th;
+  return GR_OK;
+}
 
+/* The image's names, types and planes (npix floats each), once every
+ * chunk's description passed; a name twice is refused. */
+static gr_status read_alloc_image(const char *label, const chunk_layout *L,
+                                  const exr_attr_chlist_t *chlist, size_t npix, gr_exr_image *img,
+                                  char *err, size_t err_len) {
+  img->width = (int)L->width;
+  img->height = (int)L->height;
+  img->names = (char **)calloc((size_t)chlist->num_channels, sizeof(char *));
+  img->types = (gr_exr_pixel_type *)calloc((size_t)chlist->num_channels, sizeof(gr_exr_pixel_type));
+  img->data = (float **)calloc((size_t)chlist->num_channels, sizeof(float *));
+  if (img->names == NULL || img->types == NULL || img->data == NULL) {
+    gr_exr_set_err(err, err_len, "Cannot read '%s': out of memory.", label);
+    return GR_ERR_OUT_OF_MEMORY;
+  }
+  img->nchannels = chlist->num_channels;
+  for (size_t c = 0; c < (size_t)img->nchannels; ++c) {
+    const exr_attr_chlist_entry_t *e = &chlist->entries[c];
+    size_t len = strlen(e->name.str);
+    img->names[c] = (char *)malloc(len + 1);
+    img->data[c] = (float *)malloc(npix * sizeof(float));
+    if (img->names[c] == NULL || img->data[c] == NULL) {
+      gr_exr_set_err(err, err_len,
+                     "Cannot read '%s': out of memory for %lld by %lld pixels in "
+                     "%d channels.",
+                     label, (long long)L->width, (long long)L->height, img->nchannels);
+      return GR_ERR_OUT_OF_MEMORY;
+    }
+    memcpy(img->names[c], e->name.str, len + 1);
+    img->types[c] = e->pixel_type == EXR_PIXEL_HALF ? GR_EXR_HALF : GR_EXR_FLOAT;
+  }
+  for (size_t c = 0; c < (size_t)img->nchannels; ++c) {
+    if (gr_exr_find_channel(img, img->names[c]) != (int)c) {
+      gr_exr_set_err(err, err_len, "Cannot read '%s': channel '%s' appears twice.", label,
+                     img->names[c]);
+      return GR_ERR_FORMAT;
+    }
+  }
+  return GR_OK;
+}
+
+/* The sentence for walk_chunks' failure rv at the chunk fault names. */
+static gr_status read_chunk_error(const char *label, const gr_exr_msg *msg, const chunk_layout *L,
+                                  const chunk_fault *fault, exr_result_t rv, char *err,
+                                  size_t err_len) {
+  char where[64];
+  if (L->tiled)
+    snprintf(where, sizeof where, "tile (%lld, %lld)", (long long)fault->x, (long long)fault->y);
+  else
+    snprintf(where, sizeof where, "scanline %lld", (long long)fault->y);
+  if (fault->implausible && L->undecodable)
+    gr_exr_set_err(err, err_len,
+                   "Cannot read '%s': the OpenEXR library in use cannot decode its %s compression "
+                   "(at %s).",
+                   label, compression_name(L->compression), where);
+  else if (fault->implausible)
+    gr_exr_set_err(err, err_len,
+                   "Cannot read '%s': the chunk at %s claims %llu bytes of pixels from %llu "
+                   "compressed bytes, more than its compression can hold; the file is corrupt.",
+                   label, where, (unsigned long long)fault->unpacked,
+                   (unsigned long long)fault->packed);
+  else if (rv == EXR_ERR_FEATURE_NOT_IMPLEMENTED)
+    gr_exr_set_err(err, err_len,
+                   "Cannot read '%s': the OpenEXR library in use cannot decode its %s compression "
+                   "(at %s; OpenEXR: %s).",
+                   label, compression_name(L->compression), where, gr_exr_detail(msg, rv));
+  else
+    gr_exr_set_err(err, err_len,
+                   "Cannot read '%s': the file is truncated or corrupt at %s (OpenEXR: %s).", label,
+                   where, gr_exr_detail(msg, rv));
+  return read_status(rv);
+}
+
+/* gr_exr_read and gr_exr_read_memory: opens the file or the buffer of src
+ * (label names it in every message: the path of a file), then parses, checks
+ * and decodes part 0. The arguments are checked by the callers. */
+static gr_status read_exr(const char *label, read_source *src, gr_exr_image *out, char *err,
+                          size_t err_len) {
+  gr_status st = GR_OK;
+  exr_context_t ctxt = NULL;
+  exr_decode_pipeline_t dec;
+  int dec_live = 0;
+  gr_exr_msg *msg = &src->msg;
+  exr_storage_t storage = EXR_STORAGE_LAST_TYPE;
+  const exr_attr_chlist_t *chlist = NULL;
+  chunk_layout L;
+  chunk_fault fault;
+  size_t npix = 0;
+  gr_exr_image img;
+
+  memset(&img, 0, sizeof img);
+  memset(&dec, 0, sizeof dec);
+  memset(msg, 0, sizeof *msg);
+  memset(&L, 0, sizeof L);
+  memset(&fault, 0, sizeof fault);
+
+  st = read_open(label, src, &ctxt, err, err_len);
+  if (st != GR_OK)
+    goto cleanup;
+  L.ctxt = ctxt;
+  st = read_header(label, msg, &L, &storage, &chlist, err, err_len);
+  if (st == GR_OK)
+    st = read_size_guards(label, &L, chlist, &npix, err, err_len);
+  if (st == GR_OK)
+    st = read_check_channels(label, chlist, err, err_len);
+  if (st == GR_OK)
+    st = gr_exr_meta_read(ctxt, label, &img.meta, err, err_len);
+  if (st == GR_OK)
+    st = read_chunk_layout(label, msg, storage, &L, err, err_len);
   /* Pass 0 checks every chunk's description against the file; pass 1
    * allocates the image and decodes. */
-  for (pass = 0; pass < 2; ++pass) {
-    if (pass == 1) {
-      img.width = (int)L.width;
-      img.height = (int)L.height;
-      img.names = (char **)calloc((size_t)chlist->num_channels, sizeof(char *));
-      img.types =
-          (gr_exr_pixel_type *)calloc((size_t)chlist->num_channels, sizeof(gr_exr_pixel_type));
-      img.data = (float **)calloc((size_t)chlist->num_channels, sizeof(float *));
-      if (img.names == NULL || img.types == NULL || img.data == NULL) {
-        st = GR_ERR_OUT_OF_MEMORY;
-        gr_exr_set_err(err, err_len, "Cannot read '%s': out of memory.", label);
-        goto cleanup;
-      }
-      img.nchannels = chlist->num_channels;
-      for (c = 0; c < (size_t)img.nchannels; ++c) {
-        const exr_attr_chlist_entry_t *e = &chlist->entries[c];
-        size_t len = strlen(e->name.str);
-        img.names[c] = (char *)malloc(len + 1);
-        img.data[c] = (float *)malloc(npix * sizeof(float));
-        if (img.names[c] == NULL || img.data[c] == NULL) {
-          st = GR_ERR_OUT_OF_MEMORY;
-          gr_exr_set_err(err, err_len,
-                         "Cannot read '%s': out of memory for %lld by %lld pixels in "
-                         "%d channels.",
-                         label, (long long)L.width, (long long)L.height, img.nchannels);
-          goto cleanup;
-        }
-        memcpy(img.names[c], e->name.str, len + 1);
-        img.types[c] = e->pixel_type == EXR_PIXEL_HALF ? GR_EXR_HALF : GR_EXR_FLOAT;
-      }
-      for (c = 0; c < (size_t)img.nchannels; ++c) {
-        if (gr_exr_find_channel(&img, img.names[c]) != (int)c) {
-          st = GR_ERR_FORMAT;
-          gr_exr_set_err(err, err_len, "Cannot read '%s': channel '%s' appears twice.", label,
-                         img.names[c]);
-          goto cleanup;
-        }
-      }
-    }
-    rv = walk_chunks(&L, pass == 1 ? &img : NULL, &dec, &dec_live, &fault);
-    if (rv != EXR_ERR_SUCCESS) {
-      char where[64];
-      st = read_status(rv);
-      if (L.tiled)
-        snprintf(where, sizeof where, "tile (%lld, %lld)", (long long)fault.x, (long long)fault.y);
-      else
-        snprintf(where, sizeof where, "scanline %lld", (long long)fault.y);
-      if (fault.implausible && L.undecodable)
-        gr_exr_set_err(
-            err, err_len,
-            "Cannot read '%s': the OpenEXR library in use cannot decode its %s compression "
-            "(at %s).",
-            label, compression_name(L.compression), where);
-      else if (fault.implausible)
-        gr_exr_set_err(err, err_len,
-                       "Cannot read '%s': the chunk at %s claims %llu bytes of pixels from %llu "
-                       "compressed bytes, more than its compression can hold; the file is corrupt.",
-                       label, where, (unsigned long long)fault.unpacked,
-                       (unsigned long long)fault.packed);
-      else if (rv == EXR_ERR_FEATURE_NOT_IMPLEMENTED)
-        gr_exr_set_err(
-            err, err_len,
-            "Cannot read '%s': the OpenEXR library in use cannot decode its %s compression "
-            "(at %s; OpenEXR: %s).",
-            label, compression_name(L.compression), where, gr_exr_detail(msg, rv));
-      else
-        gr_exr_set_err(err, err_len,
-                       "Cannot read '%s': the file is truncated or corrupt at %s (OpenEXR: %s).",
-                       label, where, gr_exr_detail(msg, rv));
-      goto cleanup;
-    }
+  for (int pass = 0; st == GR_OK && pass < 2; ++pass) {
+    if (pass == 1)
+      st = read_alloc_image(label, &L, chlist, npix, &img, err, err_len);
+    if (st != GR_OK)
+      break;
+    exr_result_t rv = walk_chunks(&L, pass == 1 ? &img : NULL, &dec, &dec_live, &fault);
+    if (rv != EXR_ERR_SUCCESS)
+      st = read_chunk_error(label, msg, &L, &fault, rv, err, err_len);
   }
-
   /* File rows run north to south; memory row 0 is south. */
-  for (c = 0; c < (size_t)img.nchannels; ++c)
+  for (size_t c = 0; st == GR_OK && c < (size_t)img.nchannels; ++c)
     flip_rows(img.data[c], (size_t)img.width, (size_t)img.height);
 
 cleanup:
