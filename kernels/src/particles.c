@@ -2,6 +2,7 @@
 #include "graupel/particles.h"
 #include "graupel/cl_runtime.h"
 #include "particles_shared.h"
+#include "runtime_internal.h"
 
 #include <limits.h>
 #include <math.h>
@@ -109,23 +110,21 @@ gr_status gr_particles_params_validate(const gr_particles_params *p, char *msg, 
     msg = scratch;
     msg_len = sizeof(scratch);
   }
-  if (!p) {
-    snprintf(msg, msg_len, "Invalid particle parameters: no parameters were given.");
-    return GR_ERR_INVALID_ARGUMENT;
-  }
+  const char *what = "Invalid particle parameters";
+  if (!p)
+    return gr_params_missing(what, msg, msg_len);
   if (p->kind != GR_PARTICLES_RAIN && p->kind != GR_PARTICLES_SNOW) {
     snprintf(msg, msg_len,
              "Invalid particle parameters: the kind is %d but must be 0 (rain) or 1 (snow).",
              p->kind);
     return GR_ERR_INVALID_ARGUMENT;
   }
-  for (int row = 0; row < GR_PA_ROWS; ++row) {
-    double v = gr_pa_get(p, row);
-    if (!gr_param_accepts(&gr_pa_bounds[row], v)) {
-      gr_param_explain(&gr_pa_bounds[row], v, "Invalid particle parameters", msg, msg_len);
-      return GR_ERR_INVALID_ARGUMENT;
-    }
-  }
+  double values[GR_PA_ROWS];
+  for (int row = 0; row < GR_PA_ROWS; ++row)
+    values[row] = gr_pa_get(p, row);
+  if (gr_params_check_table(gr_pa_bounds, NULL, GR_PA_ROWS, values, what, NULL, GR_PARAM_SAY_GOT,
+                            msg, msg_len) != GR_OK)
+    return GR_ERR_INVALID_ARGUMENT;
   static const char axis[3] = {'x', 'y', 'z'};
   for (int c = 0; c < 3; ++c)
     if (!(fabs(p->wind[c]) <= GR_PARTICLES_MAX_WIND)) {

@@ -2,6 +2,7 @@
 #include "graupel/procedural_terrain.h"
 #include "graupel/cl_runtime.h"
 #include "procedural_terrain_shared.h"
+#include "runtime_internal.h"
 
 #include <limits.h>
 #include <math.h>
@@ -131,33 +132,14 @@ void gr_procedural_terrain_params_init(gr_procedural_terrain_params *p) {
 
 gr_status gr_procedural_terrain_params_validate(const gr_procedural_terrain_params *p, char *msg,
                                                 size_t msg_len) {
-  if (!p) {
-    if (msg && msg_len)
-      snprintf(msg, msg_len, "Invalid terrain noise parameters: no parameters were given.");
-    return GR_ERR_INVALID_ARGUMENT;
-  }
-  for (int row = 0; row < GR_PT_ROWS; ++row) {
-    const gr_param_bound *b = &gr_pt_bounds[row];
-    double v = gr_pt_get(p, row);
-    if (gr_param_accepts(b, v))
-      continue;
-    if (msg && msg_len) {
-      const char *hint = gr_pt_hints[row] ? gr_pt_hints[row] : "";
-      const char *sep = b->unit[0] ? " " : "";
-      if (b->min_open)
-        snprintf(msg, msg_len,
-                 "Invalid terrain noise parameters: %s%s is %.15g but must be above %.15g and at "
-                 "most %.15g%s%s.",
-                 b->property, hint, v, b->min, b->max, sep, b->unit);
-      else
-        snprintf(msg, msg_len,
-                 "Invalid terrain noise parameters: %s%s is %.15g but must lie between %.15g and "
-                 "%.15g%s%s.",
-                 b->property, hint, v, b->min, b->max, sep, b->unit);
-    }
-    return GR_ERR_INVALID_ARGUMENT;
-  }
-  return GR_OK;
+  const char *what = "Invalid terrain noise parameters";
+  if (!p)
+    return gr_params_missing(what, msg, msg_len);
+  double values[GR_PT_ROWS];
+  for (int row = 0; row < GR_PT_ROWS; ++row)
+    values[row] = gr_pt_get(p, row);
+  return gr_params_check_table(gr_pt_bounds, NULL, GR_PT_ROWS, values, what, gr_pt_hints,
+                               GR_PARAM_SAY_IS_RANGE, msg, msg_len);
 }
 
 /* Fills the per-octave tables in double, so every device gets the same

@@ -8,6 +8,7 @@
  * the field checks, and the handle's life cycle (memory, create, destroy,
  * set_params, reset). */
 #include "rain_runoff_internal.h"
+#include "runtime_internal.h"
 
 /* The one place each range is written: the validator, the field checks, the
  * filter's clamps, the XML domains and the README follow it. */
@@ -112,19 +113,15 @@ static double gr_rain_runoff_param_value(const gr_rain_runoff_params *p, int row
 
 gr_status gr_rain_runoff_params_validate(const gr_rain_runoff_params *p, char *msg,
                                          size_t msg_len) {
-  if (!p) {
-    if (msg && msg_len)
-      snprintf(msg, msg_len, "Invalid rain runoff parameters: no parameters were given.");
+  const char *what = "Invalid rain runoff parameters";
+  if (!p)
+    return gr_params_missing(what, msg, msg_len);
+  double values[GR_RAIN_RUNOFF_P_COUNT];
+  for (int row = 0; row < GR_RAIN_RUNOFF_P_COUNT; ++row)
+    values[row] = gr_rain_runoff_param_value(p, row);
+  if (gr_params_check_table(gr_rain_runoff_bounds, NULL, GR_RAIN_RUNOFF_P_COUNT, values, what, NULL,
+                            GR_PARAM_SAY_GOT, msg, msg_len) != GR_OK)
     return GR_ERR_INVALID_ARGUMENT;
-  }
-  for (int row = 0; row < GR_RAIN_RUNOFF_P_COUNT; ++row) {
-    const gr_param_bound *r = &gr_rain_runoff_bounds[row];
-    double v = gr_rain_runoff_param_value(p, row);
-    if (gr_param_accepts(r, v))
-      continue;
-    gr_param_explain(r, v, "Invalid rain runoff parameters", msg, msg_len);
-    return GR_ERR_INVALID_ARGUMENT;
-  }
   if (p->flow_model == GR_FLOW_LOCAL_INERTIAL && p->manning_n < GR_RAIN_RUNOFF_LI_MIN_N) {
     if (msg && msg_len)
       snprintf(msg, msg_len,

@@ -3,6 +3,7 @@
 #include "graupel/sky.h"
 #include "graupel/cl_runtime.h"
 #include "sky_shared.h"
+#include "runtime_internal.h"
 
 #include <limits.h>
 #include <math.h>
@@ -75,30 +76,6 @@ const gr_param_bound *gr_sky_param_bounds(int *count) {
   return gr_sky_bounds;
 }
 
-/* One sentence for a refused row: the property, what it means, the value
- * and the range (a whole-number row with an open min names its first
- * accepted value). */
-static void gr_sky_explain(const char *what, int row, double v, char *msg, size_t msg_len) {
-  if (!msg || !msg_len)
-    return;
-  const gr_param_bound *b = &gr_sky_bounds[row];
-  const char *hint = gr_sky_hints[row] ? gr_sky_hints[row] : "";
-  const char *sep = b->unit[0] ? " " : "";
-  if (b->integer)
-    snprintf(msg, msg_len,
-             "Invalid %s parameters: %s%s is %.15g but must be a whole number from "
-             "%.15g to %.15g.",
-             what, b->property, hint, v, b->min_open ? b->min + 1.0 : b->min, b->max);
-  else if (b->min_open)
-    snprintf(msg, msg_len,
-             "Invalid %s parameters: %s%s is %.15g but must be above %.15g and at most %.15g%s%s.",
-             what, b->property, hint, v, b->min, b->max, sep, b->unit);
-  else
-    snprintf(msg, msg_len,
-             "Invalid %s parameters: %s%s is %.15g but must lie between %.15g and %.15g%s%s.", what,
-             b->property, hint, v, b->min, b->max, sep, b->unit);
-}
-
 /* ------------------------------------------------------------ lightning */
 
 void gr_lightning_params_init(gr_lightning_params *p) {
@@ -114,19 +91,15 @@ void gr_lightning_params_init(gr_lightning_params *p) {
 }
 
 gr_status gr_lightning_params_validate(const gr_lightning_params *p, char *msg, size_t msg_len) {
-  if (!p) {
-    if (msg && msg_len)
-      snprintf(msg, msg_len, "Invalid lightning parameters: no parameters were given.");
-    return GR_ERR_INVALID_ARGUMENT;
-  }
+  const char *what = "Invalid lightning parameters";
+  if (!p)
+    return gr_params_missing(what, msg, msg_len);
   const int rows[] = {GR_SKY_CONTROL_POINTS, GR_SKY_STRANDS, GR_SKY_JITTER, GR_SKY_SEED,
                       GR_SKY_FLICKER_RATE};
   const double values[] = {p->control_points, p->strands, p->jitter, p->seed, p->flicker_rate};
-  for (int r = 0; r < 5; ++r)
-    if (!gr_param_accepts(&gr_sky_bounds[rows[r]], values[r])) {
-      gr_sky_explain("lightning", rows[r], values[r], msg, msg_len);
-      return GR_ERR_INVALID_ARGUMENT;
-    }
+  if (gr_params_check_table(gr_sky_bounds, rows, 5, values, what, gr_sky_hints,
+                            GR_PARAM_SAY_IS_WHOLE_FIRST, msg, msg_len) != GR_OK)
+    return GR_ERR_INVALID_ARGUMENT;
   if (!isfinite(p->time)) {
     if (msg && msg_len)
       snprintf(msg, msg_len, "Invalid lightning parameters: the time is %g s but must be finite.",
@@ -370,21 +343,15 @@ void gr_cloud_cover_params_init(gr_cloud_cover_params *p) {
 
 gr_status gr_cloud_cover_params_validate(const gr_cloud_cover_params *p, char *msg,
                                          size_t msg_len) {
-  if (!p) {
-    if (msg && msg_len)
-      snprintf(msg, msg_len, "Invalid cloud cover parameters: no parameters were given.");
-    return GR_ERR_INVALID_ARGUMENT;
-  }
+  const char *what = "Invalid cloud cover parameters";
+  if (!p)
+    return gr_params_missing(what, msg, msg_len);
   const int rows[] = {GR_SKY_COVER,          GR_SKY_SCALE,      GR_SKY_SHARPNESS, GR_SKY_WIND_SPEED,
                       GR_SKY_WIND_DIRECTION, GR_SKY_RESOLUTION, GR_SKY_SIZE,      GR_SKY_SEED};
   const double values[] = {p->cover,          p->scale,      p->sharpness, p->wind_speed,
                            p->wind_direction, p->resolution, p->size,      p->seed};
-  for (int r = 0; r < 8; ++r)
-    if (!gr_param_accepts(&gr_sky_bounds[rows[r]], values[r])) {
-      gr_sky_explain("cloud cover", rows[r], values[r], msg, msg_len);
-      return GR_ERR_INVALID_ARGUMENT;
-    }
-  return GR_OK;
+  return gr_params_check_table(gr_sky_bounds, rows, 8, values, what, gr_sky_hints,
+                               GR_PARAM_SAY_IS_WHOLE_FIRST, msg, msg_len);
 }
 
 void gr_cloud_cover_grid(const gr_cloud_cover_params *p, gr_grid *out) {

@@ -6,6 +6,7 @@
  * timing, the device arrays' helpers, and the handle's life cycle (memory,
  * create, destroy, parameters, fields, reset). */
 #include "snow_accumulation_internal.h"
+#include "runtime_internal.h"
 
 /* The one place each range is written. SnowfallRate: heavy snowfall is a
  * few cm/h, record falls about 20 cm/h. SnowDensity: fresh snow is 30 to
@@ -93,19 +94,15 @@ static double gr_snac_param_value(const gr_snow_accumulation_params *p, int row)
 
 gr_status gr_snow_accumulation_params_validate(const gr_snow_accumulation_params *p, char *msg,
                                                size_t msg_len) {
-  if (!p) {
-    if (msg && msg_len)
-      snprintf(msg, msg_len, "Invalid snow accumulation parameters: no parameters were given.");
+  const char *what = "Invalid snow accumulation parameters";
+  if (!p)
+    return gr_params_missing(what, msg, msg_len);
+  double values[GR_SNAC_P_COUNT];
+  for (int row = 0; row < GR_SNAC_P_COUNT; ++row)
+    values[row] = gr_snac_param_value(p, row);
+  if (gr_params_check_table(gr_snac_bounds, NULL, GR_SNAC_P_COUNT, values, what, NULL,
+                            GR_PARAM_SAY_GOT, msg, msg_len) != GR_OK)
     return GR_ERR_INVALID_ARGUMENT;
-  }
-  for (int row = 0; row < GR_SNAC_P_COUNT; ++row) {
-    const gr_param_bound *r = &gr_snac_bounds[row];
-    double v = gr_snac_param_value(p, row);
-    if (gr_param_accepts(r, v))
-      continue;
-    gr_param_explain(r, v, "Invalid snow accumulation parameters", msg, msg_len);
-    return GR_ERR_INVALID_ARGUMENT;
-  }
   const double *d = p->direction;
   double len = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
   if (!isfinite(d[0]) || !isfinite(d[1]) || !isfinite(d[2]) || !isfinite(len) || len < 1e-9 ||

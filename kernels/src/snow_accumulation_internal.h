@@ -3,7 +3,8 @@
  * checkpoint layout, the parameter table's rows, the handle's state, the
  * kernel arguments' helpers, and the private functions of
  * snow_accumulation.c (parameters, device arrays, life cycle),
- * snow_accumulation_objects.c, snow_accumulation_step.c and
+ * snow_accumulation_objects.c, snow_accumulation_view.c (the direction and
+ * the exposure view), snow_accumulation_step.c and
  * snow_accumulation_pieces.c (rows, halos, checkpoints). */
 #ifndef GRAUPEL_SNOW_ACCUMULATION_INTERNAL_H
 #define GRAUPEL_SNOW_ACCUMULATION_INTERNAL_H
@@ -160,6 +161,29 @@ gr_status gr_snac_upload_geometry(gr_snow_accumulation *s);
 
 /* snow_accumulation_objects.c */
 void gr_snac_release_textures(cl_mem *pos, cl_mem *nrm, cl_mem *local, cl_mem *arr);
+
+/* snow_accumulation_view.c */
+/* The view of one step: where rays along d cross z = 0 (tau), the extent
+ * of the terrain's and the objects' crossings, and the texel. */
+typedef struct gr_snac_view {
+  float tau_x, tau_y, qx0, qy0, inv_texel, texel;
+  int vw, vh;
+} gr_snac_view;
+
+/* This step's unit snow direction: SnowDirection turned by up to Flutter. */
+void gr_snac_direction(const gr_snow_accumulation *s, double d[3]);
+/* The view of a step along d. */
+void gr_snac_view_of(const gr_snow_accumulation *s, const double d[3], gr_snac_view *v);
+/* A piece's view combined with the other pieces' where it matters. Waits. */
+gr_status gr_snac_view_reduce(gr_snow_accumulation *s, const gr_snac_view *v);
+/* The exposure of nv faces (or samples) at pos, nrm in the pieces'
+ * combined view into s->o_surface. Waits. */
+gr_status gr_snac_object_exposure(gr_snow_accumulation *s, cl_mem pos, cl_mem nrm, cl_int nv,
+                                  const gr_snac_view *v, const float dir[3]);
+/* The snow surface under nv faces (or samples) at pos, nrm into
+ * s->o_surface, over the pieces. Waits. */
+gr_status gr_snac_object_surface(gr_snow_accumulation *s, cl_mem pos, cl_mem nrm, cl_int nv,
+                                 float texel);
 
 /* snow_accumulation_pieces.c */
 gr_status gr_snac_piece_check(const gr_grid *g, const gr_snow_accumulation_params *p, int *ring_s,

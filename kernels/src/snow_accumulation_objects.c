@@ -322,7 +322,20 @@ static gr_status gr_snac_textures(gr_snow_accumulation *s, const unsigned char *
   return GR_OK;
 }
 
-static gr_status gr_snac_set_objects_impl(gr_snow_accumulation *s, const gr_mesh *meshes, int n) {
+/* The layout of a new set of objects: where each object's points and
+ * faces start, which objects keep their snow, and whether all do. */
+typedef struct gr_snac_object_set {
+  int n;
+  int first[GR_SNOW_ACCUMULATION_MAX_OBJECTS + 1], trifirst[GR_SNOW_ACCUMULATION_MAX_OBJECTS + 1];
+  unsigned char kept[GR_SNOW_ACCUMULATION_MAX_OBJECTS];
+  long long nv, nt;
+  int same;
+} gr_snac_object_set;
+
+/* Checks the meshes (remembered in s->memo) and counts their points and
+ * faces into set. */
+static gr_status gr_snac_object_counts(gr_snow_accumulation *s, const gr_mesh *meshes, int n,
+                                       gr_snac_object_set *set) {
   char msg[320];
   if (n < 0 || n > GR_SNOW_ACCUMULATION_MAX_OBJECTS || (n > 0 && !meshes))
     return gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
@@ -330,78 +343,137 @@ static gr_status gr_snac_set_objects_impl(gr_snow_accumulation *s, const gr_mesh
                         "(got %d%s).",
                         GR_SNOW_ACCUMULATION_MAX_OBJECTS, n,
                         n > 0 && !meshes ? " and no meshes" : "");
-  int first[GR_SNOW_ACCUMULATION_MAX_OBJECTS + 1];
-  long long nv = 0, nt = 0;
+  set->n = n;
+  set->nv = set->nt = 0;
   for (int o = 0; o < n; ++o) {
     if (gr_mesh_check(&s->memo[o], &meshes[o], 0, msg, sizeof(msg)) != GR_OK)
       return gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT, "Object %d: %s", o, msg);
-    first[o] = (int)nv;
-    nv += meshes[o].nvertices;
-    nt += meshes[o].ntriangles;
-    if (nv > INT_MAX / 4 || nt > INT_MAX / 16)
+    set->first[o] = (int)set->nv;
+    set->nv += meshes[o].nvertices;
+    set->nt += meshes[o].ntriangles;
+    if (set->nv > INT_MAX / 4 || set->nt > INT_MAX / 16)
       return gr_set_error(s->ctx, GR_ERR_TOO_LARGE,
                           "The objects have more than %d mesh points or %d triangles, more than "
                           "the core addresses; simplify the meshes.",
                           INT_MAX / 4, INT_MAX / 16);
   }
-  first[n] = (int)nv;
-  /* Which objects keep their snow: the same index with as many points and
-   * faces (the snow lives on the faces). */
-  unsigned char kept[GR_SNOW_ACCUMULATION_MAX_OBJECTS];
-  int trifirst[GR_SNOW_ACCUMULATION_MAX_OBJECTS + 1];
-  trifirst[0] = 0;
+  set->first[n] = (int)set->nv;
+  return GR_OK;
+}
+
+/* Which objects keep their snow: the same index with as many points and
+ * faces (the snow lives on the faces). */
+static void gr_snac_object_kept(const gr_snow_accumulation *s, const gr_mesh *meshes,
+                                gr_snac_object_set *set) {
+  int n = set->n;
+  set->trifirst[0] = 0;
   for (int o = 0; o < n; ++o) {
-    kept[o] = (unsigned char)(o < s->nobjects && meshes[o].nvertices == s->nverts[o] &&
-                              meshes[o].ntriangles == s->trifirst[o + 1] - s->trifirst[o]);
-    trifirst[o + 1] = trifirst[o] + meshes[o].ntriangles;
+    set->kept[o] = (unsigned char)(o < s->nobjects && meshes[o].nvertices == s->nverts[o] &&
+                                   meshes[o].ntriangles == s->trifirst[o + 1] - s->trifirst[o]);
+    set->trifirst[o + 1] = set->trifirst[o] + meshes[o].ntriangles;
   }
-  int same = n == s->nobjects;
-  for (int o = 0; same && o < n; ++o)
-    same = kept[o];
+  set->same = n == s->nobjects;
+  for (int o = 0; set->same && o < n; ++o)
+    set->same = set->kept[o];
+}
+
+/* The device buffers of another set of faces (nb: triangles, positions,
+ * normals, lattice, area; na: the snow's arrays), the snow cleared. */
+static gr_status gr_snac_object_buffers(gr_snow_accumulation *s, const gr_snac_object_set *set,
+                                        cl_mem nb[5], cl_mem na[GR_SNAC_ARRAYS]) {
+  gr_status st = GR_OK;
+  size_t T = set->nt ? (size_t)set->nt : 1;
+  size_t sizes[5] = {T * 9, T * 3, T * 3, T * 3, T};
+  for (int b = 0; st == GR_OK && b < 5; ++b)
+    st = gr_buffer_create(s->ctx, CL_MEM_READ_WRITE, sizes[b] * sizeof(float), NULL, &nb[b]);
+  for (int a = 0; st == GR_OK && a < GR_SNAC_ARRAYS; ++a)
+    st = gr_buffer_create(s->ctx, CL_MEM_READ_WRITE, T * sizeof(float), NULL, &na[a]);
+  for (int a = 0; st == GR_OK && a < GR_SNAC_ARRAYS; ++a) {
+    float zero = 0.0f;
+    st = gr_cl_check(s->ctx,
+                     clEnqueueFillBuffer(gr_context_queue(s->ctx), na[a], &zero, sizeof(zero), 0,
+                                         T * sizeof(float), 0, NULL, NULL),
+                     "Clearing the objects' snow");
+  }
+  return st;
+}
+
+/* Kept objects' state to their new place in na, the rest zero; the snow of
+ * objects that go is dropped (counted in the ledger). */
+static gr_status gr_snac_object_snow_move(gr_snow_accumulation *s, const gr_snac_object_set *set,
+                                          cl_mem na[GR_SNAC_ARRAYS]) {
+  gr_status st = GR_OK;
+  double fall = 0.0, shed = 0.0, stored = 0.0;
+  for (int o = 0; st == GR_OK && o < s->nobjects; ++o) {
+    int keep = o < set->n && set->kept[o], faces = s->trifirst[o + 1] - s->trifirst[o];
+    if (keep && faces > 0) {
+      for (int a = 0; st == GR_OK && a < GR_SNAC_ARRAYS; ++a)
+        st = gr_cl_check(s->ctx,
+                         clEnqueueCopyBuffer(gr_context_queue(s->ctx), s->o_arr[a], na[a],
+                                             (size_t)s->trifirst[o] * sizeof(float),
+                                             (size_t)set->trifirst[o] * sizeof(float),
+                                             (size_t)faces * sizeof(float), 0, NULL, NULL),
+                         "Copying an object's snow");
+    } else if (!keep) {
+      double sums[GR_SNAC_SUMS];
+      st = gr_snac_sums(s, 1, s->trifirst[o], faces, sums);
+      stored += sums[0], fall += sums[1], shed += sums[2];
+    }
+  }
+  if (st == GR_OK) {
+    s->retired_fall += fall;
+    s->retired_shed += shed;
+    s->dropped += stored;
+  }
+  return st;
+}
+
+/* The new set becomes the handle's: its buffers (when it brought new ones),
+ * host geometry, counts and boxes; a texture goes with its object, a kept
+ * object keeps its texture (its samples move with it). */
+static void gr_snac_object_adopt(gr_snow_accumulation *s, const gr_mesh *meshes,
+                                 const gr_snac_object_set *set, const gr_snac_geometry *g,
+                                 cl_mem nb[5], cl_mem na[GR_SNAC_ARRAYS]) {
+  int n = set->n;
+  if (!set->same) {
+    gr_snac_release_objects(s);
+    s->o_tri = nb[0], s->o_pos = nb[1], s->o_nrm = nb[2], s->o_local = nb[3], s->o_area = nb[4];
+    memcpy(s->o_arr, na, GR_SNAC_ARRAYS * sizeof(cl_mem));
+  }
+  free(s->hv), free(s->ht), free(s->hnrm), free(s->harea), free(s->hlocal);
+  s->hv = g->hv, s->ht = g->ht, s->hnrm = g->nrm, s->harea = g->area, s->hlocal = g->hlocal;
+  s->nobjects = n;
+  s->nv = (int)set->nv;
+  s->ntri = (int)set->nt;
+  for (int o = 0; o < n; ++o)
+    s->nverts[o] = meshes[o].nvertices;
+  memcpy(s->first, set->first, (size_t)(n + 1) * sizeof(int));
+  memcpy(s->ob_lo, g->lo, sizeof(g->lo));
+  memcpy(s->ob_hi, g->hi, sizeof(g->hi));
+  memcpy(s->trifirst, set->trifirst, (size_t)(n + 1) * sizeof(int));
+  for (int o = 0; o < GR_SNOW_ACCUMULATION_MAX_OBJECTS; ++o)
+    if (s->tsize[o] > 0 && (o >= n || !set->kept[o])) {
+      free(s->tuv[o]);
+      s->tuv[o] = NULL;
+      s->tsize[o] = 0;
+    }
+}
+
+static gr_status gr_snac_set_objects_impl(gr_snow_accumulation *s, const gr_mesh *meshes, int n) {
+  gr_snac_object_set set;
+  gr_status st = gr_snac_object_counts(s, meshes, n, &set);
+  if (st != GR_OK)
+    return st;
+  gr_snac_object_kept(s, meshes, &set);
   gr_snac_geometry g;
   memset(&g, 0, sizeof(g));
-  gr_status st = gr_snac_build_geometry(s, meshes, n, first, (int)nv, (int)nt, &g);
+  st = gr_snac_build_geometry(s, meshes, n, set.first, (int)set.nv, (int)set.nt, &g);
   cl_mem nb[5] = {NULL, NULL, NULL, NULL, NULL}, na[GR_SNAC_ARRAYS];
   memset(na, 0, sizeof(na));
-  size_t T = nt ? (size_t)nt : 1;
-  if (!same) {
-    size_t sizes[5] = {T * 9, T * 3, T * 3, T * 3, T};
-    for (int b = 0; st == GR_OK && b < 5; ++b)
-      st = gr_buffer_create(s->ctx, CL_MEM_READ_WRITE, sizes[b] * sizeof(float), NULL, &nb[b]);
-    for (int a = 0; st == GR_OK && a < GR_SNAC_ARRAYS; ++a)
-      st = gr_buffer_create(s->ctx, CL_MEM_READ_WRITE, T * sizeof(float), NULL, &na[a]);
-    /* Kept objects' state to their new place, the rest zero; the snow of
-     * objects that go is dropped (counted). */
-    for (int a = 0; st == GR_OK && a < GR_SNAC_ARRAYS; ++a) {
-      float zero = 0.0f;
-      st = gr_cl_check(s->ctx,
-                       clEnqueueFillBuffer(gr_context_queue(s->ctx), na[a], &zero, sizeof(zero), 0,
-                                           T * sizeof(float), 0, NULL, NULL),
-                       "Clearing the objects' snow");
-    }
-    double fall = 0.0, shed = 0.0, stored = 0.0;
-    for (int o = 0; st == GR_OK && o < s->nobjects; ++o) {
-      int keep = o < n && kept[o], faces = s->trifirst[o + 1] - s->trifirst[o];
-      if (keep && faces > 0) {
-        for (int a = 0; st == GR_OK && a < GR_SNAC_ARRAYS; ++a)
-          st = gr_cl_check(s->ctx,
-                           clEnqueueCopyBuffer(gr_context_queue(s->ctx), s->o_arr[a], na[a],
-                                               (size_t)s->trifirst[o] * sizeof(float),
-                                               (size_t)trifirst[o] * sizeof(float),
-                                               (size_t)faces * sizeof(float), 0, NULL, NULL),
-                           "Copying an object's snow");
-      } else if (!keep) {
-        double sums[GR_SNAC_SUMS];
-        st = gr_snac_sums(s, 1, s->trifirst[o], faces, sums);
-        stored += sums[0], fall += sums[1], shed += sums[2];
-      }
-    }
-    if (st == GR_OK) {
-      s->retired_fall += fall;
-      s->retired_shed += shed;
-      s->dropped += stored;
-    }
-  }
+  if (!set.same && st == GR_OK)
+    st = gr_snac_object_buffers(s, &set, nb, na);
+  if (!set.same && st == GR_OK)
+    st = gr_snac_object_snow_move(s, &set, na);
   if (st != GR_OK) {
     for (int b = 0; b < 5; ++b)
       gr_buffer_release(&nb[b]);
@@ -410,37 +482,14 @@ static gr_status gr_snac_set_objects_impl(gr_snow_accumulation *s, const gr_mesh
     gr_snac_geometry_free(&g);
     return st;
   }
-  if (!same) {
-    gr_snac_release_objects(s);
-    s->o_tri = nb[0], s->o_pos = nb[1], s->o_nrm = nb[2], s->o_local = nb[3], s->o_area = nb[4];
-    memcpy(s->o_arr, na, sizeof(na));
-  }
-  free(s->hv), free(s->ht), free(s->hnrm), free(s->harea), free(s->hlocal);
-  s->hv = g.hv, s->ht = g.ht, s->hnrm = g.nrm, s->harea = g.area, s->hlocal = g.hlocal;
-  s->nobjects = n;
-  s->nv = (int)nv;
-  s->ntri = (int)nt;
-  for (int o = 0; o < n; ++o)
-    s->nverts[o] = meshes[o].nvertices;
-  memcpy(s->first, first, (size_t)(n + 1) * sizeof(int));
-  memcpy(s->ob_lo, g.lo, sizeof(g.lo));
-  memcpy(s->ob_hi, g.hi, sizeof(g.hi));
-  memcpy(s->trifirst, trifirst, (size_t)(n + 1) * sizeof(int));
-  /* A texture goes with its object; a kept object keeps its texture (its
-   * samples move with it). */
-  for (int o = 0; o < GR_SNOW_ACCUMULATION_MAX_OBJECTS; ++o)
-    if (s->tsize[o] > 0 && (o >= n || !kept[o])) {
-      free(s->tuv[o]);
-      s->tuv[o] = NULL;
-      s->tsize[o] = 0;
-    }
-  st = gr_snac_textures(s, kept);
-  if (st == GR_OK && nt > 0) {
-    st = gr_buffer_write(s->ctx, s->o_nrm, 0, (size_t)nt * 3 * sizeof(float), g.nrm);
+  gr_snac_object_adopt(s, meshes, &set, &g, nb, na);
+  st = gr_snac_textures(s, set.kept);
+  if (st == GR_OK && set.nt > 0) {
+    st = gr_buffer_write(s->ctx, s->o_nrm, 0, (size_t)set.nt * 3 * sizeof(float), g.nrm);
     if (st == GR_OK)
-      st = gr_buffer_write(s->ctx, s->o_local, 0, (size_t)nt * 3 * sizeof(float), g.local);
+      st = gr_buffer_write(s->ctx, s->o_local, 0, (size_t)set.nt * 3 * sizeof(float), g.local);
     if (st == GR_OK)
-      st = gr_buffer_write(s->ctx, s->o_area, 0, (size_t)nt * sizeof(float), g.area);
+      st = gr_buffer_write(s->ctx, s->o_area, 0, (size_t)set.nt * sizeof(float), g.area);
     if (st == GR_OK)
       st = gr_snac_upload_geometry(s);
   }

@@ -1,351 +1,39 @@
-/* Snow accumulation core, host side: the step (snow_accumulation_internal.h):
- * the snowfall's direction and the exposure view, the objects' exposure and
- * surface, the step itself, and what it gives back (fields, the ledger). */
+/* Snow accumulation core, host side: the step (snow_accumulation_internal.h)
+ * in its stages, and what it gives back (fields, the ledger). The
+ * snowfall's direction and the exposure view are in
+ * snow_accumulation_view.c. */
 #include "snow_accumulation_internal.h"
 
-/* A 64-bit mix (splitmix64): the flutter's random numbers per step. */
-static uint64_t gr_snac_mix(uint64_t x) {
-  x += 0x9e3779b97f4a7c15ULL;
-  x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ULL;
-  x = (x ^ (x >> 27)) * 0x94d049bb133111ebULL;
-  return x ^ (x >> 31);
-}
+/* What the stages of one step pass their kernels: the grid, the view, the
+ * snowfall's direction and the step's rates, in the kernels' types. */
+typedef struct gr_snac_step_vars {
+  cl_int nx, ny, gi0, gj0;
+  float dx, dy, zref;
+  float dir_x, dir_y, dir_z;
+  float rate_dt, amplitude, max_depth, kdt, keep;
+  cl_uint seed;
+  cl_int terrain_drawn, pieced, vw, vh;
+  gr_snac_view v;
+} gr_snac_step_vars;
 
-/* This step's unit snow direction: SnowDirection turned by up to Flutter,
- * uniformly over the cone's disc, seeded by Seed and the step's number. */
-static void gr_snac_direction(const gr_snow_accumulation *s, double d[3]) {
-  const double *p = s->params.direction;
-  double len = sqrt(p[0] * p[0] + p[1] * p[1] + p[2] * p[2]);
-  for (int a = 0; a < 3; ++a)
-    d[a] = p[a] / len;
-  if (!(s->params.flutter > 0.0))
-    return;
-  uint64_t h = gr_snac_mix(((uint64_t)(uint32_t)s->params.seed << 32) ^ (uint64_t)s->steps);
-  double u1 = (double)(h >> 11) / 9007199254740992.0;
-  double u2 = (double)(gr_snac_mix(h) >> 11) / 9007199254740992.0;
-  double alpha = s->params.flutter * sqrt(u1), beta = 2.0 * GR_SNAC_PI * u2;
-  /* e1, e2: unit vectors across d. */
-  double e1[3] = {1.0, 0.0, 0.0};
-  if (fabs(d[0]) > 0.9)
-    e1[0] = 0.0, e1[1] = 1.0;
-  double dot = e1[0] * d[0] + e1[1] * d[1] + e1[2] * d[2];
-  for (int a = 0; a < 3; ++a)
-    e1[a] -= dot * d[a];
-  double l1 = sqrt(e1[0] * e1[0] + e1[1] * e1[1] + e1[2] * e1[2]);
-  for (int a = 0; a < 3; ++a)
-    e1[a] /= l1;
-  double e2[3] = {d[1] * e1[2] - d[2] * e1[1], d[2] * e1[0] - d[0] * e1[2],
-                  d[0] * e1[1] - d[1] * e1[0]};
-  for (int a = 0; a < 3; ++a)
-    d[a] = cos(alpha) * d[a] + sin(alpha) * (cos(beta) * e1[a] + sin(beta) * e2[a]);
-}
-
-/* The view of one step: where rays along d cross z = 0 (tau), the extent
- * of the terrain's and the objects' crossings, and the texel. */
-typedef struct gr_snac_view {
-  float tau_x, tau_y, qx0, qy0, inv_texel, texel;
-  int vw, vh;
-} gr_snac_view;
-
-static void gr_snac_view_of(const gr_snow_accumulation *s, const double d[3], gr_snac_view *v) {
-  const gr_grid *g = &s->grid;
-  double tx = -d[0] / d[2], ty = -d[1] / d[2];
-  /* The domain's extent (a piece's view is the whole domain's). */
-  double W = (s->gnx - 1) * g->dx, H = (s->gny - 1) * g->dy;
-  double box[2][3][2] = {
-      {{0.0, W}, {0.0, H}, {s->bmin - s->zref, s->bmax + s->snow_bound - s->zref}},
-      {{0, 0}, {0, 0}, {0, 0}}};
-  int nbox = 1;
-  if (s->nv > 0) {
-    /* The objects, but no further than half the grid beyond it: an object
-     * far away would coarsen the view of the terrain. */
-    double lox = s->ob_lo[0] - g->x0, hix = s->ob_hi[0] - g->x0;
-    double loy = s->ob_lo[1] - g->y0, hiy = s->ob_hi[1] - g->y0;
-    box[1][0][0] = fmax(lox, -0.5 * W - g->dx), box[1][0][1] = fmin(hix, 1.5 * W + g->dx);
-    box[1][1][0] = fmax(loy, -0.5 * H - g->dy), box[1][1][1] = fmin(hiy, 1.5 * H + g->dy);
-    box[1][2][0] = s->ob_lo[2] - s->zref, box[1][2][1] = s->ob_hi[2] - s->zref;
-    nbox = box[1][0][0] <= box[1][0][1] && box[1][1][0] <= box[1][1][1] ? 2 : 1;
-  }
-  double qlo[2] = {HUGE_VAL, HUGE_VAL}, qhi[2] = {-HUGE_VAL, -HUGE_VAL};
-  for (int b = 0; b < nbox; ++b)
-    for (int k = 0; k < 8; ++k) {
-      double x = box[b][0][k & 1], y = box[b][1][(k >> 1) & 1], z = box[b][2][(k >> 2) & 1];
-      double q[2] = {x + z * tx, y + z * ty};
-      for (int a = 0; a < 2; ++a)
-        qlo[a] = fmin(qlo[a], q[a]), qhi[a] = fmax(qhi[a], q[a]);
-    }
-  int res = s->params.exposure_resolution;
-  double span = fmax(qhi[0] - qlo[0], qhi[1] - qlo[1]);
-  double texel = span > 0.0 ? span / res : fmax(g->dx, g->dy) / res;
-  int m = GR_SNAC_VIEW_MARGIN;
-  v->tau_x = (float)tx, v->tau_y = (float)ty;
-  v->texel = (float)texel;
-  v->inv_texel = (float)(1.0 / texel);
-  v->qx0 = (float)(qlo[0] - m * texel);
-  v->qy0 = (float)(qlo[1] - m * texel);
-  v->vw = (int)fmin(ceil((qhi[0] - qlo[0]) / texel), (double)res) + 2 * m + 1;
-  v->vh = (int)fmin(ceil((qhi[1] - qlo[1]) / texel), (double)res) + 2 * m + 1;
-}
-
-/* The view rows [lo, hi] that points projected between heights zlo and
- * zhi (relative to zref) at y from ylo to yhi (relative to grid point
- * (0, 0)) can fall in, with two rows to spare beyond the float rounding of
- * the kernels' projection; lo > hi when none. */
-static void gr_snac_band(const gr_snac_view *v, double ylo, double yhi, double zlo, double zhi,
-                         int *lo, int *hi) {
-  double ty = v->tau_y, qy0 = v->qy0, inv = v->inv_texel, qmin = HUGE_VAL, qmax = -HUGE_VAL;
-  for (int k = 0; k < 4; ++k) {
-    double y = k & 1 ? yhi : ylo, z = k & 2 ? zhi : zlo;
-    double q = (y + z * ty - qy0) * inv;
-    qmin = fmin(qmin, q), qmax = fmax(qmax, q);
-  }
-  double big = fmax(fabs(ylo), fabs(yhi)) + fmax(fabs(zlo), fabs(zhi)) * fabs(ty) + fabs(qy0);
-  double slack = 2.0 + 1e-5 * big * inv;
-  double a = floor(qmin - slack), b = ceil(qmax + slack);
-  *lo = a < 0.0 ? 0 : (int)fmin(a, (double)v->vh);
-  *hi = b > v->vh - 1.0 ? v->vh - 1 : (int)fmax(b, -1.0);
-}
-
-/* The pieces' views combined, texel by texel, with a maximum (ints travel
- * exactly as doubles), in the rows where that can change a texel that a
- * piece reads. A piece draws its local cells (ring included) into rows of
- * a band its rows and the surface's height range bound, and its grid
- * points read only there; outside every other piece's band the others'
- * views hold the objects alone, which every piece draws the same, so a
- * piece's own texel is already the maximum. The rows two or more bands
- * cover are found by one reduction of 2 values a row (the highest and
- * lowest piece covering it) and only they are combined: a band of about
- * the ring plus the relief times the snow's slope across the cut, instead
- * of the whole view. The objects' points read rows anywhere: their
- * exposure is combined per point (snow_accumulation_object_exposure),
- * unless combining the rows under them costs fewer values. Waits. */
-static gr_status gr_snac_view_reduce(gr_snow_accumulation *s, const gr_snac_view *v) {
-  size_t vh = (size_t)v->vh, vw = (size_t)v->vw;
-  if (vh > s->view_rows_cap) {
-    unsigned char *r = realloc(s->view_rows, vh);
-    if (r)
-      s->view_rows = r;
-    double *c = r ? realloc(s->view_cover, 2 * vh * sizeof(double)) : NULL;
-    if (c)
-      s->view_cover = c;
-    if (!r || !c)
-      return gr_set_error(s->ctx, GR_ERR_OUT_OF_MEMORY, "Out of host memory.");
-    s->view_rows_cap = vh;
-  }
-  unsigned char *rows = s->view_rows;
-  double *cover = s->view_cover;
-  /* This piece's band: its local rows, every height the view's box allows. */
-  double zlo = fmin(0.0, s->bmin - s->zref), zhi = s->bmax + s->snow_bound - s->zref;
-  int lo, hi;
-  gr_snac_band(v, (double)s->row0 * s->grid.dy, (double)(s->row0 + s->grid.ny - 1) * s->grid.dy,
-               zlo, zhi, &lo, &hi);
-  double id = (double)(s->row0 + s->ring_s); /* the first own row: one per piece */
-  for (size_t r = 0; r < vh; ++r) {
-    int in = (int)r >= lo && (int)r <= hi;
-    cover[2 * r] = in ? id : -HUGE_VAL;
-    cover[2 * r + 1] = in ? -id : -HUGE_VAL;
-  }
-  gr_status st = gr_snac_allreduce(s, cover, 2 * vh, GR_REDUCE_MAX);
-  if (st != GR_OK)
-    return st;
-  for (size_t r = 0; r < vh; ++r)
-    rows[r] = cover[2 * r] > -HUGE_VAL && cover[2 * r] != -cover[2 * r + 1];
-  /* The objects: the rows under their box (the same on every piece), or a
-   * value per face and sample, whichever is fewer values. */
-  s->objects_by_point = 0;
-  size_t points = (size_t)s->ntri + (size_t)s->ns;
-  if (points > 0) {
-    double half = GR_SNAC_NORMAL_OFFSET * v->texel; /* a face's test position */
-    gr_snac_band(v, s->ob_lo[1] - s->grid.y0 - half, s->ob_hi[1] - s->grid.y0 + half,
-                 s->ob_lo[2] - s->zref - half, s->ob_hi[2] - s->zref + half, &lo, &hi);
-    size_t extra = 0;
-    for (int r = lo; r <= hi; ++r)
-      extra += !rows[r];
-    if (extra * vw > points)
-      s->objects_by_point = 1;
-    else
-      for (int r = lo; r <= hi; ++r)
-        rows[r] = 1;
-  }
-  size_t longest = 0, run = 0;
-  for (size_t r = 0; r < vh; ++r) {
-    run = rows[r] ? run + 1 : 0;
-    longest = run > longest ? run : longest;
-  }
-  if (longest == 0)
-    return GR_OK;
-  cl_int *keys = malloc(longest * vw * sizeof(cl_int));
-  double *vals = malloc(longest * vw * sizeof(double));
-  if (!keys || !vals)
-    st = gr_set_error(s->ctx, GR_ERR_OUT_OF_MEMORY, "Out of host memory.");
-  for (size_t r = 0; st == GR_OK && r < vh;) {
-    if (!rows[r]) {
-      ++r;
-      continue;
-    }
-    size_t r1 = r;
-    while (r1 < vh && rows[r1])
-      ++r1;
-    size_t n = (r1 - r) * vw, at = r * vw;
-    st = gr_buffer_read(s->ctx, s->view, at * sizeof(cl_int), n * sizeof(cl_int), keys);
-    for (size_t t = 0; st == GR_OK && t < n; ++t)
-      vals[t] = (double)keys[t];
-    if (st == GR_OK)
-      st = gr_snac_allreduce(s, vals, n, GR_REDUCE_MAX);
-    for (size_t t = 0; st == GR_OK && t < n; ++t)
-      keys[t] = (cl_int)vals[t];
-    if (st == GR_OK)
-      st = gr_buffer_write(s->ctx, s->view, at * sizeof(cl_int), n * sizeof(cl_int), keys);
-    r = r1;
-  }
-  free(keys), free(vals);
-  return st;
-}
-
-/* Room for n values per face or sample in s->o_surface. */
-static gr_status gr_snac_point_buffer(gr_snow_accumulation *s, size_t n) {
-  if (n <= s->o_surface_cap)
-    return GR_OK;
-  gr_buffer_release(&s->o_surface);
-  s->o_surface_cap = 0;
-  gr_status st =
-      gr_buffer_create(s->ctx, CL_MEM_READ_WRITE, n * sizeof(float), NULL, &s->o_surface);
-  if (st == GR_OK)
-    s->o_surface_cap = n;
-  return st;
-}
-
-/* The exposure of n faces (or samples) at pos, nrm in the pieces'
- * combined view into s->o_surface: each piece's from its own view, the
- * minimum over the pieces (snow_accumulation_object_exposure). Waits. */
-static gr_status gr_snac_object_exposure(gr_snow_accumulation *s, cl_mem pos, cl_mem nrm, cl_int nv,
-                                         const gr_snac_view *v, const float dir[3]) {
-  gr_status st = gr_snac_point_buffer(s, (size_t)nv);
-  if (st != GR_OK)
-    return st;
-  cl_int vw = v->vw, vh = v->vh;
-  const gr_snac_arg a[] = {GR_SNAC_MEM("pos", pos),
-                           GR_SNAC_MEM("nrm", nrm),
-                           GR_SNAC_VAL("nv", nv),
-                           GR_SNAC_VAL("dir_x", dir[0]),
-                           GR_SNAC_VAL("dir_y", dir[1]),
-                           GR_SNAC_VAL("dir_z", dir[2]),
-                           GR_SNAC_VAL("tau_x", v->tau_x),
-                           GR_SNAC_VAL("tau_y", v->tau_y),
-                           GR_SNAC_VAL("qx0", v->qx0),
-                           GR_SNAC_VAL("qy0", v->qy0),
-                           GR_SNAC_VAL("inv_texel", v->inv_texel),
-                           GR_SNAC_VAL("texel", v->texel),
-                           GR_SNAC_VAL("vw", vw),
-                           GR_SNAC_VAL("vh", vh),
-                           GR_SNAC_MEM("view", s->view),
-                           GR_SNAC_MEM("exposure", s->o_surface)};
-  st = gr_snac_args(s, s->object_exposure, a, sizeof(a) / sizeof(a[0]));
-  if (st == GR_OK)
-    st = gr_enqueue_1d(s->ctx, s->object_exposure, (size_t)nv);
-  float *f = malloc((size_t)nv * sizeof(float));
-  double *d = malloc((size_t)nv * sizeof(double));
-  if (st == GR_OK && (!f || !d))
-    st = gr_set_error(s->ctx, GR_ERR_OUT_OF_MEMORY, "Out of host memory.");
-  if (st == GR_OK)
-    st = gr_buffer_read(s->ctx, s->o_surface, 0, (size_t)nv * sizeof(float), f);
-  for (cl_int k = 0; st == GR_OK && k < nv; ++k)
-    d[k] = -(double)f[k];
-  if (st == GR_OK)
-    st = gr_snac_allreduce(s, d, (size_t)nv, GR_REDUCE_MAX);
-  for (cl_int k = 0; st == GR_OK && k < nv; ++k)
-    f[k] = (float)-d[k];
-  if (st == GR_OK)
-    st = gr_buffer_write(s->ctx, s->o_surface, 0, (size_t)nv * sizeof(float), f);
-  free(f), free(d);
-  return st;
-}
-
-/* The snow surface under n faces (or samples) at pos, nrm into
- * s->o_surface: each piece gives the points over its own cells, the
- * allreduce the rest (snow_accumulation_object_surface). Waits. */
-static gr_status gr_snac_object_surface(gr_snow_accumulation *s, cl_mem pos, cl_mem nrm, cl_int nv,
-                                        float texel) {
-  gr_status st = gr_snac_point_buffer(s, (size_t)nv);
-  if (st != GR_OK)
-    return st;
-  cl_int gnx = s->gnx, gny = s->gny, row0 = s->row0, own_lo = s->row0 + s->ring_s;
-  cl_int own_hi = own_lo + s->own_ny - 1;
-  float gdx = (float)s->grid.dx, gdy = (float)s->grid.dy, zref = (float)s->zref;
-  const gr_snac_arg a[] = {GR_SNAC_MEM("pos", pos),
-                           GR_SNAC_MEM("nrm", nrm),
-                           GR_SNAC_VAL("nv", nv),
-                           GR_SNAC_VAL("texel", texel),
-                           GR_SNAC_MEM("ground", s->ground),
-                           GR_SNAC_MEM("gdepth", s->arr[0]),
-                           GR_SNAC_VAL("gnx", gnx),
-                           GR_SNAC_VAL("gny", gny),
-                           GR_SNAC_VAL("row0", row0),
-                           GR_SNAC_VAL("own_lo", own_lo),
-                           GR_SNAC_VAL("own_hi", own_hi),
-                           GR_SNAC_VAL("gdx", gdx),
-                           GR_SNAC_VAL("gdy", gdy),
-                           GR_SNAC_VAL("zref", zref),
-                           GR_SNAC_MEM("surface", s->o_surface)};
-  st = gr_snac_args(s, s->object_surface, a, sizeof(a) / sizeof(a[0]));
-  if (st == GR_OK)
-    st = gr_enqueue_1d(s->ctx, s->object_surface, (size_t)nv);
-  float *f = malloc((size_t)nv * sizeof(float));
-  double *d = malloc((size_t)nv * sizeof(double));
-  if (st == GR_OK && (!f || !d))
-    st = gr_set_error(s->ctx, GR_ERR_OUT_OF_MEMORY, "Out of host memory.");
-  if (st == GR_OK)
-    st = gr_buffer_read(s->ctx, s->o_surface, 0, (size_t)nv * sizeof(float), f);
-  for (cl_int k = 0; st == GR_OK && k < nv; ++k)
-    d[k] = (double)f[k];
-  if (st == GR_OK)
-    st = gr_snac_allreduce(s, d, (size_t)nv, GR_REDUCE_MAX);
-  for (cl_int k = 0; st == GR_OK && k < nv; ++k)
-    f[k] = (float)d[k];
-  if (st == GR_OK)
-    st = gr_buffer_write(s->ctx, s->o_surface, 0, (size_t)nv * sizeof(float), f);
-  free(f), free(d);
-  return st;
-}
-
-static gr_status gr_snac_step_impl(gr_snow_accumulation *s, double dt) {
+/* Whether the terrain is drawn into the view: only where it could hide
+ * itself, where a triangle of the snow surface rises faster than the snow
+ * falls steeply (snow_accumulation_slope_reduce). Snow straight down, or a
+ * surface gentler than the snow's descent, leaves a view of the objects
+ * alone, and a far cheaper step. A piece's cells (its local arrays, ring
+ * included, are all the domain's) give its share of the maximum; the
+ * pieces then agree on it and on the view's box through the allreduce. */
+static gr_status gr_snac_terrain_drawn(gr_snow_accumulation *s, const double dd[3],
+                                       gr_snac_step_vars *sv) {
   gr_context *ctx = s->ctx;
-  const gr_grid *g = &s->grid;
-  double t0 = gr_snac_now_ms();
-  if (s->timing) {
-    gr_status st = gr_finish(ctx);
-    if (st != GR_OK)
-      return st;
-    t0 = s->t_mark = gr_snac_now_ms();
-  }
-  double dd[3];
-  gr_snac_direction(s, dd);
-  cl_int nx = g->nx, ny = g->ny, gi0 = 0, gj0 = s->row0;
-  float dx = (float)g->dx, dy = (float)g->dy;
-  int pieced = gr_snac_pieced(s);
-  if (pieced && (!s->allreduce || !s->halo_exchange))
-    return gr_set_error(ctx, GR_ERR_INVALID_ARGUMENT,
-                        "A snow accumulation piece with neighbours steps only with an allreduce "
-                        "and a halo exchange set (gr_snow_accumulation_set_allreduce, "
-                        "gr_snow_accumulation_set_halo_exchange).");
-
-  /* The terrain is drawn into the view only where it could hide itself:
-   * where a triangle of the snow surface rises faster than the snow falls
-   * steeply (snow_accumulation_slope_reduce). Snow straight down, or a
-   * surface gentler than the snow's descent, leaves a view of the objects
-   * alone, and a far cheaper step. A piece's cells (its local arrays, ring
-   * included, are all the domain's) give its share of the maximum. */
-  cl_int terrain_drawn = 1;
+  sv->terrain_drawn = 1;
   double horiz = hypot(dd[0], dd[1]);
   double g2[2] = {0.0, 0.0};
   {
-    cl_int cells = nx * ny;
-    const gr_snac_arg sa[] = {GR_SNAC_MEM("ground", s->ground),
-                              GR_SNAC_MEM("depth", s->arr[0]),
-                              GR_SNAC_VAL("nx", nx),
-                              GR_SNAC_VAL("ny", ny),
-                              GR_SNAC_VAL("dx", dx),
-                              GR_SNAC_VAL("dy", dy),
+    cl_int cells = sv->nx * sv->ny;
+    const gr_snac_arg sa[] = {GR_SNAC_MEM("ground", s->ground), GR_SNAC_MEM("depth", s->arr[0]),
+                              GR_SNAC_VAL("nx", sv->nx),        GR_SNAC_VAL("ny", sv->ny),
+                              GR_SNAC_VAL("dx", sv->dx),        GR_SNAC_VAL("dy", sv->dy),
                               GR_SNAC_VAL("n", cells)};
     /* Snow straight down cannot be hidden by the surface: no reduction
      * (and no read-back) that step. */
@@ -356,7 +44,7 @@ static gr_status gr_snac_step_impl(gr_snow_accumulation *s, double dt) {
     if (sst != GR_OK)
       return sst;
   }
-  if (pieced) {
+  if (sv->pieced) {
     /* What the view's box and the drawing decision rest on, over the
      * domain: every piece then sets up the same view as the whole grid. */
     double m[6] = {g2[0], g2[1], -s->bmin, s->bmax, s->init_max, s->snow_bound};
@@ -374,45 +62,50 @@ static gr_status gr_snac_step_impl(gr_snow_accumulation *s, double dt) {
   }
   double steepest = sqrt(g2[0] * g2[0] + g2[1] * g2[1]);
   if (horiz == 0.0 || steepest * (1.0 + GR_SNAC_SLOPE_MARGIN) * horiz < fabs(dd[2]))
-    terrain_drawn = 0;
-  gr_snac_view v;
-  gr_snac_view_of(s, dd, &v);
-  cl_int vw = v.vw, vh = v.vh;
-  float zref = (float)s->zref;
-  float dir_x = (float)dd[0], dir_y = (float)dd[1], dir_z = (float)dd[2];
+    sv->terrain_drawn = 0;
+  return GR_OK;
+}
+
+/* The step's view and rates, once the terrain decision is made. */
+static void gr_snac_step_rates(const gr_snow_accumulation *s, double dt, const double dd[3],
+                               gr_snac_step_vars *sv) {
+  gr_snac_view_of(s, dd, &sv->v);
+  sv->vw = sv->v.vw, sv->vh = sv->v.vh;
+  sv->zref = (float)s->zref;
+  sv->dir_x = (float)dd[0], sv->dir_y = (float)dd[1], sv->dir_z = (float)dd[2];
   const gr_snow_accumulation_params *p = &s->params;
-  float rate_dt = (float)(p->snowfall_rate * dt), amplitude = (float)p->noise_amplitude;
-  float max_depth = (float)p->max_depth;
+  sv->rate_dt = (float)(p->snowfall_rate * dt), sv->amplitude = (float)p->noise_amplitude;
+  sv->max_depth = (float)p->max_depth;
   /* Stability as a relaxation rate: k = -ln(1 - f), so that an excess
    * alone keeps (1 - f)^t after t seconds; the step integrates it with the
    * growth (snac_settle) from keep = e^-k dt and k dt. f = 1: k infinite
    * (kdt 1e30), all the excess goes. */
   double krate = p->stability_factor >= 1.0 ? HUGE_VAL : -log1p(-p->stability_factor);
-  float kdt = (float)fmin(krate * dt, 1.0e30);
-  float keep = (float)exp(-krate * dt);
-  cl_uint seed = (cl_uint)p->seed;
-  double inv_scale = 1.0 / p->noise_scale;
+  sv->kdt = (float)fmin(krate * dt, 1.0e30);
+  sv->keep = (float)exp(-krate * dt);
+  sv->seed = (cl_uint)p->seed;
+}
+
+/* The noise is fixed in space: made again only for another seed or
+ * scale. */
+static gr_status gr_snac_make_noise(gr_snow_accumulation *s, const gr_snac_step_vars *sv) {
+  const gr_grid *g = &s->grid;
+  double inv_scale = 1.0 / s->params.noise_scale;
   float noise_x0 = (float)fmod(g->x0 * inv_scale, GR_SNAC_NOISE_PERIOD);
   float noise_y0 = (float)fmod(g->y0 * inv_scale, GR_SNAC_NOISE_PERIOD);
   float noise_dx = (float)(g->dx * inv_scale), noise_dy = (float)(g->dy * inv_scale);
-  /* The noise is fixed in space: made again only for another seed or
-   * scale. */
+  cl_uint seed = sv->seed;
   gr_status nst = GR_OK;
   if (!s->noise_made || s->noise_seed != seed || s->noise_key[0] != noise_x0 ||
       s->noise_key[1] != noise_y0 || s->noise_key[2] != noise_dx || s->noise_key[3] != noise_dy) {
-    const gr_snac_arg na[] = {GR_SNAC_VAL("nx", nx),
-                              GR_SNAC_VAL("ny", ny),
-                              GR_SNAC_VAL("gi0", gi0),
-                              GR_SNAC_VAL("gj0", gj0),
-                              GR_SNAC_VAL("noise_x0", noise_x0),
-                              GR_SNAC_VAL("noise_y0", noise_y0),
-                              GR_SNAC_VAL("noise_dx", noise_dx),
-                              GR_SNAC_VAL("noise_dy", noise_dy),
-                              GR_SNAC_VAL("seed", seed),
-                              GR_SNAC_MEM("noise", s->noise)};
+    const gr_snac_arg na[] = {GR_SNAC_VAL("nx", sv->nx),         GR_SNAC_VAL("ny", sv->ny),
+                              GR_SNAC_VAL("gi0", sv->gi0),       GR_SNAC_VAL("gj0", sv->gj0),
+                              GR_SNAC_VAL("noise_x0", noise_x0), GR_SNAC_VAL("noise_y0", noise_y0),
+                              GR_SNAC_VAL("noise_dx", noise_dx), GR_SNAC_VAL("noise_dy", noise_dy),
+                              GR_SNAC_VAL("seed", seed),         GR_SNAC_MEM("noise", s->noise)};
     nst = gr_snac_args(s, s->noise_k, na, sizeof(na) / sizeof(na[0]));
     if (nst == GR_OK)
-      nst = gr_enqueue_2d(ctx, s->noise_k, 0, 0, (size_t)nx, (size_t)ny, NULL);
+      nst = gr_enqueue_2d(s->ctx, s->noise_k, 0, 0, (size_t)sv->nx, (size_t)sv->ny, NULL);
     if (nst == GR_OK) {
       s->noise_made = 1;
       s->noise_seed = seed;
@@ -420,50 +113,46 @@ static gr_status gr_snac_step_impl(gr_snow_accumulation *s, double dt) {
       s->noise_key[2] = noise_dx, s->noise_key[3] = noise_dy;
     }
   }
-  if (s->timing)
-    s->tm.host_ms += gr_snac_now_ms() - t0, s->t_mark = gr_snac_now_ms();
-  if (nst != GR_OK)
-    return nst;
+  return nst;
+}
 
-  /* 1. the view */
+/* 1. the view: the terrain (when drawn) and the objects' triangles; a
+ * piece's views are then merged over the pieces. */
+static gr_status gr_snac_draw_view(gr_snow_accumulation *s, gr_snac_step_vars *sv) {
+  gr_context *ctx = s->ctx;
+  const gr_snac_view *v = &sv->v;
   cl_int empty = GR_SNAC_EMPTY;
-  gr_status st =
-      gr_cl_check(ctx,
-                  clEnqueueFillBuffer(gr_context_queue(ctx), s->view, &empty, sizeof(empty), 0,
-                                      (size_t)vw * (size_t)vh * sizeof(cl_int), 0, NULL, NULL),
-                  "Clearing the exposure view");
-  const gr_snac_arg rt[] = {GR_SNAC_MEM("ground", s->ground),
-                            GR_SNAC_MEM("depth", s->arr[0]),
-                            GR_SNAC_VAL("nx", nx),
-                            GR_SNAC_VAL("ny", ny),
-                            GR_SNAC_VAL("gi0", gi0),
-                            GR_SNAC_VAL("gj0", gj0),
-                            GR_SNAC_VAL("dx", dx),
-                            GR_SNAC_VAL("dy", dy),
-                            GR_SNAC_VAL("zref", zref),
-                            GR_SNAC_VAL("tau_x", v.tau_x),
-                            GR_SNAC_VAL("tau_y", v.tau_y),
-                            GR_SNAC_VAL("qx0", v.qx0),
-                            GR_SNAC_VAL("qy0", v.qy0),
-                            GR_SNAC_VAL("inv_texel", v.inv_texel),
-                            GR_SNAC_VAL("vw", vw),
-                            GR_SNAC_VAL("vh", vh),
-                            GR_SNAC_MEM("view", s->view)};
+  gr_status st = gr_cl_check(
+      ctx,
+      clEnqueueFillBuffer(gr_context_queue(ctx), s->view, &empty, sizeof(empty), 0,
+                          (size_t)sv->vw * (size_t)sv->vh * sizeof(cl_int), 0, NULL, NULL),
+      "Clearing the exposure view");
+  const gr_snac_arg rt[] = {
+      GR_SNAC_MEM("ground", s->ground), GR_SNAC_MEM("depth", s->arr[0]),
+      GR_SNAC_VAL("nx", sv->nx),        GR_SNAC_VAL("ny", sv->ny),
+      GR_SNAC_VAL("gi0", sv->gi0),      GR_SNAC_VAL("gj0", sv->gj0),
+      GR_SNAC_VAL("dx", sv->dx),        GR_SNAC_VAL("dy", sv->dy),
+      GR_SNAC_VAL("zref", sv->zref),    GR_SNAC_VAL("tau_x", v->tau_x),
+      GR_SNAC_VAL("tau_y", v->tau_y),   GR_SNAC_VAL("qx0", v->qx0),
+      GR_SNAC_VAL("qy0", v->qy0),       GR_SNAC_VAL("inv_texel", v->inv_texel),
+      GR_SNAC_VAL("vw", sv->vw),        GR_SNAC_VAL("vh", sv->vh),
+      GR_SNAC_MEM("view", s->view)};
   if (st == GR_OK)
     st = gr_snac_args(s, s->raster_terrain, rt, sizeof(rt) / sizeof(rt[0]));
-  if (st == GR_OK && nx > 1 && ny > 1 && terrain_drawn)
-    st = gr_enqueue_2d(ctx, s->raster_terrain, 0, 0, (size_t)(nx - 1), (size_t)(ny - 1), NULL);
+  if (st == GR_OK && sv->nx > 1 && sv->ny > 1 && sv->terrain_drawn)
+    st = gr_enqueue_2d(ctx, s->raster_terrain, 0, 0, (size_t)(sv->nx - 1), (size_t)(sv->ny - 1),
+                       NULL);
   cl_int ntri = s->ntri;
   if (st == GR_OK && ntri > 0) {
     const gr_snac_arg ro[] = {GR_SNAC_MEM("tri", s->o_tri),
                               GR_SNAC_VAL("ntri", ntri),
-                              GR_SNAC_VAL("tau_x", v.tau_x),
-                              GR_SNAC_VAL("tau_y", v.tau_y),
-                              GR_SNAC_VAL("qx0", v.qx0),
-                              GR_SNAC_VAL("qy0", v.qy0),
-                              GR_SNAC_VAL("inv_texel", v.inv_texel),
-                              GR_SNAC_VAL("vw", vw),
-                              GR_SNAC_VAL("vh", vh),
+                              GR_SNAC_VAL("tau_x", v->tau_x),
+                              GR_SNAC_VAL("tau_y", v->tau_y),
+                              GR_SNAC_VAL("qx0", v->qx0),
+                              GR_SNAC_VAL("qy0", v->qy0),
+                              GR_SNAC_VAL("inv_texel", v->inv_texel),
+                              GR_SNAC_VAL("vw", sv->vw),
+                              GR_SNAC_VAL("vh", sv->vh),
                               GR_SNAC_MEM("view", s->view)};
     st = gr_snac_args(s, s->raster_objects, ro, sizeof(ro) / sizeof(ro[0]));
     if (st == GR_OK)
@@ -472,96 +161,110 @@ static gr_status gr_snac_step_impl(gr_snow_accumulation *s, double dt) {
   /* A piece drew its own cells: the views' maximum over the pieces, texel
    * by texel, is the whole grid's view (see "Pieces" in the header). */
   s->objects_by_point = 0;
-  if (st == GR_OK && pieced && terrain_drawn)
-    st = gr_snac_view_reduce(s, &v);
+  if (st == GR_OK && sv->pieced && sv->terrain_drawn)
+    st = gr_snac_view_reduce(s, v);
   if (st == GR_OK)
     st = gr_snac_mark(s, &s->tm.view_ms);
+  return st;
+}
 
-  /* 2-3. exposure and growth of the grid points */
+/* 2-3. exposure and growth of the grid points. */
+static gr_status gr_snac_grow_points(gr_snow_accumulation *s, gr_snac_step_vars *sv) {
+  const gr_snac_view *v = &sv->v;
   const gr_snac_arg ex[] = {GR_SNAC_MEM("ground", s->ground),
                             GR_SNAC_MEM("depth", s->arr[0]),
-                            GR_SNAC_VAL("nx", nx),
-                            GR_SNAC_VAL("ny", ny),
-                            GR_SNAC_VAL("gi0", gi0),
-                            GR_SNAC_VAL("gj0", gj0),
-                            GR_SNAC_VAL("dx", dx),
-                            GR_SNAC_VAL("dy", dy),
-                            GR_SNAC_VAL("zref", zref),
-                            GR_SNAC_VAL("dir_x", dir_x),
-                            GR_SNAC_VAL("dir_y", dir_y),
-                            GR_SNAC_VAL("dir_z", dir_z),
-                            GR_SNAC_VAL("tau_x", v.tau_x),
-                            GR_SNAC_VAL("tau_y", v.tau_y),
-                            GR_SNAC_VAL("qx0", v.qx0),
-                            GR_SNAC_VAL("qy0", v.qy0),
-                            GR_SNAC_VAL("inv_texel", v.inv_texel),
-                            GR_SNAC_VAL("texel", v.texel),
-                            GR_SNAC_VAL("vw", vw),
-                            GR_SNAC_VAL("vh", vh),
+                            GR_SNAC_VAL("nx", sv->nx),
+                            GR_SNAC_VAL("ny", sv->ny),
+                            GR_SNAC_VAL("gi0", sv->gi0),
+                            GR_SNAC_VAL("gj0", sv->gj0),
+                            GR_SNAC_VAL("dx", sv->dx),
+                            GR_SNAC_VAL("dy", sv->dy),
+                            GR_SNAC_VAL("zref", sv->zref),
+                            GR_SNAC_VAL("dir_x", sv->dir_x),
+                            GR_SNAC_VAL("dir_y", sv->dir_y),
+                            GR_SNAC_VAL("dir_z", sv->dir_z),
+                            GR_SNAC_VAL("tau_x", v->tau_x),
+                            GR_SNAC_VAL("tau_y", v->tau_y),
+                            GR_SNAC_VAL("qx0", v->qx0),
+                            GR_SNAC_VAL("qy0", v->qy0),
+                            GR_SNAC_VAL("inv_texel", v->inv_texel),
+                            GR_SNAC_VAL("texel", v->texel),
+                            GR_SNAC_VAL("vw", sv->vw),
+                            GR_SNAC_VAL("vh", sv->vh),
                             GR_SNAC_MEM("view", s->view),
-                            GR_SNAC_VAL("rate_dt", rate_dt),
-                            GR_SNAC_VAL("amplitude", amplitude),
+                            GR_SNAC_VAL("rate_dt", sv->rate_dt),
+                            GR_SNAC_VAL("amplitude", sv->amplitude),
                             GR_SNAC_MEM("noise", s->noise),
                             GR_SNAC_MEM("exposure", s->arr[6]),
                             GR_SNAC_MEM("growth", s->growth)};
+  gr_status st = gr_snac_args(s, s->exposure_k, ex, sizeof(ex) / sizeof(ex[0]));
   if (st == GR_OK)
-    st = gr_snac_args(s, s->exposure_k, ex, sizeof(ex) / sizeof(ex[0]));
-  if (st == GR_OK)
-    st = gr_enqueue_2d(ctx, s->exposure_k, 0, 0, (size_t)nx, (size_t)ny, NULL);
+    st = gr_enqueue_2d(s->ctx, s->exposure_k, 0, 0, (size_t)sv->nx, (size_t)sv->ny, NULL);
   if (st == GR_OK)
     st = gr_snac_mark(s, &s->tm.exposure_ms);
+  return st;
+}
 
-  /* 4. blur and dilation, between growth and scratch */
+/* 4. blur and dilation, between growth and scratch; *cur gets the buffer
+ * that holds the result. */
+static gr_status gr_snac_blur_growth(gr_snow_accumulation *s, gr_snac_step_vars *sv,
+                                     cl_mem *cur_out) {
+  gr_context *ctx = s->ctx;
+  gr_status st = GR_OK;
   cl_mem cur = s->growth, other = s->scratch;
-  cl_int radius = p->blur_radius;
+  cl_int radius = s->params.blur_radius;
   for (cl_int axis = 0; st == GR_OK && radius > 0 && axis < 2; ++axis) {
-    const gr_snac_arg bl[] = {GR_SNAC_MEM("in", cur),    GR_SNAC_VAL("nx", nx),
-                              GR_SNAC_VAL("ny", ny),     GR_SNAC_VAL("radius", radius),
+    const gr_snac_arg bl[] = {GR_SNAC_MEM("in", cur),    GR_SNAC_VAL("nx", sv->nx),
+                              GR_SNAC_VAL("ny", sv->ny), GR_SNAC_VAL("radius", radius),
                               GR_SNAC_VAL("axis", axis), GR_SNAC_MEM("w", s->weights),
                               GR_SNAC_MEM("out", other)};
     st = gr_snac_args(s, s->blur, bl, sizeof(bl) / sizeof(bl[0]));
     if (st == GR_OK)
-      st = gr_enqueue_2d(ctx, s->blur, 0, 0, (size_t)nx, (size_t)ny, NULL);
+      st = gr_enqueue_2d(ctx, s->blur, 0, 0, (size_t)sv->nx, (size_t)sv->ny, NULL);
     cl_mem t = cur;
     cur = other, other = t;
   }
-  if (st == GR_OK && p->dilation) {
-    const gr_snac_arg dl[] = {GR_SNAC_MEM("in", cur), GR_SNAC_VAL("nx", nx), GR_SNAC_VAL("ny", ny),
-                              GR_SNAC_MEM("out", other)};
+  if (st == GR_OK && s->params.dilation) {
+    const gr_snac_arg dl[] = {GR_SNAC_MEM("in", cur), GR_SNAC_VAL("nx", sv->nx),
+                              GR_SNAC_VAL("ny", sv->ny), GR_SNAC_MEM("out", other)};
     st = gr_snac_args(s, s->dilate, dl, sizeof(dl) / sizeof(dl[0]));
     if (st == GR_OK)
-      st = gr_enqueue_2d(ctx, s->dilate, 0, 0, (size_t)nx, (size_t)ny, NULL);
+      st = gr_enqueue_2d(ctx, s->dilate, 0, 0, (size_t)sv->nx, (size_t)sv->ny, NULL);
     cl_mem t = cur;
     cur = other, other = t;
   }
   if (st == GR_OK)
     st = gr_snac_mark(s, &s->tm.blur_ms);
+  *cur_out = cur;
+  return st;
+}
 
-  /* 5. increment and stability */
+/* 5. increment and stability of the grid points from the growth in cur;
+ * then a piece's ring: the snow depth the next step's normals, blur and
+ * view (and this step's objects) read beyond its own rows. */
+static gr_status gr_snac_apply_growth(gr_snow_accumulation *s, gr_snac_step_vars *sv, cl_mem cur) {
+  gr_context *ctx = s->ctx;
   const gr_snac_arg ap[] = {GR_SNAC_MEM("ground", s->ground),
-                            GR_SNAC_VAL("nx", nx),
-                            GR_SNAC_VAL("ny", ny),
-                            GR_SNAC_VAL("dx", dx),
-                            GR_SNAC_VAL("dy", dy),
+                            GR_SNAC_VAL("nx", sv->nx),
+                            GR_SNAC_VAL("ny", sv->ny),
+                            GR_SNAC_VAL("dx", sv->dx),
+                            GR_SNAC_VAL("dy", sv->dy),
                             GR_SNAC_MEM("growth", cur),
-                            GR_SNAC_VAL("max_depth", max_depth),
-                            GR_SNAC_VAL("keep", keep),
-                            GR_SNAC_VAL("kdt", kdt),
+                            GR_SNAC_VAL("max_depth", sv->max_depth),
+                            GR_SNAC_VAL("keep", sv->keep),
+                            GR_SNAC_VAL("kdt", sv->kdt),
                             GR_SNAC_MEM("depth", s->arr[0]),
                             GR_SNAC_MEM("depth_lo", s->arr[1]),
                             GR_SNAC_MEM("fall", s->arr[2]),
                             GR_SNAC_MEM("fall_lo", s->arr[3]),
                             GR_SNAC_MEM("shed", s->arr[4]),
                             GR_SNAC_MEM("shed_lo", s->arr[5])};
+  gr_status st = gr_snac_args(s, s->apply, ap, sizeof(ap) / sizeof(ap[0]));
   if (st == GR_OK)
-    st = gr_snac_args(s, s->apply, ap, sizeof(ap) / sizeof(ap[0]));
-  if (st == GR_OK)
-    st = gr_enqueue_2d(ctx, s->apply, 0, 0, (size_t)nx, (size_t)ny, NULL);
+    st = gr_enqueue_2d(ctx, s->apply, 0, 0, (size_t)sv->nx, (size_t)sv->ny, NULL);
   if (st == GR_OK)
     st = gr_snac_mark(s, &s->tm.apply_ms);
-  /* A piece's ring: the snow depth the next step's normals, blur and view
-   * (and this step's objects) read beyond its own rows. */
-  if (st == GR_OK && pieced) {
+  if (st == GR_OK && sv->pieced) {
     st = s->halo_exchange(s->halo_user);
     if (st != GR_OK)
       st = gr_set_error(ctx, st,
@@ -570,77 +273,127 @@ static gr_status gr_snac_step_impl(gr_snow_accumulation *s, double dt) {
                         "piece's ring is not fresh, so restore a checkpoint before stepping on.",
                         s->steps + 1, gr_status_string(st));
   }
+  return st;
+}
 
-  /* the objects' faces (their centroids), then the accumulation textures'
-   * samples: the same exposure, growth and stability, on their own arrays */
-  for (int pass = 0; pass < 2; ++pass) {
-    cl_int nv = pass ? s->ns : s->ntri;
-    if (st != GR_OK || nv == 0)
-      continue;
-    const cl_mem *A = pass ? s->t_arr : s->o_arr;
-    const cl_mem *P = pass ? &s->t_pos : &s->o_pos, *N = pass ? &s->t_nrm : &s->o_nrm,
-                 *L = pass ? &s->t_local : &s->o_local;
-    const gr_snac_arg ob[] = {GR_SNAC_MEM("pos", *P),
-                              GR_SNAC_MEM("nrm", *N),
-                              GR_SNAC_MEM("lattice", *L),
-                              GR_SNAC_VAL("nv", nv),
-                              GR_SNAC_VAL("dir_x", dir_x),
-                              GR_SNAC_VAL("dir_y", dir_y),
-                              GR_SNAC_VAL("dir_z", dir_z),
-                              GR_SNAC_VAL("tau_x", v.tau_x),
-                              GR_SNAC_VAL("tau_y", v.tau_y),
-                              GR_SNAC_VAL("qx0", v.qx0),
-                              GR_SNAC_VAL("qy0", v.qy0),
-                              GR_SNAC_VAL("inv_texel", v.inv_texel),
-                              GR_SNAC_VAL("texel", v.texel),
-                              GR_SNAC_VAL("vw", vw),
-                              GR_SNAC_VAL("vh", vh),
-                              GR_SNAC_MEM("view", s->view),
-                              GR_SNAC_VAL("rate_dt", rate_dt),
-                              GR_SNAC_VAL("amplitude", amplitude),
-                              GR_SNAC_VAL("seed", seed),
-                              GR_SNAC_VAL("max_depth", max_depth),
-                              GR_SNAC_VAL("keep", keep),
-                              GR_SNAC_VAL("kdt", kdt),
-                              GR_SNAC_VAL("terrain_drawn", terrain_drawn),
-                              GR_SNAC_MEM("ground", s->ground),
-                              GR_SNAC_MEM("gdepth", s->arr[0]),
-                              GR_SNAC_VAL("gnx", nx),
-                              GR_SNAC_VAL("gny", ny),
-                              GR_SNAC_VAL("gdx", dx),
-                              GR_SNAC_VAL("gdy", dy),
-                              GR_SNAC_VAL("zref", zref),
-                              GR_SNAC_MEM("exposure", A[6]),
-                              GR_SNAC_MEM("depth", A[0]),
-                              GR_SNAC_MEM("depth_lo", A[1]),
-                              GR_SNAC_MEM("fall", A[2]),
-                              GR_SNAC_MEM("fall_lo", A[3]),
-                              GR_SNAC_MEM("shed", A[4]),
-                              GR_SNAC_MEM("shed_lo", A[5])};
-    /* On a piece, the surface under the points when the objects kernel
-     * needs it (no terrain in the view) comes from the pieces that hold
-     * it. */
-    cl_int have_surface = pieced && !terrain_drawn;
-    cl_int have_exposure = pieced && terrain_drawn && s->objects_by_point;
-    if (have_surface)
-      st = gr_snac_object_surface(s, *P, *N, nv, v.texel);
-    if (have_exposure) {
-      const float dir[3] = {dir_x, dir_y, dir_z};
-      st = gr_snac_object_exposure(s, *P, *N, nv, &v, dir);
-    }
-    cl_mem surf = have_surface || have_exposure ? s->o_surface : s->ground;
-    const gr_snac_arg ob2[] = {GR_SNAC_VAL("have_surface", have_surface),
-                               GR_SNAC_VAL("have_exposure", have_exposure),
-                               GR_SNAC_MEM("surface", surf)};
-    if (st == GR_OK)
-      st = gr_snac_args(s, s->objects_k, ob, sizeof(ob) / sizeof(ob[0]));
-    if (st == GR_OK)
-      st = gr_snac_args(s, s->objects_k, ob2, sizeof(ob2) / sizeof(ob2[0]));
-    if (st == GR_OK)
-      st = gr_enqueue_1d(ctx, s->objects_k, (size_t)nv);
-    if (st == GR_OK)
-      st = gr_snac_mark(s, &s->tm.objects_ms);
+/* The same exposure, growth and stability on the objects' own arrays:
+ * pass 0 their faces (centroids), pass 1 the accumulation textures'
+ * samples. */
+static gr_status gr_snac_grow_objects(gr_snow_accumulation *s, gr_snac_step_vars *sv, int pass) {
+  gr_context *ctx = s->ctx;
+  const gr_snac_view *v = &sv->v;
+  gr_status st = GR_OK;
+  cl_int nv = pass ? s->ns : s->ntri;
+  if (nv == 0)
+    return GR_OK;
+  const cl_mem *A = pass ? s->t_arr : s->o_arr;
+  const cl_mem *P = pass ? &s->t_pos : &s->o_pos, *N = pass ? &s->t_nrm : &s->o_nrm,
+               *L = pass ? &s->t_local : &s->o_local;
+  const gr_snac_arg ob[] = {GR_SNAC_MEM("pos", *P),
+                            GR_SNAC_MEM("nrm", *N),
+                            GR_SNAC_MEM("lattice", *L),
+                            GR_SNAC_VAL("nv", nv),
+                            GR_SNAC_VAL("dir_x", sv->dir_x),
+                            GR_SNAC_VAL("dir_y", sv->dir_y),
+                            GR_SNAC_VAL("dir_z", sv->dir_z),
+                            GR_SNAC_VAL("tau_x", v->tau_x),
+                            GR_SNAC_VAL("tau_y", v->tau_y),
+                            GR_SNAC_VAL("qx0", v->qx0),
+                            GR_SNAC_VAL("qy0", v->qy0),
+                            GR_SNAC_VAL("inv_texel", v->inv_texel),
+                            GR_SNAC_VAL("texel", v->texel),
+                            GR_SNAC_VAL("vw", sv->vw),
+                            GR_SNAC_VAL("vh", sv->vh),
+                            GR_SNAC_MEM("view", s->view),
+                            GR_SNAC_VAL("rate_dt", sv->rate_dt),
+                            GR_SNAC_VAL("amplitude", sv->amplitude),
+                            GR_SNAC_VAL("seed", sv->seed),
+                            GR_SNAC_VAL("max_depth", sv->max_depth),
+                            GR_SNAC_VAL("keep", sv->keep),
+                            GR_SNAC_VAL("kdt", sv->kdt),
+                            GR_SNAC_VAL("terrain_drawn", sv->terrain_drawn),
+                            GR_SNAC_MEM("ground", s->ground),
+                            GR_SNAC_MEM("gdepth", s->arr[0]),
+                            GR_SNAC_VAL("gnx", sv->nx),
+                            GR_SNAC_VAL("gny", sv->ny),
+                            GR_SNAC_VAL("gdx", sv->dx),
+                            GR_SNAC_VAL("gdy", sv->dy),
+                            GR_SNAC_VAL("zref", sv->zref),
+                            GR_SNAC_MEM("exposure", A[6]),
+                            GR_SNAC_MEM("depth", A[0]),
+                            GR_SNAC_MEM("depth_lo", A[1]),
+                            GR_SNAC_MEM("fall", A[2]),
+                            GR_SNAC_MEM("fall_lo", A[3]),
+                            GR_SNAC_MEM("shed", A[4]),
+                            GR_SNAC_MEM("shed_lo", A[5])};
+  /* On a piece, the surface under the points when the objects kernel
+   * needs it (no terrain in the view) comes from the pieces that hold
+   * it. */
+  cl_int have_surface = sv->pieced && !sv->terrain_drawn;
+  cl_int have_exposure = sv->pieced && sv->terrain_drawn && s->objects_by_point;
+  if (have_surface)
+    st = gr_snac_object_surface(s, *P, *N, nv, v->texel);
+  if (have_exposure) {
+    const float dir[3] = {sv->dir_x, sv->dir_y, sv->dir_z};
+    st = gr_snac_object_exposure(s, *P, *N, nv, v, dir);
   }
+  cl_mem surf = have_surface || have_exposure ? s->o_surface : s->ground;
+  const gr_snac_arg ob2[] = {GR_SNAC_VAL("have_surface", have_surface),
+                             GR_SNAC_VAL("have_exposure", have_exposure),
+                             GR_SNAC_MEM("surface", surf)};
+  if (st == GR_OK)
+    st = gr_snac_args(s, s->objects_k, ob, sizeof(ob) / sizeof(ob[0]));
+  if (st == GR_OK)
+    st = gr_snac_args(s, s->objects_k, ob2, sizeof(ob2) / sizeof(ob2[0]));
+  if (st == GR_OK)
+    st = gr_enqueue_1d(ctx, s->objects_k, (size_t)nv);
+  if (st == GR_OK)
+    st = gr_snac_mark(s, &s->tm.objects_ms);
+  return st;
+}
+
+static gr_status gr_snac_step_impl(gr_snow_accumulation *s, double dt) {
+  gr_context *ctx = s->ctx;
+  const gr_grid *g = &s->grid;
+  double t0 = gr_snac_now_ms();
+  if (s->timing) {
+    gr_status st = gr_finish(ctx);
+    if (st != GR_OK)
+      return st;
+    t0 = s->t_mark = gr_snac_now_ms();
+  }
+  double dd[3];
+  gr_snac_direction(s, dd);
+  gr_snac_step_vars sv;
+  memset(&sv, 0, sizeof(sv));
+  sv.nx = g->nx, sv.ny = g->ny, sv.gi0 = 0, sv.gj0 = s->row0;
+  sv.dx = (float)g->dx, sv.dy = (float)g->dy;
+  sv.pieced = gr_snac_pieced(s);
+  if (sv.pieced && (!s->allreduce || !s->halo_exchange))
+    return gr_set_error(ctx, GR_ERR_INVALID_ARGUMENT,
+                        "A snow accumulation piece with neighbours steps only with an allreduce "
+                        "and a halo exchange set (gr_snow_accumulation_set_allreduce, "
+                        "gr_snow_accumulation_set_halo_exchange).");
+  gr_status st = gr_snac_terrain_drawn(s, dd, &sv);
+  if (st != GR_OK)
+    return st;
+  gr_snac_step_rates(s, dt, dd, &sv);
+  st = gr_snac_make_noise(s, &sv);
+  if (s->timing)
+    s->tm.host_ms += gr_snac_now_ms() - t0, s->t_mark = gr_snac_now_ms();
+  if (st != GR_OK)
+    return st;
+
+  st = gr_snac_draw_view(s, &sv);
+  if (st == GR_OK)
+    st = gr_snac_grow_points(s, &sv);
+  cl_mem cur = s->growth;
+  if (st == GR_OK)
+    st = gr_snac_blur_growth(s, &sv, &cur);
+  if (st == GR_OK)
+    st = gr_snac_apply_growth(s, &sv, cur);
+  for (int pass = 0; st == GR_OK && pass < 2; ++pass)
+    st = gr_snac_grow_objects(s, &sv, pass);
   if (st == GR_OK && s->timing)
     s->tm.steps++;
   if (st == GR_OK && (s->steps + 1) % GR_SNAC_SYNC_EVERY == 0)

@@ -6,6 +6,7 @@
  * timing, the device arrays' helpers, and the handle's life cycle (memory,
  * create, destroy, parameters, fields, objects, reset). */
 #include "snow_deformation_internal.h"
+#include "runtime_internal.h"
 
 /* The one place each range is written. Densities: Table 3.1 of the thesis
  * spans 30 (new snow) to 900 (ice) kg/m^3; sand reaches about 2000. */
@@ -79,19 +80,15 @@ static double gr_snow_param_value(const gr_snow_deformation_params *p, int row) 
 
 gr_status gr_snow_deformation_params_validate(const gr_snow_deformation_params *p, char *msg,
                                               size_t msg_len) {
-  if (!p) {
-    if (msg && msg_len)
-      snprintf(msg, msg_len, "Invalid snow deformation parameters: no parameters were given.");
+  const char *what = "Invalid snow deformation parameters";
+  if (!p)
+    return gr_params_missing(what, msg, msg_len);
+  double values[GR_SNOW_P_COUNT];
+  for (int row = 0; row < GR_SNOW_P_COUNT; ++row)
+    values[row] = gr_snow_param_value(p, row);
+  if (gr_params_check_table(gr_snow_bounds, NULL, GR_SNOW_P_COUNT, values, what, NULL,
+                            GR_PARAM_SAY_GOT, msg, msg_len) != GR_OK)
     return GR_ERR_INVALID_ARGUMENT;
-  }
-  for (int row = 0; row < GR_SNOW_P_COUNT; ++row) {
-    const gr_param_bound *r = &gr_snow_bounds[row];
-    double v = gr_snow_param_value(p, row);
-    if (gr_param_accepts(r, v))
-      continue;
-    gr_param_explain(r, v, "Invalid snow deformation parameters", msg, msg_len);
-    return GR_ERR_INVALID_ARGUMENT;
-  }
   if (p->min_density > p->max_density) {
     if (msg && msg_len)
       snprintf(msg, msg_len,

@@ -2,57 +2,15 @@
  * checkpoints (snow_deformation_internal.h): the piece contract, the
  * allreduce and the halo exchange, and the state's bytes saved and loaded. */
 #include "snow_deformation_internal.h"
+#include "runtime_internal.h"
 
 /* ------------------------------------------------------ pieces and halos */
 
 /* The piece contract (graupel.h, snow_deformation.h): which sides have a
  * neighbour, and so a ring of GR_SNOW_DEFORMATION_GHOST points. */
 gr_status gr_snow_piece_rings(const gr_grid *g, int ring[4], char *msg, size_t len) {
-  long long gnx = g->global_nx > 0 ? g->global_nx : g->nx;
-  long long gny = g->global_ny > 0 ? g->global_ny : g->ny;
-  int whole_x = g->global_nx <= 0, whole_y = g->global_ny <= 0;
-  const int G = GR_SNOW_DEFORMATION_GHOST;
-  memset(ring, 0, 4 * sizeof(int));
-  if (g->global_nx < 0 || g->global_ny < 0 || g->ghost < 0 || g->i0 < 0 || g->j0 < 0) {
-    snprintf(msg, len,
-             "Invalid grid: i0, j0, global_nx, global_ny and ghost must be 0 or more (got %d, "
-             "%d, %d, %d, %d).",
-             g->i0, g->j0, g->global_nx, g->global_ny, g->ghost);
-    return GR_ERR_INVALID_ARGUMENT;
-  }
-  if ((whole_x && g->i0 != 0) || (whole_y && g->j0 != 0) ||
-      (!whole_x && (long long)g->i0 + g->nx > gnx) ||
-      (!whole_y && (long long)g->j0 + g->ny > gny)) {
-    snprintf(msg, len,
-             "Invalid grid: the piece of %d x %d points at (%d, %d) reaches beyond the domain of "
-             "%lld x %lld points; give global_nx and global_ny of the whole domain.",
-             g->nx, g->ny, g->i0, g->j0, gnx, gny);
-    return GR_ERR_INVALID_ARGUMENT;
-  }
-  if (!whole_x) {
-    ring[0] = g->i0 > 0 ? G : 0;
-    ring[1] = (long long)g->i0 + g->nx < gnx ? G : 0;
-  }
-  if (!whole_y) {
-    ring[2] = g->j0 > 0 ? G : 0;
-    ring[3] = (long long)g->j0 + g->ny < gny ? G : 0;
-  }
-  int any = ring[0] || ring[1] || ring[2] || ring[3];
-  if (any && g->ghost != G) {
-    snprintf(msg, len,
-             "Invalid grid: a snow deformation piece with neighbours needs a ghost ring of %d "
-             "points (got ghost = %d); set grid.ghost to %d.",
-             G, g->ghost, G);
-    return GR_ERR_INVALID_ARGUMENT;
-  }
-  if (((ring[0] || ring[1]) && g->nx < G) || ((ring[2] || ring[3]) && g->ny < G)) {
-    snprintf(msg, len,
-             "Invalid grid: a snow deformation piece of %d x %d points is narrower than its "
-             "ghost ring of %d toward a neighbour; split the domain into fewer pieces.",
-             g->nx, g->ny, G);
-    return GR_ERR_INVALID_ARGUMENT;
-  }
-  return GR_OK;
+  return gr_grid_piece_check(g, "snow deformation", GR_SNOW_DEFORMATION_GHOST, "", 1, ring, msg,
+                             len);
 }
 
 int gr_snow_has_ring(const gr_snow_deformation *s) {

@@ -236,52 +236,67 @@ static gr_status gr_snow_deposit(gr_snow_deformation *s, const gr_snow_cwin *win
   return st;
 }
 
-static gr_status gr_snow_object_step(gr_snow_deformation *s, int o, double dt) {
-  const gr_snow_object *ob = &s->objects[o];
+/* An object's windows on the local arrays. The kernels run on the object's
+ * box grown by two (W: the underside, +inf beyond the box, and the
+ * overlap, 0 there) and by one (C: the contour ring and everything that
+ * reads the contour). Outside W nothing changes, and the step's reset
+ * clears W again. On a piece the windows are cut to the local arrays, ring
+ * included, and may be empty there: the piece still takes part in the
+ * object's global sums and halo exchange. A launch is rounded up to whole
+ * work-groups: the kernels stop at the window's end (x_end, y_end), as
+ * what lies beyond is another object's or step's. */
+typedef struct gr_snow_obj_win {
+  int wx0, wy0, wx1, wy1, cx0, cy0, cx1, cy1;
+  int w_on, c_on;
+  size_t WX0, WY0, WW, WH, CX0, CY0, CW, CH;
+  cl_int wx_end, wy_end, cx_end, cy_end;
+} gr_snow_obj_win;
+
+static void gr_snow_object_windows(const gr_snow_deformation *s, const gr_snow_object *ob,
+                                   gr_snow_obj_win *w) {
+  int nx = s->grid.nx, ny = s->grid.ny;
+  w->wx0 = ob->bi0 - 2 > 0 ? ob->bi0 - 2 : 0;
+  w->wy0 = ob->bj0 - 2 > 0 ? ob->bj0 - 2 : 0;
+  w->wx1 = ob->bi1 + 2 < nx - 1 ? ob->bi1 + 2 : nx - 1;
+  w->wy1 = ob->bj1 + 2 < ny - 1 ? ob->bj1 + 2 : ny - 1;
+  w->cx0 = ob->bi0 - 1 > 0 ? ob->bi0 - 1 : 0;
+  w->cy0 = ob->bj0 - 1 > 0 ? ob->bj0 - 1 : 0;
+  w->cx1 = ob->bi1 + 1 < nx - 1 ? ob->bi1 + 1 : nx - 1;
+  w->cy1 = ob->bj1 + 1 < ny - 1 ? ob->bj1 + 1 : ny - 1;
+  w->w_on = w->wx0 <= w->wx1 && w->wy0 <= w->wy1;
+  w->c_on = w->cx0 <= w->cx1 && w->cy0 <= w->cy1;
+  w->WX0 = (size_t)w->wx0, w->WY0 = (size_t)w->wy0;
+  w->WW = (size_t)(w->wx1 - w->wx0 + 1), w->WH = (size_t)(w->wy1 - w->wy0 + 1);
+  w->CX0 = (size_t)w->cx0, w->CY0 = (size_t)w->cy0;
+  w->CW = (size_t)(w->cx1 - w->cx0 + 1), w->CH = (size_t)(w->cy1 - w->cy0 + 1);
+  w->wx_end = w->wx1 + 1, w->wy_end = w->wy1 + 1, w->cx_end = w->cx1 + 1, w->cy_end = w->cy1 + 1;
+}
+
+/* The object's underside: W cleared, then its triangles rastered. */
+static gr_status gr_snow_object_raster(gr_snow_deformation *s, const gr_snow_object *ob,
+                                       gr_snow_obj_win *w) {
   gr_context *ctx = s->ctx;
   int nx = s->grid.nx, ny = s->grid.ny;
   float dx = (float)s->grid.dx, dy = (float)s->grid.dy;
-  s->area[o] = 0.0;
-  if (ob->bi0 > ob->bi1 || ob->bj0 > ob->bj1)
-    return GR_OK; /* wholly off the (whole) grid: it touches nothing, on every piece */
-  /* The kernels run on the object's box grown by two (W: the underside,
-   * +inf beyond the box, and the overlap, 0 there) and by one (the contour
-   * ring and everything that reads the contour). Outside W nothing changes,
-   * and the step's reset clears W again. On a piece the windows are cut to
-   * the local arrays, ring included, and may be empty there: the piece
-   * still takes part in the object's global sums and halo exchange. */
-  int wx0 = ob->bi0 - 2 > 0 ? ob->bi0 - 2 : 0, wy0 = ob->bj0 - 2 > 0 ? ob->bj0 - 2 : 0;
-  int wx1 = ob->bi1 + 2 < nx - 1 ? ob->bi1 + 2 : nx - 1,
-      wy1 = ob->bj1 + 2 < ny - 1 ? ob->bj1 + 2 : ny - 1;
-  int cx0 = ob->bi0 - 1 > 0 ? ob->bi0 - 1 : 0, cy0 = ob->bj0 - 1 > 0 ? ob->bj0 - 1 : 0;
-  int cx1 = ob->bi1 + 1 < nx - 1 ? ob->bi1 + 1 : nx - 1,
-      cy1 = ob->bj1 + 1 < ny - 1 ? ob->bj1 + 1 : ny - 1;
-  int w_on = wx0 <= wx1 && wy0 <= wy1, c_on = cx0 <= cx1 && cy0 <= cy1;
-  size_t WX0 = (size_t)wx0, WY0 = (size_t)wy0, WW = (size_t)(wx1 - wx0 + 1),
-         WH = (size_t)(wy1 - wy0 + 1), CX0 = (size_t)cx0, CY0 = (size_t)cy0,
-         CW = (size_t)(cx1 - cx0 + 1), CH = (size_t)(cy1 - cy0 + 1);
-  /* A launch is rounded up to whole work-groups: the kernels stop at the
-   * window's end, as what lies beyond is another object's or step's. */
-  cl_int wx_end = wx1 + 1, wy_end = wy1 + 1, cx_end = cx1 + 1, cy_end = cy1 + 1;
   /* The raster's box and loop in the domain's indices (the same floats on
    * every piece), cut to the local arrays. */
   cl_int first = ob->first, count = ob->count, ox = s->ox, oy = s->oy;
   cl_int bi0 = (ob->bi0 > 0 ? ob->bi0 : 0) + ox, bi1 = (ob->bi1 < nx - 1 ? ob->bi1 : nx - 1) + ox,
          bj0 = (ob->bj0 > 0 ? ob->bj0 : 0) + oy, bj1 = (ob->bj1 < ny - 1 ? ob->bj1 : ny - 1) + oy;
   gr_status st = GR_OK;
-  if (w_on) {
-    gr_snow_dirty(s, wx0, wy0, wx1, wy1);
+  if (w->w_on) {
+    gr_snow_dirty(s, w->wx0, w->wy0, w->wx1, w->wy1);
     st = GR_SNOW_ARG(s, s->raster_clear, "nx", nx);
     if (st == GR_OK)
       st = GR_SNOW_ARG(s, s->raster_clear, "ny", ny);
     if (st == GR_OK)
-      st = GR_SNOW_ARG(s, s->raster_clear, "x_end", wx_end);
+      st = GR_SNOW_ARG(s, s->raster_clear, "x_end", w->wx_end);
     if (st == GR_OK)
-      st = GR_SNOW_ARG(s, s->raster_clear, "y_end", wy_end);
+      st = GR_SNOW_ARG(s, s->raster_clear, "y_end", w->wy_end);
     if (st == GR_OK)
       st = GR_SNOW_ARG(s, s->raster_clear, "under", s->under);
     if (st == GR_OK)
-      st = gr_enqueue_2d(ctx, s->raster_clear, WX0, WY0, WW, WH, NULL);
+      st = gr_enqueue_2d(ctx, s->raster_clear, w->WX0, w->WY0, w->WW, w->WH, NULL);
   }
   const gr_snow_arg raster[] = {{"tri", sizeof(cl_mem), &s->tri},
                                 {"first", sizeof(first), &first},
@@ -303,8 +318,14 @@ static gr_status gr_snow_object_step(gr_snow_deformation *s, int o, double dt) {
   }
   if (st == GR_OK)
     st = gr_snow_mark(s, &s->tm.raster_ms);
-  /* overlap */
-  if (st == GR_OK && w_on) {
+  return st;
+}
+
+/* The overlap of the underside and the snow on W. */
+static gr_status gr_snow_object_overlap(gr_snow_deformation *s, gr_snow_obj_win *w) {
+  int nx = s->grid.nx, ny = s->grid.ny;
+  gr_status st = GR_OK;
+  if (w->w_on) {
     st = GR_SNOW_ARG(s, s->overlap_k, "ground", s->ground);
     if (st == GR_OK)
       st = GR_SNOW_ARG(s, s->overlap_k, "depth", s->depth[s->cur]);
@@ -317,15 +338,21 @@ static gr_status gr_snow_object_step(gr_snow_deformation *s, int o, double dt) {
     if (st == GR_OK)
       st = GR_SNOW_ARG(s, s->overlap_k, "overlap", s->overlap);
     if (st == GR_OK)
-      st = GR_SNOW_ARG(s, s->overlap_k, "x_end", wx_end);
+      st = GR_SNOW_ARG(s, s->overlap_k, "x_end", w->wx_end);
     if (st == GR_OK)
-      st = GR_SNOW_ARG(s, s->overlap_k, "y_end", wy_end);
+      st = GR_SNOW_ARG(s, s->overlap_k, "y_end", w->wy_end);
     if (st == GR_OK)
-      st = gr_enqueue_2d(ctx, s->overlap_k, WX0, WY0, WW, WH, NULL);
+      st = gr_enqueue_2d(s->ctx, s->overlap_k, w->WX0, w->WY0, w->WW, w->WH, NULL);
   }
   if (st == GR_OK)
     st = gr_snow_mark(s, &s->tm.press_ms);
-  /* contour and weights */
+  return st;
+}
+
+/* The contour's direction: the object's motion in x and y, and the weight
+ * of the ring at rest (straight down: a uniform ring). */
+static void gr_snow_object_direction(const gr_snow_deformation *s, const gr_snow_object *ob,
+                                     float *vx, float *vy, float *rest) {
   double vn = sqrt(ob->v[0] * ob->v[0] + ob->v[1] * ob->v[1] + ob->v[2] * ob->v[2]);
   double ux = 0.0, uy = 0.0, uz = -1.0; /* at rest: straight down, a uniform ring */
   if (vn > 0.0) {
@@ -333,23 +360,21 @@ static gr_status gr_snow_object_step(gr_snow_deformation *s, int o, double dt) {
     uy = ob->v[1] / vn;
     uz = ob->v[2] / vn;
   }
-  float vx = (float)ux, vy = (float)uy, rest = (float)(uz * uz / s->params.direction_falloff);
-  gr_snow_cwin win = {CX0, CY0, CW, CH, cx_end, cy_end, 0, 0, 1, 0, c_on};
-  if (st == GR_OK && c_on)
-    st = gr_snow_contour_ring(s, &win, 0, vx, vy, rest);
-  if (st == GR_OK)
-    st = gr_snow_mark(s, &s->tm.contour_ms);
-  /* Totals over the piece's own points of the contour window (fixed point:
-   * the same integers however the domain is split), then over the
-   * domain. */
-  long long q[GR_SNOW_OBJ_SUMS];
-  int rx0 = cx0, ry0 = cy0, rx1 = cx1, ry1 = cy1;
+  *vx = (float)ux, *vy = (float)uy, *rest = (float)(uz * uz / s->params.direction_falloff);
+}
+
+/* Totals over the piece's own points of the contour window (fixed point:
+ * the same integers however the domain is split), then over the domain,
+ * into q; win gets the own part of the window. */
+static gr_status gr_snow_object_sums(gr_snow_deformation *s, const gr_snow_obj_win *w,
+                                     gr_snow_cwin *win, long long q[GR_SNOW_OBJ_SUMS]) {
+  int nx = s->grid.nx;
+  int rx0 = w->cx0, ry0 = w->cy0, rx1 = w->cx1, ry1 = w->cy1;
   gr_snow_own_clip(s, &rx0, &ry0, &rx1, &ry1);
   cl_int cw = rx1 - rx0 + 1, cn = rx0 <= rx1 && ry0 <= ry1 ? cw * (ry1 - ry0 + 1) : 0;
   cw = cw > 0 ? cw : 1;
-  win.rx0 = rx0, win.ry0 = ry0, win.rw = cw, win.rn = cn;
-  if (st == GR_OK)
-    st = gr_snow_press_args(s, s->obj_reduce);
+  win->rx0 = rx0, win->ry0 = ry0, win->rw = cw, win->rn = cn;
+  gr_status st = gr_snow_press_args(s, s->obj_reduce);
   if (st == GR_OK)
     st = GR_SNOW_ARG(s, s->obj_reduce, "nx", nx);
   if (st == GR_OK)
@@ -361,13 +386,21 @@ static gr_status gr_snow_object_step(gr_snow_deformation *s, int o, double dt) {
   if (st == GR_OK)
     st = GR_SNOW_ARG(s, s->obj_reduce, "n", cn);
   if (st == GR_OK)
-    st = gr_reduction_i64_run(ctx, &s->red_obj, s->obj_reduce, q);
+    st = gr_reduction_i64_run(s->ctx, &s->red_obj, s->obj_reduce, q);
   if (st == GR_OK)
     st = gr_snow_allreduce_i64(s, q, GR_SNOW_OBJ_SUMS);
   if (st == GR_OK)
     st = gr_snow_mark(s, &s->tm.press_ms);
-  if (st != GR_OK)
-    return st;
+  return st;
+}
+
+/* The press from the object's sums q: the ledger's compressed and
+ * displaced snow, the force on the object and its contact area, then the
+ * displaced snow deposited on the contour. */
+static gr_status gr_snow_object_press(gr_snow_deformation *s, int o, double dt,
+                                      const gr_snow_cwin *win, const long long q[GR_SNOW_OBJ_SUMS],
+                                      float vx, float vy, float rest) {
+  const gr_snow_object *ob = &s->objects[o];
   /* sums, per unit cell area: 0 e, 1 e rho, 2 weights, 3 contour points,
    * 4 D rho, 5 D - e, 6 contact points */
   const double quantum = 1.0 / GR_SNOW_QUANTUM_INV, press_mass = 1.0 / GR_SNOW_PRESS_MASS_INV;
@@ -402,11 +435,37 @@ static gr_status gr_snow_object_step(gr_snow_deformation *s, int o, double dt) {
       s->force[o][a] += -m * ob->v[a] / dt;
   }
   s->area[o] = sums[6] * area;
-  if (st == GR_OK)
-    st = gr_snow_deposit(s, &win, press, add_depth, add_rho, give, vx, vy, rest);
+  gr_status st = gr_snow_deposit(s, win, press, add_depth, add_rho, give, vx, vy, rest);
   if (st == GR_OK)
     st = gr_snow_mark(s, &s->tm.distribution_ms);
   return st;
+}
+
+/* One object's press on the snow: its underside, the overlap, the contour
+ * ring, the sums over the domain, then the press itself. */
+static gr_status gr_snow_object_step(gr_snow_deformation *s, int o, double dt) {
+  const gr_snow_object *ob = &s->objects[o];
+  s->area[o] = 0.0;
+  if (ob->bi0 > ob->bi1 || ob->bj0 > ob->bj1)
+    return GR_OK; /* wholly off the (whole) grid: it touches nothing, on every piece */
+  gr_snow_obj_win w;
+  gr_snow_object_windows(s, ob, &w);
+  gr_status st = gr_snow_object_raster(s, ob, &w);
+  if (st == GR_OK)
+    st = gr_snow_object_overlap(s, &w);
+  float vx, vy, rest;
+  gr_snow_object_direction(s, ob, &vx, &vy, &rest);
+  gr_snow_cwin win = {w.CX0, w.CY0, w.CW, w.CH, w.cx_end, w.cy_end, 0, 0, 1, 0, w.c_on};
+  if (st == GR_OK && w.c_on)
+    st = gr_snow_contour_ring(s, &win, 0, vx, vy, rest);
+  if (st == GR_OK)
+    st = gr_snow_mark(s, &s->tm.contour_ms);
+  long long q[GR_SNOW_OBJ_SUMS];
+  if (st == GR_OK)
+    st = gr_snow_object_sums(s, &w, &win, q);
+  if (st != GR_OK)
+    return st;
+  return gr_snow_object_press(s, o, dt, &win, q, vx, vy, rest);
 }
 
 gr_status gr_snow_deformation_step(gr_snow_deformation *s, double dt) {

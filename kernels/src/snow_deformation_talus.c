@@ -427,6 +427,212 @@ static gr_status gr_snow_relax_reach(gr_snow_deformation *s, int hops, float tol
   return st;
 }
 
+/* The box of the points the step touched, [*x0, *x1] x [*y0, *y1]
+ * (inclusive, not yet cut to the arrays; empty when nothing did): every
+ * point after a full change, else the objects' boxes grown by two and the
+ * points the last step left unrelaxed. */
+static void gr_snow_relax_box(const gr_snow_deformation *s, int *x0, int *y0, int *x1, int *y1) {
+  int nx = s->grid.nx, ny = s->grid.ny;
+  *x0 = nx, *x1 = -1, *y0 = ny, *y1 = -1;
+  if (s->relax_full) {
+    *x0 = *y0 = 0;
+    *x1 = nx - 1;
+    *y1 = ny - 1;
+    return;
+  }
+  for (int o = 0; o < s->nobjects; ++o) {
+    const gr_snow_object *ob = &s->objects[o];
+    if (ob->bi0 > ob->bi1 || ob->bj0 > ob->bj1)
+      continue;
+    *x0 = *x0 < ob->bi0 - 2 ? *x0 : ob->bi0 - 2;
+    *x1 = *x1 > ob->bi1 + 2 ? *x1 : ob->bi1 + 2;
+    *y0 = *y0 < ob->bj0 - 2 ? *y0 : ob->bj0 - 2;
+    *y1 = *y1 > ob->bj1 + 2 ? *y1 : ob->bj1 + 2;
+  }
+  if (s->rest[0] <= s->rest[2] && s->rest[1] <= s->rest[3]) {
+    *x0 = *x0 < s->rest[0] ? *x0 : s->rest[0];
+    *y0 = *y0 < s->rest[1] ? *y0 : s->rest[1];
+    *x1 = *x1 > s->rest[2] ? *x1 : s->rest[2];
+    *y1 = *y1 > s->rest[3] ? *y1 : s->rest[3];
+  }
+}
+
+/* One relaxation's iterations in flight. Launches in flight: on GPUs,
+ * where a read-back between launches costs more than the launch, only
+ * every GR_SNOW_CHECK_EVERY-th launch is checked and a check is read back
+ * GR_SNOW_CHECK_LAG checks later, so the window of a launch is the last box
+ * read grown by every iteration launched since. A launch after the one
+ * whose check says nothing could move changes nothing (no point gives), so
+ * the lag changes what is computed, never the result or the iteration
+ * count. */
+typedef struct gr_snow_relax_run {
+  int nx, ny;
+  float tol;
+  int x0, y0, x1, y1;     /* the givers' box */
+  int lx0, ly0, lx1, ly1; /* the last launch's window */
+  int lag, cap, every;
+  /* per check in flight: the iterations launched before its launch, and
+   * whether it is empty (a piece with none of the window) */
+  int before[GR_SNOW_CHECK_LAG + 1], empty[GR_SNOW_CHECK_LAG + 1];
+  int launched, started, read, it_launched, done;
+  int it; /* the iterations the relaxation counts */
+} gr_snow_relax_run;
+
+/* Cuts the givers' box to the local arrays. */
+static void gr_snow_relax_cut(gr_snow_relax_run *r) {
+  r->x0 = r->x0 > 0 ? r->x0 : 0;
+  r->y0 = r->y0 > 0 ? r->y0 : 0;
+  r->x1 = r->x1 < r->nx - 1 ? r->x1 : r->nx - 1;
+  r->y1 = r->y1 < r->ny - 1 ? r->y1 : r->ny - 1;
+}
+
+/* The tail: whether the givers' window grown by two is small enough for
+ * one work-group (not on a piece with a ring: it would need an exchange
+ * every iteration). */
+static int gr_snow_relax_in_tail(const gr_snow_deformation *s, const gr_snow_relax_run *r) {
+  int nx = r->nx, ny = r->ny;
+  int gx = (r->x1 + 2 < nx - 1 ? r->x1 + 2 : nx - 1) - (r->x0 - 2 > 0 ? r->x0 - 2 : 0) + 1,
+      gy = (r->y1 + 2 < ny - 1 ? r->y1 + 2 : ny - 1) - (r->y0 - 2 > 0 ? r->y0 - 2 : 0) + 1;
+  return s->group && !gr_snow_has_ring(s) && r->it_launched < r->cap &&
+         (double)gx * gy <= (double)s->group_area;
+}
+
+/* The tail in one work-group, once every check in flight is read. */
+static gr_status gr_snow_relax_tail(gr_snow_deformation *s, gr_snow_relax_run *r) {
+  gr_snow_relax_cut(r);
+  gr_status st =
+      gr_snow_relax_group(s, &r->x0, &r->y0, &r->x1, &r->y1, r->cap,
+                          GR_SNOW_BLOCK_ITERATIONS * r->every, r->tol, &r->it_launched, &r->done);
+  if (st == GR_OK)
+    r->it = r->it_launched;
+  return st;
+}
+
+/* One launch of up to GR_SNOW_BLOCK_ITERATIONS iterations on the givers'
+ * box, and its check when one is due. */
+static gr_status gr_snow_relax_launch(gr_snow_deformation *s, gr_snow_relax_run *r) {
+  int nx = r->nx, ny = r->ny;
+  gr_status st = GR_OK;
+  int left = r->cap - r->it_launched;
+  cl_int iters = left < GR_SNOW_BLOCK_ITERATIONS ? left : GR_SNOW_BLOCK_ITERATIONS;
+  gr_snow_relax_cut(r);
+  int x0 = r->x0, y0 = r->y0, x1 = r->x1, y1 = r->y1;
+  cl_int gx0 = x0, gy0 = y0, gx_end = x1 + 1, gy_end = y1 + 1;
+  /* The launch's window: R grown by the iterations. */
+  int mx0 = x0 - iters > 0 ? x0 - iters : 0, my0 = y0 - iters > 0 ? y0 - iters : 0;
+  cl_int mx_end = x1 + iters + 1 < nx ? x1 + iters + 1 : nx,
+         my_end = y1 + iters + 1 < ny ? y1 + iters + 1 : ny;
+  /* The buffer the first write goes to lags the state on the last
+   * window; it must not where that write does not reach: all of the
+   * launch's window in one blocked launch, R grown by one in the first
+   * of the one-launch iterations (each later one covers its
+   * predecessor's). */
+  int grow = s->blocked ? iters : 1;
+  int fx0 = x0 - grow > 0 ? x0 - grow : 0, fy0 = y0 - grow > 0 ? y0 - grow : 0;
+  int fx1 = x1 + grow < nx - 1 ? x1 + grow : nx - 1, fy1 = y1 + grow < ny - 1 ? y1 + grow : ny - 1;
+  if (r->lx0 < fx0 || r->ly0 < fy0 || r->lx1 > fx1 || r->ly1 > fy1)
+    st = gr_snow_sync_rect(s, r->lx0, r->ly0, r->lx1, r->ly1);
+  if (st == GR_OK && s->blocked)
+    st =
+        gr_snow_relax_blocked(s, gx0, gy0, gx_end, gy_end, mx0, my0, mx_end, my_end, iters, r->tol);
+  for (cl_int t = 0; st == GR_OK && !s->blocked && t < iters; ++t)
+    st = gr_snow_relax_once(s, gx0, gy0, gx_end, gy_end, t, r->tol);
+  if (st == GR_OK)
+    st = gr_snow_piece_sync(s); /* pieces: the ring the launch used up */
+  if (st == GR_OK)
+    r->lx0 = mx0, r->ly0 = my0, r->lx1 = mx_end - 1, r->ly1 = my_end - 1;
+  int slot = r->started % (r->lag + 1);
+  if (st == GR_OK && r->launched % r->every == 0) {
+    st = gr_snow_relax_check_start(s, &s->red_check[slot], x0, y0, x1, y1, &r->empty[slot]);
+    r->before[slot] = r->it_launched;
+    r->started += st == GR_OK;
+  }
+  if (st == GR_OK) {
+    r->it_launched += iters;
+    ++r->launched;
+    /* until a box is read */
+    r->x0 -= iters, r->x1 += iters, r->y0 -= iters, r->y1 += iters;
+  }
+  return st;
+}
+
+/* Reads the oldest check in flight: done when nothing could move at its
+ * launch, else the givers' box it found, grown by the iterations since. */
+static gr_status gr_snow_relax_read(gr_snow_deformation *s, gr_snow_relax_run *r) {
+  double m[GR_SNOW_CHECK_MAXES];
+  int slot = r->read % (r->lag + 1);
+  gr_status st = gr_snow_relax_check_finish(s, &s->red_check[slot], r->empty[slot], m);
+  ++r->read;
+  if (st == GR_OK && m[0] <= r->tol) {
+    /* nothing could move: that launch and those after changed nothing */
+    r->it = r->before[slot];
+    r->done = 1;
+  } else if (st == GR_OK) {
+    r->it = r->it_launched;
+    int g = r->it_launched - r->before[slot]; /* iterations since that check's launch began */
+    r->x0 = (int)-m[1] - g, r->x1 = (int)m[2] + g;
+    r->y0 = (int)-m[3] - g, r->y1 = (int)m[4] + g;
+  }
+  return st;
+}
+
+/* The iterations until nothing can move or the cap, then the wait for the
+ * checks still in flight (after the end, or an error). */
+static gr_status gr_snow_relax_iterate(gr_snow_deformation *s, gr_snow_relax_run *r) {
+  gr_status st = GR_OK;
+  while (st == GR_OK && !r->done) {
+    if (s->reach_on) { /* no giver beyond the reach (and no read beyond its ceilings) */
+      const int *b = s->reach_box;
+      r->x0 = r->x0 > b[0] ? r->x0 : b[0], r->y0 = r->y0 > b[1] ? r->y0 : b[1];
+      r->x1 = r->x1 < b[2] ? r->x1 : b[2], r->y1 = r->y1 < b[3] ? r->y1 : b[3];
+    }
+    int tail = gr_snow_relax_in_tail(s, r);
+    if (tail && r->read == r->started)
+      st = gr_snow_relax_tail(s, r);
+    else if (!tail && r->it_launched < r->cap && r->started - r->read <= r->lag)
+      st = gr_snow_relax_launch(s, r);
+    else if (r->read == r->started)
+      break; /* the cap, every check read */
+    else
+      st = gr_snow_relax_read(s, r);
+  }
+  for (; r->read < r->started; ++r->read)
+    if (!r->empty[r->read % (r->lag + 1)])
+      gr_reduction_finish(s->ctx, &s->red_check[r->read % (r->lag + 1)], NULL, NULL);
+  return st;
+}
+
+/* The points the next step's talus starts from (s->rest). Stopped by the
+ * cap: the last box read, grown by the iterations since, holds every point
+ * that may still move. Under a reach: snow moved a point an iteration from
+ * the points that could move (movers), within the reach, so only there,
+ * and next to it, may a point have an excess now (the edge of the reach,
+ * where the front slides on next step). Not cut to the local arrays: the
+ * domain's box, so that every piece goes on with the next step's talus
+ * alike. */
+static void gr_snow_relax_rest(gr_snow_deformation *s, const gr_snow_relax_run *r, int ok,
+                               const int movers[4]) {
+  int nx = r->nx, ny = r->ny;
+  s->rest[0] = s->rest[1] = 0;
+  s->rest[2] = s->rest[3] = -1;
+  if (ok && !r->done) {
+    s->rest[0] = r->x0 > 0 ? r->x0 : 0, s->rest[1] = r->y0 > 0 ? r->y0 : 0;
+    s->rest[2] = r->x1 < nx - 1 ? r->x1 : nx - 1, s->rest[3] = r->y1 < ny - 1 ? r->y1 : ny - 1;
+  }
+  if (ok && s->reach_on) {
+    const int *b = s->reach_all, g = r->it_launched + 1;
+    int e[4] = {movers[0] - g, movers[1] - g, movers[2] + g, movers[3] + g};
+    e[0] = e[0] > b[0] - 1 ? e[0] : b[0] - 1, e[1] = e[1] > b[1] - 1 ? e[1] : b[1] - 1;
+    e[2] = e[2] < b[2] + 1 ? e[2] : b[2] + 1, e[3] = e[3] < b[3] + 1 ? e[3] : b[3] + 1;
+    if (s->rest[0] > s->rest[2] || s->rest[1] > s->rest[3])
+      memcpy(s->rest, e, sizeof(e));
+    s->rest[0] = s->rest[0] < e[0] ? s->rest[0] : e[0];
+    s->rest[1] = s->rest[1] < e[1] ? s->rest[1] : e[1];
+    s->rest[2] = s->rest[2] > e[2] ? s->rest[2] : e[2];
+    s->rest[3] = s->rest[3] > e[3] ? s->rest[3] : e[3];
+  }
+}
+
 /* Talus relaxation on a window that follows the snow that can move.
  *
  * The window: the givers R (at first the objects' boxes grown by the
@@ -451,49 +657,28 @@ static gr_status gr_snow_relax_reach(gr_snow_deformation *s, int hops, float tol
  * last window copied across). */
 gr_status gr_snow_relax(gr_snow_deformation *s, double dt) {
   int nx = s->grid.nx, ny = s->grid.ny;
-  float tol = gr_snow_tolerance(s);
   gr_status st = GR_OK;
-  int it = 0, x0 = nx, x1 = -1, y0 = ny, y1 = -1;
+  gr_snow_relax_run r;
+  memset(&r, 0, sizeof(r));
+  r.nx = nx, r.ny = ny;
+  r.tol = gr_snow_tolerance(s);
   s->relax_iterations = 0;
-  if (s->relax_full) {
-    x0 = y0 = 0;
-    x1 = nx - 1;
-    y1 = ny - 1;
-  } else {
-    for (int o = 0; o < s->nobjects; ++o) {
-      const gr_snow_object *ob = &s->objects[o];
-      if (ob->bi0 > ob->bi1 || ob->bj0 > ob->bj1)
-        continue;
-      x0 = x0 < ob->bi0 - 2 ? x0 : ob->bi0 - 2;
-      x1 = x1 > ob->bi1 + 2 ? x1 : ob->bi1 + 2;
-      y0 = y0 < ob->bj0 - 2 ? y0 : ob->bj0 - 2;
-      y1 = y1 > ob->bj1 + 2 ? y1 : ob->bj1 + 2;
-    }
-    if (s->rest[0] <= s->rest[2] && s->rest[1] <= s->rest[3]) {
-      x0 = x0 < s->rest[0] ? x0 : s->rest[0];
-      y0 = y0 < s->rest[1] ? y0 : s->rest[1];
-      x1 = x1 > s->rest[2] ? x1 : s->rest[2];
-      y1 = y1 > s->rest[3] ? y1 : s->rest[3];
-    }
-  }
+  gr_snow_relax_box(s, &r.x0, &r.y0, &r.x1, &r.y1);
   if (s->params.max_relax_iterations == 0) {
-    s->sync_full |= x0 <= x1;   /* the objects changed the state alone */
-    if (x0 <= x1 && y0 <= y1) { /* all of it may still move */
-      s->rest[0] = x0 > 0 ? x0 : 0, s->rest[1] = y0 > 0 ? y0 : 0;
-      s->rest[2] = x1 < nx - 1 ? x1 : nx - 1, s->rest[3] = y1 < ny - 1 ? y1 : ny - 1;
+    s->sync_full |= r.x0 <= r.x1;       /* the objects changed the state alone */
+    if (r.x0 <= r.x1 && r.y0 <= r.y1) { /* all of it may still move */
+      s->rest[0] = r.x0 > 0 ? r.x0 : 0, s->rest[1] = r.y0 > 0 ? r.y0 : 0;
+      s->rest[2] = r.x1 < nx - 1 ? r.x1 : nx - 1, s->rest[3] = r.y1 < ny - 1 ? r.y1 : ny - 1;
     }
     return GR_OK;
   }
-  if (x0 > x1 || y0 > y1)
+  if (r.x0 > r.x1 || r.y0 > r.y1)
     return GR_OK; /* nothing touched the snow: it stays as relaxed as it was */
-  x0 = x0 > 0 ? x0 : 0;
-  y0 = y0 > 0 ? y0 : 0;
-  x1 = x1 < nx - 1 ? x1 : nx - 1;
-  y1 = y1 < ny - 1 ? y1 : ny - 1;
+  gr_snow_relax_cut(&r);
   if (s->sync_full || s->relax_full)
     st = gr_snow_sync_rect(s, 0, 0, nx - 1, ny - 1);
   else
-    st = gr_snow_sync_rect(s, x0, y0, x1, y1);
+    st = gr_snow_sync_rect(s, r.x0, r.y0, r.x1, r.y1);
   s->relax_full = s->sync_full = 0;
   /* SlumpSpeed: the talus runs on the step's reach only (the givers'
    * window from the movers on). */
@@ -502,8 +687,8 @@ gr_status gr_snow_relax(gr_snow_deformation *s, double dt) {
   s->reach_on = 0;
   if (st == GR_OK && hops > 0) {
     int any = 0;
-    st = gr_snow_relax_reach(s, hops, tol, &x0, &y0, &x1, &y1, &any);
-    movers[0] = x0, movers[1] = y0, movers[2] = x1, movers[3] = y1;
+    st = gr_snow_relax_reach(s, hops, r.tol, &r.x0, &r.y0, &r.x1, &r.y1, &any);
+    movers[0] = r.x0, movers[1] = r.y0, movers[2] = r.x1, movers[3] = r.y1;
     if (st != GR_OK || !any) {
       s->reach_on = 0;
       s->rest[0] = s->rest[1] = 0;
@@ -511,139 +696,16 @@ gr_status gr_snow_relax(gr_snow_deformation *s, double dt) {
       return st; /* nothing can move: the snow is as relaxed as it was */
     }
   }
-  int lx0 = 0, ly0 = 0, lx1 = -1, ly1 = -1; /* the last launch's window */
-  /* Launches in flight: on GPUs, where a read-back between launches costs
-   * more than the launch, only every GR_SNOW_CHECK_EVERY-th launch is
-   * checked and a check is read back GR_SNOW_CHECK_LAG checks later, so the
-   * window of a launch is the last box read grown by every iteration
-   * launched since. A launch after the
-   * one whose check says nothing could move changes nothing (no point
-   * gives), so the lag changes what is computed, never the result or the
-   * iteration count. */
-  const int lag = s->blocked ? GR_SNOW_CHECK_LAG : 0, cap = s->params.max_relax_iterations;
-  const int every = s->blocked ? GR_SNOW_CHECK_EVERY : 1;
-  /* per check in flight: the iterations launched before its launch, and
-   * whether it is empty (a piece with none of the window) */
-  int before[GR_SNOW_CHECK_LAG + 1], empty[GR_SNOW_CHECK_LAG + 1];
-  int launched = 0, started = 0, read = 0, it_launched = 0, done = 0;
-  while (st == GR_OK && !done) {
-    if (s->reach_on) { /* no giver beyond the reach (and no read beyond its ceilings) */
-      const int *b = s->reach_box;
-      x0 = x0 > b[0] ? x0 : b[0], y0 = y0 > b[1] ? y0 : b[1];
-      x1 = x1 < b[2] ? x1 : b[2], y1 = y1 < b[3] ? y1 : b[3];
-    }
-    /* The tail: once the givers' window grown by two is small, in one
-     * work-group (not on a piece with a ring: it would need an exchange
-     * every iteration), after every check in flight is read. */
-    int gx = (x1 + 2 < nx - 1 ? x1 + 2 : nx - 1) - (x0 - 2 > 0 ? x0 - 2 : 0) + 1,
-        gy = (y1 + 2 < ny - 1 ? y1 + 2 : ny - 1) - (y0 - 2 > 0 ? y0 - 2 : 0) + 1;
-    int tail = s->group && !gr_snow_has_ring(s) && it_launched < cap &&
-               (double)gx * gy <= (double)s->group_area;
-    if (tail && read == started) {
-      x0 = x0 > 0 ? x0 : 0;
-      y0 = y0 > 0 ? y0 : 0;
-      x1 = x1 < nx - 1 ? x1 : nx - 1;
-      y1 = y1 < ny - 1 ? y1 : ny - 1;
-      st = gr_snow_relax_group(s, &x0, &y0, &x1, &y1, cap, GR_SNOW_BLOCK_ITERATIONS * every, tol,
-                               &it_launched, &done);
-      if (st == GR_OK)
-        it = it_launched;
-      continue;
-    }
-    if (!tail && it_launched < cap && started - read <= lag) {
-      int left = cap - it_launched;
-      cl_int iters = left < GR_SNOW_BLOCK_ITERATIONS ? left : GR_SNOW_BLOCK_ITERATIONS;
-      x0 = x0 > 0 ? x0 : 0;
-      y0 = y0 > 0 ? y0 : 0;
-      x1 = x1 < nx - 1 ? x1 : nx - 1;
-      y1 = y1 < ny - 1 ? y1 : ny - 1;
-      cl_int gx0 = x0, gy0 = y0, gx_end = x1 + 1, gy_end = y1 + 1;
-      /* The launch's window: R grown by the iterations. */
-      int mx0 = x0 - iters > 0 ? x0 - iters : 0, my0 = y0 - iters > 0 ? y0 - iters : 0;
-      cl_int mx_end = x1 + iters + 1 < nx ? x1 + iters + 1 : nx,
-             my_end = y1 + iters + 1 < ny ? y1 + iters + 1 : ny;
-      /* The buffer the first write goes to lags the state on the last
-       * window; it must not where that write does not reach: all of the
-       * launch's window in one blocked launch, R grown by one in the first
-       * of the one-launch iterations (each later one covers its
-       * predecessor's). */
-      int grow = s->blocked ? iters : 1;
-      int fx0 = x0 - grow > 0 ? x0 - grow : 0, fy0 = y0 - grow > 0 ? y0 - grow : 0;
-      int fx1 = x1 + grow < nx - 1 ? x1 + grow : nx - 1,
-          fy1 = y1 + grow < ny - 1 ? y1 + grow : ny - 1;
-      if (lx0 < fx0 || ly0 < fy0 || lx1 > fx1 || ly1 > fy1)
-        st = gr_snow_sync_rect(s, lx0, ly0, lx1, ly1);
-      if (st == GR_OK && s->blocked)
-        st = gr_snow_relax_blocked(s, gx0, gy0, gx_end, gy_end, mx0, my0, mx_end, my_end, iters,
-                                   tol);
-      for (cl_int t = 0; st == GR_OK && !s->blocked && t < iters; ++t)
-        st = gr_snow_relax_once(s, gx0, gy0, gx_end, gy_end, t, tol);
-      if (st == GR_OK)
-        st = gr_snow_piece_sync(s); /* pieces: the ring the launch used up */
-      if (st == GR_OK)
-        lx0 = mx0, ly0 = my0, lx1 = mx_end - 1, ly1 = my_end - 1;
-      int slot = started % (lag + 1);
-      if (st == GR_OK && launched % every == 0) {
-        st = gr_snow_relax_check_start(s, &s->red_check[slot], x0, y0, x1, y1, &empty[slot]);
-        before[slot] = it_launched;
-        started += st == GR_OK;
-      }
-      if (st == GR_OK) {
-        it_launched += iters;
-        ++launched;
-        x0 -= iters, x1 += iters, y0 -= iters, y1 += iters; /* until a box is read */
-      }
-      continue;
-    }
-    if (read == started)
-      break; /* the cap, every check read */
-    double m[GR_SNOW_CHECK_MAXES];
-    int slot = read % (lag + 1);
-    st = gr_snow_relax_check_finish(s, &s->red_check[slot], empty[slot], m);
-    ++read;
-    if (st == GR_OK && m[0] <= tol) {
-      it = before[slot]; /* nothing could move: that launch and those after changed nothing */
-      done = 1;
-    } else if (st == GR_OK) {
-      it = it_launched;
-      int g = it_launched - before[slot]; /* iterations since that check's launch began */
-      x0 = (int)-m[1] - g, x1 = (int)m[2] + g;
-      y0 = (int)-m[3] - g, y1 = (int)m[4] + g;
-    }
-  }
-  /* Checks still in flight (after the end, or an error): wait for them. */
-  for (; read < started; ++read)
-    if (!empty[read % (lag + 1)])
-      gr_reduction_finish(s->ctx, &s->red_check[read % (lag + 1)], NULL, NULL);
-  /* Stopped by the cap: the last box read, grown by the iterations since,
-   * holds every point that may still move. */
-  s->rest[0] = s->rest[1] = 0;
-  s->rest[2] = s->rest[3] = -1;
-  if (st == GR_OK && !done) {
-    s->rest[0] = x0 > 0 ? x0 : 0, s->rest[1] = y0 > 0 ? y0 : 0;
-    s->rest[2] = x1 < nx - 1 ? x1 : nx - 1, s->rest[3] = y1 < ny - 1 ? y1 : ny - 1;
-  }
-  /* Under a reach: snow moved a point an iteration from the points that
-   * could move, within the reach, so only there, and next to it, may a
-   * point have an excess now (the edge of the reach, where the front
-   * slides on next step). Not cut to the local arrays: the domain's box,
-   * so that every piece goes on with the next step's talus alike. */
-  if (st == GR_OK && s->reach_on) {
-    const int *b = s->reach_all, g = it_launched + 1;
-    int e[4] = {movers[0] - g, movers[1] - g, movers[2] + g, movers[3] + g};
-    e[0] = e[0] > b[0] - 1 ? e[0] : b[0] - 1, e[1] = e[1] > b[1] - 1 ? e[1] : b[1] - 1;
-    e[2] = e[2] < b[2] + 1 ? e[2] : b[2] + 1, e[3] = e[3] < b[3] + 1 ? e[3] : b[3] + 1;
-    if (s->rest[0] > s->rest[2] || s->rest[1] > s->rest[3])
-      memcpy(s->rest, e, sizeof(e));
-    s->rest[0] = s->rest[0] < e[0] ? s->rest[0] : e[0];
-    s->rest[1] = s->rest[1] < e[1] ? s->rest[1] : e[1];
-    s->rest[2] = s->rest[2] > e[2] ? s->rest[2] : e[2];
-    s->rest[3] = s->rest[3] > e[3] ? s->rest[3] : e[3];
-  }
+  r.lx0 = 0, r.ly0 = 0, r.lx1 = -1, r.ly1 = -1; /* no launch yet */
+  r.lag = s->blocked ? GR_SNOW_CHECK_LAG : 0, r.cap = s->params.max_relax_iterations;
+  r.every = s->blocked ? GR_SNOW_CHECK_EVERY : 1;
+  if (st == GR_OK)
+    st = gr_snow_relax_iterate(s, &r);
+  gr_snow_relax_rest(s, &r, st == GR_OK, movers);
   s->reach_on = 0;
   /* Both buffers equal again: the last window from the state. */
   if (st == GR_OK)
-    st = gr_snow_sync_rect(s, lx0, ly0, lx1, ly1);
-  s->relax_iterations = it;
+    st = gr_snow_sync_rect(s, r.lx0, r.ly0, r.lx1, r.ly1);
+  s->relax_iterations = r.it;
   return st;
 }

@@ -2,6 +2,7 @@
 #include "graupel/terrain_analysis.h"
 #include "graupel/cl_runtime.h"
 #include "terrain_analysis_shared.h"
+#include "runtime_internal.h"
 
 #include <float.h>
 #include <math.h>
@@ -124,38 +125,14 @@ void gr_terrain_analysis_params_init(gr_terrain_analysis_params *p) {
 
 gr_status gr_terrain_analysis_params_validate(const gr_terrain_analysis_params *p, char *msg,
                                               size_t msg_len) {
-  if (!p) {
-    if (msg && msg_len)
-      snprintf(msg, msg_len, "Invalid terrain analysis parameters: no parameters were given.");
-    return GR_ERR_INVALID_ARGUMENT;
-  }
-  for (int row = 0; row < GR_TA_ROWS; ++row) {
-    const gr_param_bound *b = &gr_ta_bounds[row];
-    double v = gr_ta_get(p, row);
-    if (gr_param_accepts(b, v))
-      continue;
-    if (msg && msg_len) {
-      const char *hint = gr_ta_hints[row] ? gr_ta_hints[row] : "";
-      const char *sep = b->unit[0] ? " " : "";
-      if (b->min_open)
-        snprintf(msg, msg_len,
-                 "Invalid terrain analysis parameters: %s%s is %.15g but must be above %.15g and "
-                 "at most %.15g%s%s.",
-                 b->property, hint, v, b->min, b->max, sep, b->unit);
-      else if (b->integer)
-        snprintf(msg, msg_len,
-                 "Invalid terrain analysis parameters: %s%s is %.15g but must be a whole number "
-                 "from %.15g to %.15g.",
-                 b->property, hint, v, b->min, b->max);
-      else
-        snprintf(msg, msg_len,
-                 "Invalid terrain analysis parameters: %s%s is %.15g but must lie between %.15g "
-                 "and %.15g%s%s.",
-                 b->property, hint, v, b->min, b->max, sep, b->unit);
-    }
-    return GR_ERR_INVALID_ARGUMENT;
-  }
-  return GR_OK;
+  const char *what = "Invalid terrain analysis parameters";
+  if (!p)
+    return gr_params_missing(what, msg, msg_len);
+  double values[GR_TA_ROWS];
+  for (int row = 0; row < GR_TA_ROWS; ++row)
+    values[row] = gr_ta_get(p, row);
+  return gr_params_check_table(gr_ta_bounds, NULL, GR_TA_ROWS, values, what, gr_ta_hints,
+                               GR_PARAM_SAY_IS_OPEN_FIRST, msg, msg_len);
 }
 
 void gr_terrain_analysis_destroy(gr_terrain_analysis *t) {
