@@ -84,112 +84,80 @@ vtkSmartPointer<vtkFloatArray> ReadOutput(gr_terrain_analysis *t, gr_terrain_out
 }
 } // namespace
 
-int vtkTerrainAnalysisFilter::RequestData(vtkInformation *, vtkInformationVector **inputVector,
-                                          vtkInformationVector *outputVector) {
+vtkDataArray *vtkTerrainAnalysisFilter::Heights(vtkImageData *input, std::string &name) {
   const char *label = this->GetLabel();
-  vtkImageData *input = vtkImageData::GetData(inputVector[0]);
-  vtkImageData *output = vtkImageData::GetData(outputVector);
-  output->Initialize();
-  if (this->AbortRequested(label, false)) {
-    return 1;
-  }
   if (!input) {
     vtkErrorMacro(<< label << " needs a terrain image on its Input.");
-    return 0;
+    return nullptr;
   }
   int dims[3];
   input->GetDimensions(dims);
   if (input->GetNumberOfPoints() < 1 || dims[2] != 1) {
     vtkErrorMacro(<< label << " needs a 2-D terrain (nx x ny x 1 points) on its Input; it got "
                   << dims[0] << " x " << dims[1] << " x " << dims[2] << " points.");
-    return 0;
+    return nullptr;
   }
   double spacing[3];
   input->GetSpacing(spacing);
   if (!(spacing[0] > 0.0) || !(spacing[1] > 0.0)) {
     vtkErrorMacro(<< label << " needs a terrain spacing above 0 m in x and y; the Input has "
                   << spacing[0] << " and " << spacing[1] << " m.");
-    return 0;
+    return nullptr;
   }
   // No name (a proxy made before its input had arrays to list) means the
   // default, elevation.
   vtkInformation *arrayInfo = this->GetInputArrayInformation(0);
-  const char *name = arrayInfo && arrayInfo->Has(vtkDataObject::FIELD_NAME())
-                         ? arrayInfo->Get(vtkDataObject::FIELD_NAME())
-                         : nullptr;
-  if (!name || !*name) {
-    name = "elevation";
-  }
-  vtkDataArray *heights = input->GetPointData()->GetArray(name);
+  const char *chosen = arrayInfo && arrayInfo->Has(vtkDataObject::FIELD_NAME())
+                           ? arrayInfo->Get(vtkDataObject::FIELD_NAME())
+                           : nullptr;
+  name = chosen && *chosen ? chosen : "elevation";
+  vtkDataArray *heights = input->GetPointData()->GetArray(name.c_str());
   if (!heights || heights->GetNumberOfComponents() != 1) {
     vtkErrorMacro(<< label << "'s Input has no one-component point array '" << name
                   << "'; give the terrain heights (m) that name, or choose the array of heights "
                      "(e.g. elevation or snow_surface) as the Height Array.");
-    return 0;
+    return nullptr;
   }
+  return heights;
+}
 
-  gr_terrain_analysis_params p;
-  gr_terrain_analysis_params_init(&p);
-  p.sun_azimuth = this->SunAzimuth;
-  p.sun_elevation = this->SunElevation;
-  p.penumbra_width = this->PenumbraWidth;
-  p.model_shadows = this->ModelShadows ? 1 : 0;
-  p.cover_mode = this->CoverMode;
-  p.snow_exponent = this->SnowExponent;
-  p.snow_cover_limit = this->SnowCoverLimit;
-  p.rock_slope = this->RockSlope;
-  p.water_level = this->WaterLevel;
+bool vtkTerrainAnalysisFilter::CoreParams(gr_terrain_analysis_params *p) {
+  gr_terrain_analysis_params_init(p);
+  p->sun_azimuth = this->SunAzimuth;
+  p->sun_elevation = this->SunElevation;
+  p->penumbra_width = this->PenumbraWidth;
+  p->model_shadows = this->ModelShadows ? 1 : 0;
+  p->cover_mode = this->CoverMode;
+  p->snow_exponent = this->SnowExponent;
+  p->snow_cover_limit = this->SnowCoverLimit;
+  p->rock_slope = this->RockSlope;
+  p->water_level = this->WaterLevel;
   char msg[256];
-  if (gr_terrain_analysis_params_validate(&p, msg, sizeof(msg)) != GR_OK) {
-    vtkErrorMacro(<< label << ": " << msg);
-    return 0;
+  if (gr_terrain_analysis_params_validate(p, msg, sizeof(msg)) != GR_OK) {
+    vtkErrorMacro(<< this->GetLabel() << ": " << msg);
+    return false;
   }
+  return true;
+}
 
-  gr_grid grid = {};
-  grid.nx = dims[0];
-  grid.ny = dims[1];
-  grid.dx = spacing[0];
-  grid.dy = spacing[1];
-  double origin[3];
-  input->GetOrigin(origin);
-  grid.x0 = origin[0];
-  grid.y0 = origin[1];
-
-  gr_context *ctx = this->GetContext();
-  if (!ctx) {
-    return 0;
-  }
-  // The core's buffers, the output arrays (the shadow's float, or every
-  // output: 33 bytes a point) and a float copy of heights stored otherwise.
-  gr_memory_need need;
-  gr_terrain_analysis_memory(&grid, &need);
-  const double points = static_cast<double>(grid.nx) * grid.ny;
-  const double outputBytes = this->GetShadowOnly() ? 4.0 : 4.0 * (1 + 3 + 4) + 1.0;
-  const double copyBytes = vtkFloatArray::SafeDownCast(heights) ? 0.0 : 4.0;
-  if (!this->ReportError(graupel::MemoryRefusal(
-          ctx, label, graupel::GridSubject(grid.nx, grid.ny),
-          graupel::WithHostArrays(need, points, outputBytes + copyBytes),
-          "resample the terrain to fewer points (e.g. with Resample To Image)"))) {
-    return 0;
-  }
-  this->SetProgressText((std::string(label) + ": " + std::to_string(grid.nx) + " x " +
-                         std::to_string(grid.ny) + " points")
-                            .c_str());
+int vtkTerrainAnalysisFilter::Compute(gr_context *ctx, const gr_grid &grid,
+                                      const gr_terrain_analysis_params &p, vtkDataArray *heights,
+                                      const std::string &name,
+                                      std::vector<vtkSmartPointer<vtkDataArray>> &arrays) {
+  const char *label = this->GetLabel();
   gr_terrain_analysis *t = nullptr;
   gr_status st = gr_terrain_analysis_create(ctx, &grid, &p, &t);
   if (st != GR_OK) {
     return this->ReportFailure(st, (std::string(label) + " could not set up").c_str(),
                                gr_terrain_analysis_last_error(nullptr));
   }
-  std::string what = std::string(label) + "'s Input array '" + name + "'";
   st = gr_terrain_analysis_set_heights(t, graupel::AsFloat(heights)->GetPointer(0));
   if (st != GR_OK) {
     std::string why = gr_terrain_analysis_last_error(t);
     gr_terrain_analysis_destroy(t);
-    vtkErrorMacro(<< what << ": " << why);
+    vtkErrorMacro(<< label << "'s Input array '" << name << "': " << why);
     return 0;
   }
-
   // The shadow band by band (about a million points each), so that a large
   // terrain reports progress and can be aborted between bands.
   const bool shadow = this->GetShadowOnly() || this->ModelShadows;
@@ -204,15 +172,13 @@ int vtkTerrainAnalysisFilter::RequestData(vtkInformation *, vtkInformationVector
     this->UpdateProgress(0.9 * (row + rows) / grid.ny);
     if (st == GR_OK && this->AbortRequested(label, true)) {
       gr_terrain_analysis_destroy(t);
-      return 1;
+      return -1;
     }
   }
   if (st == GR_OK && !this->GetShadowOnly()) {
     st = gr_terrain_analysis_compute(t);
   }
-
   const vtkIdType npoints = static_cast<vtkIdType>(grid.nx) * grid.ny;
-  std::vector<vtkSmartPointer<vtkDataArray>> arrays;
   if (st == GR_OK && shadow) {
     arrays.emplace_back(ReadOutput(t, GR_TERRAIN_SHADOW, npoints, &st));
   }
@@ -243,7 +209,61 @@ int vtkTerrainAnalysisFilter::RequestData(vtkInformation *, vtkInformationVector
   }
   gr_terrain_analysis_destroy(t);
   this->UpdateProgress(1.0);
+  return 1;
+}
 
+int vtkTerrainAnalysisFilter::RequestData(vtkInformation *, vtkInformationVector **inputVector,
+                                          vtkInformationVector *outputVector) {
+  const char *label = this->GetLabel();
+  vtkImageData *input = vtkImageData::GetData(inputVector[0]);
+  vtkImageData *output = vtkImageData::GetData(outputVector);
+  output->Initialize();
+  if (this->AbortRequested(label, false)) {
+    return 1;
+  }
+  std::string name;
+  vtkDataArray *heights = this->Heights(input, name);
+  gr_terrain_analysis_params p;
+  if (!heights || !this->CoreParams(&p)) {
+    return 0;
+  }
+  int dims[3];
+  double spacing[3], origin[3];
+  input->GetDimensions(dims);
+  input->GetSpacing(spacing);
+  input->GetOrigin(origin);
+  gr_grid grid = {};
+  grid.nx = dims[0];
+  grid.ny = dims[1];
+  grid.dx = spacing[0];
+  grid.dy = spacing[1];
+  grid.x0 = origin[0];
+  grid.y0 = origin[1];
+  gr_context *ctx = this->GetContext();
+  if (!ctx) {
+    return 0;
+  }
+  // The core's buffers, the output arrays (the shadow's float, or every
+  // output: 33 bytes a point) and a float copy of heights stored otherwise.
+  gr_memory_need need;
+  gr_terrain_analysis_memory(&grid, &need);
+  const double points = static_cast<double>(grid.nx) * grid.ny;
+  const double outputBytes = this->GetShadowOnly() ? 4.0 : 4.0 * (1 + 3 + 4) + 1.0;
+  const double copyBytes = vtkFloatArray::SafeDownCast(heights) ? 0.0 : 4.0;
+  if (!this->ReportError(graupel::MemoryRefusal(
+          ctx, label, graupel::GridSubject(grid.nx, grid.ny),
+          graupel::WithHostArrays(need, points, outputBytes + copyBytes),
+          "resample the terrain to fewer points (e.g. with Resample To Image)"))) {
+    return 0;
+  }
+  this->SetProgressText((std::string(label) + ": " + std::to_string(grid.nx) + " x " +
+                         std::to_string(grid.ny) + " points")
+                            .c_str());
+  std::vector<vtkSmartPointer<vtkDataArray>> arrays;
+  const int done = this->Compute(ctx, grid, p, heights, name, arrays);
+  if (done <= 0) {
+    return done < 0 ? 1 : 0; // aborted (an empty output) or failed (said why)
+  }
   output->ShallowCopy(input);
   vtkPointData *pd = output->GetPointData();
   for (const auto &a : arrays) {

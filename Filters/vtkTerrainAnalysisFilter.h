@@ -34,6 +34,16 @@
 
 #include "GraupelFiltersModule.h"
 #include "vtkGraupelAlgorithm.h"
+#include "vtkSmartPointer.h" // for the output arrays
+
+#include <string>
+#include <vector>
+
+class vtkDataArray;
+class vtkImageData;
+struct gr_context;
+struct gr_grid;
+struct gr_terrain_analysis_params;
 
 class GRAUPELFILTERS_EXPORT vtkTerrainAnalysisFilter : public vtkGraupelAlgorithm {
 public:
@@ -123,6 +133,15 @@ protected:
   double WaterLevel = 0.0;
 
 private:
+  // RequestData's parts: the Input's heights checked (and the array's name);
+  // the properties as the core's parameters; the core run (1 done, 0 failed
+  // after one sentence, -1 aborted) with its output arrays.
+  vtkDataArray *Heights(vtkImageData *input, std::string &name);
+  bool CoreParams(struct gr_terrain_analysis_params *p);
+  int Compute(struct gr_context *ctx, const struct gr_grid &grid,
+              const struct gr_terrain_analysis_params &p, vtkDataArray *heights,
+              const std::string &name, std::vector<vtkSmartPointer<vtkDataArray>> &arrays);
+
   vtkTerrainAnalysisFilter(const vtkTerrainAnalysisFilter &) = delete;
   void operator=(const vtkTerrainAnalysisFilter &) = delete;
 };
