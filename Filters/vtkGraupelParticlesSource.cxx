@@ -77,36 +77,24 @@ int vtkGraupelParticlesSource::RequestUpdateExtent(vtkInformation *,
   return 1;
 }
 
-int vtkGraupelParticlesSource::RequestData(vtkInformation *, vtkInformationVector **inputVector,
-                                           vtkInformationVector *outputVector) {
+bool vtkGraupelParticlesSource::CoreParams(vtkImageData *terrain, gr_particles_params *p) {
   const char *label = this->GetLabel();
-  vtkInformation *outInfo = outputVector->GetInformationObject(0);
-  vtkPolyData *output = vtkPolyData::GetData(outInfo);
-  output->Initialize();
-  const double time = outInfo->Has(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP())
-                          ? outInfo->Get(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP())
-                          : 0.0;
-
-  gr_particles_params p;
-  gr_particles_params_init(&p);
-  p.count = this->Count;
-  p.seed = this->Seed;
-  p.exposure_time = this->ExposureTime;
+  gr_particles_params_init(p);
+  p->count = this->Count;
+  p->seed = this->Seed;
+  p->exposure_time = this->ExposureTime;
   for (int c = 0; c < 3; ++c) {
-    p.wind[c] = this->Wind[c];
+    p->wind[c] = this->Wind[c];
   }
   for (int c = 0; c < 6; ++c) {
-    p.region[c] = this->Region[c];
+    p->region[c] = this->Region[c];
   }
-  vtkImageData *terrain = inputVector[0]->GetNumberOfInformationObjects()
-                              ? vtkImageData::GetData(inputVector[0])
-                              : nullptr;
   if (terrain) {
     if (terrain->GetNumberOfPoints() < 1) {
       vtkErrorMacro(<< label
                     << "'s Input is an empty image; connect a terrain with points, or "
                        "disconnect it and give the Region.");
-      return 0;
+      return false;
     }
     double b[6];
     terrain->GetBounds(b);
@@ -118,28 +106,25 @@ int vtkGraupelParticlesSource::RequestData(vtkInformation *, vtkInformationVecto
       lo = range[0];
       hi = range[1];
     }
-    p.region[0] = b[0];
-    p.region[1] = b[1];
-    p.region[2] = b[2];
-    p.region[3] = b[3];
-    p.region[4] = lo;
-    p.region[5] = hi + (this->Region[5] - this->Region[4]);
+    p->region[0] = b[0];
+    p->region[1] = b[1];
+    p->region[2] = b[2];
+    p->region[3] = b[3];
+    p->region[4] = lo;
+    p->region[5] = hi + (this->Region[5] - this->Region[4]);
   }
-  this->FillParameters(&p);
+  this->FillParameters(p);
   char msg[512];
-  if (gr_particles_params_validate(&p, msg, sizeof(msg)) != GR_OK) {
+  if (gr_particles_params_validate(p, msg, sizeof(msg)) != GR_OK) {
     vtkErrorMacro(<< label << (terrain ? " (region from the Input's bounds)" : "") << ": " << msg);
-    return 0;
+    return false;
   }
-  if (!std::isfinite(time)) {
-    vtkErrorMacro(<< label << ": the requested time is not a finite number of seconds.");
-    return 0;
-  }
+  return true;
+}
 
-  gr_context *ctx = this->GetContext();
-  if (!ctx) {
-    return 0;
-  }
+int vtkGraupelParticlesSource::Compute(gr_context *ctx, const gr_particles_params &p, double time,
+                                       vtkPoints *points, vtkSmartPointer<vtkFloatArray> *arrays) {
+  const char *label = this->GetLabel();
   // The core's outputs (unless a core of this Count holds them already), their
   // host copies and one vertex cell a particle (offset and connectivity).
   gr_memory_need need;
@@ -167,9 +152,6 @@ int vtkGraupelParticlesSource::RequestData(vtkInformation *, vtkInformationVecto
     st = gr_particles_compute(this->Core, time);
   }
   const vtkIdType n = p.count;
-  vtkNew<vtkPoints> points;
-  points->SetDataTypeToFloat();
-  vtkSmartPointer<vtkFloatArray> arrays[GR_PARTICLES_OUTPUT_COUNT];
   for (int o = 0; o < GR_PARTICLES_OUTPUT_COUNT && st == GR_OK; ++o) {
     const auto out = static_cast<gr_particles_output>(o);
     if (o == GR_PARTICLES_POSITION) {
@@ -198,8 +180,41 @@ int vtkGraupelParticlesSource::RequestData(vtkInformation *, vtkInformationVecto
     return this->ReportFailure(
         st, (std::string(label) + " could not compute the particles").c_str(), why.c_str());
   }
+  return 1;
+}
 
+int vtkGraupelParticlesSource::RequestData(vtkInformation *, vtkInformationVector **inputVector,
+                                           vtkInformationVector *outputVector) {
+  const char *label = this->GetLabel();
+  vtkInformation *outInfo = outputVector->GetInformationObject(0);
+  vtkPolyData *output = vtkPolyData::GetData(outInfo);
+  output->Initialize();
+  const double time = outInfo->Has(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP())
+                          ? outInfo->Get(vtkStreamingDemandDrivenPipeline::UPDATE_TIME_STEP())
+                          : 0.0;
+  vtkImageData *terrain = inputVector[0]->GetNumberOfInformationObjects()
+                              ? vtkImageData::GetData(inputVector[0])
+                              : nullptr;
+  gr_particles_params p;
+  if (!this->CoreParams(terrain, &p)) {
+    return 0;
+  }
+  if (!std::isfinite(time)) {
+    vtkErrorMacro(<< label << ": the requested time is not a finite number of seconds.");
+    return 0;
+  }
+  gr_context *ctx = this->GetContext();
+  if (!ctx) {
+    return 0;
+  }
+  vtkNew<vtkPoints> points;
+  points->SetDataTypeToFloat();
+  vtkSmartPointer<vtkFloatArray> arrays[GR_PARTICLES_OUTPUT_COUNT];
+  if (!this->Compute(ctx, p, time, points, arrays)) {
+    return 0;
+  }
   // One vertex per point: offsets 0..n, connectivity 0..n-1.
+  const vtkIdType n = p.count;
   vtkNew<vtkIdTypeArray> offsets, connectivity;
   offsets->SetNumberOfTuples(n + 1);
   connectivity->SetNumberOfTuples(n);

@@ -29,6 +29,11 @@
 
 #include "GraupelFiltersModule.h"
 #include "vtkGraupelAlgorithm.h"
+#include "vtkSmartPointer.h" // for the output arrays
+
+class vtkFloatArray;
+class vtkImageData;
+class vtkPoints;
 
 struct gr_particles;
 struct gr_particles_params;
@@ -93,6 +98,13 @@ protected:
   double Region[6] = {0.0, 100.0, 0.0, 100.0, 0.0, 50.0};
 
 private:
+  // RequestData's parts: the properties (and the Input's bounds) as the
+  // core's parameters; the core run and its outputs read. false / 0 after
+  // one sentence.
+  bool CoreParams(vtkImageData *terrain, gr_particles_params *p);
+  int Compute(gr_context *ctx, const gr_particles_params &p, double time, vtkPoints *points,
+              vtkSmartPointer<vtkFloatArray> *arrays);
+
   vtkGraupelParticlesSource(const vtkGraupelParticlesSource &) = delete;
   void operator=(const vtkGraupelParticlesSource &) = delete;
 
