@@ -678,6 +678,92 @@ int vtkGraupelSimulation::RequestData(vtkInformation *request, vtkInformationVec
   return ok;
 }
 
+int vtkGraupelSimulation::PlanRequest(vtkInformation *outInfo, vtkInformationVector **inputVector) {
+  const Key key = this->CurrentKey();
+  if (this->HasFailed && key == this->FailedKey) {
+    // Said why already; nothing changed since.
+    return 0;
+  }
+  this->HasFailed = false;
+  this->FailedKey = key;
+  if (!this->CheckTimes()) {
+    this->InvalidateState();
+    this->HasFailed = true;
+    return 0;
+  }
+  this->Target = this->TargetIndex(outInfo);
+  if (this->StateIndex < 0 || !(key == this->StateKey) ||
+      this->StateLayout != this->PieceLayout->GetSignature()) {
+    this->InvalidateState();
+    if (!this->GetContext()) {
+      this->HasFailed = true;
+      return 0;
+    }
+    ++this->RestartCount;
+    this->RestartIndex = -1;
+    if (!this->SetUpState(inputVector)) {
+      this->ReleaseState();
+      this->HasFailed = true;
+      return 0;
+    }
+    this->StateIndex = 0;
+    this->StateTime = 0.0;
+    this->StateLost = false;
+    this->StateKey = key;
+    this->StateLayout = this->PieceLayout->GetSignature();
+    if (this->RestartFile && *this->RestartFile && !this->ReadRestartFile()) {
+      this->InvalidateState();
+      this->HasFailed = true;
+      return 0;
+    }
+  }
+  if (!this->Rewind(this->Target)) {
+    this->InvalidateState();
+    this->HasFailed = true;
+    return 0;
+  }
+  this->ReportProgress(this->StateTime);
+  return 1;
+}
+
+int vtkGraupelSimulation::NextKnot(vtkInformation *request, double &next) {
+  // Each temporal input at the time step that holds now, else another pass.
+  const int nports = this->GetNumberOfInputPorts();
+  bool waiting = false;
+  next = this->GetOutputTime(this->StateIndex + 1);
+  for (int port = 0; port < nports; ++port) {
+    if (!this->IsInputTemporal(port)) {
+      continue;
+    }
+    const double need = this->InputTimeAt(port, this->StateTime);
+    if (need != this->DeliveredTime[static_cast<size_t>(port)]) {
+      if (this->Continuing && need == this->PendingTime[static_cast<size_t>(port)]) {
+        this->Finish(request);
+        this->InvalidateState();
+        this->HasFailed = true;
+        vtkErrorMacro(<< this->GetSimulationLabel() << ": input " << port
+                      << " did not update to time " << need
+                      << " s; the pipeline above it must honour time requests.");
+        return KNOT_FAILED;
+      }
+      this->PendingTime[static_cast<size_t>(port)] = need;
+      waiting = true;
+    }
+    const std::vector<double> &times = this->InputTimes[static_cast<size_t>(port)];
+    auto after = std::upper_bound(times.begin(), times.end(), this->StateTime);
+    if (after != times.end()) {
+      next = std::min(next, *after);
+    }
+  }
+  if (waiting) {
+    request->Set(vtkStreamingDemandDrivenPipeline::CONTINUE_EXECUTING(), 1);
+    this->Continuing = true;
+    ++this->ExtraPassCount;
+    return KNOT_WAIT;
+  }
+  return KNOT_READY;
+}
+
 int vtkGraupelSimulation::UpdateState(vtkInformation *request, vtkInformationVector **inputVector,
                                       vtkInformationVector *outputVector) {
   vtkInformation *outInfo = outputVector->GetInformationObject(0);
@@ -698,90 +784,17 @@ int vtkGraupelSimulation::UpdateState(vtkInformation *request, vtkInformationVec
     return 1;
   }
 #endif
-  if (!this->Continuing) {
-    const Key key = this->CurrentKey();
-    if (this->HasFailed && key == this->FailedKey) {
-      // Said why already; nothing changed since.
-      return 0;
-    }
-    this->HasFailed = false;
-    this->FailedKey = key;
-    if (!this->CheckTimes()) {
-      this->InvalidateState();
-      this->HasFailed = true;
-      return 0;
-    }
-    this->Target = this->TargetIndex(outInfo);
-    if (this->StateIndex < 0 || !(key == this->StateKey) ||
-        this->StateLayout != this->PieceLayout->GetSignature()) {
-      this->InvalidateState();
-      if (!this->GetContext()) {
-        this->HasFailed = true;
-        return 0;
-      }
-      ++this->RestartCount;
-      this->RestartIndex = -1;
-      if (!this->SetUpState(inputVector)) {
-        this->ReleaseState();
-        this->HasFailed = true;
-        return 0;
-      }
-      this->StateIndex = 0;
-      this->StateTime = 0.0;
-      this->StateLost = false;
-      this->StateKey = key;
-      this->StateLayout = this->PieceLayout->GetSignature();
-      if (this->RestartFile && *this->RestartFile && !this->ReadRestartFile()) {
-        this->InvalidateState();
-        this->HasFailed = true;
-        return 0;
-      }
-    }
-    if (!this->Rewind(this->Target)) {
-      this->InvalidateState();
-      this->HasFailed = true;
-      return 0;
-    }
-    this->ReportProgress(this->StateTime);
+  if (!this->Continuing && !this->PlanRequest(outInfo, inputVector)) {
+    return 0;
   }
 
   const double goal = this->GetOutputTime(this->Target);
-  const int nports = this->GetNumberOfInputPorts();
   while (this->StateTime < goal) {
-    // Each temporal input at the time step that holds now, else another pass.
-    bool waiting = false;
-    double next = this->GetOutputTime(this->StateIndex + 1);
-    for (int port = 0; port < nports; ++port) {
-      if (!this->IsInputTemporal(port)) {
-        continue;
-      }
-      const double need = this->InputTimeAt(port, this->StateTime);
-      if (need != this->DeliveredTime[static_cast<size_t>(port)]) {
-        if (this->Continuing && need == this->PendingTime[static_cast<size_t>(port)]) {
-          this->Finish(request);
-          this->InvalidateState();
-          this->HasFailed = true;
-          vtkErrorMacro(<< this->GetSimulationLabel() << ": input " << port
-                        << " did not update to time " << need
-                        << " s; the pipeline above it must honour time requests.");
-          return 0;
-        }
-        this->PendingTime[static_cast<size_t>(port)] = need;
-        waiting = true;
-      }
-      const std::vector<double> &times = this->InputTimes[static_cast<size_t>(port)];
-      auto after = std::upper_bound(times.begin(), times.end(), this->StateTime);
-      if (after != times.end()) {
-        next = std::min(next, *after);
-      }
+    double next = 0.0;
+    const int knot = this->NextKnot(request, next);
+    if (knot != KNOT_READY) {
+      return knot == KNOT_WAIT ? 1 : 0;
     }
-    if (waiting) {
-      request->Set(vtkStreamingDemandDrivenPipeline::CONTINUE_EXECUTING(), 1);
-      this->Continuing = true;
-      ++this->ExtraPassCount;
-      return 1;
-    }
-
     const int result = this->AdvanceState(this->StateTime, next);
     if (result == ADVANCE_FAILED) {
       this->Finish(request);

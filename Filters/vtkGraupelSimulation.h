@@ -369,6 +369,20 @@ private:
   /** RequestData for output 0: the state brought to the requested time and filled in. */
   int UpdateState(vtkInformation *request, vtkInformationVector **inputVector,
                   vtkInformationVector *outputVector);
+  /**
+   * UpdateState's first pass of a request: the failure seen before, the
+   * times, the target output, a set-up (and restart file) when the key or
+   * the pieces changed, the rewind to a checkpoint. 0 after one sentence.
+   */
+  int PlanRequest(vtkInformation *outInfo, vtkInformationVector **inputVector);
+  enum { KNOT_READY, KNOT_WAIT, KNOT_FAILED };
+  /**
+   * The next knot after the state's time (the next output time or temporal
+   * input time step): KNOT_READY with next set; KNOT_WAIT when a temporal
+   * input must be read at another time first (another pass is asked for);
+   * KNOT_FAILED after one sentence when an input did not honour that.
+   */
+  int NextKnot(vtkInformation *request, double &next);
 
   double DefaultEndTime = EndTime; // the base's, until SetTimeDefaults
   double DefaultOutputInterval = OutputInterval;
