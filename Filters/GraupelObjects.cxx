@@ -15,6 +15,136 @@
 
 namespace graupel {
 
+namespace {
+
+// The object's centre (its bounds' middle) and velocity: the filter's, or
+// the block's field array 'velocity'. An error message, or empty.
+std::string ReadMotion(const char *filter, size_t k, vtkPolyData *pd, const double velocity[3],
+                       Object &o) {
+  double b[6];
+  pd->GetBounds(b);
+  for (int c = 0; c < 3; ++c) {
+    o.centre[c] = 0.5 * (b[2 * c] + b[2 * c + 1]);
+    o.velocity[c] = velocity[c];
+  }
+  vtkDataArray *v = pd->GetFieldData()->GetArray("velocity");
+  if (v) {
+    if (v->GetNumberOfComponents() != 3 || v->GetNumberOfTuples() < 1) {
+      std::ostringstream msg;
+      msg << filter << "'s Objects block " << k
+          << " has a field array 'velocity' that is not one 3-component "
+          << "value (m/s); give it 3 components or remove it.";
+      return msg.str();
+    }
+    v->GetTuple(0, o.velocity);
+  }
+  return std::string();
+}
+
+// Vertices::Merged: points at the same place become one vertex, relative
+// to the centre; vertexOf maps each point to its vertex.
+void ReadMergedVertices(vtkPolyData *pd, Object &o, std::vector<int> &vertexOf) {
+  const vtkIdType n = pd->GetNumberOfPoints();
+  std::map<std::array<double, 3>, int> merged;
+  for (vtkIdType i = 0; i < n; ++i) {
+    std::array<double, 3> p;
+    pd->GetPoint(i, p.data());
+    auto found = merged.emplace(p, static_cast<int>(merged.size()));
+    vertexOf[static_cast<size_t>(i)] = found.first->second;
+    if (found.second) {
+      for (int c = 0; c < 3; ++c) {
+        o.vertices.push_back(static_cast<float>(p[static_cast<size_t>(c)] - o.centre[c]));
+      }
+    }
+  }
+}
+
+// One vertex per point, relative to the centre, and the texture
+// coordinates where the points have them.
+void ReadPointVertices(vtkPolyData *pd, Object &o, std::vector<int> &vertexOf) {
+  const vtkIdType n = pd->GetNumberOfPoints();
+  o.vertices.resize(3 * static_cast<size_t>(n));
+  for (vtkIdType i = 0; i < n; ++i) {
+    double p[3];
+    pd->GetPoint(i, p);
+    for (int c = 0; c < 3; ++c) {
+      o.vertices[3 * static_cast<size_t>(i) + c] = static_cast<float>(p[c] - o.centre[c]);
+    }
+    vertexOf[static_cast<size_t>(i)] = static_cast<int>(i);
+  }
+  // Texture coordinates (the first two components) give the object an
+  // accumulation texture.
+  if (vtkDataArray *tc = pd->GetPointData()->GetTCoords()) {
+    if (tc->GetNumberOfComponents() >= 2 && tc->GetNumberOfTuples() == n) {
+      o.uv.resize(2 * static_cast<size_t>(n));
+      for (vtkIdType i = 0; i < n; ++i) {
+        for (int c = 0; c < 2; ++c) {
+          o.uv[2 * static_cast<size_t>(i) + c] = static_cast<float>(tc->GetComponent(i, c));
+        }
+      }
+    }
+  }
+}
+
+// Polygons as fans, strips with alternating winding: the triangles the
+// core takes, without a dependency on VTK's filters.
+void ReadTriangles(vtkPolyData *pd, const std::vector<int> &vertexOf, Object &o) {
+  const vtkIdType n = pd->GetNumberOfPoints();
+  // An id out of range becomes -1, which gr_mesh_validate names.
+  auto vertex = [&](vtkIdType id) {
+    return id >= 0 && id < n ? vertexOf[static_cast<size_t>(id)] : -1;
+  };
+  vtkNew<vtkIdList> ids;
+  vtkCellArray *polys = pd->GetPolys();
+  for (polys->InitTraversal(); polys->GetNextCell(ids);) {
+    for (vtkIdType j = 2; j < ids->GetNumberOfIds(); ++j) {
+      o.triangles.insert(o.triangles.end(),
+                         {vertex(ids->GetId(0)), vertex(ids->GetId(j - 1)), vertex(ids->GetId(j))});
+    }
+  }
+  vtkCellArray *strips = pd->GetStrips();
+  for (strips->InitTraversal(); strips->GetNextCell(ids);) {
+    for (vtkIdType j = 2; j < ids->GetNumberOfIds(); ++j) {
+      const int a = vertex(ids->GetId(j - 2));
+      const int b1 = vertex(ids->GetId(j - 1));
+      const int c = vertex(ids->GetId(j));
+      if (j % 2 == 0) {
+        o.triangles.insert(o.triangles.end(), {a, b1, c});
+      } else {
+        o.triangles.insert(o.triangles.end(), {b1, a, c});
+      }
+    }
+  }
+}
+
+// Block k of count as one object, its mesh validated. An error message, or
+// empty.
+std::string ReadObject(const char *filter, size_t k, size_t count, vtkPolyData *pd,
+                       const double velocity[3], Vertices vertices, int closed, Object &o) {
+  std::string error = ReadMotion(filter, k, pd, velocity, o);
+  if (!error.empty()) {
+    return error;
+  }
+  std::vector<int> vertexOf(static_cast<size_t>(pd->GetNumberOfPoints()));
+  if (vertices == Vertices::Merged) {
+    ReadMergedVertices(pd, o, vertexOf);
+  } else {
+    ReadPointVertices(pd, o, vertexOf);
+  }
+  ReadTriangles(pd, vertexOf, o);
+  const gr_mesh mesh = MeshOf(o);
+  char invalid[512];
+  if (gr_mesh_validate(&mesh, closed, invalid, sizeof(invalid)) != GR_OK) {
+    std::ostringstream msg;
+    msg << filter << "'s Objects" << (count > 1 ? " block " + std::to_string(k) : std::string())
+        << ": " << invalid;
+    return msg.str();
+  }
+  return std::string();
+}
+
+} // namespace
+
 std::string ReadObjects(const char *filter, vtkDataObject *input, size_t maxObjects,
                         const double velocity[3], Vertices vertices, int closed, bool inputTemporal,
                         const std::vector<double> &path, std::vector<Object> &objects,
@@ -35,95 +165,11 @@ std::string ReadObjects(const char *filter, vtkDataObject *input, size_t maxObje
     return msg.str();
   }
   for (size_t k = 0; k < leaves.size(); ++k) {
-    vtkPolyData *pd = leaves[k];
     Object o;
-    double b[6];
-    pd->GetBounds(b);
-    for (int c = 0; c < 3; ++c) {
-      o.centre[c] = 0.5 * (b[2 * c] + b[2 * c + 1]);
-      o.velocity[c] = velocity[c];
-    }
-    vtkDataArray *v = pd->GetFieldData()->GetArray("velocity");
-    if (v) {
-      if (v->GetNumberOfComponents() != 3 || v->GetNumberOfTuples() < 1) {
-        msg << filter << "'s Objects block " << k
-            << " has a field array 'velocity' that is not one 3-component "
-            << "value (m/s); give it 3 components or remove it.";
-        return msg.str();
-      }
-      v->GetTuple(0, o.velocity);
-    }
-    const vtkIdType n = pd->GetNumberOfPoints();
-    std::vector<int> vertexOf(static_cast<size_t>(n));
-    if (vertices == Vertices::Merged) {
-      std::map<std::array<double, 3>, int> merged;
-      for (vtkIdType i = 0; i < n; ++i) {
-        std::array<double, 3> p;
-        pd->GetPoint(i, p.data());
-        auto found = merged.emplace(p, static_cast<int>(merged.size()));
-        vertexOf[static_cast<size_t>(i)] = found.first->second;
-        if (found.second) {
-          for (int c = 0; c < 3; ++c) {
-            o.vertices.push_back(static_cast<float>(p[static_cast<size_t>(c)] - o.centre[c]));
-          }
-        }
-      }
-    } else {
-      o.vertices.resize(3 * static_cast<size_t>(n));
-      for (vtkIdType i = 0; i < n; ++i) {
-        double p[3];
-        pd->GetPoint(i, p);
-        for (int c = 0; c < 3; ++c) {
-          o.vertices[3 * static_cast<size_t>(i) + c] = static_cast<float>(p[c] - o.centre[c]);
-        }
-        vertexOf[static_cast<size_t>(i)] = static_cast<int>(i);
-      }
-      // Texture coordinates (the first two components) give the object an
-      // accumulation texture.
-      if (vtkDataArray *tc = pd->GetPointData()->GetTCoords()) {
-        if (tc->GetNumberOfComponents() >= 2 && tc->GetNumberOfTuples() == n) {
-          o.uv.resize(2 * static_cast<size_t>(n));
-          for (vtkIdType i = 0; i < n; ++i) {
-            for (int c = 0; c < 2; ++c) {
-              o.uv[2 * static_cast<size_t>(i) + c] = static_cast<float>(tc->GetComponent(i, c));
-            }
-          }
-        }
-      }
-    }
-    // An id out of range becomes -1, which gr_mesh_validate names.
-    auto vertex = [&](vtkIdType id) {
-      return id >= 0 && id < n ? vertexOf[static_cast<size_t>(id)] : -1;
-    };
-    // Polygons as fans, strips with alternating winding: the triangles the
-    // core takes, without a dependency on VTK's filters.
-    vtkNew<vtkIdList> ids;
-    vtkCellArray *polys = pd->GetPolys();
-    for (polys->InitTraversal(); polys->GetNextCell(ids);) {
-      for (vtkIdType j = 2; j < ids->GetNumberOfIds(); ++j) {
-        o.triangles.insert(o.triangles.end(), {vertex(ids->GetId(0)), vertex(ids->GetId(j - 1)),
-                                               vertex(ids->GetId(j))});
-      }
-    }
-    vtkCellArray *strips = pd->GetStrips();
-    for (strips->InitTraversal(); strips->GetNextCell(ids);) {
-      for (vtkIdType j = 2; j < ids->GetNumberOfIds(); ++j) {
-        const int a = vertex(ids->GetId(j - 2));
-        const int b1 = vertex(ids->GetId(j - 1));
-        const int c = vertex(ids->GetId(j));
-        if (j % 2 == 0) {
-          o.triangles.insert(o.triangles.end(), {a, b1, c});
-        } else {
-          o.triangles.insert(o.triangles.end(), {b1, a, c});
-        }
-      }
-    }
-    const gr_mesh mesh = MeshOf(o);
-    char invalid[512];
-    if (gr_mesh_validate(&mesh, closed, invalid, sizeof(invalid)) != GR_OK) {
-      msg << filter << "'s Objects"
-          << (leaves.size() > 1 ? " block " + std::to_string(k) : std::string()) << ": " << invalid;
-      return msg.str();
+    const std::string error =
+        ReadObject(filter, k, leaves.size(), leaves[k], velocity, vertices, closed, o);
+    if (!error.empty()) {
+      return error;
     }
     objects.push_back(std::move(o));
   }

@@ -353,9 +353,9 @@ static const char *base_request(const char *device) {
   return env && env[0] ? env : "auto";
 }
 
-int gr_bench_split_run(const char *name, const gr_bench_core *core, int n, int steps,
-                       const char *device, int k, int verify) {
-  const gr_bench_split *sp = core->split;
+/* The request's limits: 0 when the core, the size and the pieces suit
+ * --devices (and --verify), else 2 with the message printed. */
+static int check_split(const char *name, const gr_bench_split *sp, int n, int k, int verify) {
   if (!sp) {
     fprintf(stderr,
             "graupel-bench: --devices needs a core that runs as pieces of a split "
@@ -376,109 +376,120 @@ int gr_bench_split_run(const char *name, const gr_bench_core *core, int n, int s
                     "host: use --size 4096 or less with it.\n");
     return 2;
   }
-  const char *base = base_request(device);
-  /* Piece r on the (r mod d)-th of the d devices the request matches: a
-   * ":N" request is one device. */
+  return 0;
+}
+
+/* One context per piece, piece r on the (r mod d)-th of the d devices base
+ * matches (a ":N" request is one device), and each piece's strip of rows;
+ * *distinct the d. Prints which device has which pieces. Returns 0, else
+ * the exit status (1, or 77 when --verify finds no OpenCL device). */
+static int open_pieces(split_team *t, split_member *m, const char *base, int verify,
+                       int *distinct) {
+  int k = t->k, n = t->n;
   int has_index = strchr(base, ':') != NULL;
-  split_member *m = calloc((size_t)k, sizeof(*m));
-  split_team t;
-  memset(&t, 0, sizeof(t));
-  t.split = sp;
-  t.core = core;
-  t.k = k;
-  t.n = n;
-  t.steps = steps;
-  size_t cells = (size_t)n * (size_t)n;
-  int distinct = 0, rc = 1;
   char request[300];
-  if (!m) {
-    fprintf(stderr, "graupel-bench: out of host memory.\n");
-    return 1;
-  }
-  pthread_mutex_init(&t.barrier.lock, NULL);
-  pthread_cond_init(&t.barrier.turn, NULL);
-  t.barrier.count = k;
+  *distinct = 0;
   for (int r = 0; r < k; ++r) {
     gr_context_options opt;
     gr_context_options_init(&opt);
     if (has_index)
       snprintf(request, sizeof(request), "%s", base);
     else
-      snprintf(request, sizeof(request), "%s:%d", base, distinct ? r % distinct : r);
+      snprintf(request, sizeof(request), "%s:%d", base, *distinct ? r % *distinct : r);
     opt.device = request;
     gr_status st = gr_context_create(&opt, &m[r].ctx);
-    if (st != GR_OK && r > 0 && !has_index && !distinct) {
-      distinct = r; /* no r-th device: share the first r */
-      snprintf(request, sizeof(request), "%s:%d", base, r % distinct);
+    if (st != GR_OK && r > 0 && !has_index && !*distinct) {
+      *distinct = r; /* no r-th device: share the first r */
+      snprintf(request, sizeof(request), "%s:%d", base, r % *distinct);
       st = gr_context_create(&opt, &m[r].ctx);
     }
     if (st != GR_OK) {
       fprintf(stderr, "graupel-bench: %s\n", gr_last_error(NULL));
-      rc = st == GR_ERR_NO_PLATFORM || st == GR_ERR_NO_DEVICE ? (verify ? 77 : 1) : 1;
+      int rc = st == GR_ERR_NO_PLATFORM || st == GR_ERR_NO_DEVICE ? (verify ? 77 : 1) : 1;
       if (rc == 77)
         printf("graupel-bench: no OpenCL device: --verify skipped.\n");
-      goto done;
+      return rc;
     }
-    m[r].team = &t;
+    m[r].team = t;
     m[r].rank = r;
     m[r].j0 = (int)((long long)n * r / k);
     m[r].ny = (int)((long long)n * (r + 1) / k) - m[r].j0;
   }
   if (has_index)
-    distinct = 1;
-  else if (!distinct)
-    distinct = k;
+    *distinct = 1;
+  else if (!*distinct)
+    *distinct = k;
   for (int r = 0; r < k; ++r)
-    m[r].device = r % distinct;
-  for (int d = 0; d < distinct; ++d) {
+    m[r].device = r % *distinct;
+  for (int d = 0; d < *distinct; ++d) {
     printf("device %d: %s (%s): pieces", d, gr_context_device_name(m[d].ctx),
            gr_context_platform_name(m[d].ctx));
-    for (int r = d; r < k; r += distinct)
+    for (int r = d; r < k; r += *distinct)
       printf(" %d", r);
     printf("\n");
   }
-  if (distinct < k)
+  if (*distinct < k)
     printf("note: %d pieces on %d device%s ('%s' matches no more): the pieces share them, so the "
            "figures measure the split's cost, not a speed-up\n",
-           k, distinct, distinct == 1 ? "" : "s", base);
+           k, *distinct, *distinct == 1 ? "" : "s", base);
+  return 0;
+}
 
-  double copy_bps = 0.0;
+/* The copy rates of the distinct devices added up into *copy_bps; 0, or -1
+ * with the message printed. */
+static int probe_copy(const split_team *t, split_member *m, int distinct, double *copy_bps) {
+  size_t cells = (size_t)t->n * (size_t)t->n;
+  *copy_bps = 0.0;
   for (int d = 0; d < distinct; ++d) {
     double bps = 0.0;
     /* Each device probed alone; one device's pieces share its copy rate. */
-    if (gr_bench_copy_bandwidth(m[d].ctx, cells / (size_t)k * 4, &bps) != GR_OK) {
+    if (gr_bench_copy_bandwidth(m[d].ctx, cells / (size_t)t->k * 4, &bps) != GR_OK) {
       fprintf(stderr, "graupel-bench: %s\n", gr_last_error(m[d].ctx));
-      goto done;
+      return -1;
     }
-    copy_bps += bps;
+    *copy_bps += bps;
   }
+  return 0;
+}
 
-  t.slots = calloc((size_t)k * SPLIT_SLOTS, sizeof(double));
-  t.mail[0] = calloc((size_t)2 * k, sizeof(void *));
-  t.mail[1] = calloc((size_t)2 * k, sizeof(void *));
-  int ok = t.slots && t.mail[0] && t.mail[1];
+/* The allreduce slots, the mailboxes' tables and, with --verify, the whole
+ * grid's outputs; each piece's link. 0, or -1 with the message printed. */
+static int team_alloc(split_team *t, split_member *m, int verify) {
+  const gr_bench_split *sp = t->split;
+  int k = t->k;
+  size_t cells = (size_t)t->n * (size_t)t->n;
+  t->slots = calloc((size_t)k * SPLIT_SLOTS, sizeof(double));
+  t->mail[0] = calloc((size_t)2 * k, sizeof(void *));
+  t->mail[1] = calloc((size_t)2 * k, sizeof(void *));
+  int ok = t->slots && t->mail[0] && t->mail[1];
   if (ok && verify) {
-    t.gathered = calloc((size_t)sp->outputs, sizeof(float *));
-    ok = t.gathered != NULL;
+    t->gathered = calloc((size_t)sp->outputs, sizeof(float *));
+    ok = t->gathered != NULL;
     for (int i = 0; ok && i < sp->outputs; ++i) {
       const char *out = NULL;
       int comps = 1;
       ok = sp->output(NULL, i, &out, &comps, NULL) == GR_OK &&
-           (t.gathered[i] = malloc(cells * (size_t)comps * sizeof(float))) != NULL;
+           (t->gathered[i] = malloc(cells * (size_t)comps * sizeof(float))) != NULL;
     }
   }
   if (!ok) {
     fprintf(stderr, "graupel-bench: out of host memory%s.\n", verify ? " for --verify" : "");
-    goto done;
+    return -1;
   }
   for (int r = 0; r < k; ++r)
     m[r].link = (gr_bench_link){split_allreduce, &m[r], split_exchange, &m[r]};
+  return 0;
+}
 
+/* One thread per piece, all joined; the pieces' failures printed (the
+ * first cause before the aborts it caused). Returns 1 when any failed. */
+static int run_pieces(split_team *t, split_member *m) {
+  int k = t->k;
   pthread_t *threads = calloc((size_t)k, sizeof(pthread_t));
   int started = 0;
   for (; threads && started < k; ++started)
     if (pthread_create(&threads[started], NULL, member_run, &m[started]) != 0) {
-      barrier_break(&t.barrier);
+      barrier_break(&t->barrier);
       break;
     }
   for (int r = 0; r < started; ++r)
@@ -495,38 +506,57 @@ int gr_bench_split_run(const char *name, const gr_bench_core *core, int n, int s
       fprintf(stderr, "graupel-bench: %s\n", m[r].error);
       failed = 1;
     }
-  if (failed)
-    goto done;
+  return failed;
+}
 
-  double t0 = m[0].t0, t1 = m[0].t1, halo = 0.0, wait = 0.0, barrier = 0.0;
-  double allreduce = 0.0, step_allreduce = 0.0;
-  int calls = 0, step_calls = 0;
-  double step_values = 0.0;
-  unsigned long exchanges = 0;
-  size_t halo_bytes = 0;
+/* The pieces' figures combined: the slowest piece's times, the whole run's
+ * span. */
+typedef struct split_figures {
+  double elapsed, halo, wait, barrier, allreduce, step_allreduce;
+  int calls, step_calls;
+  double step_values;
+  unsigned long exchanges;
+  size_t halo_bytes;
+  double ms, mcells, bw, frac;
+} split_figures;
+
+static void combine_figures(const split_team *t, const split_member *m, double copy_bps,
+                            split_figures *f) {
+  int k = t->k, steps = t->steps;
+  size_t cells = (size_t)t->n * (size_t)t->n;
+  double t0 = m[0].t0, t1 = m[0].t1;
+  memset(f, 0, sizeof(*f));
   for (int r = 0; r < k; ++r) {
     t0 = fmin(t0, m[r].t0);
     t1 = fmax(t1, m[r].t1);
-    halo = fmax(halo, m[r].halo_s);
-    wait = fmax(wait, m[r].wait_s);
-    barrier = fmax(barrier, m[r].barrier_s);
-    step_allreduce = fmax(step_allreduce, m[r].step_allreduce_s);
-    allreduce = fmax(allreduce, m[r].allreduce_s - m[r].step_allreduce_s);
-    step_calls = m[r].step_allreduce_calls;
-    step_values = fmax(step_values, m[r].step_allreduce_values);
-    calls = m[r].allreduce_calls - m[r].step_allreduce_calls;
-    exchanges = m[r].step_exchanges;
-    halo_bytes += m[r].halo_bytes[0] + m[r].halo_bytes[1];
+    f->halo = fmax(f->halo, m[r].halo_s);
+    f->wait = fmax(f->wait, m[r].wait_s);
+    f->barrier = fmax(f->barrier, m[r].barrier_s);
+    f->step_allreduce = fmax(f->step_allreduce, m[r].step_allreduce_s);
+    f->allreduce = fmax(f->allreduce, m[r].allreduce_s - m[r].step_allreduce_s);
+    f->step_calls = m[r].step_allreduce_calls;
+    f->step_values = fmax(f->step_values, m[r].step_allreduce_values);
+    f->calls = m[r].allreduce_calls - m[r].step_allreduce_calls;
+    f->exchanges = m[r].step_exchanges;
+    f->halo_bytes += m[r].halo_bytes[0] + m[r].halo_bytes[1];
   }
-  double elapsed = t1 - t0;
-  double ms = 1e3 * elapsed / steps, mcells = (double)cells / (elapsed / steps) / 1e6;
-  double bw = core->bytes_per_cell * (double)cells / (elapsed / steps);
-  double frac = copy_bps > 0.0 ? bw / copy_bps : 0.0;
+  f->elapsed = t1 - t0;
+  f->ms = 1e3 * f->elapsed / steps;
+  f->mcells = (double)cells / (f->elapsed / steps) / 1e6;
+  f->bw = t->core->bytes_per_cell * (double)cells / (f->elapsed / steps);
+  f->frac = copy_bps > 0.0 ? f->bw / copy_bps : 0.0;
+}
+
+/* The figures' lines, the machine-readable one aside. */
+static void print_figures(const split_team *t, const split_member *m, const char *name,
+                          double copy_bps, int distinct, const split_figures *f) {
+  int k = t->k, n = t->n, steps = t->steps;
   printf("copy probe: %.1f GB/s over %d device%s\n", copy_bps / 1e9, distinct,
          distinct == 1 ? "" : "s");
   printf("%s: %d x %d in %d strips along y (ring %d rows), %d steps: %.4f ms/step, %.1f "
          "Mcells/s, %.2f GB/s (%.3f of copy)\n",
-         name, n, n, k, k > 1 ? ring : 0, steps, ms, mcells, bw / 1e9, frac);
+         name, n, n, k, k > 1 ? t->split->ring() : 0, steps, f->ms, f->mcells, f->bw / 1e9,
+         f->frac);
   for (int r = 0; r < k; ++r)
     printf("  piece %d: rows %d-%d on device %d: device wait %.4f, halo copies %.4f, barrier "
            "%.4f ms/step\n",
@@ -535,40 +565,89 @@ int gr_bench_split_run(const char *name, const gr_bench_core *core, int n, int s
   printf("%s: halo exchange %.4f ms/step (copies, the slowest piece's; %.4g exchanges a step, "
          "%zu bytes each over all pieces), barrier wait %.4f ms/step; allreduce %.4f ms/step "
          "(%.4g calls a step), %.4f ms in %d calls after the steps (the summary)\n",
-         name, 1e3 * halo / steps, (double)exchanges / steps, halo_bytes, 1e3 * barrier / steps,
-         1e3 * step_allreduce / steps, (double)step_calls / steps, 1e3 * allreduce, calls);
+         name, 1e3 * f->halo / steps, (double)f->exchanges / steps, f->halo_bytes,
+         1e3 * f->barrier / steps, 1e3 * f->step_allreduce / steps, (double)f->step_calls / steps,
+         1e3 * f->allreduce, f->calls);
   /* What an MPI run would send through MPI_Allreduce: 8 bytes a value. */
   printf("%s: allreduce %.0f bytes a step per piece (%.4g values of 8 bytes)\n", name,
-         8.0 * step_values / steps, step_values / steps);
-  if (t.summary[0])
-    printf("%s\n", t.summary);
+         8.0 * f->step_values / steps, f->step_values / steps);
+  if (t->summary[0])
+    printf("%s\n", t->summary);
+}
+
+/* Every piece's state and context, the mailboxes, the slots, the gathered
+ * outputs and the barrier released. */
+static void team_free(split_team *t, split_member *m) {
+  int k = t->k;
+  for (int r = 0; r < k; ++r) {
+    if (m[r].state)
+      t->core->teardown(m[r].state);
+    gr_context_release(m[r].ctx);
+  }
+  for (int p = 0; p < 2; ++p) {
+    for (int i = 0; t->mail[p] && i < 2 * k; ++i)
+      free(t->mail[p][i]);
+    free(t->mail[p]);
+  }
+  for (int i = 0; t->gathered && i < t->split->outputs; ++i)
+    free(t->gathered[i]);
+  free(t->gathered);
+  free(t->slots);
+  pthread_mutex_destroy(&t->barrier.lock);
+  pthread_cond_destroy(&t->barrier.turn);
+  free(m);
+}
+
+/* The pieces opened, run and measured; --verify's comparison. Returns the
+ * exit status. */
+static int split_measure(split_team *t, split_member *m, const char *name, const char *base,
+                         int verify) {
+  int distinct = 0;
+  double copy_bps = 0.0;
+  int rc = open_pieces(t, m, base, verify, &distinct);
+  if (rc != 0)
+    return rc;
+  if (probe_copy(t, m, distinct, &copy_bps) != 0 || team_alloc(t, m, verify) != 0 ||
+      run_pieces(t, m) != 0)
+    return 1;
+  split_figures f;
+  combine_figures(t, m, copy_bps, &f);
+  print_figures(t, m, name, copy_bps, distinct, &f);
   rc = 0;
   if (verify) {
-    long differ = verify_whole(&t, m[0].ctx, name);
+    long differ = verify_whole(t, m[0].ctx, name);
     rc = differ == 0 ? 0 : 1;
   }
   printf("core=%s size=%d steps=%d devices=%d ms_per_step=%.6g mcells_per_s=%.6g "
          "bw_fraction=%.4g halo_ms_per_step=%.6g allreduce_bytes_per_step=%.0f device=\"%s\"\n",
-         name, n, steps, k, ms, mcells, frac, 1e3 * halo / steps, 8.0 * step_values / steps,
-         gr_context_device_name(m[0].ctx));
+         name, t->n, t->steps, t->k, f.ms, f.mcells, f.frac, 1e3 * f.halo / t->steps,
+         8.0 * f.step_values / t->steps, gr_context_device_name(m[0].ctx));
+  return rc;
+}
 
-done:
-  for (int r = 0; r < k; ++r) {
-    if (m[r].state)
-      core->teardown(m[r].state);
-    gr_context_release(m[r].ctx);
+int gr_bench_split_run(const char *name, const gr_bench_core *core, int n, int steps,
+                       const char *device, int k, int verify) {
+  const gr_bench_split *sp = core->split;
+  int rc = check_split(name, sp, n, k, verify);
+  if (rc != 0)
+    return rc;
+  const char *base = base_request(device);
+  split_member *m = calloc((size_t)k, sizeof(*m));
+  split_team t;
+  memset(&t, 0, sizeof(t));
+  t.split = sp;
+  t.core = core;
+  t.k = k;
+  t.n = n;
+  t.steps = steps;
+  if (!m) {
+    fprintf(stderr, "graupel-bench: out of host memory.\n");
+    return 1;
   }
-  for (int p = 0; p < 2; ++p) {
-    for (int i = 0; t.mail[p] && i < 2 * k; ++i)
-      free(t.mail[p][i]);
-    free(t.mail[p]);
-  }
-  for (int i = 0; t.gathered && i < sp->outputs; ++i)
-    free(t.gathered[i]);
-  free(t.gathered);
-  free(t.slots);
-  pthread_mutex_destroy(&t.barrier.lock);
-  pthread_cond_destroy(&t.barrier.turn);
-  free(m);
+  pthread_mutex_init(&t.barrier.lock, NULL);
+  pthread_cond_init(&t.barrier.turn, NULL);
+  t.barrier.count = k;
+  rc = split_measure(&t, m, name, base, verify);
+  team_free(&t, m);
   return rc;
 }

@@ -152,24 +152,34 @@ static void usage(FILE *f) {
             cores[i].get()->about);
 }
 
-int main(int argc, char **argv) {
-  const char *core_name = NULL, *device = NULL;
-  int size = 1024, steps = 50, list = 0, devices = 0, verify = 0;
+/* The command line. */
+typedef struct bench_args {
+  const char *core_name, *device;
+  int size, steps, list, devices, verify;
+} bench_args;
+
+/* Reads argv into a. Returns -1 to go on, else main's exit status: 0 after
+ * --help, 2 after an unknown argument (with the usage on stderr). */
+static int parse_args(int argc, char **argv, bench_args *a) {
+  a->core_name = a->device = NULL;
+  a->size = 1024;
+  a->steps = 50;
+  a->list = a->devices = a->verify = 0;
   for (int i = 1; i < argc; ++i) {
     if (strcmp(argv[i], "--core") == 0 && i + 1 < argc)
-      core_name = argv[++i];
+      a->core_name = argv[++i];
     else if (strcmp(argv[i], "--size") == 0 && i + 1 < argc)
-      size = atoi(argv[++i]);
+      a->size = atoi(argv[++i]);
     else if (strcmp(argv[i], "--steps") == 0 && i + 1 < argc)
-      steps = atoi(argv[++i]);
+      a->steps = atoi(argv[++i]);
     else if (strcmp(argv[i], "--device") == 0 && i + 1 < argc)
-      device = argv[++i];
+      a->device = argv[++i];
     else if (strcmp(argv[i], "--devices") == 0 && i + 1 < argc)
-      devices = atoi(argv[++i]);
+      a->devices = atoi(argv[++i]);
     else if (strcmp(argv[i], "--verify") == 0)
-      verify = 1;
+      a->verify = 1;
     else if (strcmp(argv[i], "--list") == 0)
-      list = 1;
+      a->list = 1;
     else if (strcmp(argv[i], "--help") == 0 || strcmp(argv[i], "-h") == 0) {
       usage(stdout);
       return 0;
@@ -179,40 +189,76 @@ int main(int argc, char **argv) {
       return 2;
     }
   }
-  if (list) {
-    int count = 0;
-    gr_device_info infos[16];
-    if (gr_device_list(infos, 16, &count) != GR_OK) {
-      fprintf(stderr, "graupel-bench: %s\n", gr_last_error(NULL));
-      return 1;
-    }
-    for (int i = 0; i < count && i < 16; ++i)
-      printf("%d: %s | %s | %s | %d CUs | %.0f MiB\n", i, infos[i].name, infos[i].platform,
-             infos[i].is_gpu ? "GPU" : "CPU", infos[i].compute_units,
-             (double)infos[i].global_mem_bytes / 1048576.0);
-    return 0;
+  return -1;
+}
+
+/* --list: every OpenCL device, one a line. */
+static int list_devices(void) {
+  int count = 0;
+  gr_device_info infos[16];
+  if (gr_device_list(infos, 16, &count) != GR_OK) {
+    fprintf(stderr, "graupel-bench: %s\n", gr_last_error(NULL));
+    return 1;
   }
-  const bench_entry *entry = NULL;
-  for (int i = 0; core_name && i < ncores; ++i)
-    if (strcmp(cores[i].name, core_name) == 0)
-      entry = &cores[i];
-  const gr_bench_core *core = entry ? entry->get() : NULL;
-  if (!core || size < 1 || steps < 1) {
+  for (int i = 0; i < count && i < 16; ++i)
+    printf("%d: %s | %s | %s | %d CUs | %.0f MiB\n", i, infos[i].name, infos[i].platform,
+           infos[i].is_gpu ? "GPU" : "CPU", infos[i].compute_units,
+           (double)infos[i].global_mem_bytes / 1048576.0);
+  return 0;
+}
+
+/* The core --core names, into *entry and *core, and the other options
+ * checked. Returns -1 to go on, else main's exit status (2, the message
+ * printed). */
+static int check_args(const bench_args *a, const bench_entry **entry, const gr_bench_core **core) {
+  *entry = NULL;
+  for (int i = 0; a->core_name && i < ncores; ++i)
+    if (strcmp(cores[i].name, a->core_name) == 0)
+      *entry = &cores[i];
+  *core = *entry ? (*entry)->get() : NULL;
+  if (!*core || a->size < 1 || a->steps < 1) {
     fprintf(stderr, "graupel-bench: %s.\n",
-            !core ? "name a core with --core" : "--size and --steps must be positive");
+            !*core ? "name a core with --core" : "--size and --steps must be positive");
     usage(stderr);
     return 2;
   }
-  if (devices < 0 || devices > 64 || (verify && devices == 0)) {
+  if (a->devices < 0 || a->devices > 64 || (a->verify && a->devices == 0)) {
     fprintf(stderr, "graupel-bench: %s.\n",
-            verify && devices == 0 ? "--verify compares --devices D with one whole grid: add "
-                                     "--devices D"
-                                   : "--devices takes 1 to 64");
+            a->verify && a->devices == 0 ? "--verify compares --devices D with one whole grid: "
+                                           "add --devices D"
+                                         : "--devices takes 1 to 64");
     return 2;
   }
-  if (devices > 0)
-    return gr_bench_split_run(entry->name, core, size, steps, device, devices, verify);
+  return -1;
+}
 
+/* The copy probe, the core's set-up, two warm-up steps and the timed ones:
+ * *elapsed the seconds the timed steps took. */
+static gr_status time_steps(gr_context *ctx, const gr_bench_core *core, int size, int steps,
+                            double *copy_bps, void **state, double *elapsed) {
+  double cells = (double)size * (double)size;
+  gr_status st = gr_bench_copy_bandwidth(ctx, (size_t)(cells * 4.0), copy_bps);
+  if (st == GR_OK)
+    st = core->setup(ctx, size, state);
+  /* Warm-up: first launches pay for compilation and first touch. */
+  for (int i = 0; st == GR_OK && i < 2; ++i)
+    st = core->step(*state);
+  if (st == GR_OK)
+    st = gr_finish(ctx);
+  if (st == GR_OK) {
+    double t0 = gr_bench_now_s();
+    for (int i = 0; st == GR_OK && i < steps; ++i)
+      st = core->step(*state);
+    if (st == GR_OK)
+      st = gr_finish(ctx);
+    *elapsed = gr_bench_now_s() - t0;
+  }
+  return st;
+}
+
+/* The whole grid on one device (no --devices). */
+static int run_one_device(const bench_entry *entry, const gr_bench_core *core, int size, int steps,
+                          const char *device) {
   gr_context_options opt;
   gr_context_options_init(&opt);
   opt.device = device;
@@ -223,25 +269,9 @@ int main(int argc, char **argv) {
   }
   const char *dev = gr_context_device_name(ctx);
   double cells = (double)size * (double)size;
-  double copy_bps = 0.0;
+  double copy_bps = 0.0, elapsed = 0.0;
   void *state = NULL;
-  gr_status st = gr_bench_copy_bandwidth(ctx, (size_t)(cells * 4.0), &copy_bps);
-  if (st == GR_OK)
-    st = core->setup(ctx, size, &state);
-  /* Warm-up: first launches pay for compilation and first touch. */
-  for (int i = 0; st == GR_OK && i < 2; ++i)
-    st = core->step(state);
-  if (st == GR_OK)
-    st = gr_finish(ctx);
-  double elapsed = 0.0;
-  if (st == GR_OK) {
-    double t0 = gr_bench_now_s();
-    for (int i = 0; st == GR_OK && i < steps; ++i)
-      st = core->step(state);
-    if (st == GR_OK)
-      st = gr_finish(ctx);
-    elapsed = gr_bench_now_s() - t0;
-  }
+  gr_status st = time_steps(ctx, core, size, steps, &copy_bps, &state, &elapsed);
   if (st != GR_OK) {
     fprintf(stderr, "graupel-bench: %s\n", gr_last_error(ctx));
     if (state)
@@ -273,4 +303,21 @@ int main(int argc, char **argv) {
   core->teardown(state);
   gr_context_release(ctx);
   return 0;
+}
+
+int main(int argc, char **argv) {
+  bench_args a;
+  int rc = parse_args(argc, argv, &a);
+  if (rc >= 0)
+    return rc;
+  if (a.list)
+    return list_devices();
+  const bench_entry *entry = NULL;
+  const gr_bench_core *core = NULL;
+  rc = check_args(&a, &entry, &core);
+  if (rc >= 0)
+    return rc;
+  if (a.devices > 0)
+    return gr_bench_split_run(entry->name, core, a.size, a.steps, a.device, a.devices, a.verify);
+  return run_one_device(entry, core, a.size, a.steps, a.device);
 }
