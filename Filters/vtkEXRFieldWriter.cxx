@@ -58,8 +58,9 @@ const char *vtkEXRFieldWriter::Label() const {
   return "EXR Field Writer";
 }
 
-bool vtkEXRFieldWriter::ChoosePlanes(vtkImageData *input, std::vector<std::string> &names,
-                                     std::vector<std::vector<float>> &planes) {
+bool vtkEXRFieldWriter::ChoosePlanes(vtkImageData *input, Planes &out) {
+  std::vector<std::string> &names = out.names;
+  std::vector<std::vector<float>> &planes = out.data;
   if (!this->FileName || !*this->FileName) {
     vtkErrorMacro(<< this->Label() << ": no FileName was set; give the path of the file to write.");
     this->SetErrorCode(vtkErrorCode::NoFileNameError);
@@ -118,31 +119,20 @@ bool vtkEXRFieldWriter::ChoosePlanes(vtkImageData *input, std::vector<std::strin
       planes.push_back(std::move(plane));
     }
   }
-  return true;
-}
-
-void vtkEXRFieldWriter::PlanePointers(const std::vector<std::string> &names,
-                                      const std::vector<std::vector<float>> &planes,
-                                      std::vector<const char *> &namePtrs,
-                                      std::vector<const float *> &dataPtrs) {
   for (size_t c = 0; c < names.size(); ++c) {
-    namePtrs.push_back(names[c].c_str());
-    dataPtrs.push_back(planes[c].data());
+    out.namePtrs.push_back(names[c].c_str());
+    out.dataPtrs.push_back(planes[c].data());
   }
+  std::copy(dims, dims + 3, out.dims);
+  return true;
 }
 
 void vtkEXRFieldWriter::WriteData() {
   vtkImageData *input = this->GetInput();
-  std::vector<std::string> names;
-  std::vector<std::vector<float>> planes;
-  if (!this->ChoosePlanes(input, names, planes)) {
+  Planes planes;
+  if (!this->ChoosePlanes(input, planes)) {
     return;
   }
-  int dims[3];
-  input->GetDimensions(dims);
-  std::vector<const char *> namePtrs;
-  std::vector<const float *> dataPtrs;
-  PlanePointers(names, planes, namePtrs, dataPtrs);
   // Geometry and field data (the ledger, the device name) travel in the
   // header, so a reopened file is where it was and keeps its record.
   gr_exr_meta meta{};
@@ -211,10 +201,10 @@ void vtkEXRFieldWriter::WriteData() {
   meta.fields = metaFields.empty() ? nullptr : metaFields.data();
 
   char err[1024] = "";
-  gr_status st = gr_exr_write_meta(this->FileName, dims[0], dims[1], static_cast<int>(names.size()),
-                                   namePtrs.data(), dataPtrs.data(),
-                                   this->PixelType == HALF ? GR_EXR_HALF : GR_EXR_FLOAT, &meta, err,
-                                   sizeof(err));
+  gr_status st = gr_exr_write_meta(
+      this->FileName, planes.dims[0], planes.dims[1], static_cast<int>(planes.names.size()),
+      planes.namePtrs.data(), planes.dataPtrs.data(),
+      this->PixelType == HALF ? GR_EXR_HALF : GR_EXR_FLOAT, &meta, err, sizeof(err));
   if (st != GR_OK) {
     vtkErrorMacro("EXR Field Writer: " << err);
     this->SetErrorCode(vtkErrorCode::CannotOpenFileError);

@@ -67,19 +67,21 @@ protected:
   int FillInputPortInformation(int port, vtkInformation *info) override;
   /** The writer's name in its error sentences. */
   virtual const char *Label() const;
+  /** The chosen point arrays as float planes, with the C views the core's writers take. */
+  struct Planes {
+    std::vector<std::string> names;
+    std::vector<std::vector<float>> data;
+    std::vector<const char *> namePtrs;
+    std::vector<const float *> dataPtrs;
+    int dims[3] = {0, 0, 0};
+  };
   /**
    * The chosen point arrays of a 2-D input as float planes, one per
    * component (NAME.x/.y/.z for three, NAME.0, NAME.1, ... for others).
    * False, with one error sentence and the error code set, when there is no
    * FileName, the input is not 2-D, or an array asked for is missing.
    */
-  bool ChoosePlanes(vtkImageData *input, std::vector<std::string> &names,
-                    std::vector<std::vector<float>> &planes);
-  /** The C views of ChoosePlanes' names and planes, for the core's writers. */
-  static void PlanePointers(const std::vector<std::string> &names,
-                            const std::vector<std::vector<float>> &planes,
-                            std::vector<const char *> &namePtrs,
-                            std::vector<const float *> &dataPtrs);
+  bool ChoosePlanes(vtkImageData *input, Planes &out);
 
   char *FileName = nullptr;
   int PixelType = FLOAT;

@@ -19,19 +19,13 @@ const char *vtkGeoTIFFWriter::Label() const {
 
 void vtkGeoTIFFWriter::WriteData() {
   vtkImageData *input = this->GetInput();
-  std::vector<std::string> names;
-  std::vector<std::vector<float>> planes;
-  if (!this->ChoosePlanes(input, names, planes)) {
+  Planes planes;
+  if (!this->ChoosePlanes(input, planes)) {
     return;
   }
-  int dims[3];
   double spacing[3], origin[3];
-  input->GetDimensions(dims);
   input->GetSpacing(spacing);
   input->GetOrigin(origin);
-  std::vector<const char *> namePtrs;
-  std::vector<const float *> dataPtrs;
-  PlanePointers(names, planes, namePtrs, dataPtrs);
   std::string crs;
   if (auto *a =
           vtkStringArray::SafeDownCast(input->GetFieldData()->GetAbstractArray("graupel_crs"))) {
@@ -40,8 +34,9 @@ void vtkGeoTIFFWriter::WriteData() {
     }
   }
   char err[1024] = "";
-  if (gr_raster_write(this->FileName, dims[0], dims[1], static_cast<int>(names.size()),
-                      namePtrs.data(), dataPtrs.data(), spacing, origin, crs.c_str(), err,
+  if (gr_raster_write(this->FileName, planes.dims[0], planes.dims[1],
+                      static_cast<int>(planes.names.size()), planes.namePtrs.data(),
+                      planes.dataPtrs.data(), spacing, origin, crs.c_str(), err,
                       sizeof(err)) != GR_OK) {
     vtkErrorMacro(<< this->Label() << ": " << err);
     this->SetErrorCode(vtkErrorCode::CannotOpenFileError);
