@@ -98,6 +98,13 @@ bool CacheRange(vtkDataArray *array) {
   if (!array || array->GetNumberOfTuples() == 0) {
     return false;
   }
+  // Already cached (an input's array passed on): Modified() would have
+  // removed these keys had its values changed since.
+  vtkInformation *cache = array->HasInformation() ? array->GetInformation() : nullptr;
+  if (cache && cache->Has(vtkDataArray::PER_COMPONENT()) &&
+      cache->Has(vtkDataArray::PER_FINITE_COMPONENT())) {
+    return true;
+  }
   const int nc = array->GetNumberOfComponents();
   const long long tuples = array->GetNumberOfTuples();
   std::vector<double> comp;
