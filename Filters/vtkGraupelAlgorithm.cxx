@@ -1,6 +1,9 @@
 #include "vtkGraupelAlgorithm.h"
 
 #include "GraupelRanges.h"
+#include "GraupelTerrain.h"
+#include "vtkImageData.h"
+#include "vtkPointData.h"
 
 #include "vtkDataObject.h"
 #include "vtkDemandDrivenPipeline.h"
@@ -39,7 +42,25 @@ vtkGraupelAlgorithm::vtkGraupelAlgorithm() {
   this->SetDevice("auto");
 }
 
+namespace {
+// The name of the array the heights come from.
+std::string HeightsName(vtkImageData *terrain, const graupel::HeightsChoice &choice) {
+  int association = 0;
+  vtkDataArray *a = graupel::FindHeights(terrain, choice, &association, nullptr);
+  return a && a->GetName() ? a->GetName() : "elevation";
+}
+} // namespace
+
+struct vtkGraupelAlgorithm::TerrainViews {
+  std::vector<graupel::TerrainView> ports;
+  // The last refusal and the last warning, said once: what they were about.
+  std::string failedKey, warnedKey;
+  // The Height Array that holds for the Input of the running update.
+  graupel::HeightsChoice effective;
+};
+
 vtkGraupelAlgorithm::~vtkGraupelAlgorithm() {
+  delete this->Views;
   gr_context_release(this->Context);
   delete[] this->Device;
 }
@@ -208,6 +229,20 @@ vtkTypeBool vtkGraupelAlgorithm::ProcessRequest(vtkInformation *request,
                                                 vtkInformationVector *outInfo) {
   if (request->Has(vtkDemandDrivenPipeline::REQUEST_INFORMATION())) {
     this->InformationFailed = !this->RequestInformation(request, inInfo, outInfo);
+    const int port = this->GetTerrainPort();
+    bool imageOut = false;
+    for (int i = 0; i < this->GetNumberOfOutputPorts(); ++i) {
+      vtkInformation *p = this->GetOutputPortInformation(i);
+      imageOut =
+          imageOut || (p->Has(vtkDataObject::DATA_TYPE_NAME()) &&
+                       std::strcmp(p->Get(vtkDataObject::DATA_TYPE_NAME()), "vtkImageData") == 0);
+    }
+    // Heights in cells: the outputs are the cells' centres (GraupelTerrain.h).
+    this->TerrainCells =
+        !this->InformationFailed && imageOut && port >= 0 && graupel::HeightsAreCells(this, port);
+    if (this->TerrainCells) {
+      graupel::CellCentreInformation(inInfo[port]->GetInformationObject(0), outInfo);
+    }
     if (this->InformationFailed) {
       // Said why already; an empty extent lets the data pass go through quietly.
       static const int empty[6] = {0, -1, 0, -1, 0, -1};
@@ -228,7 +263,9 @@ vtkTypeBool vtkGraupelAlgorithm::ProcessRequest(vtkInformation *request,
         note.second.said = true;
       }
     }
-    if (this->InformationFailed || !this->RequestData(request, inInfo, outInfo)) {
+    std::vector<std::pair<vtkInformation *, vtkSmartPointer<vtkDataObject>>> restore;
+    const bool viewed = !this->InformationFailed && this->SwapInViews(inInfo, restore);
+    if (this->InformationFailed || !viewed || !this->RequestData(request, inInfo, outInfo)) {
       // The sentence was reported where the failure happened; see the header
       // for why this is not returned as 0.
       this->EmptyOutputs(outInfo);
@@ -256,9 +293,113 @@ vtkTypeBool vtkGraupelAlgorithm::ProcessRequest(vtkInformation *request,
         }
       }
     }
+    for (auto &r : restore) {
+      r.first->Set(vtkDataObject::DATA_OBJECT(), r.second);
+    }
     return 1;
   }
   return this->Superclass::ProcessRequest(request, inInfo, outInfo);
+}
+
+vtkDataArray *vtkGraupelAlgorithm::TerrainHeights(vtkImageData *terrain, std::string *why) {
+  const int port = this->GetTerrainPort();
+  if (terrain && this->Views && port >= 0 &&
+      static_cast<size_t>(port) < this->Views->ports.size() &&
+      this->Views->ports[static_cast<size_t>(port)].Current() == terrain) {
+    return terrain->GetPointData()->GetArray("elevation");
+  }
+  int association = vtkDataObject::FIELD_ASSOCIATION_POINTS;
+  bool replaced = false;
+  const graupel::HeightsChoice choice =
+      this->Views ? this->Views->effective
+                  : graupel::EffectiveHeights(terrain, graupel::ChosenHeights(this), &replaced);
+  vtkDataArray *a = graupel::FindHeights(terrain, choice, &association, why);
+  if (a && association != vtkDataObject::FIELD_ASSOCIATION_POINTS) {
+    if (why) {
+      *why = "holds its heights as cell data where points were expected";
+    }
+    return nullptr;
+  }
+  return a;
+}
+
+bool vtkGraupelAlgorithm::SwapInViews(
+    vtkInformationVector **inInfo,
+    std::vector<std::pair<vtkInformation *, vtkSmartPointer<vtkDataObject>>> &restore) {
+  const int port = this->GetTerrainPort();
+  vtkInformation *info = port >= 0 && this->GetNumberOfInputConnections(port) > 0
+                             ? inInfo[port]->GetInformationObject(0)
+                             : nullptr;
+  auto *terrain = info ? vtkImageData::GetData(info) : nullptr;
+  if (!terrain) {
+    return true;
+  }
+  if (!this->Views) {
+    this->Views = new TerrainViews;
+  }
+  this->Views->ports.resize(static_cast<size_t>(this->GetNumberOfInputPorts()));
+  auto put = [&](vtkInformation *where, vtkImageData *original, vtkImageData *view) {
+    if (view != original) {
+      restore.emplace_back(where, original);
+      where->Set(vtkDataObject::DATA_OBJECT(), view);
+    }
+  };
+  bool replaced = false;
+  const graupel::HeightsChoice chosen = graupel::ChosenHeights(this);
+  const graupel::HeightsChoice choice = graupel::EffectiveHeights(terrain, chosen, &replaced);
+  this->Views->effective = choice;
+  // A refusal is said once while this filter's settings stay (ParaView asks
+  // for the same output several times, and some readers run again each time).
+  auto refuse = [&](const std::string &sentence) {
+    const std::string key = std::to_string(this->GetMTime()) + ' ' + sentence;
+    if (this->Views->failedKey != key) {
+      this->Views->failedKey = key;
+      this->ReportError(sentence);
+    }
+    return false;
+  };
+  int association = vtkDataObject::FIELD_ASSOCIATION_POINTS;
+  if (replaced && graupel::FindHeights(terrain, choice, &association, nullptr)) {
+    // ParaView keeps a Height Array when the Input changes: said once.
+    const std::string sentence = this->Label() + ": the Input has no array '" + chosen.name +
+                                 "' (its Height Array); its heights are taken from '" +
+                                 HeightsName(terrain, choice) + "' instead.";
+    if (this->Views->warnedKey != std::to_string(this->GetMTime()) + sentence) {
+      this->Views->warnedKey = std::to_string(this->GetMTime()) + sentence;
+      vtkWarningMacro(<< sentence);
+    }
+  }
+  std::string error;
+  vtkImageData *view = this->Views->ports[static_cast<size_t>(port)].Get(
+      terrain, choice, this->Label(), "Input", &error);
+  if (!view) {
+    return refuse(error);
+  }
+  this->Views->failedKey.clear();
+  const bool cells = view != terrain && view->GetNumberOfPoints() != terrain->GetNumberOfPoints();
+  if (cells != this->TerrainCells && association >= 0 &&
+      graupel::FindHeights(terrain, choice, &association, nullptr)) {
+    // The input's arrays changed kind after this filter's information pass
+    // (its extent was announced for the other kind): the next update sees them.
+    this->Modified();
+    this->ReportError(this->Label() + "'s Input now holds its heights as " +
+                      (cells ? "cell" : "point") +
+                      " data, which it did not when its extent was announced; update it again.");
+    return false;
+  }
+  put(info, terrain, view);
+  int dims[3];
+  terrain->GetDimensions(dims);
+  for (int p = 0; cells && p < this->GetNumberOfInputPorts(); ++p) {
+    for (int c = 0; p != port && c < this->GetNumberOfInputConnections(p); ++c) {
+      vtkInformation *other = inInfo[p]->GetInformationObject(c);
+      auto *image = vtkImageData::GetData(other);
+      if (image && c == 0) {
+        put(other, image, this->Views->ports[static_cast<size_t>(p)].Other(image, dims));
+      }
+    }
+  }
+  return true;
 }
 
 void vtkGraupelAlgorithm::PrintSelf(ostream &os, vtkIndent indent) {

@@ -36,6 +36,7 @@
 
 #include "GraupelFiltersModule.h"
 #include "vtkAlgorithm.h"
+#include "vtkSmartPointer.h" // for the views put in the inputs
 #include "vtkVersionMacros.h"
 
 // VTK's aborted-output protocol (AbortOutput, vtkAlgorithm::ABORTED) came
@@ -49,9 +50,12 @@
 #include <map>
 #include <string>
 #include <utility>
+#include <vector>
 
 struct gr_context;
+class vtkDataArray;
 class vtkDataObject;
+class vtkImageData;
 
 class GRAUPELFILTERS_EXPORT vtkGraupelAlgorithm : public vtkAlgorithm {
 public:
@@ -166,6 +170,26 @@ protected:
 
   char *Device = nullptr;
 
+  /**
+   * The input port that takes a terrain, whose heights come from the Height
+   * Array (input array 0; see GraupelTerrain.h): 0 by default, -1 for none.
+   * While RequestData runs, that port (and, when the heights are cells,
+   * every other image input of the raster's size) holds the view of cell
+   * centres with `elevation` that the filters read: they look up
+   * `elevation` as point data and nothing else.
+   */
+  virtual int GetTerrainPort() { return this->GetNumberOfInputPorts() > 0 ? 0 : -1; }
+
+  /**
+   * The heights of the terrain the filter reads (its Input during
+   * RequestData, the view or the input itself): a one-component point
+   * array; nullptr with the reason in *why when there is none.
+   */
+  vtkDataArray *TerrainHeights(vtkImageData *terrain, std::string *why = nullptr);
+
+  /** The terrain's heights are cell data: the outputs are the cells' centres. */
+  bool GetTerrainCells() const { return this->TerrainCells; }
+
 private:
   vtkGraupelAlgorithm(const vtkGraupelAlgorithm &) = delete;
   void operator=(const vtkGraupelAlgorithm &) = delete;
@@ -173,6 +197,15 @@ private:
   gr_context *Context = nullptr;
   // RequestInformation failed (and said why): the data pass is skipped.
   bool InformationFailed = false;
+  // The terrain's heights are cells (RequestInformation) and the views.
+  bool TerrainCells = false;
+  struct TerrainViews;
+  TerrainViews *Views = nullptr;
+  // Puts the terrain views in the inputs' information; false after saying
+  // why. restore gets what to put back after RequestData.
+  bool
+  SwapInViews(vtkInformationVector **inInfo,
+              std::vector<std::pair<vtkInformation *, vtkSmartPointer<vtkDataObject>>> &restore);
   // Values moved into their range: property -> the sentence, whether it
   // was said, and the value used.
   struct ClampNote {

@@ -99,7 +99,7 @@ bool vtkGraupelParticlesSource::CoreParams(vtkImageData *terrain, gr_particles_p
     double b[6];
     terrain->GetBounds(b);
     double lo = b[4], hi = b[5];
-    vtkDataArray *elevation = terrain->GetPointData()->GetArray("elevation");
+    vtkDataArray *elevation = this->TerrainHeights(terrain); // the Height Array
     if (elevation && elevation->GetNumberOfComponents() == 1) {
       double range[2];
       elevation->GetRange(range, 0);

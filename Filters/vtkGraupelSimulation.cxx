@@ -1,4 +1,5 @@
 #include "vtkGraupelSimulation.h"
+#include "GraupelTerrain.h"
 
 #include "vtkCellData.h"
 #include "vtkDataArray.h"
@@ -605,29 +606,12 @@ int vtkGraupelSimulation::CheckMemory(const gr_grid &grid, const gr_memory_need 
 }
 
 vtkDataArray *vtkGraupelSimulation::GetElevation(vtkImageData *terrain, const char *inputName) {
-  vtkDataArray *a = terrain ? terrain->GetPointData()->GetArray("elevation") : nullptr;
-  vtkCellData *cells = terrain ? terrain->GetCellData() : nullptr;
-  vtkDataArray *cellHeights = nullptr;
-  for (int k = 0; !a && cells && k < cells->GetNumberOfArrays() && !cellHeights; ++k) {
-    vtkDataArray *c = cells->GetArray(k);
-    const char *name = c ? c->GetName() : nullptr;
-    if (name && strncmp(name, "vtk", 3) != 0 && c->GetNumberOfComponents() == 1) {
-      cellHeights = c; // e.g. ParaView's GDAL Raster Reader's 'Elevation'
-    }
-  }
-  if (!a && cellHeights) {
-    vtkErrorMacro(<< this->GetSimulationLabel() << "'s " << inputName
-                  << " holds its heights as cell data ('" << cellHeights->GetName()
-                  << "', as ParaView's GDAL Raster Reader gives a raster, in the raster's own "
-                     "units); open the file with Graupel's GIS Raster Reader instead, which "
-                     "gives the point array 'elevation' in metres.");
-    return nullptr;
-  }
-  if (!a || a->GetNumberOfComponents() != 1) {
-    vtkErrorMacro(<< this->GetSimulationLabel() << "'s " << inputName
-                  << " has no one-component point array 'elevation'; name the terrain's "
-                     "heights (m) so, e.g. with a Calculator whose Result Array Name is "
-                     "elevation.");
+  // The Input is the terrain or its view (vtkGraupelAlgorithm,
+  // GraupelTerrain.h): the chosen heights as a point array.
+  std::string why;
+  vtkDataArray *a = this->TerrainHeights(terrain, &why);
+  if (!a) {
+    vtkErrorMacro(<< graupel::NoHeightsSentence(this->GetSimulationLabel(), inputName, why));
     return nullptr;
   }
   double spacing[3];

@@ -112,7 +112,9 @@ int vtkLightningSource::RequestData(vtkInformation *, vtkInformationVector **inp
     terrain->GetBounds(bounds);
     // A flat image with `elevation` (Procedural Terrain, the EXR reader)
     // stands for the surface z + elevation.
-    vtkDataArray *elevation = terrain->GetPointData()->GetArray("elevation");
+    vtkImageData *image = vtkImageData::SafeDownCast(terrain);
+    vtkDataArray *elevation = image ? this->TerrainHeights(image) // the Height Array
+                                    : terrain->GetPointData()->GetArray("elevation");
     const bool lifted = elevation && elevation->GetNumberOfComponents() == 1 &&
                         bounds[5] == bounds[4] && vtkImageData::SafeDownCast(terrain);
     const vtkIdType k = static_cast<vtkIdType>(

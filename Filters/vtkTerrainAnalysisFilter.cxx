@@ -1,4 +1,5 @@
 #include "vtkTerrainAnalysisFilter.h"
+#include "GraupelTerrain.h"
 
 #include "vtkDataArray.h"
 #include "vtkFloatArray.h"
@@ -51,7 +52,6 @@ vtkTerrainAnalysisFilter::vtkTerrainAnalysisFilter() {
   this->SnowCoverLimit = p.snow_cover_limit;
   this->RockSlope = p.rock_slope;
   this->WaterLevel = p.water_level;
-  this->SetInputArrayToProcess(0, 0, 0, vtkDataObject::FIELD_ASSOCIATION_POINTS, "elevation");
 }
 
 int vtkTerrainAnalysisFilter::RequestUpdateExtent(vtkInformation *,
@@ -104,20 +104,15 @@ vtkDataArray *vtkTerrainAnalysisFilter::Heights(vtkImageData *input, std::string
                   << spacing[0] << " and " << spacing[1] << " m.");
     return nullptr;
   }
-  // No name (a proxy made before its input had arrays to list) means the
-  // default, elevation.
-  vtkInformation *arrayInfo = this->GetInputArrayInformation(0);
-  const char *chosen = arrayInfo && arrayInfo->Has(vtkDataObject::FIELD_NAME())
-                           ? arrayInfo->Get(vtkDataObject::FIELD_NAME())
-                           : nullptr;
-  name = chosen && *chosen ? chosen : "elevation";
-  vtkDataArray *heights = input->GetPointData()->GetArray(name.c_str());
-  if (!heights || heights->GetNumberOfComponents() != 1) {
-    vtkErrorMacro(<< label << "'s Input has no one-component point array '" << name
-                  << "'; give the terrain heights (m) that name, or choose the array of heights "
-                     "(e.g. elevation or snow_surface) as the Height Array.");
+  // The Height Array, point or cell data (the Input is then the view of
+  // cell centres: GraupelTerrain.h); by default elevation.
+  std::string why;
+  vtkDataArray *heights = this->TerrainHeights(input, &why);
+  if (!heights) {
+    vtkErrorMacro(<< graupel::NoHeightsSentence(label, "Input", why));
     return nullptr;
   }
+  name = heights->GetName() ? heights->GetName() : "elevation";
   return heights;
 }
 

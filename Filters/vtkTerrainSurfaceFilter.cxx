@@ -1,4 +1,5 @@
 #include "vtkTerrainSurfaceFilter.h"
+#include "GraupelTerrain.h"
 
 #include "vtkAbstractArray.h"
 #include "vtkCellArray.h"
@@ -28,6 +29,12 @@
 #include <vector>
 
 vtkStandardNewMacro(vtkTerrainSurfaceFilter);
+
+vtkTerrainSurfaceFilter::vtkTerrainSurfaceFilter() : CellView(new graupel::TerrainView) {}
+
+vtkTerrainSurfaceFilter::~vtkTerrainSurfaceFilter() {
+  delete this->CellView;
+}
 
 namespace {
 // The order in which the data choose: the topmost surface the data have
@@ -167,6 +174,23 @@ int vtkTerrainSurfaceFilter::RequestData(vtkInformation *, vtkInformationVector 
     output->Initialize();
     this->ConsumeAbort();
     return 1;
+  }
+  // A raster's heights as cells (ParaView's GDAL Raster Reader): drawn at
+  // the cells' centres, no-data cells as holes (GraupelTerrain.h).
+  if (!ChooseHeightArray(input, this->HeightArray)) {
+    graupel::HeightsChoice choice;
+    choice.name = this->HeightArray;
+    int association = 0;
+    if (graupel::FindHeights(input, choice, &association, nullptr) &&
+        association == vtkDataObject::FIELD_ASSOCIATION_CELLS) {
+      std::string error;
+      input = this->CellView->Get(input, choice, "Terrain Surface", "Input", &error);
+      if (!input) {
+        vtkErrorMacro(<< error);
+        output->Initialize();
+        return 1;
+      }
+    }
   }
   Surface g;
   if (!this->Prepare(input, g) || !this->Lowest(g)) {

@@ -49,6 +49,9 @@
 
 class vtkCellArray;
 class vtkFloatArray;
+namespace graupel {
+class TerrainView;
+}
 class vtkImageData;
 class vtkPointData;
 class vtkPoints;
@@ -118,8 +121,8 @@ public:
   static const char *ChooseColorArray(vtkDataObject *input, const std::string &wanted);
 
 protected:
-  vtkTerrainSurfaceFilter() = default;
-  ~vtkTerrainSurfaceFilter() override = default;
+  vtkTerrainSurfaceFilter();
+  ~vtkTerrainSurfaceFilter() override;
 
   int FillInputPortInformation(int port, vtkInformation *info) override;
   int RequestUpdateExtent(vtkInformation *, vtkInformationVector **,
@@ -149,6 +152,8 @@ protected:
   vtkIdType MaximumPoints = 4194304;
 
 private:
+  // The view of a raster's cells as points (GraupelTerrain.h), kept between updates.
+  graupel::TerrainView *CellView;
   vtkTerrainSurfaceFilter(const vtkTerrainSurfaceFilter &) = delete;
   void operator=(const vtkTerrainSurfaceFilter &) = delete;
 };

@@ -250,7 +250,7 @@ int vtkWaterSurfaceFilter::SetUpState(vtkInformationVector **inputVector) {
     return 0;
   }
   if (ledger.wet_points == 0 && !this->IsInputTemporal(0)) {
-    vtkDataArray *elevation = terrain->GetPointData()->GetArray("elevation");
+    vtkDataArray *elevation = this->TerrainHeights(terrain);
     vtkDataArray *depth = terrain->GetPointData()->GetArray("water_depth");
     if (this->UseLakeLevel) {
       vtkErrorMacro("Water Surface has no water: no elevation of the Input lies below LakeLevel ("

@@ -19,6 +19,13 @@ graupel/raster_io.h), checked against GDAL itself (osgeo, gdalwarp's library):
   * Bad input, one sentence each and an empty output: a corrupt file, a
     rotated geotransform, a multi-band raster without a band chosen, a band
     it lacks; a raster without a CRS is read with one warning.
+  * ParaView's own GDAL Raster Reader (cell data 'Elevation', ghost cells
+    for no data, the CRS as a PROJ string): Rain Runoff runs on it with no
+    other filter, its points the cells' centres, heights, NaN and depths
+    equal to the GIS reader's bit for bit, the CRS carried; the Height Array
+    chosen as cells gives the same, one it lacks and a geographic file are
+    refused in one sentence; Terrain Surface draws the cells as the GIS
+    reader's points. A terrain whose only array is 'dem' runs too.
 """
 import math
 import os
@@ -288,21 +295,116 @@ T.check(not errs and len(warns) == 1 and "no coordinate reference system" in war
         "no CRS: one warning, the spacing taken as metres (%s, %s %s)"
         % (warns, o.GetSpacing(), o.GetOrigin()))
 
-# ---- ParaView's own GDAL reader: cells, refused with the way out ----------------
+# ---- ParaView's own GDAL reader: its cells are the samples -----------------------
 try:
     from vtkmodules.vtkIOGDAL import vtkGDALRasterReader
 except ImportError:  # the VTK-alone build's VTK 9.1 has no GDAL module
     vtkGDALRasterReader = None
-if vtkGDALRasterReader is not None:
+
+
+def gdal_rain(path, choose=None):
+    """Rain Runoff straight on ParaView's GDAL Raster Reader (cell data
+    'Elevation', a vtkGhostType for the no-data cells), nothing between."""
     pv = vtkGDALRasterReader()
-    pv.SetFileName(utm_tif)
-    cells_rain = vtkRainRunoffFilter_cls()
-    cells_rain.SetInputConnection(pv.GetOutputPort())
-    caught = T.ErrorCatcher(cells_rain)
-    cells_rain.UpdateTimeStep(0.0)
-    T.check(cells_rain.GetOutput().GetNumberOfPoints() == 0 and len(caught.messages) == 1
-            and "as cell data ('Elevation'" in caught.messages[0]
-            and "GIS Raster Reader" in caught.messages[0],
-            "ParaView's GDAL reader (cells): one sentence naming the GIS Raster Reader (%s)"
-            % caught.messages)
+    pv.SetFileName(path)
+    f = vtkRainRunoffFilter_cls()
+    f.SetInputConnection(pv.GetOutputPort())
+    if choose:
+        f.SetInputArrayToProcess(0, 0, 0, choose[0], choose[1])
+    f.SetRainRate(50.0)
+    f.SetEndTime(600.0)
+    f.SetOutputInterval(300.0)
+    caught = T.ErrorCatcher(f)
+    f.UpdateTimeStep(600.0)
+    return pv, f, f.GetOutput(), caught.messages
+
+
+if vtkGDALRasterReader is not None and depth is not None:
+    keep, cells_rain, o, errs = gdal_rain(utm_tif)
+    pv_out = keep.GetOutput()
+    T.check(pv_out.GetCellData().GetArray("Elevation") is not None
+            and pv_out.GetPointData().GetNumberOfArrays() == 0,
+            "ParaView's reader gives cell data only (%s)" % pv_out.GetCellData().GetArrayName(0))
+    T.check(not errs and o.GetNumberOfPoints() > 0, "Rain Runoff runs on it untouched (%s)" % errs)
+    if o.GetNumberOfPoints():
+        T.check(o.GetDimensions()[:2] == img.GetDimensions()[:2]
+                and np.allclose(o.GetOrigin()[:2], img.GetOrigin()[:2], rtol=0, atol=1e-6)
+                and o.GetSpacing()[:2] == img.GetSpacing()[:2],
+                "the cells' centres are the points: %s at %s (Graupel's reader %s at %s)"
+                % (o.GetDimensions(), o.GetOrigin(), img.GetDimensions(), img.GetOrigin()))
+        ev = vtk_to_numpy(o.GetPointData().GetArray("elevation")).reshape(got.shape)
+        T.check(np.array_equal(ev, got, equal_nan=True),
+                "heights equal Graupel's reader's, NaN at the %d no-data cells" % nodata.sum())
+        dv = vtk_to_numpy(o.GetPointData().GetArray("water_depth")).reshape(got.shape)
+        T.check(np.array_equal(dv, depth, equal_nan=True) and np.isnan(dv[nodata]).all(),
+                "depths equal the GIS reader's and the EXR route's to the bit; no-data stays NaN")
+        crs_pv = o.GetFieldData().GetAbstractArray("graupel_crs")
+        T.check(crs_pv is not None and osr.SpatialReference(wkt=crs_pv.GetValue(0)).IsSame(inp),
+                "its CRS (MAP_PROJECTION) reaches the output as graupel_crs")
+    # The Height Array chosen the ParaView way: the same; one it lacks: one sentence.
+    _, _, o2, errs = gdal_rain(utm_tif, (1, "Elevation"))
+    T.check(not errs and o2.GetNumberOfPoints() and np.array_equal(
+        vtk_to_numpy(o2.GetPointData().GetArray("water_depth")).reshape(got.shape), depth,
+        equal_nan=True), "Height Array = cells 'Elevation': the same depths (%s)" % errs)
+    # One it lacks (ParaView keeps the Height Array when the Input changes):
+    # one warning, and the default heights.
+    _, f3, o3, errs = gdal_rain(utm_tif, (1, "Height"))
+    T.check(not errs and o3.GetNumberOfPoints() and np.array_equal(
+        vtk_to_numpy(o3.GetPointData().GetArray("water_depth")).reshape(got.shape), depth,
+        equal_nan=True), "a Height Array it lacks: the default heights (%s)" % errs)
+    w3 = T.ErrorCatcher(f3, event="WarningEvent")
+    f3.Modified()
+    f3.UpdateTimeStep(600.0)
+    T.check(len(w3.messages) == 1 and "no array 'Height'" in w3.messages[0]
+            and "'Elevation' instead" in w3.messages[0], "and one warning naming both (%s)"
+            % w3.messages)
+    # Terrain Surface draws the raster's cells at their centres, no-data as holes.
+    surf = graupel.vtkTerrainSurfaceFilter()
+    surf.SetInputConnection(keep.GetOutputPort())
+    surf.SetSkirt(False)
+    surf.SetVerticalExaggeration(1.0)
+    surf_gis = graupel.vtkTerrainSurfaceFilter()
+    surf_gis.SetInputData(img)
+    surf_gis.SetSkirt(False)
+    surf_gis.SetVerticalExaggeration(1.0)
+    caught = T.ErrorCatcher(surf)
+    surf.Update()
+    surf_gis.Update()
+    sa, sb = surf.GetOutput(), surf_gis.GetOutput()
+    T.check(not caught.messages and sa.GetNumberOfPolys() > 0
+            and sa.GetNumberOfPoints() == sb.GetNumberOfPoints()
+            and sa.GetNumberOfPolys() == sb.GetNumberOfPolys()
+            and np.array_equal(vtk_to_numpy(sa.GetPoints().GetData()),
+                               vtk_to_numpy(sb.GetPoints().GetData())),
+            "Terrain Surface on the cells: the GIS reader's surface (%d quads, %s)"
+            % (sa.GetNumberOfPolys(), caught.messages))
+    # The geographic file through ParaView's reader: degrees are refused.
+    _, _, o4, errs = gdal_rain(DEM)
+    T.check(o4.GetNumberOfPoints() == 0 and len(errs) == 1 and "geographic coordinates" in errs[0]
+            and "GIS Raster Reader" in errs[0], "degrees as metres refused in one sentence (%s)"
+            % errs)
+
+# ---- any point array as the heights --------------------------------------------
+lifted = graupel.vtkRainRunoffFilter()
+calc_src = graupel.vtkGISRasterReader()
+calc_src.SetFileName(utm_tif)
+calc_src.Update()
+renamed = calc_src.GetOutput().NewInstance()
+renamed.DeepCopy(calc_src.GetOutput())
+renamed.GetPointData().GetArray("elevation").SetName("dem")
+from vtkmodules.vtkCommonExecutionModel import vtkTrivialProducer  # noqa: E402
+
+renamed_src = vtkTrivialProducer()
+renamed_src.SetOutput(renamed)
+lifted.SetInputConnection(renamed_src.GetOutputPort())
+lifted.SetRainRate(50.0)
+lifted.SetEndTime(600.0)
+lifted.SetOutputInterval(300.0)
+caught = T.ErrorCatcher(lifted)
+lifted.UpdateTimeStep(600.0)
+lo = lifted.GetOutput()
+T.check(not caught.messages and lo.GetNumberOfPoints() and depth is not None and np.array_equal(
+    vtk_to_numpy(lo.GetPointData().GetArray("water_depth")).reshape(got.shape), depth,
+    equal_nan=True), "the only array, named dem, is taken as the heights: the same depths (%s)"
+    % caught.messages)
 T.finish()

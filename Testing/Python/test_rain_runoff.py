@@ -741,7 +741,8 @@ bad_elev = bowl.copy()
 bad_elev[3, 7] = np.inf  # NaN is a no-data point; infinities are refused
 cases = [
     ({"elevation": bad_elev}, {}, "elevation"),
-    ({"height": bowl}, {}, "elevation"),  # no elevation, and no active scalars
+    # no elevation, no active scalars, and two arrays: nothing to take as heights
+    ({"height": bowl, "roughness": bowl}, {}, "elevation"),
     ({"elevation": bowl, "water_depth": -np.ones((NY, NX))}, {}, "water_depth"),
     ({"elevation": bowl}, {"RainRate": float("nan")}, "RainRate"),
     ({"elevation": bowl}, {"ManningN": float("nan")}, "ManningN"),
@@ -799,16 +800,31 @@ at(g, 10.0)
 T.check("mm/h" in errs.text() and "m/s" not in errs.text(),
         "a RainRate error speaks mm/h: %r" % errs.text()[:200])
 
-# No `elevation` array: refused, active scalars are not guessed at, and one
-# sentence only, however often and for whatever time the output is asked for.
-src = image({"height": bowl})
+# No `elevation` array: the active scalars are the heights (the Height Array's
+# default rule), the same water as under the name elevation.
+src = image({"height": bowl, "roughness": 0.0 * bowl})
 src.GetPointData().SetActiveScalars("height")
+g = vtkRainRunoffFilter()
+g.SetInputConnection(producer(src).GetOutputPort())
+g.SetEndTime(60.0)
+g.SetOutputInterval(10.0)
+g.SetRainRate(10.0)
+errs = T.ErrorCatcher(g)
+d_active, _ = at(g, 20.0)
+d_named, _ = at(rain(bowl), 20.0)
+T.check(not errs.messages and d_active is not None and np.array_equal(d_active, d_named),
+        "the active scalars 'height' as the heights: the same depths (%s)" % errs.messages)
+# Nothing to take (two arrays, no elevation, no active scalars): refused, one
+# sentence only, however often and for whatever time the output is asked for.
+src = image({"height": bowl, "roughness": 0.0 * bowl})
+src.GetPointData().SetActiveScalars(None)
 g = vtkRainRunoffFilter()
 g.SetInputConnection(producer(src).GetOutputPort())
 errs = T.ErrorCatcher(g)
 for t in (10.0, 10.0, 20.0, 0.0):
     d, _ = at(g, t)
-T.check(d is None and len(errs.messages) == 1 and "'elevation'" in errs.text(),
+T.check(d is None and len(errs.messages) == 1 and "'elevation'" in errs.text()
+        and "Height Array" in errs.text(),
         "missing elevation refused once with a sentence naming it: %d %r"
         % (len(errs.messages), errs.text()[:200]))
 

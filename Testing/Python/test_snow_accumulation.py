@@ -658,7 +658,9 @@ nan_ground[5, 7] = np.nan
 good = snow(box(B), NoiseAmplitude=0.0)
 ref_d, _ = at(good, 2 * HOUR)
 cases = [
-    ("no elevation", {"ground": {"height": np.zeros((N, N))}}, ["'elevation'"]),
+    # Two arrays, neither elevation nor the active scalars: nothing to take as heights.
+    ("no elevation", {"ground": {"height": np.zeros((N, N)), "roughness": np.zeros((N, N))}},
+     ["'elevation'", "Height Array"]),
     ("NaN elevation", {"ground": {"elevation": nan_ground}}, ["elevation", "nan", "(7, 5)"]),
     ("degenerate direction", {"props": {"SnowDirection": (0.0, 0.0, 0.0)}}, ["SnowDirection"]),
     ("upward direction", {"props": {"SnowDirection": (0.0, 0.2, 1.0)}}, ["SnowDirection", "down"]),

@@ -563,7 +563,9 @@ nan_ground = np.zeros((N, N))
 nan_ground[5, 7] = np.nan
 cases = [
     ("open mesh", {"objects": plane.GetOutput()}, ["Objects", "open"]),
-    ("no elevation", {"ground": {"height": np.zeros((N, N))}}, ["'elevation'"]),
+    # Two arrays, neither elevation nor the active scalars: nothing to take as heights.
+    ("no elevation", {"ground": {"height": np.zeros((N, N)), "roughness": np.zeros((N, N))}},
+     ["'elevation'", "Height Array"]),
     ("NaN elevation", {"ground": {"elevation": nan_ground}}, ["elevation"]),
     ("mismatched snow_depth", {"ground": {"elevation": np.zeros((N, N)),
                                           "snow_depth": np.zeros((N, N - 1))}}, ["snow_depth"]),

@@ -412,3 +412,42 @@ gr_status gr_raster_write(const char *path, int width, int height, int nbands,
   CPLPopErrorHandler();
   return st;
 }
+
+gr_status gr_raster_crs_describe(const char *definition, gr_raster_crs *out, char *err,
+                                 size_t err_len) {
+  if (!out || !definition || !definition[0]) {
+    gr_raster_say(err, err_len, "No coordinate reference system was given.");
+    return GR_ERR_INVALID_ARGUMENT;
+  }
+  memset(out, 0, sizeof *out);
+  CPLPushErrorHandler(CPLQuietErrorHandler);
+  OGRSpatialReferenceH srs = OSRNewSpatialReference(NULL);
+  gr_status st = GR_OK;
+  char *wkt = NULL;
+  if (!srs || OSRSetFromUserInput(srs, definition) != OGRERR_NONE ||
+      OSRExportToWkt(srs, &wkt) != OGRERR_NONE) {
+    gr_raster_say(err, err_len, "The coordinate reference system '%.80s' could not be read: %s",
+                  definition, gr_raster_gdal_message("GDAL does not know it."));
+    gr_raster_end_sentence(err, err_len);
+    st = GR_ERR_FORMAT;
+  } else {
+    out->wkt = gr_raster_strdup(wkt);
+    out->geographic = OSRIsGeographic(srs) ? 1 : 0;
+    double unit = OSRIsProjected(srs) ? OSRGetLinearUnits(srs, NULL) : 1.0;
+    out->metres_per_unit = (unit > 0.0 && isfinite(unit)) ? unit : 1.0;
+    if (!out->wkt)
+      st = GR_ERR_OUT_OF_MEMORY;
+  }
+  CPLFree(wkt);
+  if (srs)
+    OSRDestroySpatialReference(srs);
+  CPLPopErrorHandler();
+  return st;
+}
+
+void gr_raster_crs_free(gr_raster_crs *c) {
+  if (!c)
+    return;
+  free(c->wkt);
+  memset(c, 0, sizeof *c);
+}

@@ -76,6 +76,24 @@ GR_API gr_status gr_raster_write(const char *path, int width, int height, int nb
                                  const double spacing[2], const double origin[2],
                                  const char *crs_wkt, char *err, size_t err_len);
 
+/** What a CRS definition (WKT, PROJ string, "EPSG:n") says about units. */
+typedef struct gr_raster_crs {
+  char *wkt;              /**< the CRS as WKT (free with gr_raster_crs_free) */
+  int geographic;         /**< 1: coordinates in degrees */
+  double metres_per_unit; /**< a projected CRS's linear unit in metres (1 otherwise) */
+} gr_raster_crs;
+
+/**
+ * Reads a CRS definition as GDAL does (ParaView's GDAL Raster Reader keeps
+ * one as a PROJ string in the field data MAP_PROJECTION). GR_ERR_FORMAT and
+ * a sentence in err when GDAL cannot read it.
+ */
+GR_API gr_status gr_raster_crs_describe(const char *definition, gr_raster_crs *out, char *err,
+                                        size_t err_len);
+
+/** Frees what gr_raster_crs_describe allocated and zeroes the struct. NULL is fine. */
+GR_API void gr_raster_crs_free(gr_raster_crs *c);
+
 #ifdef __cplusplus
 }
 #endif
