@@ -33,14 +33,20 @@ GR_INLINE float gr_sm_bilinear(__global const float *restrict h, int nx, int ny,
  * domain's terrain (nx x gny; the own rows start at its row j0): a ray
  * steps one cell along its faster axis, reading the terrain bilinearly, and
  * keeps the steepest rise; it ends where it leaves the domain or where the
- * highest terrain (h_max) could no longer rise above what it found. */
-__kernel void snow_melt_horizon(__global const float *restrict terrain, int nx, int gny, int j0,
-                                int own_ny, float dx, float dy, int sectors, float h_max,
+ * highest terrain (h_max) could no longer rise above what it found. Blocks
+ * of GR_SNOW_MELT_BLOCK cells whose highest point (block_max: the block and
+ * the row and column after it, all a bilinear read inside it touches) could
+ * not rise above what was found are stepped over whole: samples that cannot
+ * change a maximum are never taken, so the answer is the full march's. */
+__kernel void snow_melt_horizon(__global const float *restrict terrain,
+                                __global const float *restrict block_max, int nx, int gny,
+                                int j0, int own_ny, float dx, float dy, int sectors, float h_max,
                                 __global float *restrict horizon) {
   int i = get_global_id(0), jj = get_global_id(1);
   if (i >= nx || jj >= own_ny)
     return;
   int j = j0 + jj, n = nx * own_ny, c = gr_idx(i, jj, nx);
+  int bnx = (nx + GR_SNOW_MELT_BLOCK - 1) / GR_SNOW_MELT_BLOCK;
   float h0 = terrain[gr_idx(i, j, nx)];
   float x_end = (float)(nx - 1), y_end = (float)(gny - 1);
   for (int k = 0; k < sectors; ++k) {
@@ -49,14 +55,28 @@ __kernel void snow_melt_horizon(__global const float *restrict terrain, int nx, 
     float step_len = 1.0f / fmax(fabs(ux), fabs(uy));
     float step_i = ux * step_len, step_j = uy * step_len;
     float best = 0.0f; /* the tangent of the highest rise, never below level */
-    for (int q = 1;; ++q) {
+    for (int q = 1;;) {
       float x = (float)i + (float)q * step_i, y = (float)j + (float)q * step_j;
       if (!(x >= 0.0f && x <= x_end && y >= 0.0f && y <= y_end))
         break;
       float t = (float)q * step_len;
       if ((h_max - h0) / t <= best)
         break;
+      int bi = (int)x / GR_SNOW_MELT_BLOCK, bj = (int)y / GR_SNOW_MELT_BLOCK;
+      if ((block_max[bj * bnx + bi] - h0) / t <= best) {
+        /* The first step whose sample lies in another block. */
+        float lo_x = (float)(bi * GR_SNOW_MELT_BLOCK), lo_y = (float)(bj * GR_SNOW_MELT_BLOCK);
+        float qx = step_i > 0.0f   ? ceil((lo_x + GR_SNOW_MELT_BLOCK - (float)i) / step_i)
+                   : step_i < 0.0f ? floor(((float)i - lo_x) / -step_i) + 1.0f
+                                   : INFINITY;
+        float qy = step_j > 0.0f   ? ceil((lo_y + GR_SNOW_MELT_BLOCK - (float)j) / step_j)
+                   : step_j < 0.0f ? floor(((float)j - lo_y) / -step_j) + 1.0f
+                                   : INFINITY;
+        q = max(q + 1, (int)fmin(fmin(qx, qy), 1.0e9f));
+        continue;
+      }
       best = fmax(best, (gr_sm_bilinear(terrain, nx, gny, x, y) - h0) / t);
+      ++q;
     }
     horizon[k * n + c] = atan(best);
   }

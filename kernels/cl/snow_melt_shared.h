@@ -34,6 +34,10 @@
 #define GR_SNOW_MELT_RECORD 8
 #define GR_SNOW_MELT_TABLE_RECORDS 1024
 
+/* The horizons' rays step over blocks of this many cells square whose
+ * highest point cannot rise above the horizon found so far. */
+#define GR_SNOW_MELT_BLOCK 16
+
 /* What the derive kernel writes. */
 #define GR_SNOW_MELT_DERIVE_DEPTH 0
 #define GR_SNOW_MELT_DERIVE_DENSITY 1

@@ -517,12 +517,32 @@ static gr_status gr_sm_set_terrain_impl(gr_snow_melt *s, const float *terrain) {
     s->has_terrain = 1;
     return GR_OK;
   }
+  /* Each block's highest point, over the block and one cell around it
+   * (every point a bilinear read in the block touches). */
+  const int nx_ = s->gnx, ny_ = s->gny, B = GR_SNOW_MELT_BLOCK;
+  const int bnx = (nx_ + B - 1) / B, bny = (ny_ + B - 1) / B;
+  float *bmax = malloc(sizeof(float) * (size_t)bnx * (size_t)bny);
+  if (!bmax)
+    return gr_set_error(s->ctx, GR_ERR_OUT_OF_MEMORY, "Out of host memory.");
   float h_max = terrain[0];
-  for (size_t c = 1; c < whole; ++c)
-    h_max = terrain[c] > h_max ? terrain[c] : h_max;
-  cl_mem buf = NULL;
+  for (int bj = 0; bj < bny; ++bj)
+    for (int bi = 0; bi < bnx; ++bi) {
+      float m = -INFINITY;
+      int j1 = (bj + 1) * B < ny_ - 1 ? (bj + 1) * B : ny_ - 1;
+      int i1 = (bi + 1) * B < nx_ - 1 ? (bi + 1) * B : nx_ - 1;
+      for (int j = bj * B > 0 ? bj * B - 1 : 0; j <= j1; ++j)
+        for (int i = bi * B > 0 ? bi * B - 1 : 0; i <= i1; ++i)
+          m = terrain[(size_t)j * nx_ + i] > m ? terrain[(size_t)j * nx_ + i] : m;
+      bmax[bj * bnx + bi] = m;
+      h_max = m > h_max ? m : h_max;
+    }
+  cl_mem buf = NULL, blocks = NULL;
   size_t hbytes = 4 * s->n * (size_t)s->params.horizon_sectors;
   st = gr_buffer_create(s->ctx, CL_MEM_READ_ONLY, 4 * whole, terrain, &buf);
+  if (st == GR_OK)
+    st = gr_buffer_create(s->ctx, CL_MEM_READ_ONLY, sizeof(float) * (size_t)bnx * bny, bmax,
+                          &blocks);
+  free(bmax);
   if (st == GR_OK && !s->horizon)
     st = gr_buffer_create(s->ctx, CL_MEM_READ_WRITE, hbytes, NULL, &s->horizon);
   cl_int nx = s->gnx, gny = s->gny, j0 = s->grid.j0, own_ny = s->own_ny;
@@ -530,7 +550,8 @@ static gr_status gr_sm_set_terrain_impl(gr_snow_melt *s, const float *terrain) {
   cl_float dx = (cl_float)s->grid.dx, dy = (cl_float)s->grid.dy;
   const size_t m = sizeof(cl_mem);
   const gr_sm_arg args[] = {
-      {"terrain", m, &buf},         {"nx", sizeof(nx), &nx},
+      {"terrain", m, &buf},         {"block_max", m, &blocks},
+      {"nx", sizeof(nx), &nx},
       {"gny", sizeof(gny), &gny},   {"j0", sizeof(j0), &j0},
       {"own_ny", sizeof(own_ny), &own_ny}, {"dx", sizeof(dx), &dx},
       {"dy", sizeof(dy), &dy},      {"sectors", sizeof(sectors), &sectors},
@@ -543,6 +564,7 @@ static gr_status gr_sm_set_terrain_impl(gr_snow_melt *s, const float *terrain) {
   if (st == GR_OK)
     st = gr_finish(s->ctx);
   gr_buffer_release(&buf);
+  gr_buffer_release(&blocks);
   if (st == GR_OK)
     s->has_terrain = 1;
   return st;
