@@ -6,9 +6,13 @@
 #include "reduce.h"
 #include "snow_melt_shared.h"
 
-/* m of water equivalent as the state's integers (2^-32 m), to nearest. */
+/* m (>= 0) of water equivalent as the state's integers (2^-32 m), to
+ * nearest: a cut toward zero after adding 1/2 below 2^23 units (where the
+ * sum is exact), the float itself from there (a whole number from 2^23 on).
+ * PoCL vectorises this, where convert_long_rte is a call per work-item. */
 GR_INLINE long gr_sm_units(float m) {
-  return convert_long_rte(m * 4294967296.0f);
+  float u = m * 4294967296.0f;
+  return convert_long(u < 8388608.0f ? u + 0.5f : u);
 }
 
 GR_INLINE float gr_sm_metres(long u) {
@@ -112,7 +116,8 @@ GR_INLINE float gr_sm_radiation(__global const float *restrict table, int first,
 }
 
 /* One step of dt (dt_h hours) at each own point c < n, in the order of
- * snow_melt.h: the forcing, snowfall, rain, melt, refreezing, release and
+ * snow_melt.h (precip_m: the forcing's precipitation in the step, m;
+ * field_m: m per mm/h of the precipitation field): the forcing, snowfall, rain, melt, refreezing, release and
  * settling. The water is in integers (gr_sm_units), every transfer one
  * integer taken from one side and added to the other and to its
  * accumulators, so the balance is exact. */
@@ -125,7 +130,8 @@ __kernel void snow_melt_step(__global long *restrict frozen, __global long *rest
                              __global const float *restrict precipitation,
                              __global const float *restrict table, int first, int ns, int n,
                              int sectors, int shadows, int use_t, int use_p, float t_ref,
-                             float lapse_per_m, float z_ref, float precip, float dt_h, float mf_h,
+                             float lapse_per_m, float z_ref, float precip_m, float field_m,
+                             float dt_h, float mf_h,
                              float rad_factor, float t0, float ts, float band, float rho_new,
                              float rho_max, float settle, float capacity, float refreeze_h,
                              float rain_heat) {
@@ -133,7 +139,6 @@ __kernel void snow_melt_step(__global long *restrict frozen, __global long *rest
   if (c >= n)
     return;
   float T = use_t ? temperature[c] : t_ref + lapse_per_m * (elevation[c] - z_ref);
-  float P = use_p ? precipitation[c] : precip; /* mm/h */
   float4 nrm = normal[c];
   float I = gr_sm_radiation(table, first, ns, nrm, horizon, c, n, sectors, shadows);
   long F = frozen[c], L = liquid[c];
@@ -141,7 +146,7 @@ __kernel void snow_melt_step(__global long *restrict frozen, __global long *rest
   /* Precipitation: the rain's integers, the snow the rest of the total. */
   float fl = band > 0.0f ? clamp((T - (ts - 0.5f * band)) / band, 0.0f, 1.0f)
                          : (T >= ts ? 1.0f : 0.0f);
-  float p_m = P * dt_h * 0.001f;
+  float p_m = use_p ? precipitation[c] * field_m : precip_m; /* m in the step */
   long total = gr_sm_units(p_m), rain = gr_sm_units(p_m * fl);
   rain = min(rain, total);
   long snow = total - rain;

@@ -68,7 +68,8 @@ static gr_status gr_sm_step_args(gr_snow_melt *s, double dt, cl_int ns) {
   cl_int n = (cl_int)s->n, sectors = p->horizon_sectors, shadows = p->cast_shadows != 0;
   cl_int use_t = f->use_temperature_field != 0, use_p = f->use_precipitation_field != 0;
   cl_float t_ref = (cl_float)f->air_temperature, lapse_per_m = (cl_float)(p->lapse_rate / 1000.0);
-  cl_float z_ref = (cl_float)p->reference_elevation, precip = (cl_float)f->precipitation;
+  cl_float z_ref = (cl_float)p->reference_elevation;
+  cl_float precip_m = (cl_float)(f->precipitation * dt / 3.6e6), field_m = (cl_float)(dt / 3.6e6);
   cl_float dt_h = (cl_float)(dt / 3600.0), mf_h = (cl_float)(p->melt_factor / 24.0);
   cl_float rad_factor = (cl_float)p->radiation_factor, t0 = (cl_float)p->threshold;
   cl_float ts = (cl_float)p->rain_snow_threshold, band = (cl_float)p->rain_snow_band;
@@ -100,7 +101,8 @@ static gr_status gr_sm_step_args(gr_snow_melt *s, double dt, cl_int ns) {
       {"t_ref", sizeof(t_ref), &t_ref},
       {"lapse_per_m", sizeof(lapse_per_m), &lapse_per_m},
       {"z_ref", sizeof(z_ref), &z_ref},
-      {"precip", sizeof(precip), &precip},
+      {"precip_m", sizeof(precip_m), &precip_m},
+      {"field_m", sizeof(field_m), &field_m},
       {"dt_h", sizeof(dt_h), &dt_h},
       {"mf_h", sizeof(mf_h), &mf_h},
       {"rad_factor", sizeof(rad_factor), &rad_factor},
