@@ -108,8 +108,7 @@ static void test_temperature_index(void) {
   double area = g.dx * g.dy * g.nx * g.ny;
   printf("temperature index: SWE %.9f m after 10 days at 5 degC (MF %.1f): %.9f m; released "
          "%.9f m, melt rate %.6f mm/h\n",
-         swe, p.melt_factor, want, l.released_volume / area,
-         at(s, &g, GR_SNOW_MELT_MELT_RATE, 0));
+         swe, p.melt_factor, want, l.released_volume / area, at(s, &g, GR_SNOW_MELT_MELT_RATE, 0));
   CHECK_NEAR(swe, want, 1e-6);
   CHECK_NEAR(l.melt_volume / area, 0.09, 1e-6);
   CHECK_NEAR(l.released_volume / area, 0.09, 1e-6);
@@ -222,8 +221,8 @@ static void test_bare_ground(void) {
   gr_snow_melt_ledger l = ledger(s);
   double area = g.dx * g.dy * g.nx * g.ny;
   printf("bare ground: rain %.9f m, released %.9f m, release rate %.6f mm/h, swe %g\n",
-         l.rain_volume / area, l.released_volume / area,
-         at(s, &g, GR_SNOW_MELT_WATER_RELEASE, 4), at(s, &g, GR_SNOW_MELT_SWE, 4));
+         l.rain_volume / area, l.released_volume / area, at(s, &g, GR_SNOW_MELT_WATER_RELEASE, 4),
+         at(s, &g, GR_SNOW_MELT_SWE, 4));
   CHECK_NEAR(l.rain_volume / area, 0.006, 1e-9);
   CHECK(l.released_volume == l.rain_volume);
   CHECK(l.released_since_mark == l.rain_volume);
@@ -331,8 +330,8 @@ static void test_radiation(void) {
   double shade_melt = at(s, &w, GR_SNOW_MELT_MELT_RATE, behind);
   double lit_melt = at(s, &w, GR_SNOW_MELT_MELT_RATE, before);
   double up[3] = {0.0, 0.0, 1.0};
-  double I = mean_radiation(p.latitude, p.start_day, p.start_hour, 1.0 / 60.0, up,
-                            p.transmissivity);
+  double I =
+      mean_radiation(p.latitude, p.start_day, p.start_hour, 1.0 / 60.0, up, p.transmissivity);
   printf("shadow: behind the wall melt %.6f mm/h (index alone %.6f), radiation %g; before it "
          "%.6f mm/h (%.6f), radiation %.2f W/m^2 (analytic %.2f)\n",
          shade_melt, index, at(s, &w, GR_SNOW_MELT_RADIATION, behind), lit_melt,
@@ -472,7 +471,8 @@ static void pc_params(gr_snow_melt_params *p) {
 }
 
 /* The weather of run part k: T_ref, precipitation, the field or not. */
-static const double pc_weather[4][3] = {{9.0, 1.0, 1}, {2.0, 0.0, 0}, {-4.0, 2.0, 1}, {12.0, 0.5, 0}};
+static const double pc_weather[4][3] = {
+    {9.0, 1.0, 1}, {2.0, 0.0, 0}, {-4.0, 2.0, 1}, {12.0, 0.5, 0}};
 
 /* Advances parts k0 .. k1 - 1 of the run (each 7 h, marked first). */
 static gr_status pc_drive(gr_snow_melt *s, int k0, int k1) {

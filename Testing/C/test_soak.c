@@ -728,8 +728,8 @@ static void soak_snow_melt(long n) {
   long first = 0, done = 0;
   double t0 = (double)clock(), most = 0.0;
   while (st == GR_OK && done < n) {
-    gr_snow_melt_forcing f = {uniform(-8.0, 16.0), uniform(0.0, 1.0) < 0.5 ? 0.0 : uniform(0.0, 2.0),
-                              0, 0};
+    gr_snow_melt_forcing f = {uniform(-8.0, 16.0),
+                              uniform(0.0, 1.0) < 0.5 ? 0.0 : uniform(0.0, 2.0), 0, 0};
     long chunk = n - done < 50 ? n - done : 50;
     st = gr_snow_melt_set_forcing(sim, &f);
     if (st == GR_OK)

@@ -46,12 +46,25 @@ static const fuzz_field fields[] = {FUZZ_FIELD_D(gr_snow_melt_params, latitude),
                                     FUZZ_FIELD_I(gr_snow_melt_params, horizon_sectors)};
 #define NFIELDS ((int)(sizeof fields / sizeof fields[0]))
 /* The table row of each field. */
-static const char *const rows[] = {
-    "Latitude",          "StartDayOfYear",  "StartHour",      "TimeStep",
-    "MeltFactor",        "RadiationFactor", "ThresholdTemperature", "LapseRate",
-    "ReferenceElevation", "Transmissivity", "RainSnowThreshold", "RainSnowBand",
-    "NewSnowDensity",    "MaxDensity",      "SettlingTime",   "LiquidWaterCapacity",
-    "RefreezeFactor",    "CastShadows",     "HorizonSectors"};
+static const char *const rows[] = {"Latitude",
+                                   "StartDayOfYear",
+                                   "StartHour",
+                                   "TimeStep",
+                                   "MeltFactor",
+                                   "RadiationFactor",
+                                   "ThresholdTemperature",
+                                   "LapseRate",
+                                   "ReferenceElevation",
+                                   "Transmissivity",
+                                   "RainSnowThreshold",
+                                   "RainSnowBand",
+                                   "NewSnowDensity",
+                                   "MaxDensity",
+                                   "SettlingTime",
+                                   "LiquidWaterCapacity",
+                                   "RefreezeFactor",
+                                   "CastShadows",
+                                   "HorizonSectors"};
 
 static gr_status validate(const void *p, char *msg, size_t len) {
   return gr_snow_melt_params_validate((const gr_snow_melt_params *)p, msg, len);

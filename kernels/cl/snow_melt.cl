@@ -21,8 +21,7 @@ GR_INLINE float gr_sm_metres(long u) {
 
 /* h at the fractional index (x, y) of an nx x ny field, 0 <= x <= nx-1,
  * 0 <= y <= ny-1 (terrain_analysis.cl's reading). */
-GR_INLINE float gr_sm_bilinear(__global const float *restrict h, int nx, int ny, float x,
-                               float y) {
+GR_INLINE float gr_sm_bilinear(__global const float *restrict h, int nx, int ny, float x, float y) {
   int ix = min((int)x, max(nx - 2, 0)), iy = min((int)y, max(ny - 2, 0));
   float fx = x - (float)ix, fy = y - (float)iy;
   int ix1 = min(ix + 1, nx - 1), iy1 = min(iy + 1, ny - 1);
@@ -43,8 +42,8 @@ GR_INLINE float gr_sm_bilinear(__global const float *restrict h, int nx, int ny,
  * not rise above what was found are stepped over whole: samples that cannot
  * change a maximum are never taken, so the answer is the full march's. */
 __kernel void snow_melt_horizon(__global const float *restrict terrain,
-                                __global const float *restrict block_max, int nx, int gny,
-                                int j0, int own_ny, float dx, float dy, int sectors, float h_max,
+                                __global const float *restrict block_max, int nx, int gny, int j0,
+                                int own_ny, float dx, float dy, int sectors, float h_max,
                                 __global float *restrict horizon) {
   int i = get_global_id(0), jj = get_global_id(1);
   if (i >= nx || jj >= own_ny)
@@ -91,9 +90,9 @@ __kernel void snow_melt_horizon(__global const float *restrict terrain,
  * cos(theta) on the slope of unit normal nrm.xyz, nrm.w = ln(Psi) P / P0;
  * 0 where the sun is down, behind the slope or (shadows) below the horizon
  * interpolated between the sectors around its azimuth. */
-GR_INLINE float gr_sm_radiation(__global const float *restrict table, int first, int ns,
-                                float4 nrm, __global const float *restrict horizon, int c, int n,
-                                int sectors, int shadows) {
+GR_INLINE float gr_sm_radiation(__global const float *restrict table, int first, int ns, float4 nrm,
+                                __global const float *restrict horizon, int c, int n, int sectors,
+                                int shadows) {
   float sum = 0.0f;
   for (int q = 0; q < ns; ++q) {
     __global const float *r = table + (first + q) * GR_SNOW_MELT_RECORD;
@@ -117,24 +116,19 @@ GR_INLINE float gr_sm_radiation(__global const float *restrict table, int first,
 
 /* One step of dt (dt_h hours) at each own point c < n, in the order of
  * snow_melt.h (precip_m: the forcing's precipitation in the step, m;
- * field_m: m per mm/h of the precipitation field): the forcing, snowfall, rain, melt, refreezing, release and
- * settling. The water is in integers (gr_sm_units), every transfer one
- * integer taken from one side and added to the other and to its
- * accumulators, so the balance is exact. */
-__kernel void snow_melt_step(__global long *restrict frozen, __global long *restrict liquid,
-                             __global float *restrict density, __global float *restrict radiation,
-                             __global long *restrict acc, __global const float *restrict elevation,
-                             __global const float4 *restrict normal,
-                             __global const float *restrict horizon,
-                             __global const float *restrict temperature,
-                             __global const float *restrict precipitation,
-                             __global const float *restrict table, int first, int ns, int n,
-                             int sectors, int shadows, int use_t, int use_p, float t_ref,
-                             float lapse_per_m, float z_ref, float precip_m, float field_m,
-                             float dt_h, float mf_h,
-                             float rad_factor, float t0, float ts, float band, float rho_new,
-                             float rho_max, float settle, float capacity, float refreeze_h,
-                             float rain_heat) {
+ * field_m: m per mm/h of the precipitation field): the forcing, snowfall, rain, melt, refreezing,
+ * release and settling. The water is in integers (gr_sm_units), every transfer one integer taken
+ * from one side and added to the other and to its accumulators, so the balance is exact. */
+__kernel void snow_melt_step(
+    __global long *restrict frozen, __global long *restrict liquid,
+    __global float *restrict density, __global float *restrict radiation,
+    __global long *restrict acc, __global const float *restrict elevation,
+    __global const float4 *restrict normal, __global const float *restrict horizon,
+    __global const float *restrict temperature, __global const float *restrict precipitation,
+    __global const float *restrict table, int first, int ns, int n, int sectors, int shadows,
+    int use_t, int use_p, float t_ref, float lapse_per_m, float z_ref, float precip_m,
+    float field_m, float dt_h, float mf_h, float rad_factor, float t0, float ts, float band,
+    float rho_new, float rho_max, float settle, float capacity, float refreeze_h, float rain_heat) {
   int c = get_global_id(0);
   if (c >= n)
     return;
@@ -144,8 +138,8 @@ __kernel void snow_melt_step(__global long *restrict frozen, __global long *rest
   long F = frozen[c], L = liquid[c];
   float rho = density[c];
   /* Precipitation: the rain's integers, the snow the rest of the total. */
-  float fl = band > 0.0f ? clamp((T - (ts - 0.5f * band)) / band, 0.0f, 1.0f)
-                         : (T >= ts ? 1.0f : 0.0f);
+  float fl =
+      band > 0.0f ? clamp((T - (ts - 0.5f * band)) / band, 0.0f, 1.0f) : (T >= ts ? 1.0f : 0.0f);
   float p_m = use_p ? precipitation[c] * field_m : precip_m; /* m in the step */
   long total = gr_sm_units(p_m), rain = gr_sm_units(p_m * fl);
   rain = min(rain, total);

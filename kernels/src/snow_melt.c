@@ -68,7 +68,7 @@ static const gr_param_bound gr_sm_bounds[GR_SM_P_COUNT] = {
 };
 
 static const char *const gr_sm_names[GR_SNOW_MELT_OUTPUT_COUNT] = {
-    "snow_depth", "snow_density", "swe",       "liquid_water",
+    "snow_depth", "snow_density",  "swe",       "liquid_water",
     "melt_rate",  "water_release", "radiation", "released_depth"};
 
 const char *gr_snow_melt_output_name(gr_snow_melt_output o) {
@@ -195,9 +195,9 @@ void gr_snow_melt_destroy(gr_snow_melt *s) {
   for (size_t i = 0; i < sizeof(kernels) / sizeof(kernels[0]); ++i)
     if (kernels[i])
       clReleaseKernel(kernels[i]);
-  cl_mem *bufs[] = {&s->frozen,  &s->liquid,      &s->density,       &s->radiation,
-                    &s->acc,     &s->elevation,   &s->normal,        &s->horizon,
-                    &s->temperature, &s->precipitation, &s->table, &s->scratch};
+  cl_mem *bufs[] = {&s->frozen,      &s->liquid,        &s->density, &s->radiation,
+                    &s->acc,         &s->elevation,     &s->normal,  &s->horizon,
+                    &s->temperature, &s->precipitation, &s->table,   &s->scratch};
   for (size_t i = 0; i < sizeof(bufs) / sizeof(bufs[0]); ++i)
     gr_buffer_release(bufs[i]);
   gr_reduction_i64_release(&s->ledger);
@@ -301,7 +301,7 @@ static gr_status gr_sm_upload_ground(gr_snow_melt *s, const float *local) {
                            : ((double)row[i + 1] - row[i - 1]) * 0.5 * inv_dx;
       if (rows > 1) {
         double south = r > 0 ? row[i - nx] : z, north = r < rows - 1 ? row[i + nx] : z;
-        gy = r == 0 ? (north - z) * inv_dy
+        gy = r == 0          ? (north - z) * inv_dy
              : r == rows - 1 ? (z - south) * inv_dy
                              : (north - south) * 0.5 * inv_dy;
       }
@@ -391,16 +391,16 @@ static size_t gr_sm_local_points(const gr_snow_melt *s) {
 }
 
 /* Checks an input's floats: finite and within [lo, hi]; names the point. */
-static gr_status gr_sm_check(gr_snow_melt *s, const char *name, const float *v, size_t n,
-                             size_t nx, size_t row0, double lo, double hi, const char *rule) {
+static gr_status gr_sm_check(gr_snow_melt *s, const char *name, const float *v, size_t n, size_t nx,
+                             size_t row0, double lo, double hi, const char *rule) {
   for (size_t c = 0; c < n; ++c) {
     double x = v[c];
     if (isfinite(x) && x >= lo && x <= hi)
       continue;
-    return gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
-                        "The snow melt's %s has %s at point (%zu, %zu): %s.", name,
-                        isnan(x) ? "NaN" : (isinf(x) ? "an infinite value" : "a value out of range"),
-                        c % nx, c / nx + row0, rule);
+    return gr_set_error(
+        s->ctx, GR_ERR_INVALID_ARGUMENT, "The snow melt's %s has %s at point (%zu, %zu): %s.", name,
+        isnan(x) ? "NaN" : (isinf(x) ? "an infinite value" : "a value out of range"), c % nx,
+        c / nx + row0, rule);
   }
   return GR_OK;
 }
@@ -434,8 +434,8 @@ static gr_status gr_sm_set_field_impl(gr_snow_melt *s, int field, const float *h
       memcpy(s->snow_density, own, 4 * s->n);
     break;
   case GR_SNOW_MELT_TEMPERATURE:
-    st = gr_sm_check(s, "air_temperature", own, s->n, nx, row0 + s->ring_s,
-                     -GR_SM_MAX_TEMPERATURE, GR_SM_MAX_TEMPERATURE,
+    st = gr_sm_check(s, "air_temperature", own, s->n, nx, row0 + s->ring_s, -GR_SM_MAX_TEMPERATURE,
+                     GR_SM_MAX_TEMPERATURE,
                      "every air temperature must be a finite number of degC within +-100");
     if (st == GR_OK)
       st = gr_buffer_write(s->ctx, s->temperature, 0, 4 * s->n, own);
@@ -508,8 +508,8 @@ gr_status gr_snow_melt_set_forcing(gr_snow_melt *s, const gr_snow_melt_forcing *
  * terrain's buffer is released after. */
 static gr_status gr_sm_set_terrain_impl(gr_snow_melt *s, const float *terrain) {
   size_t whole = (size_t)s->gnx * (size_t)s->gny;
-  gr_status st = gr_sm_check(s, "terrain", terrain, whole, (size_t)s->gnx, 0,
-                             -GR_SM_MAX_ELEVATION, GR_SM_MAX_ELEVATION,
+  gr_status st = gr_sm_check(s, "terrain", terrain, whole, (size_t)s->gnx, 0, -GR_SM_MAX_ELEVATION,
+                             GR_SM_MAX_ELEVATION,
                              "every elevation must be a finite number of metres within +-1e6 m");
   if (st != GR_OK)
     return st;
@@ -550,12 +550,17 @@ static gr_status gr_sm_set_terrain_impl(gr_snow_melt *s, const float *terrain) {
   cl_float dx = (cl_float)s->grid.dx, dy = (cl_float)s->grid.dy;
   const size_t m = sizeof(cl_mem);
   const gr_sm_arg args[] = {
-      {"terrain", m, &buf},         {"block_max", m, &blocks},
+      {"terrain", m, &buf},
+      {"block_max", m, &blocks},
       {"nx", sizeof(nx), &nx},
-      {"gny", sizeof(gny), &gny},   {"j0", sizeof(j0), &j0},
-      {"own_ny", sizeof(own_ny), &own_ny}, {"dx", sizeof(dx), &dx},
-      {"dy", sizeof(dy), &dy},      {"sectors", sizeof(sectors), &sectors},
-      {"h_max", sizeof(h_max), &h_max}, {"horizon", m, &s->horizon},
+      {"gny", sizeof(gny), &gny},
+      {"j0", sizeof(j0), &j0},
+      {"own_ny", sizeof(own_ny), &own_ny},
+      {"dx", sizeof(dx), &dx},
+      {"dy", sizeof(dy), &dy},
+      {"sectors", sizeof(sectors), &sectors},
+      {"h_max", sizeof(h_max), &h_max},
+      {"horizon", m, &s->horizon},
   };
   if (st == GR_OK)
     st = GR_SM_ARGS(s, s->horizon_k, args);

@@ -125,10 +125,10 @@ static gr_status gr_sm_batch(gr_snow_melt *s, int count, double dt, int ns) {
   double t = s->time, sub = dt / ns;
   for (int k = 0; k < count; ++k, t += dt)
     for (int q = 0; q < ns; ++q)
-      gr_sm_sun(&s->params, t + (q + 0.5) * sub, s->records + (size_t)(k * ns + q) * GR_SNOW_MELT_RECORD);
-  gr_status st = gr_buffer_write(s->ctx, s->table, 0,
-                                 sizeof(float) * GR_SNOW_MELT_RECORD * (size_t)(count * ns),
-                                 s->records);
+      gr_sm_sun(&s->params, t + (q + 0.5) * sub,
+                s->records + (size_t)(k * ns + q) * GR_SNOW_MELT_RECORD);
+  gr_status st = gr_buffer_write(
+      s->ctx, s->table, 0, sizeof(float) * GR_SNOW_MELT_RECORD * (size_t)(count * ns), s->records);
   for (int k = 0; st == GR_OK && k < count; ++k) {
     cl_int first = k * ns;
     st = gr_kernel_arg(s->ctx, s->step_k, "first", sizeof(first), &first);
@@ -228,8 +228,8 @@ gr_status gr_snow_melt_mark(gr_snow_melt *s) {
   if (st == GR_OK)
     st = gr_cl_check(s->ctx,
                      clEnqueueFillBuffer(gr_context_queue(s->ctx), s->acc, &(cl_uint){0},
-                                         sizeof(cl_uint), GR_SNOW_MELT_ACC_MARK_MELT * row,
-                                         2 * row, 0, NULL, NULL),
+                                         sizeof(cl_uint), GR_SNOW_MELT_ACC_MARK_MELT * row, 2 * row,
+                                         0, NULL, NULL),
                      "Clearing the snow melt's sums since the mark");
   if (st == GR_OK)
     s->mark_time = s->time;
@@ -257,10 +257,14 @@ static gr_status gr_sm_get_impl(gr_snow_melt *s, gr_snow_melt_output o, float *h
   cl_int n = (cl_int)s->n, w = what[o];
   const size_t m = sizeof(cl_mem);
   const gr_sm_arg args[] = {
-      {"frozen", m, &s->frozen},   {"liquid", m, &s->liquid},
-      {"density", m, &s->density}, {"radiation", m, &s->radiation},
-      {"acc", m, &s->acc},         {"out", m, &s->scratch},
-      {"n", sizeof(n), &n},        {"what", sizeof(w), &w},
+      {"frozen", m, &s->frozen},
+      {"liquid", m, &s->liquid},
+      {"density", m, &s->density},
+      {"radiation", m, &s->radiation},
+      {"acc", m, &s->acc},
+      {"out", m, &s->scratch},
+      {"n", sizeof(n), &n},
+      {"what", sizeof(w), &w},
       {"rate_scale", sizeof(rate_scale), &rate_scale},
   };
   st = GR_SM_ARGS(s, s->derive_k, args);

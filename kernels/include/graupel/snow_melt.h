@@ -165,25 +165,25 @@ GR_API const char *gr_snow_melt_output_name(gr_snow_melt_output o);
  * nowhere else.
  */
 typedef struct gr_snow_melt_params {
-  double latitude;        /**< Latitude, deg, -90 .. 90 */
-  int start_day;          /**< StartDayOfYear, 1 .. 366 */
-  double start_hour;      /**< StartHour, local solar time, h, 0 .. 24 */
-  double time_step;       /**< TimeStep, s, 1 .. 86400 */
-  double melt_factor;     /**< MeltFactor MF, mm w.e. degC^-1 d^-1 */
-  double radiation_factor; /**< RadiationFactor a, mm w.e. h^-1 degC^-1 (W m^-2)^-1 */
-  double threshold;       /**< ThresholdTemperature T0, degC */
-  double lapse_rate;      /**< LapseRate, degC/km */
+  double latitude;            /**< Latitude, deg, -90 .. 90 */
+  int start_day;              /**< StartDayOfYear, 1 .. 366 */
+  double start_hour;          /**< StartHour, local solar time, h, 0 .. 24 */
+  double time_step;           /**< TimeStep, s, 1 .. 86400 */
+  double melt_factor;         /**< MeltFactor MF, mm w.e. degC^-1 d^-1 */
+  double radiation_factor;    /**< RadiationFactor a, mm w.e. h^-1 degC^-1 (W m^-2)^-1 */
+  double threshold;           /**< ThresholdTemperature T0, degC */
+  double lapse_rate;          /**< LapseRate, degC/km */
   double reference_elevation; /**< ReferenceElevation, m: where T = T_ref */
-  double transmissivity;  /**< Transmissivity Psi_a, (0, 1] */
+  double transmissivity;      /**< Transmissivity Psi_a, (0, 1] */
   double rain_snow_threshold; /**< RainSnowThreshold Ts, degC */
-  double rain_snow_band;  /**< RainSnowBand dT, degC */
-  double new_snow_density; /**< NewSnowDensity, kg/m^3 */
-  double max_density;     /**< MaxDensity, kg/m^3, at least NewSnowDensity */
-  double settling_time;   /**< SettlingTime, s (the table's unit: days) */
-  double liquid_capacity; /**< LiquidWaterCapacity, fraction of the frozen SWE */
-  double refreeze_factor; /**< RefreezeFactor, mm w.e. degC^-1 d^-1 */
-  int cast_shadows;       /**< CastShadows, 0 or 1 */
-  int horizon_sectors;    /**< HorizonSectors, 4 .. 360 */
+  double rain_snow_band;      /**< RainSnowBand dT, degC */
+  double new_snow_density;    /**< NewSnowDensity, kg/m^3 */
+  double max_density;         /**< MaxDensity, kg/m^3, at least NewSnowDensity */
+  double settling_time;       /**< SettlingTime, s (the table's unit: days) */
+  double liquid_capacity;     /**< LiquidWaterCapacity, fraction of the frozen SWE */
+  double refreeze_factor;     /**< RefreezeFactor, mm w.e. degC^-1 d^-1 */
+  int cast_shadows;           /**< CastShadows, 0 or 1 */
+  int horizon_sectors;        /**< HorizonSectors, 4 .. 360 */
 } gr_snow_melt_params;
 
 /** The table's defaults. */
@@ -198,9 +198,9 @@ GR_API const gr_param_bound *gr_snow_melt_param_bounds(int *count);
 
 /** The forcing of the next advances: constant over each. */
 typedef struct gr_snow_melt_forcing {
-  double air_temperature;    /**< T_ref, degC at ReferenceElevation, +-100 */
-  double precipitation;      /**< mm/h, 0 .. 1000 */
-  int use_temperature_field; /**< 1: T is the GR_SNOW_MELT_TEMPERATURE field */
+  double air_temperature;      /**< T_ref, degC at ReferenceElevation, +-100 */
+  double precipitation;        /**< mm/h, 0 .. 1000 */
+  int use_temperature_field;   /**< 1: T is the GR_SNOW_MELT_TEMPERATURE field */
   int use_precipitation_field; /**< 1: P is the GR_SNOW_MELT_PRECIPITATION field */
 } gr_snow_melt_forcing;
 
