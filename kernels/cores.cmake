@@ -14,6 +14,7 @@ set(GRAUPEL_CORES
   sky
   snow_accumulation
   snow_deformation
+  snow_melt
   terrain_analysis
   water_surface
 )

@@ -18,6 +18,13 @@
  *                            (1e-9 of the snowfall); a checkpoint goes into
  *                            a second simulation, freed again, every 10^4
  *                            steps
+ *   test_soak snow_melt N    hills with snow under weather drawn anew every
+ *                            50 hourly steps (snowfall, rain, warm, cold),
+ *                            N steps; every 1000 steps the fields must be
+ *                            finite and in range and the ledger exact
+ *                            (balance 0, in = stored + released to 1e-9);
+ *                            a checkpoint goes into a second simulation,
+ *                            freed again, every 10^4 steps
  *   test_soak snow_deformation N    a box moving in circles over a small snow
  *                            field, stepped N times; every 1000 steps the
  *                            depth and density must be finite and in range
@@ -35,6 +42,7 @@
 #include "graupel/procedural_terrain.h"
 #include "graupel/snow_accumulation.h"
 #include "graupel/snow_deformation.h"
+#include "graupel/snow_melt.h"
 #include "graupel/water_surface.h"
 #include "gr_test.h"
 
@@ -683,10 +691,117 @@ static void soak_water_surface(long n) {
   gr_context_release(ctx);
 }
 
+/* Snow Melt: hills of 24 x 20 points with snow, cast shadows, weather
+ * drawn anew every 50 hourly steps; every 1000 steps the fields are finite
+ * and in range and the ledger exact, every 10 000 a checkpoint goes
+ * through another simulation. */
+static void soak_snow_melt(long n) {
+  gr_context *ctx = NULL;
+  if (gr_context_acquire(NULL, &ctx) != GR_OK) {
+    CHECK_MSG(0, "%s", gr_last_error(NULL));
+    return;
+  }
+  const gr_grid g = {24, 20, 25.0, 25.0, 0.0, 0.0, 0, 0};
+  const size_t cells = (size_t)g.nx * (size_t)g.ny;
+  float *z = malloc(cells * sizeof(float)), *d = malloc(cells * sizeof(float));
+  float *rho = malloc(cells * sizeof(float)), *w = malloc(cells * sizeof(float));
+  for (size_t c = 0; c < cells; ++c) {
+    double i = (double)(c % (size_t)g.nx), j = (double)(c / (size_t)g.nx);
+    z[c] = (float)(1200.0 + 150.0 * sin(0.4 * i) * cos(0.3 * j) + 10.0 * j);
+    d[c] = (float)(0.5 + 0.4 * sin(0.2 * i + 0.1 * j));
+    rho[c] = 250.0f;
+  }
+  gr_snow_melt_params p;
+  gr_snow_melt_params_init(&p);
+  p.start_day = 300;
+  gr_snow_melt *sim = NULL;
+  gr_status st = gr_snow_melt_create(ctx, &g, &p, &sim);
+  if (st == GR_OK)
+    st = gr_snow_melt_set_field(sim, GR_FIELD_ELEVATION, z);
+  if (st == GR_OK)
+    st = gr_snow_melt_set_field(sim, GR_FIELD_SNOW_DEPTH, d);
+  if (st == GR_OK)
+    st = gr_snow_melt_set_field(sim, GR_FIELD_SNOW_DENSITY, rho);
+  if (st == GR_OK)
+    st = gr_snow_melt_set_terrain(sim, z);
+  CHECK_MSG(st == GR_OK, "set-up: %s", sim ? gr_snow_melt_last_error(sim) : gr_last_error(ctx));
+  long first = 0, done = 0;
+  double t0 = (double)clock(), most = 0.0;
+  while (st == GR_OK && done < n) {
+    gr_snow_melt_forcing f = {uniform(-8.0, 16.0),
+                              uniform(0.0, 1.0) < 0.5 ? 0.0 : uniform(0.0, 2.0), 0, 0};
+    long chunk = n - done < 50 ? n - done : 50;
+    st = gr_snow_melt_set_forcing(sim, &f);
+    if (st == GR_OK)
+      st = gr_snow_melt_mark(sim);
+    if (st == GR_OK)
+      st = gr_snow_melt_advance(sim, 3600.0 * (double)chunk, NULL);
+    done += chunk;
+    if (st == GR_OK && (done % 1000 == 0 || done == n)) {
+      gr_snow_melt_ledger led;
+      int bad = 0;
+      for (int o = 0; st == GR_OK && o < GR_SNOW_MELT_OUTPUT_COUNT; ++o) {
+        st = gr_snow_melt_get(sim, (gr_snow_melt_output)o, w);
+        for (size_t i = 0; st == GR_OK && i < cells; ++i)
+          bad += !(w[i] >= 0.0f && w[i] < 1e5f);
+        if (o == GR_SNOW_MELT_SNOW_DEPTH)
+          for (size_t i = 0; i < cells; ++i)
+            most = fmax(most, w[i]);
+      }
+      if (st == GR_OK)
+        st = gr_snow_melt_ledger_get(sim, &led);
+      if (st != GR_OK)
+        break;
+      CHECK_MSG(bad == 0, "step %ld: %d output values not finite or out of range", done, bad);
+      double in = led.snowfall_in + led.snowfall_volume + led.rain_volume;
+      double out = led.stored_swe_volume + led.stored_liquid_volume + led.released_volume;
+      CHECK_MSG(led.balance_error == 0.0 && fabs(in - out) <= 1e-9 * in,
+                "step %ld: balance error %g m^3, in - out %g of %g m^3", done, led.balance_error,
+                in - out, in);
+      CHECK_MSG(led.steps == done, "ledger counts %lld steps, %ld were taken", led.steps, done);
+      if (done % 10000 == 0) {
+        gr_snow_melt *other = NULL;
+        size_t bytes = 0;
+        gr_status so = gr_snow_melt_create(ctx, &g, &p, &other);
+        if (so == GR_OK)
+          so = gr_snow_melt_set_terrain(other, z);
+        if (so == GR_OK)
+          so = gr_snow_melt_state_size(sim, &bytes);
+        void *state = so == GR_OK ? malloc(bytes) : NULL;
+        if (state) {
+          so = gr_snow_melt_state_save(sim, state, bytes);
+          if (so == GR_OK)
+            so = gr_snow_melt_state_load(other, state, bytes);
+        }
+        gr_snow_melt_ledger lo;
+        if (so == GR_OK)
+          so = gr_snow_melt_ledger_get(other, &lo);
+        CHECK_MSG(so == GR_OK && lo.steps == done && lo.released_volume == led.released_volume,
+                  "checkpoint: %s", other ? gr_snow_melt_last_error(other) : gr_last_error(ctx));
+        free(state);
+        gr_snow_melt_destroy(other);
+      }
+    }
+    if (first == 0 && done >= n / 10)
+      first = rss_kib();
+    if (gr_test_failures > 10)
+      break;
+  }
+  CHECK_MSG(st == GR_OK, "step %ld: %s", done, sim ? gr_snow_melt_last_error(sim) : "");
+  long last = rss_kib();
+  printf("snow melt soak: %ld steps in %.1f s CPU; deepest snow %.3f m; the ledger exact at every "
+         "check; resident %ld KiB after %ld steps, %ld KiB at the end\n",
+         done, ((double)clock() - t0) / CLOCKS_PER_SEC, most, first, n / 10, last);
+  CHECK_MSG(last - first < GR_SOAK_SLACK_KIB, "resident memory grew by %ld KiB", last - first);
+  gr_snow_melt_destroy(sim);
+  free(z), free(d), free(rho), free(w);
+  gr_context_release(ctx);
+}
+
 int main(int argc, char **argv) {
   if (argc < 3) {
     fprintf(stderr, "usage: test_soak runtime N | procedural_terrain N DIR | rain_runoff N | "
-                    "snow_accumulation N | snow_deformation N | water_surface N\n");
+                    "snow_accumulation N | snow_deformation N | snow_melt N | water_surface N\n");
     return 2;
   }
   long n = atol(argv[2]);
@@ -706,9 +821,11 @@ int main(int argc, char **argv) {
     soak_snow_deformation(n);
   else if (strcmp(argv[1], "water_surface") == 0)
     soak_water_surface(n);
+  else if (strcmp(argv[1], "snow_melt") == 0)
+    soak_snow_melt(n);
   else {
     fprintf(stderr, "usage: test_soak runtime N | procedural_terrain N DIR | rain_runoff N | "
-                    "snow_accumulation N | snow_deformation N | water_surface N\n");
+                    "snow_accumulation N | snow_deformation N | snow_melt N | water_surface N\n");
     return 2;
   }
   return GR_TEST_RESULT();
