@@ -233,12 +233,40 @@ static void test_refusals(void) {
   CPLFree(wkt);
 }
 
+/* What a CRS definition says (ParaView's GDAL reader keeps a PROJ string). */
+static void test_crs_describe(void) {
+  gr_raster_crs c;
+  char err[512] = "";
+  CHECK(gr_raster_crs_describe("+proj=longlat +datum=NAD83 +no_defs", &c, err, sizeof err) ==
+        GR_OK);
+  CHECK_MSG(c.geographic == 1 && c.metres_per_unit == 1.0 && c.wkt && strstr(c.wkt, "1983"),
+            "degrees: %d %g", c.geographic, c.metres_per_unit);
+  gr_raster_crs_free(&c);
+  CHECK(c.wkt == NULL);
+  CHECK(gr_raster_crs_describe("EPSG:2274", &c, err, sizeof err) == GR_OK);
+  CHECK_NEAR(c.metres_per_unit, 1200.0 / 3937.0, 1e-12);
+  CHECK(c.geographic == 0);
+  gr_raster_crs_free(&c);
+  CHECK(gr_raster_crs_describe("+proj=utm +zone=16 +datum=NAD83 +units=m +no_defs", &c, err,
+                               sizeof err) == GR_OK &&
+        c.geographic == 0 && c.metres_per_unit == 1.0);
+  gr_raster_crs_free(&c);
+  memset(err, 0, sizeof err);
+  CHECK(gr_raster_crs_describe("no such CRS", &c, err, sizeof err) == GR_ERR_FORMAT);
+  CHECK_MSG(strstr(err, "no such CRS") && err[strlen(err) - 1] == '.', "one sentence: %s", err);
+  CHECK(c.wkt == NULL);
+  CHECK(gr_raster_crs_describe("", &c, err, sizeof err) == GR_ERR_INVALID_ARGUMENT);
+  CHECK(gr_raster_crs_describe(NULL, &c, err, sizeof err) == GR_ERR_INVALID_ARGUMENT);
+  gr_raster_crs_free(NULL);
+}
+
 static const gr_subtest tests[] = {
     {"geographic", test_geographic, 0},
     {"roundtrip_metres", test_roundtrip_metres, 0},
     {"roundtrip_feet", test_roundtrip_feet, 0},
     {"no_crs", test_no_crs, 0},
     {"refusals", test_refusals, 0},
+    {"crs_describe", test_crs_describe, 0},
 };
 
 int main(int argc, char **argv) {

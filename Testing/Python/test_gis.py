@@ -378,6 +378,14 @@ if vtkGDALRasterReader is not None and depth is not None:
                                vtk_to_numpy(sb.GetPoints().GetData())),
             "Terrain Surface on the cells: the GIS reader's surface (%d quads, %s)"
             % (sa.GetNumberOfPolys(), caught.messages))
+    # A CRS in US survey feet through ParaView's reader: metres, as the GIS reader's.
+    _, _, o5, errs = gdal_rain(feet_tif)
+    T.check(not errs and o5.GetNumberOfPoints() == img_ft.GetNumberOfPoints()
+            and abs(o5.GetSpacing()[0] - img_ft.GetSpacing()[0]) < 1e-9
+            and np.allclose(o5.GetOrigin()[:2], img_ft.GetOrigin()[:2], rtol=0, atol=1e-6),
+            "feet through ParaView's reader: spacing %.6f m, origin %s (GIS reader %.6f, %s; %s)"
+            % (o5.GetSpacing()[0], o5.GetOrigin()[:2], img_ft.GetSpacing()[0],
+               img_ft.GetOrigin()[:2], errs))
     # The geographic file through ParaView's reader: degrees are refused.
     _, _, o4, errs = gdal_rain(DEM)
     T.check(o4.GetNumberOfPoints() == 0 and len(errs) == 1 and "geographic coordinates" in errs[0]
