@@ -179,6 +179,18 @@ T.check(err < 1e-6, "a row at 9 h cuts the 6-12 h interval: SWE at 12 h within %
 T.check(abs(float(v["melt_rate"].mean()) - MF * (TEMP - T0) / 24.0 * 0.5) < 1e-5,
         "melt_rate at 12 h is the interval's mean (%g mm/h)" % v["melt_rate"].mean())
 
+# ---- an edited Forcing table sets the simulation up again -----------------------------
+edited = melt(forcing={"time": [0.0], "air_temperature": [TEMP]}, RadiationFactor=0.0,
+              ThresholdTemperature=0.0, LapseRate=0.0)
+_, out = at(edited, 6 * HOUR)
+before = field(out, "melt_volume")
+_keep[-1].GetOutputDataObject(0).GetColumnByName("air_temperature").SetValue(0, 2 * TEMP)
+_keep[-1].GetOutputDataObject(0).Modified()
+_, out = at(edited, 6 * HOUR)
+T.check(abs(field(out, "melt_volume") - 2 * before) <= 1e-6 * before,
+        "a Forcing edited upstream is read again: melt %g -> %g m3"
+        % (before, field(out, "melt_volume")))
+
 # ---- Forcing: three rows equal constant runs split by hand, bit for bit --------------
 ROWS = {"time": [0.0, 12 * HOUR, 30 * HOUR], "air_temperature": [4.0, -2.0, 7.0],
         "precipitation": [0.0, 1.5, 0.4]}
