@@ -82,7 +82,7 @@ def fmt(row):
 # filter comes it is named here, so that a core without a proxy is a
 # decision, not an oversight. Its table is checked against its page
 # when the filter brings its page in docs/.
-CORE_ONLY = {"snow_melt"}
+CORE_ONLY = set()
 LoadPlugin(a.plugin, ns=globals())
 pxm = servermanager.ProxyManager()
 DECLARED = {}  # core -> [(group, name, class)] from <GraupelCore name=.../> hints
