@@ -130,6 +130,23 @@ void vtkGraupelSimulation::SetInputPortPolicy(int port, int policy) {
   this->Modified();
 }
 
+void vtkGraupelSimulation::SetInputFrameHold(int port, int hold) {
+  if (port < 0 || this->GetInputFrameHold(port) == hold) {
+    return;
+  }
+  if (static_cast<size_t>(port) >= this->FrameHolds.size()) {
+    this->FrameHolds.resize(static_cast<size_t>(port) + 1, HOLD_FROM_TIME);
+  }
+  this->FrameHolds[static_cast<size_t>(port)] = hold;
+  this->Modified();
+}
+
+int vtkGraupelSimulation::GetInputFrameHold(int port) const {
+  return port >= 0 && static_cast<size_t>(port) < this->FrameHolds.size()
+             ? this->FrameHolds[static_cast<size_t>(port)]
+             : HOLD_FROM_TIME;
+}
+
 bool vtkGraupelSimulation::IsInputTemporal(int port) const {
   return port >= 0 && static_cast<size_t>(port) < this->InputTimes.size() &&
          this->InputTimes[static_cast<size_t>(port)].size() >= 2;
@@ -250,8 +267,15 @@ double vtkGraupelSimulation::GetTemporalInputTime(int port) const {
 
 double vtkGraupelSimulation::InputTimeAt(int port, double t) const {
   const std::vector<double> &times = this->InputTimes[static_cast<size_t>(port)];
-  // The last time step at or before t; before the first, the first holds.
+  // t is where an advance starts; it ends at the next knot, at most the
+  // first time step after t (NextKnot), so one step holds over all of it.
   auto it = std::upper_bound(times.begin(), times.end(), t);
+  if (this->GetInputFrameHold(port) == HOLD_INTERVAL_BEFORE) {
+    // The step that ends the interval (t, next]: the first after t; after
+    // the last, the last holds.
+    return it == times.end() ? times.back() : *it;
+  }
+  // The last time step at or before t; before the first, the first holds.
   return it == times.begin() ? times.front() : *(it - 1);
 }
 

@@ -50,6 +50,16 @@ public:
   /** Input port policies (see "Inputs in time" in Filters/README.md). */
   enum InputPolicy { STATIC_INPUT = 0, TEMPORAL_INPUT = 1 };
 
+  /**
+   * Over which simulated times a temporal input's time step tau_k holds
+   * (see "Inputs in time" in Filters/README.md): HOLD_FROM_TIME, [tau_k,
+   * tau_k+1), sample and hold, the default; HOLD_INTERVAL_BEFORE, (tau_k-1,
+   * tau_k], for data that are a mean over the interval before their time
+   * (an upstream simulation's rate between its outputs). Either way the
+   * first step holds before the first time and the last after the last.
+   */
+  enum InputFrameHold { HOLD_FROM_TIME = 0, HOLD_INTERVAL_BEFORE = 1 };
+
   ///@{
   /** Simulated time at the last output, seconds (default 600). */
   vtkSetMacro(EndTime, double);
@@ -205,6 +215,14 @@ protected:
 
   /** Sets a port's policy (STATIC_INPUT by default); call in the constructor. */
   void SetInputPortPolicy(int port, int policy);
+
+  /**
+   * Sets a temporal port's InputFrameHold (HOLD_FROM_TIME by default): in
+   * the constructor, or from a property's setter (the filter's MTime then
+   * sets the simulation up again).
+   */
+  void SetInputFrameHold(int port, int hold);
+  int GetInputFrameHold(int port) const;
 
   /** Sets EndTime and OutputInterval, the class's defaults; call in the constructor. */
   void SetTimeDefaults(double endTime, double outputInterval);
@@ -406,7 +424,11 @@ private:
   int TargetIndex(vtkInformation *outInfo) const;
   /** The time the next update for target starts stepping from. */
   double PlannedStart(int target) const;
-  /** Input time step of a temporal port that holds at time t. */
+  /**
+   * Input time step of a temporal port that holds over the advance that
+   * starts at time t (by its InputFrameHold: the last at or before t, or
+   * the first after t).
+   */
   double InputTimeAt(int port, double t) const;
   /** Goes to the best kept state for target: the state, a checkpoint or time 0. */
   int Rewind(int target);
@@ -419,6 +441,7 @@ private:
   int ReadRestartFile();
 
   std::vector<int> Policies;
+  std::vector<int> FrameHolds;                 // per port: InputFrameHold
   std::vector<std::vector<double>> InputTimes; // per port; empty when static
   std::vector<double> DeliveredTime;           // per port: time asked of it this pass
   std::vector<double> PendingTime;             // per port: time to ask of it next pass

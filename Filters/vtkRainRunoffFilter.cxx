@@ -64,6 +64,19 @@ GRAUPEL_TABLE_SETTER(vtkRainRunoffFilter, LevelSouth, double, gr_rain_runoff_par
 GRAUPEL_TABLE_SETTER(vtkRainRunoffFilter, LevelNorth, double, gr_rain_runoff_param_bounds)
 GRAUPEL_TABLE_SETTER(vtkRainRunoffFilter, NoDataBoundary, int, gr_rain_runoff_param_bounds)
 
+void vtkRainRunoffFilter::SetRainFrames(int value) {
+  // Not a parameter of the core: which frame the base hands the core when.
+  value = value < FRAME_FROM_ITS_TIME          ? FRAME_FROM_ITS_TIME
+          : value > FRAME_OVER_INTERVAL_BEFORE ? FRAME_OVER_INTERVAL_BEFORE
+                                               : value;
+  if (value != this->RainFrames) {
+    this->RainFrames = value;
+    this->SetInputFrameHold(0, value == FRAME_OVER_INTERVAL_BEFORE ? HOLD_INTERVAL_BEFORE
+                                                                   : HOLD_FROM_TIME);
+    this->Modified();
+  }
+}
+
 void vtkRainRunoffFilter::SetBoundary(int value) {
   this->SetBoundaryWest(value);
   this->SetBoundaryEast(value);
@@ -687,7 +700,9 @@ int vtkRainRunoffFilter::AdvanceState(double t0, double t1) {
     this->InflowsReadAt = this->GetTemporalInputTime(3);
   }
   // A temporal Input followed in time (FollowInputTime): its rain_rate of
-  // the time step that holds over [t0, t1], e.g. a series of radar frames.
+  // the time step that holds over [t0, t1] by RainFrames, e.g. a series of
+  // radar frames (from their time on) or Snow Melt's mean release (over the
+  // interval before).
   if (this->IsInputTemporal(0) && this->GetTemporalInputTime(0) != this->RainReadAt) {
     if (!this->SetRainFromInput(vtkImageData::SafeDownCast(this->GetTemporalInput(0)))) {
       return ADVANCE_FAILED;
@@ -986,4 +1001,8 @@ void vtkRainRunoffFilter::PrintSelf(ostream &os, vtkIndent indent) {
   os << indent << "WettingDepth: " << this->WettingDepth << " m\n";
   os << indent << "DebrisFactor: " << this->DebrisFactor << "\n";
   os << indent << "NoDataBoundary: " << (this->NoDataBoundary == OPEN ? "outfall" : "wall") << "\n";
+  os << indent << "RainFrames: "
+     << (this->RainFrames == FRAME_OVER_INTERVAL_BEFORE ? "over the interval before"
+                                                        : "from its time on")
+     << "\n";
 }

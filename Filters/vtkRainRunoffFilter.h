@@ -42,6 +42,7 @@ public:
 
   enum Boundaries { OPEN = 0, CLOSED = 1, TRANSMISSIVE = 2, LEVEL = 3 };
   enum FlowModels { SHALLOW_WATER = 0, LOCAL_INERTIAL = 1 };
+  enum RainFramesKinds { FRAME_FROM_ITS_TIME = 0, FRAME_OVER_INTERVAL_BEFORE = 1 };
 
   ///@{
   /** Rain intensity, mm/h (default 100: a cloudburst that shows on real terrain in 600 s). */
@@ -136,6 +137,20 @@ public:
   vtkGetMacro(DebrisFactor, double);
   ///@}
 
+  ///@{
+  /**
+   * With FollowInputTime, over which simulated times each frame's
+   * `rain_rate` (a time step of the Input) rains. 0 (default), from its
+   * time on: the frame at t_k over [t_k, t_k+1) (sample and hold, radar
+   * frames). 1, over the interval before it: the frame at t_k over
+   * (t_k-1, t_k], for rates that are a mean over the interval ending at
+   * their time (Snow Melt's water release). Either way the first frame
+   * rains before the first time and the last after the last.
+   */
+  void SetRainFrames(int value);
+  vtkGetMacro(RainFrames, int);
+  ///@}
+
   /** Connects the optional permeability map (input port 1). */
   void SetPermeabilityMapConnection(vtkAlgorithmOutput *output);
   /** Connects the optional gauge points (input port 2). */
@@ -211,6 +226,7 @@ protected:
   double CourantNumber = 0.7;
   double WettingDepth = 0.01;
   double DebrisFactor = 0.0;
+  int RainFrames = FRAME_FROM_ITS_TIME;
 
 private:
   vtkRainRunoffFilter(const vtkRainRunoffFilter &) = delete;
