@@ -90,7 +90,13 @@ bool ForeignUnits(vtkDataObject *data, double *unit, std::string *wkt, std::stri
 
 HeightsChoice ChosenHeights(vtkAlgorithm *alg) {
   HeightsChoice c;
-  vtkInformation *info = alg ? alg->GetInputArrayInformation(0) : nullptr;
+  // Read without creating: vtkAlgorithm::GetInputArrayInformation makes the
+  // entry (and modifies the algorithm) when there is none.
+  vtkInformationVector *arrays =
+      alg ? alg->GetInformation()->Get(vtkAlgorithm::INPUT_ARRAYS_TO_PROCESS()) : nullptr;
+  vtkInformation *info = arrays && arrays->GetNumberOfInformationObjects() > 0
+                             ? arrays->GetInformationObject(0)
+                             : nullptr;
   if (info && info->Has(vtkDataObject::FIELD_NAME())) {
     const char *name = info->Get(vtkDataObject::FIELD_NAME());
     c.name = name ? name : "";
@@ -190,7 +196,16 @@ bool HeightsAreCells(vtkAlgorithm *alg, int port) {
     // not known before it does. Run it now, once (not a series in time,
     // whose frames the filter asks for one by one: a cell raster series
     // takes one more update, announced by RequestData).
+    // Graupel's own sources and readers give point heights: no need to ask
+    // them (running one here made ParaView run it twice, the simulation
+    // after it set up twice).
     vtkAlgorithmOutput *conn = alg->GetInputConnection(port, 0);
+    vtkAlgorithm *producer = conn ? conn->GetProducer() : nullptr;
+    if (producer &&
+        (producer->IsA("vtkGraupelAlgorithm") || producer->IsA("vtkEXRHeightFieldReader") ||
+         producer->IsA("vtkGISRasterReader"))) {
+      return false;
+    }
     if (conn && conn->GetProducer()) {
       conn->GetProducer()->Update(conn->GetIndex());
       in = vtkDataSet::SafeDownCast(alg->GetInputDataObject(port, 0));

@@ -629,6 +629,51 @@ int vtkGraupelSimulation::CheckMemory(const gr_grid &grid, const gr_memory_need 
       graupel::WithHostArrays(need, static_cast<double>(grid.nx) * grid.ny, hostBytes), fix));
 }
 
+namespace {
+// What a Height Array means: "" for the default rule (none, or elevation).
+std::string HeightsKey(vtkAlgorithm *alg) {
+  const graupel::HeightsChoice c = graupel::ChosenHeights(alg);
+  return (c.name.empty() || c.name == "elevation") ? std::string()
+                                                   : c.name + '/' + std::to_string(c.association);
+}
+} // namespace
+
+void vtkGraupelSimulation::KeepStateIfSameHeights(const std::string &before, vtkMTimeType was) {
+  if (HeightsKey(this) != before) {
+    return;
+  }
+  const vtkMTimeType now = this->GetMTime();
+  if (this->StateKey.filter == was) {
+    this->StateKey.filter = now;
+  }
+  if (this->FailedKey.filter == was) {
+    this->FailedKey.filter = now;
+  }
+}
+
+void vtkGraupelSimulation::SetInputArrayToProcess(int idx, int port, int connection,
+                                                  int fieldAssociation, const char *name) {
+  const std::string before = HeightsKey(this);
+  const vtkMTimeType was = this->GetMTime();
+  this->Superclass::SetInputArrayToProcess(idx, port, connection, fieldAssociation, name);
+  this->KeepStateIfSameHeights(before, was);
+}
+
+void vtkGraupelSimulation::SetInputArrayToProcess(int idx, int port, int connection,
+                                                  const char *fieldAssociation, const char *name) {
+  const std::string before = HeightsKey(this);
+  const vtkMTimeType was = this->GetMTime();
+  this->Superclass::SetInputArrayToProcess(idx, port, connection, fieldAssociation, name);
+  this->KeepStateIfSameHeights(before, was);
+}
+
+void vtkGraupelSimulation::SetInputArrayToProcess(int idx, vtkInformation *info) {
+  const std::string before = HeightsKey(this);
+  const vtkMTimeType was = this->GetMTime();
+  this->Superclass::SetInputArrayToProcess(idx, info);
+  this->KeepStateIfSameHeights(before, was);
+}
+
 vtkDataArray *vtkGraupelSimulation::GetElevation(vtkImageData *terrain, const char *inputName) {
   // The Input is the terrain or its view (vtkGraupelAlgorithm,
   // GraupelTerrain.h): the chosen heights as a point array.

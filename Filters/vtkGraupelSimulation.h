@@ -134,6 +134,18 @@ public:
    * written.
    */
   virtual void SetCheckpointFile(const char *path);
+
+  /**
+   * The Height Array (input array 0) as vtkAlgorithm's; setting one that
+   * means the same heights (ParaView fills in the association of the
+   * default, elevation, after the first update) keeps the state.
+   */
+  using Superclass::SetInputArrayToProcess;
+  void SetInputArrayToProcess(int idx, int port, int connection, int fieldAssociation,
+                              const char *name) override;
+  void SetInputArrayToProcess(int idx, int port, int connection, const char *fieldAssociation,
+                              const char *name) override;
+  void SetInputArrayToProcess(int idx, vtkInformation *info) override;
   vtkGetStringMacro(CheckpointFile);
   ///@}
 
@@ -324,6 +336,8 @@ protected:
    * forgotten Spacing). nullptr after the error.
    */
   vtkDataArray *GetElevation(vtkImageData *terrain, const char *inputName);
+  // After a Height Array is set: keeps the state when it means the same heights.
+  void KeepStateIfSameHeights(const std::string &before, vtkMTimeType was);
 
   /**
    * The terrain on the Input: refuses none, one that is not 2-D with at
