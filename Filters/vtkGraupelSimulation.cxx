@@ -465,20 +465,22 @@ vtkGraupelSimulation::Key vtkGraupelSimulation::CurrentKey() {
   Key key;
   key.filter = this->GetMTime();
   for (int port = 0; port < this->GetNumberOfInputPorts(); ++port) {
+    // What an input is made from changes with its pipeline, not with its
+    // data object: a temporal input's data change with every time read, and
+    // a static one's when its producer merely runs again for another
+    // request (ParaView asks an input for its data information at the
+    // animation's time), which must not set the simulation up again.
     vtkMTimeType t = 0;
+    vtkInformation *inInfo =
+        this->GetNumberOfInputConnections(port) ? this->GetInputInformation(port, 0) : nullptr;
+    vtkExecutive *producer = inInfo ? vtkExecutive::PRODUCER()->GetExecutive(inInfo) : nullptr;
+    if (auto *ddp = vtkDemandDrivenPipeline::SafeDownCast(producer)) {
+      t = ddp->GetPipelineMTime();
+    } else if (vtkDataObject *in = inInfo ? this->GetInputDataObject(port, 0) : nullptr) {
+      t = in->GetMTime();
+    }
     if (this->IsInputTemporal(port)) {
-      // A temporal input's data changes with every time read; what it is
-      // made from changes with its pipeline.
-      vtkInformation *inInfo = this->GetInputInformation(port, 0);
-      vtkExecutive *producer = inInfo ? vtkExecutive::PRODUCER()->GetExecutive(inInfo) : nullptr;
-      if (auto *ddp = vtkDemandDrivenPipeline::SafeDownCast(producer)) {
-        t = ddp->GetPipelineMTime();
-      }
       key.times.push_back(this->InputTimes[static_cast<size_t>(port)]);
-    } else {
-      vtkDataObject *in =
-          this->GetNumberOfInputConnections(port) ? this->GetInputDataObject(port, 0) : nullptr;
-      t = in ? in->GetMTime() : 0;
     }
     key.inputs.push_back(t);
   }
