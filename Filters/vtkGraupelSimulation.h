@@ -261,17 +261,29 @@ protected:
    */
   virtual int FillOutput(vtkDataObject *output, vtkInformation *outInfo) = 0;
 
-  /**
-   * For a grid simulation's FillOutput: gives output (an image) the terrain
-   * input's geometry, cropped to the extent outInfo requests, and one float
-   * point array per field (gr_field values), each read from the core by
-   * read(field, values) into the whole grid (a gr_status). The first field
-   * becomes the active scalars. A failed read is reported with detail() (the
-   * core's own sentence); returns 0 then.
-   */
   /** The core's grid of a 2-D terrain image: its points, spacing and origin (a whole grid). */
   static void TerrainGrid(vtkImageData *terrain, gr_grid *grid);
 
+  /** One float point array of FillImage: name, components, and its read. */
+  struct ImageArray {
+    std::string name;
+    int components;
+    // Reads the core's own points (the whole grid, or a split run's own
+    // rows) into values; a gr_status.
+    std::function<int(float *)> read;
+  };
+
+  /**
+   * For a grid simulation's FillOutput (vtkGraupelSimulationImage.cxx):
+   * gives output (an image) the terrain input's geometry, cropped to the
+   * extent outInfo requests, and the arrays, each read from the core and in
+   * a split run assembled into the requested rows; the first becomes the
+   * active scalars; `piece_cells` when the core runs as pieces. A failed read
+   * is reported with detail() (the core's own sentence); returns 0 then.
+   */
+  int FillImage(vtkDataObject *output, vtkInformation *outInfo,
+                const std::vector<ImageArray> &arrays, const std::function<const char *()> &detail);
+  /** The same for gr_field outputs, each read by read(field, values). */
   int FillImage(vtkDataObject *output, vtkInformation *outInfo, const int *fields, int count,
                 const std::function<int(int, float *)> &read,
                 const std::function<const char *()> &detail);

@@ -420,101 +420,45 @@ int vtkSnowMeltFilter::LoadState(const std::vector<unsigned char> &bytes) {
 }
 
 int vtkSnowMeltFilter::FillOutput(vtkDataObject *outputObject, vtkInformation *outInfo) {
-  vtkImageData *output = vtkImageData::SafeDownCast(outputObject);
-  vtkImageData *input = vtkImageData::GetData(this->GetInputInformation(0, 0));
-  if (!output || !input) {
-    return 0;
-  }
-  int extent[6];
-  if (outInfo && outInfo->Has(vtkStreamingDemandDrivenPipeline::UPDATE_EXTENT())) {
-    outInfo->Get(vtkStreamingDemandDrivenPipeline::UPDATE_EXTENT(), extent);
-  } else {
-    input->GetExtent(extent);
-  }
-  const int *inExtent = input->GetExtent();
-  graupel::Pieces &pieces = this->GetPieces();
-  // The core's own points: the whole grid, or a split run's own rows; the
-  // rows handed out: the whole grid's, or the requested rows (the row a
-  // strip shares with the next comes from that rank). Cropped below.
-  const int nx = this->Dimensions[0];
-  const int ownRows = pieces.IsSplit() ? pieces.GetOwnRows() : this->Dimensions[1];
-  const vtkIdType n = static_cast<vtkIdType>(nx) * ownRows;
-  int rows[2] = {inExtent[2], inExtent[3]};
-  if (pieces.IsSplit()) {
-    rows[0] = extent[2];
-    rows[1] = extent[3];
-  }
-  const vtkIdType outPoints = static_cast<vtkIdType>(nx) * (rows[1] - rows[0] + 1);
-  vtkNew<vtkImageData> whole;
-  whole->SetExtent(inExtent[0], inExtent[1], rows[0], rows[1], inExtent[4], inExtent[5]);
-  whole->SetOrigin(input->GetOrigin());
-  whole->SetSpacing(input->GetSpacing());
   const gr_snow_melt_output outputs[] = {GR_SNOW_MELT_SNOW_DEPTH, GR_SNOW_MELT_SNOW_DENSITY,
                                          GR_SNOW_MELT_SWE,        GR_SNOW_MELT_LIQUID_WATER,
                                          GR_SNOW_MELT_MELT_RATE,  GR_SNOW_MELT_WATER_RELEASE,
                                          GR_SNOW_MELT_RADIATION};
-  std::vector<float> assembled;
-  vtkFloatArray *release = nullptr;
+  std::vector<ImageArray> arrays;
   for (gr_snow_melt_output o : outputs) {
-    vtkNew<vtkFloatArray> a;
-    a->SetName(gr_snow_melt_output_name(o));
-    if (!a->Allocate(std::max(n, outPoints))) {
-      vtkErrorMacro("Snow Melt: out of host memory for the output fields.");
-      return 0;
-    }
-    a->SetNumberOfTuples(n);
-    const gr_status st = gr_snow_melt_get(this->Simulation, o, a->GetPointer(0));
-    if (st != GR_OK) {
-      return this->ReportFailure(st, "Snow Melt could not read its fields back",
-                                 gr_snow_melt_last_error(this->Simulation));
-    }
-    if (pieces.IsSplit()) {
-      std::string why;
-      if (!pieces.Rows(a->GetPointer(0), nx, 1, rows[0] - inExtent[2], rows[1] - inExtent[2],
-                       assembled, why)) {
-        vtkErrorMacro(
-            "Snow Melt could not assemble its piece from the neighbouring ranks: " << why << ".");
-        return 0;
-      }
-      a->SetNumberOfTuples(static_cast<vtkIdType>(assembled.size()));
-      std::copy(assembled.begin(), assembled.end(), a->GetPointer(0));
-    }
-    if (o == GR_SNOW_MELT_WATER_RELEASE) {
-      release = a;
-    }
-    whole->GetPointData()->AddArray(a);
+    arrays.push_back({gr_snow_melt_output_name(o), 1, [this, o](float *values) {
+                        return static_cast<int>(gr_snow_melt_get(this->Simulation, o, values));
+                      }});
   }
-  // The heights, as the core was given them.
-  vtkNew<vtkFloatArray> elevation;
-  elevation->SetName("elevation");
-  elevation->SetNumberOfTuples(outPoints);
-  const size_t first = static_cast<size_t>(rows[0] - inExtent[2]) * static_cast<size_t>(nx);
-  if (first + static_cast<size_t>(outPoints) > this->Elevation.size()) {
-    vtkErrorMacro(
-        "Snow Melt's output rows lie beyond its terrain; this is a bug: please report it.");
+  // The heights, as the core was given them: the own rows of the whole grid's.
+  arrays.push_back(
+      {"elevation", 1, [this](float *values) {
+         graupel::Pieces &pieces = this->GetPieces();
+         const size_t nx = static_cast<size_t>(this->Dimensions[0]);
+         const size_t first =
+             pieces.IsSplit() ? static_cast<size_t>(pieces.GetOwnFirstRow()) * nx : 0;
+         const size_t count =
+             nx * static_cast<size_t>(pieces.IsSplit() ? pieces.GetOwnRows() : this->Dimensions[1]);
+         if (first + count > this->Elevation.size()) {
+           return static_cast<int>(GR_ERR_INVALID_ARGUMENT);
+         }
+         std::copy_n(this->Elevation.begin() + static_cast<std::ptrdiff_t>(first), count, values);
+         return static_cast<int>(GR_OK);
+       }});
+  if (!this->FillImage(outputObject, outInfo, arrays,
+                       [this] { return gr_snow_melt_last_error(this->Simulation); })) {
     return 0;
   }
-  std::copy(this->Elevation.begin() + static_cast<std::ptrdiff_t>(first),
-            this->Elevation.begin() + static_cast<std::ptrdiff_t>(first) + outPoints,
-            elevation->GetPointer(0));
-  whole->GetPointData()->AddArray(elevation);
   // Rain Runoff's rain: the water released, m/s.
+  vtkImageData *output = vtkImageData::SafeDownCast(outputObject);
+  vtkDataArray *release = output->GetPointData()->GetArray("water_release");
   vtkNew<vtkFloatArray> rain;
   rain->SetName("rain_rate");
   rain->SetNumberOfTuples(release->GetNumberOfTuples());
   for (vtkIdType k = 0; k < release->GetNumberOfTuples(); ++k) {
-    rain->SetValue(k, static_cast<float>(static_cast<double>(release->GetValue(k)) / 3.6e6));
+    rain->SetValue(k, static_cast<float>(release->GetComponent(k, 0) / 3.6e6));
   }
-  whole->GetPointData()->AddArray(rain);
-  whole->GetPointData()->SetActiveScalars("snow_depth");
-  output->ShallowCopy(whole);
-  output->Crop(extent);
-  vtkNew<vtkDoubleArray> cells;
-  cells->SetName("piece_cells");
-  cells->InsertNextValue(
-      static_cast<double>(pieces.IsSplit() ? pieces.GetPieceCells()
-                                           : static_cast<vtkIdType>(nx) * this->Dimensions[1]));
-  output->GetFieldData()->AddArray(cells);
+  output->GetPointData()->AddArray(rain);
 
   gr_snow_melt_ledger ledger;
   const gr_status st = gr_snow_melt_ledger_get(this->Simulation, &ledger);

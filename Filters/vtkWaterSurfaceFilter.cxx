@@ -310,78 +310,22 @@ int vtkWaterSurfaceFilter::LoadState(const std::vector<unsigned char> &bytes) {
 }
 
 int vtkWaterSurfaceFilter::FillOutput(vtkDataObject *outputObject, vtkInformation *outInfo) {
-  vtkImageData *output = vtkImageData::SafeDownCast(outputObject);
-  vtkImageData *input = vtkImageData::GetData(this->GetInputInformation(0, 0));
-  if (!output || !input) {
-    return 0;
-  }
-  int extent[6];
-  if (outInfo && outInfo->Has(vtkStreamingDemandDrivenPipeline::UPDATE_EXTENT())) {
-    outInfo->Get(vtkStreamingDemandDrivenPipeline::UPDATE_EXTENT(), extent);
-  } else {
-    input->GetExtent(extent);
-  }
-  const int *inExtent = input->GetExtent();
-  graupel::Pieces &pieces = this->GetPieces();
-  // The core's own points: the whole grid, or a split run's own rows; the
-  // rows handed out: the whole grid's, or the requested rows (the row a
-  // strip shares with the next comes from that rank). Cropped below.
-  const int nx = this->Dimensions[0];
-  const int ownRows = pieces.IsSplit() ? pieces.GetOwnRows() : this->Dimensions[1];
-  const vtkIdType n = static_cast<vtkIdType>(nx) * ownRows;
-  int rows[2] = {inExtent[2], inExtent[3]};
-  if (pieces.IsSplit()) {
-    rows[0] = extent[2];
-    rows[1] = extent[3];
-  }
-  vtkNew<vtkImageData> whole;
-  whole->SetExtent(inExtent[0], inExtent[1], rows[0], rows[1], inExtent[4], inExtent[5]);
-  whole->SetOrigin(input->GetOrigin());
-  whole->SetSpacing(input->GetSpacing());
   const gr_water_surface_output outputs[] = {GR_WATER_WAVE_HEIGHT, GR_WATER_SURFACE,
                                              GR_WATER_NORMAL,      GR_WATER_WET,
                                              GR_WATER_ELEVATION,   GR_WATER_DEPTH};
-  std::vector<float> assembled;
+  std::vector<ImageArray> arrays;
   for (gr_water_surface_output o : outputs) {
-    const int components = gr_water_surface_output_components(o);
-    vtkNew<vtkFloatArray> a;
-    a->SetName(gr_water_surface_output_name(o));
-    a->SetNumberOfComponents(components);
-    if (!a->Allocate(n * components)) {
-      vtkErrorMacro("Water Surface: out of host memory for the output fields.");
-      return 0;
-    }
-    a->SetNumberOfTuples(n);
-    const gr_status st = gr_water_surface_get(this->Simulation, o, a->GetPointer(0));
-    if (st != GR_OK) {
-      return this->ReportFailure(st, "Water Surface could not read its fields back",
-                                 gr_water_surface_last_error(this->Simulation));
-    }
-    if (pieces.IsSplit()) {
-      std::string why;
-      if (!pieces.Rows(a->GetPointer(0), nx, components, rows[0] - inExtent[2],
-                       rows[1] - inExtent[2], assembled, why)) {
-        vtkErrorMacro("Water Surface could not assemble its piece from the neighbouring ranks: "
-                      << why << ".");
-        return 0;
-      }
-      a->SetNumberOfTuples(static_cast<vtkIdType>(assembled.size()) / components);
-      std::copy(assembled.begin(), assembled.end(), a->GetPointer(0));
-    }
-    whole->GetPointData()->AddArray(a);
+    arrays.push_back({gr_water_surface_output_name(o), gr_water_surface_output_components(o),
+                      [this, o](float *values) {
+                        return static_cast<int>(gr_water_surface_get(this->Simulation, o, values));
+                      }});
   }
-  whole->GetPointData()->SetActiveScalars("wave_height");
-  whole->GetPointData()->SetActiveNormals("normal");
-  output->ShallowCopy(whole);
-  output->Crop(extent);
-  // What this rank simulated, ring included: the split a user can see.
-  vtkNew<vtkDoubleArray> cells;
-  cells->SetName("piece_cells");
-  cells->InsertNextValue(
-      static_cast<double>(pieces.IsSplit() ? pieces.GetPieceCells()
-                                           : static_cast<vtkIdType>(nx) * this->Dimensions[1]));
-  output->GetFieldData()->AddArray(cells);
-
+  if (!this->FillImage(outputObject, outInfo, arrays,
+                       [this] { return gr_water_surface_last_error(this->Simulation); })) {
+    return 0;
+  }
+  vtkImageData *output = vtkImageData::SafeDownCast(outputObject);
+  output->GetPointData()->SetActiveNormals("normal");
   gr_water_surface_ledger ledger;
   const gr_status st = gr_water_surface_ledger_get(this->Simulation, &ledger);
   if (st != GR_OK) {
