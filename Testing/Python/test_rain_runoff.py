@@ -814,6 +814,19 @@ d_active, _ = at(g, 20.0)
 d_named, _ = at(rain(bowl), 20.0)
 T.check(not errs.messages and d_active is not None and np.array_equal(d_active, d_named),
         "the active scalars 'height' as the heights: the same depths (%s)" % errs.messages)
+# Choosing the heights it already reads (as ParaView does once the Input's
+# arrays are known) keeps the state; choosing other heights sets it up again.
+before = g.GetRestartCount()
+g.SetInputArrayToProcess(0, 0, 0, 0, "elevation")
+at(g, 30.0)
+g.SetInputArrayToProcess(0, 0, 0, 0, "")
+at(g, 40.0)
+T.check(g.GetRestartCount() == before, "the default Height Array set again: no new set-up "
+        "(%d, %d)" % (before, g.GetRestartCount()))
+g.SetInputArrayToProcess(0, 0, 0, 0, "roughness")
+at(g, 40.0)
+T.check(g.GetRestartCount() == before + 1, "another Height Array: set up again (%d)"
+        % g.GetRestartCount())
 # Nothing to take (two arrays, no elevation, no active scalars): refused, one
 # sentence only, however often and for whatever time the output is asked for.
 src = image({"height": bowl, "roughness": 0.0 * bowl})
