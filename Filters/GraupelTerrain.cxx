@@ -191,21 +191,24 @@ bool HeightsAreCells(vtkAlgorithm *alg, int port) {
                              in->GetCellData()->GetNumberOfArrays() == 0);
   vtkInformation *inInfo = alg->GetInputInformation(port, 0);
   const bool temporal = inInfo && inInfo->Has(vtkStreamingDemandDrivenPipeline::TIME_STEPS());
+  // A producer that announces its active scalars as point data (Graupel's
+  // sources and readers, vtkDataObject::SetPointDataActiveScalarInfo) and
+  // none as cell data gives point heights: nothing to run to find out.
+  const bool announcedPoints =
+      inInfo &&
+      vtkDataObject::GetActiveFieldInformation(inInfo, vtkDataObject::FIELD_ASSOCIATION_POINTS,
+                                               vtkDataSetAttributes::SCALARS) &&
+      !vtkDataObject::GetActiveFieldInformation(inInfo, vtkDataObject::FIELD_ASSOCIATION_CELLS,
+                                                vtkDataSetAttributes::SCALARS);
+  if (empty && announcedPoints) {
+    return chosen.association == vtkDataObject::FIELD_ASSOCIATION_CELLS;
+  }
   if (empty && chosen.association < 0 && !temporal) {
     // A first update: the input has not run yet, so what its arrays are is
     // not known before it does. Run it now, once (not a series in time,
     // whose frames the filter asks for one by one: a cell raster series
     // takes one more update, announced by RequestData).
-    // Graupel's own sources and readers give point heights: no need to ask
-    // them (running one here made ParaView run it twice, the simulation
-    // after it set up twice).
     vtkAlgorithmOutput *conn = alg->GetInputConnection(port, 0);
-    vtkAlgorithm *producer = conn ? conn->GetProducer() : nullptr;
-    if (producer &&
-        (producer->IsA("vtkGraupelAlgorithm") || producer->IsA("vtkEXRHeightFieldReader") ||
-         producer->IsA("vtkGISRasterReader"))) {
-      return false;
-    }
     if (conn && conn->GetProducer()) {
       conn->GetProducer()->Update(conn->GetIndex());
       in = vtkDataSet::SafeDownCast(alg->GetInputDataObject(port, 0));

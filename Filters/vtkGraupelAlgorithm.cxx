@@ -243,6 +243,16 @@ vtkTypeBool vtkGraupelAlgorithm::ProcessRequest(vtkInformation *request,
     if (this->TerrainCells) {
       graupel::CellCentreInformation(inInfo[port]->GetInformationObject(0), outInfo);
     }
+    // Graupel's images are point data: a filter after this one need not run
+    // it to learn where its heights are (HeightsAreCells).
+    for (int i = 0; imageOut && !this->InformationFailed && i < this->GetNumberOfOutputPorts();
+         ++i) {
+      vtkInformation *p = this->GetOutputPortInformation(i);
+      if (p->Has(vtkDataObject::DATA_TYPE_NAME()) &&
+          std::strcmp(p->Get(vtkDataObject::DATA_TYPE_NAME()), "vtkImageData") == 0) {
+        vtkDataObject::SetPointDataActiveScalarInfo(outInfo->GetInformationObject(i), VTK_FLOAT, 1);
+      }
+    }
     if (this->InformationFailed) {
       // Said why already; an empty extent lets the data pass go through quietly.
       static const int empty[6] = {0, -1, 0, -1, 0, -1};
