@@ -68,7 +68,8 @@ bool ForeignUnits(vtkDataObject *data, double *unit, std::string *wkt, std::stri
   gr_raster_crs c;
   char err[512] = "";
   if (gr_raster_crs_describe(crs.c_str(), &c, err, sizeof err) != GR_OK) {
-    *why = err;
+    *why = "has a coordinate reference system GDAL cannot read, so its units are not known (" +
+           std::string(err) + ")";
     return false;
   }
   const bool ok = !c.geographic;
@@ -318,6 +319,13 @@ vtkImageData *TerrainView::Get(vtkImageData *input, const HeightsChoice &choice,
   if (!heights) {
     return input;
   }
+  // The same input (object and time) and heights: the view built for them.
+  std::ostringstream key;
+  key << heights->GetName() << ' ' << association;
+  if (this->View && this->Source == input && this->SourceTime == input->GetMTime() &&
+      this->Key == key.str()) {
+    return this->View;
+  }
   double unit = 1.0;
   std::string wkt, why;
   if (!ForeignUnits(input, &unit, &wkt, &why)) {
@@ -336,12 +344,6 @@ vtkImageData *TerrainView::Get(vtkImageData *input, const HeightsChoice &choice,
                             : std::numeric_limits<double>::quiet_NaN();
   if (!cells && !ghosts && unit == 1.0 && wkt.empty() && !std::isfinite(noData)) {
     return input; // point heights as they are: the filter reads the chosen array itself
-  }
-  std::ostringstream key;
-  key << heights->GetName() << ' ' << association << ' ' << unit;
-  if (this->View && this->Source == input && this->SourceTime == input->GetMTime() &&
-      this->Key == key.str()) {
-    return this->View;
   }
   vtkSmartPointer<vtkImageData> view = Structure(input, cells, unit);
   PassArrays(cells ? static_cast<vtkDataSetAttributes *>(input->GetCellData())
