@@ -494,7 +494,7 @@ def main():
            ("outflow_M", "outflow", (0.05, 0.15, 0.45))],
           "The chain's water ledger (closes to %.1g of the water in)"
           % max(abs(r["closure_error"]) / r["water_in"] for r in rows),
-          "10\u2076 m\u00b3")
+          "million m\u00b3")
     size = (a.width, a.height)
     view, pictures, numbers = None, [], []
     for k, (t, caption) in enumerate(DATES, 1):
