@@ -6,13 +6,18 @@ from the same scene builders the demos and the reference images use:
   snow_deformation.pvsm    the wheel through snow of demo_snow_deformation.py
   snow_accumulation.pvsm   the hut and trees under snow and the sledge across
                            it, of demo_snow_accumulation.py
+  season.pvsm              season_scene.py's chain (winter snow on the DEM,
+                           March melt, runoff) shown on 19 March as Apply
+                           shows Snow Melt (coloured by snow_depth)
 
     xvfb-run -a pvbatch Examples/make_states.py [--plugin .../Graupel.so] [--scene NAME]
 
 A state holds the pipeline, not its data: loading one runs the simulations
 again. Data files are written relative to Examples/states/ (the DEM as
 ../../Data/jacksboro_fault_dem.exr; the snow accumulation's hut, trees and
-sledge, made in Python, as .vtm/.vtp files next to the states), so a state
+sledge, made in Python, as .vtm/.vtp files next to the states; the season's
+conditioned DEM and forcing table as season_terrain.vti and
+season_forcing.csv), so a state
 loads from any checkout: in the GUI, File > Load State, then "Search files
 under specified directory" (the state's own folder, the default); in Python,
 LoadState(path, data_directory=<Examples/states>). Each scene is written by
@@ -27,7 +32,7 @@ import sys
 
 here = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, here)
-SCENES = ("terrain", "rain_jacksboro", "snow_deformation", "snow_accumulation")
+SCENES = ("season", "terrain", "rain_jacksboro", "snow_deformation", "snow_accumulation")
 
 p = argparse.ArgumentParser()
 p.add_argument("--out", default=os.path.join(here, "states"))
@@ -78,6 +83,40 @@ def file_producer(data):
     return reader
 
 
+def season_terrain(image):
+    """Stands in for season_scene.terrain_producer: the filled DEM as a .vti
+    next to the states, read back."""
+    from vtkmodules.vtkIOXML import vtkXMLImageDataWriter
+
+    path = os.path.join(out, "season_terrain.vti")
+    writer = vtkXMLImageDataWriter()
+    writer.SetFileName(path)
+    writer.SetInputData(image)
+    writer.SetDataModeToAppended()
+    writer.SetCompressorTypeToZLib()
+    writer.Write()
+    written.append(path)
+    reader = pvs.XMLImageDataReader(FileName=[path])
+    reader.UpdatePipeline()
+    return reader
+
+
+def season_forcing(table):
+    """Stands in for season_scene.table_producer: the forcing as a CSV file
+    next to the states (times written as decimals: read as doubles)."""
+    path = os.path.join(out, "season_forcing.csv")
+    names = [table.GetColumnName(k) for k in range(table.GetNumberOfColumns())]
+    with open(path, "w") as f:
+        f.write(",".join(names) + "\n")
+        for i in range(table.GetNumberOfRows()):
+            f.write(",".join("%.3f" % table.GetValue(i, k).ToDouble()
+                             for k in range(len(names))) + "\n")
+    written.append(path)
+    reader = pvs.CSVReader(FileName=[path])
+    reader.UpdatePipeline()
+    return reader
+
+
 def at_time(t):
     """Puts the animation (and so every view) at `t` seconds, as the state loads."""
     scene = pvs.GetAnimationScene()
@@ -89,6 +128,17 @@ def at_time(t):
 if args.scene == "terrain":
     terrain = pvs.ProceduralTerrain(Dimensions=[512, 512], Spacing=2.0, Seed=2026)
     graupel_scene.show_terrain(terrain)
+elif args.scene == "season":
+    import season_scene  # noqa: E402
+
+    season_scene.terrain_producer = season_terrain
+    season_scene.table_producer = season_forcing
+    parts = season_scene.build(os.path.join(here, "..", "Data"))
+    for name in ("analysis",):  # the pictures' light: not part of the state
+        pvs.Delete(parts[name])
+    t = season_scene.DATES[2][0]
+    at_time(t)
+    graupel_scene.show_surface(parts["melt"], color="snow_depth", time=t, exaggeration=2.5)
 elif args.scene == "rain_jacksboro":
     dem = pvs.EXRHeightFieldReader(
         FileName=os.path.realpath(os.path.join(here, "..", "Data", "jacksboro_fault_dem.exr")))
@@ -115,7 +165,7 @@ data_dir = os.path.realpath(os.path.join(here, "..", "Data"))
 text = text.replace(data_dir + "/", "../../Data/")
 for path in written:
     text = text.replace(path, os.path.basename(path))
-left = re.findall(r'value="(/[^"]*\.(?:exr|vtm|vtp|vti))"', text)
+left = re.findall(r'value="(/[^"]*\.(?:exr|vtm|vtp|vti|csv))"', text)
 if left:
     sys.exit("make_states: absolute data paths left in %s: %s" % (state, left))
 open(state, "w").write(text)
