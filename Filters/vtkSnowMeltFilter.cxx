@@ -22,6 +22,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -295,7 +296,8 @@ int vtkSnowMeltFilter::SetUpState(vtkInformationVector **inputVector) {
   // uploads' staging planes and the whole grid's heights kept for the output.
   gr_memory_need need;
   gr_snow_melt_memory(&grid, &p, &need);
-  if (!this->CheckMemory(grid, need, 4.0 * (10 + 3 + 1))) {
+  // With FollowInputTime, a frame's two forcing planes are staged too.
+  if (!this->CheckMemory(grid, need, 4.0 * (10 + 3 + 1 + (this->FollowInputTime ? 2 : 0)))) {
     return 0;
   }
   const vtkIdType n = static_cast<vtkIdType>(dims[0]) * dims[1];
@@ -348,11 +350,67 @@ int vtkSnowMeltFilter::SetUpState(vtkInformationVector **inputVector) {
     }
   }
   this->Elevation.assign(elevation->GetPointer(0), elevation->GetPointer(0) + n);
+  // A followed Input: the per-point forcing of the frame it holds now.
+  this->UseTemperatureField = 0;
+  this->UsePrecipitationField = 0;
+  if (this->FollowInputTime && !this->SetForcingFromInput(terrain)) {
+    this->ReleaseState();
+    return 0;
+  }
+  this->FrameReadAt = this->GetTemporalInputTime(0);
   gr_snow_melt_set_progress(this->Simulation, &vtkGraupelSimulation::CoreProgress, this);
   return 1;
 }
 
+int vtkSnowMeltFilter::SetForcingFromInput(vtkImageData *frame) {
+  const struct {
+    const char *name;
+    int field;
+    int *use;
+  } arrays[] = {{"air_temperature", GR_SNOW_MELT_TEMPERATURE, &this->UseTemperatureField},
+                {"precipitation", GR_SNOW_MELT_PRECIPITATION, &this->UsePrecipitationField}};
+  vtkPointData *pd = frame ? frame->GetPointData() : nullptr;
+  int dims[3] = {0, 0, 0};
+  if (frame) {
+    frame->GetDimensions(dims);
+  }
+  const double t = this->GetTemporalInputTime(0);
+  for (const auto &a : arrays) {
+    // Each frame decides alone: without the array, the Forcing table or the
+    // constant property holds over its interval.
+    *a.use = 0;
+    vtkDataArray *array = pd ? pd->GetArray(a.name) : nullptr;
+    if (!array) {
+      continue;
+    }
+    if (dims[0] != this->Dimensions[0] || dims[1] != this->Dimensions[1] ||
+        array->GetNumberOfComponents() != 1) {
+      vtkErrorMacro("Snow Melt's Input at t = "
+                    << t << " s has " << dims[0] << " x " << dims[1] << " points with "
+                    << array->GetNumberOfComponents() << " component(s) of '" << a.name
+                    << "' but the simulation runs on " << this->Dimensions[0] << " x "
+                    << this->Dimensions[1]
+                    << " points; give every time step the same grid and one value a point.");
+      return 0;
+    }
+    vtkSmartPointer<vtkFloatArray> values = AsFloat(array);
+    const std::vector<float> local =
+        this->GetPieces().LocalField(values->GetPointer(0), dims[0], 1);
+    const gr_status st = gr_snow_melt_set_field(this->Simulation, a.field, local.data());
+    if (st != GR_OK) {
+      vtkErrorMacro(
+          "Snow Melt's Input at t = " << t << " s: " << gr_snow_melt_last_error(this->Simulation));
+      return 0;
+    }
+    *a.use = 1;
+  }
+  return 1;
+}
+
 int vtkSnowMeltFilter::ResetState() {
+  // The followed Input's forcing is not in the core's state: the next
+  // advance sets that of the frame it needs again.
+  this->FrameReadAt = std::numeric_limits<double>::quiet_NaN();
   const gr_status st = gr_snow_melt_reset(this->Simulation);
   gr_snow_melt_set_progress(this->Simulation, &vtkGraupelSimulation::CoreProgress, this);
   return st == GR_OK ? 1
@@ -375,6 +433,14 @@ int vtkSnowMeltFilter::AdvanceState(double t0, double t1) {
                                  gr_snow_melt_last_error(this->Simulation));
     }
   }
+  // A followed Input (FollowInputTime): the per-point forcing of the frame
+  // that holds over [t0, t1] (the base cuts the advances at the frames).
+  if (this->IsInputTemporal(0) && this->GetTemporalInputTime(0) != this->FrameReadAt) {
+    if (!this->SetForcingFromInput(vtkImageData::SafeDownCast(this->GetTemporalInput(0)))) {
+      return ADVANCE_FAILED;
+    }
+    this->FrameReadAt = this->GetTemporalInputTime(0);
+  }
   // Pieces split at the Forcing's row times: the forcing is constant over
   // each advance. The cuts depend on t0, t1 and the table only.
   double t = t0;
@@ -385,8 +451,8 @@ int vtkSnowMeltFilter::AdvanceState(double t0, double t1) {
       next = *after;
     }
     gr_snow_melt_forcing f;
-    f.use_temperature_field = 0;
-    f.use_precipitation_field = 0;
+    f.use_temperature_field = this->UseTemperatureField;
+    f.use_precipitation_field = this->UsePrecipitationField;
     this->ForcingAt(t, f.air_temperature, f.precipitation);
     gr_status st = gr_snow_melt_set_forcing(this->Simulation, &f);
     if (st != GR_OK) {
@@ -416,6 +482,7 @@ int vtkSnowMeltFilter::SaveState(std::vector<unsigned char> &bytes) {
 }
 
 int vtkSnowMeltFilter::LoadState(const std::vector<unsigned char> &bytes) {
+  this->FrameReadAt = std::numeric_limits<double>::quiet_NaN();
   return gr_snow_melt_state_load(this->Simulation, bytes.data(), bytes.size()) == GR_OK;
 }
 

@@ -21,6 +21,23 @@
  * column that is missing, or no table, gives the constant properties
  * AirTemperature and Precipitation.
  *
+ * Per-point forcing from a temporal Input (FollowInputTime 1): each time
+ * step (frame) of the Input that has the point array `air_temperature`
+ * (degC at the point; the lapse rate is not applied to it) and/or
+ * `precipitation` (mm/h) sets that forcing point by point, held from the
+ * frame's time until the next frame's (sample and hold, as the frames of a
+ * weather model or a radar; before the first frame the first holds, after
+ * the last the last). The core is advanced in pieces split at the frames'
+ * times, as at the Forcing's rows. A frame without one of the arrays leaves
+ * that quantity to the Forcing table or the constant property over its
+ * interval, as without the Input's arrays; so each frame decides alone and
+ * the result never depends on the order in which times are asked. A value
+ * that is not finite or out of range (+-100 degC, 0 to 1000 mm/h) is
+ * refused with one sentence naming the frame's time and the point, and an
+ * empty output. The heights and the initial snow are read once, at
+ * set-up: give every frame the same. With FollowInputTime 0 the Input's
+ * air_temperature and precipitation are not read.
+ *
  * The output has the Input's grid and the point arrays `snow_depth` (m;
  * active scalars), `snow_density` (kg/m^3), `swe` and `liquid_water` (m
  * w.e.), `melt_rate` and `water_release` (mm/h, the means over the output
@@ -53,6 +70,7 @@
 #include <vector>
 
 struct gr_snow_melt;
+class vtkImageData;
 
 class GRAUPELFILTERS_EXPORT vtkSnowMeltFilter : public vtkGraupelSimulation {
 public:
@@ -174,6 +192,12 @@ private:
   int ReadForcing(vtkInformationVector **inputVector);
   /** The forcing that holds from time t on (s). */
   void ForcingAt(double t, double &temperature, double &precipitation) const;
+  /**
+   * With FollowInputTime, the per-point air_temperature and precipitation
+   * of the Input's frame now (frame), each to the core where the frame has
+   * it, and the use flags; 0 after one sentence.
+   */
+  int SetForcingFromInput(vtkImageData *frame);
 
   gr_snow_melt *Simulation = nullptr;
   int Dimensions[2] = {0, 0};
@@ -181,6 +205,11 @@ private:
   std::vector<double> ForcingTimes;       // empty: no table
   std::vector<double> ForcingTemperature; // empty: the column is missing
   std::vector<double> ForcingPrecipitation;
+  // The followed Input's frame whose per-point forcing the core holds (NaN:
+  // none yet, read it at the next advance) and which of its fields apply.
+  double FrameReadAt = 0.0;
+  int UseTemperatureField = 0;
+  int UsePrecipitationField = 0;
 };
 
 #endif

@@ -5,8 +5,10 @@
  * against an independent sun-geometry formula; a point behind a wall gets
  * the temperature term only), settling (independent of the step), the
  * ledger over 10^4 steps of mixed weather, determinism, pieces (2 and 3
- * strips on threads give the whole grid's bits), checkpoints, bad input and
- * the parameter table.
+ * strips on threads give the whole grid's bits), checkpoints, every OpenCL
+ * device present against the first (a GPU against PoCL: the integer state
+ * within a stated tolerance, each ledger closed exactly), bad input and the
+ * parameter table.
  *
  *   test_snow_melt            every subtest but memcheck
  *   test_snow_melt memcheck   the host-code paths only, on tiny grids */
@@ -706,6 +708,197 @@ static void test_checkpoint(void) {
   pc_free(&dm);
 }
 
+/* --------------------------------------------------- devices agree */
+
+/* Bytes before the frozen integers in a checkpoint: the state's size of a
+ * 2 x 2 and a 3 x 2 grid give the bytes a point and the header; the
+ * frozen (8 a point) and then the liquid integers (8) follow it
+ * (snow_melt_step.c's gr_sm_state_parts). */
+static size_t dv_header_bytes(gr_context *c) {
+  gr_snow_melt_params p;
+  plain_params(&p);
+  size_t size[2] = {0, 0};
+  for (int k = 0; k < 2; ++k) {
+    gr_grid g = {2 + k, 2, 1.0, 1.0};
+    gr_snow_melt *s = NULL;
+    CHECK(gr_snow_melt_create(c, &g, &p, &s) == GR_OK);
+    CHECK(gr_snow_melt_state_size(s, &size[k]) == GR_OK);
+    gr_snow_melt_destroy(s);
+  }
+  size_t per_point = (size[1] - size[0]) / 2;
+  return size[0] - 4 * per_point;
+}
+
+enum { DV_NX = 64, DV_NY = 48, DV_MAX = 8 };
+
+/* One device's run: the integer state, every output, the ledger. */
+typedef struct dv_run {
+  char name[128];
+  long long *frozen, *liquid;
+  float *out;
+  gr_snow_melt_ledger l;
+} dv_run;
+
+/* The scenario on device `name`: 64 x 48 hills of 25 m (1150 to 1650 m),
+ * sun and cast shadows on, varying snow, 48 hourly steps in 4 parts of
+ * 12 h, each marked first: warm sun (melt, the liquid held and released),
+ * rain on the lower and snow on the upper slopes (the per-point
+ * precipitation field), a cold night with snowfall (refreezing), a warm
+ * morning again. 0 when the device could not run it. */
+static int dv_scenario(const char *name, dv_run *r) {
+  gr_context_options opt;
+  gr_context_options_init(&opt);
+  opt.device = name;
+  gr_context *c = NULL;
+  gr_status st = gr_context_create(&opt, &c);
+  CHECK_MSG(st == GR_OK, "%s: %s", name, gr_last_error(NULL));
+  if (st != GR_OK)
+    return 0;
+  const gr_grid g = {DV_NX, DV_NY, 25.0, 25.0, 1000.0, 2000.0};
+  const size_t n = (size_t)DV_NX * DV_NY;
+  float *z = malloc(n * 4), *d = malloc(n * 4), *rho = malloc(n * 4), *pr = malloc(n * 4);
+  for (size_t k = 0; k < n; ++k) {
+    double i = (double)(k % DV_NX), j = (double)(k / DV_NX);
+    z[k] = (float)(1400.0 + 150.0 * sin(0.21 * i) * cos(0.17 * j) + 4.0 * j -
+                   60.0 * exp(-((i - 40.0) * (i - 40.0) + (j - 20.0) * (j - 20.0)) / 50.0));
+    d[k] = (float)(0.15 + 0.5 * (z[k] - 1150.0) / 500.0 + 0.05 * sin(0.9 * i + 0.4 * j));
+    rho[k] = (float)(220.0 + 40.0 * cos(0.3 * i - 0.2 * j));
+    pr[k] = (float)(1.0 + 0.8 * sin(0.11 * i + 0.07 * j));
+  }
+  gr_snow_melt_params p;
+  gr_snow_melt_params_init(&p);
+  p.start_day = 110;
+  p.start_hour = 5.0;
+  p.time_step = 3600.0;
+  p.reference_elevation = 1400.0;
+  p.cast_shadows = 1;
+  /* T_ref at 1400 m, precipitation (constant, or the field) by part. */
+  const gr_snow_melt_forcing weather[4] = {
+      {7.0, 0.0, 0, 0}, {1.0, 0.0, 0, 1}, {-6.0, 0.6, 0, 0}, {9.0, 0.0, 0, 0}};
+  gr_snow_melt *s = NULL;
+  st = gr_snow_melt_create(c, &g, &p, &s);
+  CHECK_MSG(st == GR_OK, "%s: %s", name, gr_last_error(NULL));
+  const int fields[4] = {GR_FIELD_ELEVATION, GR_FIELD_SNOW_DEPTH, GR_FIELD_SNOW_DENSITY,
+                         GR_SNOW_MELT_PRECIPITATION};
+  const float *values[4] = {z, d, rho, pr};
+  for (int k = 0; st == GR_OK && k < 4; ++k)
+    st = gr_snow_melt_set_field(s, fields[k], values[k]);
+  if (st == GR_OK)
+    st = gr_snow_melt_set_terrain(s, z);
+  for (int k = 0; st == GR_OK && k < 4; ++k) {
+    st = gr_snow_melt_set_forcing(s, &weather[k]);
+    if (st == GR_OK)
+      st = gr_snow_melt_mark(s);
+    if (st == GR_OK)
+      st = gr_snow_melt_advance(s, 12.0 * 3600.0, NULL);
+  }
+  CHECK_MSG(st == GR_OK, "%s: %s", name, s ? gr_snow_melt_last_error(s) : "");
+  size_t bytes = 0, head = dv_header_bytes(c);
+  unsigned char *state = NULL;
+  if (st == GR_OK)
+    st = gr_snow_melt_state_size(s, &bytes);
+  if (st == GR_OK && bytes >= head + 16 * n) {
+    state = malloc(bytes);
+    st = gr_snow_melt_state_save(s, state, bytes);
+  }
+  CHECK_MSG(st == GR_OK && state, "%s: state of %zu bytes", name, bytes);
+  int ok = st == GR_OK && state != NULL;
+  if (ok) {
+    snprintf(r->name, sizeof(r->name), "%s", name);
+    r->frozen = malloc(8 * n), r->liquid = malloc(8 * n);
+    memcpy(r->frozen, state + head, 8 * n);
+    memcpy(r->liquid, state + head + 8 * n, 8 * n);
+    r->out = pc_outputs(s, &g);
+    r->l = ledger(s);
+  }
+  free(state), free(z), free(d), free(rho), free(pr);
+  gr_snow_melt_destroy(s);
+  gr_context_release(c);
+  return ok;
+}
+
+/* The scenario above on every OpenCL device present (a GPU against PoCL),
+ * as test_procedural_terrain's devices_agree: with one device there is
+ * nothing to compare. Each device closes its ledger exactly (balance 0:
+ * integers). Between devices the transfers are rounded to the state's
+ * integers (2^-32 m) from floats that the transcendental functions feed
+ * (exp in the radiation, sin, cos and atan in the horizons, divisions in
+ * the rain fraction and the density): OpenCL 1.2 lets them differ by a few
+ * ULP (exp 3, sin/cos 4, atan 5, divide 2.5), and FP_CONTRACT is off, so
+ * nothing else differs. A step's largest transfer here is about 2e7 units
+ * (5 mm); a few ULP of it, about 5 units, over 48 steps bound a point's
+ * frozen and liquid integers to some 250 units: they are held to DV_UNITS
+ * (1024 units, 2.4e-7 m w.e.). An H200 against PoCL 5.0 differs at 70 %
+ * of the points by at most 10 units. Beyond that, a point whose horizon
+ * angle and the sun's elevation differ by no more than those ULPs would be
+ * lit in a sub-step on one device and shaded on the other (a quarter hour
+ * of sun, up to some mm w.e.; none seen): at most DV_FLIPS_PER_MILLE points
+ * a thousand may do that, by at most 1 cm w.e. */
+#define DV_UNITS 1024LL
+#define DV_FLIPS_PER_MILLE 5
+static void test_devices_agree(void) {
+  int count = 0;
+  gr_device_info infos[DV_MAX];
+  if (gr_device_list(infos, DV_MAX, &count) != GR_OK || count < 2) {
+    printf("one OpenCL device: cross-device agreement not tested here\n");
+    return;
+  }
+  const size_t n = (size_t)DV_NX * DV_NY;
+  dv_run runs[DV_MAX];
+  memset(runs, 0, sizeof(runs));
+  int have = 0;
+  for (int k = 0; k < count && k < DV_MAX; ++k) {
+    /* Identical GPUs share a name: the first of them stands for all. */
+    int seen = 0;
+    for (int q = 0; q < have; ++q)
+      seen |= strcmp(runs[q].name, infos[k].name) == 0;
+    if (seen || !dv_scenario(infos[k].name, &runs[have]))
+      continue;
+    const gr_snow_melt_ledger *l = &runs[have].l;
+    printf("%s: balance error %.3g m^3; melt %.6f, rain %.6f, snow %.6f, refrozen %.6f, "
+           "released %.6f m^3 over %lld steps\n",
+           infos[k].name, l->balance_error, l->melt_volume, l->rain_volume, l->snowfall_volume,
+           l->refrozen_volume, l->released_volume, l->steps);
+    CHECK_MSG(l->balance_error == 0.0, "%s: balance error %.3g m^3", infos[k].name,
+              l->balance_error);
+    CHECK(l->steps == 48 && l->melt_volume > 0.0 && l->rain_volume > 0.0 &&
+          l->snowfall_volume > 0.0 && l->refrozen_volume > 0.0 && l->released_volume > 0.0);
+    ++have;
+  }
+  for (int k = 1; k < have; ++k) {
+    long long worst = 0, worst_flip = 0;
+    long differ = 0, flips = 0, out_differ = 0;
+    for (size_t c = 0; c < n; ++c) {
+      long long dF = llabs(runs[k].frozen[c] - runs[0].frozen[c]);
+      long long dL = llabs(runs[k].liquid[c] - runs[0].liquid[c]);
+      long long dmax = dF > dL ? dF : dL;
+      differ += dmax != 0;
+      if (dmax > DV_UNITS) {
+        ++flips;
+        worst_flip = dmax > worst_flip ? dmax : worst_flip;
+      } else {
+        worst = dmax > worst ? dmax : worst;
+      }
+    }
+    for (size_t v = 0; v < GR_SNOW_MELT_OUTPUT_COUNT * n; ++v)
+      out_differ += memcmp(&runs[k].out[v], &runs[0].out[v], 4) != 0;
+    double mean_melt = runs[0].l.melt_volume / (25.0 * 25.0 * (double)n);
+    printf("%s vs %s: frozen/liquid integers differ at %ld of %zu points, by at most %lld "
+           "units (%.3g m) within the ULP tolerance; %ld points beyond %lld units (shadow "
+           "flips), the largest %.3g m (mean melt %.4f m); %ld of %zu output values differ in "
+           "their bits\n",
+           runs[k].name, runs[0].name, differ, n, worst, (double)worst * 0x1p-32, flips, DV_UNITS,
+           (double)worst_flip * 0x1p-32, mean_melt, out_differ,
+           (size_t)GR_SNOW_MELT_OUTPUT_COUNT * n);
+    CHECK_MSG((size_t)flips * 1000 <= (size_t)DV_FLIPS_PER_MILLE * n,
+              "%s: %ld points differ by more than %lld units", runs[k].name, flips, DV_UNITS);
+    CHECK_MSG(worst_flip <= (long long)(0.01 * 4294967296.0), "%s: a point differs by %.3g m w.e.",
+              runs[k].name, (double)worst_flip * 0x1p-32);
+  }
+  for (int k = 0; k < have; ++k)
+    free(runs[k].frozen), free(runs[k].liquid), free(runs[k].out);
+}
+
 /* ------------------------------------------------------------ bad input */
 
 /* One sentence: not empty, ends with a full stop, no new line. */
@@ -871,6 +1064,7 @@ static const gr_subtest tests[] = {
     {"determinism", test_determinism, 0},
     {"pieces", test_pieces, 0},
     {"checkpoint", test_checkpoint, 0},
+    {"devices_agree", test_devices_agree, 0},
     {"errors", test_errors, 0},
     {"param_table", test_param_table, 0},
     {"memcheck", test_memcheck, 1},
