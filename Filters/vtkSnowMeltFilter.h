@@ -51,6 +51,17 @@
  * `stored_liquid_volume` and `balance_error` (exactly 0: the core's state is
  * fixed point). The model is described in kernels/include/graupel/snow_melt.h.
  *
+ * The season as a chain (Snow Accumulation -> Snow Melt -> Rain Runoff),
+ * not one simulation stepping the three cores in lockstep: the filters
+ * already exist, each keeps its own time step (an hour for the snow,
+ * seconds for the water), and the chain is what users save in a state
+ * file, split over ranks and check-point like any other. The price is a
+ * coupling through output times, made exact by the rate being a mean:
+ * rain_rate at an output is the release over the interval before it, and
+ * Rain Runoff with RainFrames 1 rains each frame over that same interval,
+ * so the water Rain Runoff books equals what Snow Melt released, whatever
+ * the output interval (py.melt_runoff).
+ *
  * In an MPI run (pvbatch, pvserver) each rank simulates its strip along y
  * with a ring of 1 row (the slopes); the horizons come from the whole
  * terrain, given to every rank; the ledger is reduced over the ranks
