@@ -1,6 +1,7 @@
 #include "vtkGraupelAlgorithm.h"
 
 #include "GraupelRanges.h"
+#include "GraupelRemoteAbort.h"
 #include "GraupelTerrain.h"
 #include "vtkImageData.h"
 #include "vtkPointData.h"
@@ -162,7 +163,27 @@ int vtkGraupelAlgorithm::ReportError(const std::string &sentence) {
   return 0;
 }
 
+bool vtkGraupelAlgorithm::SendRemoteAbort(vtkMultiProcessController *toServer) {
+  return graupel::SendRemoteAbort(toServer);
+}
+
+void vtkGraupelAlgorithm::SetRemoteClientLookup(vtkMultiProcessController *(*lookup)()) {
+  graupel::SetClientLookup(lookup);
+}
+
+void vtkGraupelAlgorithm::BeginRemoteRequest() {
+  graupel::BeginRemoteRequest();
+}
+
+void vtkGraupelAlgorithm::EndRemoteRequest() {
+  graupel::EndRemoteRequest();
+}
+
 bool vtkGraupelAlgorithm::AbortRequested(const char *label, bool started) {
+  // A band-wise update has no time of its own: the abort holds for this algorithm.
+  if (graupel::RemoteAbortAsked(this, 0.0, !started)) {
+    this->SetAbortExecute(1);
+  }
   if (!this->GetAbortExecute()) {
     return false;
   }

@@ -56,6 +56,7 @@ struct gr_context;
 class vtkDataArray;
 class vtkDataObject;
 class vtkImageData;
+class vtkMultiProcessController;
 
 class GRAUPELFILTERS_EXPORT vtkGraupelAlgorithm : public vtkAlgorithm {
 public:
@@ -74,6 +75,28 @@ public:
 
   /** Name of the device the last update ran on ("" before the first). */
   const char *GetDeviceName() const;
+
+  /**
+   * From a ParaView client: asks the remote server behind `toServer` (the
+   * session's DATA_SERVER_ROOT controller) to abort the Graupel update it
+   * runs now, which stops at its next progress report (see
+   * GraupelRemoteAbort.h). pvpython: graupel.remote.abort_update(). False
+   * when `toServer` is no socket connection.
+   */
+  static bool SendRemoteAbort(vtkMultiProcessController *toServer);
+
+#ifndef __VTK_WRAP__
+  /**
+   * On a server process: how to find the server root's controller for its
+   * client, whose socket Graupel's updates poll for a remote abort. The
+   * plugin installs it (vtkGraupelRemote.h); nullptr turns the poll off.
+   */
+  static void SetRemoteClientLookup(vtkMultiProcessController *(*lookup)());
+  /** On a server process: a client request's progress bracket begins, ends (GraupelRemoteAbort.h).
+   */
+  static void BeginRemoteRequest();
+  static void EndRemoteRequest();
+#endif
 
   /**
    * The largest buffer the chosen device allows, in bytes (0 when there is
@@ -178,7 +201,9 @@ protected:
    * centres with `elevation` that the filters read: they look up
    * `elevation` as point data and nothing else.
    */
-  virtual int GetTerrainPort() { return this->GetNumberOfInputPorts() > 0 ? 0 : -1; }
+  virtual int GetTerrainPort() {
+    return this->GetNumberOfInputPorts() > 0 ? 0 : -1;
+  }
 
   /**
    * The heights of the terrain the filter reads (its Input during
@@ -188,7 +213,9 @@ protected:
   vtkDataArray *TerrainHeights(vtkImageData *terrain, std::string *why = nullptr);
 
   /** The terrain's heights are cell data: the outputs are the cells' centres. */
-  bool GetTerrainCells() const { return this->TerrainCells; }
+  bool GetTerrainCells() const {
+    return this->TerrainCells;
+  }
 
 private:
   vtkGraupelAlgorithm(const vtkGraupelAlgorithm &) = delete;

@@ -1,4 +1,5 @@
 #include "vtkGraupelSimulation.h"
+#include "GraupelRemoteAbort.h"
 #include "GraupelTerrain.h"
 
 #include "vtkCellData.h"
@@ -559,6 +560,9 @@ int vtkGraupelSimulation::ReportProgress(double t) {
   const std::string text = std::string(this->GetSimulationLabel()) + ": " + ProgressTimes(t, goal);
   this->SetProgressText(text.c_str());
   this->UpdateProgress(std::max(0.0, std::min(1.0, fraction)));
+  if (graupel::RemoteAbortAsked(this, goal, false)) {
+    this->SetAbortExecute(1); // a remote client's abort, or the client gone
+  }
   return this->GetAbortExecute() ? 1 : 0;
 }
 
@@ -828,6 +832,10 @@ int vtkGraupelSimulation::UpdateState(vtkInformation *request, vtkInformationVec
   if (!this->Continuing) {
     // Collective on a parallel request: every rank plans at once.
     this->PieceLayout->Plan(outInfo, this->PieceRing);
+  }
+  if (!this->Continuing &&
+      graupel::RemoteAbortAsked(this, this->GetOutputTime(this->TargetIndex(outInfo)), true)) {
+    this->AbortExecute = 1; // a remote client's abort holds for the time it stopped
   }
 #if GRAUPEL_VTK_ABORT_OUTPUT
   if (!this->Continuing &&
