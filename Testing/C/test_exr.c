@@ -22,6 +22,13 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include <dirent.h>
+#include <signal.h>
+#include <sys/resource.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
 static const char *g_dir = ".";
 
 /* ------------------------------------------------------------------------ */
@@ -48,6 +55,11 @@ static int save_bytes(const char *path, const void *buf, size_t n) {
   ok = n == 0 || fwrite(buf, 1, n, f) == n;
   ok = (fclose(f) == 0) && ok;
   return ok;
+}
+
+static long file_size(const char *path) {
+  struct stat st;
+  return stat(path, &st) == 0 ? (long)st.st_size : -1;
 }
 
 static int file_exists(const char *path) {
@@ -1498,6 +1510,69 @@ static void test_write_errors(void) {
   }
 }
 
+/* A write that fails part-way (a file-size limit, as a full disk) leaves
+ * the earlier file of that name whole and no temporary file behind; the
+ * next write, with room, replaces it. The limited write runs in a child
+ * process (RLIMIT_FSIZE, SIGXFSZ ignored, as `ulimit -f` in a shell). */
+static void test_write_atomic(void) {
+  enum { N = 256 };
+  static float small[4 * 4], big[N * N];
+  const char *names[1] = {"elevation"};
+  const float *ds[1] = {small}, *db[1] = {big};
+  char path[1024], err[512];
+  for (int i = 0; i < 16; ++i)
+    small[i] = (float)i;
+  /* Noise does not compress: the big file needs about 256 KiB. */
+  unsigned state = 12345u;
+  for (int i = 0; i < N * N; ++i) {
+    state = state * 1664525u + 1013904223u;
+    big[i] = (float)(state >> 8);
+  }
+  scratch_path(path, sizeof path, "atomic.exr");
+  remove(path);
+  CHECK(gr_exr_write(path, 4, 4, 1, names, ds, GR_EXR_FLOAT, err, sizeof err) == GR_OK);
+  long before = file_size(path);
+  CHECK(before > 0);
+
+  fflush(NULL);
+  pid_t child = fork();
+  if (child == 0) {
+    struct rlimit lim = {64 * 1024, 64 * 1024};
+    signal(SIGXFSZ, SIG_IGN);
+    setrlimit(RLIMIT_FSIZE, &lim);
+    gr_status st = gr_exr_write(path, N, N, 1, names, db, GR_EXR_FLOAT, err, sizeof err);
+    printf("  limited write: status %d: %s\n", (int)st, err);
+    fflush(stdout);
+    _exit(st == GR_ERR_IO && is_sentence_with(err, path) ? 0 : 1);
+  }
+  int status = 0;
+  CHECK(child > 0 && waitpid(child, &status, 0) == child);
+  CHECK_MSG(WIFEXITED(status) && WEXITSTATUS(status) == 0,
+            "the write beyond the limit fails with one sentence naming the file (%d)", status);
+  CHECK_MSG(file_size(path) == before, "the earlier file is whole (%ld bytes, was %ld)",
+            file_size(path), before);
+  gr_exr_image img;
+  CHECK(gr_exr_read(path, &img, err, sizeof err) == GR_OK);
+  if (img.width == 4 && img.height == 4 && img.nchannels == 1) {
+    CHECK(memcmp(img.data[0], small, sizeof small) == 0);
+  } else {
+    CHECK_MSG(0, "read back %d x %d x %d", img.width, img.height, img.nchannels);
+  }
+  gr_exr_image_free(&img);
+  /* No temporary file left beside it. */
+  DIR *dir = opendir(g_dir);
+  int strays = 0;
+  for (struct dirent *e = dir ? readdir(dir) : NULL; e; e = readdir(dir))
+    strays += strncmp(e->d_name, "atomic", 6) == 0 && strcmp(e->d_name, "atomic.exr") != 0;
+  if (dir)
+    closedir(dir);
+  CHECK_MSG(strays == 0, "%d temporary files left", strays);
+  /* With room again the same write succeeds. */
+  CHECK(gr_exr_write(path, N, N, 1, names, db, GR_EXR_FLOAT, err, sizeof err) == GR_OK);
+  CHECK(file_size(path) > 64 * 1024);
+  remove(path);
+}
+
 /* ------------------------------------------------------------------------ */
 /* gr_exr_find_channel and gr_exr_image_free                                */
 /* ------------------------------------------------------------------------ */
@@ -1839,6 +1914,7 @@ static const gr_subtest tests[] = {
     {"undecodable_compression", test_undecodable_compression, 0},
     {"memory_reads", test_memory_reads, 0},
     {"write_errors", test_write_errors, 0},
+    {"write_atomic", test_write_atomic, 0},
     {"helpers", test_helpers, 0},
     {"meta_roundtrip", test_meta_roundtrip, 0},
     {"meta_bad_values", test_meta_bad_values, 0},

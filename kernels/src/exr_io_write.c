@@ -241,7 +241,7 @@ gr_status gr_exr_write_meta(const char *path, int width, int height, int nchanne
   gr_status st = GR_OK;
   exr_result_t rv = EXR_ERR_SUCCESS;
   exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
-  int file_created = 0, longnames = 0;
+  int longnames = 0;
   gr_exr_msg msg;
   write_job job;
 
@@ -260,14 +260,15 @@ gr_status gr_exr_write_meta(const char *path, int width, int height, int nchanne
   init.error_handler_fn = &gr_exr_capture_error;
   init.user_data = &msg;
 
-  rv = exr_start_write(&job.ctxt, path, EXR_WRITE_FILE_DIRECTLY, &init);
+  /* A temporary file in the same folder, renamed over path once complete:
+   * a failed write (a full disk) or a kill leaves an earlier file whole. */
+  rv = exr_start_write(&job.ctxt, path, EXR_INTERMEDIATE_TEMP_FILE, &init);
   if (rv != EXR_ERR_SUCCESS) {
     st = rv == EXR_ERR_OUT_OF_MEMORY ? GR_ERR_OUT_OF_MEMORY : GR_ERR_IO;
     gr_exr_set_err(err, err_len, "Cannot write '%s': the file cannot be created (OpenEXR: %s).",
                    path, gr_exr_detail(&msg, rv));
     goto cleanup;
   }
-  file_created = 1;
 
   rv = write_header(&job, type == GR_EXR_HALF ? EXR_PIXEL_HALF : EXR_PIXEL_FLOAT, meta, longnames);
   if (rv != EXR_ERR_SUCCESS) {
@@ -326,7 +327,5 @@ cleanup:
   if (job.ctxt != NULL)
     exr_finish(&job.ctxt);
   free(job.stage);
-  if (st != GR_OK && file_created)
-    remove(path);
   return st;
 }
