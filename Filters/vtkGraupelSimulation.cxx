@@ -40,6 +40,18 @@
 #endif
 
 namespace {
+// Whether the state may serve an output at goal from time t (a kept state or
+// a checkpoint). With an input read in time (inputTimes: per port, empty
+// when static), the output shows what that input held over the advance that
+// ends at goal (Water Surface's water, the objects' time step), which a state
+// merely restored at goal did not read: it steps into goal from before, as a
+// forward run does. Time 0, with nothing before it, is set up or reset.
+bool ServesFrom(double t, double goal, const std::vector<std::vector<double>> &inputTimes) {
+  const bool temporal = std::any_of(inputTimes.begin(), inputTimes.end(),
+                                    [](const std::vector<double> &v) { return v.size() >= 2; });
+  return (temporal && goal > 0.0) ? t < goal : t <= goal;
+}
+
 // The host's physical memory in bytes; 0 when unknown.
 double PhysicalMemoryBytes() {
 #if defined(_SC_PHYS_PAGES) && defined(_SC_PAGESIZE)
@@ -390,12 +402,13 @@ int vtkGraupelSimulation::TargetIndex(vtkInformation *outInfo) const {
 
 double vtkGraupelSimulation::PlannedStart(int target) const {
   const double goal = this->GetOutputTime(target);
-  double start = (this->StateIndex >= 0 && !this->StateLost && this->StateTime <= goal)
+  double start = (this->StateIndex >= 0 && !this->StateLost &&
+                  ServesFrom(this->StateTime, goal, this->InputTimes))
                      ? this->StateTime
                      : 0.0;
   for (const Checkpoint &c : this->Checkpoints) {
     const double tc = this->GetOutputTime(c.index);
-    if (tc <= goal && tc > start) {
+    if (ServesFrom(tc, goal, this->InputTimes) && tc > start) {
       start = tc;
     }
   }
@@ -490,11 +503,13 @@ vtkGraupelSimulation::Key vtkGraupelSimulation::CurrentKey() {
 
 int vtkGraupelSimulation::Rewind(int target) {
   const double goal = this->GetOutputTime(target);
-  const bool stateUsable = this->StateIndex >= 0 && !this->StateLost && this->StateTime <= goal;
+  const bool stateUsable = this->StateIndex >= 0 && !this->StateLost &&
+                           ServesFrom(this->StateTime, goal, this->InputTimes);
   const Checkpoint *best = nullptr;
   for (const Checkpoint &c : this->Checkpoints) {
     const double tc = this->GetOutputTime(c.index);
-    if (tc <= goal && (!stateUsable || tc > this->StateTime) && (!best || c.index > best->index)) {
+    if (ServesFrom(tc, goal, this->InputTimes) && (!stateUsable || tc > this->StateTime) &&
+        (!best || c.index > best->index)) {
       best = &c;
     }
   }

@@ -273,9 +273,20 @@ int vtkWaterSurfaceFilter::ResetState() {
   // The input is read again before the next step (it may be of another time).
   this->WaterReadAt = std::numeric_limits<double>::quiet_NaN();
   const gr_status st = gr_water_surface_reset(this->Simulation);
-  return st == GR_OK ? 1
-                     : this->ReportFailure(st, "Water Surface could not restart",
-                                           gr_water_surface_last_error(this->Simulation));
+  if (st != GR_OK) {
+    return this->ReportFailure(st, "Water Surface could not restart",
+                               gr_water_surface_last_error(this->Simulation));
+  }
+  // Water followed in time: the time step that holds from 0 on (the one this
+  // pass delivers) is read now, so that the output at time 0, which no
+  // advance precedes, shows it as the set-up's does, not the last one read.
+  if (this->IsInputTemporal(0)) {
+    if (!this->ReadWater(this->GetTemporalInput(0))) {
+      return 0;
+    }
+    this->WaterReadAt = this->GetTemporalInputTime(0);
+  }
+  return 1;
 }
 
 int vtkWaterSurfaceFilter::AdvanceState(double t0, double t1) {

@@ -130,9 +130,13 @@ for kill in range(a.kills):
         continue
     _, verdict, k, digest = said[0].split()
     restarts += 1
+    # A writer that finished before the kill (a loaded machine) left the
+    # checkpoint of the last output: the restart's request one further is
+    # past EndTime and gives that output.
+    k = min(int(k), N)
     if verdict != "ok":
         refused += 1
-    elif digest != reference.get(int(k)):
+    elif digest != reference.get(k):
         wrong += 1
 print("%d kills: %d restarts, %d refused, %d with other bits" % (a.kills, restarts, refused, wrong))
 T.check(restarts >= a.kills // 2, "most kills left a checkpoint (%d of %d)" % (restarts, a.kills))

@@ -6,9 +6,12 @@
     checkpoint (manifest and piece) is intact and restarts; the simulation's
     state in memory is unharmed (the next output equals an uninterrupted
     run's); with room again the next checkpoint is written and restarts.
-  * Two simulations in one process on one device, updated in interleaved
-    order (Rain Runoff on two terrains, Snow Deformation beside them), give
-    the same bits as each alone.
+  * Simulations in one process on one device, updated in interleaved
+    order, give the same bits as each alone: every simulation of the module
+    (Rain Runoff with FlowModel 0 and 1 on two terrains, Snow Deformation,
+    Snow Accumulation, Snow Melt, Water Surface), each output port's every
+    array and the ledger compared (gr_check.digest_all), with times that go
+    back as well as forward.
 """
 import os
 import resource
@@ -21,12 +24,15 @@ import gr_check as T  # noqa: E402
 
 a = T.args()
 
-from vtkmodules.vtkFiltersSources import vtkSphereSource  # noqa: E402
+from vtkmodules.vtkFiltersSources import vtkCubeSource, vtkSphereSource  # noqa: E402
 
 from graupel import (  # noqa: E402
     vtkProceduralTerrainSource,
     vtkRainRunoffFilter,
+    vtkSnowAccumulationFilter,
     vtkSnowDeformationFilter,
+    vtkSnowMeltFilter,
+    vtkWaterSurfaceFilter,
 )
 
 folder = os.path.join(a.scratch, "faults")
@@ -88,12 +94,12 @@ T.check(files == ["run.3.0.vti", "run.json"], "the new checkpoint replaced the o
 again = rain_runoff(terrain(3), RestartFile=manifest)
 T.check(digest(again, 80.0) == reference[80.0], "and it restarts to the uninterrupted run's bits")
 
-# ---- two simulations interleaved on one device ------------------------------
-alone_a = rain_runoff(terrain(5), FlowModel=0)
-alone_b = rain_runoff(terrain(6, 80), FlowModel=1)
+# ---- simulations interleaved on one device ---------------------------------
 sphere = vtkSphereSource()
 sphere.SetRadius(2.0)
 sphere.SetCenter(40.0, 40.0, 0.0)
+box = vtkCubeSource()
+box.SetBounds(20.0, 30.0, 20.0, 36.0, 0.0, 4.0)
 
 
 def snow(t):
@@ -106,21 +112,70 @@ def snow(t):
     return s
 
 
-alone_s = snow(terrain(7, 64))
-times = [20.0, 60.0, 40.0, 100.0, 200.0]
-snow_times = [0.25, 0.75, 0.5, 1.0, 0.25]
-want_a = [digest(alone_a, t) for t in times]
-want_b = [digest(alone_b, t) for t in times]
-want_s = [digest(alone_s, t, ("snow_depth", "snow_density")) for t in snow_times]
-ia, ib, isn = rain_runoff(terrain(5), FlowModel=0), rain_runoff(terrain(6, 80), FlowModel=1), \
-    snow(terrain(7, 64))
-got_a, got_b, got_s = [], [], []
-for k in range(len(times)):
-    got_b.append(digest(ib, times[k]))
-    got_s.append(digest(isn, snow_times[k], ("snow_depth", "snow_density")))
-    got_a.append(digest(ia, times[k]))
-T.check(got_a == want_a and got_b == want_b and got_s == want_s,
-        "interleaved updates give each simulation's own bits (%s %s %s)"
-        % (got_a == want_a, got_b == want_b, got_s == want_s))
-T.check(len(set(want_a)) == len(set(times)), "the times differ (the check can fail)")
+def accumulation(t):
+    s = vtkSnowAccumulationFilter()
+    s.SetInputConnection(t.GetOutputPort())
+    s.SetObjectsConnection(box.GetOutputPort())
+    s.SetSnowfallRate(3.0)
+    s.SetNoiseAmplitude(0.2)
+    s.SetExposureResolution(64)
+    s.SetTimeStep(900.0)
+    s.SetEndTime(4 * 3600.0)
+    s.SetOutputInterval(3600.0)
+    return s
+
+
+def melt(t):
+    s = vtkSnowMeltFilter()
+    s.SetInputConnection(t.GetOutputPort())
+    s.SetInitialSnowDepth(0.5)
+    s.SetAirTemperature(3.0)
+    s.SetCastShadows(1)
+    s.SetEndTime(4 * 86400.0)
+    s.SetOutputInterval(86400.0)
+    return s
+
+
+def water(t):
+    t.Update()
+    low, high = t.GetOutput().GetPointData().GetArray("elevation").GetRange()
+    s = vtkWaterSurfaceFilter()
+    s.SetInputConnection(t.GetOutputPort())
+    s.SetUseLakeLevel(1)
+    s.SetLakeLevel(low + 0.4 * (high - low))
+    s.SetDropRate(0.2)
+    s.SetEndTime(4.0)
+    s.SetOutputInterval(1.0)
+    return s
+
+
+# (name, a maker of the simulation on its own terrain, the times asked, in
+# an order that goes back as well as forward)
+cases = [
+    ("Rain Runoff, FlowModel 0", lambda: rain_runoff(terrain(5), FlowModel=0),
+     [20.0, 60.0, 40.0, 100.0, 200.0]),
+    ("Rain Runoff, FlowModel 1", lambda: rain_runoff(terrain(6, 80), FlowModel=1),
+     [20.0, 60.0, 40.0, 100.0, 200.0]),
+    ("Snow Deformation", lambda: snow(terrain(7, 64)), [0.25, 0.75, 0.5, 1.0, 0.25]),
+    ("Snow Accumulation", lambda: accumulation(terrain(8, 48)),
+     [3600.0, 10800.0, 7200.0, 14400.0, 0.0]),
+    ("Snow Melt", lambda: melt(terrain(9, 48)), [86400.0, 3 * 86400.0, 172800.0, 345600.0,
+                                                 86400.0]),
+    ("Water Surface", lambda: water(terrain(10, 48)), [1.0, 3.0, 2.0, 4.0, 1.0]),
+]
+want = {name: [T.digest_all(make(), t) for t in times] for name, make, times in cases}
+# All of them in one process, each request of one followed by one of the
+# next, in turn (the last simulation updated before each is another one).
+together = [(name, make(), times) for name, make, times in cases]
+caught = T.ErrorCatcher(*[sim for _, sim, _ in together])
+got = {name: [] for name, _, _ in cases}
+for k in range(5):
+    for name, sim, times in reversed(together) if k % 2 else together:
+        got[name].append(T.digest_all(sim, times[k]))
+T.check(not caught.messages, "interleaved: no errors (%s)" % caught.text()[:300])
+for name, _, times in cases:
+    T.check(got[name] == want[name], "interleaved, %s gives its own bits alone (%s)"
+            % (name, [g == w for g, w in zip(got[name], want[name])]))
+    T.check(len(set(want[name])) == len(set(times)),
+            "%s: the times differ (the check can fail)" % name)
 T.finish()
