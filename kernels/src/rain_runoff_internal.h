@@ -39,8 +39,17 @@
  * are built for their tile (GR_SW_TILE_ATTR) it bounds their registers by
  * itself (on the H200 32 for the interior's tiles, 47 for the rim's), so
  * the cap now binds the separate launches and the local inertial kernels
- * (RESULTS.md, "2026-12-01, fourth session"). */
+ * (RESULTS.md, "2026-12-01, fourth session"). A local inertial program is
+ * built without it: its update, its loads all issued before its stores,
+ * took 0.58 ms at 4096^2 uncapped against 0.67 capped (RESULTS.md,
+ * "2026-12-02"). */
 #define GR_RAIN_RUNOFF_NV_REGISTERS 32
+/* The local inertial kernels' work-group on GPUs: 32 x 4 cells, a warp a
+ * row (the runtime's 16 x 16 gives a warp two half rows: the H200's step
+ * at 4096^2 took 1.04 ms with it, 0.70 with 32 x 4 and the update's loads
+ * first). */
+#define GR_RAIN_RUNOFF_LI_GROUP_X 32
+#define GR_RAIN_RUNOFF_LI_GROUP_Y 4
 /* advance re-reads the stable step after 1 to 64 steps (see
  * gr_rain_runoff_advance_impl). */
 #define GR_RAIN_RUNOFF_CHUNK_MIN 1

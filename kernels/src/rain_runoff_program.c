@@ -421,7 +421,7 @@ gr_status gr_rain_runoff_specialise(gr_rain_runoff *s) {
   if (tile[0] > 0)
     len += snprintf(opt + len, sizeof(opt) - (size_t)len, "-DGR_SW_TILE_X=%zu -DGR_SW_TILE_Y=%zu ",
                     tile[0], tile[1]);
-  if (s->nv_registers)
+  if (s->nv_registers && sw)
     snprintf(opt + len, sizeof(opt) - (size_t)len, "-cl-nv-maxrregcount=%d",
              GR_RAIN_RUNOFF_NV_REGISTERS);
   cl_program prog = NULL;

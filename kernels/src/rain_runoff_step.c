@@ -382,17 +382,20 @@ static gr_status gr_rain_runoff_li_launch(gr_rain_runoff *s, int fused, int edge
     st = gr_rain_runoff_arg_at(s, s->update, s->ix_update[a], m, eargs[a + 4]);
   if (st == GR_OK)
     st = gr_rain_runoff_arg_at(s, s->update, s->ix_update[2], sizeof(map_time), &map_time);
+  /* GPUs: a warp a row (GR_RAIN_RUNOFF_LI_GROUP_X); CPUs: the runtime's. */
+  static const size_t li_group[2] = {GR_RAIN_RUNOFF_LI_GROUP_X, GR_RAIN_RUNOFF_LI_GROUP_Y};
+  const size_t *lg = s->gpu ? li_group : NULL;
   if (st == GR_OK)
-    st = gr_enqueue_2d(s->ctx, s->flux, 0, 0, (size_t)s->nxl + 1, (size_t)s->nyl + 1, NULL);
+    st = gr_enqueue_2d(s->ctx, s->flux, 0, 0, (size_t)s->nxl + 1, (size_t)s->nyl + 1, lg);
   /* The edges that are not open, after the flux kernel wrote them so. */
   if (st == GR_OK && edges)
     st = gr_enqueue_1d(s->ctx, s->flux_edges, 2 * ((size_t)s->nxl + (size_t)s->nyl));
   if (st == GR_OK)
     s->cur = now; /* the flux kernel is enqueued: the new faces are current */
   if (st == GR_OK)
-    st = gr_enqueue_2d(s->ctx, s->limit, 0, 0, (size_t)s->nxl, (size_t)s->nyl, NULL);
+    st = gr_enqueue_2d(s->ctx, s->limit, 0, 0, (size_t)s->nxl, (size_t)s->nyl, lg);
   if (st == GR_OK)
-    st = gr_enqueue_2d(s->ctx, s->update, 0, 0, (size_t)s->nxl, (size_t)s->nyl, NULL);
+    st = gr_enqueue_2d(s->ctx, s->update, 0, 0, (size_t)s->nxl, (size_t)s->nyl, lg);
   return st;
 }
 
