@@ -9,8 +9,11 @@
 #include "vtkAlgorithm.h"
 #include "vtkCallbackCommand.h"
 #include "vtkCommand.h"
+#include "vtkGraupelAlgorithm.h"
 #include "vtkNew.h"
+#include "vtkPVSession.h"
 #include "vtkSMProxy.h"
+#include "vtkSMSession.h"
 #include "vtkWeakPointer.h"
 
 #include <QAbstractButton>
@@ -42,9 +45,8 @@ void AbortAgain(vtkObject *caller, unsigned long, void *, void *) {
   }
 }
 
-bool IsBuiltin() {
-  pqServer *server = pqApplicationCore::instance()->getActiveServer();
-  return server && !server->isRemote();
+pqServer *ActiveServer() {
+  return pqApplicationCore::instance()->getActiveServer();
 }
 
 // For the GUI test (Testing/Python/check_gui_plugin.py): with
@@ -179,10 +181,12 @@ void pqGraupelAbortStarter::onSourceAdded(pqPipelineSource *source) {
 }
 
 void pqGraupelAbortStarter::onProgressStart() {
-  if (this->Active || !IsBuiltin()) {
+  pqServer *server = ActiveServer();
+  if (this->Active || !server) {
     return;
   }
   this->Active = true;
+  this->Remote = server->isRemote();
   // Only an algorithm that reports progress in this update is aborted.
   LastProgressing = nullptr;
   QApplication::instance()->installEventFilter(this);
@@ -219,10 +223,14 @@ void pqGraupelAbortStarter::onProgress(const QString &text, int percent) {
   // crashed (Testing/Python/check_gui_docks.py).
   // Terrain Surface (a polydata filter of the plugin) too, except while the
   // look adds one: that update runs inside a timer's handler.
-  if (!LastProgressing ||
-      !(LastProgressing->IsA("vtkGraupelAlgorithm") ||
-        LastProgressing->IsA("vtkTerrainSurfaceFilter")) ||
-      pqGraupelApplyLook::busy()) {
+  // With a remote server the algorithms run there: a Graupel simulation's
+  // progress says "<Simulation>: t = 1200 s of 3600 s".
+  const bool graupel =
+      this->Remote
+          ? text.contains(QLatin1String(": t = ")) && text.contains(QLatin1String(" s of "))
+          : LastProgressing && (LastProgressing->IsA("vtkGraupelAlgorithm") ||
+                                LastProgressing->IsA("vtkTerrainSurfaceFilter"));
+  if (!graupel || pqGraupelApplyLook::busy()) {
     return;
   }
   if (!this->TestArmed && text.contains(QLatin1String(" s of "))) {
@@ -250,6 +258,15 @@ void pqGraupelAbortStarter::releaseAbort() {
 }
 
 void pqGraupelAbortStarter::onAbort() {
+  if (this->Active && this->Remote) {
+    // The server's Graupel update listens for this (Filters/GraupelRemoteAbort.h).
+    pqServer *server = ActiveServer();
+    vtkSMSession *session = server ? server->session() : nullptr;
+    if (session) {
+      vtkGraupelAlgorithm::SendRemoteAbort(session->GetController(vtkPVSession::DATA_SERVER_ROOT));
+    }
+    return;
+  }
   if (this->Active && LastProgressing) {
     Aborted = LastProgressing;
     Aborted->SetAbortExecuteAndUpdateTime();

@@ -74,7 +74,8 @@ private:
   void releaseAbort();
 
   Q_DISABLE_COPY(pqGraupelAbortStarter)
-  bool Active = false;     // a builtin update shows progress now
+  bool Active = false;     // an update shows progress now
+  bool Remote = false;     // ... on a remote server
   bool Processing = false; // inside our processEvents
   bool TestArmed = false;  // GRAUPEL_GUI_TEST_ABORT_MS looked at
 };
