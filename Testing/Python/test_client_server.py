@@ -90,7 +90,8 @@ print("DRIFT", repr([drift.FieldData[n].GetRange()[0] for n in
       ("stored_volume_terrain", "stored_volume_objects", "shed_volume", "dropped_volume")]),
       flush=True)
 """ % {"res": SPHERE_RES}
-CONNECT = r"""
+# Every client: connect to the server (it may still be starting).
+REACH = r"""
 import os, signal, sys, time
 from paraview.simple import *
 from paraview import servermanager
@@ -101,6 +102,8 @@ for k in range(150):
         break
     except Exception:
         time.sleep(0.2)
+"""
+CONNECT = REACH + r"""
 print("RANKS", servermanager.ActiveConnection.GetNumberOfDataPartitions(), flush=True)
 LoadPlugin(PLUGIN, remote=True, ns=globals())
 LoadPlugin(PLUGIN, remote=False, ns=globals())
@@ -159,17 +162,7 @@ print("LEDGER", repr([rain.FieldData[n].GetRange()[0] for n in
 Disconnect()
 """
 # Loaded at start on both sides from the build's plugin configuration file.
-CONFIGURED = r"""
-import sys, time
-from paraview.simple import *
-from paraview import servermanager
-port = int(sys.argv[1])
-for k in range(150):
-    try:
-        Connect("localhost", port)
-        break
-    except Exception:
-        time.sleep(0.2)
+CONFIGURED = REACH + r"""
 terrain = ProceduralTerrain(Dimensions=[40, 30])
 rain = RainRunoff(Input=terrain, EndTime=60.0, OutputInterval=60.0)
 rain.UpdatePipeline(60.0)
