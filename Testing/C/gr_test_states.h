@@ -95,7 +95,7 @@ static gr_mesh gr_state_box_at(double x, double y, double z) {
 /* ------------------------------------------------------------- the set-up */
 
 static gr_status gr_state_make_rain_runoff(gr_context *ctx, void **out) {
-  const gr_grid g = {GR_STATE_NX, GR_STATE_NY, 5.0, 5.0, 0.0, 0.0, 0, 0};
+  const gr_grid g = {GR_STATE_NX, GR_STATE_NY, 5.0, 5.0, 0.0, 0.0, 0, 0, 0, 0, 0};
   float z[GR_STATE_CELLS];
   for (int c = 0; c < GR_STATE_CELLS; ++c)
     z[c] = (float)(0.05 * (c % GR_STATE_NX) + 0.3 * sin(0.7 * (c / GR_STATE_NX)));
@@ -113,7 +113,7 @@ static gr_status gr_state_make_rain_runoff(gr_context *ctx, void **out) {
 }
 
 static gr_status gr_state_make_snow_accumulation(gr_context *ctx, void **out) {
-  const gr_grid g = {GR_STATE_NX, GR_STATE_NY, 0.2, 0.2, 0.0, 0.0, 0, 0};
+  const gr_grid g = {GR_STATE_NX, GR_STATE_NY, 0.2, 0.2, 0.0, 0.0, 0, 0, 0, 0, 0};
   float z[GR_STATE_CELLS];
   for (int c = 0; c < GR_STATE_CELLS; ++c)
     z[c] = (float)(0.2 * sin(0.9 * (c % GR_STATE_NX)) * cos(0.5 * (c / GR_STATE_NX)));
@@ -136,7 +136,7 @@ static gr_status gr_state_make_snow_accumulation(gr_context *ctx, void **out) {
 }
 
 static gr_status gr_state_make_snow_deformation(gr_context *ctx, void **out) {
-  const gr_grid g = {GR_STATE_NX, GR_STATE_NY, 0.1, 0.1, 0.0, 0.0, 0, 0};
+  const gr_grid g = {GR_STATE_NX, GR_STATE_NY, 0.1, 0.1, 0.0, 0.0, 0, 0, 0, 0, 0};
   float z[GR_STATE_CELLS], d[GR_STATE_CELLS];
   for (int c = 0; c < GR_STATE_CELLS; ++c) {
     z[c] = (float)(0.02 * (c % GR_STATE_NX));
@@ -161,7 +161,7 @@ static gr_status gr_state_make_snow_deformation(gr_context *ctx, void **out) {
 }
 
 static gr_status gr_state_make_snow_melt(gr_context *ctx, void **out) {
-  const gr_grid g = {GR_STATE_NX, GR_STATE_NY, 25.0, 25.0, 0.0, 0.0, 0, 0};
+  const gr_grid g = {GR_STATE_NX, GR_STATE_NY, 25.0, 25.0, 0.0, 0.0, 0, 0, 0, 0, 0};
   float z[GR_STATE_CELLS], d[GR_STATE_CELLS], rho[GR_STATE_CELLS];
   for (int c = 0; c < GR_STATE_CELLS; ++c) {
     z[c] = (float)(1200.0 + 100.0 * sin(0.4 * (c % GR_STATE_NX)) + 10.0 * (c / GR_STATE_NX));
@@ -190,7 +190,7 @@ static gr_status gr_state_make_snow_melt(gr_context *ctx, void **out) {
 }
 
 static gr_status gr_state_make_water_surface(gr_context *ctx, void **out) {
-  const gr_grid g = {GR_STATE_NX, GR_STATE_NY, 0.5, 0.5, 0.0, 0.0, 0, 0};
+  const gr_grid g = {GR_STATE_NX, GR_STATE_NY, 0.5, 0.5, 0.0, 0.0, 0, 0, 0, 0, 0};
   float z[GR_STATE_CELLS], h[GR_STATE_CELLS];
   for (int c = 0; c < GR_STATE_CELLS; ++c) {
     double x = (c % GR_STATE_NX - 0.5 * (GR_STATE_NX - 1)) / (0.5 * GR_STATE_NX);

@@ -10,6 +10,9 @@
  *     them) each place is refused by one of the two, so every float is
  *     checked to be finite and every int64 not to be negative before
  *     anything is loaded;
+ *   - the largest int64 at every 8-byte place of those 2048 bytes: a state
+ *     that loads steps and keeps a ledger (a step count of 2^63 - 1 was
+ *     loaded, and the next step overflowed it: fuzz_state_load);
  *   - every refusal is a sentence and leaves
  *     the state as it was: state_save gives the valid bytes back, and the
  *     simulation steps on from them to the valid state one step on, bit for
@@ -94,6 +97,29 @@ static int sweep(const gr_state_core *c, int width, unsigned char *buf, unsigned
   return bad;
 }
 
+/* The largest int64 at every 8-byte place of the first HEADER_ROOM bytes
+ * (a header's counts and sums): a state that loads must step, and keep a
+ * ledger, without overflowing (the sanitizer build traps on it). Returns
+ * the places where it loaded and then did not step. */
+static int huge_counts(const gr_state_core *c, unsigned char *buf) {
+  const int64_t big = INT64_MAX;
+  int bad = 0;
+  for (size_t at = 0; at + 8 <= HEADER_ROOM && at + 8 <= c->bytes; at += 8) {
+    memcpy(buf, c->valid, c->bytes);
+    memcpy(buf + at, &big, 8);
+    gr_status st = c->load(c->sim, buf, c->bytes);
+    if (st != GR_OK) {
+      bad += !refused_with_sentence(c, st);
+      continue;
+    }
+    gr_status stepped = c->step(c->sim);
+    bad += (stepped != GR_OK && !refused_with_sentence(c, stepped)) ||
+           (c->ledger(c->sim) != GR_OK && !refused_with_sentence(c, GR_ERR_FORMAT));
+    bad += c->load(c->sim, c->valid, c->bytes) != GR_OK;
+  }
+  return bad;
+}
+
 static void check_core(int k) {
   gr_state_core *c = &cores[k];
   if (!made || !c->sim) {
@@ -128,7 +154,7 @@ static void check_core(int k) {
   }
   CHECK(intact(c, back, 1));
 
-  int bad = sweep(c, 4, buf, back, refused) + sweep(c, 8, buf, back, refused);
+  int bad = sweep(c, 4, buf, back, refused) + sweep(c, 8, buf, back, refused) + huge_counts(c, buf);
   CHECK_MSG(bad == 0, "%s: %d refusals without a sentence or with the state changed", c->name, bad);
   size_t open = 0, first_open = 0, floats = 0, wides = 0;
   for (size_t p = HEADER_ROOM / 4; p < c->bytes / 4; ++p) {

@@ -284,10 +284,10 @@ static gr_status gr_rain_runoff_state_load_impl(gr_rain_runoff *s, const void *h
   /* The rain's sums stay below 2^109 and 2^125 (gr_rain_runoff_rain_book);
    * the initial water's words below 2^62 (graupel/reduce.h's bounds). */
   const int64_t rain_top = INT64_C(1) << 61, initial_top = INT64_C(1) << 62;
-  if (!(hd.time >= 0.0 && hd.time < HUGE_VAL) || hd.steps < 0 || hd.rain_hi[0] < 0 ||
-      hd.rain_hi[0] > rain_top || hd.rain_hi[1] < -rain_top || hd.rain_hi[1] > rain_top ||
-      hd.initial[0] < -initial_top || hd.initial[0] > initial_top || hd.initial[1] < -initial_top ||
-      hd.initial[1] > initial_top)
+  if (!(hd.time >= 0.0 && hd.time < HUGE_VAL) || hd.steps < 0 || hd.steps > GR_STATE_MAX_STEPS ||
+      hd.rain_hi[0] < 0 || hd.rain_hi[0] > rain_top || hd.rain_hi[1] < -rain_top ||
+      hd.rain_hi[1] > rain_top || hd.initial[0] < -initial_top || hd.initial[0] > initial_top ||
+      hd.initial[1] < -initial_top || hd.initial[1] > initial_top)
     return gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
                         "The rain runoff state's header is damaged (time %g s, %lld steps): "
                         "pass the bytes gr_rain_runoff_state_save wrote.",

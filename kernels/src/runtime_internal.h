@@ -7,6 +7,7 @@
 #include "graupel/runtime.h"
 
 #include <stddef.h>
+#include <stdint.h>
 
 /* How gr_params_check_table words a refused row. */
 typedef enum gr_param_wording {
@@ -45,6 +46,11 @@ gr_status gr_params_missing(const char *what, char *msg, size_t msg_len);
  * Otherwise a sentence goes to msg (when msg and msg_len). */
 gr_status gr_grid_piece_check(const gr_grid *g, const char *core, int need, const char *need_for,
                               int origin_checked, int ring[4], char *msg, size_t msg_len);
+
+/* The most steps a saved state may count: every core adds to its count as
+ * it steps (an int64; 2^53 also keeps it exact as the double the ledgers
+ * give). */
+#define GR_STATE_MAX_STEPS (INT64_C(1) << 53)
 
 /* A part of a saved state (gr_<core>_state_load's bytes) that
  * gr_state_check reads: count values from byte offset, float32 ('f'),

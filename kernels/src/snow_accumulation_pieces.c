@@ -297,7 +297,7 @@ gr_status gr_snow_accumulation_state_load(gr_snow_accumulation *s, const void *h
   /* Every other number finite (the bound of the snow and the time not
    * negative): checked before anything is written, so that a refused state
    * leaves the simulation as it was. */
-  if (!(hd.time >= 0.0 && hd.time < HUGE_VAL) || hd.steps < 0 ||
+  if (!(hd.time >= 0.0 && hd.time < HUGE_VAL) || hd.steps < 0 || hd.steps > GR_STATE_MAX_STEPS ||
       !(hd.snow_bound >= 0.0 && hd.snow_bound < HUGE_VAL) || !isfinite(hd.initial_objects) ||
       !isfinite(hd.retired_fall) || !isfinite(hd.retired_shed) || !isfinite(hd.dropped))
     return GR_SNAC_KEEP_ERROR(

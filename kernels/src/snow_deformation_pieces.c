@@ -336,10 +336,13 @@ gr_status gr_snow_deformation_state_load(gr_snow_deformation *s, const void *hos
    * refused state leaves the simulation as it was. */
   const int gx = s->grid.global_nx > 0 ? s->grid.global_nx : s->grid.nx;
   const int gy = s->grid.global_ny > 0 ? s->grid.global_ny : s->grid.ny;
-  int box_ok = hd.relax_iterations >= 0;
+  const int64_t words_top = INT64_C(1) << 62; /* the ledger's initial words (reduce.h) */
+  int box_ok = hd.relax_iterations >= 0 && hd.initial_q >= -words_top &&
+               hd.initial_q <= words_top && hd.initial_m >= -words_top && hd.initial_m <= words_top;
   for (int q = 0; q < 4; ++q)
     box_ok &= hd.rest[q] >= -(gx + gy + 2) && hd.rest[q] <= gx + gy + 2;
-  if (!(hd.time >= 0.0 && hd.time < HUGE_VAL) || hd.steps < 0 || !box_ok)
+  if (!(hd.time >= 0.0 && hd.time < HUGE_VAL) || hd.steps < 0 || hd.steps > GR_STATE_MAX_STEPS ||
+      !box_ok)
     return GR_SNOW_KEEP_ERROR(
         s, gr_set_error(s->ctx, GR_ERR_FORMAT,
                         "The snow deformation state's header is damaged (time %g s, %lld steps): "

@@ -457,7 +457,7 @@ static gr_status gr_sm_load_impl(gr_snow_melt *s, const void *host, size_t bytes
                         "of the grid (or piece) it was saved from.",
                         (int)hd.nx, (int)hd.ny, (int)hd.j0, bytes, s->grid.nx, s->own_ny,
                         s->grid.j0, need);
-  if (!(hd.time >= 0.0 && hd.time < HUGE_VAL) || hd.steps < 0 ||
+  if (!(hd.time >= 0.0 && hd.time < HUGE_VAL) || hd.steps < 0 || hd.steps > GR_STATE_MAX_STEPS ||
       !(hd.mark_time >= 0.0 && hd.mark_time <= hd.time))
     return gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
                         "The snow melt state's header is damaged (time %g s, %lld steps): pass "

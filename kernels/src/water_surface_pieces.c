@@ -177,7 +177,8 @@ static gr_status gr_ws_load_impl(gr_water_surface *s, const void *host, size_t b
                         "simulation of the grid (or piece) it was saved from.",
                         (int)hd.nx, (int)hd.ny, (int)hd.j0, bytes, s->grid.nx, s->grid.ny,
                         s->grid.j0, need);
-  if (!(hd.time >= 0.0 && hd.time < HUGE_VAL) || hd.steps < 0 || !isfinite(hd.initial_sum))
+  if (!(hd.time >= 0.0 && hd.time < HUGE_VAL) || hd.steps < 0 || hd.steps > GR_STATE_MAX_STEPS ||
+      !isfinite(hd.initial_sum))
     return gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
                         "The water surface state's header is damaged (time %g s, %lld steps): "
                         "pass the bytes gr_water_surface_state_save wrote.",
