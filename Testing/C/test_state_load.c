@@ -13,6 +13,10 @@
  *   - the largest int64 at every 8-byte place of those 2048 bytes: a state
  *     that loads steps and keeps a ledger (a step count of 2^63 - 1 was
  *     loaded, and the next step overflowed it: fuzz_state_load);
+ *   - every float past those bytes 3e38: a state that loads steps and
+ *     keeps a ledger (a huge depth made rain runoff's int64 ledger sums
+ *     overflow on the host, fuzz_state_load found; core.runtime.sums_wrap
+ *     pins the sums themselves);
  *   - every refusal is a sentence and leaves
  *     the state as it was: state_save gives the valid bytes back, and the
  *     simulation steps on from them to the valid state one step on, bit for
@@ -120,6 +124,23 @@ static int huge_counts(const gr_state_core *c, unsigned char *buf) {
   return bad;
 }
 
+/* Every float past the first HEADER_ROOM bytes 3e38 (finite, near the
+ * largest): refused, or loaded and then stepped with a ledger that does
+ * not overflow (the sanitizer build traps on it). 0 when so. */
+static int huge_floats(const gr_state_core *c, unsigned char *buf) {
+  const float big = 3e38f;
+  memcpy(buf, c->valid, c->bytes);
+  for (size_t at = HEADER_ROOM; at + 4 <= c->bytes; at += 4)
+    memcpy(buf + at, &big, 4);
+  gr_status st = c->load(c->sim, buf, c->bytes);
+  if (st != GR_OK)
+    return !refused_with_sentence(c, st);
+  gr_status stepped = c->step(c->sim), kept = c->ledger(c->sim);
+  int bad = (stepped != GR_OK && !refused_with_sentence(c, stepped)) ||
+            (kept != GR_OK && !refused_with_sentence(c, kept));
+  return bad + (c->load(c->sim, c->valid, c->bytes) != GR_OK);
+}
+
 static void check_core(int k) {
   gr_state_core *c = &cores[k];
   if (!made || !c->sim) {
@@ -154,7 +175,8 @@ static void check_core(int k) {
   }
   CHECK(intact(c, back, 1));
 
-  int bad = sweep(c, 4, buf, back, refused) + sweep(c, 8, buf, back, refused) + huge_counts(c, buf);
+  int bad = sweep(c, 4, buf, back, refused) + sweep(c, 8, buf, back, refused) +
+            huge_counts(c, buf) + huge_floats(c, buf);
   CHECK_MSG(bad == 0, "%s: %d refusals without a sentence or with the state changed", c->name, bad);
   size_t open = 0, first_open = 0, floats = 0, wides = 0;
   for (size_t p = HEADER_ROOM / 4; p < c->bytes / 4; ++p) {
