@@ -27,6 +27,7 @@
 
 #include "graupel/checkpoint.h"
 
+#include <algorithm>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
@@ -133,11 +134,12 @@ std::string WriteManifest(const gr_checkpoint &c, const std::string &manifest,
 // The manifest's text, up to one byte more than the core reads (which it
 // then refuses as too large); false if the file cannot be opened or read.
 bool ReadManifestText(const std::string &manifest, std::string &text) {
-  std::ifstream in(manifest, std::ios::binary);
-  if (!in) {
+  std::ifstream in(manifest, std::ios::binary | std::ios::ate);
+  const std::streamoff size = in ? static_cast<std::streamoff>(in.tellg()) : -1;
+  if (size < 0 || !in.seekg(0)) {
     return false;
   }
-  text.resize(GR_CHECKPOINT_MAX_TEXT + 1);
+  text.resize(static_cast<size_t>(std::min<std::streamoff>(size, GR_CHECKPOINT_MAX_TEXT + 1)));
   in.read(&text[0], static_cast<std::streamsize>(text.size()));
   text.resize(static_cast<size_t>(in.gcount()));
   return !in.bad();

@@ -35,8 +35,9 @@
  * or exceeds GR_CHECKPOINT_MAX_TEXT; a key given twice; a key missing or of
  * the wrong type; another format or version; and every value outside the
  * ranges gr_checkpoint documents (gr_checkpoint_validate). The reader never
- * recurses deeper than GR_CHECKPOINT_MAX_DEPTH and allocates only the
- * pieces, at most GR_CHECKPOINT_MAX_RANKS of them.
+ * recurses deeper than GR_CHECKPOINT_MAX_DEPTH; it allocates a table of the
+ * text's values (20 bytes each, at most 2^21 of them, freed before it
+ * returns) and the pieces, at most GR_CHECKPOINT_MAX_RANKS of them.
  *
  * What needs the simulation (its label, its grid, this run's ranks and
  * rows, its output times, the pieces' files and bytes) is checked by the
