@@ -22,10 +22,12 @@
 #include "vtkXMLDataObjectWriter.h"
 #include "vtkXMLGenericDataObjectReader.h"
 #include "vtkXMLWriter.h"
-#include "vtk_jsoncpp.h"
 
 #include "GraupelPieces.h"
 
+#include "graupel/checkpoint.h"
+
+#include <algorithm>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
@@ -95,17 +97,32 @@ std::string WritePiece(vtkXMLWriter *writer, vtkDataObject *output,
   return std::string();
 }
 
-// Writes the manifest's text whole, flushed, then renamed, after every
+// A manifest (graupel/checkpoint.h) that frees its pieces.
+struct Manifest : gr_checkpoint {
+  Manifest() : gr_checkpoint() {}
+  ~Manifest() { gr_checkpoint_free(this); }
+  Manifest(const Manifest &) = delete;
+  Manifest &operator=(const Manifest &) = delete;
+};
+
+// Writes the manifest's text (the core's, every double to the last bit, as
+// the restart compares them) whole, flushed, then renamed, after every
 // piece it names: a reader never sees half a manifest, nor one whose
-// pieces are missing. "" or why not.
-std::string WriteManifest(const Json::Value &root, const std::string &manifest) {
-  // Every double to the last bit (17 digits), as the restart compares them.
-  Json::StreamWriterBuilder builder;
-  builder["indentation"] = "  ";
-  builder["precision"] = 17;
+// pieces are missing. "" or why not; a sentence of the core's (a manifest
+// it would not write) goes to sentence.
+std::string WriteManifest(const gr_checkpoint &c, const std::string &manifest,
+                          std::string &sentence) {
+  char *text = nullptr;
+  size_t len = 0;
+  char msg[1024];
+  if (gr_checkpoint_format(&c, &text, &len, msg, sizeof(msg)) != GR_OK) {
+    sentence = msg;
+    return "its manifest could not be made";
+  }
   const std::string part = manifest + ".part";
   std::ofstream out(part, std::ios::binary | std::ios::trunc);
-  out << Json::writeString(builder, root) << "\n";
+  out.write(text, static_cast<std::streamsize>(len));
+  gr_checkpoint_text_free(text);
   out.close();
   if (!out) {
     std::remove(part.c_str());
@@ -114,13 +131,28 @@ std::string WriteManifest(const Json::Value &root, const std::string &manifest) 
   return Publish(part, manifest) ? std::string() : "the manifest could not be put in place";
 }
 
-// The state bytes of a manifest's piece (beside the manifest, holding as
-// many bytes as the manifest says): "" with bytes filled, or why not.
-std::string ReadPieceState(const Json::Value &piece, const std::string &folder,
+// The manifest's text, up to one byte more than the core reads (which it
+// then refuses as too large); false if the file cannot be opened or read.
+bool ReadManifestText(const std::string &manifest, std::string &text) {
+  std::ifstream in(manifest, std::ios::binary | std::ios::ate);
+  const std::streamoff size = in ? static_cast<std::streamoff>(in.tellg()) : -1;
+  if (size < 0 || !in.seekg(0)) {
+    return false;
+  }
+  text.resize(static_cast<size_t>(std::min<std::streamoff>(size, GR_CHECKPOINT_MAX_TEXT + 1)));
+  in.read(&text[0], static_cast<std::streamsize>(text.size()));
+  text.resize(static_cast<size_t>(in.gcount()));
+  return !in.bad();
+}
+
+// The state bytes of a manifest's piece (beside the manifest: the core
+// refused a name with a folder in it; holding as many bytes as the
+// manifest says): "" with bytes filled, or why not.
+std::string ReadPieceState(const gr_checkpoint_piece &piece, const std::string &folder,
                            std::vector<unsigned char> &bytes) {
-  const std::string file = folder + piece["file"].asString();
+  const std::string file = folder + piece.file;
   std::ostringstream m;
-  if (piece["file"].asString().find('/') != std::string::npos || !std::ifstream(file).good()) {
+  if (!std::ifstream(file).good()) {
     m << "names the piece " << file << ", which could not be opened; keep the pieces "
       << "beside the manifest";
     return m.str();
@@ -135,11 +167,9 @@ std::string ReadPieceState(const Json::Value &piece, const std::string &folder,
   if (!state || state->GetNumberOfComponents() != 1) {
     m << "names the piece " << file
       << ", which holds no state (field array graupel_state); write it again";
-  } else if (!piece["bytes"].isIntegral() ||
-             piece["bytes"].asInt64() != static_cast<Json::Int64>(state->GetNumberOfTuples())) {
+  } else if (piece.bytes != static_cast<long long>(state->GetNumberOfTuples())) {
     m << "names the piece " << file << ", whose state holds " << state->GetNumberOfTuples()
-      << " bytes where the manifest says " << piece["bytes"].asString()
-      << "; it belongs to another checkpoint";
+      << " bytes where the manifest says " << piece.bytes << "; it belongs to another checkpoint";
   } else {
     bytes.assign(state->GetPointer(0), state->GetPointer(0) + state->GetNumberOfTuples());
   }
@@ -252,41 +282,45 @@ int vtkGraupelSimulation::WriteCheckpointFile(vtkDataObject *output) {
   if (why.empty() && table.back() != 0.0) {
     why = "another rank could not write its piece";
   }
+  std::string sentence; // the core's, when it would not write the manifest
   if (why.empty() && rank == 0) {
-    int points[2];
-    GridPoints(vtkImageData::GetData(this->GetInputInformation(0, 0)), points);
-    if (!split) {
-      table[1] = points[1] - 1;
+    Manifest m;
+    char msg[1024];
+    if (gr_checkpoint_init(&m, ranks, msg, sizeof(msg)) != GR_OK) {
+      why = std::string("its manifest could not be made (") + msg + ")";
+    } else {
+      std::snprintf(m.simulation, sizeof(m.simulation), "%s", label.c_str());
+      std::snprintf(m.class_name, sizeof(m.class_name), "%s", this->GetClassName());
+      m.output_index = this->StateIndex;
+      m.time = this->StateTime;
+      m.output_interval = this->OutputInterval;
+      if (vtkDataArray *steps = output->GetFieldData()->GetArray("steps")) {
+        m.has_steps = 1;
+        m.steps = steps->GetTuple1(0);
+      }
+      GridPoints(vtkImageData::GetData(this->GetInputInformation(0, 0)), m.grid);
+      if (!split) {
+        table[1] = m.grid[1] - 1;
+      }
+      m.split = split ? 1 : 0;
+      for (int r = 0; r < ranks; ++r) {
+        const size_t q = 3 * static_cast<size_t>(r);
+        gr_checkpoint_piece &piece = m.pieces[r];
+        piece.rows[0] = static_cast<int>(table[q]);
+        piece.rows[1] = static_cast<int>(table[q + 1]);
+        std::snprintf(piece.file, sizeof(piece.file), "%s",
+                      PieceName(stem, index, r, extension).c_str());
+        piece.bytes = static_cast<long long>(table[q + 2]);
+      }
+      why = WriteManifest(m, manifest, sentence);
     }
-    Json::Value root(Json::objectValue);
-    root["format"] = "graupel-checkpoint";
-    root["version"] = 1;
-    root["simulation"] = label;
-    root["class"] = this->GetClassName();
-    root["output_index"] = this->StateIndex;
-    root["time"] = this->StateTime;
-    root["output_interval"] = this->OutputInterval;
-    if (vtkDataArray *steps = output->GetFieldData()->GetArray("steps")) {
-      root["steps"] = steps->GetTuple1(0);
-    }
-    root["grid"].append(points[0]);
-    root["grid"].append(points[1]);
-    root["split"] = split;
-    root["ranks"] = ranks;
-    Json::Value &list = root["pieces"] = Json::Value(Json::arrayValue);
-    for (int r = 0; r < ranks; ++r) {
-      const size_t q = 3 * static_cast<size_t>(r);
-      Json::Value piece(Json::objectValue);
-      piece["rank"] = r;
-      piece["rows"].append(static_cast<Json::Int64>(table[q]));
-      piece["rows"].append(static_cast<Json::Int64>(table[q + 1]));
-      piece["file"] = PieceName(stem, index, r, extension);
-      piece["bytes"] = static_cast<Json::Int64>(table[q + 2]);
-      list.append(piece);
-    }
-    why = WriteManifest(root, manifest);
   }
   const bool failed = pieces.AnyRank(!why.empty());
+  if (failed && !sentence.empty()) {
+    vtkErrorMacro(<< label << " could not write its CheckpointFile " << manifest << ": "
+                  << sentence);
+    return 0;
+  }
   if (failed) {
     vtkErrorMacro(<< label << " could not write its CheckpointFile " << manifest << ": "
                   << (why.empty() ? std::string("another rank could not write its part") : why)
@@ -312,88 +346,76 @@ int vtkGraupelSimulation::ReadRestartFile() {
   const std::string manifest = this->RestartFile;
   std::string folder, stem;
   SplitManifestPath(manifest, folder, stem);
-  std::string why;
+  std::string why;      // said after "<label>'s RestartFile <manifest> "
+  std::string sentence; // or the core's whole sentence on the manifest
   std::vector<unsigned char> bytes;
   int index = -1;
 
-  Json::Value root;
-  {
-    std::ifstream in(manifest, std::ios::binary);
-    Json::CharReaderBuilder builder;
-    std::string errors;
-    if (!in) {
-      why = "could not be opened; give the .json a CheckpointFile wrote";
-    } else if (!Json::parseFromStream(builder, in, &root, &errors) || !root.isObject() ||
-               root.get("format", "").asString() != "graupel-checkpoint") {
-      why = "is not a Graupel checkpoint manifest; give the .json a CheckpointFile wrote";
-    }
-  }
-  auto integer = [&root](const char *key) {
-    const Json::Value &v = root[key];
-    return v.isInt() ? v.asInt() : -1;
-  };
-  if (why.empty()) {
-    const std::string simulation = root.get("simulation", "").asString();
-    const Json::Value &grid = root["grid"];
-    const Json::Value &list = root["pieces"];
+  // The manifest's every value checked by the core (graupel/checkpoint.h);
+  // what needs this run (its label, grid, ranks, rows and output times,
+  // the piece's file) checked here.
+  Manifest m;
+  std::string text;
+  char msg[1536];
+  const std::string subject = label + "'s RestartFile " + manifest;
+  if (!ReadManifestText(manifest, text)) {
+    why = "could not be opened; give the .json a CheckpointFile wrote";
+  } else if (gr_checkpoint_parse(text.data(), text.size(), subject.c_str(), &m, msg, sizeof(msg)) !=
+             GR_OK) {
+    sentence = msg;
+  } else {
     int points[2];
     GridPoints(vtkImageData::GetData(this->GetInputInformation(0, 0)), points);
-    const int wroteRanks = integer("ranks");
-    const bool wroteSplit = root.get("split", false).asBool();
-    index = integer("output_index");
-    const double time = root.get("time", -1.0).asDouble();
-    const double interval = root.get("output_interval", 0.0).asDouble();
-    std::ostringstream m;
-    if (simulation != label) {
-      m << "was written by " << (simulation.empty() ? "another program" : simulation) << ", not "
-        << label << "; give a checkpoint of this simulation";
-    } else if (!grid.isArray() || grid.size() != 2 || !grid[0].isInt() || !grid[1].isInt() ||
-               grid[0].asInt() != points[0] || grid[1].asInt() != points[1]) {
-      m << "holds a grid of " << (grid.isArray() && grid.size() == 2 ? grid[0].asString() : "?")
-        << " x " << (grid.isArray() && grid.size() == 2 ? grid[1].asString() : "?")
-        << " points, but the Input has " << points[0] << " x " << points[1]
-        << "; restart with the terrain it was written with";
-    } else if (wroteRanks != ranks || wroteSplit != split) {
+    index = m.output_index;
+    std::ostringstream say;
+    if (m.simulation != label) {
+      say << "was written by " << (m.simulation[0] ? m.simulation : "another program") << ", not "
+          << label << "; give a checkpoint of this simulation";
+    } else if (m.grid[0] != points[0] || m.grid[1] != points[1]) {
+      say << "holds a grid of " << m.grid[0] << " x " << m.grid[1] << " points, but the Input has "
+          << points[0] << " x " << points[1] << "; restart with the terrain it was written with";
+    } else if (m.ranks != ranks || (m.split != 0) != split) {
       auto says = [](int n, bool s) {
         return s ? "split over " + std::to_string(n) + " ranks" : std::string("whole on one rank");
       };
-      m << "was written " << says(wroteRanks, wroteSplit) << " and this run is "
-        << says(ranks, split) << "; restart it on "
-        << (wroteSplit ? std::to_string(wroteRanks) + " ranks (mpiexec -n " +
-                             std::to_string(wroteRanks) + ")"
-                       : std::string("one process"));
-    } else if (index < 0 || index >= this->GetNumberOfOutputTimes() ||
-               this->GetOutputTime(index) != time || interval != this->OutputInterval) {
-      m << "was written at t = " << time << " s (output " << index << ", OutputInterval "
-        << interval << " s), which is not an output time of this run (OutputInterval "
-        << this->OutputInterval << " s, EndTime " << this->EndTime
-        << " s); restart with the output times it was written with";
-    } else if (!list.isArray() || static_cast<int>(list.size()) != ranks ||
-               !list[rank].isObject() || !list[rank]["rows"].isArray() ||
-               list[rank]["rows"].size() != 2 || !list[rank]["file"].isString()) {
-      m << "lists no piece for rank " << rank << "; give the .json a CheckpointFile wrote";
+      say << "was written " << says(m.ranks, m.split != 0) << " and this run is "
+          << says(ranks, split) << "; restart it on "
+          << (m.split
+                  ? std::to_string(m.ranks) + " ranks (mpiexec -n " + std::to_string(m.ranks) + ")"
+                  : std::string("one process"));
+    } else if (index >= this->GetNumberOfOutputTimes() || this->GetOutputTime(index) != m.time ||
+               m.output_interval != this->OutputInterval) {
+      say << "was written at t = " << m.time << " s (output " << index << ", OutputInterval "
+          << m.output_interval << " s), which is not an output time of this run (OutputInterval "
+          << this->OutputInterval << " s, EndTime " << this->EndTime
+          << " s); restart with the output times it was written with";
     } else {
-      const Json::Value &piece = list[rank];
-      const int lo = piece["rows"][0].asInt(), hi = piece["rows"][1].asInt();
+      // The core checked that there is one piece per rank, in rank order.
+      const gr_checkpoint_piece &piece = m.pieces[rank];
       const int ownLo = split ? pieces.GetOwnFirstRow() : 0;
       const int ownHi = split ? ownLo + pieces.GetOwnRows() - 1 : points[1] - 1;
-      if (lo != ownLo || hi != ownHi) {
-        m << "gives rank " << rank << " the rows " << lo << " to " << hi
-          << ", and this run gives it " << ownLo << " to " << ownHi
-          << "; restart with the terrain and ranks it was written with";
+      if (piece.rows[0] != ownLo || piece.rows[1] != ownHi) {
+        say << "gives rank " << rank << " the rows " << piece.rows[0] << " to " << piece.rows[1]
+            << ", and this run gives it " << ownLo << " to " << ownHi
+            << "; restart with the terrain and ranks it was written with";
       } else {
-        m << ReadPieceState(piece, folder, bytes);
+        say << ReadPieceState(piece, folder, bytes);
       }
     }
-    why = m.str();
+    why = say.str();
   }
-  if (why.empty() && !this->LoadState(bytes)) {
-    why = "holds a state that does not fit this simulation; restart with the inputs and "
-          "properties it was written with";
+  if (why.empty() && sentence.empty() && !this->LoadState(bytes)) {
+    why = "holds a state that this simulation does not take (a damaged piece, or one saved "
+          "with other inputs or properties); restart with an intact checkpoint and the inputs "
+          "and properties it was written with";
   }
-  const bool failed = pieces.AnyRank(!why.empty());
+  const bool failed = pieces.AnyRank(!why.empty() || !sentence.empty());
+  if (failed && !sentence.empty()) {
+    vtkErrorMacro(<< sentence);
+    return 0;
+  }
   if (failed) {
-    vtkErrorMacro(<< label << "'s RestartFile " << manifest << " "
+    vtkErrorMacro(<< subject << " "
                   << (why.empty() ? std::string("could not be read by another rank") : why) << ".");
     return 0;
   }

@@ -904,6 +904,45 @@ static void test_fixed_point(void) {
   CHECK(got_w.lo == want_w.lo && got_w.hi == want_w.hi);
 }
 
+/* Integer sums beyond reduce.h's bounds wrap modulo 2^64 on the host as on
+ * the device, never overflow (the sanitizer build traps on an overflow): a
+ * damaged checkpoint's huge depths made rain runoff's ledger add two
+ * partial sums of 2^62 (fuzz_state_load). */
+static void test_sums_wrap(void) {
+  const long long quarter = 1ll << 62;
+  gr_fixed f = {quarter, quarter};
+  gr_fixed_add(&f, f);
+  CHECK(f.coarse == INT64_MIN && f.fine == INT64_MIN);
+  gr_fixed_add(&f, f);
+  CHECK(f.coarse == 0 && f.fine == 0);
+  gr_context *ctx = NULL;
+  CHECK(gr_context_create(NULL, &ctx) == GR_OK);
+  if (!ctx)
+    return;
+  /* Every group's partial sum is 2^62. */
+  const char *src = "__kernel void quarters(__global long *partial, __local long *scratch) {"
+                    " if (get_local_id(0) == 0) partial[get_group_id(0)] = 1L << 62; }";
+  cl_program prog = NULL;
+  cl_kernel k = NULL;
+  gr_reduction_i64 r;
+  memset(&r, 0, sizeof(r));
+  CHECK(gr_program_build_source(ctx, src, NULL, &prog) == GR_OK);
+  if (prog)
+    CHECK(gr_kernel_create(ctx, prog, "quarters", &k) == GR_OK);
+  if (k && gr_reduction_i64_init(ctx, k, 1u << 16, 1, &r) == GR_OK) {
+    long long sum = 0;
+    CHECK(gr_reduction_i64_run(ctx, &r, k, &sum) == GR_OK);
+    const unsigned long long want = (unsigned long long)r.groups << 62;
+    CHECK_MSG(r.groups >= 2 && sum == (long long)want, "%zu groups: %lld", r.groups, sum);
+  }
+  gr_reduction_i64_release(&r);
+  if (k)
+    clReleaseKernel(k);
+  if (prog)
+    clReleaseProgram(prog);
+  gr_context_release(ctx);
+}
+
 static const gr_subtest tests[] = {
     {"no_platform", test_no_platform, 1}, /* only with OCL_ICD_VENDORS at an empty folder */
     {"names", test_names, 0},
@@ -918,6 +957,7 @@ static const gr_subtest tests[] = {
     {"mesh_memo", test_mesh_memo, 0},
     {"points", test_points, 0},
     {"fixed_point", test_fixed_point, 0},
+    {"sums_wrap", test_sums_wrap, 0},
     {"memcheck", test_memcheck, 1}, /* what valgrind runs */
 };
 

@@ -8,12 +8,18 @@ with RestartFile set to it, asked for output 2k, starts from output k (its
 RestartIndex) and gives, on every rank, the fields, the ledger (and Rain
 Runoff's hydrograph) of an uninterrupted run to 2k bit for bit. A manifest
 that says another number of ranks, one of another simulation, or one whose
-piece is gone, and a CheckpointFile that cannot be written, are refused
-with one sentence and an empty output."""
+piece is gone, manifests tampered with (a NaN time, a piece's file outside
+the folder, text cut short, another version, rows beyond the grid), a
+piece whose state holds a NaN, and a CheckpointFile that cannot be written,
+are refused with one sentence and an empty output."""
 import builtins
 import json
 import os
 import sys
+
+import numpy as np
+from vtkmodules.util.numpy_support import vtk_to_numpy
+from vtkmodules.vtkIOXML import vtkXMLImageDataReader, vtkXMLImageDataWriter
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import gr_check as T  # noqa: E402
@@ -219,6 +225,47 @@ refused("a piece of another size", rain_runoff, sizes, 80.0,
         ["RestartFile", "bytes where the manifest says", "another checkpoint"])
 refused("no manifest", rain_runoff, os.path.join(folder, "nothing.json"), 80.0,
         ["RestartFile", "could not be opened"])
+
+
+# Manifests tampered with, refused by the core's reader (graupel/checkpoint.h)
+# with its one sentence under the filter's subject.
+def write_manifest(name, text):
+    path = os.path.join(folder, name + ".json")
+    with open(path, "w") as f:
+        f.write(text)
+    return path
+
+
+for name, text, words in (
+        ("nan_time", json.dumps(dict(rr, time=float("nan"))), ["gives 'time' as nan"]),
+        ("traversal", json.dumps(dict(rr, pieces=[dict(p, file="../" + p["file"])
+                                                  for p in rr["pieces"]])),
+         ["no file beside the manifest"]),
+        ("cut_short", json.dumps(rr)[:150], ["is not a Graupel checkpoint manifest", "cut short"]),
+        ("version_2", json.dumps(dict(rr, version=2)), ["is of version 2"]),
+        ("rows_beyond", json.dumps(dict(rr, pieces=[dict(p, rows=[p["rows"][0], 104])
+                                                    for p in rr["pieces"]])),
+         ["the rows", "its grid has the rows 0 to 103"])):
+    refused("a manifest tampered with (%s)" % name, rain_runoff, write_manifest(name, text), 80.0,
+            ["Rain Runoff's RestartFile", name + ".json"] + words)
+
+# A piece whose state holds a NaN (a float in the core's arrays): the core's
+# reader refuses it before loading anything.
+poisoned = dict(rr, pieces=[dict(p, file="poisoned_" + p["file"]) for p in rr["pieces"]])
+for p, q in zip(rr["pieces"], poisoned["pieces"]):
+    reader = vtkXMLImageDataReader()
+    reader.SetFileName(os.path.join(folder, p["file"]))
+    reader.Update()
+    image = reader.GetOutput()
+    state = vtk_to_numpy(image.GetFieldData().GetAbstractArray("graupel_state"))
+    state[4096:4100] = np.frombuffer(np.float32(np.nan).tobytes(), np.uint8)
+    writer = vtkXMLImageDataWriter()
+    writer.SetInputData(image)
+    writer.SetFileName(os.path.join(folder, q["file"]))
+    writer.Write()
+refused("a piece whose state holds a NaN", rain_runoff,
+        write_manifest("poisoned", json.dumps(poisoned)), 80.0,
+        ["RestartFile", "holds a state that this simulation does not take", "damaged"])
 # A CheckpointFile in a folder that is not there: one sentence, an empty output.
 nowhere = rain_runoff(CheckpointFile=os.path.join(folder, "no_such_folder", "x.json"))
 errs = T.ErrorCatcher(nowhere.GetClientSideObject())

@@ -281,20 +281,34 @@ static gr_status gr_rain_runoff_state_load_impl(gr_rain_runoff *s, const void *h
                         "The rain runoff state has %zu bytes but a %d x %d simulation's state "
                         "has %zu: pass the whole buffer gr_rain_runoff_state_save filled.",
                         bytes, s->nxl, s->nyl, need);
-  /* The rain's sums stay below 2^109 and 2^125 (gr_rain_runoff_rain_book). */
-  const int64_t rain_top = INT64_C(1) << 61;
-  if (!(hd.time >= 0.0 && hd.time < HUGE_VAL) || hd.steps < 0 || hd.rain_hi[0] < 0 ||
-      hd.rain_hi[0] > rain_top || hd.rain_hi[1] < -rain_top || hd.rain_hi[1] > rain_top)
+  /* The rain's sums stay below 2^109 and 2^125 (gr_rain_runoff_rain_book);
+   * the initial water's words below 2^62 (graupel/reduce.h's bounds). */
+  const int64_t rain_top = INT64_C(1) << 61, initial_top = INT64_C(1) << 62;
+  if (!(hd.time >= 0.0 && hd.time < HUGE_VAL) || hd.steps < 0 || hd.steps > GR_STATE_MAX_STEPS ||
+      hd.rain_hi[0] < 0 || hd.rain_hi[0] > rain_top || hd.rain_hi[1] < -rain_top ||
+      hd.rain_hi[1] > rain_top || hd.initial[0] < -initial_top || hd.initial[0] > initial_top ||
+      hd.initial[1] < -initial_top || hd.initial[1] > initial_top)
     return gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
                         "The rain runoff state's header is damaged (time %g s, %lld steps): "
                         "pass the bytes gr_rain_runoff_state_save wrote.",
                         hd.time, (long long)hd.steps);
+  /* Every float finite, checked before anything is written, so that a
+   * refused state leaves the simulation as it was. */
+  const size_t cells = gr_rain_runoff_cells(s);
+  const gr_state_part parts[] = {
+      {"water depth", sizeof(hd), cells, 'f', -HUGE_VAL, HUGE_VAL},
+      {"per-cell arrays", sizeof(hd) + 4 * cells, (GR_RAIN_RUNOFF_STATE_CELL_ARRAYS - 1) * cells,
+       'f', -HUGE_VAL, HUGE_VAL},
+      {"face discharges", sizeof(hd) + 4 * GR_RAIN_RUNOFF_STATE_CELL_ARRAYS * cells,
+       gr_rain_runoff_xfaces(s) + gr_rain_runoff_yfaces(s), 'f', -HUGE_VAL, HUGE_VAL}};
+  gr_status st = gr_state_check("rain runoff", "rain_runoff", host, parts, 3);
+  if (st != GR_OK)
+    return st;
   /* Into face set 0, which becomes current. */
   const unsigned char *at = (const unsigned char *)host + sizeof(hd);
   cl_mem bufs[GR_RAIN_RUNOFF_STATE_CELL_ARRAYS + 2];
   size_t sizes[GR_RAIN_RUNOFF_STATE_CELL_ARRAYS + 2];
   int n = gr_rain_runoff_state_arrays(s, 0, bufs, sizes);
-  gr_status st = GR_OK;
   for (int i = 0; st == GR_OK && i < n; ++i) {
     st = gr_buffer_write(s->ctx, bufs[i], 0, sizes[i], at);
     at += sizes[i];

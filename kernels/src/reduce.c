@@ -166,6 +166,14 @@ void gr_reduction_release(gr_reduction *r) {
 
 /* ------------------------------------------------------ integer reductions */
 
+/* a + b modulo 2^64, as the devices' integer sums wrap: within the bounds
+ * reduce.h gives it is a + b; beyond them (a damaged or hostile state's
+ * values) the total is wrong but defined, where a signed overflow would
+ * not be. */
+static long long gr_i64_add(long long a, long long b) {
+  return (long long)((unsigned long long)a + (unsigned long long)b);
+}
+
 gr_status gr_reduction_i64_init(gr_context *ctx, cl_kernel k, size_t items, int nsum,
                                 gr_reduction_i64 *r) {
   return gr_reduction_i64_init_max(ctx, k, items, nsum, 0, r);
@@ -230,7 +238,7 @@ gr_status gr_reduction_i64_run_max(gr_context *ctx, gr_reduction_i64 *r, cl_kern
   for (size_t grp = 0; grp < r->groups; ++grp) {
     const long long *p = r->host + (size_t)slots * grp;
     for (int q = 0; q < r->nsum; ++q)
-      sums[q] += p[q];
+      sums[q] = gr_i64_add(sums[q], p[q]);
     for (int q = 0; q < r->nmax; ++q)
       maxes[q] = p[r->nsum + q] > maxes[q] ? p[r->nsum + q] : maxes[q];
   }
@@ -260,8 +268,8 @@ gr_fixed gr_fixed_from_float(float x) {
 }
 
 void gr_fixed_add(gr_fixed *sum, gr_fixed x) {
-  sum->coarse += x.coarse;
-  sum->fine += x.fine;
+  sum->coarse = gr_i64_add(sum->coarse, x.coarse);
+  sum->fine = gr_i64_add(sum->fine, x.fine);
 }
 
 static gr_wide gr_wide_of(long long v) {

@@ -552,3 +552,41 @@ gr_status gr_field_check_range(const char *name, const float *values, size_t n, 
   }
   return GR_OK;
 }
+
+gr_status gr_state_check(const char *core, const char *fn, const void *bytes,
+                         const gr_state_part *parts, int nparts) {
+  for (int k = 0; k < nparts; ++k) {
+    const gr_state_part *p = &parts[k];
+    const size_t width = p->kind == 'f' ? 4 : 8;
+    const unsigned char *at = (const unsigned char *)bytes + p->offset;
+    for (size_t c = 0; c < p->count; ++c, at += width) {
+      double v;
+      long long w = 0;
+      if (p->kind == 'f') {
+        float f;
+        memcpy(&f, at, sizeof(f));
+        v = f;
+      } else if (p->kind == 'd') {
+        memcpy(&v, at, sizeof(v));
+      } else {
+        memcpy(&w, at, sizeof(w));
+        v = (double)w;
+      }
+      if (isfinite(v) && v >= p->lo && v <= p->hi)
+        continue;
+      char value[48], range[96] = "";
+      if (p->kind == 'l')
+        snprintf(value, sizeof(value), "%lld", w);
+      else
+        snprintf(value, sizeof(value), "%g", v);
+      if (p->lo > -HUGE_VAL || p->hi < HUGE_VAL)
+        snprintf(range, sizeof(range), " and from %.9g to %.9g", p->lo, p->hi);
+      return gr_set_error(NULL, GR_ERR_FORMAT,
+                          "The %s state's %s has the value %s at entry %zu of %zu, where every "
+                          "value is finite%s: the bytes are damaged; pass the bytes "
+                          "gr_%s_state_save wrote.",
+                          core, p->name, value, c, p->count, range, fn);
+    }
+  }
+  return GR_OK;
+}

@@ -7,6 +7,7 @@
 #include "graupel/runtime.h"
 
 #include <stddef.h>
+#include <stdint.h>
 
 /* How gr_params_check_table words a refused row. */
 typedef enum gr_param_wording {
@@ -45,5 +46,32 @@ gr_status gr_params_missing(const char *what, char *msg, size_t msg_len);
  * Otherwise a sentence goes to msg (when msg and msg_len). */
 gr_status gr_grid_piece_check(const gr_grid *g, const char *core, int need, const char *need_for,
                               int origin_checked, int ring[4], char *msg, size_t msg_len);
+
+/* The most steps a saved state may count: every core adds to its count as
+ * it steps (an int64; 2^53 also keeps it exact as the double the ledgers
+ * give). */
+#define GR_STATE_MAX_STEPS (INT64_C(1) << 53)
+
+/* A part of a saved state (gr_<core>_state_load's bytes) that
+ * gr_state_check reads: count values from byte offset, float32 ('f'),
+ * float64 ('d') or int64 ('l'), each finite and from lo to hi. */
+typedef struct gr_state_part {
+  const char *name; /* what it holds, for the sentence: "water depth" */
+  size_t offset, count;
+  char kind;
+  double lo, hi;
+} gr_state_part;
+
+/* The check every core's state_load makes before it writes any of the
+ * bytes to the device, so that a refused state leaves the simulation as it
+ * was: every value of every part (which the caller has checked lie within
+ * the bytes; any alignment) finite and within its range. GR_OK, or
+ * GR_ERR_FORMAT with the sentence "The <core> state's <name> has the value
+ * <v> at entry k of n, where every value is finite [and from lo to hi]:
+ * the bytes are damaged; pass the bytes gr_<fn>_state_save wrote." as the
+ * thread's error (gr_set_error). core names the simulation ("rain
+ * runoff"), fn its functions ("rain_runoff"). */
+gr_status gr_state_check(const char *core, const char *fn, const void *bytes,
+                         const gr_state_part *parts, int nparts);
 
 #endif

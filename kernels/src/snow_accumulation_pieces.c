@@ -3,6 +3,7 @@
  * allreduce, the rows and sums across pieces, the halo exchange, and the
  * state's bytes saved and loaded. */
 #include "snow_accumulation_internal.h"
+#include "runtime_internal.h"
 
 /* ------------------------------------------------------ pieces and rows */
 
@@ -293,7 +294,27 @@ gr_status gr_snow_accumulation_state_load(gr_snow_accumulation *s, const void *h
                             (double)v));
     }
   }
-  gr_status st = GR_OK;
+  /* Every other number finite (the bound of the snow and the time not
+   * negative): checked before anything is written, so that a refused state
+   * leaves the simulation as it was. */
+  if (!(hd.time >= 0.0 && hd.time < HUGE_VAL) || hd.steps < 0 || hd.steps > GR_STATE_MAX_STEPS ||
+      !(hd.snow_bound >= 0.0 && hd.snow_bound < HUGE_VAL) || !isfinite(hd.initial_objects) ||
+      !isfinite(hd.retired_fall) || !isfinite(hd.retired_shed) || !isfinite(hd.dropped))
+    return GR_SNAC_KEEP_ERROR(
+        s, gr_set_error(s->ctx, GR_ERR_FORMAT,
+                        "The snow accumulation state's header is damaged (time %g s, %lld "
+                        "steps): pass the bytes gr_snow_accumulation_state_save wrote.",
+                        hd.time, (long long)hd.steps));
+  const size_t off = sizeof(hd), faces = (size_t)s->ntri + (size_t)s->ns;
+  const gr_state_part parts[] = {
+      {"grid arrays", off, GR_SNAC_ARRAYS * gcells, 'f', -HUGE_VAL, HUGE_VAL},
+      {"object arrays", off + GR_SNAC_ARRAYS * gb, GR_SNAC_ARRAYS * faces, 'f', -HUGE_VAL,
+       HUGE_VAL},
+      {"initial snow per row", off + GR_SNAC_ARRAYS * (gb + ob + tb), (size_t)s->own_ny, 'd',
+       -HUGE_VAL, HUGE_VAL}};
+  gr_status st = gr_state_check("snow accumulation", "snow_accumulation", host, parts, 3);
+  if (st != GR_OK)
+    return GR_SNAC_KEEP_ERROR(s, st);
   const char *at = base;
   for (int a = 0; st == GR_OK && a < GR_SNAC_ARRAYS; ++a, at += gb)
     st = gr_buffer_write(s->ctx, s->arr[a], 0, gb, at);

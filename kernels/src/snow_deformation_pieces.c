@@ -330,6 +330,34 @@ gr_status gr_snow_deformation_state_load(gr_snow_deformation *s, const void *hos
                           "damaged; load an intact one.",
                           (double)v));
   }
+  /* The rest of the arrays and of the header's numbers finite, the
+   * talus's box within reach of the domain (its corners are grown and
+   * compared as ints): checked before anything is written, so that a
+   * refused state leaves the simulation as it was. */
+  const int gx = s->grid.global_nx > 0 ? s->grid.global_nx : s->grid.nx;
+  const int gy = s->grid.global_ny > 0 ? s->grid.global_ny : s->grid.ny;
+  const int64_t words_top = INT64_C(1) << 62; /* the ledger's initial words (reduce.h) */
+  int box_ok = hd.relax_iterations >= 0 && hd.initial_q >= -words_top &&
+               hd.initial_q <= words_top && hd.initial_m >= -words_top && hd.initial_m <= words_top;
+  for (int q = 0; q < 4; ++q)
+    box_ok &= hd.rest[q] >= -(gx + gy + 2) && hd.rest[q] <= gx + gy + 2;
+  if (!(hd.time >= 0.0 && hd.time < HUGE_VAL) || hd.steps < 0 || hd.steps > GR_STATE_MAX_STEPS ||
+      !box_ok)
+    return GR_SNOW_KEEP_ERROR(
+        s, gr_set_error(s->ctx, GR_ERR_FORMAT,
+                        "The snow deformation state's header is damaged (time %g s, %lld steps): "
+                        "pass the bytes gr_snow_deformation_state_save wrote.",
+                        hd.time, (long long)hd.steps));
+  const size_t nd =
+      (offsetof(gr_snow_state_header, impulse_time) - offsetof(gr_snow_state_header, force)) /
+          sizeof(double) +
+      1;
+  const gr_state_part parts[] = {
+      {"overlap and contact", sizeof(hd) + 2 * ab, 2 * gr_snow_cells(s), 'f', -HUGE_VAL, HUGE_VAL},
+      {"volumes", offsetof(gr_snow_state_header, compressed), 4, 'd', -HUGE_VAL, HUGE_VAL},
+      {"forces and impulses", offsetof(gr_snow_state_header, force), nd, 'd', -HUGE_VAL, HUGE_VAL}};
+  if (gr_state_check("snow deformation", "snow_deformation", host, parts, 3) != GR_OK)
+    return GR_SNOW_KEEP_ERROR(s, GR_ERR_FORMAT);
   gr_status st = GR_OK;
   for (int a = 0; st == GR_OK && a < GR_SNOW_STATE_ARRAYS; ++a)
     st = gr_buffer_write(s->ctx, gr_snow_state_array(s, a), 0, ab, base + (size_t)a * ab);

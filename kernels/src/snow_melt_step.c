@@ -457,17 +457,30 @@ static gr_status gr_sm_load_impl(gr_snow_melt *s, const void *host, size_t bytes
                         "of the grid (or piece) it was saved from.",
                         (int)hd.nx, (int)hd.ny, (int)hd.j0, bytes, s->grid.nx, s->own_ny,
                         s->grid.j0, need);
-  if (!(hd.time >= 0.0 && hd.time < HUGE_VAL) || hd.steps < 0 ||
+  if (!(hd.time >= 0.0 && hd.time < HUGE_VAL) || hd.steps < 0 || hd.steps > GR_STATE_MAX_STEPS ||
       !(hd.mark_time >= 0.0 && hd.mark_time <= hd.time))
     return gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
                         "The snow melt state's header is damaged (time %g s, %lld steps): pass "
                         "the bytes gr_snow_melt_state_save wrote.",
                         hd.time, (long long)hd.steps);
+  /* The water's integers not negative (and summable), the densities as
+   * set_field takes them, the radiation finite: checked before anything is
+   * written, so that a refused state leaves the simulation as it was. */
+  const double top = 4611686018427387904.0; /* 2^62 */
+  const size_t n = s->n, o = sizeof(hd);
+  const gr_state_part check[] = {
+      {"frozen water", o, n, 'l', 0.0, top},
+      {"liquid water", o + 8 * n, n, 'l', 0.0, top},
+      {"snow density", o + 16 * n, n, 'f', 0.0, 1000.0},
+      {"radiation", o + 20 * n, n, 'f', -HUGE_VAL, HUGE_VAL},
+      {"accumulators", o + 24 * n, GR_SNOW_MELT_ACCS * n, 'l', 0.0, top}};
+  gr_status st = gr_state_check("snow melt", "snow_melt", host, check, 5);
+  if (st != GR_OK)
+    return st;
   const unsigned char *at = (const unsigned char *)host + sizeof(hd);
   cl_mem bufs[5];
   size_t sizes[5];
   int parts = gr_sm_state_parts(s, bufs, sizes);
-  gr_status st = GR_OK;
   for (int k = 0; st == GR_OK && k < parts; at += sizes[k], ++k)
     st = gr_buffer_write(s->ctx, bufs[k], 0, sizes[k], at);
   if (st != GR_OK)

@@ -10,7 +10,6 @@
 /* set_field's sanity bounds: beyond them float differences overflow. */
 #define GR_WS_MAX_ELEVATION 1.0e6
 #define GR_WS_MAX_DEPTH 1.0e4
-#define GR_WS_MAX_WAVE 1.0e4
 
 /* The parameter table's rows, in gr_water_surface_param_bounds' order. */
 enum {

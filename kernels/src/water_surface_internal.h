@@ -60,6 +60,9 @@ struct gr_water_surface {
   char error[1024];
 };
 
+/* set_wave's bound on the wave height, which a checkpoint's wave keeps too. */
+#define GR_WS_MAX_WAVE 1.0e4
+
 #define GR_WS_KEEP(s, st) gr_error_keep((s)->error, sizeof((s)->error), (st))
 
 /* The local arrays' points (a piece: own rows and rings). */

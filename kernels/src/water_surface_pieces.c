@@ -177,13 +177,23 @@ static gr_status gr_ws_load_impl(gr_water_surface *s, const void *host, size_t b
                         "simulation of the grid (or piece) it was saved from.",
                         (int)hd.nx, (int)hd.ny, (int)hd.j0, bytes, s->grid.nx, s->grid.ny,
                         s->grid.j0, need);
-  if (!(hd.time >= 0.0 && hd.time < HUGE_VAL) || hd.steps < 0 || !isfinite(hd.initial_sum))
+  if (!(hd.time >= 0.0 && hd.time < HUGE_VAL) || hd.steps < 0 || hd.steps > GR_STATE_MAX_STEPS ||
+      !isfinite(hd.initial_sum))
     return gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
                         "The water surface state's header is damaged (time %g s, %lld steps): "
                         "pass the bytes gr_water_surface_state_save wrote.",
                         hd.time, (long long)hd.steps);
+  /* The wave within set_wave's bounds and its velocity finite, checked
+   * before anything is written, so that a refused state leaves the
+   * simulation as it was. */
+  const gr_state_part parts[] = {
+      {"wave height", sizeof(hd), gr_ws_points(s), 'f', -GR_WS_MAX_WAVE, GR_WS_MAX_WAVE},
+      {"wave velocity", sizeof(hd) + fb, gr_ws_points(s), 'f', -HUGE_VAL, HUGE_VAL}};
+  gr_status st = gr_state_check("water surface", "water_surface", host, parts, 2);
+  if (st != GR_OK)
+    return st;
   const unsigned char *at = (const unsigned char *)host + sizeof(hd);
-  gr_status st = gr_buffer_write(s->ctx, s->h[s->cur], 0, fb, at);
+  st = gr_buffer_write(s->ctx, s->h[s->cur], 0, fb, at);
   if (st == GR_OK)
     st = gr_buffer_write(s->ctx, s->v, 0, fb, at + fb);
   if (st != GR_OK)

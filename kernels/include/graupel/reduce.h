@@ -90,7 +90,8 @@ GR_API gr_status gr_reduction_i64_init_max(gr_context *ctx, cl_kernel k, size_t 
 
 /**
  * Runs k (its own arguments already set; this sets `partial` and `scratch`
- * by name), waits, and returns the nsum totals.
+ * by name), waits, and returns the nsum totals (summed modulo 2^64, as the
+ * device sums: beyond the bounds below a total wraps, never overflows).
  */
 GR_API gr_status gr_reduction_i64_run(gr_context *ctx, gr_reduction_i64 *r, cl_kernel k,
                                       long long *sums);
@@ -149,7 +150,7 @@ typedef struct gr_wide {
 /** x as cl/reduce.h's gr_fixed_add adds it on a device (the same integers). */
 GR_API gr_fixed gr_fixed_from_float(float x);
 
-/** *sum += x, word by word (exact). */
+/** *sum += x, word by word (exact within the bounds above; modulo 2^64 beyond them). */
 GR_API void gr_fixed_add(gr_fixed *sum, gr_fixed x);
 
 /** The value of x (coarse 2^30 + fine, exactly, then rounded once to double). */
