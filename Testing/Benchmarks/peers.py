@@ -17,6 +17,15 @@ the depth recorded every 30 min.
   the DEM's rows, columns and resolutions; dx and dy from r.slope.aspect
   (timed apart), rain_value 50, infil_value 0, man_value 0.03, niterations
   180, output_step 30 with -t, a fixed random_seed, nprocs = the cores.
+- ANUGA (the same physics as FlowModel 0: the 2-D shallow-water equations by
+  finite volumes, second order) on Graupel's cells: a mesh whose vertices are
+  the cells' corners, each cell (centred on a DEM point) cut into two
+  triangles that take its elevation (flat, as Graupel's cell is; a mesh on the
+  points themselves smooths each one-point pit into its six triangles), a
+  Rate_operator for the rain, Manning friction, a transmissive boundary on
+  every edge (water leaves where it flows out), its default flow algorithm
+  unless --anuga-algorithm says otherwise; a cell's depth is the mean of its
+  two triangles'.
 - Landlab's OverlandFlow (de Almeida et al. 2012, the scheme of FlowModel 1)
   on a RasterModelGrid with the DEM's own spacings (xy_spacing=(74.5, 92.1):
   Landlab's raster grid allows rectangular cells; its step uses the shorter;
@@ -34,7 +43,9 @@ all it waited for (on a shared machine they move less with the load).
     python3 Testing/Benchmarks/peers.py --build build-vtk --out /tmp/peers  # + depth fields
     python3 Testing/Benchmarks/peers.py --build build-vtk --profile  # where Graupel's time goes
 
-`--only graupel,grass,landlab` picks runs; `--hours`, `--rain`, `--manning`,
+`--only graupel,grass,landlab,anuga` picks runs (ANUGA, whose run takes the longest, only when
+named); `--core-lib DIR` runs Graupel with the core library in DIR (a `core` preset's
+build-core/kernels) in place of the build tree's; `--hours`, `--rain`, `--manning`,
 `--max-time-step` change the scenario (MaxTimeStep is Graupel's; its default, 3600 s, is no
 cap). Not part of the test command: its figures go in RESULTS.md.
 """
@@ -61,6 +72,14 @@ def log(*a):
 
 # ---------------------------------------------------------------- install
 
+def install_anuga(venv):
+    """ANUGA from PyPI (a wheel for Python 3.11) into a venv of its own."""
+    py = os.path.join(venv, "bin", "python3")
+    if not os.path.exists(py):
+        subprocess.check_call([sys.executable, "-m", "venv", venv])
+    subprocess.check_call([py, "-m", "pip", "install", "-q", "anuga"])
+
+
 def install(venv):
     """grass-core from Debian (as root), landlab from PyPI into a venv of its
     own: landlab pulls a numpy 2 that Debian's VTK 9.1 must not see."""
@@ -81,6 +100,21 @@ def install(venv):
 
 
 # ---------------------------------------------------------------- workers
+
+def read_dem(a):
+    """The DEM worker_dem wrote: its elevations (row 0 south) and spacings."""
+    import numpy as np
+    dem = np.load(os.path.join(a.work, "dem.npz"))
+    return dem["elevation"], float(dem["dx"]), float(dem["dy"])
+
+
+def save(a, res, depth):
+    """A worker's result: its figures (RESULT.json) and final depths (RESULT.npz)."""
+    import numpy as np
+    np.savez(a.result + ".npz", depth=depth)
+    with open(a.result + ".json", "w") as fp:
+        json.dump(res, fp)
+
 
 def worker_dem(a):
     """Reads the EXR with Graupel's reader and writes dem.npz (row 0 south)."""
@@ -107,6 +141,9 @@ def worker_graupel(a):
     from vtkmodules.util.numpy_support import vtk_to_numpy
     from graupel import vtkEXRHeightFieldReader, vtkRainRunoffFilter
     t_import = time.perf_counter() - t0
+    with open("/proc/self/maps") as fp:  # which core library runs (--core-lib)
+        core = sorted({ln.split()[-1] for ln in fp if "libgraupel_core" in ln})
+    log("graupel: core library %s" % ", ".join(core))
 
     t0 = time.perf_counter()
     r = vtkEXRHeightFieldReader()
@@ -153,9 +190,7 @@ def worker_graupel(a):
         "stored_volume": field("stored_volume"), "balance_error": field("balance_error"),
         "max_time_step": f.GetMaxTimeStep(),
     }
-    np.savez(a.result + ".npz", depth=depth)
-    with open(a.result + ".json", "w") as fp:
-        json.dump(res, fp)
+    save(a, res, depth)
 
 
 def worker_landlab(a):
@@ -164,15 +199,14 @@ def worker_landlab(a):
     from landlab import RasterModelGrid
     from landlab.components import OverlandFlow
     t_import = time.perf_counter() - t0
-    dem = np.load(os.path.join(a.work, "dem.npz"))
-    z = dem["elevation"]
+    z, dx, dy = read_dem(a)
     ny, nx = z.shape
     t0 = time.perf_counter()
     if a.square:
-        d = 0.5 * (float(dem["dx"]) + float(dem["dy"]))
+        d = 0.5 * (dx + dy)
         grid = RasterModelGrid((ny, nx), xy_spacing=(d, d))
     else:
-        grid = RasterModelGrid((ny, nx), xy_spacing=(float(dem["dx"]), float(dem["dy"])))
+        grid = RasterModelGrid((ny, nx), xy_spacing=(dx, dy))
     grid.add_field("topographic__elevation", z.reshape(-1).copy(), at="node")
     grid.add_zeros("surface_water__depth", at="node")
     of = OverlandFlow(grid, mannings_n=a.manning, rainfall_intensity=a.rain * MM_PER_H,
@@ -206,9 +240,54 @@ def worker_landlab(a):
     res = {"t_import": t_import, "t_setup": t_setup, "t_run": t_run, "steps": steps,
            "rain_volume": rain, "stored_volume": stored, "outflow_volume": rain - stored,
            "spacing": [grid.dx, grid.dy]}
-    np.savez(a.result + ".npz", depth=depth)
-    with open(a.result + ".json", "w") as fp:
-        json.dump(res, fp)
+    save(a, res, depth)
+
+
+def worker_anuga(a):
+    t0 = time.perf_counter()
+    import numpy as np
+    import anuga
+    from anuga.abstract_2d_finite_volumes.mesh_factory import rectangular
+    t_import = time.perf_counter() - t0
+    z, dx, dy = read_dem(a)
+    ny, nx = z.shape
+    t0 = time.perf_counter()
+    # Cell (i, j) is centred on DEM point (i, j), at x = i dx, y = j dy.
+    points, tris, boundary = rectangular(nx, ny, nx * dx, ny * dy, origin=(-0.5 * dx, -0.5 * dy))
+    domain = anuga.Domain(points, tris, boundary)
+    xy = domain.centroid_coordinates
+    cell = (np.floor(xy[:, 1] / dy + 0.5).astype(int) * nx
+            + np.floor(xy[:, 0] / dx + 0.5).astype(int))
+    domain.set_name("anuga")
+    domain.set_datadir(a.work)
+    domain.set_store(False)
+    if a.anuga_algorithm:
+        domain.set_flow_algorithm(a.anuga_algorithm)
+    zc = z.reshape(-1)[cell]
+    domain.set_quantity("elevation", numeric=np.repeat(zc[:, None], 3, axis=1),
+                        location="vertices")
+    domain.set_quantity("friction", a.manning)
+    domain.set_quantity("stage", expression="elevation")
+    edge = anuga.Transmissive_boundary(domain)
+    domain.set_boundary({tag: edge for tag in domain.get_boundary_tags()})
+    anuga.Rate_operator(domain, rate=a.rain * MM_PER_H)
+    t_setup = time.perf_counter() - t0
+    end = a.hours * 3600.0
+    t0 = time.perf_counter()
+    steps = 0
+    for _ in domain.evolve(yieldstep=a.interval * 60.0, finaltime=end):
+        steps += domain.number_of_steps  # the steps since the last yield
+    t_run = time.perf_counter() - t0
+    height = domain.get_quantity("height")
+    stored = float((height.centroid_values * domain.areas).sum())
+    depth = (np.bincount(cell, weights=height.centroid_values, minlength=nx * ny)
+             / np.bincount(cell, minlength=nx * ny)).reshape(ny, nx)
+    rain = a.rain * MM_PER_H * end * float(domain.areas.sum())
+    res = {"t_import": t_import, "t_setup": t_setup, "t_run": t_run,
+           "steps": int(steps), "triangles": len(domain),
+           "flow_algorithm": domain.get_flow_algorithm(), "rain_volume": rain,
+           "stored_volume": stored, "outflow_volume": rain - stored}
+    save(a, res, depth)
 
 
 def worker_grass(a):
@@ -246,22 +325,26 @@ def worker_grass(a):
     rain = a.rain * MM_PER_H * a.hours * 3600.0 * nx * ny * area
     res = {"t_prep": t_prep, "t_run": t_run, "rain_volume": rain, "stored_volume": stored,
            "outflow_volume": rain - stored, "depth_map": last, "maps": sorted(maps)}
-    np.savez(a.result + ".npz", depth=depth)
-    with open(a.result + ".json", "w") as fp:
-        json.dump(res, fp)
+    save(a, res, depth)
 
 
 # ---------------------------------------------------------------- driver
 
-def graupel_env(build, deps):
+def graupel_env(build, deps, core_lib=None):
+    """The Python module of BUILD; core_lib: a folder whose libgraupel_core
+    the module loads instead of its own (its RUNPATH yields to
+    LD_LIBRARY_PATH)."""
     env = dict(os.environ)
     mod = glob.glob(os.path.join(build, "lib*", "python3", "site-packages"))
     if not mod:
         sys.exit("no Graupel Python module under %s (build the `vtk` preset)" % build)
     paths = [mod[0]]
+    libs = [core_lib] if core_lib else []
     if deps:
         paths.append(os.path.join(deps, "usr", "lib", "python3", "dist-packages"))
-        env["LD_LIBRARY_PATH"] = os.path.join(deps, "usr", "lib", "x86_64-linux-gnu")
+        libs.append(os.path.join(deps, "usr", "lib", "x86_64-linux-gnu"))
+    if libs:
+        env["LD_LIBRARY_PATH"] = ":".join(libs)
     env["PYTHONPATH"] = ":".join(paths)
     return env
 
@@ -316,6 +399,10 @@ def main():
     ap.add_argument("--python", default="/usr/bin/python3",
                     help="interpreter for Graupel (python3 with the vtk build, pvpython)")
     ap.add_argument("--venv", help="venv holding landlab (default: BUILD/peers-venv)")
+    ap.add_argument("--anuga-venv", help="venv holding ANUGA (default: BUILD/peers-anuga-venv)")
+    ap.add_argument("--anuga-algorithm", help="ANUGA's flow algorithm (default: its own, DE0)")
+    ap.add_argument("--core-lib", help="folder of the libgraupel_core to run (a core build's "
+                    "build-core/kernels) in place of BUILD's")
     ap.add_argument("--only", default="graupel,grass,landlab")
     ap.add_argument("--models", default="0,1", help="Graupel FlowModels to run")
     ap.add_argument("--hours", type=float, default=3.0)
@@ -349,14 +436,17 @@ def main():
 
     if a.worker:
         {"dem": worker_dem, "graupel": worker_graupel, "landlab": worker_landlab,
-         "grass": worker_grass}[a.worker](a)
+         "grass": worker_grass, "anuga": worker_anuga}[a.worker](a)
         return
 
     venv = a.venv or (os.path.join(os.path.abspath(a.build), "peers-venv") if a.build else None)
+    anuga_venv = a.anuga_venv or (os.path.join(os.path.abspath(a.build), "peers-anuga-venv")
+                                  if a.build else None)
     if a.install:
         if not venv:
             sys.exit("--install needs --venv or --build (the venv goes into the build tree)")
         install(venv)
+        install_anuga(anuga_venv)
         if not a.build:
             return
     if not a.build:
@@ -369,7 +459,7 @@ def main():
     a.work = a.out or tempfile.mkdtemp(prefix="graupel-peers-")
     os.makedirs(a.work, exist_ok=True)
     me = os.path.abspath(__file__)
-    genv = graupel_env(a.build, deps)
+    genv = graupel_env(a.build, deps, a.core_lib and os.path.abspath(a.core_lib))
     child([a.python, me, "--worker", "dem", "--work", a.work], genv, "reading the DEM")
 
     if a.profile:
@@ -415,6 +505,20 @@ def main():
             cmd.append("--square")
         wall = child(cmd, dict(os.environ), "landlab")
         rows.append(("Landlab OverlandFlow", load(res), wall))
+
+    if "anuga" in only:
+        py = os.path.join(anuga_venv, "bin", "python3") if anuga_venv else None
+        if not py or not os.path.exists(py):
+            sys.exit("no ANUGA venv at %s: run with --install" % anuga_venv)
+        res = os.path.join(a.work, "anuga")
+        log("anuga: Domain.evolve")
+        cmd = [py, me, "--worker", "anuga", "--result", res] + common_args(a)
+        if a.anuga_algorithm:
+            cmd += ["--anuga-algorithm", a.anuga_algorithm]
+        env = dict(os.environ)
+        env.setdefault("OMP_NUM_THREADS", str(os.cpu_count()))
+        wall = child(cmd, env, "anuga")
+        rows.append(("ANUGA", load(res), wall))
 
     report(rows, a)
     if not a.out:

@@ -10,13 +10,14 @@
  * Perthame (2004), second order: minmod slopes of the depth, the surface
  * (as bed differences plus depth differences, so that large elevations
  * lose nothing to rounding; flat within the depths' rounding, gr_sw_rise),
- * and the velocities; Heun's method (SSP-RK2) in time. A step is seven
+ * and the velocities; Heun's method (SSP-RK2) in time. A step is nine
  * launches, each a gather that writes only what its own work-item owns:
  * rain_runoff_sw_prep (stage 1's points: the depth
  * after rain and infiltration, the velocities), then per stage
- * rain_runoff_sw_faces* (every face once, stored: the two cells that share
- * it read the same floats, so the mass that leaves one cell is the float
- * that arrives in the other), rain_runoff_sw_update* (every cell from its
+ * rain_runoff_sw_faces* and rain_runoff_sw_rim* (every face once, the
+ * interior's without the edges' cases, then the rim's, stored: the two cells
+ * that share it read the same floats, so the mass that leaves one cell is
+ * the float that arrives in the other), rain_runoff_sw_update* (every cell from its
  * four faces; stage 2 also folds the new state into the flood maps) and
  * rain_runoff_sw_edges (the rim's cells book the stage's edge flows).
  * Every face reads two cells either side of it, so a stage reads two cells
@@ -331,9 +332,10 @@ GR_INLINE void gr_sw_line_flux(gr_sw_pt q0, gr_sw_pt q1, gr_sw_pt q2, gr_sw_pt q
  * n - 2): inner, both its cells with both neighbours, no line continued,
  * no ghost, no edge stop; the same floats without the edges' cases. The
  * fused stages call it for whole tiles of such faces (a branch every
- * work-item takes alike). In the separate launches' faces kernel the same
- * branch per work-group made PoCL's step 35 % slower (at 1024^2, 26 ms ->
- * 36 ms): CPUs keep gr_sw_line_flux for every face. */
+ * work-item takes alike), and the separate launches for the interior's
+ * faces in a launch of their own (rain_runoff_sw_faces*; the same branch per
+ * work-group in one kernel made PoCL's step 35 % slower, 26 -> 36 ms at
+ * 1024^2). */
 GR_INLINE void gr_sw_inner_flux(gr_sw_pt q0, gr_sw_pt q1, gr_sw_pt q2, gr_sw_pt q3, float g,
                                 float *fh, float *fmL, float *fmR, float *ft, float *sh,
                                 float *se) {
@@ -496,35 +498,95 @@ GR_INLINE gr_sw_pt gr_sw_point(__global const float *restrict ph, __global const
   return p;
 }
 
-/* Every face of a stage, once: work-item (i, j) of an (nx+1) x (ny+1)
- * launch owns the x-face left of cell (i, j) (for j < ny) and the y-face
- * below it (for i < nx), from the points (ph, pu, pv) two cells either
- * side. Indices stay linear and loads beyond the array masked, so that CPU
- * compilers vectorise the loads. */
+/* The faces of a stage at (i, j), once: the x-face left of cell (i, j)
+ * (for j < ny) and the y-face below it (for i < nx), from the points (ph,
+ * pu, pv) two cells either side. Indices stay linear and loads beyond the
+ * array masked, so that CPU compilers vectorise the loads. inner: both
+ * faces lie two cells or more inside the grid (2 <= i <= nx - 2, 2 <= j <=
+ * ny - 2), so they take gr_sw_inner_flux, the same floats without the
+ * edges' cases (ghosts, picks, stops), which made up about a third of a
+ * face's instructions on CPUs. */
+GR_INLINE void gr_sw_faces_at(__global const float *restrict ph, __global const float *restrict pu,
+                              __global const float *restrict pv, __global const float *restrict b,
+                              __global float *restrict fx, __global float *restrict fy, int nx,
+                              int ny, float g, int bnd_w, int bnd_e, int bnd_s, int bnd_n,
+                              float lvl_w, float lvl_e, float lvl_s, float lvl_n, int i, int j,
+                              const int inner) {
+  int c = j * nx + i;
+  if (inner || j < ny) {
+    gr_sw_pt q0 = gr_sw_point(ph, pu, pv, b, inner || i >= 2, c - 2);
+    gr_sw_pt q1 = gr_sw_point(ph, pu, pv, b, inner || i >= 1, c - 1);
+    gr_sw_pt q2 = gr_sw_point(ph, pu, pv, b, inner || i < nx, c);
+    gr_sw_pt q3 = gr_sw_point(ph, pu, pv, b, inner || i + 1 < nx, c + 1);
+    int f = j * (nx + 1) + i, plane = (nx + 1) * ny;
+    if (inner) {
+      float fh, fmL, fmR, ft, sh, se;
+      gr_sw_inner_flux(q0, q1, q2, q3, g, &fh, &fmL, &fmR, &ft, &sh, &se);
+      GR_SW_PUT_FACE(fx, f, plane, fh, fmL, fmR, ft, sh, se);
+    } else {
+      gr_sw_line_face(q0, q1, q2, q3, i, nx, bnd_w, bnd_e, lvl_w, lvl_e, g, fx, f, plane);
+    }
+  }
+  if (inner || i < nx) {
+    gr_sw_pt q0 = gr_sw_point(ph, pv, pu, b, inner || j >= 2, c - 2 * nx);
+    gr_sw_pt q1 = gr_sw_point(ph, pv, pu, b, inner || j >= 1, c - nx);
+    gr_sw_pt q2 = gr_sw_point(ph, pv, pu, b, inner || j < ny, c);
+    gr_sw_pt q3 = gr_sw_point(ph, pv, pu, b, inner || j + 1 < ny, c + nx);
+    int plane = nx * (ny + 1);
+    if (inner) {
+      float fh, fmL, fmR, ft, sh, se;
+      gr_sw_inner_flux(q0, q1, q2, q3, g, &fh, &fmL, &fmR, &ft, &sh, &se);
+      GR_SW_PUT_FACE(fy, c, plane, fh, fmL, fmR, ft, sh, se);
+    } else {
+      gr_sw_line_face(q0, q1, q2, q3, j, ny, bnd_s, bnd_n, lvl_s, lvl_n, g, fy, c, plane);
+    }
+  }
+}
+
+/* The interior's faces (gr_sw_faces_at, inner): work-item (i, j) of a
+ * launch at offset (2, 2) over (nx - 3) x (ny - 3), rounded up to whole
+ * work-groups. */
 GR_INLINE void gr_sw_faces(__global const float *restrict ph, __global const float *restrict pu,
                            __global const float *restrict pv, __global const float *restrict b,
                            __global float *restrict fx, __global float *restrict fy, int nx, int ny,
                            float g, int bnd_w, int bnd_e, int bnd_s, int bnd_n, float lvl_w,
                            float lvl_e, float lvl_s, float lvl_n) {
   int i = get_global_id(0), j = get_global_id(1);
-  if (!gr_inside(i, j, nx + 1, ny + 1))
+  if (i > nx - 2 || j > ny - 2)
     return;
-  int c = j * nx + i;
-  if (j < ny) {
-    gr_sw_pt q0 = gr_sw_point(ph, pu, pv, b, i >= 2, c - 2);
-    gr_sw_pt q1 = gr_sw_point(ph, pu, pv, b, i >= 1, c - 1);
-    gr_sw_pt q2 = gr_sw_point(ph, pu, pv, b, i < nx, c);
-    gr_sw_pt q3 = gr_sw_point(ph, pu, pv, b, i + 1 < nx, c + 1);
-    gr_sw_line_face(q0, q1, q2, q3, i, nx, bnd_w, bnd_e, lvl_w, lvl_e, g, fx, j * (nx + 1) + i,
-                    (nx + 1) * ny);
+  gr_sw_faces_at(ph, pu, pv, b, fx, fy, nx, ny, g, bnd_w, bnd_e, bnd_s, bnd_n, lvl_w, lvl_e, lvl_s,
+                 lvl_n, i, j, 1);
+}
+
+/* The rim's faces, every (i, j) of the (nx + 1) x (ny + 1) faces' grid
+ * outside the interior (gr_sw_faces), with their edges' cases: one
+ * work-item each, numbered along the two rows at either end, then four a
+ * row in between (columns 0, 1, nx - 1, nx); the whole grid where it has no
+ * interior (nx or ny under 4). gr_rain_runoff_sw_rim_count on the host
+ * counts them. */
+GR_INLINE void gr_sw_rim_faces(__global const float *restrict ph, __global const float *restrict pu,
+                               __global const float *restrict pv, __global const float *restrict b,
+                               __global float *restrict fx, __global float *restrict fy, int nx,
+                               int ny, float g, int bnd_w, int bnd_e, int bnd_s, int bnd_n,
+                               float lvl_w, float lvl_e, float lvl_s, float lvl_n) {
+  int k = get_global_id(0), w = nx + 1, i, j;
+  if (nx < 4 || ny < 4) {
+    if (k >= w * (ny + 1))
+      return;
+    i = k % w;
+    j = k / w;
+  } else if (k < 4 * w) {
+    i = k % w;
+    j = k < 2 * w ? k / w : ny - 3 + k / w; /* rows 0, 1, then ny - 1, ny */
+  } else {
+    int t = k - 4 * w, col = t % 4;
+    if (t >= 4 * (ny - 3))
+      return;
+    j = 2 + t / 4;
+    i = col < 2 ? col : nx - 3 + col; /* columns 0, 1, nx - 1, nx */
   }
-  if (i < nx) {
-    gr_sw_pt q0 = gr_sw_point(ph, pv, pu, b, j >= 2, c - 2 * nx);
-    gr_sw_pt q1 = gr_sw_point(ph, pv, pu, b, j >= 1, c - nx);
-    gr_sw_pt q2 = gr_sw_point(ph, pv, pu, b, j < ny, c);
-    gr_sw_pt q3 = gr_sw_point(ph, pv, pu, b, j + 1 < ny, c + nx);
-    gr_sw_line_face(q0, q1, q2, q3, j, ny, bnd_s, bnd_n, lvl_s, lvl_n, g, fy, c, nx * (ny + 1));
-  }
+  gr_sw_faces_at(ph, pu, pv, b, fx, fy, nx, ny, g, bnd_w, bnd_e, bnd_s, bnd_n, lvl_w, lvl_e, lvl_s,
+                 lvl_n, i, j, 0);
 }
 
 __kernel void rain_runoff_sw_faces1(GR_SW_STEP_ARGS) {
@@ -535,6 +597,16 @@ __kernel void rain_runoff_sw_faces1(GR_SW_STEP_ARGS) {
 __kernel void rain_runoff_sw_faces2(GR_SW_STEP_ARGS) {
   gr_sw_faces(h1, u1, v1, b, fx, fy, nx, ny, g, bnd_w, bnd_e, bnd_s, bnd_n, lvl_w, lvl_e, lvl_s,
               lvl_n);
+}
+
+__kernel void rain_runoff_sw_rim1(GR_SW_STEP_ARGS) {
+  gr_sw_rim_faces(wh, wu, wv, b, fx, fy, nx, ny, g, bnd_w, bnd_e, bnd_s, bnd_n, lvl_w, lvl_e, lvl_s,
+                  lvl_n);
+}
+
+__kernel void rain_runoff_sw_rim2(GR_SW_STEP_ARGS) {
+  gr_sw_rim_faces(h1, u1, v1, b, fx, fy, nx, ny, g, bnd_w, bnd_e, bnd_s, bnd_n, lvl_w, lvl_e, lvl_s,
+                  lvl_n);
 }
 
 /* One stage of Heun's method for every cell (one work-item per cell of the

@@ -394,6 +394,8 @@ void gr_rain_runoff_destroy(gr_rain_runoff *s) {
       clReleaseKernel(s->sw_stage[k]);
     if (s->sw_inner[k])
       clReleaseKernel(s->sw_inner[k]);
+    if (s->sw_rim_faces[k])
+      clReleaseKernel(s->sw_rim_faces[k]);
   }
   gr_reduction_i64_release(&s->ledger);
   gr_reduction_release(&s->speed);

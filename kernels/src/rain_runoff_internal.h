@@ -128,6 +128,9 @@ struct gr_rain_runoff {
   /* Shallow water's step: the points of stage 1, then per stage the faces
    * and the cells' update. */
   cl_kernel sw_prep, sw_faces[2], sw_update[2], sw_edges;
+  /* The rim's faces of each stage (rain_runoff_sw_rim1, 2; sw_faces takes
+   * the interior's), sw_rim_faces work-items. */
+  cl_kernel sw_rim_faces[2];
   /* Or each stage in two launches, when sw_fused, in work-groups of
    * sw_local cells (the tile; sw_tile_bytes of local memory,
    * gr_rain_runoff_sw_shape): the interior's tiles (sw_inner:

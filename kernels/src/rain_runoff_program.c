@@ -400,17 +400,18 @@ gr_status gr_rain_runoff_specialise(gr_rain_runoff *s) {
       "rain_runoff_sw_update2", "rain_runoff_sw_edges",   "rain_runoff_sw_stage1",
       "rain_runoff_sw_stage2",  "rain_runoff_reduce",     "rain_runoff_derive",
       "rain_runoff_sw_speed",   "rain_runoff_li_speed",   "rain_runoff_maps",
-      "rain_runoff_source",     "rain_runoff_sw_inner1",  "rain_runoff_sw_inner2"};
+      "rain_runoff_source",     "rain_runoff_sw_inner1",  "rain_runoff_sw_inner2",
+      "rain_runoff_sw_rim1",    "rain_runoff_sw_rim2"};
   enum { GR_RR_KERNELS = sizeof(names) / sizeof(names[0]) };
   /* The shallow-water model's kernels (none in a local inertial program). */
-  static const unsigned char sw_only[GR_RR_KERNELS] = {0, 0, 0, 0, 0, 1, 1, 1, 1, 1, 1,
-                                                       1, 1, 0, 0, 1, 0, 0, 0, 1, 1};
+  static const unsigned char sw_only[GR_RR_KERNELS] = {0, 0, 0, 0, 0, 1, 1, 1, 1, 1, 1, 1,
+                                                       1, 0, 0, 1, 0, 0, 0, 1, 1, 1, 1};
   cl_kernel *slots[GR_RR_KERNELS] = {
-      &s->flux,       &s->flux_edges,  &s->limit,       &s->update,       &s->li_step,
-      &s->sw_prep,    &s->sw_faces[0], &s->sw_faces[1], &s->sw_update[0], &s->sw_update[1],
-      &s->sw_edges,   &s->sw_stage[0], &s->sw_stage[1], &s->reduce,       &s->derive,
-      &s->sw_speed,   &s->li_speed,    &s->maps,        &s->source,       &s->sw_inner[0],
-      &s->sw_inner[1]};
+      &s->flux,        &s->flux_edges,      &s->limit,          &s->update,       &s->li_step,
+      &s->sw_prep,     &s->sw_faces[0],     &s->sw_faces[1],    &s->sw_update[0], &s->sw_update[1],
+      &s->sw_edges,    &s->sw_stage[0],     &s->sw_stage[1],    &s->reduce,       &s->derive,
+      &s->sw_speed,    &s->li_speed,        &s->maps,           &s->source,       &s->sw_inner[0],
+      &s->sw_inner[1], &s->sw_rim_faces[0], &s->sw_rim_faces[1]};
   char opt[224] = "";
   int len = 0;
   if (s->specialise)

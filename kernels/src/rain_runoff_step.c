@@ -146,11 +146,11 @@ static gr_status gr_rain_runoff_bind_sw(gr_rain_runoff *s, const gr_rain_runoff_
   };
   /* The separate launches, then the fused stages, which take the same
    * arguments. */
-  cl_kernel swk[10] = {s->sw_prep,      s->sw_faces[0], s->sw_update[0], s->sw_faces[1],
-                       s->sw_update[1], s->sw_edges,    s->sw_stage[0],  s->sw_stage[1],
-                       s->sw_inner[0],  s->sw_inner[1]};
+  cl_kernel swk[12] = {s->sw_prep,      s->sw_faces[0], s->sw_update[0],    s->sw_faces[1],
+                       s->sw_update[1], s->sw_edges,    s->sw_stage[0],     s->sw_stage[1],
+                       s->sw_inner[0],  s->sw_inner[1], s->sw_rim_faces[0], s->sw_rim_faces[1]};
   gr_status st = GR_OK;
-  for (int k = 0; st == GR_OK && k < 10; ++k) {
+  for (int k = 0; st == GR_OK && k < 12; ++k) {
     st = GR_RAIN_RUNOFF_ARGS(s, swk[k], sw);
     if (st == GR_OK)
       st = gr_rain_runoff_bind_inputs(s, swk[k], v);
@@ -325,8 +325,15 @@ static gr_status gr_rain_runoff_sw_launch(gr_rain_runoff *s, cl_float map_time) 
   if (st == GR_OK && !s->sw_fused)
     st = gr_kernel_arg(s->ctx, s->sw_update[1], "map_time", sizeof(map_time), &map_time);
   for (int stage = 0; st == GR_OK && !s->sw_fused && stage < 2; ++stage) {
-    st = gr_enqueue_2d(s->ctx, s->sw_faces[stage], 0, 0, (size_t)s->nxl + 1, (size_t)s->nyl + 1,
-                       NULL);
+    /* The interior's faces (rain_runoff_sw_faces*, at offset (2, 2)),
+     * then the rim's (rain_runoff_sw_rim*). */
+    size_t nx = (size_t)s->nxl, ny = (size_t)s->nyl, rim = (nx + 1) * (ny + 1);
+    if (nx >= 4 && ny >= 4) {
+      st = gr_enqueue_2d(s->ctx, s->sw_faces[stage], 2, 2, nx - 3, ny - 3, NULL);
+      rim = 4 * (nx + 1) + 4 * (ny - 3);
+    }
+    if (st == GR_OK)
+      st = gr_enqueue_1d(s->ctx, s->sw_rim_faces[stage], rim);
     if (st == GR_OK)
       st = gr_enqueue_2d(s->ctx, s->sw_update[stage], 0, 0, (size_t)s->nxl, (size_t)s->nyl, NULL);
     /* The rim's cells book the stage's edge flows (after their update). */
