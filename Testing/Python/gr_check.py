@@ -171,6 +171,20 @@ def piece_compare(algorithm, ref, fields, ledger, nx, ny, extra=()):
         out.GetPointData().AddArray(arr)
 
 
+def table(columns):
+    """A vtkTable of double columns from {name: values}."""
+    from vtkmodules.vtkCommonCore import vtkDoubleArray
+    from vtkmodules.vtkCommonDataModel import vtkTable
+    t = vtkTable()
+    for name, values in columns.items():
+        c = vtkDoubleArray()
+        c.SetName(name)
+        for v in values:
+            c.InsertNextValue(v)
+        t.AddColumn(c)
+    return t
+
+
 def digest(alg, time, names):
     """SHA-256 of the named point arrays of alg's output at time (b"none" for
     a missing one): one value to compare runs by, bit for bit."""

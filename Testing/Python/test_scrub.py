@@ -71,8 +71,8 @@ a = T.args(extra)
 
 import numpy as np  # noqa: E402
 from vtkmodules.util.numpy_support import numpy_to_vtk  # noqa: E402
-from vtkmodules.vtkCommonCore import vtkDoubleArray, vtkFloatArray, vtkPoints  # noqa: E402
-from vtkmodules.vtkCommonDataModel import vtkImageData, vtkPolyData, vtkTable  # noqa: E402
+from vtkmodules.vtkCommonCore import vtkFloatArray, vtkPoints  # noqa: E402
+from vtkmodules.vtkCommonDataModel import vtkImageData, vtkPolyData  # noqa: E402
 from vtkmodules.vtkCommonExecutionModel import (  # noqa: E402
     vtkStreamingDemandDrivenPipeline as SDDP,
     vtkTrivialProducer,
@@ -134,14 +134,7 @@ def points(xy, discharge=None):
 
 
 def table(columns):
-    t = vtkTable()
-    for name, values in columns.items():
-        c = vtkDoubleArray()
-        c.SetName(name)
-        for v in values:
-            c.InsertNextValue(v)
-        t.AddColumn(c)
-    return producer(t)
+    return producer(T.table(columns))
 
 
 class Steps(TimedSource):

@@ -21,8 +21,7 @@ import gr_check as T  # noqa: E402
 a = T.args()
 
 from vtkmodules.util.numpy_support import vtk_to_numpy, numpy_to_vtk  # noqa: E402
-from vtkmodules.vtkCommonCore import vtkDoubleArray  # noqa: E402
-from vtkmodules.vtkCommonDataModel import vtkImageData, vtkTable  # noqa: E402
+from vtkmodules.vtkCommonDataModel import vtkImageData  # noqa: E402
 from vtkmodules.vtkCommonExecutionModel import (  # noqa: E402
     vtkStreamingDemandDrivenPipeline as SDDP,
     vtkTrivialProducer,
@@ -51,17 +50,6 @@ def image(arrays, dims=(NX, NY), spacing=DX):
     return img
 
 
-def table(columns):
-    t = vtkTable()
-    for name, values in columns.items():
-        c = vtkDoubleArray()
-        c.SetName(name)
-        for v in values:
-            c.InsertNextValue(v)
-        t.AddColumn(c)
-    return t
-
-
 def producer(data):
     p = vtkTrivialProducer()
     p.SetOutput(data)
@@ -79,7 +67,7 @@ def melt(arrays=SNOW, forcing=None, **kw):
     f = vtkSnowMeltFilter()
     f.SetInputConnection(producer(image(arrays)))
     if forcing is not None:
-        f.SetInputConnection(1, producer(table(forcing)))
+        f.SetInputConnection(1, producer(T.table(forcing)))
     f.SetEndTime(kw.pop("EndTime", 2 * DAY))
     f.SetOutputInterval(kw.pop("OutputInterval", 6 * HOUR))
     for k, v in kw.items():
