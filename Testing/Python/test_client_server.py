@@ -13,7 +13,8 @@ Progress and abort: a long Rain Runoff's progress reaches the client, whose
 progress observer then calls graupel.remote.abort_update(); the server's
 update must end within a second of that, with an empty output and the
 warning once on the client, and the same filter must then run another time
-to pvbatch's bits. An error (a RainRunoff on a 3-D image) reaches the
+to pvbatch's bits; an abort sent while the server idles is dropped (the
+pipeline after it gives pvbatch's bits). An error (a RainRunoff on a 3-D image) reaches the
 client as one sentence and the pipeline stays usable; when the client
 disconnects the server ranks exit, leaving no process behind.
 
@@ -135,6 +136,8 @@ long.UpdatePipeline(600.0)
 print("AGAIN", repr([long.FieldData[n].GetRange()[0] for n in
       ("rain_volume", "outflow_volume", "stored_volume", "balance_error")]), flush=True)
 Delete(long)
+# An abort with nothing running is dropped when the server reads it.
+print("IDLE ABORT", remote.abort_update(), flush=True)
 """ + PIPELINE + r"""
 bad = RainRunoff(Input=Wavelet())
 bad.UpdatePipeline(0.0)
@@ -295,6 +298,9 @@ for key in ("LEDGER", "PLOUGH", "DRIFT"):
     T.check(got.get(key) is not None and got.get(key) == expected.get(key),
             "the %s ledger is pvbatch's to the bit (%s | %s)" % (key.lower(), got.get(key),
                                                                   expected.get(key)))
+T.check(got.get("IDLE") == "ABORT True",
+        "an abort sent while the server idles is dropped: the pipeline after it runs to "
+        "pvbatch's bits (%s)" % got.get("IDLE"))
 T.check(got.get("AGAIN") is not None and got.get("AGAIN") == expected.get("LEDGER"),
         "the aborted filter runs again to pvbatch's bits (%s)" % got.get("AGAIN"))
 
