@@ -4,7 +4,8 @@
  * stable length is the drops' Gaussians and the wave update. --devices K:
  * the same lake in K strips along y (a ring of 1 + the drops' reach, 3
  * rows; one row of wave height exchanged per step on the host), --verify
- * comparing every output with one whole grid's, bit for bit. */
+ * comparing every output with one whole grid's, bit for bit.
+ * GRAUPEL_BENCH_DROPS=0: no raindrops (DropRate 0), the wave update alone. */
 #include "bench.h"
 
 #include <math.h>
@@ -30,7 +31,8 @@ static void water_params(gr_water_surface_params *p) {
   p->damping = 0.05;
   p->use_lake_level = 1;
   p->lake_level = 4.0;
-  p->drop_rate = 0.05;
+  const char *drops = getenv("GRAUPEL_BENCH_DROPS");
+  p->drop_rate = drops && strcmp(drops, "0") == 0 ? 0.0 : 0.05;
   p->drop_radius = 1.0;
 }
 
