@@ -28,12 +28,8 @@ GR_INLINE float gr_ws_offset(uint h) {
 #define GR_WS_TILE_X 32
 #endif
 #ifndef GR_WS_TILE_Y
-#define GR_WS_TILE_Y 8
+#define GR_WS_TILE_Y 16
 #endif
-
-/* drop_at's mark for a point where no drop falls this step (the offsets
- * lie in (-0.5, 0.5)). */
-#define GR_WS_NO_DROP 2.0f
 
 /* One step of the wave equation h_tt = c^2 lap(h) - gamma h_t on the wet
  * points, symplectic Euler (the leapfrog scheme with v = h_t at half steps):
@@ -54,10 +50,11 @@ GR_INLINE float gr_ws_offset(uint h) {
  * threshold (the chance rate dx dy dt times 2^24), at a position hashed
  * uniformly within the point's cell. g lives in local memory only: each
  * work-group first decides the drops of its tile and of the points within
- * 1 + reach of it (drop_at: one hash per point, not one per point and
- * neighbour within reach), then sums g over its tile and the ring of one
- * point the Laplacian reads (g_tile), each point's drops in the order of
- * rows, then columns, whichever tile computes it: g is a pure function of
+ * 1 + reach of it (one hash per point, not one per point and neighbour
+ * within reach: drop_at holds a drop's offsets, drop_mask a bit per point
+ * of each row), then sums g over its tile and the ring of one point the
+ * Laplacian reads (g_tile), each point's drops in the order of rows, then
+ * columns, whichever tile computes it: g is a pure function of
  * the point, so the step's Laplacian of g takes the same value from both
  * sides of a face, and a piece of a split domain, which hashes the domain's
  * indices, makes the whole grid's drops and bits (the ring's further rows
@@ -68,42 +65,58 @@ water_surface_step(__global const float *restrict h_in, __global float *restrict
                    float inv_dx2, float inv_dy2, float c2dt, float dt, float damp, int drops,
                    float drop_coef, int j_lo, int j_hi, float dx, float dy, float inv_2sig2,
                    int reach_x, int reach_y, uint threshold, uint seed, uint step_lo, uint step_hi,
-                   int gj0, __local float2 *restrict drop_at, __local float *restrict g_tile) {
+                   int gj0, __local float2 *restrict drop_at, __local uint *restrict drop_mask,
+                   __local float *restrict g_tile) {
   const int lx = get_local_id(0), ly = get_local_id(1);
   const int lid = lx + GR_WS_TILE_X * ly, wg = GR_WS_TILE_X * GR_WS_TILE_Y;
   const int i = get_global_id(0), j = get_global_id(1);
   const int gw = GR_WS_TILE_X + 2, gh = GR_WS_TILE_Y + 2;
   if (drops) {
-    /* The drops window's first point (the tile's, less 1 + reach) and size. */
+    /* The drops window's first point (the tile's, less 1 + reach), its size,
+     * and the words of a row's bit mask (one spare: two-word reads). */
     const int di0 = i - lx - 1 - reach_x, dj0 = j - ly - 1 - reach_y;
-    const int dw = gw + 2 * reach_x, dh = gh + 2 * reach_y;
+    const int dw = gw + 2 * reach_x, dh = gh + 2 * reach_y, mw = (dw + 31) / 32 + 1;
+    const float inv_dw = 1.0f / (float)dw;
     const uint key = gr_ws_step_key(step_lo, step_hi, seed);
+    for (int q = lid; q < dh * mw; q += wg)
+      drop_mask[q] = 0u;
+    barrier(CLK_LOCAL_MEM_FENCE);
     for (int q = lid; q < dw * dh; q += wg) {
-      int a = di0 + q % dw, b = dj0 + q / dw;
-      float2 d = (float2)(GR_WS_NO_DROP, 0.0f);
+      /* q / dw: (q + 1/2) / dw is at least 1 / (2 dw) from an integer,
+       * far more than the float's error at these sizes. */
+      int qj = (int)(((float)q + 0.5f) * inv_dw), qi = q - qj * dw;
+      int a = di0 + qi, b = dj0 + qj;
       if (a >= 0 && a < nx && b >= 0 && b < ny && wet[gr_idx(a, b, nx)]) {
         uint h = gr_ws_drop_hash(a, b + gj0, key);
-        if ((h >> 8) < threshold)
-          d = (float2)(gr_ws_offset(gr_hash_u32(h ^ 0x68e31da4U)),
-                       gr_ws_offset(gr_hash_u32(h ^ 0xb5297a4dU)));
+        if ((h >> 8) < threshold) {
+          drop_at[q] = (float2)(gr_ws_offset(gr_hash_u32(h ^ 0x68e31da4U)),
+                                gr_ws_offset(gr_hash_u32(h ^ 0xb5297a4dU)));
+          atomic_or(&drop_mask[qj * mw + (qi >> 5)], 1u << (qi & 31));
+        }
       }
-      drop_at[q] = d;
     }
     barrier(CLK_LOCAL_MEM_FENCE);
-    /* g over the tile and its ring of one point; a window reaching beyond
-     * the local arrays meets only no-drop marks there. */
+    /* g over the tile and its ring of one point, row by row of the window,
+     * each row's drops in the order of their columns (the set bits of the
+     * row's mask); a window reaching beyond the local arrays meets no drop
+     * there. */
+    const uint wmask = (1u << (2 * reach_x + 1)) - 1u;
     for (int q = lid; q < gw * gh; q += wg) {
       int qi = q % gw, qj = q / gw, gi = di0 + reach_x + qi, gj = dj0 + reach_y + qj;
       float sum = 0.0f;
       if (gi >= 0 && gi < nx && gj >= 0 && gj < ny && wet[gr_idx(gi, gj, nx)])
-        for (int b = 0; b <= 2 * reach_y; ++b)
-          for (int a = 0; a <= 2 * reach_x; ++a) {
+        for (int b = 0; b <= 2 * reach_y; ++b) {
+          int row = (qj + b) * mw + (qi >> 5);
+          ulong m = ((ulong)drop_mask[row + 1] << 32) | (ulong)drop_mask[row];
+          uint bits = (uint)(m >> (qi & 31)) & wmask;
+          while (bits) {
+            int a = 31 - (int)clz(bits & (0u - bits));
+            bits &= bits - 1u;
             float2 d = drop_at[(qi + a) + (qj + b) * dw];
-            if (d.x == GR_WS_NO_DROP)
-              continue;
             float rx = ((float)(reach_x - a) - d.x) * dx, ry = ((float)(reach_y - b) - d.y) * dy;
             sum += exp(-(rx * rx + ry * ry) * inv_2sig2);
           }
+        }
       g_tile[q] = sum;
     }
     barrier(CLK_LOCAL_MEM_FENCE);

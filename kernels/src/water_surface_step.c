@@ -49,12 +49,14 @@ static gr_status gr_ws_enqueue_one(gr_water_surface *s, double dt) {
   cl_float c2dt = (cl_float)(p->wave_speed * p->wave_speed * dt), dtf = (cl_float)dt;
   cl_float damp = (cl_float)exp(-p->damping * dt);
   cl_float drop_coef = (cl_float)(0.5 * p->drop_amplitude * p->drop_radius * p->drop_radius);
-  /* The tile's local memory: the drops of the tile and 1 + reach around it,
-   * g on the tile and one around it (a float2 and a float without drops). */
+  /* The tile's local memory: the drops of the tile and 1 + reach around it
+   * (their offsets, and a bit mask per row of words of 32 points with one
+   * spare word), g on the tile and one around it; minimal without drops. */
   const size_t *tile = s->tile;
   size_t gw = tile[0] + 2, gh = tile[1] + 2;
-  size_t drop_bytes =
-      drops ? (gw + 2 * (size_t)rx) * (gh + 2 * (size_t)ry) * sizeof(cl_float2) : sizeof(cl_float2);
+  size_t dw = gw + 2 * (size_t)rx, dh = gh + 2 * (size_t)ry, mw = (dw + 31) / 32 + 1;
+  size_t drop_bytes = drops ? dw * dh * sizeof(cl_float2) : sizeof(cl_float2);
+  size_t mask_bytes = drops ? dh * mw * sizeof(cl_uint) : sizeof(cl_uint);
   size_t g_bytes = drops ? gw * gh * sizeof(cl_float) : sizeof(cl_float);
   int now = 1 - s->cur;
   cl_int j_lo = s->ring_s, j_hi = s->ring_s + s->own_ny;
@@ -85,6 +87,7 @@ static gr_status gr_ws_enqueue_one(gr_water_surface *s, double dt) {
       {"step_hi", sizeof(step_hi), &step_hi},
       {"gj0", sizeof(gj0), &gj0},
       {"drop_at", drop_bytes, NULL},
+      {"drop_mask", mask_bytes, NULL},
       {"g_tile", g_bytes, NULL},
   };
   gr_status st = GR_WS_ARGS(s, s->step, args);
