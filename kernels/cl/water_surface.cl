@@ -6,12 +6,15 @@
 #include "reduce.h"
 #include "water_surface_shared.h"
 
-/* The hash that decides whether a raindrop falls at point (a, b) during step
- * (step_hi, step_lo) of the simulation with this seed: a pure function, so a
- * step computes the same drops whenever it is taken. */
-GR_INLINE uint gr_ws_drop_hash(int a, int b, uint step_lo, uint step_hi, uint seed) {
-  uint s = gr_hash_u32(step_lo ^ gr_hash_u32(step_hi ^ (seed * 0x27d4eb2dU)));
-  return gr_hash3(a, b, s);
+/* The key of step (step_hi, step_lo) of the simulation with this seed, and
+ * the hash of it that decides whether a raindrop falls at point (a, b)
+ * during that step: a pure function, so a step computes the same drops
+ * whenever it is taken. */
+GR_INLINE uint gr_ws_step_key(uint step_lo, uint step_hi, uint seed) {
+  return gr_hash_u32(step_lo ^ gr_hash_u32(step_hi ^ (seed * 0x27d4eb2dU)));
+}
+GR_INLINE uint gr_ws_drop_hash(int a, int b, uint key) {
+  return gr_hash3(a, b, key);
 }
 
 /* A uniform number in (-0.5, 0.5) from the top 24 bits of a hash. */
@@ -19,42 +22,14 @@ GR_INLINE float gr_ws_offset(uint h) {
   return ((float)(h >> 8) + 0.5f) * (1.0f / 16777216.0f) - 0.5f;
 }
 
-/* g = the sum of the unit Gaussians exp(-r^2 / (2 sigma^2)) of this step's
- * drops within reach_x, reach_y points of each wet point (0 on dry points).
- * A drop falls at wet point (a, b) when the top 24 bits of its hash are below
- * threshold (the chance rate dx dy dt times 2^24), at a position hashed
- * uniformly within the point's cell. Every point's g is computed here once,
- * so the step's Laplacian of g takes the same value from both sides of a
- * face. Rows j_lo .. j_hi - 1 of the local arrays, whose row 0 is the
- * domain's row gj0: a piece of a split domain hashes the domain's indices,
- * so it makes the whole grid's drops, and computes g on its own rows and
- * the ring row next to them (the step's Laplacian reads it), the ring's
- * further rows giving the wet points within reach. */
-__kernel void water_surface_drops(__global const uchar *restrict wet, __global float *restrict g,
-                                  int nx, int ny, float dx, float dy, float inv_2sig2, int reach_x,
-                                  int reach_y, uint threshold, uint seed, uint step_lo,
-                                  uint step_hi, int j_lo, int j_hi, int gj0) {
-  int i = get_global_id(0), j = get_global_id(1);
-  if (i >= nx || j < j_lo || j >= j_hi)
-    return;
-  int c = gr_idx(i, j, nx);
-  float sum = 0.0f;
-  if (wet[c]) {
-    int a0 = max(i - reach_x, 0), a1 = min(i + reach_x, nx - 1);
-    int b0 = max(j - reach_y, 0), b1 = min(j + reach_y, ny - 1);
-    for (int b = b0; b <= b1; ++b)
-      for (int a = a0; a <= a1; ++a) {
-        uint h = gr_ws_drop_hash(a, b + gj0, step_lo, step_hi, seed);
-        if ((h >> 8) >= threshold || !wet[gr_idx(a, b, nx)])
-          continue;
-        float ox = gr_ws_offset(gr_hash_u32(h ^ 0x68e31da4U));
-        float oy = gr_ws_offset(gr_hash_u32(h ^ 0xb5297a4dU));
-        float rx = ((float)(i - a) - ox) * dx, ry = ((float)(j - b) - oy) * dy;
-        sum += exp(-(rx * rx + ry * ry) * inv_2sig2);
-      }
-  }
-  g[c] = sum;
-}
+/* The work-group of the step: a tile of GR_WS_TILE_X x GR_WS_TILE_Y points
+ * (the host asks the kernel for it, so -D can change it). */
+#ifndef GR_WS_TILE_X
+#define GR_WS_TILE_X 32
+#endif
+#ifndef GR_WS_TILE_Y
+#define GR_WS_TILE_Y 16
+#endif
 
 /* One step of the wave equation h_tt = c^2 lap(h) - gamma h_t on the wet
  * points, symplectic Euler (the leapfrog scheme with v = h_t at half steps):
@@ -65,16 +40,87 @@ __kernel void water_surface_drops(__global const uchar *restrict wet, __global f
  * h over the wet points stays constant to rounding. The drops add
  * drop_coef * lap(g), the same masked Laplacian of this step's Gaussians:
  * a dimple of depth DropAmplitude with a ring around it, whose sum is zero
- * in the same way. Dry points hold no wave. Rows j_lo .. j_hi - 1: a
- * piece's own rows (its ring's first row is the neighbour's, exchanged
- * after the step). */
-__kernel void water_surface_step(__global const float *restrict h_in,
-                                 __global float *restrict h_out, __global float *restrict v,
-                                 __global const uchar *restrict wet,
-                                 __global const float *restrict g, int nx, int ny, float inv_dx2,
-                                 float inv_dy2, float c2dt, float dt, float damp, int drops,
-                                 float drop_coef, int j_lo, int j_hi) {
-  int i = get_global_id(0), j = get_global_id(1);
+ * in the same way. Dry points hold no wave. Rows j_lo .. j_hi - 1 of the
+ * local arrays, whose row 0 is the domain's row gj0: a piece's own rows
+ * (its ring's first row is the neighbour's, exchanged after the step).
+ *
+ * g = the sum of the unit Gaussians exp(-r^2 / (2 sigma^2)) of this step's
+ * drops within reach_x, reach_y points of each wet point (0 on dry points).
+ * A drop falls at wet point (a, b) when the top 24 bits of its hash are below
+ * threshold (the chance rate dx dy dt times 2^24), at a position hashed
+ * uniformly within the point's cell. g lives in local memory only: each
+ * work-group first decides the drops of its tile and of the points within
+ * 1 + reach of it (one hash per point, not one per point and neighbour
+ * within reach: drop_at holds a drop's offsets, drop_mask a bit per point
+ * of each row), then sums g over its tile and the ring of one point the
+ * Laplacian reads (g_tile), each point's drops in the order of rows, then
+ * columns, whichever tile computes it: g is a pure function of
+ * the point, so the step's Laplacian of g takes the same value from both
+ * sides of a face, and a piece of a split domain, which hashes the domain's
+ * indices, makes the whole grid's drops and bits (the ring's further rows
+ * giving the wet points within reach). */
+__kernel __attribute__((reqd_work_group_size(GR_WS_TILE_X, GR_WS_TILE_Y, 1))) void
+water_surface_step(__global const float *restrict h_in, __global float *restrict h_out,
+                   __global float *restrict v, __global const uchar *restrict wet, int nx, int ny,
+                   float inv_dx2, float inv_dy2, float c2dt, float dt, float damp, int drops,
+                   float drop_coef, int j_lo, int j_hi, float dx, float dy, float inv_2sig2,
+                   int reach_x, int reach_y, uint threshold, uint seed, uint step_lo, uint step_hi,
+                   int gj0, __local float2 *restrict drop_at, __local uint *restrict drop_mask,
+                   __local float *restrict g_tile) {
+  const int lx = get_local_id(0), ly = get_local_id(1);
+  const int lid = lx + GR_WS_TILE_X * ly, wg = GR_WS_TILE_X * GR_WS_TILE_Y;
+  const int i = get_global_id(0), j = get_global_id(1);
+  const int gw = GR_WS_TILE_X + 2, gh = GR_WS_TILE_Y + 2;
+  if (drops) {
+    /* The drops window's first point (the tile's, less 1 + reach), its size,
+     * and the words of a row's bit mask (one spare: two-word reads). */
+    const int di0 = i - lx - 1 - reach_x, dj0 = j - ly - 1 - reach_y;
+    const int dw = gw + 2 * reach_x, dh = gh + 2 * reach_y, mw = (dw + 31) / 32 + 1;
+    const float inv_dw = 1.0f / (float)dw;
+    const uint key = gr_ws_step_key(step_lo, step_hi, seed);
+    for (int q = lid; q < dh * mw; q += wg)
+      drop_mask[q] = 0u;
+    barrier(CLK_LOCAL_MEM_FENCE);
+    for (int q = lid; q < dw * dh; q += wg) {
+      /* q / dw: (q + 1/2) / dw is at least 1 / (2 dw) from an integer,
+       * far more than the float's error at these sizes. */
+      int qj = (int)(((float)q + 0.5f) * inv_dw), qi = q - qj * dw;
+      int a = di0 + qi, b = dj0 + qj;
+      if (a >= 0 && a < nx && b >= 0 && b < ny && wet[gr_idx(a, b, nx)]) {
+        uint h = gr_ws_drop_hash(a, b + gj0, key);
+        if ((h >> 8) < threshold) {
+          drop_at[q] = (float2)(gr_ws_offset(gr_hash_u32(h ^ 0x68e31da4U)),
+                                gr_ws_offset(gr_hash_u32(h ^ 0xb5297a4dU)));
+          atomic_or(&drop_mask[qj * mw + (qi >> 5)], 1u << (qi & 31));
+        }
+      }
+    }
+    barrier(CLK_LOCAL_MEM_FENCE);
+    /* g over the tile and its ring of one point, row by row of the window,
+     * each row's drops in the order of their columns (the set bits of the
+     * row's mask); a window reaching beyond the local arrays meets no drop
+     * there. */
+    const uint wmask = (1u << (2 * reach_x + 1)) - 1u;
+    for (int q = lid; q < gw * gh; q += wg) {
+      int qi = q % gw, qj = q / gw, gi = di0 + reach_x + qi, gj = dj0 + reach_y + qj;
+      float sum = 0.0f;
+      if (gi >= 0 && gi < nx && gj >= 0 && gj < ny && wet[gr_idx(gi, gj, nx)])
+        for (int b = 0; b <= 2 * reach_y; ++b) {
+          int row = (qj + b) * mw + (qi >> 5);
+          ulong m = ((ulong)drop_mask[row + 1] << 32) | (ulong)drop_mask[row];
+          uint bits = (uint)(m >> (qi & 31)) & wmask;
+          while (bits) {
+            int a = 31 - (int)clz(bits & (0u - bits));
+            bits &= bits - 1u;
+            float2 d = drop_at[(qi + a) + (qj + b) * dw];
+            float rx = ((float)(reach_x - a) - d.x) * dx, ry = ((float)(reach_y - b) - d.y) * dy;
+            sum += exp(-(rx * rx + ry * ry) * inv_2sig2);
+          }
+        }
+      g_tile[q] = sum;
+    }
+    barrier(CLK_LOCAL_MEM_FENCE);
+  }
   if (i >= nx || j < j_lo || j >= j_hi)
     return;
   int c = gr_idx(i, j, nx);
@@ -83,27 +129,28 @@ __kernel void water_surface_step(__global const float *restrict h_in,
     v[c] = 0.0f;
     return;
   }
+  const int t = (lx + 1) + (ly + 1) * gw; /* this point in g_tile */
   float hc = h_in[c], lap = 0.0f, dlap = 0.0f;
-  float gc = drops ? g[c] : 0.0f;
+  float gc = drops ? g_tile[t] : 0.0f;
   if (i > 0 && wet[c - 1]) {
     lap += (h_in[c - 1] - hc) * inv_dx2;
     if (drops)
-      dlap += (g[c - 1] - gc) * inv_dx2;
+      dlap += (g_tile[t - 1] - gc) * inv_dx2;
   }
   if (i < nx - 1 && wet[c + 1]) {
     lap += (h_in[c + 1] - hc) * inv_dx2;
     if (drops)
-      dlap += (g[c + 1] - gc) * inv_dx2;
+      dlap += (g_tile[t + 1] - gc) * inv_dx2;
   }
   if (j > 0 && wet[c - nx]) {
     lap += (h_in[c - nx] - hc) * inv_dy2;
     if (drops)
-      dlap += (g[c - nx] - gc) * inv_dy2;
+      dlap += (g_tile[t - gw] - gc) * inv_dy2;
   }
   if (j < ny - 1 && wet[c + nx]) {
     lap += (h_in[c + nx] - hc) * inv_dy2;
     if (drops)
-      dlap += (g[c + nx] - gc) * inv_dy2;
+      dlap += (g_tile[t + gw] - gc) * inv_dy2;
   }
   float vn = (v[c] + c2dt * lap) * damp;
   float hn = hc + dt * vn;

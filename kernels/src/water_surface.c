@@ -149,11 +149,11 @@ gr_status gr_ws_fill(gr_water_surface *s, cl_mem buf, float value, size_t bytes)
 void gr_water_surface_destroy(gr_water_surface *s) {
   if (!s)
     return;
-  cl_kernel kernels[] = {s->drops, s->step, s->reduce, s->derive};
+  cl_kernel kernels[] = {s->step, s->reduce, s->derive};
   for (size_t i = 0; i < sizeof(kernels) / sizeof(kernels[0]); ++i)
     if (kernels[i])
       clReleaseKernel(kernels[i]);
-  cl_mem *bufs[] = {&s->h[0], &s->h[1], &s->v, &s->wet, &s->base, &s->g, &s->h0, &s->scratch};
+  cl_mem *bufs[] = {&s->h[0], &s->h[1], &s->v, &s->wet, &s->base, &s->h0, &s->scratch};
   for (size_t i = 0; i < sizeof(bufs) / sizeof(bufs[0]); ++i)
     gr_buffer_release(bufs[i]);
   gr_reduction_i64_release(&s->ledger);
@@ -173,8 +173,8 @@ gr_status gr_water_surface_memory(const gr_grid *grid, gr_memory_need *out) {
   double n = (double)grid->nx * ((double)grid->ny + 2.0 * (grid->ghost > 0 ? grid->ghost : 0));
   memset(out, 0, sizeof(*out));
   out->points = (double)grid->nx * (double)grid->ny;
-  /* h twice, v, base, g, h0 and the scratch's 3: 9 floats and a byte a point. */
-  out->device = (9.0 * 4.0 + 1.0) * n;
+  /* h twice, v, base, h0 and the scratch's 3: 8 floats and a byte a point. */
+  out->device = (8.0 * 4.0 + 1.0) * n;
   out->largest = 3.0 * 4.0 * n; /* the scratch */
   out->host = (4.0 + 4.0 + 4.0 + 1.0) * n;
   out->state = 2.0 * sizeof(float) * n; /* gr_ws_state_bytes */
@@ -224,13 +224,18 @@ gr_status gr_water_surface_create(gr_context *ctx, const gr_grid *grid,
     gr_water_surface_destroy(s);
     return gr_set_error(ctx, GR_ERR_OUT_OF_MEMORY, "Out of host memory.");
   }
-  size_t fb = n * sizeof(cl_float);
+  size_t fb = n * sizeof(cl_float), tile3[3] = {0, 0, 0};
   cl_program prog = NULL;
   gr_status st = gr_program_get(ctx, "water_surface", NULL, &prog);
   if (st == GR_OK)
-    st = gr_kernel_create(ctx, prog, "water_surface_drops", &s->drops);
-  if (st == GR_OK)
     st = gr_kernel_create(ctx, prog, "water_surface_step", &s->step);
+  if (st == GR_OK)
+    st = gr_cl_check(ctx,
+                     clGetKernelWorkGroupInfo(s->step, gr_context_device(ctx),
+                                              CL_KERNEL_COMPILE_WORK_GROUP_SIZE, 3 * sizeof(size_t),
+                                              tile3, NULL),
+                     "Asking the water surface step for its work-group");
+  s->tile[0] = tile3[0], s->tile[1] = tile3[1];
   if (st == GR_OK)
     st = gr_kernel_create(ctx, prog, "water_surface_reduce", &s->reduce);
   if (st == GR_OK)

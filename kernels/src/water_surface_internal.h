@@ -33,13 +33,13 @@ struct gr_water_surface {
   gr_halo_exchange_fn halo_exchange;
   void *halo_user;
   gr_water_surface_params params;
-  cl_kernel drops, step, reduce, derive;
-  cl_mem h[2]; /* wave height; [cur] is the latest */
+  cl_kernel step, reduce, derive;
+  size_t tile[2]; /* the step's work-group (its reqd_work_group_size) */
+  cl_mem h[2];    /* wave height; [cur] is the latest */
   int cur;
   cl_mem v;                 /* vertical velocity h_t, at half steps */
   cl_mem wet;               /* uchar per point */
   cl_mem base;              /* the still surface, m */
-  cl_mem g;                 /* this step's drop Gaussians, on first use */
   cl_mem h0;                /* the initial wave, once set_wave was called */
   cl_mem scratch;           /* derived outputs, 3 floats per point, on first use */
   float *elevation, *depth; /* host copies of the inputs (depth once set) */

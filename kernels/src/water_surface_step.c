@@ -26,7 +26,9 @@ gr_status gr_water_surface_stable_dt(gr_water_surface *s, double *dt) {
   return GR_OK;
 }
 
-/* Enqueues one step of dt: this step's drops, then the wave update. */
+/* Enqueues one step of dt: the wave update with this step's drops (one
+ * kernel, which decides the drops and sums their Gaussians in local memory
+ * tile by tile). */
 static gr_status gr_ws_enqueue_one(gr_water_surface *s, double dt) {
   const gr_water_surface_params *p = &s->params;
   const gr_grid *gd = &s->grid;
@@ -35,52 +37,27 @@ static gr_status gr_ws_enqueue_one(gr_water_surface *s, double dt) {
   double chance = p->drop_rate * gd->dx * gd->dy * dt;
   cl_uint threshold = chance >= 1.0 ? (cl_uint)16777216u : (cl_uint)floor(chance * 16777216.0);
   cl_int drops = p->drop_amplitude > 0.0 && threshold > 0;
-  gr_status st = GR_OK;
-  if (drops && !s->g)
-    st = gr_buffer_create(s->ctx, CL_MEM_READ_WRITE, gr_ws_points(s) * sizeof(cl_float), NULL,
-                          &s->g);
-  if (st == GR_OK && drops) {
-    double sigma = p->drop_radius;
-    cl_int rx = gr_ws_reach(sigma, gd->dx), ry = gr_ws_reach(sigma, gd->dy);
-    /* The own rows and the ring row next to them (the step reads its g). */
-    cl_int j_lo = s->ring_s ? s->ring_s - 1 : 0;
-    cl_int j_hi = s->ring_n ? s->ring_s + s->own_ny + 1 : ny, gj0 = s->row0;
-    cl_float dx = (cl_float)gd->dx, dy = (cl_float)gd->dy;
-    cl_float inv_2sig2 = (cl_float)(1.0 / (2.0 * sigma * sigma));
-    cl_uint seed = (cl_uint)p->seed;
-    uint64_t k = (uint64_t)s->steps;
-    cl_uint step_lo = (cl_uint)(k & 0xffffffffu), step_hi = (cl_uint)(k >> 32);
-    const gr_ws_arg args[] = {
-        {"wet", m, &s->wet},
-        {"g", m, &s->g},
-        {"nx", sizeof(nx), &nx},
-        {"ny", sizeof(ny), &ny},
-        {"dx", sizeof(dx), &dx},
-        {"dy", sizeof(dy), &dy},
-        {"inv_2sig2", sizeof(inv_2sig2), &inv_2sig2},
-        {"reach_x", sizeof(rx), &rx},
-        {"reach_y", sizeof(ry), &ry},
-        {"threshold", sizeof(threshold), &threshold},
-        {"seed", sizeof(seed), &seed},
-        {"step_lo", sizeof(step_lo), &step_lo},
-        {"step_hi", sizeof(step_hi), &step_hi},
-        {"j_lo", sizeof(j_lo), &j_lo},
-        {"j_hi", sizeof(j_hi), &j_hi},
-        {"gj0", sizeof(gj0), &gj0},
-    };
-    st = GR_WS_ARGS(s, s->drops, args);
-    if (st == GR_OK)
-      st =
-          gr_enqueue_2d(s->ctx, s->drops, 0, (size_t)j_lo, (size_t)nx, (size_t)(j_hi - j_lo), NULL);
-  }
-  if (st != GR_OK)
-    return st;
+  double sigma = p->drop_radius;
+  cl_int rx = gr_ws_reach(sigma, gd->dx), ry = gr_ws_reach(sigma, gd->dy), gj0 = s->row0;
+  cl_float dx = (cl_float)gd->dx, dy = (cl_float)gd->dy;
+  cl_float inv_2sig2 = (cl_float)(1.0 / (2.0 * sigma * sigma));
+  cl_uint seed = (cl_uint)p->seed;
+  uint64_t k = (uint64_t)s->steps;
+  cl_uint step_lo = (cl_uint)(k & 0xffffffffu), step_hi = (cl_uint)(k >> 32);
   cl_float inv_dx2 = (cl_float)(1.0 / (gd->dx * gd->dx));
   cl_float inv_dy2 = (cl_float)(1.0 / (gd->dy * gd->dy));
   cl_float c2dt = (cl_float)(p->wave_speed * p->wave_speed * dt), dtf = (cl_float)dt;
   cl_float damp = (cl_float)exp(-p->damping * dt);
   cl_float drop_coef = (cl_float)(0.5 * p->drop_amplitude * p->drop_radius * p->drop_radius);
-  cl_mem g = s->g ? s->g : s->base; /* bound but not read without drops */
+  /* The tile's local memory: the drops of the tile and 1 + reach around it
+   * (their offsets, and a bit mask per row of words of 32 points with one
+   * spare word), g on the tile and one around it; minimal without drops. */
+  const size_t *tile = s->tile;
+  size_t gw = tile[0] + 2, gh = tile[1] + 2;
+  size_t dw = gw + 2 * (size_t)rx, dh = gh + 2 * (size_t)ry, mw = (dw + 31) / 32 + 1;
+  size_t drop_bytes = drops ? dw * dh * sizeof(cl_float2) : sizeof(cl_float2);
+  size_t mask_bytes = drops ? dh * mw * sizeof(cl_uint) : sizeof(cl_uint);
+  size_t g_bytes = drops ? gw * gh * sizeof(cl_float) : sizeof(cl_float);
   int now = 1 - s->cur;
   cl_int j_lo = s->ring_s, j_hi = s->ring_s + s->own_ny;
   const gr_ws_arg args[] = {
@@ -88,7 +65,6 @@ static gr_status gr_ws_enqueue_one(gr_water_surface *s, double dt) {
       {"h_out", m, &s->h[now]},
       {"v", m, &s->v},
       {"wet", m, &s->wet},
-      {"g", m, &g},
       {"nx", sizeof(nx), &nx},
       {"ny", sizeof(ny), &ny},
       {"inv_dx2", sizeof(inv_dx2), &inv_dx2},
@@ -100,10 +76,23 @@ static gr_status gr_ws_enqueue_one(gr_water_surface *s, double dt) {
       {"drop_coef", sizeof(drop_coef), &drop_coef},
       {"j_lo", sizeof(j_lo), &j_lo},
       {"j_hi", sizeof(j_hi), &j_hi},
+      {"dx", sizeof(dx), &dx},
+      {"dy", sizeof(dy), &dy},
+      {"inv_2sig2", sizeof(inv_2sig2), &inv_2sig2},
+      {"reach_x", sizeof(rx), &rx},
+      {"reach_y", sizeof(ry), &ry},
+      {"threshold", sizeof(threshold), &threshold},
+      {"seed", sizeof(seed), &seed},
+      {"step_lo", sizeof(step_lo), &step_lo},
+      {"step_hi", sizeof(step_hi), &step_hi},
+      {"gj0", sizeof(gj0), &gj0},
+      {"drop_at", drop_bytes, NULL},
+      {"drop_mask", mask_bytes, NULL},
+      {"g_tile", g_bytes, NULL},
   };
-  st = GR_WS_ARGS(s, s->step, args);
+  gr_status st = GR_WS_ARGS(s, s->step, args);
   if (st == GR_OK)
-    st = gr_enqueue_2d(s->ctx, s->step, 0, (size_t)j_lo, (size_t)nx, (size_t)(j_hi - j_lo), NULL);
+    st = gr_enqueue_2d(s->ctx, s->step, 0, (size_t)j_lo, (size_t)nx, (size_t)(j_hi - j_lo), tile);
   if (st != GR_OK)
     return st;
   s->cur = now;

@@ -152,9 +152,9 @@ typedef struct gr_water_surface_ledger {
 typedef struct gr_water_surface gr_water_surface;
 
 /**
- * What a simulation on grid needs (memory.h), its ring included: 37 bytes a
- * point on the device (h twice, v, base, the drops' g, the initial h and
- * the derived fields' three floats, the wet mask's byte) and 13 on the host
+ * What a simulation on grid needs (memory.h), its ring included: 33 bytes a
+ * point on the device (h twice, v, base, the initial h and the derived
+ * fields' three floats, the wet mask's byte) and 13 on the host
  * (the elevation, the depth, and the wet mask and still surface made when
  * the water is prepared). GR_ERR_INVALID_ARGUMENT without grid or out.
  */
