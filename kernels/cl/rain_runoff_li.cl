@@ -21,6 +21,8 @@
  *   rain_runoff_update  per cell: rain, infiltration and the four faces'
  *                       limited discharges q* K(upwind) into the new depth,
  *                       and the new state into the flood maps.
+ * On GPUs the last two are one launch, rain_runoff_limit_update (the same
+ * floats; see there).
  * The face arrays keep q* and the cell array K: the discharge that flows is
  * q* K(upwind cell), the same float from the same two inputs in both cells
  * that share the face, so what leaves one cell arrives in the other. Rain
@@ -445,6 +447,62 @@ rain_runoff_update(__global float *restrict h, __global float *restrict h_comp,
                              outflow_comp, inflow, inflow_comp, dt, inv_dx, inv_dy, max_depth,
                              max_speed, arrival, wet_time, wet_time_comp, max_hazard, wetting_depth,
                              debris_factor, map_time);
+}
+
+/* rain_runoff_limit and rain_runoff_update in one launch (GPUs: the
+ * limiter's own launch read the depth and the faces and wrote K, which the
+ * update read again): each work-item computes K of its cell and of its four
+ * neighbours from their depths after rain and infiltration and their faces
+ * (gr_rain_runoff_k, as rain_runoff_limit: the same floats), writes its
+ * own K to limit, and updates its cell (gr_rain_runoff_update_cell). The
+ * neighbours' K needs their depths at the step's start, so the depth is
+ * read from h and the new one written to h_out (the host swaps them after
+ * the step, as after rain_runoff_li_step). On the H200 at 4096^2 the step
+ * took 0.646 ms against 0.680 with the two launches: the limiter's launch
+ * and its 16 bytes a cell gone, its five limiters a cell recomputed from
+ * the caches. Taller work-groups (32 x 8: 0.663, 32 x 16: 0.686) and the
+ * neighbours' K from local memory within the work-group (0.654) were
+ * slower than the 32 x 4 of the other launches. */
+__kernel void rain_runoff_limit_update(
+    __global const float *restrict h, __global float *restrict h_out,
+    __global float *restrict h_comp, __global const float *restrict rain,
+    __global const float *restrict perm, __global const float *restrict src, int use_src,
+    __global const float *restrict nodata, int use_nodata, __global const float *restrict qx,
+    __global const float *restrict qy, __global float *restrict limit,
+    __global float *restrict infiltrated, __global float *restrict infiltrated_comp,
+    __global float *restrict outflow, __global float *restrict outflow_comp,
+    __global float *restrict inflow, __global float *restrict inflow_comp, int nx, int ny, float dt,
+    float inv_dx, float inv_dy, int use_rain, float rain_uniform, int use_perm, float perm_uniform,
+    GR_RAIN_RUNOFF_MAP_ARGS, float map_time) {
+  int i = get_global_id(0), j = get_global_id(1);
+  if (!gr_inside(i, j, nx, ny))
+    return;
+  int c = gr_idx(i, j, nx);
+  float qw = qx[j * (nx + 1) + i], qe = qx[j * (nx + 1) + i + 1];
+  float qs = qy[j * nx + i], qn = qy[(j + 1) * nx + i];
+  float h0 = h[c], r = GR_RAIN_RUNOFF_RAIN(c), k = GR_RAIN_RUNOFF_PERM(c),
+        sc = GR_RAIN_RUNOFF_SRC(c);
+  /* rain_runoff_limit's K of cell m = (mi, mj) (masked, not clamped,
+   * neighbours: 1 beyond the grid, as rain_runoff_update takes it). */
+#define GR_LU_K(m, mi, mj)                                                                         \
+  gr_rain_runoff_k(gr_rain_runoff_wet(h[m], GR_RAIN_RUNOFF_RAIN(m), GR_RAIN_RUNOFF_SRC(m),         \
+                                      GR_RAIN_RUNOFF_PERM(m), dt),                                 \
+                   qx[(mj) * (nx + 1) + (mi)], qx[(mj) * (nx + 1) + (mi) + 1], qy[(mj)*nx + (mi)], \
+                   qy[((mj) + 1) * nx + (mi)], dt, inv_dx, inv_dy)
+  float kc =
+      gr_rain_runoff_k(gr_rain_runoff_wet(h0, r, sc, k, dt), qw, qe, qs, qn, dt, inv_dx, inv_dy);
+  float kw = i > 0 ? GR_LU_K(c - 1, i - 1, j) : 1.0f;
+  float ke = i < nx - 1 ? GR_LU_K(c + 1, i + 1, j) : 1.0f;
+  float ks = j > 0 ? GR_LU_K(c - nx, i, j - 1) : 1.0f;
+  float kn = j < ny - 1 ? GR_LU_K(c + nx, i, j + 1) : 1.0f;
+#undef GR_LU_K
+  gr_rain_runoff_update_cell(i, j, c, nx, ny, h0, r, k, sc, kc, kw, ke, ks, kn, qw, qe, qs, qn,
+                             h_out, h_comp, nodata, use_nodata, infiltrated, infiltrated_comp,
+                             outflow, outflow_comp, inflow, inflow_comp, dt, inv_dx, inv_dy,
+                             max_depth, max_speed, arrival, wet_time, wet_time_comp, max_hazard,
+                             wetting_depth, debris_factor, map_time);
+  /* After the update's stores: it loads everything before them. */
+  limit[c] = kc;
 }
 
 /* The local inertial step in one launch (FlowModel 1; the same floats as

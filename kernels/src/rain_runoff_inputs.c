@@ -686,10 +686,10 @@ gr_status gr_rain_runoff_hyetograph_step(gr_rain_runoff *s, double t0, double t1
   cl_float rf =
       (cl_float)(gr_rain_runoff_table_integral(s->hy_t, s->hy_r, s->hy_n, t0, t1) / (t1 - t0));
   int sw = s->params.flow_model == GR_FLOW_SHALLOW_WATER;
-  cl_kernel li[5] = {s->flux_edges, s->li_step, s->flux, s->limit, s->update};
+  cl_kernel li[6] = {s->flux_edges, s->li_step, s->flux, s->limit, s->update, s->limit_update};
   cl_kernel swk[5] = {s->sw_prep, s->sw_faces[0], s->sw_update[0], s->sw_faces[1], s->sw_update[1]};
   gr_status st = GR_OK;
-  for (int k = 0; st == GR_OK && k < (sw ? 5 : (s->fused ? 2 : 5)); ++k)
+  for (int k = 0; st == GR_OK && k < (sw ? 5 : (s->fused ? 2 : 6)); ++k)
     st = sw ? gr_kernel_arg(s->ctx, swk[k], "rain_uniform", sizeof(rf), &rf)
             : gr_rain_runoff_arg_at(s, li[k], s->ix_rain[k], sizeof(rf), &rf);
   for (int k = 0; st == GR_OK && sw && k < 4; ++k)

@@ -119,12 +119,20 @@ struct gr_rain_runoff {
   int fused;
   size_t li_local[2];
   cl_mem h_alt, k_alt;
+  /* The limiter and the update in one launch (rain_runoff_limit_update;
+   * merged: the three launches take it in place of rain_runoff_limit and
+   * rain_runoff_update, GPUs by default), reading h and writing h_alt,
+   * swapped after every such step. */
+  cl_kernel limit_update;
+  int merged;
   /* The indices of the arguments that change every step, looked up once:
    * li_step's (h, h_out, limit, limit_out, qx_old, qy_old, qx, qy,
    * map_time), flux_edges' (h, limit, qx_old, qy_old, qx, qy), flux's
-   * (qx_old, qy_old, qx, qy), limit's and update's (qx, qy; map_time). */
-  cl_uint ix_step[9], ix_edges[6], ix_flux[4], ix_limit[2], ix_update[3];
-  cl_uint ix_rain[5]; /* rain_uniform of flux_edges, li_step, flux, limit, update */
+   * (qx_old, qy_old, qx, qy, h), limit's and update's (qx, qy; map_time),
+   * limit_update's (qx, qy, map_time, h, h_out). */
+  cl_uint ix_step[9], ix_edges[6], ix_flux[5], ix_limit[2], ix_update[3], ix_lu[5];
+  /* rain_uniform of flux_edges, li_step, flux, limit, update, limit_update */
+  cl_uint ix_rain[6];
   /* Shallow water's step: the points of stage 1, then per stage the faces
    * and the cells' update. */
   cl_kernel sw_prep, sw_faces[2], sw_update[2], sw_edges;

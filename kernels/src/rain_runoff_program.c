@@ -81,19 +81,22 @@ static gr_status gr_rain_runoff_step_indices(gr_rain_runoff *s) {
   static const char *const step[] = {"h",      "h_out", "limit", "limit_out", "qx_old",
                                      "qy_old", "qx",    "qy",    "map_time"};
   static const char *const edges[] = {"h", "limit", "qx_old", "qy_old", "qx", "qy"};
-  static const char *const update[] = {"qx", "qy", "map_time"};
+  static const char *const update[] = {"qx", "qy", "map_time", "h", "h_out"};
+  static const char *const flux[] = {"qx_old", "qy_old", "qx", "qy", "h"};
   gr_status st = gr_rain_runoff_arg_indices(s, s->li_step, step, 9, s->ix_step);
   if (st == GR_OK)
     st = gr_rain_runoff_arg_indices(s, s->flux_edges, edges, 6, s->ix_edges);
   if (st == GR_OK)
-    st = gr_rain_runoff_arg_indices(s, s->flux, edges + 2, 4, s->ix_flux);
+    st = gr_rain_runoff_arg_indices(s, s->flux, flux, 5, s->ix_flux);
   if (st == GR_OK)
     st = gr_rain_runoff_arg_indices(s, s->limit, update, 2, s->ix_limit);
   if (st == GR_OK)
     st = gr_rain_runoff_arg_indices(s, s->update, update, 3, s->ix_update);
+  if (st == GR_OK)
+    st = gr_rain_runoff_arg_indices(s, s->limit_update, update, 5, s->ix_lu);
   static const char *const rain[] = {"rain_uniform"};
-  cl_kernel li[5] = {s->flux_edges, s->li_step, s->flux, s->limit, s->update};
-  for (int k = 0; st == GR_OK && k < 5; ++k)
+  cl_kernel li[6] = {s->flux_edges, s->li_step, s->flux, s->limit, s->update, s->limit_update};
+  for (int k = 0; st == GR_OK && k < 6; ++k)
     st = gr_rain_runoff_arg_indices(s, li[k], rain, 1, &s->ix_rain[k]);
   return st;
 }
@@ -401,17 +404,35 @@ gr_status gr_rain_runoff_specialise(gr_rain_runoff *s) {
       "rain_runoff_sw_stage2",  "rain_runoff_reduce",     "rain_runoff_derive",
       "rain_runoff_sw_speed",   "rain_runoff_li_speed",   "rain_runoff_maps",
       "rain_runoff_source",     "rain_runoff_sw_inner1",  "rain_runoff_sw_inner2",
-      "rain_runoff_sw_rim1",    "rain_runoff_sw_rim2"};
+      "rain_runoff_sw_rim1",    "rain_runoff_sw_rim2",    "rain_runoff_limit_update"};
   enum { GR_RR_KERNELS = sizeof(names) / sizeof(names[0]) };
   /* The shallow-water model's kernels (none in a local inertial program). */
   static const unsigned char sw_only[GR_RR_KERNELS] = {0, 0, 0, 0, 0, 1, 1, 1, 1, 1, 1, 1,
-                                                       1, 0, 0, 1, 0, 0, 0, 1, 1, 1, 1};
-  cl_kernel *slots[GR_RR_KERNELS] = {
-      &s->flux,        &s->flux_edges,      &s->limit,          &s->update,       &s->li_step,
-      &s->sw_prep,     &s->sw_faces[0],     &s->sw_faces[1],    &s->sw_update[0], &s->sw_update[1],
-      &s->sw_edges,    &s->sw_stage[0],     &s->sw_stage[1],    &s->reduce,       &s->derive,
-      &s->sw_speed,    &s->li_speed,        &s->maps,           &s->source,       &s->sw_inner[0],
-      &s->sw_inner[1], &s->sw_rim_faces[0], &s->sw_rim_faces[1]};
+                                                       1, 0, 0, 1, 0, 0, 0, 1, 1, 1, 1, 0};
+  cl_kernel *slots[GR_RR_KERNELS] = {&s->flux,
+                                     &s->flux_edges,
+                                     &s->limit,
+                                     &s->update,
+                                     &s->li_step,
+                                     &s->sw_prep,
+                                     &s->sw_faces[0],
+                                     &s->sw_faces[1],
+                                     &s->sw_update[0],
+                                     &s->sw_update[1],
+                                     &s->sw_edges,
+                                     &s->sw_stage[0],
+                                     &s->sw_stage[1],
+                                     &s->reduce,
+                                     &s->derive,
+                                     &s->sw_speed,
+                                     &s->li_speed,
+                                     &s->maps,
+                                     &s->source,
+                                     &s->sw_inner[0],
+                                     &s->sw_inner[1],
+                                     &s->sw_rim_faces[0],
+                                     &s->sw_rim_faces[1],
+                                     &s->limit_update};
   char opt[224] = "";
   int len = 0;
   if (s->specialise)

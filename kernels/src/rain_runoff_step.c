@@ -178,11 +178,11 @@ static gr_status gr_rain_runoff_bind_li(gr_rain_runoff *s, const gr_rain_runoff_
   /* The depth and limiter the three step kernels share (each takes those
    * it has). */
   const gr_rain_runoff_arg state[] = {{"h", m, &s->h}, {"limit", m, &s->k}};
-  cl_kernel kernels[] = {s->flux, s->flux_edges, s->limit, s->update, s->li_step};
+  cl_kernel kernels[] = {s->flux, s->flux_edges, s->limit, s->update, s->li_step, s->limit_update};
   gr_status st = GR_OK;
-  for (int i = 0; st == GR_OK && i < 5; ++i)
+  for (int i = 0; st == GR_OK && i < 6; ++i)
     st = GR_RAIN_RUNOFF_ARGS(s, kernels[i], state);
-  for (int i = 0; st == GR_OK && i < 5; ++i)
+  for (int i = 0; st == GR_OK && i < 6; ++i)
     st = gr_rain_runoff_bind_inputs(s, kernels[i], v);
   if (st == GR_OK)
     st = gr_rain_runoff_bind_friction(s, s->flux, v);
@@ -202,6 +202,10 @@ static gr_status gr_rain_runoff_bind_li(gr_rain_runoff *s, const gr_rain_runoff_
   if (st == GR_OK)
     st = gr_rain_runoff_bind_maps(s, s->update);
   if (st == GR_OK)
+    st = gr_rain_runoff_bind_books(s, s->limit_update);
+  if (st == GR_OK)
+    st = gr_rain_runoff_bind_maps(s, s->limit_update);
+  if (st == GR_OK)
     st = gr_rain_runoff_bind_books(s, s->li_step);
   if (st == GR_OK)
     st = gr_rain_runoff_bind_maps(s, s->li_step);
@@ -220,10 +224,13 @@ static gr_status gr_rain_runoff_bind_li(gr_rain_runoff *s, const gr_rain_runoff_
 /* Binds every step-kernel argument but the alternating face arrays, when
  * something they hold has changed since the last step. */
 static gr_status gr_rain_runoff_bind(gr_rain_runoff *s, cl_float dt) {
-  /* The fused step sets the depth and limiter every step (they alternate);
-   * the other kernels keep those they were bound to. */
-  int fused = s->fused && s->params.flow_model == GR_FLOW_LOCAL_INERTIAL;
-  if (s->args_set && s->args_dt == dt && (fused || (s->args_h == s->h && s->args_k == s->k)))
+  /* The fused step sets the depth and limiter every step (they alternate),
+   * the merged limiter and update the depth; the other kernels keep those
+   * they were bound to. */
+  int li = s->params.flow_model == GR_FLOW_LOCAL_INERTIAL;
+  int h_set = li && (s->fused || s->merged), k_set = li && s->fused;
+  if (s->args_set && s->args_dt == dt && (h_set || s->args_h == s->h) &&
+      (k_set || s->args_k == s->k))
     return GR_OK;
   s->args_h = s->h;
   s->args_k = s->k;
@@ -383,12 +390,23 @@ static gr_status gr_rain_runoff_li_launch(gr_rain_runoff *s, int fused, int edge
   }
   for (int a = 0; st == GR_OK && a < 4; ++a)
     st = gr_rain_runoff_arg_at(s, s->flux, s->ix_flux[a], m, eargs[a + 2]);
-  for (int a = 0; st == GR_OK && a < 2; ++a)
+  for (int a = 0; st == GR_OK && !s->merged && a < 2; ++a)
     st = gr_rain_runoff_arg_at(s, s->limit, s->ix_limit[a], m, eargs[a + 4]);
-  for (int a = 0; st == GR_OK && a < 2; ++a)
+  for (int a = 0; st == GR_OK && !s->merged && a < 2; ++a)
     st = gr_rain_runoff_arg_at(s, s->update, s->ix_update[a], m, eargs[a + 4]);
-  if (st == GR_OK)
+  if (st == GR_OK && !s->merged)
     st = gr_rain_runoff_arg_at(s, s->update, s->ix_update[2], sizeof(map_time), &map_time);
+  /* Merged: the depth alternates (limit_update reads h, writes h_alt), so
+   * the flux kernels and limit_update take it every step. */
+  const cl_mem *largs[5] = {&s->qx[now], &s->qy[now], NULL, &s->h, &s->h_alt};
+  for (int a = 0; st == GR_OK && s->merged && a < 5; ++a)
+    st = a == 2
+             ? gr_rain_runoff_arg_at(s, s->limit_update, s->ix_lu[a], sizeof(map_time), &map_time)
+             : gr_rain_runoff_arg_at(s, s->limit_update, s->ix_lu[a], m, largs[a]);
+  if (st == GR_OK && s->merged)
+    st = gr_rain_runoff_arg_at(s, s->flux, s->ix_flux[4], m, &s->h);
+  if (st == GR_OK && s->merged && edges)
+    st = gr_rain_runoff_arg_at(s, s->flux_edges, s->ix_edges[0], m, &s->h);
   /* GPUs: a warp a row (GR_RAIN_RUNOFF_LI_GROUP_X); CPUs: the runtime's. */
   static const size_t li_group[2] = {GR_RAIN_RUNOFF_LI_GROUP_X, GR_RAIN_RUNOFF_LI_GROUP_Y};
   const size_t *lg = s->gpu ? li_group : NULL;
@@ -399,6 +417,15 @@ static gr_status gr_rain_runoff_li_launch(gr_rain_runoff *s, int fused, int edge
     st = gr_enqueue_1d(s->ctx, s->flux_edges, 2 * ((size_t)s->nxl + (size_t)s->nyl));
   if (st == GR_OK)
     s->cur = now; /* the flux kernel is enqueued: the new faces are current */
+  if (st == GR_OK && s->merged) {
+    st = gr_enqueue_2d(s->ctx, s->limit_update, 0, 0, (size_t)s->nxl, (size_t)s->nyl, lg);
+    if (st == GR_OK) {
+      cl_mem t = s->h; /* the new depth is current */
+      s->h = s->h_alt;
+      s->h_alt = t;
+    }
+    return st;
+  }
   if (st == GR_OK)
     st = gr_enqueue_2d(s->ctx, s->limit, 0, 0, (size_t)s->nxl, (size_t)s->nyl, lg);
   if (st == GR_OK)
@@ -438,12 +465,11 @@ gr_status gr_rain_runoff_enqueue(gr_rain_runoff *s, double dt, int nsteps, gr_ra
     st = gr_rain_runoff_step_end(s, &b, st);
   }
   int fused = !sw && s->fused;
-  if (st == GR_OK && fused && !s->h_alt) {
-    size_t bytes = gr_rain_runoff_cells(s) * sizeof(cl_float);
+  size_t bytes = gr_rain_runoff_cells(s) * sizeof(cl_float);
+  if (st == GR_OK && !sw && (fused || s->merged) && !s->h_alt)
     st = gr_buffer_create(s->ctx, CL_MEM_READ_WRITE, bytes, NULL, &s->h_alt);
-    if (st == GR_OK)
-      st = gr_buffer_create(s->ctx, CL_MEM_READ_WRITE, bytes, NULL, &s->k_alt);
-  }
+  if (st == GR_OK && fused && !s->k_alt)
+    st = gr_buffer_create(s->ctx, CL_MEM_READ_WRITE, bytes, NULL, &s->k_alt);
   /* The fused step's work-groups: tiles of li_local - 3 cells each way. */
   size_t tx = fused ? s->li_local[0] - 3 : 1, ty = fused ? s->li_local[1] - 3 : 1;
   size_t gx = ((size_t)s->nxl + tx - 1) / tx * s->li_local[0];
