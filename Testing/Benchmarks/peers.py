@@ -604,11 +604,11 @@ def profile(a, deps):
             g, inv = 9.80665, (1.0 / dx ** 2 + 1.0 / dy ** 2) ** 0.5
             # The Courant steps the deepest water allows (rain_runoff.c):
             # local inertial cfl sqrt(0.8) / (sqrt(g h) |1/d|), shallow water
-            # (still water) cfl / 2 / (sqrt(g h) (1/dx + 1/dy)).
+            # (still water) min(1, 9 cfl / 7) / 2 / (sqrt(g h) (1/dx + 1/dy)).
             c = (g * r["max_depth"]) ** 0.5
             log("  deepest water %.2f m: Courant step %.2f s (local inertial), %.2f s (shallow "
                 "water, still)" % (r["max_depth"], 0.7 * 0.8 ** 0.5 / (c * inv),
-                                   0.35 / (c * (1.0 / dx + 1.0 / dy))))
+                                   0.45 / (c * (1.0 / dx + 1.0 / dy))))
             # Each stretch ends with a one-point sample (the wait): taken off.
             stepping = r["t_steps"] - r["reads"] * r["t_sample"]
             print("| %d | %g | %s | %.2f | %.2f | %.3f | %.4f | %d | %d | %.3f | %.2f | %.2f | %d | "

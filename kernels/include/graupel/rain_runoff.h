@@ -108,8 +108,10 @@
  * (gathers: each face is computed once per stage and read by the two cells
  * that share it), the
  * checkpoints and the pieces work as for the local inertial model; the
- * stable step is cfl / 2 / max((|u| + sqrt(g h)) / dx + (|v| + sqrt(g h))
- * / dy) over the cells (one reduction, as the local inertial model's), and
+ * stable step is c / 2 / max((|u| + sqrt(g h)) / dx + (|v| + sqrt(g h))
+ * / dy) over the cells, c = min(1, 9 cfl / 7) (0.9 at the default cfl 0.7;
+ * 1/2 is the bound that keeps depths positive; one reduction, as the local
+ * inertial model's), and
  * a piece's ring is GR_RAIN_RUNOFF_GHOST_SW cells (each stage reads two
  * cells away: one exchange per step covers both stages; the halo strip holds
  * per cell the depth, qu, qv and the depth's Kahan compensation).
