@@ -1,7 +1,7 @@
 """Rain Runoff's flood maps on the real DEM in Data/: 1 h of 50 mm/h on the
 Jacksboro fault DEM (403 x 344 points, 74.5 x 92.1 m), then the largest depth
 and the flood-hazard class (FD2321's h (v + 0.5) + DF) seen from above, and the
-hydrograph (output port 1) as a line chart. About 80 s on PoCL on two cores.
+hydrograph (output port 1) as a line chart. About 11 s on PoCL on two cores.
 
     xvfb-run -a pvbatch Examples/flood_maps.py --out out
 
