@@ -1634,9 +1634,12 @@ static float *cut(const float *global, int gnx, int x0, int y0, int w, int h) {
   return out;
 }
 
+/* The ring make_piece asks for (grid.ghost). */
+static int piece_ghost = GR_SNOW_DEFORMATION_GHOST;
+
 static int make_piece(piece *p, const domain *dm, const gr_snow_deformation_params *prm, int i0,
                       int j0, int nx, int ny) {
-  const int G = GR_SNOW_DEFORMATION_GHOST;
+  const int G = piece_ghost;
   memset(p, 0, sizeof(*p));
   p->g = dm->g;
   p->g.nx = nx, p->g.ny = ny, p->g.i0 = i0, p->g.j0 = j0;
@@ -1990,6 +1993,103 @@ static void test_pieces_y(void) {
   free_domain(&dm);
 }
 
+/* A wider ring (temporal blocking across the cut): 2 and 3 times
+ * GR_SNOW_DEFORMATION_GHOST, so 2 and 3 talus launches between exchanges
+ * and a reach's mask in one pass, end on the whole grid's bits in fewer
+ * exchanges than the narrow ring, in blocked and in one-launch iterations
+ * (pieces_y's scene split in y, 26 + 22 points; pieces_x's split in x, 30 +
+ * 34; on the split tests' snow and on rough snow). Widths the core does
+ * not take are refused. */
+static void test_pieces_wide(void) {
+  const int G = GR_SNOW_DEFORMATION_GHOST;
+  domain dm = make_domain(), rough = make_domain();
+  /* Rough snow, up to 2 m deeper at random: the talus runs on every point
+   * for many launches, its windows on the rings' outer edges too (one
+   * launch more than a ring holds before its exchange changes bits here,
+   * with a ring of 8 and of 16). */
+  for (int j = 0; j < rough.g.ny; ++j)
+    for (int i = 0; i < rough.g.nx; ++i)
+      rough.d[(size_t)j * rough.g.nx + i] += (float)(2.0 * hash01(i, j, 5));
+  for (int run = 0; run < 5; ++run) {
+    /* 0: in y, blocked; 1: in y, one launch an iteration; 2: in x, one
+     * launch; 3, 4: 0 and 2 on rough snow */
+    const int split = run < 3 ? run : run == 3 ? 0 : 2;
+    const domain *dp = run < 3 ? &dm : &rough;
+    gr_snow_deformation_params prm;
+    gr_snow_deformation_params_init(&prm);
+    int kind = split < 2 ? 1 : 0, blocked = split == 0, wide = split < 2 ? 2 * G : 3 * G;
+    if (kind == 1) {
+      prm.compression_model = GR_SNOW_COMPRESSION_CONSTANT;
+      prm.slump_speed = 30.0; /* a reach of 10 points: two passes with a ring of 8, one wider */
+    }
+    const int steps = 40;
+    gr_snow_deformation_ledger lw;
+    double fw[6], aw[2];
+    gr_snow_deformation *whole = make_whole(dp, &prm);
+    if (!whole)
+      break;
+    gr_snow_deformation_set_blocked(whole, blocked);
+    run_whole(whole, kind, steps, &lw, fw, aw);
+    CHECK(lw.displaced_volume > 1e-3);
+    int exchanges[2] = {0, 0};
+    for (int w = 0; w < 2; ++w) {
+      piece pc[2];
+      runner rn[2];
+      memset(pc, 0, sizeof(pc));
+      piece_ghost = w ? wide : G;
+      int ok = split < 2 ? make_piece(&pc[0], dp, &prm, 0, 0, 64, 26) &&
+                               make_piece(&pc[1], dp, &prm, 0, 26, 64, 22)
+                         : make_piece(&pc[0], dp, &prm, 0, 0, 30, 48) &&
+                               make_piece(&pc[1], dp, &prm, 30, 0, 34, 48);
+      piece_ghost = G;
+      if (ok) {
+        for (int k = 0; k < 2; ++k)
+          gr_snow_deformation_set_blocked(pc[k].s, blocked);
+        size_t bytes = 0;
+        CHECK(gr_snow_deformation_halo_size(
+                  pc[0].s, split < 2 ? GR_SNOW_DEFORMATION_NORTH : GR_SNOW_DEFORMATION_EAST,
+                  &bytes) == GR_OK &&
+              bytes == 2 * (size_t)(w ? wide : G) * (split < 2 ? 64 : 48) * sizeof(float));
+        run_team(pc, rn, split < 2 ? GR_SNOW_DEFORMATION_NORTH : GR_SNOW_DEFORMATION_EAST, kind,
+                 steps, -1, 0, 0);
+        for (int k = 0; k < 2; ++k)
+          CHECK_MSG(rn[k].st == GR_OK && rn[k].taken == steps, "piece %d: %s", k,
+                    gr_snow_deformation_last_error(pc[k].s));
+        char what[120];
+        snprintf(what, sizeof(what), "split in %s, %s talus, %s snow, ring %d, %d steps",
+                 split < 2 ? "y" : "x", blocked ? "blocked" : "one-launch",
+                 run < 3 ? "the" : "rough", w ? wide : G, steps);
+        check_pieces(pc, rn, whole, dp, &lw, fw, aw, scene_objects(kind), what);
+        exchanges[w] = rn[0].exchanges;
+        CHECK(rn[1].exchanges == rn[0].exchanges);
+      }
+      for (int k = 0; k < 2; ++k)
+        gr_snow_deformation_destroy(pc[k].s);
+    }
+    printf("exchanges in %d steps: %d with a ring of %d, %d with a ring of %d\n", steps,
+           exchanges[0], G, exchanges[1], wide);
+    CHECK(exchanges[1] > 0 && exchanges[1] < exchanges[0]);
+    gr_snow_deformation_destroy(whole);
+  }
+  /* Rings the core refuses: not a multiple of 8, beyond the widest, and a
+   * piece narrower than its wide ring. */
+  gr_snow_deformation_params prm;
+  gr_snow_deformation_params_init(&prm);
+  gr_grid bad = dm.g;
+  bad.nx = 30, bad.global_nx = dm.g.nx, bad.global_ny = dm.g.ny;
+  gr_snow_deformation *s = NULL;
+  const int refused[] = {12, GR_SNOW_DEFORMATION_GHOST_MAX + G, 4 * G};
+  for (int q = 0; q < 3; ++q) {
+    bad.ghost = refused[q];
+    CHECK(gr_snow_deformation_create(ctx, &bad, &prm, &s) == GR_ERR_INVALID_ARGUMENT && !s);
+    CHECK_MSG(has(gr_last_error(ctx), q < 2 ? "ghost ring of 8 points (or a multiple of 8 up to 64)"
+                                            : "narrower than its ghost ring of 32"),
+              "ghost %d: %s", bad.ghost, gr_last_error(ctx));
+  }
+  free_domain(&dm);
+  free_domain(&rough);
+}
+
 /* A stop asked by piece 1's progress callback after its 7th step stops
  * both pieces after that step (piece 0 has no callback); a failing halo
  * exchange on one piece returns its status with a sentence. */
@@ -2093,6 +2193,7 @@ static const gr_subtest tests[] = {
     {"pieces_x", test_pieces_x, 0},
     {"pieces_y", test_pieces_y, 0},
     {"pieces_leave", test_pieces_leave, 0},
+    {"pieces_wide", test_pieces_wide, 0},
     {"pieces_abort", test_pieces_abort, 0},
     {"memcheck", test_memcheck, 1},
 };

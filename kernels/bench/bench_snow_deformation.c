@@ -5,7 +5,12 @@
  * whatever its size (SlumpSpeed the default, 2 m/s, unless
  * GRAUPEL_BENCH_SLUMP_SPEED says otherwise). The report times the stages of ten more steps
  * separately and, in the same run, plain 5-point stencil passes over the
- * grid (the yardstick of the target). */
+ * grid (the yardstick of the target). As pieces (--devices) each keeps a
+ * ring of SNOW_BENCH_RING points, 4 talus launches between exchanges
+ * (GRAUPEL_BENCH_SNOW_RING: another multiple of GR_SNOW_DEFORMATION_GHOST,
+ * 8 for the core's narrow ring). GRAUPEL_BENCH_SNOW_BLOCKED=1 runs the
+ * talus in blocked launches (a GPU's way, exchanges and all) on any device,
+ * 0 in one launch an iteration. */
 #include "bench.h"
 
 #include <math.h>
@@ -16,6 +21,7 @@
 #define SPHERE_SLICES 72
 #define SPHERE_RADIUS 1.0
 #define BENCH_PI 3.14159265358979323846
+#define SNOW_BENCH_RING (4 * GR_SNOW_DEFORMATION_GHOST)
 
 typedef struct snow_deformation_bench {
   gr_snow_deformation *sim;
@@ -87,6 +93,13 @@ static gr_status snow_deformation_place(snow_deformation_bench *b) {
   return gr_snow_deformation_set_objects(b->sim, &b->mesh, 1, b->v);
 }
 
+/* The pieces' ring: SNOW_BENCH_RING, or GRAUPEL_BENCH_SNOW_RING's (the
+ * core refuses a width it does not take). */
+static int snow_deformation_ring(void) {
+  const char *ring = getenv("GRAUPEL_BENCH_SNOW_RING");
+  return ring && *ring ? atoi(ring) : SNOW_BENCH_RING;
+}
+
 /* Rows j0 .. j0 + ny - 1 of the n by n set-up (the whole grid for j0 = 0,
  * ny = n), with a ring toward each neighbouring strip: the snow is the
  * parameters' uniform cover on flat ground, and every piece sets the same
@@ -99,7 +112,7 @@ static gr_status snow_deformation_setup_piece(gr_context *ctx, int n, int j0, in
   if (!whole) {
     g.global_nx = n;
     g.global_ny = n;
-    g.ghost = GR_SNOW_DEFORMATION_GHOST;
+    g.ghost = snow_deformation_ring();
   }
   gr_snow_deformation_params p;
   gr_snow_deformation_params_init(&p);
@@ -120,6 +133,11 @@ static gr_status snow_deformation_setup_piece(gr_context *ctx, int n, int j0, in
   b->v[0] = 2.0;
   b->dt = 1.0 / 60.0;
   gr_status st = gr_snow_deformation_create(ctx, &g, &p, &b->sim);
+  /* GRAUPEL_BENCH_SNOW_BLOCKED: 1, the talus in blocked launches (a GPU's
+   * way) on any device; 0, one launch an iteration (a CPU's) */
+  const char *blocked = getenv("GRAUPEL_BENCH_SNOW_BLOCKED");
+  if (st == GR_OK && blocked && *blocked)
+    gr_snow_deformation_set_blocked(b->sim, atoi(blocked));
   if (st == GR_OK && !whole && link) {
     gr_snow_deformation_set_allreduce(b->sim, link->allreduce, link->allreduce_user);
     gr_snow_deformation_set_halo_exchange(b->sim, link->exchange, link->exchange_user);
@@ -204,10 +222,6 @@ static gr_status snow_deformation_report(void *state, gr_context *ctx) {
 }
 
 /* ------------------------------------------------------------ as pieces */
-
-static int snow_deformation_ring(void) {
-  return GR_SNOW_DEFORMATION_GHOST;
-}
 
 static gr_status snow_deformation_halo_size(void *state, int side, size_t *bytes) {
   return gr_snow_deformation_halo_size(((snow_deformation_bench *)state)->sim, side, bytes);

@@ -619,8 +619,10 @@ static int split_measure(split_team *t, split_member *m, const char *name, const
     rc = differ == 0 ? 0 : 1;
   }
   printf("core=%s size=%d steps=%d devices=%d ms_per_step=%.6g mcells_per_s=%.6g "
-         "bw_fraction=%.4g halo_ms_per_step=%.6g allreduce_bytes_per_step=%.0f device=\"%s\"\n",
+         "bw_fraction=%.4g halo_ms_per_step=%.6g exchanges_per_step=%.4g ring=%d "
+         "allreduce_bytes_per_step=%.0f device=\"%s\"\n",
          name, t->n, t->steps, t->k, f.ms, f.mcells, f.frac, 1e3 * f.halo / t->steps,
+         (double)f.exchanges / t->steps, t->k > 1 ? t->split->ring() : 0,
          8.0 * f.step_values / t->steps, gr_context_device_name(m[0].ctx));
   return rc;
 }

@@ -344,9 +344,10 @@ gr_status gr_snow_deformation_create(gr_context *ctx, const gr_grid *grid,
   int ring[4];
   if (gr_snow_piece_rings(grid, ring, msg, sizeof(msg)) != GR_OK)
     return gr_set_error(ctx, GR_ERR_INVALID_ARGUMENT, "%s", msg);
-  if (((double)grid->nx + 2 * GR_SNOW_DEFORMATION_GHOST) *
-          ((double)grid->ny + 2 * GR_SNOW_DEFORMATION_GHOST) >
-      (double)INT_MAX / 2)
+  double wide = GR_SNOW_DEFORMATION_GHOST; /* the ring, or a wider one asked for */
+  for (int q = 0; q < 4; ++q)
+    wide = ring[q] > wide ? ring[q] : wide;
+  if (((double)grid->nx + 2 * wide) * ((double)grid->ny + 2 * wide) > (double)INT_MAX / 2)
     return gr_set_error(ctx, GR_ERR_TOO_LARGE,
                         "The snow deformation grid of %d x %d points is too large: the kernels "
                         "address at most about 1e9 points; coarsen it.",

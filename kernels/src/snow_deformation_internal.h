@@ -152,6 +152,7 @@ gr_status gr_snow_relax(gr_snow_deformation *s, double dt);
 /* snow_deformation_pieces.c */
 gr_status gr_snow_piece_rings(const gr_grid *g, int ring[4], char *msg, size_t len);
 int gr_snow_has_ring(const gr_snow_deformation *s);
+int gr_snow_ring_width(const gr_snow_deformation *s);
 void gr_snow_own_clip(const gr_snow_deformation *s, int *x0, int *y0, int *x1, int *y1);
 gr_status gr_snow_allreduce(gr_snow_deformation *s, double *values, int n, gr_reduce_op op);
 gr_status gr_snow_allreduce_i64(gr_snow_deformation *s, long long *v, int n);

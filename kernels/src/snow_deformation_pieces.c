@@ -7,14 +7,31 @@
 /* ------------------------------------------------------ pieces and halos */
 
 /* The piece contract (graupel.h, snow_deformation.h): which sides have a
- * neighbour, and so a ring of GR_SNOW_DEFORMATION_GHOST points. */
+ * neighbour, and so a ring of grid.ghost points, GR_SNOW_DEFORMATION_GHOST
+ * or a multiple of it up to GR_SNOW_DEFORMATION_GHOST_MAX (anything else
+ * is refused, with GR_SNOW_DEFORMATION_GHOST as the width asked for). */
 gr_status gr_snow_piece_rings(const gr_grid *g, int ring[4], char *msg, size_t len) {
-  return gr_grid_piece_check(g, "snow deformation", GR_SNOW_DEFORMATION_GHOST, "", 1, ring, msg,
-                             len);
+  const int G = GR_SNOW_DEFORMATION_GHOST;
+  int need = g->ghost >= G && g->ghost <= GR_SNOW_DEFORMATION_GHOST_MAX && g->ghost % G == 0
+                 ? g->ghost
+                 : G;
+  char need_for[80];
+  snprintf(need_for, sizeof(need_for), " (or a multiple of %d up to %d)", G,
+           GR_SNOW_DEFORMATION_GHOST_MAX);
+  return gr_grid_piece_check(g, "snow deformation", need, need_for, 1, ring, msg, len);
 }
 
 int gr_snow_has_ring(const gr_snow_deformation *s) {
   return s->ring[0] || s->ring[1] || s->ring[2] || s->ring[3];
+}
+
+/* The piece's ring width (every side with a neighbour has the same); 0 on
+ * a whole grid. */
+int gr_snow_ring_width(const gr_snow_deformation *s) {
+  int w = 0;
+  for (int q = 0; q < 4; ++q)
+    w = s->ring[q] > w ? s->ring[q] : w;
+  return w;
 }
 
 /* Cuts the window [*x0, *x1] x [*y0, *y1] of the local arrays to the
@@ -88,15 +105,14 @@ gr_status gr_snow_piece_sync(gr_snow_deformation *s) {
   return GR_OK;
 }
 
-/* The points of a halo strip on `side`: GR_SNOW_DEFORMATION_GHOST columns
- * by the local arrays' rows (west, east), or their columns by
- * GR_SNOW_DEFORMATION_GHOST rows (south, north); 0 where the side has no
- * neighbour. */
+/* The points of a halo strip on `side`: the ring's width in columns by
+ * the local arrays' rows (west, east), or their columns by the ring's
+ * width in rows (south, north); 0 where the side has no neighbour. */
 static size_t gr_snow_strip_cells(const gr_snow_deformation *s, int side, size_t *w, size_t *h) {
   if (side < 0 || side > 3 || !s->ring[side])
     return 0;
-  *w = side < 2 ? (size_t)GR_SNOW_DEFORMATION_GHOST : (size_t)s->grid.nx;
-  *h = side < 2 ? (size_t)s->grid.ny : (size_t)GR_SNOW_DEFORMATION_GHOST;
+  *w = side < 2 ? (size_t)s->ring[side] : (size_t)s->grid.nx;
+  *h = side < 2 ? (size_t)s->grid.ny : (size_t)s->ring[side];
   return *w * *h;
 }
 
@@ -154,7 +170,7 @@ static gr_status gr_snow_halo_copy(gr_snow_deformation *s, int side, void *host,
                         "The halo buffer has %zu bytes but side %d's strip has %zu: size it with "
                         "gr_snow_deformation_halo_size.",
                         bytes, side, need);
-  const size_t g = GR_SNOW_DEFORMATION_GHOST, nxl = (size_t)s->grid.nx, nyl = (size_t)s->grid.ny;
+  const size_t g = (size_t)s->ring[side], nxl = (size_t)s->grid.nx, nyl = (size_t)s->grid.ny;
   size_t x0 = 0, y0 = 0;
   switch (side) {
   case 0:

@@ -324,11 +324,12 @@ static int gr_snow_clip_box(const gr_snow_deformation *s, const int in[4], int o
  * object feeds becomes a heap at MaxSlope on every grid (a talus cut to a
  * number of iterations carries a flux that shrinks with the spacing, and
  * piled a wall). The mask is a max filter of the seeds in passes of at
- * most GR_SNOW_DEFORMATION_GHOST - 1 points, each exchanged on a piece (a
- * seed reads its neighbours: the ring gives 7 points), so a piece's mask is
- * the whole grid's. Leaves the movers' box in *x0.. (the givers' window)
- * and the reach's box in s->reach_box and s->reach_all; *any = 0 when
- * nothing can move. */
+ * most the ring's width less one (GR_SNOW_DEFORMATION_GHOST - 1 on a whole
+ * grid), each exchanged on a piece (a seed reads its neighbours: a ring of
+ * 8 gives 7 points), so a piece's mask is the whole grid's (a square max
+ * filter of h then h' points is one of h + h'). Leaves the movers' box in
+ * *x0.. (the givers' window) and the reach's box in s->reach_box and
+ * s->reach_all; *any = 0 when nothing can move. */
 static gr_status gr_snow_relax_reach(gr_snow_deformation *s, int hops, float tol, int *x0, int *y0,
                                      int *x1, int *y1, int *any) {
   cl_int gx0 = *x0, gy0 = *y0, gx_end = *x1 + 1, gy_end = *y1 + 1, t = 0;
@@ -381,8 +382,9 @@ static gr_status gr_snow_relax_reach(gr_snow_deformation *s, int hops, float tol
                          (size_t)(cut[2] - cut[0] + 1), (size_t)(cut[3] - cut[1] + 1), NULL);
   }
   /* The max filter, hops points, in passes a piece's ring can feed. */
+  const int pass = (gr_snow_has_ring(s) ? gr_snow_ring_width(s) : GR_SNOW_DEFORMATION_GHOST) - 1;
   for (int left = hops; st == GR_OK && left > 0;) {
-    int h = left < GR_SNOW_DEFORMATION_GHOST - 1 ? left : GR_SNOW_DEFORMATION_GHOST - 1;
+    int h = left < pass ? left : pass;
     out[0] = src[0] - h, out[1] = src[1] - h, out[2] = src[2] + h, out[3] = src[3] + h;
     if (!gr_snow_clip_box(s, src, cut)) /* no seeds here */
       cut[0] = cut[1] = 0, cut[2] = cut[3] = -1;
@@ -475,7 +477,8 @@ typedef struct gr_snow_relax_run {
    * whether it is empty (a piece with none of the window) */
   int before[GR_SNOW_CHECK_LAG + 1], empty[GR_SNOW_CHECK_LAG + 1];
   int launched, started, read, it_launched, done;
-  int it; /* the iterations the relaxation counts */
+  int it;    /* the iterations the relaxation counts */
+  int stale; /* a piece: the ring's points gone stale since its last exchange */
 } gr_snow_relax_run;
 
 /* Cuts the givers' box to the local arrays. */
@@ -508,8 +511,25 @@ static gr_status gr_snow_relax_tail(gr_snow_deformation *s, gr_snow_relax_run *r
   return st;
 }
 
+/* A piece: the exchange the talus owes its ring, now when `need` more
+ * stale points would not fit in it (or at the end: need = 0, any stale
+ * point). An iteration makes two more of the ring's points stale, from its
+ * outer edge in (a move reads points two away), so a ring of
+ * GR_SNOW_DEFORMATION_GHOST takes one launch of GR_SNOW_BLOCK_ITERATIONS
+ * iterations between exchanges and a ring m times as wide m launches: the
+ * own points stay the whole grid's, and the exchanges drop m-fold. The
+ * same counts on every piece: the same exchanges. */
+static gr_status gr_snow_relax_ring(gr_snow_deformation *s, gr_snow_relax_run *r, int need) {
+  if (!gr_snow_has_ring(s) || r->stale == 0 ||
+      (need > 0 && r->stale + need <= gr_snow_ring_width(s)))
+    return GR_OK;
+  r->stale = 0;
+  return gr_snow_piece_sync(s);
+}
+
 /* One launch of up to GR_SNOW_BLOCK_ITERATIONS iterations on the givers'
- * box, and its check when one is due. */
+ * box (first, on a piece, the exchange when the ring has no room left for
+ * them), and its check when one is due. */
 static gr_status gr_snow_relax_launch(gr_snow_deformation *s, gr_snow_relax_run *r) {
   int nx = r->nx, ny = r->ny;
   gr_status st = GR_OK;
@@ -532,13 +552,15 @@ static gr_status gr_snow_relax_launch(gr_snow_deformation *s, gr_snow_relax_run 
   int fx1 = x1 + grow < nx - 1 ? x1 + grow : nx - 1, fy1 = y1 + grow < ny - 1 ? y1 + grow : ny - 1;
   if (r->lx0 < fx0 || r->ly0 < fy0 || r->lx1 > fx1 || r->ly1 > fy1)
     st = gr_snow_sync_rect(s, r->lx0, r->ly0, r->lx1, r->ly1);
+  if (st == GR_OK)
+    st = gr_snow_relax_ring(s, r, 2 * iters); /* pieces: room in the ring for the launch */
   if (st == GR_OK && s->blocked)
     st =
         gr_snow_relax_blocked(s, gx0, gy0, gx_end, gy_end, mx0, my0, mx_end, my_end, iters, r->tol);
   for (cl_int t = 0; st == GR_OK && !s->blocked && t < iters; ++t)
     st = gr_snow_relax_once(s, gx0, gy0, gx_end, gy_end, t, r->tol);
   if (st == GR_OK)
-    st = gr_snow_piece_sync(s); /* pieces: the ring the launch used up */
+    r->stale += 2 * iters; /* pieces: the ring the launch used up */
   if (st == GR_OK)
     r->lx0 = mx0, r->ly0 = my0, r->lx1 = mx_end - 1, r->ly1 = my_end - 1;
   int slot = r->started % (r->lag + 1);
@@ -701,6 +723,8 @@ gr_status gr_snow_relax(gr_snow_deformation *s, double dt) {
   r.every = s->blocked ? GR_SNOW_CHECK_EVERY : 1;
   if (st == GR_OK)
     st = gr_snow_relax_iterate(s, &r);
+  if (st == GR_OK)
+    st = gr_snow_relax_ring(s, &r, 0); /* pieces: the ring fresh for the next stage */
   gr_snow_relax_rest(s, &r, st == GR_OK, movers);
   s->reach_on = 0;
   /* Both buffers equal again: the last window from the state. */

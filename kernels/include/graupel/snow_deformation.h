@@ -367,11 +367,13 @@ GR_API gr_status gr_snow_deformation_reset(gr_snow_deformation *s);
  * A simulation may hold one piece of a domain split among processes (the
  * gr_grid piece fields: i0, j0, global_nx, global_ny, ghost). Only the
  * domain's own edges are boundaries. On every side where the piece has a
- * neighbour it keeps a ring of GR_SNOW_DEFORMATION_GHOST points, copies of
- * the neighbour's points; grid.ghost must then be GR_SNOW_DEFORMATION_GHOST
- * and the piece at least that many points wide toward the neighbour. The
- * local arrays are the piece and its ring: (nx + rings) x (ny + rings)
- * floats for set_field and checkpoints; get_field gives the own nx x ny.
+ * neighbour it keeps a ring of grid.ghost points, copies of the
+ * neighbour's points; grid.ghost must then be GR_SNOW_DEFORMATION_GHOST, or
+ * a multiple of it up to GR_SNOW_DEFORMATION_GHOST_MAX (a wider ring, see
+ * below), and the piece at least that many points wide toward the
+ * neighbour. The local arrays are the piece and its ring: (nx + rings) x
+ * (ny + rings) floats for set_field and checkpoints; get_field gives the
+ * own nx x ny.
  *
  * Why 8: a talus iteration reads points two away (a point's move reads its
  * neighbours' rates, a rate its neighbours' heights), and the talus runs
@@ -384,6 +386,14 @@ GR_API gr_status gr_snow_deformation_reset(gr_snow_deformation *s);
  * max filter of at most 7 points a pass, travels in the strips' depth
  * slot: a point's mover status reads its neighbours, so a ring of 8 feeds
  * 7 points).
+ *
+ * A wider ring, m x GR_SNOW_DEFORMATION_GHOST points (grid.ghost), trades
+ * memory and bytes per exchange (about the same bytes per step) for fewer
+ * exchanges (temporal blocking across the cut): the talus runs m launches
+ * between exchanges (each makes 8 more of the ring's points stale, from
+ * its outer edge in) and the reach's mask grows by up to grid.ghost - 1
+ * points a pass; the other stages exchange as with the narrow ring. The
+ * same bits as the whole grid's at every width.
  *
  * The exchange is the caller's (gr_snow_deformation_set_halo_exchange),
  * called by the core at those stages, so a step makes several: per ring
@@ -421,6 +431,9 @@ GR_API gr_status gr_snow_deformation_reset(gr_snow_deformation *s);
 
 /** Ring width of a piece toward each neighbour, points (2 per talus iteration x 4). */
 #define GR_SNOW_DEFORMATION_GHOST 8
+/** The widest ring a piece may ask for (grid.ghost, a multiple of GR_SNOW_DEFORMATION_GHOST):
+ * 8 talus launches between exchanges. */
+#define GR_SNOW_DEFORMATION_GHOST_MAX 64
 
 /** Sides of a piece, for the halo calls. */
 typedef enum gr_snow_deformation_side {
