@@ -70,5 +70,14 @@ c = Show(OutputPort(rain, 1), chart)
 c.SeriesVisibility = ["rain_volume_rate", "outflow_rate", "infiltration_rate"]
 chart.LeftAxisTitle = "m^3/s"
 chart.BottomAxisTitle = "time (s)"
+# The chart at the picture's own size, so its fonts are not scaled up, with
+# the legend between the rain's line and the outflow's.
+chart.ViewSize = [900, 500]
+chart.LegendLocation = "Custom"
+chart.LegendPosition = [730, 230]
+for prop in ("LeftAxisTitleFontSize", "BottomAxisTitleFontSize"):
+    setattr(chart, prop, 16)
+for prop in ("LeftAxisLabelFontSize", "BottomAxisLabelFontSize", "LegendFontSize"):
+    setattr(chart, prop, 13)
 SaveScreenshot(os.path.join(args.out, "flood_hydrograph.png"), chart, ImageResolution=[900, 500])
 print("wrote", sorted(os.listdir(args.out)))
