@@ -10,7 +10,9 @@
  * (GRAUPEL_BENCH_SNOW_RING: another multiple of GR_SNOW_DEFORMATION_GHOST,
  * 8 for the core's narrow ring). GRAUPEL_BENCH_SNOW_BLOCKED=1 runs the
  * talus in blocked launches (a GPU's way, exchanges and all) on any device,
- * 0 in one launch an iteration. */
+ * 0 in one launch an iteration. GRAUPEL_BENCH_SNOW_Y: the line the sphere
+ * ploughs along (m, 0..20; default 10, on the cut between two pieces; 5
+ * keeps it inside the first of two). */
 #include "bench.h"
 
 #include <math.h>
@@ -29,7 +31,7 @@ typedef struct snow_deformation_bench {
   float *vertices;
   int *triangles;
   int n;
-  double x, v[3], dt, x_end;
+  double x, y, v[3], dt, x_end;
 } snow_deformation_bench;
 
 /* A latitude-longitude sphere: the poles and SPHERE_STACKS - 1 rings. */
@@ -88,7 +90,7 @@ static gr_status snow_deformation_place(snow_deformation_bench *b) {
   for (int k = 0; k < 16; ++k)
     T[k] = (k % 5 == 0) ? 1.0 : 0.0;
   T[12] = b->x;
-  T[13] = 10.0;
+  T[13] = b->y;
   T[14] = 0.2 + SPHERE_RADIUS;
   return gr_snow_deformation_set_objects(b->sim, &b->mesh, 1, b->v);
 }
@@ -103,7 +105,8 @@ static int snow_deformation_ring(void) {
 /* Rows j0 .. j0 + ny - 1 of the n by n set-up (the whole grid for j0 = 0,
  * ny = n), with a ring toward each neighbouring strip: the snow is the
  * parameters' uniform cover on flat ground, and every piece sets the same
- * sphere, which ploughs along y = 10 m, across the middle strips' edges. */
+ * sphere, which ploughs along y = 10 m, across the middle strips' edges
+ * (GRAUPEL_BENCH_SNOW_Y: another line). */
 static gr_status snow_deformation_setup_piece(gr_context *ctx, int n, int j0, int ny,
                                               const gr_bench_link *link, void **state) {
   double d = 20.0 / (n > 1 ? n - 1 : 1);
@@ -130,6 +133,13 @@ static gr_status snow_deformation_setup_piece(gr_context *ctx, int n, int j0, in
   }
   b->x = 2.0;
   b->x_end = 18.0;
+  const char *y = getenv("GRAUPEL_BENCH_SNOW_Y");
+  b->y = y && *y ? atof(y) : 10.0;
+  if (!(b->y >= 0.0 && b->y <= 20.0)) {
+    snow_deformation_teardown(b);
+    return gr_set_error(ctx, GR_ERR_INVALID_ARGUMENT,
+                        "GRAUPEL_BENCH_SNOW_Y is %s: it takes a line between 0 and 20 m.", y);
+  }
   b->v[0] = 2.0;
   b->dt = 1.0 / 60.0;
   gr_status st = gr_snow_deformation_create(ctx, &g, &p, &b->sim);
