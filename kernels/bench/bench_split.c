@@ -13,7 +13,11 @@
  * into its ring (halo_set). The mailboxes alternate between two sets from
  * one exchange to the next, so one barrier per step is enough: a piece
  * cannot write a set again before every piece has passed the next barrier,
- * which it reaches only after reading that set.
+ * which it reaches only after reading that set. The mailboxes are pinned
+ * host memory on GPUs (a mapped CL_MEM_ALLOC_HOST_PTR buffer of the writing
+ * piece's context), which they copy to and from at their DMA rate; plain
+ * malloc'ed ones on other devices, with GRAUPEL_BENCH_PINNED=0, or where the
+ * mapping fails.
  *
  * Allreduce: every piece writes its values into its slot, a barrier, then
  * every piece combines the slots in piece order (the same operations on the
@@ -108,6 +112,7 @@ struct split_team {
   split_barrier barrier;
   double *slots;     /* k * SPLIT_SLOTS */
   void **mail[2];    /* [parity][2 * rank + (0 south, 1 north)] */
+  cl_mem *mail_mem[2]; /* the pinned buffer behind each mailbox, or NULL (malloc'ed) */
   float **gathered;  /* --verify: every output of the whole grid, or NULL */
   char summary[400]; /* the first piece's summary line */
 };
@@ -203,6 +208,46 @@ static gr_status member_gather(split_member *m) {
   return GR_OK;
 }
 
+/* Mailbox i of set p, written by piece m: on a GPU pinned (mapped from a
+ * CL_MEM_ALLOC_HOST_PTR buffer of m's context) unless GRAUPEL_BENCH_PINNED=0
+ * or the mapping fails, otherwise malloc'ed. 0: out of memory. */
+static int mailbox_alloc(split_member *m, int p, int i, size_t bytes) {
+  split_team *t = m->team;
+  const char *pinned = getenv("GRAUPEL_BENCH_PINNED");
+  cl_device_type type = 0;
+  clGetDeviceInfo(gr_context_device(m->ctx), CL_DEVICE_TYPE, sizeof(type), &type, NULL);
+  if ((type & CL_DEVICE_TYPE_GPU) && !(pinned && *pinned && atoi(pinned) == 0)) {
+    cl_int err = CL_SUCCESS;
+    cl_mem buf = clCreateBuffer(gr_context_cl(m->ctx), CL_MEM_ALLOC_HOST_PTR | CL_MEM_READ_WRITE,
+                                bytes, NULL, &err);
+    void *at = err == CL_SUCCESS ? clEnqueueMapBuffer(gr_context_queue(m->ctx), buf, CL_TRUE,
+                                                      CL_MAP_READ | CL_MAP_WRITE, 0, bytes, 0,
+                                                      NULL, NULL, &err)
+                                 : NULL;
+    if (at && err == CL_SUCCESS) {
+      t->mail[p][i] = at;
+      t->mail_mem[p][i] = buf;
+      return 1;
+    }
+    if (buf)
+      clReleaseMemObject(buf);
+  }
+  return (t->mail[p][i] = malloc(bytes)) != NULL;
+}
+
+/* Mailbox i of set p freed (unmapped on its writer's queue, before the
+ * writer's context goes). */
+static void mailbox_free(split_team *t, split_member *m, int p, int i) {
+  if (t->mail_mem[p] && t->mail_mem[p][i]) {
+    cl_command_queue q = gr_context_queue(m[i / 2].ctx);
+    clEnqueueUnmapMemObject(q, t->mail_mem[p][i], t->mail[p][i], 0, NULL, NULL);
+    clFinish(q);
+    clReleaseMemObject(t->mail_mem[p][i]);
+  } else if (t->mail[p]) {
+    free(t->mail[p][i]);
+  }
+}
+
 static void *member_run(void *arg) {
   split_member *m = arg;
   split_team *t = m->team;
@@ -218,7 +263,7 @@ static void *member_run(void *arg) {
     st = sp->halo_size(m->state, GR_BENCH_NORTH, &m->halo_bytes[1]);
   for (int p = 0; st == GR_OK && p < 2; ++p)
     for (int s = 0; s < 2; ++s)
-      if (m->halo_bytes[s] && !(t->mail[p][2 * m->rank + s] = malloc(m->halo_bytes[s])))
+      if (m->halo_bytes[s] && !mailbox_alloc(m, p, 2 * m->rank + s, m->halo_bytes[s]))
         st = gr_set_error(m->ctx, GR_ERR_OUT_OF_MEMORY, "Out of host memory for the halo.");
   if (st != GR_OK) {
     member_fail(m, st, "halo buffers");
@@ -461,7 +506,9 @@ static int team_alloc(split_team *t, split_member *m, int verify) {
   t->slots = calloc((size_t)k * SPLIT_SLOTS, sizeof(double));
   t->mail[0] = calloc((size_t)2 * k, sizeof(void *));
   t->mail[1] = calloc((size_t)2 * k, sizeof(void *));
-  int ok = t->slots && t->mail[0] && t->mail[1];
+  t->mail_mem[0] = calloc((size_t)2 * k, sizeof(cl_mem));
+  t->mail_mem[1] = calloc((size_t)2 * k, sizeof(cl_mem));
+  int ok = t->slots && t->mail[0] && t->mail[1] && t->mail_mem[0] && t->mail_mem[1];
   if (ok && verify) {
     t->gathered = calloc((size_t)sp->outputs, sizeof(float *));
     ok = t->gathered != NULL;
@@ -579,15 +626,16 @@ static void print_figures(const split_team *t, const split_member *m, const char
  * outputs and the barrier released. */
 static void team_free(split_team *t, split_member *m) {
   int k = t->k;
+  for (int p = 0; p < 2; ++p) {
+    for (int i = 0; t->mail[p] && i < 2 * k; ++i)
+      mailbox_free(t, m, p, i);
+    free(t->mail[p]);
+    free(t->mail_mem[p]);
+  }
   for (int r = 0; r < k; ++r) {
     if (m[r].state)
       t->core->teardown(m[r].state);
     gr_context_release(m[r].ctx);
-  }
-  for (int p = 0; p < 2; ++p) {
-    for (int i = 0; t->mail[p] && i < 2 * k; ++i)
-      free(t->mail[p][i]);
-    free(t->mail[p]);
   }
   for (int i = 0; t->gathered && i < t->split->outputs; ++i)
     free(t->gathered[i]);
