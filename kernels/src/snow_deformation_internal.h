@@ -115,6 +115,10 @@ struct gr_snow_deformation {
    * same on every piece), the mask in `weight`, the ceilings in `scratch`;
    * halo_reach: the exchange carries the mask. */
   int reach_on, reach_box[4], reach_all[4], halo_reach;
+  /* halo_cols_on: the talus' exchange copies only the local columns
+   * halo_cols[0] .. halo_cols[1] of a south or north strip (the columns its
+   * launches wrote since the last exchange, the same on every piece) */
+  int halo_cols_on, halo_cols[2];
   int dirty[4];   /* x0 y0 x1 y1: where the last step's objects wrote */
   int reset_full; /* the next step clears the per-step arrays everywhere */
   gr_progress_fn progress;

@@ -479,6 +479,7 @@ typedef struct gr_snow_relax_run {
   int launched, started, read, it_launched, done;
   int it;    /* the iterations the relaxation counts */
   int stale; /* a piece: the ring's points gone stale since its last exchange */
+  int cx0, cx1; /* a piece: the columns its launches wrote since then (cx0 > cx1: none) */
 } gr_snow_relax_run;
 
 /* Cuts the givers' box to the local arrays. */
@@ -523,8 +524,17 @@ static gr_status gr_snow_relax_ring(gr_snow_deformation *s, gr_snow_relax_run *r
   if (!gr_snow_has_ring(s) || r->stale == 0 ||
       (need > 0 && r->stale + need <= gr_snow_ring_width(s)))
     return GR_OK;
+  /* Only the columns the launches wrote since the last exchange changed,
+   * on either side of a cut (the windows are the domain's, the same on
+   * every piece): the exchange copies those (at 16384^2 the bench's talus
+   * writes about an eighth of the columns). */
+  s->halo_cols_on = r->cx0 <= r->cx1;
+  s->halo_cols[0] = r->cx0, s->halo_cols[1] = r->cx1;
   r->stale = 0;
-  return gr_snow_piece_sync(s);
+  r->cx0 = r->nx, r->cx1 = -1;
+  gr_status st = gr_snow_piece_sync(s);
+  s->halo_cols_on = 0;
+  return st;
 }
 
 /* One launch of up to GR_SNOW_BLOCK_ITERATIONS iterations on the givers'
@@ -559,8 +569,11 @@ static gr_status gr_snow_relax_launch(gr_snow_deformation *s, gr_snow_relax_run 
         gr_snow_relax_blocked(s, gx0, gy0, gx_end, gy_end, mx0, my0, mx_end, my_end, iters, r->tol);
   for (cl_int t = 0; st == GR_OK && !s->blocked && t < iters; ++t)
     st = gr_snow_relax_once(s, gx0, gy0, gx_end, gy_end, t, r->tol);
-  if (st == GR_OK)
-    r->stale += 2 * iters; /* pieces: the ring the launch used up */
+  if (st == GR_OK) {
+    r->stale += 2 * iters; /* pieces: the ring the launch used up, its columns */
+    r->cx0 = mx0 < r->cx0 ? mx0 : r->cx0;
+    r->cx1 = mx_end - 1 > r->cx1 ? mx_end - 1 : r->cx1;
+  }
   if (st == GR_OK)
     r->lx0 = mx0, r->ly0 = my0, r->lx1 = mx_end - 1, r->ly1 = my_end - 1;
   int slot = r->started % (r->lag + 1);
@@ -719,6 +732,7 @@ gr_status gr_snow_relax(gr_snow_deformation *s, double dt) {
     }
   }
   r.lx0 = 0, r.ly0 = 0, r.lx1 = -1, r.ly1 = -1; /* no launch yet */
+  r.cx0 = nx, r.cx1 = -1;
   r.lag = s->blocked ? GR_SNOW_CHECK_LAG : 0, r.cap = s->params.max_relax_iterations;
   r.every = s->blocked ? GR_SNOW_CHECK_EVERY : 1;
   if (st == GR_OK)
