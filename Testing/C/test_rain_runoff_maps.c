@@ -393,3 +393,114 @@ void test_gauges(void) {
     gr_rain_runoff_destroy(s);
   }
 }
+
+/* The wet duration by wet spells (gr_rain_runoff_wet_turn): on a bumpy bed
+ * (3 cm) with a permeability that varies by cell, a hyetograph that rains 360 mm/h,
+ * stops from 300 to 600 s and rains again, so that cells turn wet, dry and
+ * wet again at different steps, and the wetting depth changed twice between
+ * steps (1 cm, 6 mm from 700 s, 12 mm from 850 s). Steps of 0.5 s, so every
+ * time is a float exactly: after every 50th step and at the end, for every
+ * cell, wet_duration is the sum of the dt of the steps after which the
+ * depth (read back after every step) was above the wetting depth then in
+ * force, to the bit, and arrival_time the end of the first of them (or the
+ * time a new wetting depth made the cell wet), to the bit. Both flow
+ * models. */
+void test_maps_wet_spells(void) {
+  for (int model = 0; model < 2; ++model) {
+    gr_grid g = {12, 8, 2.0, 2.0, 0.0, 0.0, 0, 0};
+    size_t n = cells_of(&g);
+    float *b = alloc_field(&g, 1), *d0 = alloc_field(&g, 1), *k = alloc_field(&g, 1);
+    for (size_t c = 0; c < n; ++c) {
+      int i = (int)(c % 12), j = (int)(c / 12);
+      k[c] = (float)((3.0 + 4.0 * hash01(i, j, 21)) * 1e-5);
+      b[c] = (float)(0.03 * hash01(i, j, 22)); /* pools that stay wet, tops that dry */
+    }
+    gr_rain_runoff_params p = params_with(0.0, 0.0, GR_BOUNDARY_CLOSED);
+    p.flow_model = model ? GR_FLOW_LOCAL_INERTIAL : GR_FLOW_SHALLOW_WATER;
+    gr_rain_runoff *s = make_sim(&g, &p, b, d0);
+    const double ht[6] = {0.0, 300.0, 300.5, 600.0, 600.5, 1000.0};
+    const double hr[6] = {1e-4, 1e-4, 0.0, 0.0, 1e-4, 1e-4};
+    if (!s || gr_rain_runoff_set_field(s, GR_FIELD_PERMEABILITY, k) != GR_OK ||
+        gr_rain_runoff_set_hyetograph(s, ht, hr, 6) != GR_OK) {
+      CHECK(0);
+      gr_rain_runoff_destroy(s);
+      free(b);
+      free(d0);
+      free(k);
+      return;
+    }
+    double *wet = calloc(n, sizeof(double)), *arrive = malloc(n * sizeof(double));
+    int *state = calloc(n, sizeof(int)), *ended = calloc(n, sizeof(int));
+    for (size_t c = 0; c < n; ++c)
+      arrive[c] = -1.0;
+    const double dt = 0.5;
+    double t = 0.0;
+    long wrong = 0, checked = 0;
+    for (int step = 1; step <= 2000; ++step) {
+      if (step == 1401 || step == 1701) {
+        /* A new wetting depth at t = 700 s, then 850 s: the cells turn wet
+         * or dry at that time. */
+        p.wetting_depth = step == 1401 ? 0.006 : 0.012;
+        CHECK(gr_rain_runoff_set_params(s, &p) == GR_OK);
+        float *h = get(s, &g, GR_FIELD_WATER_DEPTH);
+        for (size_t c = 0; c < n; ++c) {
+          int now = h[c] > (float)p.wetting_depth;
+          ended[c] += state[c] && !now;
+          if (now && arrive[c] < 0.0)
+            arrive[c] = t;
+          state[c] = now;
+        }
+        free(h);
+      }
+      CHECK(gr_rain_runoff_step(s, dt, 1) == GR_OK);
+      t += dt;
+      float *h = get(s, &g, GR_FIELD_WATER_DEPTH);
+      for (size_t c = 0; c < n; ++c) {
+        int now = h[c] > (float)p.wetting_depth;
+        ended[c] += state[c] && !now;
+        if (now) {
+          wet[c] += dt;
+          if (arrive[c] < 0.0)
+            arrive[c] = t;
+        }
+        state[c] = now;
+      }
+      free(h);
+      if (step % 50 == 0) {
+        float *wd = get_map(s, &g, GR_RAIN_RUNOFF_WET_DURATION);
+        float *at = get_map(s, &g, GR_RAIN_RUNOFF_ARRIVAL_TIME);
+        for (size_t c = 0; c < n; ++c) {
+          int bad = wd[c] != (float)wet[c] ||
+                    (arrive[c] < 0.0 ? !isnan(at[c]) : at[c] != (float)arrive[c]);
+          CHECK_MSG(!bad || wrong > 0, "step %d, cell %zu: wet %.9g s (by hand %.9g), arrival %.9g",
+                    step, c, wd[c], wet[c], at[c]);
+          wrong += bad;
+          ++checked;
+        }
+        free(wd);
+        free(at);
+      }
+    }
+    int spells = 0, again = 0, never = 0, always = 0;
+    for (size_t c = 0; c < n; ++c) {
+      spells += ended[c] > 0;
+      again += ended[c] > 0 && state[c];
+      never += arrive[c] < 0.0;
+      always += ended[c] == 0 && state[c];
+    }
+    printf("wet spells, FlowModel %d, %.0f s: %ld of %ld readings differ from the sum of dt over "
+           "wet steps; %d cells dried after a spell (%d of them wet again at the end), %d wet "
+           "from their arrival to the end, %d never wet\n",
+           model, t, wrong, checked, spells, again, always, never);
+    CHECK(wrong == 0 && checked == 40 * (long)n);
+    CHECK(spells > 0 && again > 0 && always > 0);
+    free(wet);
+    free(arrive);
+    free(state);
+    free(ended);
+    free(b);
+    free(d0);
+    free(k);
+    gr_rain_runoff_destroy(s);
+  }
+}

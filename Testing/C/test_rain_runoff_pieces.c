@@ -699,8 +699,8 @@ void test_piece_checkpoint(void) {
     /* The ring is in it: 21 x 23 local cells (22 x 23 with the
      * shallow-water model's ring). */
     size_t nxl = 18 + (size_t)piece_ghost(), cells = nxl * 23, faces = (nxl + 1) * 23 + nxl * 24;
-    CHECK_MSG(bytes[0] == bytes[1] && bytes[0] > (17 * cells + faces) * sizeof(float) &&
-                  bytes[0] < (17 * cells + faces) * sizeof(float) + 128,
+    CHECK_MSG(bytes[0] == bytes[1] && bytes[0] > (19 * cells + faces) * sizeof(float) &&
+                  bytes[0] < (19 * cells + faces) * sizeof(float) + 128,
               "%zu bytes", bytes[0]);
     run_team(pc, GR_RAIN_RUNOFF_EAST, 0, 30.0, 0, NULL, a);
     CHECK(gr_rain_runoff_advance(whole, 40.0, NULL) == GR_OK);
@@ -818,4 +818,93 @@ void test_sw_pieces_edges_y(void) {
 }
 void test_sw_advance_pieces_edges_x(void) {
   run_with_edges(test_sw_advance_pieces_x);
+}
+
+/* Sets the rain-rate field r (the whole domain's) on the whole grid and on
+ * each piece (its cut, ring included). */
+static void set_rain_all(gr_rain_runoff *whole, piece *pc, int n, const domain *dm,
+                         const float *r) {
+  CHECK(gr_rain_runoff_set_field(whole, GR_FIELD_RAIN_RATE, r) == GR_OK);
+  for (int k = 0; k < n; ++k) {
+    float *local = cut(r, dm->g.nx, pc[k].g.i0 - pc[k].ring[0], pc[k].g.j0 - pc[k].ring[2],
+                       pc[k].nxl, pc[k].nyl);
+    CHECK(gr_rain_runoff_set_field(pc[k].s, GR_FIELD_RAIN_RATE, local) == GR_OK);
+    free(local);
+  }
+}
+
+/* Wet spells across a split in x: a wetting depth of 3 cm, which the split
+ * domain's water crosses both ways, and its rain stopped from step 60 to
+ * 120 of 200, so that cells dry and wet again (on either side of the split
+ * and in the rings). The wet duration, kept by its spells' starts and ends
+ * (the ring cells' too, whose depth the exchange sets), and every other
+ * field and map of the pieces are the whole grid's bit for bit; the whole
+ * grid's wet duration is the sum of the dt of the steps after which the
+ * depth (read back after every step) was above the wetting depth, to a
+ * float's rounding. Both flow models. */
+void test_pieces_wet_spells(void) {
+  for (int model = 0; model < 2; ++model) {
+    piece_model = model ? GR_FLOW_SHALLOW_WATER : GR_FLOW_LOCAL_INERTIAL;
+    domain dm = make_domain(37, 23);
+    gr_rain_runoff_params prm = piece_params();
+    prm.wetting_depth = 0.03;
+    gr_rain_runoff *whole = make_whole(&dm, &prm);
+    piece pc[2];
+    int ok = whole && make_piece(&pc[0], &dm, &prm, 0, 0, 18, 23) &&
+             make_piece(&pc[1], &dm, &prm, 18, 0, 19, 23);
+    size_t n = cells_of(&dm.g);
+    float *dry = alloc_field(&dm.g, 1);
+    double *wet = calloc(n, sizeof(double));
+    int *state = calloc(n, sizeof(int)), *ended = calloc(n, sizeof(int));
+    double t = 0.0;
+    for (int steps = 0; ok && steps < 200; ++steps) {
+      if (steps == 60 || steps == 120)
+        set_rain_all(whole, pc, 2, &dm, steps == 60 ? dry : dm.r);
+      double dw = 0.0, d0 = 0.0, d1 = 0.0;
+      CHECK(gr_rain_runoff_stable_dt(whole, &dw) == GR_OK);
+      CHECK(gr_rain_runoff_stable_dt(pc[0].s, &d0) == GR_OK);
+      CHECK(gr_rain_runoff_stable_dt(pc[1].s, &d1) == GR_OK);
+      double dt = fmin(dw, fmin(d0, d1));
+      CHECK(gr_rain_runoff_step(whole, dt, 1) == GR_OK);
+      CHECK(gr_rain_runoff_step(pc[0].s, dt, 1) == GR_OK);
+      CHECK(gr_rain_runoff_step(pc[1].s, dt, 1) == GR_OK);
+      pass_halo(&pc[0], &pc[1], GR_RAIN_RUNOFF_EAST);
+      pass_halo(&pc[1], &pc[0], GR_RAIN_RUNOFF_WEST);
+      t += dt;
+      float *h = get(whole, &dm.g, GR_FIELD_WATER_DEPTH);
+      for (size_t c = 0; c < n; ++c) {
+        int now = h[c] > (float)prm.wetting_depth;
+        ended[c] += state[c] && !now;
+        wet[c] += now ? dt : 0.0;
+        state[c] = now;
+      }
+      free(h);
+    }
+    if (ok) {
+      check_pieces(pc, 2, whole, &dm, model ? "wet spells, shallow water" : "wet spells");
+      float *wd = get_map(whole, &dm.g, GR_RAIN_RUNOFF_WET_DURATION);
+      double err = 0.0;
+      int spells = 0, again = 0;
+      for (size_t c = 0; c < n; ++c) {
+        err = fmax(err, fabs(wd[c] - wet[c]) / fmax(wet[c], 1e-30));
+        spells += ended[c] > 0;
+        again += ended[c] > 0 && wet[c] > 0.0 && state[c];
+      }
+      printf("wet spells, FlowModel %d, %.2f s: %d cells dried after a spell (%d wet again at the "
+             "end); wet_duration off the sum of dt by %.3g relative\n",
+             (int)piece_model, t, spells, again, err);
+      CHECK_MSG(err <= 1.2e-7, "wet_duration off by %g relative", err);
+      CHECK(spells > 0 && again > 0);
+      free(wd);
+    }
+    for (int k = 0; ok && k < 2; ++k)
+      gr_rain_runoff_destroy(pc[k].s);
+    gr_rain_runoff_destroy(whole);
+    free(dry);
+    free(wet);
+    free(state);
+    free(ended);
+    free_domain(&dm);
+  }
+  piece_model = GR_FLOW_LOCAL_INERTIAL;
 }

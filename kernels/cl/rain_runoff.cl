@@ -170,20 +170,32 @@ GR_INLINE void gr_rain_runoff_book_edges(__global float *restrict outflow,
 
 /* The flood maps' arguments (graupel/rain_runoff.h, "Flood maps"; see
  * rain_runoff_maps), also taken by each model's last step kernel, which
- * folds the state it leaves into the maps (map_time: the step's end). */
+ * folds the state it leaves into them (map_time: see gr_rain_runoff_map_fold).
+ * The wet duration is kept by its transitions: wet_time (+ wet_time_lo, a
+ * double-float pair) is the duration of the cell's wet spells that have
+ * ended, wet_since (+ wet_since_lo) the time the spell under way began, -1
+ * while the cell is dry; the host adds the time now - wet_since to read it
+ * (gr_rain_runoff_get_map). */
 #define GR_RAIN_RUNOFF_MAP_ARGS                                                                    \
   __global float *restrict max_depth, __global float *restrict max_speed,                          \
       __global float *restrict arrival, __global float *restrict wet_time,                         \
-      __global float *restrict wet_time_comp, __global float *restrict max_hazard,                 \
+      __global float *restrict wet_time_lo, __global float *restrict max_hazard,                   \
+      __global float *restrict wet_since, __global float *restrict wet_since_lo,                   \
       float wetting_depth, float debris_factor
 #define GR_RAIN_RUNOFF_MAP_PASS                                                                    \
-  max_depth, max_speed, arrival, wet_time, wet_time_comp, max_hazard, wetting_depth, debris_factor
+  max_depth, max_speed, arrival, wet_time, wet_time_lo, max_hazard, wet_since, wet_since_lo,       \
+      wetting_depth, debris_factor
+/* The same arrays from cell c on (their index 0; see gr_rain_runoff_update_cell). */
+#define GR_RAIN_RUNOFF_MAP_PASS_AT(c)                                                              \
+  max_depth + (c), max_speed + (c), arrival + (c), wet_time + (c), wet_time_lo + (c),              \
+      max_hazard + (c), wet_since + (c), wet_since_lo + (c), wetting_depth, debris_factor
 
-/* Cell c's flood maps as they stand (gr_rain_runoff_map_fold folds a new
- * state into them; the shallow-water stages read them early, see
- * gr_sw_cell_read). */
+/* Cell c's flood maps that every fold reads (gr_rain_runoff_map_fold folds
+ * a new state into them; the shallow-water stages read them early, see
+ * gr_sw_cell_read). The arrival and the wet duration are read only where
+ * the cell turns wet or dry (gr_rain_runoff_wet_turn). */
 typedef struct gr_rain_runoff_maps_at {
-  float md, msp, mh, ar, wt, wc;
+  float md, msp, mh;
 } gr_rain_runoff_maps_at;
 
 GR_INLINE gr_rain_runoff_maps_at gr_rain_runoff_maps_read(int c, GR_RAIN_RUNOFF_MAP_ARGS) {
@@ -191,19 +203,70 @@ GR_INLINE gr_rain_runoff_maps_at gr_rain_runoff_maps_read(int c, GR_RAIN_RUNOFF_
   m.md = max_depth[c];
   m.msp = max_speed[c];
   m.mh = max_hazard[c];
-  m.ar = arrival[c];
-  m.wt = wet_time[c];
-  m.wc = wet_time_comp[c];
+  (void)arrival;
+  (void)wet_time;
+  (void)wet_time_lo;
+  (void)wet_since;
+  (void)wet_since_lo;
   (void)wetting_depth;
   (void)debris_factor;
   return m;
 }
 
-/* Folds cell c's depth d and discharges (u, v) (m^2/s) at `time` into the
- * flood maps m read before (gr_rain_runoff_maps_read), after a step of dt
- * (0: count no time). */
-GR_INLINE void gr_rain_runoff_map_fold(int c, float d, float u, float v, gr_rain_runoff_maps_at m,
-                                       GR_RAIN_RUNOFF_MAP_ARGS, float time, float dt) {
+/* Cell c turns wet (wet) or dry at the start of the step whose end folds
+ * it, t0 = (t0_hi + t0_lo, a double-float pair): a wet spell begins at t0
+ * (and the arrival time, the step's end t1, is set where the cell was
+ * never wet), or the spell under way ends and its length t0 - wet_since
+ * joins wet_time in double-float arithmetic (TwoSum, FP_CONTRACT off: to
+ * about 2^-44 of the times). So a spell wet after the steps ending t_a ..
+ * t_b counts t_b - (t_a - dt_a), the sum of those steps' dt. A cell the
+ * maps take for dry (wet_since < 0) adds nothing when it dries: a ring
+ * cell of a piece whose depth its neighbour's exchange set. */
+GR_INLINE void gr_rain_runoff_wet_turn(int c, bool wet, GR_RAIN_RUNOFF_MAP_ARGS, float t1,
+                                       float t0_hi, float t0_lo) {
+  float sh = wet_since[c];
+  if (wet) {
+    if (sh < 0.0f) {
+      wet_since[c] = t0_hi;
+      wet_since_lo[c] = t0_lo;
+    }
+    if (arrival[c] < 0.0f)
+      arrival[c] = t1;
+  } else if (sh >= 0.0f) {
+    /* (a, e) = t0_hi - sh exactly, then the low words' difference. */
+    float a = t0_hi - sh;
+    float bb = a - t0_hi;
+    float e = (t0_hi - (a - bb)) + (-sh - bb);
+    e += t0_lo - wet_since_lo[c];
+    /* wet_time + (a + e): TwoSum of the high words, the rest to the low. */
+    float wh = wet_time[c];
+    float s = wh + a;
+    float sb = s - wh;
+    float lo = ((wh - (s - sb)) + (a - sb)) + (wet_time_lo[c] + e);
+    float hi = s + lo;
+    wet_time[c] = hi;
+    wet_time_lo[c] = lo - (hi - s);
+    wet_since[c] = -1.0f;
+    wet_since_lo[c] = 0.0f;
+  }
+  (void)max_depth;
+  (void)max_speed;
+  (void)max_hazard;
+  (void)wetting_depth;
+  (void)debris_factor;
+}
+
+/* Folds cell c's depth d and discharges (u, v) (m^2/s) into the flood maps
+ * m read before (gr_rain_runoff_maps_read): the state at the end t1 =
+ * map_time.x of a step that began at t0 = map_time.y + map_time.z (a
+ * double-float pair; t0 = t1 where no step led to it). was_wet: the cell
+ * was above the wetting depth when the maps last saw it (the step kernels:
+ * the depth at the step's start, which the fold before left; the maps
+ * kernel: wet_since >= 0), so that the arrival and the wet duration are
+ * read and written only where the cell turns wet or dry. */
+GR_INLINE void gr_rain_runoff_map_fold(int c, bool was_wet, float d, float u, float v,
+                                       gr_rain_runoff_maps_at m, GR_RAIN_RUNOFF_MAP_ARGS,
+                                       float4 map_time) {
   int moving = d >= GR_RAIN_RUNOFF_VELOCITY_DEPTH;
   /* Divided either way, then selected (a dry cell's quotient is never
    * used): a division under a condition is a branch on NVIDIA devices. */
@@ -224,20 +287,19 @@ GR_INLINE void gr_rain_runoff_map_fold(int c, float d, float u, float v, gr_rain
     max_speed[c] = speed;
   if (hazard > m.mh)
     max_hazard[c] = hazard;
-  if (wet && m.ar < 0.0f)
-    arrival[c] = time;
-  if (wet && dt > 0.0f)
-    gr_kahan_store(wet_time, wet_time_comp, c, m.wt, m.wc, dt);
+  if (wet != was_wet)
+    gr_rain_runoff_wet_turn(c, wet, GR_RAIN_RUNOFF_MAP_PASS, map_time.x, map_time.y, map_time.z);
 }
 
-/* Reads cell c's flood maps, then folds the new state into them. Every map
- * is read first, whether or not its value changes: reads that wait on the
- * new depth (arrival and wet time only where the cell is wet) cost the
- * local inertial update on the H200 4 % of its time. */
-GR_INLINE void gr_rain_runoff_map_cell(int c, float d, float u, float v, GR_RAIN_RUNOFF_MAP_ARGS,
-                                       float time, float dt) {
-  gr_rain_runoff_map_fold(c, d, u, v, gr_rain_runoff_maps_read(c, GR_RAIN_RUNOFF_MAP_PASS),
-                          GR_RAIN_RUNOFF_MAP_PASS, time, dt);
+/* Reads cell c's flood maps, then folds the new state into them. The three
+ * maxima are read first, whether or not their values change: reads that
+ * wait on the new depth cost the local inertial update on the H200 4 % of
+ * its time where every wet cell made them (the arrival and the wet time,
+ * before they were kept by transitions). */
+GR_INLINE void gr_rain_runoff_map_cell(int c, bool was_wet, float d, float u, float v,
+                                       GR_RAIN_RUNOFF_MAP_ARGS, float4 map_time) {
+  gr_rain_runoff_map_fold(c, was_wet, d, u, v, gr_rain_runoff_maps_read(c, GR_RAIN_RUNOFF_MAP_PASS),
+                          GR_RAIN_RUNOFF_MAP_PASS, map_time);
 }
 
 /* The sources of the next step, per cell (m/s of depth): the point inflows
@@ -376,13 +438,17 @@ rain_runoff_derive(__global const float *restrict h, __global const float *restr
  * discharges for shallow water, the mean of its limited faces for the local
  * inertial model, over the depth, 0 below GR_RAIN_RUNOFF_VELOCITY_DEPTH.
  * arrival < 0 means "never wet" (the host reads it as NaN: a NaN would not
- * survive a compiler's finite-math assumptions). dt = 0 folds the present
- * state in without adding time (after a reset or a new initial depth). */
+ * survive a compiler's finite-math assumptions). It folds the present
+ * state in at map_time (x: the time, y + z: the same as a double-float
+ * pair) without adding time (after a reset, a new initial depth, a loaded
+ * checkpoint or a new wetting depth), the cell's wet state before taken
+ * from the maps themselves (wet_since), not from a depth: the depth may
+ * have been set since. */
 __kernel void rain_runoff_maps(__global const float *restrict h, __global const float *restrict qu,
                                __global const float *restrict qv, __global const float *restrict qx,
                                __global const float *restrict qy,
                                __global const float *restrict limit, GR_RAIN_RUNOFF_MAP_ARGS,
-                               int nx, int ny, int sw, float time, float dt) {
+                               int nx, int ny, int sw, float4 map_time) {
   int i = get_global_id(0), j = get_global_id(1);
   if (!gr_inside(i, j, nx, ny))
     return;
@@ -403,7 +469,7 @@ __kernel void rain_runoff_maps(__global const float *restrict h, __global const 
     u = 0.5f * (fw + fe);
     v = 0.5f * (fs + fn);
   }
-  gr_rain_runoff_map_cell(c, d, u, v, GR_RAIN_RUNOFF_MAP_PASS, time, dt);
+  gr_rain_runoff_map_cell(c, wet_since[c] >= 0.0f, d, u, v, GR_RAIN_RUNOFF_MAP_PASS, map_time);
 }
 
 /* The local inertial model: always in the program (its stable step's

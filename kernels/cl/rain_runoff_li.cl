@@ -346,7 +346,7 @@ GR_INLINE void gr_rain_runoff_update_cell(
     __global float *restrict infiltrated_comp, __global float *restrict outflow,
     __global float *restrict outflow_comp, __global float *restrict inflow,
     __global float *restrict inflow_comp, float dt, float inv_dx, float inv_dy,
-    GR_RAIN_RUNOFF_MAP_ARGS, float map_time) {
+    GR_RAIN_RUNOFF_MAP_ARGS, float4 map_time) {
 #if GR_RAIN_RUNOFF_GPU
   /* On GPUs everything the update reads of global memory is loaded
    * before it stores anything (the shallow-water stages' gr_sw_cell_read):
@@ -355,9 +355,7 @@ GR_INLINE void gr_rain_runoff_update_cell(
    * and the infiltration waited on the stores before them (with the
    * program's register cap lifted and 32 x 4 work-groups the H200's update
    * at 4096^2 took 0.58 ms instead of 0.67). The same floats. */
-  gr_rain_runoff_maps_at mm =
-      gr_rain_runoff_maps_read(0, max_depth + c, max_speed + c, arrival + c, wet_time + c,
-                               wet_time_comp + c, max_hazard + c, wetting_depth, debris_factor);
+  gr_rain_runoff_maps_at mm = gr_rain_runoff_maps_read(0, GR_RAIN_RUNOFF_MAP_PASS_AT(c));
   float inf_sum = infiltrated[c], inf_comp = infiltrated_comp[c], comp0 = h_comp[c];
 #else
   float comp0 = h_comp[c];
@@ -381,19 +379,20 @@ GR_INLINE void gr_rain_runoff_update_cell(
   h_out[c] = d;
   h_comp[c] = t > 0.0f && gone == 0.0f ? comp : 0.0f;
   /* The flood maps from the new state, with the velocity VELOCITY reads
-   * (rain_runoff_derive's: an edge face limited by its own cell's K). */
+   * (rain_runoff_derive's: an edge face limited by its own cell's K); the
+   * cell was wet for them if the depth the step started from, which the
+   * fold before left, was above the wetting depth. */
+  bool was_wet = h0 > wetting_depth;
   float mw = i > 0 ? fw : gr_rain_runoff_limited(qw, kc, kc);
   float me = i < nx - 1 ? fe : gr_rain_runoff_limited(qe, kc, kc);
   float ms = j > 0 ? fs : gr_rain_runoff_limited(qs, kc, kc);
   float mn = j < ny - 1 ? fn : gr_rain_runoff_limited(qn, kc, kc);
 #if GR_RAIN_RUNOFF_GPU
-  gr_rain_runoff_map_fold(0, d, 0.5f * (mw + me), 0.5f * (ms + mn), mm, max_depth + c,
-                          max_speed + c, arrival + c, wet_time + c, wet_time_comp + c,
-                          max_hazard + c, wetting_depth, debris_factor, map_time, dt);
+  gr_rain_runoff_map_fold(0, was_wet, d, 0.5f * (mw + me), 0.5f * (ms + mn), mm,
+                          GR_RAIN_RUNOFF_MAP_PASS_AT(c), map_time);
 #else
-  gr_rain_runoff_map_cell(0, d, 0.5f * (mw + me), 0.5f * (ms + mn), max_depth + c, max_speed + c,
-                          arrival + c, wet_time + c, wet_time_comp + c, max_hazard + c,
-                          wetting_depth, debris_factor, map_time, dt);
+  gr_rain_runoff_map_cell(0, was_wet, d, 0.5f * (mw + me), 0.5f * (ms + mn),
+                          GR_RAIN_RUNOFF_MAP_PASS_AT(c), map_time);
 #endif
   if (gone != 0.0f)
     gr_kahan_add(outflow + c, outflow_comp + c, 0, gone);
@@ -429,7 +428,7 @@ rain_runoff_update(__global float *restrict h, __global float *restrict h_comp,
                    __global float *restrict outflow_comp, __global float *restrict inflow,
                    __global float *restrict inflow_comp, int nx, int ny, float dt, float inv_dx,
                    float inv_dy, int use_rain, float rain_uniform, int use_perm, float perm_uniform,
-                   GR_RAIN_RUNOFF_MAP_ARGS, float map_time) {
+                   GR_RAIN_RUNOFF_MAP_ARGS, float4 map_time) {
   int i = get_global_id(0), j = get_global_id(1);
   if (!gr_inside(i, j, nx, ny))
     return;
@@ -444,9 +443,8 @@ rain_runoff_update(__global float *restrict h, __global float *restrict h_comp,
   gr_rain_runoff_update_cell(i, j, c, nx, ny, h[c], GR_RAIN_RUNOFF_RAIN(c), GR_RAIN_RUNOFF_PERM(c),
                              GR_RAIN_RUNOFF_SRC(c), kc, kw, ke, ks, kn, qw, qe, qs, qn, h, h_comp,
                              nodata, use_nodata, infiltrated, infiltrated_comp, outflow,
-                             outflow_comp, inflow, inflow_comp, dt, inv_dx, inv_dy, max_depth,
-                             max_speed, arrival, wet_time, wet_time_comp, max_hazard, wetting_depth,
-                             debris_factor, map_time);
+                             outflow_comp, inflow, inflow_comp, dt, inv_dx, inv_dy,
+                             GR_RAIN_RUNOFF_MAP_PASS, map_time);
 }
 
 /* rain_runoff_limit and rain_runoff_update in one launch (GPUs: the
@@ -473,7 +471,7 @@ __kernel void rain_runoff_limit_update(
     __global float *restrict outflow, __global float *restrict outflow_comp,
     __global float *restrict inflow, __global float *restrict inflow_comp, int nx, int ny, float dt,
     float inv_dx, float inv_dy, int use_rain, float rain_uniform, int use_perm, float perm_uniform,
-    GR_RAIN_RUNOFF_MAP_ARGS, float map_time) {
+    GR_RAIN_RUNOFF_MAP_ARGS, float4 map_time) {
   int i = get_global_id(0), j = get_global_id(1);
   if (!gr_inside(i, j, nx, ny))
     return;
@@ -499,8 +497,7 @@ __kernel void rain_runoff_limit_update(
   gr_rain_runoff_update_cell(i, j, c, nx, ny, h0, r, k, sc, kc, kw, ke, ks, kn, qw, qe, qs, qn,
                              h_out, h_comp, nodata, use_nodata, infiltrated, infiltrated_comp,
                              outflow, outflow_comp, inflow, inflow_comp, dt, inv_dx, inv_dy,
-                             max_depth, max_speed, arrival, wet_time, wet_time_comp, max_hazard,
-                             wetting_depth, debris_factor, map_time);
+                             GR_RAIN_RUNOFF_MAP_PASS, map_time);
   /* After the update's stores: it loads everything before them. */
   limit[c] = kc;
 }
@@ -539,7 +536,7 @@ __kernel void rain_runoff_li_step(
     float rain_uniform, int use_perm, float perm_uniform, __global float *restrict infiltrated,
     __global float *restrict infiltrated_comp, __global float *restrict outflow,
     __global float *restrict outflow_comp, __global float *restrict inflow,
-    __global float *restrict inflow_comp, int fixed, GR_RAIN_RUNOFF_MAP_ARGS, float map_time,
+    __global float *restrict inflow_comp, int fixed, GR_RAIN_RUNOFF_MAP_ARGS, float4 map_time,
     __local float *restrict lmem) {
   const int lx = (int)get_local_size(0), ly = (int)get_local_size(1);
   const int a = (int)get_local_id(0), bl = (int)get_local_id(1);

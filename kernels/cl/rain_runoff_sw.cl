@@ -456,7 +456,7 @@ GR_INLINE float gr_sw_wet_q(float h, float q, float r, float s, float dt, float 
       float g, float n2, __global const float *restrict n2map, int use_n2, int use_rain,           \
       float rain_uniform, int use_perm, float perm_uniform, int bnd_w, int bnd_e, int bnd_s,       \
       int bnd_n, float lvl_w, float lvl_e, float lvl_s, float lvl_n, GR_RAIN_RUNOFF_MAP_ARGS,      \
-      float map_time
+      float4 map_time
 
 /* The arguments of a stage's cell update (gr_sw_update_cell), the state,
  * the stage and the ledger of GR_SW_STEP_ARGS. */
@@ -473,7 +473,7 @@ GR_INLINE float gr_sw_wet_q(float h, float q, float r, float s, float dt, float 
       __global float *restrict inflow_comp, int nx, int ny, float dt, float inv_dx, float inv_dy,  \
       float g, float n2, __global const float *restrict n2map, int use_n2, int use_rain,           \
       float rain_uniform, int use_perm, float perm_uniform, int bnd_w, int bnd_e, int bnd_s,       \
-      int bnd_n, GR_RAIN_RUNOFF_MAP_ARGS, float map_time
+      int bnd_n, GR_RAIN_RUNOFF_MAP_ARGS, float4 map_time
 #define GR_SW_CELL_PASS                                                                            \
   h, qu, qv, h_comp, h1, qu1, qv1, dh1, u1, v1, b, rain, perm, src, use_src, nodata, use_nodata,   \
       infiltrated, infiltrated_comp, outflow, outflow_comp, inflow, inflow_comp, nx, ny, dt,       \
@@ -752,10 +752,11 @@ GR_INLINE void gr_sw_update_cell(GR_SW_CELL_ARGS, int i, int j, gr_sw_pt x2, flo
     h_comp[c] = keep ? comp : 0.0f;
     qu[c] = u;
     qv[c] = v;
-    /* The flood maps from the new state. */
-    gr_rain_runoff_map_fold(c, d, u, v,
+    /* The flood maps from the new state (the cell was wet for them if the
+     * step's starting depth, which the fold before left, was). */
+    gr_rain_runoff_map_fold(c, h0 > wetting_depth, d, u, v,
                             given ? in.m : gr_rain_runoff_maps_read(c, GR_RAIN_RUNOFF_MAP_PASS),
-                            GR_RAIN_RUNOFF_MAP_PASS, map_time, dt);
+                            GR_RAIN_RUNOFF_MAP_PASS, map_time);
     if (gone != 0.0f)
       gr_kahan_add(outflow, outflow_comp, c, gone);
     if (inf != 0.0f)

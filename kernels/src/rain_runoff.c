@@ -450,9 +450,16 @@ gr_status gr_rain_runoff_set_params(gr_rain_runoff *s, const gr_rain_runoff_para
       return GR_RAIN_RUNOFF_KEEP_ERROR(s, st);
   }
   int rebuild = s->has_nodata && p->no_data != s->params.no_data;
+  /* A new wetting depth turns cells wet or dry without a step: the maps
+   * take it at once (their wet spells; the step kernels take a cell's wet
+   * state before a step from its depth). */
+  int rewet = p->wetting_depth != s->params.wetting_depth;
   s->params = *p;
   s->args_set = 0;
   s->maps_bound = 0;
+  gr_status st = rewet ? gr_rain_runoff_maps_update(s, s->time) : GR_OK;
+  if (st != GR_OK)
+    return GR_RAIN_RUNOFF_KEEP_ERROR(s, st);
   if (rebuild) {
     /* The no-data cells turn from walls to outfalls or back: their bed and
      * kind, from the elevation on the device and the mask. */
@@ -461,7 +468,7 @@ gr_status gr_rain_runoff_set_params(gr_rain_runoff *s, const gr_rain_runoff_para
     if (!b)
       return GR_RAIN_RUNOFF_KEEP_ERROR(
           s, gr_set_error(s->ctx, GR_ERR_OUT_OF_MEMORY, "Out of host memory."));
-    gr_status st = gr_buffer_read(s->ctx, s->b, 0, cells * sizeof(cl_float), b);
+    st = gr_buffer_read(s->ctx, s->b, 0, cells * sizeof(cl_float), b);
     for (size_t c = 0; c < cells; ++c)
       if (s->mask[c])
         b[c] = NAN;

@@ -160,7 +160,7 @@ static gr_status gr_rain_runoff_set_velocity(gr_rain_runoff *s, const float *hos
     st = gr_buffer_write(s->ctx, s->qv, 0, cells * sizeof(cl_float), qy);
   /* The maps see the new speeds from now on. */
   if (st == GR_OK)
-    st = gr_rain_runoff_maps_update(s, s->time, 0.0);
+    st = gr_rain_runoff_maps_update(s, s->time);
   free(q);
   return st;
 }
@@ -244,7 +244,7 @@ static gr_status gr_rain_runoff_set_water(gr_rain_runoff *s, const float *host) 
   }
   /* The maps count the new water from the time it is set. */
   if (st == GR_OK)
-    st = gr_rain_runoff_maps_update(s, s->time, 0.0);
+    st = gr_rain_runoff_maps_update(s, s->time);
   free(dry);
   return st;
 }

@@ -68,19 +68,25 @@
 /* Checkpoints: "GRR1" and the layout's version. */
 #define GR_RAIN_RUNOFF_STATE_MAGIC 0x31525247u
 /* 2: the piece's i0, j0; 3: qu, qv; 4: the maps; 5: the inflow; 6: the
- * ledger's initial water and rain in fixed point */
-#define GR_RAIN_RUNOFF_STATE_VERSION 6u
+ * ledger's initial water and rain in fixed point; 7: the wet duration by
+ * its spells (ended spells and the start of the one under way, double-float
+ * pairs) instead of a Kahan sum of every wet step's dt (version 6 is still
+ * read: gr_rain_runoff_state_load) */
+#define GR_RAIN_RUNOFF_STATE_VERSION 7u
 /* The rain ledger's steps: dt in units of 2^-32 s (graupel/reduce.h's fixed
  * point for the rates; see gr_rain_runoff_rain_book). */
 #define GR_RAIN_RUNOFF_STEP_BITS 32
 /* Per-cell arrays of a checkpoint: h, h_c, k, inf, inf_c, out, out_c, qu, qv,
- * the flood maps' max_depth, max_speed, arrival, wet, wet_c, max_hazard, and
- * the inflow and its compensation. */
+ * the flood maps' max_depth, max_speed, arrival, wet, wet_lo, max_hazard, the
+ * inflow and its compensation, then the maps' wet_since and wet_since_lo
+ * (version 6: the first 17, wet and wet_lo a Kahan sum and its
+ * compensation). */
 /* Per halo cell: h, k, west and south faces (local inertial); h, qu, qv and
  * h_c (shallow water). */
 #define GR_RAIN_RUNOFF_HALO_ARRAYS 4
-#define GR_RAIN_RUNOFF_STATE_CELL_ARRAYS 17
-#define GR_RAIN_RUNOFF_MAP_ARRAYS 6
+#define GR_RAIN_RUNOFF_STATE_CELL_ARRAYS 19
+#define GR_RAIN_RUNOFF_STATE_CELL_ARRAYS_6 17
+#define GR_RAIN_RUNOFF_MAP_ARRAYS 8
 /* The local inertial model's smallest Manning n (shallow water allows 0). */
 #define GR_RAIN_RUNOFF_LI_MIN_N 0.005
 
@@ -202,7 +208,8 @@ struct gr_rain_runoff {
   cl_mem qu0, qv0;     /* initial discharges, once VELOCITY was set */
   cl_mem qx[2], qy[2]; /* discharges; [cur] is the latest, the other the next */
   /* The flood maps, in gr_rain_runoff_map order but for the class (read
-   * from the rating) and with the wet duration's Kahan compensation last. */
+   * from the rating), then the wet duration's low word and the start of the
+   * cell's wet spell under way (hi, lo; -1: dry): GR_RAIN_RUNOFF_MAP_ARGS. */
   cl_mem map[GR_RAIN_RUNOFF_MAP_ARRAYS];
   int cur;
   cl_mem h0;      /* initial depth, once WATER_DEPTH was set */
@@ -328,7 +335,8 @@ gr_status gr_rain_runoff_watch_step(gr_rain_runoff *s, gr_rain_runoff_watch *w, 
 
 /* rain_runoff_outputs.c */
 gr_status gr_rain_runoff_map_args(gr_rain_runoff *s, cl_kernel k);
-gr_status gr_rain_runoff_maps_update(gr_rain_runoff *s, double time, double dt);
+cl_float4 gr_rain_runoff_map_time(double t0, double t1);
+gr_status gr_rain_runoff_maps_update(gr_rain_runoff *s, double time);
 gr_status gr_rain_runoff_maps_restart(gr_rain_runoff *s);
 
 /* rain_runoff_pieces.c */

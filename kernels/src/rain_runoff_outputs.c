@@ -7,23 +7,38 @@
 
 /* The flood maps' arguments of kernel k: the maps kernel's, and each
  * model's last step kernel's, which folds the state it leaves into them
- * (GR_RAIN_RUNOFF_MAP_ARGS in rain_runoff.cl): the six arrays, the wetting
- * depth and the debris factor. */
+ * (GR_RAIN_RUNOFF_MAP_ARGS in rain_runoff.cl): the eight arrays, the
+ * wetting depth and the debris factor. */
 gr_status gr_rain_runoff_map_args(gr_rain_runoff *s, cl_kernel k) {
   const size_t m = sizeof(cl_mem);
   cl_float wd = (cl_float)s->params.wetting_depth, df = (cl_float)s->params.debris_factor;
   const gr_rain_runoff_arg args[] = {
       {"max_depth", m, &s->map[0]},       {"max_speed", m, &s->map[1]},
       {"arrival", m, &s->map[2]},         {"wet_time", m, &s->map[3]},
-      {"max_hazard", m, &s->map[4]},      {"wet_time_comp", m, &s->map[5]},
+      {"max_hazard", m, &s->map[4]},      {"wet_time_lo", m, &s->map[5]},
+      {"wet_since", m, &s->map[6]},       {"wet_since_lo", m, &s->map[7]},
       {"wetting_depth", sizeof(wd), &wd}, {"debris_factor", sizeof(df), &df},
   };
   return GR_RAIN_RUNOFF_ARGS(s, k, args);
 }
 
-/* Folds the state now into the flood maps (rain_runoff_maps): `time` is the
- * state's time (s), dt the step that led to it (0: count no time). */
-gr_status gr_rain_runoff_maps_update(gr_rain_runoff *s, double time, double dt) {
+/* The flood maps' time argument (map_time) of a fold at the end t1 of a step
+ * that began at t0 (t0 = t1: no step): t1 as a float (the arrival time), t0
+ * as a double-float pair (where wet spells begin and end). */
+cl_float4 gr_rain_runoff_map_time(double t0, double t1) {
+  cl_float4 m;
+  m.s[0] = (cl_float)t1;
+  m.s[1] = (cl_float)t0;
+  m.s[2] = (cl_float)(t0 - (double)m.s[1]);
+  m.s[3] = 0.0f;
+  return m;
+}
+
+/* Folds the state now into the flood maps (rain_runoff_maps) at `time`, the
+ * state's time (s), adding no time: the cells' wet state before comes from
+ * the maps (wet_since), so this also mends them after the depth or the
+ * wetting depth changed outside a step. */
+gr_status gr_rain_runoff_maps_update(gr_rain_runoff *s, double time) {
   const size_t m = sizeof(cl_mem);
   gr_status st = GR_OK;
   if (!s->maps_bound) {
@@ -37,11 +52,11 @@ gr_status gr_rain_runoff_maps_update(gr_rain_runoff *s, double time, double dt) 
       st = GR_RAIN_RUNOFF_ARGS(s, s->maps, args);
     s->maps_bound = st == GR_OK;
   }
-  cl_float t = (cl_float)time, dtf = (cl_float)dt;
+  cl_float4 t = gr_rain_runoff_map_time(time, time);
   /* The depth and limiter alternate with the fused local inertial step. */
   const gr_rain_runoff_arg step[] = {
-      {"h", m, &s->h},           {"limit", m, &s->k},     {"qx", m, &s->qx[s->cur]},
-      {"qy", m, &s->qy[s->cur]}, {"time", sizeof(t), &t}, {"dt", sizeof(dtf), &dtf},
+      {"h", m, &s->h},           {"limit", m, &s->k},         {"qx", m, &s->qx[s->cur]},
+      {"qy", m, &s->qy[s->cur]}, {"map_time", sizeof(t), &t},
   };
   if (st == GR_OK)
     st = GR_RAIN_RUNOFF_ARGS(s, s->maps, step);
@@ -53,14 +68,15 @@ gr_status gr_rain_runoff_maps_update(gr_rain_runoff *s, double time, double dt) 
 }
 
 /* The maps of the water there now only (create, reset): nothing yet, never
- * wet (arrival -1), then the present state folded in at the present time. */
+ * wet (arrival -1), dry (wet_since -1), then the present state folded in at
+ * the present time. */
 gr_status gr_rain_runoff_maps_restart(gr_rain_runoff *s) {
   size_t bytes = gr_rain_runoff_cells(s) * sizeof(cl_float);
   gr_status st = GR_OK;
   for (int a = 0; st == GR_OK && a < GR_RAIN_RUNOFF_MAP_ARRAYS; ++a)
-    st = gr_rain_runoff_fill(s, s->map[a], a == 2 ? -1.0f : 0.0f, bytes);
+    st = gr_rain_runoff_fill(s, s->map[a], a == 2 || a == 6 ? -1.0f : 0.0f, bytes);
   if (st == GR_OK)
-    st = gr_rain_runoff_maps_update(s, s->time, 0.0);
+    st = gr_rain_runoff_maps_update(s, s->time);
   return st;
 }
 
@@ -297,14 +313,23 @@ static gr_status gr_rain_runoff_get_map_impl(gr_rain_runoff *s, gr_rain_runoff_m
   if (st != GR_OK)
     return st;
   if (map == GR_RAIN_RUNOFF_WET_DURATION) {
-    /* The Kahan sum with its compensation taken off. */
-    float *comp = malloc(cells * sizeof(float));
-    if (!comp)
+    /* The ended spells' duration (host: its high word; lo: its low word),
+     * and where a spell is under way (since >= 0) the time now less its
+     * start, in double. */
+    float *lo = malloc(3 * cells * sizeof(float));
+    if (!lo)
       return gr_set_error(s->ctx, GR_ERR_OUT_OF_MEMORY, "Out of host memory.");
-    st = gr_rain_runoff_read_own(s, s->map[5], 1, comp);
-    for (size_t c = 0; st == GR_OK && c < cells; ++c)
-      host[c] -= comp[c];
-    free(comp);
+    float *since = lo + cells, *since_lo = lo + 2 * cells;
+    st = gr_rain_runoff_read_own(s, s->map[5], 1, lo);
+    if (st == GR_OK)
+      st = gr_rain_runoff_read_own(s, s->map[6], 1, since);
+    if (st == GR_OK)
+      st = gr_rain_runoff_read_own(s, s->map[7], 1, since_lo);
+    for (size_t c = 0; st == GR_OK && c < cells; ++c) {
+      double now = since[c] >= 0.0f ? s->time - ((double)since[c] + (double)since_lo[c]) : 0.0;
+      host[c] = (float)(((double)host[c] + (double)lo[c]) + now);
+    }
+    free(lo);
   } else if (map == GR_RAIN_RUNOFF_ARRIVAL_TIME) {
     for (size_t c = 0; c < cells; ++c)
       host[c] = host[c] < 0.0f ? NAN : host[c];

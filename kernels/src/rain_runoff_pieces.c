@@ -147,9 +147,9 @@ gr_status gr_rain_runoff_halo_set(gr_rain_runoff *s, int side, const void *host,
 
 /* ------------------------------------------------------------ checkpoints */
 
-/* The checkpoint's header; the arrays follow it: the per-cell h, h_c, k,
- * inf, inf_c, out, out_c, then the current x- and y-faces (the other face
- * set is rewritten whole by the next step before it is read). */
+/* The checkpoint's header; the arrays follow it: the per-cell arrays
+ * (GR_RAIN_RUNOFF_STATE_CELL_ARRAYS), then the current x- and y-faces (the
+ * other face set is rewritten whole by the next step before it is read). */
 typedef struct gr_rain_runoff_state_header {
   uint32_t magic, version;
   int32_t nx, ny; /* the local arrays' */
@@ -170,10 +170,15 @@ static size_t gr_rain_runoff_yfaces(const gr_rain_runoff *s) {
   return (size_t)s->nxl * ((size_t)s->nyl + 1);
 }
 
-static size_t gr_rain_runoff_state_bytes(const gr_rain_runoff *s) {
+/* The state's bytes with `arrays` per-cell arrays (version 7's, or 6's). */
+static size_t gr_rain_runoff_state_bytes_of(const gr_rain_runoff *s, int arrays) {
   return sizeof(gr_rain_runoff_state_header) +
-         sizeof(float) * (GR_RAIN_RUNOFF_STATE_CELL_ARRAYS * gr_rain_runoff_cells(s) +
-                          gr_rain_runoff_xfaces(s) + gr_rain_runoff_yfaces(s));
+         sizeof(float) * ((size_t)arrays * gr_rain_runoff_cells(s) + gr_rain_runoff_xfaces(s) +
+                          gr_rain_runoff_yfaces(s));
+}
+
+static size_t gr_rain_runoff_state_bytes(const gr_rain_runoff *s) {
+  return gr_rain_runoff_state_bytes_of(s, GR_RAIN_RUNOFF_STATE_CELL_ARRAYS);
 }
 
 gr_status gr_rain_runoff_state_size(const gr_rain_runoff *s, size_t *bytes) {
@@ -184,13 +189,16 @@ gr_status gr_rain_runoff_state_size(const gr_rain_runoff *s, size_t *bytes) {
   return GR_OK;
 }
 
-/* The state's device arrays in checkpoint order, with their sizes. */
-static int gr_rain_runoff_state_arrays(gr_rain_runoff *s, int cur, cl_mem *bufs, size_t *sizes) {
+/* The state's device arrays in checkpoint order, with their sizes: the
+ * first `arrays` per-cell ones (version 7's, or 6's), then the faces. */
+static int gr_rain_runoff_state_arrays(gr_rain_runoff *s, int cur, int arrays, cl_mem *bufs,
+                                       size_t *sizes) {
   cl_mem cells[GR_RAIN_RUNOFF_STATE_CELL_ARRAYS] = {
-      s->h,      s->h_c,    s->k,      s->inf,    s->inf_c,  s->out,    s->out_c, s->qu,  s->qv,
-      s->map[0], s->map[1], s->map[2], s->map[3], s->map[4], s->map[5], s->in,    s->in_c};
+      s->h,      s->h_c, s->k,      s->inf,    s->inf_c,  s->out,    s->out_c,
+      s->qu,     s->qv,  s->map[0], s->map[1], s->map[2], s->map[3], s->map[4],
+      s->map[5], s->in,  s->in_c,   s->map[6], s->map[7]};
   int n = 0;
-  for (int i = 0; i < GR_RAIN_RUNOFF_STATE_CELL_ARRAYS; ++i, ++n) {
+  for (int i = 0; i < arrays; ++i, ++n) {
     bufs[n] = cells[i];
     sizes[n] = gr_rain_runoff_cells(s) * sizeof(float);
   }
@@ -229,7 +237,7 @@ static gr_status gr_rain_runoff_state_save_impl(gr_rain_runoff *s, void *host, s
   at += sizeof(hd);
   cl_mem bufs[GR_RAIN_RUNOFF_STATE_CELL_ARRAYS + 2];
   size_t sizes[GR_RAIN_RUNOFF_STATE_CELL_ARRAYS + 2];
-  int n = gr_rain_runoff_state_arrays(s, s->cur, bufs, sizes);
+  int n = gr_rain_runoff_state_arrays(s, s->cur, GR_RAIN_RUNOFF_STATE_CELL_ARRAYS, bufs, sizes);
   gr_status st = GR_OK;
   for (int i = 0; st == GR_OK && i < n; ++i) {
     st = gr_buffer_read(s->ctx, bufs[i], 0, sizes[i], at);
@@ -249,8 +257,38 @@ gr_status gr_rain_runoff_state_save(gr_rain_runoff *s, void *host, size_t bytes)
   return GR_RAIN_RUNOFF_KEEP_ERROR(s, gr_rain_runoff_state_save_impl(s, host, bytes));
 }
 
+/* Version 6's wet duration, a Kahan sum (wet, its compensation comp) of
+ * every wet step's dt, into version 7's ended spells (wet, comp become the
+ * double-float pair hi, lo of the same value): the spells under way start
+ * at the checkpoint's time (gr_rain_runoff_maps_update after the load, with
+ * wet_since -1 everywhere), where the sum stopped. */
+static gr_status gr_rain_runoff_state_wet_6(gr_rain_runoff *s, const unsigned char *wet,
+                                            const unsigned char *comp) {
+  size_t cells = gr_rain_runoff_cells(s), bytes = cells * sizeof(float);
+  float *pair = malloc(2 * bytes);
+  if (!pair)
+    return gr_set_error(s->ctx, GR_ERR_OUT_OF_MEMORY, "Out of host memory.");
+  float *lo = pair + cells;
+  for (size_t c = 0; c < cells; ++c) {
+    float w, k;
+    memcpy(&w, wet + c * sizeof(float), sizeof(float));
+    memcpy(&k, comp + c * sizeof(float), sizeof(float));
+    double v = (double)w - (double)k; /* exact: k is within w's last bits */
+    pair[c] = (float)v;
+    lo[c] = (float)(v - (double)pair[c]);
+  }
+  gr_status st = gr_buffer_write(s->ctx, s->map[3], 0, bytes, pair);
+  if (st == GR_OK)
+    st = gr_buffer_write(s->ctx, s->map[5], 0, bytes, lo);
+  if (st == GR_OK)
+    st = gr_rain_runoff_fill(s, s->map[6], -1.0f, bytes);
+  if (st == GR_OK)
+    st = gr_rain_runoff_fill(s, s->map[7], 0.0f, bytes);
+  free(pair);
+  return st;
+}
+
 static gr_status gr_rain_runoff_state_load_impl(gr_rain_runoff *s, const void *host, size_t bytes) {
-  size_t need = gr_rain_runoff_state_bytes(s);
   gr_rain_runoff_state_header hd;
   if (bytes < sizeof(hd))
     return gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
@@ -258,13 +296,17 @@ static gr_status gr_rain_runoff_state_load_impl(gr_rain_runoff *s, const void *h
                         "bytes gr_rain_runoff_state_save wrote.",
                         bytes);
   memcpy(&hd, host, sizeof(hd));
-  if (hd.magic != GR_RAIN_RUNOFF_STATE_MAGIC || hd.version != GR_RAIN_RUNOFF_STATE_VERSION)
+  /* Version 6 differs in the wet duration only (gr_rain_runoff_state_wet_6). */
+  int v6 = hd.version == 6u;
+  if (hd.magic != GR_RAIN_RUNOFF_STATE_MAGIC || (hd.version != GR_RAIN_RUNOFF_STATE_VERSION && !v6))
     return gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
                         "The bytes given are not a rain runoff state of this version (magic "
-                        "0x%08x, version %u; expected 0x%08x, version %u): pass the bytes "
+                        "0x%08x, version %u; expected 0x%08x, version %u or 6): pass the bytes "
                         "gr_rain_runoff_state_save wrote.",
                         (unsigned)hd.magic, (unsigned)hd.version, GR_RAIN_RUNOFF_STATE_MAGIC,
                         GR_RAIN_RUNOFF_STATE_VERSION);
+  const int arrays = v6 ? GR_RAIN_RUNOFF_STATE_CELL_ARRAYS_6 : GR_RAIN_RUNOFF_STATE_CELL_ARRAYS;
+  size_t need = gr_rain_runoff_state_bytes_of(s, arrays);
   if (hd.nx != s->nxl || hd.ny != s->nyl)
     return gr_set_error(s->ctx, GR_ERR_INVALID_ARGUMENT,
                         "The rain runoff state is of a %d x %d grid but this simulation's grid "
@@ -295,12 +337,12 @@ static gr_status gr_rain_runoff_state_load_impl(gr_rain_runoff *s, const void *h
   /* Every float finite, checked before anything is written, so that a
    * refused state leaves the simulation as it was. */
   const size_t cells = gr_rain_runoff_cells(s);
-  const gr_state_part parts[] = {
-      {"water depth", sizeof(hd), cells, 'f', -HUGE_VAL, HUGE_VAL},
-      {"per-cell arrays", sizeof(hd) + 4 * cells, (GR_RAIN_RUNOFF_STATE_CELL_ARRAYS - 1) * cells,
-       'f', -HUGE_VAL, HUGE_VAL},
-      {"face discharges", sizeof(hd) + 4 * GR_RAIN_RUNOFF_STATE_CELL_ARRAYS * cells,
-       gr_rain_runoff_xfaces(s) + gr_rain_runoff_yfaces(s), 'f', -HUGE_VAL, HUGE_VAL}};
+  const gr_state_part parts[] = {{"water depth", sizeof(hd), cells, 'f', -HUGE_VAL, HUGE_VAL},
+                                 {"per-cell arrays", sizeof(hd) + 4 * cells,
+                                  (size_t)(arrays - 1) * cells, 'f', -HUGE_VAL, HUGE_VAL},
+                                 {"face discharges", sizeof(hd) + 4 * (size_t)arrays * cells,
+                                  gr_rain_runoff_xfaces(s) + gr_rain_runoff_yfaces(s), 'f',
+                                  -HUGE_VAL, HUGE_VAL}};
   gr_status st = gr_state_check("rain runoff", "rain_runoff", host, parts, 3);
   if (st != GR_OK)
     return st;
@@ -308,11 +350,16 @@ static gr_status gr_rain_runoff_state_load_impl(gr_rain_runoff *s, const void *h
   const unsigned char *at = (const unsigned char *)host + sizeof(hd);
   cl_mem bufs[GR_RAIN_RUNOFF_STATE_CELL_ARRAYS + 2];
   size_t sizes[GR_RAIN_RUNOFF_STATE_CELL_ARRAYS + 2];
-  int n = gr_rain_runoff_state_arrays(s, 0, bufs, sizes);
+  int n = gr_rain_runoff_state_arrays(s, 0, arrays, bufs, sizes);
   for (int i = 0; st == GR_OK && i < n; ++i) {
     st = gr_buffer_write(s->ctx, bufs[i], 0, sizes[i], at);
     at += sizes[i];
   }
+  /* Version 6: the wet duration's arrays 12 and 14 (map[3], map[5]). */
+  const unsigned char *cells_at = (const unsigned char *)host + sizeof(hd);
+  if (st == GR_OK && v6)
+    st = gr_rain_runoff_state_wet_6(s, cells_at + 12 * cells * sizeof(float),
+                                    cells_at + 14 * cells * sizeof(float));
   if (st != GR_OK)
     return st;
   s->cur = 0;
@@ -324,7 +371,12 @@ static gr_status gr_rain_runoff_state_load_impl(gr_rain_runoff *s, const void *h
     s->rain_book[q].lo = hd.rain_lo[q];
     s->rain_book[q].hi = hd.rain_hi[q];
   }
-  return GR_OK;
+  /* The maps' wet spells from the depth loaded and this simulation's
+   * wetting depth: the spells under way of a version 6 state, or of a state
+   * saved under another wetting depth (the step kernels take a cell's wet
+   * state from its depth). A state saved under this wetting depth is left
+   * as it was: its maps already hold what the fold would add. */
+  return gr_rain_runoff_maps_update(s, s->time);
 }
 
 gr_status gr_rain_runoff_state_load(gr_rain_runoff *s, const void *host, size_t bytes) {

@@ -123,7 +123,7 @@ static gr_status gr_rain_runoff_bind_books(gr_rain_runoff *s, cl_kernel k) {
 /* The flood maps' arguments of kernel k, the last kernel of a step, which
  * folds its state into them (map_time is set before every launch). */
 static gr_status gr_rain_runoff_bind_maps(gr_rain_runoff *s, cl_kernel k) {
-  cl_float t0 = 0.0f;
+  cl_float4 t0 = gr_rain_runoff_map_time(0.0, 0.0);
   gr_status st = gr_rain_runoff_map_args(s, k);
   if (st == GR_OK)
     st = gr_kernel_arg(s->ctx, k, "map_time", sizeof(t0), &t0);
@@ -274,22 +274,24 @@ typedef struct gr_rain_runoff_batch {
   int exchange;            /* a piece with a halo exchange: one after every step */
   int per_step;            /* edge hydrographs: the sources made again before every step */
   /* The end time of each step, summed as s->time is (the flood maps'
-   * arrival times). */
+   * arrival times; the one before, the step's start, where wet spells
+   * begin and end). */
   double t_end;
   gr_fixed rate_sum; /* the hyetograph's rates the steps took (m/s, floats) */
 } gr_rain_runoff_batch;
 
 /* Before a step's launches: its sources and its share of the hyetograph;
- * *map_time gets the step's end, when its last launch folds the new state
- * into the flood maps. */
+ * *map_time gets the step's start and end (gr_rain_runoff_map_time), when
+ * its last launch folds the new state into the flood maps. */
 static gr_status gr_rain_runoff_step_begin(gr_rain_runoff *s, gr_rain_runoff_batch *b,
-                                           cl_float *map_time) {
+                                           cl_float4 *map_time) {
   gr_status st = GR_OK;
   if (b->per_step)
     st = gr_rain_runoff_sources_update(s, b->t_end, b->t_end + b->dt);
   if (st == GR_OK && s->hy_n)
     st = gr_rain_runoff_hyetograph_step(s, b->t_end, b->t_end + b->dt, &b->rate_sum);
-  *map_time = (cl_float)(b->t_end += b->dt);
+  double t0 = b->t_end;
+  *map_time = gr_rain_runoff_map_time(t0, b->t_end += b->dt);
   return st;
 }
 
@@ -307,7 +309,7 @@ static gr_status gr_rain_runoff_step_end(gr_rain_runoff *s, gr_rain_runoff_batch
 
 /* One shallow-water step's launches; stage 2's update folds the new state
  * into the flood maps at map_time. */
-static gr_status gr_rain_runoff_sw_launch(gr_rain_runoff *s, cl_float map_time) {
+static gr_status gr_rain_runoff_sw_launch(gr_rain_runoff *s, cl_float4 map_time) {
   gr_status st = GR_OK;
   /* Fused: each of Heun's stages in two launches, the interior's tiles
    * and the rim's, their faces in local memory (rain_runoff_sw_inner1, 2
@@ -355,7 +357,7 @@ static gr_status gr_rain_runoff_sw_launch(gr_rain_runoff *s, cl_float map_time) 
  * edge is not open (rain_runoff_flux_edges rewrites it). The update folds
  * the new state into the flood maps at map_time. */
 static gr_status gr_rain_runoff_li_launch(gr_rain_runoff *s, int fused, int edges, size_t gx,
-                                          size_t gy, cl_float map_time) {
+                                          size_t gy, cl_float4 map_time) {
   const size_t m = sizeof(cl_mem);
   int old = s->cur, now = 1 - s->cur;
   gr_status st = GR_OK;
@@ -458,7 +460,7 @@ gr_status gr_rain_runoff_enqueue(gr_rain_runoff *s, double dt, int nsteps, gr_ra
   for (int e = 0; e < 4; ++e)
     edges |= !s->ring[e] && s->params.boundary[e] != GR_BOUNDARY_OPEN;
   while (sw && st == GR_OK && b.done < nsteps && !*stop) {
-    cl_float map_time;
+    cl_float4 map_time;
     st = gr_rain_runoff_step_begin(s, &b, &map_time);
     if (st == GR_OK)
       st = gr_rain_runoff_sw_launch(s, map_time);
@@ -475,7 +477,7 @@ gr_status gr_rain_runoff_enqueue(gr_rain_runoff *s, double dt, int nsteps, gr_ra
   size_t gx = ((size_t)s->nxl + tx - 1) / tx * s->li_local[0];
   size_t gy = ((size_t)s->nyl + ty - 1) / ty * s->li_local[1];
   while (!sw && st == GR_OK && b.done < nsteps && !*stop) {
-    cl_float map_time;
+    cl_float4 map_time;
     st = gr_rain_runoff_step_begin(s, &b, &map_time);
     if (st == GR_OK)
       st = gr_rain_runoff_li_launch(s, fused, edges, gx, gy, map_time);

@@ -422,10 +422,16 @@ GR_API gr_status gr_rain_runoff_ledger_get(gr_rain_runoff *s, gr_rain_runoff_led
  *    front leaves behind have speeds q / h of hundreds of m/s that say
  *    nothing of the flow);
  *  - ARRIVAL_TIME (s): the end time of the first step after which
- *    h > wetting_depth (0 for water there at the start); NaN if never;
+ *    h > wetting_depth (0 for water there at the start, the time it is
+ *    set for a wetting_depth changed by set_params); NaN if never;
  *  - WET_DURATION (s): the sum of the dt of the steps after which h >
- *    wetting_depth (a Kahan sum), so a cell that stays wet has
- *    WET_DURATION + ARRIVAL_TIME = the time now + its first wet step;
+ *    wetting_depth, kept by wet spells: a spell counts from the start of
+ *    its first wet step to the start of the step after which the cell is
+ *    dry again (or to the time now while it lasts), in twice float
+ *    precision from the steps' times, so a cell that stays wet has
+ *    WET_DURATION + ARRIVAL_TIME = the time now + its first wet step (a
+ *    wetting_depth changed by set_params starts or ends spells at the time
+ *    it is set);
  *  - HAZARD_RATING: the largest flood-hazard rating
  *      HR = h (v + 0.5) + DF,  DF = debris_factor where h > 0.25 m, else 0,
  *    of the UK Defra / Environment Agency method (HR Wallingford, "Flood
@@ -442,7 +448,9 @@ GR_API gr_status gr_rain_runoff_ledger_get(gr_rain_runoff *s, gr_rain_runoff_led
  * Each step's last launch folds the state it leaves into the maps (the
  * velocity as VELOCITY reads it) and writes only the cells whose values
  * change: no launch of its own, no second read of the depth and the
- * discharges.
+ * discharges; the arrival time and the wet duration are read and written
+ * only where a cell turns wet or dry (its wet state before the step is its
+ * depth then).
  * @{
  */
 typedef enum gr_rain_runoff_map {
@@ -486,6 +494,10 @@ GR_API void gr_rain_runoff_set_progress(gr_rain_runoff *s, gr_progress_fn fn, vo
  * the host. Loading a saved state into a simulation of the same grid and
  * inputs makes every later step bit-identical to the steps that followed
  * the save. Inputs (elevation, maps) and parameters are not part of it.
+ * States saved before WET_DURATION was kept by wet spells (version 6 of
+ * the layout, a sum of every wet step's dt) still load, their spells under
+ * way starting at the saved time; the bytes of other versions are refused
+ * with a sentence.
  */
 GR_API gr_status gr_rain_runoff_state_size(const gr_rain_runoff *s, size_t *bytes);
 GR_API gr_status gr_rain_runoff_state_save(gr_rain_runoff *s, void *host, size_t bytes);
