@@ -158,13 +158,15 @@ static gr_status gr_snac_draw_view(gr_snow_accumulation *s, gr_snac_step_vars *s
     if (st == GR_OK)
       st = gr_enqueue_1d(ctx, s->raster_objects, (size_t)ntri);
   }
+  if (st == GR_OK)
+    st = gr_snac_mark(s, &s->tm.view_ms);
   /* A piece drew its own cells: the views' maximum over the pieces, texel
    * by texel, is the whole grid's view (see "Pieces" in the header). */
   s->objects_by_point = 0;
   if (st == GR_OK && sv->pieced && sv->terrain_drawn)
     st = gr_snac_view_reduce(s, v);
-  if (st == GR_OK)
-    st = gr_snac_mark(s, &s->tm.view_ms);
+  if (st == GR_OK && sv->pieced)
+    st = gr_snac_mark(s, &s->tm.combine_ms);
   return st;
 }
 
@@ -272,6 +274,8 @@ static gr_status gr_snac_apply_growth(gr_snow_accumulation *s, gr_snac_step_vars
                         "gr_snow_accumulation_set_halo_exchange) failed in step %lld with %s; the "
                         "piece's ring is not fresh, so restore a checkpoint before stepping on.",
                         s->steps + 1, gr_status_string(st));
+    else
+      st = gr_snac_mark(s, &s->tm.combine_ms);
   }
   return st;
 }
@@ -337,6 +341,8 @@ static gr_status gr_snac_grow_objects(gr_snow_accumulation *s, gr_snac_step_vars
     const float dir[3] = {sv->dir_x, sv->dir_y, sv->dir_z};
     st = gr_snac_object_exposure(s, *P, *N, nv, v, dir);
   }
+  if (st == GR_OK && (have_surface || have_exposure))
+    st = gr_snac_mark(s, &s->tm.combine_ms);
   cl_mem surf = have_surface || have_exposure ? s->o_surface : s->ground;
   const gr_snac_arg ob2[] = {GR_SNAC_VAL("have_surface", have_surface),
                              GR_SNAC_VAL("have_exposure", have_exposure),

@@ -473,6 +473,8 @@ typedef struct gr_snow_accumulation_timing {
   double apply_ms;    /**< increment and stability on the grid */
   double objects_ms;  /**< exposure, growth and stability of the faces and samples */
   double host_ms;     /**< the view's extent and the direction, on the host */
+  double combine_ms;  /**< a piece's share with the others: its view's shared rows, the
+                           objects' values and the halo exchange (0 on a whole grid) */
 } gr_snow_accumulation_timing;
 
 /** Switches per-stage timing on (non-zero; the sums restart) or off. */
