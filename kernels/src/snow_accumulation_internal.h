@@ -174,6 +174,11 @@ typedef struct gr_snac_view {
 void gr_snac_direction(const gr_snow_accumulation *s, double d[3]);
 /* The view of a step along d. */
 void gr_snac_view_of(const gr_snow_accumulation *s, const double d[3], gr_snac_view *v);
+/* The view rows [lo, hi] a piece draws the objects into when the views are
+ * combined: its band (the rows its own grid points read), from row 0 on
+ * for the first piece and up to the last row for the last, so that every
+ * row has the objects in at least one piece's view. */
+void gr_snac_object_rows(const gr_snow_accumulation *s, const gr_snac_view *v, int *lo, int *hi);
 /* A piece's view combined with the other pieces' where it matters. Waits. */
 gr_status gr_snac_view_reduce(gr_snow_accumulation *s, const gr_snac_view *v);
 /* The exposure of nv faces (or samples) at pos, nrm in the pieces'

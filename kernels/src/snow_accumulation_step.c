@@ -142,7 +142,17 @@ static gr_status gr_snac_draw_view(gr_snow_accumulation *s, gr_snac_step_vars *s
   if (st == GR_OK && sv->nx > 1 && sv->ny > 1 && sv->terrain_drawn)
     st = gr_enqueue_2d(ctx, s->raster_terrain, 0, 0, (size_t)(sv->nx - 1), (size_t)(sv->ny - 1),
                        NULL);
-  cl_int ntri = s->ntri;
+  /* The objects: every row on a whole grid, and on a piece whose view
+   * stays its own (no terrain drawn); else its share of the rows, the
+   * pieces' shares covering the view (the maximum over the pieces is
+   * then the whole view wherever it is combined, and a piece's grid points
+   * read only rows of its own share). */
+  cl_int ntri = s->ntri, row_lo = 0, row_hi = sv->vh - 1;
+  if (sv->pieced && sv->terrain_drawn) {
+    int lo, hi;
+    gr_snac_object_rows(s, v, &lo, &hi);
+    row_lo = lo, row_hi = hi;
+  }
   if (st == GR_OK && ntri > 0) {
     const gr_snac_arg ro[] = {GR_SNAC_MEM("tri", s->o_tri),
                               GR_SNAC_VAL("ntri", ntri),
@@ -153,6 +163,8 @@ static gr_status gr_snac_draw_view(gr_snow_accumulation *s, gr_snac_step_vars *s
                               GR_SNAC_VAL("inv_texel", v->inv_texel),
                               GR_SNAC_VAL("vw", sv->vw),
                               GR_SNAC_VAL("vh", sv->vh),
+                              GR_SNAC_VAL("row_lo", row_lo),
+                              GR_SNAC_VAL("row_hi", row_hi),
                               GR_SNAC_MEM("view", s->view)};
     st = gr_snac_args(s, s->raster_objects, ro, sizeof(ro) / sizeof(ro[0]));
     if (st == GR_OK)

@@ -100,13 +100,39 @@ static void gr_snac_band(const gr_snac_view *v, double ylo, double yhi, double z
   *hi = b > v->vh - 1.0 ? v->vh - 1 : (int)fmax(b, -1.0);
 }
 
+/* This piece's band: its local rows, every height the view's box allows. */
+static void gr_snac_piece_band(const gr_snow_accumulation *s, const gr_snac_view *v, int *lo,
+                               int *hi) {
+  double zlo = fmin(0.0, s->bmin - s->zref), zhi = s->bmax + s->snow_bound - s->zref;
+  gr_snac_band(v, (double)s->row0 * s->grid.dy, (double)(s->row0 + s->grid.ny - 1) * s->grid.dy,
+               zlo, zhi, lo, hi);
+}
+
+void gr_snac_object_rows(const gr_snow_accumulation *s, const gr_snac_view *v, int *lo, int *hi) {
+  gr_snac_piece_band(s, v, lo, hi);
+  if (*lo > *hi) {
+    /* No band (cannot happen for a view of the domain's box): every row. */
+    *lo = 0, *hi = v->vh - 1;
+    return;
+  }
+  /* The bands rise with the rows (a strip's band is its rows' y plus the
+   * same heights times tau_y) and neighbours' overlap (their local rows
+   * share the rings), so the first piece's band from row 0 and the last's
+   * up to the top, with every band between, cover the view. */
+  if (s->row0 == 0)
+    *lo = 0;
+  if (s->row0 + s->grid.ny == s->gny)
+    *hi = v->vh - 1;
+}
+
 /* The pieces' views combined, texel by texel, with a maximum (ints travel
  * exactly as doubles), in the rows where that can change a texel that a
  * piece reads. A piece draws its local cells (ring included) into rows of
- * a band its rows and the surface's height range bound, and its grid
- * points read only there; outside every other piece's band the others'
- * views hold the objects alone, which every piece draws the same, so a
- * piece's own texel is already the maximum. The rows two or more bands
+ * a band its rows and the surface's height range bound, and the objects
+ * into that band at least (gr_snac_object_rows); its grid points read only
+ * there, and outside every other piece's band the others' views hold
+ * objects alone, which this piece drew too, so its own texel is already
+ * the maximum. The rows two or more bands
  * cover are found by one reduction of 2 values a row (the highest and
  * lowest piece covering it) and only they are combined: a band of about
  * the ring plus the relief times the snow's slope across the cut, instead
@@ -128,11 +154,8 @@ gr_status gr_snac_view_reduce(gr_snow_accumulation *s, const gr_snac_view *v) {
   }
   unsigned char *rows = s->view_rows;
   double *cover = s->view_cover;
-  /* This piece's band: its local rows, every height the view's box allows. */
-  double zlo = fmin(0.0, s->bmin - s->zref), zhi = s->bmax + s->snow_bound - s->zref;
   int lo, hi;
-  gr_snac_band(v, (double)s->row0 * s->grid.dy, (double)(s->row0 + s->grid.ny - 1) * s->grid.dy,
-               zlo, zhi, &lo, &hi);
+  gr_snac_piece_band(s, v, &lo, &hi);
   double id = (double)(s->row0 + s->ring_s); /* the first own row: one per piece */
   for (size_t r = 0; r < vh; ++r) {
     int in = (int)r >= lo && (int)r <= hi;

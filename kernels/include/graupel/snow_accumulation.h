@@ -374,8 +374,10 @@ GR_API gr_status gr_snow_accumulation_reset(gr_snow_accumulation *s);
  * view, bit for bit, whatever the split. Only the texels that can differ
  * and are read are combined. A piece's cells, and its grid points' rays,
  * fall in a band of view rows that its rows and the view box's heights
- * bound; elsewhere its view holds the objects alone, the same on every
- * piece. So the pieces agree (a GR_REDUCE_MAX of 2 values per view row:
+ * bound, and it draws the objects into that band only (the first piece
+ * from the view's first row on, the last up to its last row: every row has
+ * the objects in some piece's view); elsewhere its view holds objects
+ * alone. So the pieces agree (a GR_REDUCE_MAX of 2 values per view row:
  * the highest and lowest piece whose band covers it) on the rows two or
  * more bands cover, a band about as wide as the ring plus the relief times
  * the snow's slope along y, and combine those rows alone (in calls of at
