@@ -1301,7 +1301,13 @@ static int pc_subdiv = 6;
 typedef struct pc_scene {
   int tilted;
   test_mesh box, kite[2];
+  float *uv; /* the box's texture coordinates (tilted snow) */
 } pc_scene;
+
+/* In tilted snow the box has an accumulation texture of PC_TEXTURE^2
+ * texels (its top's and bottom's x, y): samples beside the faces, the
+ * per-point exposure of both combined over the pieces. */
+enum { PC_TEXTURE = 16 };
 
 /* In tilted snow, two kites of 0.4 x 0.4 x 0.2 m (3 x 3 points a face)
  * besides the box: one south of the domain near the ground, one 6 m above
@@ -1313,6 +1319,12 @@ enum { PC_KITE_SUBDIV = 2, PC_KITE_POINTS = 6 * (PC_KITE_SUBDIV + 1) * (PC_KITE_
 static void pc_scene_make(pc_scene *sc, int tilted) {
   sc->tilted = tilted;
   mesh_faces(&sc->box, 1.0, 1.2, 0.6, pc_subdiv);
+  int nv = sc->box.m.nvertices;
+  sc->uv = malloc((size_t)nv * 2 * sizeof(float));
+  for (int v = 0; v < nv; ++v) {
+    sc->uv[2 * v] = (float)(0.5 + 0.45 * sc->box.v[3 * v] / 1.0);
+    sc->uv[2 * v + 1] = (float)(0.5 + 0.45 * sc->box.v[3 * v + 1] / 1.2);
+  }
   for (int q = 0; q < 2; ++q) {
     mesh_faces(&sc->kite[q], 0.2, 0.2, 0.1, PC_KITE_SUBDIV);
     mesh_pose(&sc->kite[q], 5.0, q ? 3.0 : -2.0, q ? 18.0 : 11.6);
@@ -1320,24 +1332,36 @@ static void pc_scene_make(pc_scene *sc, int tilted) {
 }
 
 static void pc_scene_free(pc_scene *sc) {
+  free(sc->uv);
   mesh_free(&sc->box);
   mesh_free(&sc->kite[0]), mesh_free(&sc->kite[1]);
 }
 
-/* The scene's objects: the box, then the kites in tilted snow. */
+/* The scene's objects: the box, then the kites and the box's texture in
+ * tilted snow. */
 static gr_status pc_set_objects(gr_snow_accumulation *s, const pc_scene *sc) {
   gr_mesh m[3] = {sc->box.m, sc->kite[0].m, sc->kite[1].m};
-  return gr_snow_accumulation_set_objects(s, m, sc->tilted ? 3 : 1);
+  gr_status st = gr_snow_accumulation_set_objects(s, m, sc->tilted ? 3 : 1);
+  if (st == GR_OK && sc->tilted)
+    st = gr_snow_accumulation_set_object_texture(s, 0, sc->uv, PC_TEXTURE);
+  return st;
 }
 
-/* Field f of the scene's objects' mesh points, the box's nv first. */
+/* Field f of the scene's objects' mesh points, the box's nv first, then
+ * in tilted snow the kites' and the box's texture (snow depth; 0 for
+ * other fields). */
 static float *pc_get_objects(gr_snow_accumulation *s, const pc_scene *sc, gr_field f, int nv) {
-  int nk = sc->tilted ? 2 : 0;
-  float *a = malloc(((size_t)nv + (size_t)nk * PC_KITE_POINTS) * sizeof(float));
+  int nk = sc->tilted ? 2 : 0, nt = sc->tilted ? PC_TEXTURE * PC_TEXTURE : 0;
+  float *a = malloc(((size_t)nv + (size_t)nk * PC_KITE_POINTS + (size_t)nt) * sizeof(float));
   gr_status st = gr_snow_accumulation_get_object_field(s, 0, f, a, nv);
   for (int q = 0; st == GR_OK && q < nk; ++q)
     st = gr_snow_accumulation_get_object_field(s, 1 + q, f, a + nv + q * PC_KITE_POINTS,
                                                PC_KITE_POINTS);
+  /* The texture holds snow depth: after the snow depth of the points. */
+  if (st == GR_OK && nt && f == GR_FIELD_SNOW_DEPTH)
+    st = gr_snow_accumulation_get_object_texture(s, 0, a + nv + nk * PC_KITE_POINTS, PC_TEXTURE);
+  else if (nt)
+    memset(a + nv + nk * PC_KITE_POINTS, 0, (size_t)nt * sizeof(float));
   CHECK_MSG(st == GR_OK, "get_object_field: %s", gr_snow_accumulation_last_error(s));
   return a;
 }
@@ -1477,7 +1501,7 @@ static void pc_check(const pc_domain *dm, int tilted, int n, pc_runner *rn,
       free(v);
     }
     const pc_scene sc = {.tilted = tilted};
-    size_t points = (size_t)nv + (tilted ? 2 * PC_KITE_POINTS : 0);
+    size_t points = (size_t)nv + (tilted ? 2 * PC_KITE_POINTS + PC_TEXTURE * PC_TEXTURE : 0);
     for (int f = 0; f < 2; ++f) {
       float *v = pc_get_objects(rn[k].s, &sc, f ? GR_FIELD_EXPOSURE : GR_FIELD_SNOW_DEPTH, nv);
       long d = pc_diff(v, wo[f], points);
@@ -1650,6 +1674,9 @@ static void test_pieces(void) {
     for (int q = 0; tilted && q < 2; ++q)
       for (int v = kper; v < 2 * kper; ++v)
         kite_bottom[q] += wo[1][nv + q * PC_KITE_POINTS + v] == 0.0f;
+    int texels_snowed = 0;
+    for (int q = 0; tilted && q < PC_TEXTURE * PC_TEXTURE; ++q)
+      texels_snowed += wo[0][nv + 2 * PC_KITE_POINTS + q] > 0.0f;
     printf(
         "pieces (%s snow): whole grid: %d hidden points on the bare ridges, box sides %d hidden, "
         "%d open; ledger stored %.6g m^3 (balance %.3g)\n",
@@ -1660,6 +1687,8 @@ static void test_pieces(void) {
       CHECK_MSG(kite_bottom[0] == kper && kite_bottom[1] == kper,
                 "the kites' bottoms: %d and %d of %d points hidden (all expected)", kite_bottom[0],
                 kite_bottom[1], kper);
+      CHECK_MSG(texels_snowed > PC_TEXTURE, "the box's texture: %d texels with snow",
+                texels_snowed);
     } else
       CHECK_MSG(side_hidden > 10 && side_open > 10,
                 "the sunk box's sides: %d hidden, %d open (both expected)", side_hidden, side_open);

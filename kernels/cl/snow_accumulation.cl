@@ -393,19 +393,19 @@ __kernel void snow_accumulation_object_surface(__global const float *restrict po
 }
 
 /* A piece's exposure of the mesh points (or samples) from its own view,
- * for the steps with the terrain in the view: a point is exposed when no
- * texel value above it on its ray exceeds its key, and the pieces' views
- * combine by a maximum, so a point is exposed in the combined view exactly
- * when it is exposed in every piece's: the minimum over the pieces of this
- * (through a GR_REDUCE_MAX of its negation) is snow_accumulation_objects'
- * exposure, bit for bit, without combining the view's texels under the
- * objects. */
+ * for the steps with the terrain in the view, into exposure[first + v]: a
+ * point is exposed when no texel value above it on its ray exceeds its
+ * key, and the pieces' views combine by a maximum, so a point is exposed
+ * in the combined view exactly when it is exposed in every piece's: the
+ * minimum over the pieces of this (through a GR_REDUCE_MAX of its
+ * negation) is snow_accumulation_objects' exposure, bit for bit, without
+ * combining the view's texels under the objects. */
 __kernel void snow_accumulation_object_exposure(__global const float *restrict pos,
                                                 __global const float *restrict nrm, int nv,
                                                 float dir_x, float dir_y, float dir_z, float tau_x,
                                                 float tau_y, float qx0, float qy0, float inv_texel,
                                                 float texel, int vw, int vh,
-                                                __global const int *restrict view,
+                                                __global const int *restrict view, int first,
                                                 __global float *restrict exposure) {
   int v = get_global_id(0);
   if (v >= nv)
@@ -413,7 +413,7 @@ __kernel void snow_accumulation_object_exposure(__global const float *restrict p
   float3 d = (float3)(dir_x, dir_y, dir_z);
   float3 n = (float3)(nrm[3 * v], nrm[3 * v + 1], nrm[3 * v + 2]);
   float3 p = snac_mesh_point(pos, n, v, texel);
-  exposure[v] =
+  exposure[first + v] =
       snac_exposed(view, vw, vh, p.x, p.y, p.z, n, d, tau_x, tau_y, qx0, qy0, inv_texel, texel);
 }
 
@@ -429,7 +429,7 @@ __kernel void snow_accumulation_objects(
     __global const int *restrict view, float rate_dt, float amplitude, uint seed, float max_depth,
     float keep, float kdt, int terrain_drawn, __global const float *restrict ground,
     __global const float *restrict gdepth, int gnx, int gny, float gdx, float gdy, float zref,
-    int have_surface, int have_exposure, __global const float *restrict surface,
+    int have_surface, int have_exposure, int surface_first, __global const float *restrict surface,
     __global float *restrict exposure, __global float *restrict depth,
     __global float *restrict depth_lo, __global float *restrict fall,
     __global float *restrict fall_lo, __global float *restrict shed,
@@ -440,9 +440,10 @@ __kernel void snow_accumulation_objects(
   float3 d = (float3)(dir_x, dir_y, dir_z);
   float3 n = (float3)(nrm[3 * v], nrm[3 * v + 1], nrm[3 * v + 2]);
   float3 p = snac_mesh_point(pos, n, v, texel);
-  /* have_exposure: surface holds the pieces' combined exposure of the
-   * points (snow_accumulation_object_exposure), the view only this piece's. */
-  float e = have_exposure ? surface[v]
+  /* have_exposure: surface from surface_first holds the pieces' combined
+   * exposure of the points (snow_accumulation_object_exposure), the view
+   * only this piece's. */
+  float e = have_exposure ? surface[surface_first + v]
                           : snac_exposed(view, vw, vh, p.x, p.y, p.z, n, d, tau_x, tau_y, qx0, qy0,
                                          inv_texel, texel);
   /* Without the terrain in the view, a point under the snow surface (an
@@ -451,7 +452,7 @@ __kernel void snow_accumulation_objects(
    * reduced snow_accumulation_object_surface, the same floats). */
   if (!terrain_drawn && e > 0.0f) {
     float hs = have_surface
-                   ? surface[v]
+                   ? surface[surface_first + v]
                    : snac_surface_at(ground, gdepth, gnx, gny, 0, gdx, gdy, zref, p.x, p.y);
     if (p.z < hs)
       e = 0.0f;

@@ -175,8 +175,9 @@ static gr_status gr_snac_draw_view(gr_snow_accumulation *s, gr_snac_step_vars *s
   /* A piece drew its own cells: the views' maximum over the pieces, texel
    * by texel, is the whole grid's view (see "Pieces" in the header). */
   s->objects_by_point = 0;
+  const float dir[3] = {sv->dir_x, sv->dir_y, sv->dir_z};
   if (st == GR_OK && sv->pieced && sv->terrain_drawn)
-    st = gr_snac_view_reduce(s, v);
+    st = gr_snac_view_reduce(s, v, dir);
   if (st == GR_OK && sv->pieced)
     st = gr_snac_mark(s, &s->tm.combine_ms);
   return st;
@@ -344,21 +345,20 @@ static gr_status gr_snac_grow_objects(gr_snow_accumulation *s, gr_snac_step_vars
                             GR_SNAC_MEM("shed_lo", A[5])};
   /* On a piece, the surface under the points when the objects kernel
    * needs it (no terrain in the view) comes from the pieces that hold
-   * it. */
+   * it; their exposure in the combined view, where it was combined per
+   * point, is in s->o_surface already (faces, then samples:
+   * gr_snac_view_reduce). */
   cl_int have_surface = sv->pieced && !sv->terrain_drawn;
   cl_int have_exposure = sv->pieced && sv->terrain_drawn && s->objects_by_point;
+  cl_int surface_first = have_exposure && pass ? s->ntri : 0;
   if (have_surface)
     st = gr_snac_object_surface(s, *P, *N, nv, v->texel);
-  if (have_exposure) {
-    const float dir[3] = {sv->dir_x, sv->dir_y, sv->dir_z};
-    st = gr_snac_object_exposure(s, *P, *N, nv, v, dir);
-  }
-  if (st == GR_OK && (have_surface || have_exposure))
+  if (st == GR_OK && have_surface)
     st = gr_snac_mark(s, &s->tm.combine_ms);
   cl_mem surf = have_surface || have_exposure ? s->o_surface : s->ground;
-  const gr_snac_arg ob2[] = {GR_SNAC_VAL("have_surface", have_surface),
-                             GR_SNAC_VAL("have_exposure", have_exposure),
-                             GR_SNAC_MEM("surface", surf)};
+  const gr_snac_arg ob2[] = {
+      GR_SNAC_VAL("have_surface", have_surface), GR_SNAC_VAL("have_exposure", have_exposure),
+      GR_SNAC_VAL("surface_first", surface_first), GR_SNAC_MEM("surface", surf)};
   if (st == GR_OK)
     st = gr_snac_args(s, s->objects_k, ob, sizeof(ob) / sizeof(ob[0]));
   if (st == GR_OK)

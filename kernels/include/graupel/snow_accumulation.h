@@ -386,7 +386,8 @@ GR_API gr_status gr_snow_accumulation_reset(gr_snow_accumulation *s);
  * their exposure (a point is exposed when every piece's view leaves it
  * exposed) is combined per face and sample, GR_REDUCE_MAX of minus
  * the exposure, or, where that is more values, the view rows under the
- * objects are combined too. At 1024^2 with ExposureResolution 1024 and two
+ * objects are combined too; the rows and the points go in one allreduce
+ * (one read-back and one write) a step. At 1024^2 with ExposureResolution 1024 and two
  * pieces, graupel-bench's scene reduces about 0.37 MB a step per piece
  * instead of the whole view's 8 MB. This happens in the steps where the
  * terrain is drawn at all: where the surface rises slower than the snow
