@@ -1294,10 +1294,77 @@ static pc_domain pc_make_domain(void) {
  * 24, 32), sunk 0.2 m into the ground's middle height and sliding along x;
  * tilted, fluttering snow (the terrain in the view) or straight down (the
  * objects alone, buried mesh points found through the pieces' surface). */
+/* The box's points along an edge of a face, less one: 6 (294 points), or
+ * 40 (10086 points, more than the view rows under the box hold texels). */
+static int pc_subdiv = 6;
+
 typedef struct pc_scene {
   int tilted;
-  test_mesh box;
+  test_mesh box, kite[2];
+  float *uv; /* the box's texture coordinates (tilted snow) */
 } pc_scene;
+
+/* In tilted snow the box has an accumulation texture of PC_TEXTURE^2
+ * texels (its top's and bottom's x, y): samples beside the faces, the
+ * per-point exposure of both combined over the pieces. */
+enum { PC_TEXTURE = 16 };
+
+/* In tilted snow, two kites of 0.4 x 0.4 x 0.2 m (3 x 3 points a face)
+ * besides the box: one south of the domain near the ground, one 6 m above
+ * its northern rows, so that their rays cross view rows below and above
+ * every piece's band, the rows only the first and the last piece draw the
+ * objects into; each kite's top hides its bottom there. */
+enum { PC_KITE_SUBDIV = 2, PC_KITE_POINTS = 6 * (PC_KITE_SUBDIV + 1) * (PC_KITE_SUBDIV + 1) };
+
+static void pc_scene_make(pc_scene *sc, int tilted) {
+  sc->tilted = tilted;
+  mesh_faces(&sc->box, 1.0, 1.2, 0.6, pc_subdiv);
+  int nv = sc->box.m.nvertices;
+  sc->uv = malloc((size_t)nv * 2 * sizeof(float));
+  for (int v = 0; v < nv; ++v) {
+    sc->uv[2 * v] = (float)(0.5 + 0.45 * sc->box.v[3 * v] / 1.0);
+    sc->uv[2 * v + 1] = (float)(0.5 + 0.45 * sc->box.v[3 * v + 1] / 1.2);
+  }
+  for (int q = 0; q < 2; ++q) {
+    mesh_faces(&sc->kite[q], 0.2, 0.2, 0.1, PC_KITE_SUBDIV);
+    mesh_pose(&sc->kite[q], 5.0, q ? 3.0 : -2.0, q ? 18.0 : 11.6);
+  }
+}
+
+static void pc_scene_free(pc_scene *sc) {
+  free(sc->uv);
+  mesh_free(&sc->box);
+  mesh_free(&sc->kite[0]), mesh_free(&sc->kite[1]);
+}
+
+/* The scene's objects: the box, then the kites and the box's texture in
+ * tilted snow. */
+static gr_status pc_set_objects(gr_snow_accumulation *s, const pc_scene *sc) {
+  gr_mesh m[3] = {sc->box.m, sc->kite[0].m, sc->kite[1].m};
+  gr_status st = gr_snow_accumulation_set_objects(s, m, sc->tilted ? 3 : 1);
+  if (st == GR_OK && sc->tilted)
+    st = gr_snow_accumulation_set_object_texture(s, 0, sc->uv, PC_TEXTURE);
+  return st;
+}
+
+/* Field f of the scene's objects' mesh points, the box's nv first, then
+ * in tilted snow the kites' and the box's texture (snow depth; 0 for
+ * other fields). */
+static float *pc_get_objects(gr_snow_accumulation *s, const pc_scene *sc, gr_field f, int nv) {
+  int nk = sc->tilted ? 2 : 0, nt = sc->tilted ? PC_TEXTURE * PC_TEXTURE : 0;
+  float *a = malloc(((size_t)nv + (size_t)nk * PC_KITE_POINTS + (size_t)nt) * sizeof(float));
+  gr_status st = gr_snow_accumulation_get_object_field(s, 0, f, a, nv);
+  for (int q = 0; st == GR_OK && q < nk; ++q)
+    st = gr_snow_accumulation_get_object_field(s, 1 + q, f, a + nv + q * PC_KITE_POINTS,
+                                               PC_KITE_POINTS);
+  /* The texture holds snow depth: after the snow depth of the points. */
+  if (st == GR_OK && nt && f == GR_FIELD_SNOW_DEPTH)
+    st = gr_snow_accumulation_get_object_texture(s, 0, a + nv + nk * PC_KITE_POINTS, PC_TEXTURE);
+  else if (nt)
+    memset(a + nv + nk * PC_KITE_POINTS, 0, (size_t)nt * sizeof(float));
+  CHECK_MSG(st == GR_OK, "get_object_field: %s", gr_snow_accumulation_last_error(s));
+  return a;
+}
 
 static void pc_params(gr_snow_accumulation_params *p, int tilted) {
   gr_snow_accumulation_params_init(p);
@@ -1325,7 +1392,7 @@ enum { PC_MAX = 3, PC_STEPS = 12 };
 
 typedef struct pc_runner {
   gr_test_team *t;
-  int rank, exchanges, reductions;
+  int rank, tilted, exchanges, reductions;
   double values; /* reduced, over every call */
   /* Steps k0 .. k1 - 1 of the scene; the state saved after save_at steps
    * (0: none); a progress callback that stops after stop_at steps (0: none). */
@@ -1363,20 +1430,16 @@ static gr_status pc_exchange(void *user) {
   return gr_test_team_exchange(r->t, r->rank, r->s, pc_halo);
 }
 
-/* The box's points along an edge of a face, less one: 6 (294 points), or
- * 40 (10086 points, more than the view rows under the box hold texels). */
-static int pc_subdiv = 6;
-
 static void *pc_run(void *arg) {
   pc_runner *r = arg;
   pc_scene sc;
-  mesh_faces(&sc.box, 1.0, 1.2, 0.6, pc_subdiv);
+  pc_scene_make(&sc, r->tilted);
   gr_status st = GR_OK;
   if (r->stop_at)
     gr_snow_accumulation_set_progress(r->s, pc_stop, r);
   for (int k = r->k0; st == GR_OK && k < r->k1; ++k) {
     pc_pose(&sc, k);
-    st = gr_snow_accumulation_set_objects(r->s, &sc.box.m, 1);
+    st = pc_set_objects(r->s, &sc);
     if (st == GR_OK)
       st = gr_snow_accumulation_step(r->s, 90.0);
     if (st == GR_OK && ++r->taken == r->save_at) {
@@ -1390,7 +1453,7 @@ static void *pc_run(void *arg) {
   gr_status s2 = gr_snow_accumulation_ledger_get(r->s, &r->l);
   r->st = st == GR_OK ? s2 : st;
   gr_snow_accumulation_set_progress(r->s, NULL, NULL);
-  mesh_free(&sc.box);
+  pc_scene_free(&sc);
   return NULL;
 }
 
@@ -1437,9 +1500,11 @@ static void pc_check(const pc_domain *dm, int tilted, int n, pc_runner *rn,
                 tilted ? "tilted" : "vertical", n, how, k, d, gr_field_name(fields[f]));
       free(v);
     }
+    const pc_scene sc = {.tilted = tilted};
+    size_t points = (size_t)nv + (tilted ? 2 * PC_KITE_POINTS + PC_TEXTURE * PC_TEXTURE : 0);
     for (int f = 0; f < 2; ++f) {
-      float *v = get_object(rn[k].s, 0, f ? GR_FIELD_EXPOSURE : GR_FIELD_SNOW_DEPTH, nv);
-      long d = pc_diff(v, wo[f], (size_t)nv);
+      float *v = pc_get_objects(rn[k].s, &sc, f ? GR_FIELD_EXPOSURE : GR_FIELD_SNOW_DEPTH, nv);
+      long d = pc_diff(v, wo[f], points);
       CHECK_MSG(d == 0, "%d pieces%s: piece %d: %ld mesh points' %s differ", n, how, k, d,
                 f ? "exposure" : "snow depth");
       free(v);
@@ -1478,7 +1543,8 @@ static void pc_split(const pc_domain *dm, int tilted, int n, const int *cuts,
   for (int k = 0; k < n; ++k) {
     memset(&rn[k], 0, sizeof(rn[k]));
     int j0 = k ? cuts[k - 1] : 0, j1 = k + 1 < n ? cuts[k] : dm->g.ny;
-    rn[k].t = &t, rn[k].rank = k, rn[k].k1 = PC_STEPS, rn[k].save_at = PC_STEPS / 2;
+    rn[k].t = &t, rn[k].rank = k, rn[k].tilted = tilted, rn[k].k1 = PC_STEPS;
+    rn[k].save_at = PC_STEPS / 2;
     rn[k].s = pc_piece(dm, &p, j0, j1 - j0, ghost, &rn[k].g);
     ok = ok && rn[k].s;
     for (int side = 2; ok && side < 4; ++side) {
@@ -1571,10 +1637,10 @@ static void test_pieces(void) {
     CHECK(gr_snow_accumulation_set_field(whole, GR_FIELD_ELEVATION, dm.b) == GR_OK);
     CHECK(gr_snow_accumulation_set_field(whole, GR_FIELD_SNOW_DEPTH, dm.d) == GR_OK);
     pc_scene sc;
-    mesh_faces(&sc.box, 1.0, 1.2, 0.6, pc_subdiv);
+    pc_scene_make(&sc, tilted);
     for (int k = 0; k < PC_STEPS; ++k) {
       pc_pose(&sc, k);
-      CHECK(gr_snow_accumulation_set_objects(whole, &sc.box.m, 1) == GR_OK);
+      CHECK(pc_set_objects(whole, &sc) == GR_OK);
       st = gr_snow_accumulation_step(whole, 90.0);
       CHECK_MSG(st == GR_OK, "whole step %d: %s", k, gr_snow_accumulation_last_error(whole));
     }
@@ -1583,8 +1649,8 @@ static void test_pieces(void) {
     const int nv = sc.box.m.nvertices;
     float *wf[3] = {get(whole, GR_FIELD_SNOW_DEPTH, n), get(whole, GR_FIELD_SNOW_SURFACE, n),
                     get(whole, GR_FIELD_EXPOSURE, n)};
-    float *wo[2] = {get_object(whole, 0, GR_FIELD_SNOW_DEPTH, nv),
-                    get_object(whole, 0, GR_FIELD_EXPOSURE, nv)};
+    float *wo[2] = {pc_get_objects(whole, &sc, GR_FIELD_SNOW_DEPTH, nv),
+                    pc_get_objects(whole, &sc, GR_FIELD_EXPOSURE, nv)};
     /* The scene does what it is for: tilted snow leaves grid points in
      * the lee of the bare ridges hidden (no box), and straight down the
      * box's side faces are hidden below the snow surface and open above
@@ -1603,14 +1669,27 @@ static void test_pieces(void) {
     }
     for (int v = 2 * per; v < 6 * per; ++v)
       side_hidden += wo[1][v] == 0.0f, side_open += wo[1][v] == 1.0f;
+    /* Each kite's bottom is hidden by its top (its rows are drawn). */
+    int kite_bottom[2] = {0, 0}, kper = PC_KITE_POINTS / 6;
+    for (int q = 0; tilted && q < 2; ++q)
+      for (int v = kper; v < 2 * kper; ++v)
+        kite_bottom[q] += wo[1][nv + q * PC_KITE_POINTS + v] == 0.0f;
+    int texels_snowed = 0;
+    for (int q = 0; tilted && q < PC_TEXTURE * PC_TEXTURE; ++q)
+      texels_snowed += wo[0][nv + 2 * PC_KITE_POINTS + q] > 0.0f;
     printf(
         "pieces (%s snow): whole grid: %d hidden points on the bare ridges, box sides %d hidden, "
         "%d open; ledger stored %.6g m^3 (balance %.3g)\n",
         tilted ? "tilted" : "vertical", lee, side_hidden, side_open, lw.stored_volume,
         lw.balance_error);
-    if (tilted)
+    if (tilted) {
       CHECK_MSG(lee > 10, "tilted snow hides only %d grid points in the ridges' lee", lee);
-    else
+      CHECK_MSG(kite_bottom[0] == kper && kite_bottom[1] == kper,
+                "the kites' bottoms: %d and %d of %d points hidden (all expected)", kite_bottom[0],
+                kite_bottom[1], kper);
+      CHECK_MSG(texels_snowed > PC_TEXTURE, "the box's texture: %d texels with snow",
+                texels_snowed);
+    } else
       CHECK_MSG(side_hidden > 10 && side_open > 10,
                 "the sunk box's sides: %d hidden, %d open (both expected)", side_hidden, side_open);
     CHECK(fabs(lw.balance_error) < 1e-9 * lw.stored_volume);
@@ -1620,7 +1699,7 @@ static void test_pieces(void) {
     for (int f = 0; f < 3; ++f)
       free(wf[f]);
     free(wo[0]), free(wo[1]);
-    mesh_free(&sc.box);
+    pc_scene_free(&sc);
     gr_snow_accumulation_destroy(whole);
   }
   /* Error paths: a column split, a ring narrower than BlurRadius needs,

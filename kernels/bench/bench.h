@@ -50,6 +50,9 @@ typedef struct gr_bench_split {
   gr_status (*summary)(void *state, char *line, size_t len);
   /* The piece's latest error ("" if none). */
   const char *(*last_error)(void *state);
+  /* Optional, collective: a few more steps with the core's per-stage timing
+   * on, one line of the piece's stages (ms a step); printed per piece. */
+  gr_status (*stages)(void *state, char *line, size_t len);
 } gr_bench_split;
 
 typedef struct gr_bench_core {

@@ -230,9 +230,11 @@ static const char *rain_runoff_last_error(void *state) {
 }
 
 static const gr_bench_split split = {
-    rain_runoff_setup_piece, rain_runoff_ring,     rain_runoff_halo_size,
-    rain_runoff_halo_get,    rain_runoff_halo_set, VERIFY_FIELDS + GR_RAIN_RUNOFF_MAP_COUNT,
-    rain_runoff_output,      rain_runoff_summary,  rain_runoff_last_error};
+    rain_runoff_setup_piece, rain_runoff_ring,
+    rain_runoff_halo_size,   rain_runoff_halo_get,
+    rain_runoff_halo_set,    VERIFY_FIELDS + GR_RAIN_RUNOFF_MAP_COUNT,
+    rain_runoff_output,      rain_runoff_summary,
+    rain_runoff_last_error,  NULL};
 
 /* Per cell and step of the local inertial model, each array once per
  * launch (neighbours come from cache): flux reads depth, elevation, the old

@@ -218,11 +218,37 @@ static gr_status snow_accumulation_step(void *state) {
   return gr_snow_accumulation_step(b->sim, 60.0);
 }
 
+/* Ten more steps with the stages timed (each stage waits for the device),
+ * into one line. Collective on a piece (the steps are). */
+static gr_status snow_accumulation_stage_line(snow_accumulation_bench *b, char *line, size_t len) {
+  gr_snow_accumulation_timing tm;
+  const int timed = 10;
+  gr_status st = GR_OK;
+  gr_snow_accumulation_set_timing(b->sim, 1);
+  for (int k = 0; st == GR_OK && k < timed; ++k)
+    st = snow_accumulation_step(b);
+  if (st == GR_OK)
+    st = gr_snow_accumulation_timing_get(b->sim, &tm);
+  gr_snow_accumulation_set_timing(b->sim, 0);
+  if (st == GR_OK) {
+    double q = 1.0 / (double)tm.steps;
+    double total = (tm.host_ms + tm.view_ms + tm.exposure_ms + tm.blur_ms + tm.apply_ms +
+                    tm.objects_ms + tm.combine_ms) *
+                   q;
+    snprintf(line, len,
+             "ms/step over %lld steps, ExposureResolution %d: host %.3f, view (clear + raster) "
+             "%.3f, exposure+growth %.3f, blur+dilation %.3f, increment+stability %.3f, mesh "
+             "points %.3f, combine (pieces) %.3f; total %.3f",
+             tm.steps, env_int("GRAUPEL_BENCH_RESOLUTION", 1024), tm.host_ms * q, tm.view_ms * q,
+             tm.exposure_ms * q, tm.blur_ms * q, tm.apply_ms * q, tm.objects_ms * q,
+             tm.combine_ms * q, total);
+  }
+  return st;
+}
+
 static gr_status snow_accumulation_report(void *state, gr_context *ctx) {
   snow_accumulation_bench *b = state;
   gr_snow_accumulation_ledger l;
-  gr_snow_accumulation_timing tm;
-  const int timed = 10;
   (void)ctx;
   gr_status st = gr_snow_accumulation_ledger_get(b->sim, &l);
   int tris = 0;
@@ -233,22 +259,11 @@ static gr_status snow_accumulation_report(void *state, gr_context *ctx) {
            "stored %.4g m^3 (objects %.4g), shed %.4g, balance %.3g of the snowfall\n",
            l.steps, l.time, tris, b->nboxes, l.stored_volume, l.stored_volume_objects,
            l.shed_volume, l.snowfall_volume > 0 ? fabs(l.balance_error) / l.snowfall_volume : 0.0);
-  gr_snow_accumulation_set_timing(b->sim, 1);
-  for (int k = 0; st == GR_OK && k < timed; ++k)
-    st = snow_accumulation_step(b);
+  char line[400];
   if (st == GR_OK)
-    st = gr_snow_accumulation_timing_get(b->sim, &tm);
-  gr_snow_accumulation_set_timing(b->sim, 0);
-  if (st == GR_OK) {
-    double q = 1.0 / (double)tm.steps;
-    double total =
-        (tm.host_ms + tm.view_ms + tm.exposure_ms + tm.blur_ms + tm.apply_ms + tm.objects_ms) * q;
-    printf("snow_accumulation stages (ms/step over %lld steps, ExposureResolution %d): host %.3f, "
-           "view (clear + raster) %.3f, exposure+growth %.3f, blur+dilation %.3f, "
-           "increment+stability %.3f, mesh points %.3f; total %.3f\n",
-           tm.steps, env_int("GRAUPEL_BENCH_RESOLUTION", 1024), tm.host_ms * q, tm.view_ms * q,
-           tm.exposure_ms * q, tm.blur_ms * q, tm.apply_ms * q, tm.objects_ms * q, total);
-  }
+    st = snow_accumulation_stage_line(b, line, sizeof(line));
+  if (st == GR_OK)
+    printf("snow_accumulation stages (%s)\n", line);
   return st;
 }
 
@@ -323,12 +338,16 @@ static const char *snow_accumulation_last_error(void *state) {
   return gr_snow_accumulation_last_error(((snow_accumulation_bench *)state)->sim);
 }
 
+static gr_status snow_accumulation_stages(void *state, char *line, size_t len) {
+  return snow_accumulation_stage_line(state, line, len);
+}
+
 static const gr_bench_split split = {
     snow_accumulation_setup_piece, snow_accumulation_ring,
     snow_accumulation_halo_size,   snow_accumulation_halo_get,
     snow_accumulation_halo_set,    (int)(sizeof(verify_fields) / sizeof(verify_fields[0])),
     snow_accumulation_output,      snow_accumulation_summary,
-    snow_accumulation_last_error};
+    snow_accumulation_last_error,  snow_accumulation_stages};
 
 /* Per grid point and step, roughly: the raster reads 2 arrays, the
  * exposure reads 2 (and their neighbours) and writes 2, blur reads and

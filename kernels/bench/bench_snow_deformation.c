@@ -282,7 +282,7 @@ static const gr_bench_split split = {
     snow_deformation_halo_size,   snow_deformation_halo_get,
     snow_deformation_halo_set,    (int)(sizeof(verify_fields) / sizeof(verify_fields[0])),
     snow_deformation_output,      snow_deformation_summary,
-    snow_deformation_last_error};
+    snow_deformation_last_error,  NULL};
 
 /* Per point and step, roughly: raster writes U (4 B), overlap reads 3 and
  * writes 1 array, contour reads D and writes cw, the reduction reads 6, the

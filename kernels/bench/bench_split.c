@@ -103,6 +103,7 @@ typedef struct split_member {
   double t0, t1; /* the timed steps' start and end */
   gr_status st;
   char error[600];
+  char stages[400]; /* the piece's stage line (gr_bench_split's stages), or "" */
 } split_member;
 
 struct split_team {
@@ -309,8 +310,14 @@ static void *member_run(void *arg) {
     if (m->rank == 0)
       memcpy(t->summary, line, sizeof(line));
   }
-  if (t->gathered && (st = member_gather(m)) != GR_OK)
+  if (t->gathered && (st = member_gather(m)) != GR_OK) {
     member_fail(m, st, "read-back");
+    return NULL;
+  }
+  /* After the read-back: --verify's whole grid runs as many steps as the
+   * pieces before it. */
+  if (sp->stages && (st = sp->stages(m->state, m->stages, sizeof(m->stages))) != GR_OK)
+    member_fail(m, st, "stages");
   return NULL;
 }
 
@@ -620,6 +627,9 @@ static void print_figures(const split_team *t, const split_member *m, const char
          8.0 * f->step_values / steps, f->step_values / steps);
   if (t->summary[0])
     printf("%s\n", t->summary);
+  for (int r = 0; r < k; ++r)
+    if (m[r].stages[0])
+      printf("  piece %d stages (%s)\n", r, m[r].stages);
 }
 
 /* Every piece's state and context, the mailboxes, the slots, the gathered

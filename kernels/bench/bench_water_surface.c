@@ -169,9 +169,11 @@ static const char *water_last_error(void *state) {
 }
 
 static const gr_bench_split split = {
-    water_setup_piece, water_ring,     water_halo_size,
-    water_halo_get,    water_halo_set, (int)(sizeof(verify_outputs) / sizeof(verify_outputs[0])),
-    water_output,      water_summary,  water_last_error};
+    water_setup_piece, water_ring,
+    water_halo_size,   water_halo_get,
+    water_halo_set,    (int)(sizeof(verify_outputs) / sizeof(verify_outputs[0])),
+    water_output,      water_summary,
+    water_last_error,  NULL};
 
 /* Per point and step: h, v and the wet mask read, h and v written (17 B);
  * the drops are hashed and their Gaussians summed in local memory, the

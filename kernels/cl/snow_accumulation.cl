@@ -34,9 +34,10 @@ GR_INLINE void snac_df_add(float *hi, float *lo, float x) {
 /* Writes triangle (a, b, c) into the view: (u, v) in texels, z the height
  * on the ray; every texel whose centre it covers (edges widened by a
  * millionth of the area: a closed surface leaves no pin-hole) keeps the
- * highest z. Triangles seen edge-on cover nothing. */
-GR_INLINE void snac_raster(__global int *restrict view, int vw, int vh, float3 a, float3 b,
-                           float3 c) {
+ * highest z, in the view rows row_lo .. row_hi only (a texel's value does
+ * not depend on the rows drawn). Triangles seen edge-on cover nothing. */
+GR_INLINE void snac_raster(__global int *restrict view, int vw, int vh, int row_lo, int row_hi,
+                           float3 a, float3 b, float3 c) {
   float area = (b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x);
   if (!(fabs(area) > 0.0f))
     return;
@@ -46,8 +47,8 @@ GR_INLINE void snac_raster(__global int *restrict view, int vw, int vh, float3 a
     return; /* outside the view, or not finite */
   int i0 = max(0, (int)ceil(fmax(umin, -1.0f) - 0.5f));
   int i1 = min(vw - 1, (int)floor(fmin(umax, (float)vw + 1.0f) - 0.5f));
-  int j0 = max(0, (int)ceil(fmax(vmin, -1.0f) - 0.5f));
-  int j1 = min(vh - 1, (int)floor(fmin(vmax, (float)vh + 1.0f) - 0.5f));
+  int j0 = max(row_lo, (int)ceil(fmax(vmin, -1.0f) - 0.5f));
+  int j1 = min(row_hi, (int)floor(fmin(vmax, (float)vh + 1.0f) - 0.5f));
   float sg = area > 0.0f ? 1.0f : -1.0f, tol = -1.0e-6f * fabs(area);
   for (int j = j0; j <= j1; ++j) {
     float py = (float)j + 0.5f;
@@ -89,8 +90,8 @@ __kernel void snow_accumulation_raster_terrain(__global const float *restrict gr
     p[k] = snac_project((float)(gi0 + a) * dx, (float)(gj0 + b) * dy, (ground[c] + depth[c]) - zref,
                         tau_x, tau_y, qx0, qy0, inv_texel);
   }
-  snac_raster(view, vw, vh, p[0], p[1], p[3]);
-  snac_raster(view, vw, vh, p[0], p[3], p[2]);
+  snac_raster(view, vw, vh, 0, vh - 1, p[0], p[1], p[3]);
+  snac_raster(view, vw, vh, 0, vh - 1, p[0], p[3], p[2]);
 }
 
 /* The steepest rise of the snow surface between neighbouring grid points,
@@ -121,11 +122,12 @@ __kernel void snow_accumulation_slope_reduce(__global const float *restrict grou
 }
 
 /* The objects' triangles at their poses (9 floats each, relative to grid
- * point (0, 0) and zref). */
+ * point (0, 0) and zref), into the view rows row_lo .. row_hi (a piece's
+ * share: snow_accumulation_view.c, gr_snac_object_rows). */
 __kernel void snow_accumulation_raster_objects(__global const float *restrict tri, int ntri,
                                                float tau_x, float tau_y, float qx0, float qy0,
-                                               float inv_texel, int vw, int vh,
-                                               __global int *restrict view) {
+                                               float inv_texel, int vw, int vh, int row_lo,
+                                               int row_hi, __global int *restrict view) {
   int t = get_global_id(0);
   if (t >= ntri)
     return;
@@ -133,7 +135,7 @@ __kernel void snow_accumulation_raster_objects(__global const float *restrict tr
   float3 a = snac_project(v[0], v[1], v[2], tau_x, tau_y, qx0, qy0, inv_texel);
   float3 b = snac_project(v[3], v[4], v[5], tau_x, tau_y, qx0, qy0, inv_texel);
   float3 c = snac_project(v[6], v[7], v[8], tau_x, tau_y, qx0, qy0, inv_texel);
-  snac_raster(view, vw, vh, a, b, c);
+  snac_raster(view, vw, vh, max(row_lo, 0), min(row_hi, vh - 1), a, b, c);
 }
 
 /* 1 when the point (x, y, z) with unit normal n is exposed: nothing on its
@@ -391,19 +393,19 @@ __kernel void snow_accumulation_object_surface(__global const float *restrict po
 }
 
 /* A piece's exposure of the mesh points (or samples) from its own view,
- * for the steps with the terrain in the view: a point is exposed when no
- * texel value above it on its ray exceeds its key, and the pieces' views
- * combine by a maximum, so a point is exposed in the combined view exactly
- * when it is exposed in every piece's: the minimum over the pieces of this
- * (through a GR_REDUCE_MAX of its negation) is snow_accumulation_objects'
- * exposure, bit for bit, without combining the view's texels under the
- * objects. */
+ * for the steps with the terrain in the view, into exposure[first + v]: a
+ * point is exposed when no texel value above it on its ray exceeds its
+ * key, and the pieces' views combine by a maximum, so a point is exposed
+ * in the combined view exactly when it is exposed in every piece's: the
+ * minimum over the pieces of this (through a GR_REDUCE_MAX of its
+ * negation) is snow_accumulation_objects' exposure, bit for bit, without
+ * combining the view's texels under the objects. */
 __kernel void snow_accumulation_object_exposure(__global const float *restrict pos,
                                                 __global const float *restrict nrm, int nv,
                                                 float dir_x, float dir_y, float dir_z, float tau_x,
                                                 float tau_y, float qx0, float qy0, float inv_texel,
                                                 float texel, int vw, int vh,
-                                                __global const int *restrict view,
+                                                __global const int *restrict view, int first,
                                                 __global float *restrict exposure) {
   int v = get_global_id(0);
   if (v >= nv)
@@ -411,7 +413,7 @@ __kernel void snow_accumulation_object_exposure(__global const float *restrict p
   float3 d = (float3)(dir_x, dir_y, dir_z);
   float3 n = (float3)(nrm[3 * v], nrm[3 * v + 1], nrm[3 * v + 2]);
   float3 p = snac_mesh_point(pos, n, v, texel);
-  exposure[v] =
+  exposure[first + v] =
       snac_exposed(view, vw, vh, p.x, p.y, p.z, n, d, tau_x, tau_y, qx0, qy0, inv_texel, texel);
 }
 
@@ -427,7 +429,7 @@ __kernel void snow_accumulation_objects(
     __global const int *restrict view, float rate_dt, float amplitude, uint seed, float max_depth,
     float keep, float kdt, int terrain_drawn, __global const float *restrict ground,
     __global const float *restrict gdepth, int gnx, int gny, float gdx, float gdy, float zref,
-    int have_surface, int have_exposure, __global const float *restrict surface,
+    int have_surface, int have_exposure, int surface_first, __global const float *restrict surface,
     __global float *restrict exposure, __global float *restrict depth,
     __global float *restrict depth_lo, __global float *restrict fall,
     __global float *restrict fall_lo, __global float *restrict shed,
@@ -438,9 +440,10 @@ __kernel void snow_accumulation_objects(
   float3 d = (float3)(dir_x, dir_y, dir_z);
   float3 n = (float3)(nrm[3 * v], nrm[3 * v + 1], nrm[3 * v + 2]);
   float3 p = snac_mesh_point(pos, n, v, texel);
-  /* have_exposure: surface holds the pieces' combined exposure of the
-   * points (snow_accumulation_object_exposure), the view only this piece's. */
-  float e = have_exposure ? surface[v]
+  /* have_exposure: surface from surface_first holds the pieces' combined
+   * exposure of the points (snow_accumulation_object_exposure), the view
+   * only this piece's. */
+  float e = have_exposure ? surface[surface_first + v]
                           : snac_exposed(view, vw, vh, p.x, p.y, p.z, n, d, tau_x, tau_y, qx0, qy0,
                                          inv_texel, texel);
   /* Without the terrain in the view, a point under the snow surface (an
@@ -449,7 +452,7 @@ __kernel void snow_accumulation_objects(
    * reduced snow_accumulation_object_surface, the same floats). */
   if (!terrain_drawn && e > 0.0f) {
     float hs = have_surface
-                   ? surface[v]
+                   ? surface[surface_first + v]
                    : snac_surface_at(ground, gdepth, gnx, gny, 0, gdx, gdy, zref, p.x, p.y);
     if (p.z < hs)
       e = 0.0f;

@@ -174,12 +174,20 @@ typedef struct gr_snac_view {
 void gr_snac_direction(const gr_snow_accumulation *s, double d[3]);
 /* The view of a step along d. */
 void gr_snac_view_of(const gr_snow_accumulation *s, const double d[3], gr_snac_view *v);
-/* A piece's view combined with the other pieces' where it matters. Waits. */
-gr_status gr_snac_view_reduce(gr_snow_accumulation *s, const gr_snac_view *v);
-/* The exposure of nv faces (or samples) at pos, nrm in the pieces'
- * combined view into s->o_surface. Waits. */
+/* The view rows [lo, hi] a piece draws the objects into when the views are
+ * combined: its band (the rows its own grid points read), from row 0 on
+ * for the first piece and up to the last row for the last, so that every
+ * row has the objects in at least one piece's view. */
+void gr_snac_object_rows(const gr_snow_accumulation *s, const gr_snac_view *v, int *lo, int *hi);
+/* A piece's view combined with the other pieces' where it matters, and
+ * with objects_by_point the faces' and samples' exposure in the combined
+ * view into s->o_surface (faces first, then samples), in one allreduce
+ * (snow direction dir). Waits. */
+gr_status gr_snac_view_reduce(gr_snow_accumulation *s, const gr_snac_view *v, const float dir[3]);
+/* This piece's exposure of nv faces (or samples) at pos, nrm from its own
+ * view into s->o_surface from first on. Enqueues only. */
 gr_status gr_snac_object_exposure(gr_snow_accumulation *s, cl_mem pos, cl_mem nrm, cl_int nv,
-                                  const gr_snac_view *v, const float dir[3]);
+                                  cl_int first, const gr_snac_view *v, const float dir[3]);
 /* The snow surface under nv faces (or samples) at pos, nrm into
  * s->o_surface, over the pieces. Waits. */
 gr_status gr_snac_object_surface(gr_snow_accumulation *s, cl_mem pos, cl_mem nrm, cl_int nv,

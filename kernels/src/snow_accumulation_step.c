@@ -142,7 +142,17 @@ static gr_status gr_snac_draw_view(gr_snow_accumulation *s, gr_snac_step_vars *s
   if (st == GR_OK && sv->nx > 1 && sv->ny > 1 && sv->terrain_drawn)
     st = gr_enqueue_2d(ctx, s->raster_terrain, 0, 0, (size_t)(sv->nx - 1), (size_t)(sv->ny - 1),
                        NULL);
-  cl_int ntri = s->ntri;
+  /* The objects: every row on a whole grid, and on a piece whose view
+   * stays its own (no terrain drawn); else its share of the rows, the
+   * pieces' shares covering the view (the maximum over the pieces is
+   * then the whole view wherever it is combined, and a piece's grid points
+   * read only rows of its own share). */
+  cl_int ntri = s->ntri, row_lo = 0, row_hi = sv->vh - 1;
+  if (sv->pieced && sv->terrain_drawn) {
+    int lo, hi;
+    gr_snac_object_rows(s, v, &lo, &hi);
+    row_lo = lo, row_hi = hi;
+  }
   if (st == GR_OK && ntri > 0) {
     const gr_snac_arg ro[] = {GR_SNAC_MEM("tri", s->o_tri),
                               GR_SNAC_VAL("ntri", ntri),
@@ -153,18 +163,23 @@ static gr_status gr_snac_draw_view(gr_snow_accumulation *s, gr_snac_step_vars *s
                               GR_SNAC_VAL("inv_texel", v->inv_texel),
                               GR_SNAC_VAL("vw", sv->vw),
                               GR_SNAC_VAL("vh", sv->vh),
+                              GR_SNAC_VAL("row_lo", row_lo),
+                              GR_SNAC_VAL("row_hi", row_hi),
                               GR_SNAC_MEM("view", s->view)};
     st = gr_snac_args(s, s->raster_objects, ro, sizeof(ro) / sizeof(ro[0]));
     if (st == GR_OK)
       st = gr_enqueue_1d(ctx, s->raster_objects, (size_t)ntri);
   }
+  if (st == GR_OK)
+    st = gr_snac_mark(s, &s->tm.view_ms);
   /* A piece drew its own cells: the views' maximum over the pieces, texel
    * by texel, is the whole grid's view (see "Pieces" in the header). */
   s->objects_by_point = 0;
+  const float dir[3] = {sv->dir_x, sv->dir_y, sv->dir_z};
   if (st == GR_OK && sv->pieced && sv->terrain_drawn)
-    st = gr_snac_view_reduce(s, v);
-  if (st == GR_OK)
-    st = gr_snac_mark(s, &s->tm.view_ms);
+    st = gr_snac_view_reduce(s, v, dir);
+  if (st == GR_OK && sv->pieced)
+    st = gr_snac_mark(s, &s->tm.combine_ms);
   return st;
 }
 
@@ -272,6 +287,8 @@ static gr_status gr_snac_apply_growth(gr_snow_accumulation *s, gr_snac_step_vars
                         "gr_snow_accumulation_set_halo_exchange) failed in step %lld with %s; the "
                         "piece's ring is not fresh, so restore a checkpoint before stepping on.",
                         s->steps + 1, gr_status_string(st));
+    else
+      st = gr_snac_mark(s, &s->tm.combine_ms);
   }
   return st;
 }
@@ -328,19 +345,20 @@ static gr_status gr_snac_grow_objects(gr_snow_accumulation *s, gr_snac_step_vars
                             GR_SNAC_MEM("shed_lo", A[5])};
   /* On a piece, the surface under the points when the objects kernel
    * needs it (no terrain in the view) comes from the pieces that hold
-   * it. */
+   * it; their exposure in the combined view, where it was combined per
+   * point, is in s->o_surface already (faces, then samples:
+   * gr_snac_view_reduce). */
   cl_int have_surface = sv->pieced && !sv->terrain_drawn;
   cl_int have_exposure = sv->pieced && sv->terrain_drawn && s->objects_by_point;
+  cl_int surface_first = have_exposure && pass ? s->ntri : 0;
   if (have_surface)
     st = gr_snac_object_surface(s, *P, *N, nv, v->texel);
-  if (have_exposure) {
-    const float dir[3] = {sv->dir_x, sv->dir_y, sv->dir_z};
-    st = gr_snac_object_exposure(s, *P, *N, nv, v, dir);
-  }
+  if (st == GR_OK && have_surface)
+    st = gr_snac_mark(s, &s->tm.combine_ms);
   cl_mem surf = have_surface || have_exposure ? s->o_surface : s->ground;
-  const gr_snac_arg ob2[] = {GR_SNAC_VAL("have_surface", have_surface),
-                             GR_SNAC_VAL("have_exposure", have_exposure),
-                             GR_SNAC_MEM("surface", surf)};
+  const gr_snac_arg ob2[] = {
+      GR_SNAC_VAL("have_surface", have_surface), GR_SNAC_VAL("have_exposure", have_exposure),
+      GR_SNAC_VAL("surface_first", surface_first), GR_SNAC_MEM("surface", surf)};
   if (st == GR_OK)
     st = gr_snac_args(s, s->objects_k, ob, sizeof(ob) / sizeof(ob[0]));
   if (st == GR_OK)

@@ -100,20 +100,60 @@ static void gr_snac_band(const gr_snac_view *v, double ylo, double yhi, double z
   *hi = b > v->vh - 1.0 ? v->vh - 1 : (int)fmax(b, -1.0);
 }
 
+/* Room for n values per face or sample in s->o_surface. */
+static gr_status gr_snac_point_buffer(gr_snow_accumulation *s, size_t n) {
+  if (n <= s->o_surface_cap)
+    return GR_OK;
+  gr_buffer_release(&s->o_surface);
+  s->o_surface_cap = 0;
+  gr_status st =
+      gr_buffer_create(s->ctx, CL_MEM_READ_WRITE, n * sizeof(float), NULL, &s->o_surface);
+  if (st == GR_OK)
+    s->o_surface_cap = n;
+  return st;
+}
+
+/* This piece's band: its local rows, every height the view's box allows. */
+static void gr_snac_piece_band(const gr_snow_accumulation *s, const gr_snac_view *v, int *lo,
+                               int *hi) {
+  double zlo = fmin(0.0, s->bmin - s->zref), zhi = s->bmax + s->snow_bound - s->zref;
+  gr_snac_band(v, (double)s->row0 * s->grid.dy, (double)(s->row0 + s->grid.ny - 1) * s->grid.dy,
+               zlo, zhi, lo, hi);
+}
+
+void gr_snac_object_rows(const gr_snow_accumulation *s, const gr_snac_view *v, int *lo, int *hi) {
+  gr_snac_piece_band(s, v, lo, hi);
+  if (*lo > *hi) {
+    /* No band (cannot happen for a view of the domain's box): every row. */
+    *lo = 0, *hi = v->vh - 1;
+    return;
+  }
+  /* The bands rise with the rows (a strip's band is its rows' y plus the
+   * same heights times tau_y) and neighbours' overlap (their local rows
+   * share the rings), so the first piece's band from row 0 and the last's
+   * up to the top, with every band between, cover the view. */
+  if (s->row0 == 0)
+    *lo = 0;
+  if (s->row0 + s->grid.ny == s->gny)
+    *hi = v->vh - 1;
+}
+
 /* The pieces' views combined, texel by texel, with a maximum (ints travel
  * exactly as doubles), in the rows where that can change a texel that a
  * piece reads. A piece draws its local cells (ring included) into rows of
- * a band its rows and the surface's height range bound, and its grid
- * points read only there; outside every other piece's band the others'
- * views hold the objects alone, which every piece draws the same, so a
- * piece's own texel is already the maximum. The rows two or more bands
- * cover are found by one reduction of 2 values a row (the highest and
- * lowest piece covering it) and only they are combined: a band of about
- * the ring plus the relief times the snow's slope across the cut, instead
- * of the whole view. The objects' points read rows anywhere: their
- * exposure is combined per point (snow_accumulation_object_exposure),
- * unless combining the rows under them costs fewer values. Waits. */
-gr_status gr_snac_view_reduce(gr_snow_accumulation *s, const gr_snac_view *v) {
+ * a band its rows and the surface's height range bound, and the objects
+ * into that band at least (gr_snac_object_rows); its grid points read only
+ * there, and outside every other piece's band the others' views hold
+ * objects alone, which this piece drew too, so its own texel is already
+ * the maximum. The rows two or more bands cover are found by one
+ * reduction of 2 values a row (the highest and lowest piece covering it)
+ * and only they are combined: a band of about the ring plus the relief
+ * times the snow's slope across the cut, instead of the whole view. The
+ * objects' points read rows anywhere: their exposure is combined per point
+ * (snow_accumulation_object_exposure), unless combining the rows under
+ * them costs fewer values. The rows and the points travel in one
+ * allreduce, a read-back and a write each. Waits. */
+gr_status gr_snac_view_reduce(gr_snow_accumulation *s, const gr_snac_view *v, const float dir[3]) {
   size_t vh = (size_t)v->vh, vw = (size_t)v->vw;
   if (vh > s->view_rows_cap) {
     unsigned char *r = realloc(s->view_rows, vh);
@@ -128,11 +168,8 @@ gr_status gr_snac_view_reduce(gr_snow_accumulation *s, const gr_snac_view *v) {
   }
   unsigned char *rows = s->view_rows;
   double *cover = s->view_cover;
-  /* This piece's band: its local rows, every height the view's box allows. */
-  double zlo = fmin(0.0, s->bmin - s->zref), zhi = s->bmax + s->snow_bound - s->zref;
   int lo, hi;
-  gr_snac_band(v, (double)s->row0 * s->grid.dy, (double)(s->row0 + s->grid.ny - 1) * s->grid.dy,
-               zlo, zhi, &lo, &hi);
+  gr_snac_piece_band(s, v, &lo, &hi);
   double id = (double)(s->row0 + s->ring_s); /* the first own row: one per piece */
   for (size_t r = 0; r < vh; ++r) {
     int in = (int)r >= lo && (int)r <= hi;
@@ -161,62 +198,77 @@ gr_status gr_snac_view_reduce(gr_snow_accumulation *s, const gr_snac_view *v) {
       for (int r = lo; r <= hi; ++r)
         rows[r] = 1;
   }
-  size_t longest = 0, run = 0;
-  for (size_t r = 0; r < vh; ++r) {
-    run = rows[r] ? run + 1 : 0;
-    longest = run > longest ? run : longest;
-  }
-  if (longest == 0)
+  /* Every value the pieces combine this step in one allreduce: the rows
+   * (ints travel exactly as doubles), then with objects_by_point minus the
+   * faces' and the samples' exposure from this piece's view. */
+  size_t nrows = 0;
+  for (size_t r = 0; r < vh; ++r)
+    nrows += rows[r];
+  size_t texels = nrows * vw, n = texels + (s->objects_by_point ? points : 0);
+  if (n == 0)
     return GR_OK;
-  cl_int *keys = malloc(longest * vw * sizeof(cl_int));
-  double *vals = malloc(longest * vw * sizeof(double));
-  if (!keys || !vals)
+  if (s->objects_by_point) {
+    st = gr_snac_point_buffer(s, points);
+    if (st == GR_OK)
+      st = gr_snac_object_exposure(s, s->o_pos, s->o_nrm, s->ntri, 0, v, dir);
+    if (st == GR_OK)
+      st = gr_snac_object_exposure(s, s->t_pos, s->t_nrm, s->ns, s->ntri, v, dir);
+    if (st != GR_OK)
+      return st;
+  }
+  cl_int *keys = malloc(texels * sizeof(cl_int) + 1);
+  float *f = malloc((n - texels) * sizeof(float) + 1);
+  double *vals = malloc(n * sizeof(double));
+  if (!keys || !f || !vals)
     st = gr_set_error(s->ctx, GR_ERR_OUT_OF_MEMORY, "Out of host memory.");
-  for (size_t r = 0; st == GR_OK && r < vh;) {
-    if (!rows[r]) {
-      ++r;
-      continue;
-    }
+  /* The runs of rows, in order. */
+  for (size_t r = 0, at = 0; st == GR_OK && r < vh;) {
     size_t r1 = r;
     while (r1 < vh && rows[r1])
       ++r1;
-    size_t n = (r1 - r) * vw, at = r * vw;
-    st = gr_buffer_read(s->ctx, s->view, at * sizeof(cl_int), n * sizeof(cl_int), keys);
-    for (size_t t = 0; st == GR_OK && t < n; ++t)
-      vals[t] = (double)keys[t];
-    if (st == GR_OK)
-      st = gr_snac_allreduce(s, vals, n, GR_REDUCE_MAX);
-    for (size_t t = 0; st == GR_OK && t < n; ++t)
-      keys[t] = (cl_int)vals[t];
-    if (st == GR_OK)
-      st = gr_buffer_write(s->ctx, s->view, at * sizeof(cl_int), n * sizeof(cl_int), keys);
-    r = r1;
+    if (r1 > r) {
+      size_t m = (r1 - r) * vw;
+      st = gr_buffer_read(s->ctx, s->view, r * vw * sizeof(cl_int), m * sizeof(cl_int), keys + at);
+      at += m;
+    }
+    r = r1 > r ? r1 : r + 1;
   }
-  free(keys), free(vals);
-  return st;
-}
-
-/* Room for n values per face or sample in s->o_surface. */
-static gr_status gr_snac_point_buffer(gr_snow_accumulation *s, size_t n) {
-  if (n <= s->o_surface_cap)
-    return GR_OK;
-  gr_buffer_release(&s->o_surface);
-  s->o_surface_cap = 0;
-  gr_status st =
-      gr_buffer_create(s->ctx, CL_MEM_READ_WRITE, n * sizeof(float), NULL, &s->o_surface);
+  if (st == GR_OK && n > texels)
+    st = gr_buffer_read(s->ctx, s->o_surface, 0, (n - texels) * sizeof(float), f);
+  for (size_t q = 0; st == GR_OK && q < texels; ++q)
+    vals[q] = (double)keys[q];
+  for (size_t q = texels; st == GR_OK && q < n; ++q)
+    vals[q] = -(double)f[q - texels];
   if (st == GR_OK)
-    s->o_surface_cap = n;
+    st = gr_snac_allreduce(s, vals, n, GR_REDUCE_MAX);
+  for (size_t q = 0; st == GR_OK && q < texels; ++q)
+    keys[q] = (cl_int)vals[q];
+  for (size_t q = texels; st == GR_OK && q < n; ++q)
+    f[q - texels] = (float)-vals[q];
+  for (size_t r = 0, at = 0; st == GR_OK && r < vh;) {
+    size_t r1 = r;
+    while (r1 < vh && rows[r1])
+      ++r1;
+    if (r1 > r) {
+      size_t m = (r1 - r) * vw;
+      st = gr_buffer_write(s->ctx, s->view, r * vw * sizeof(cl_int), m * sizeof(cl_int), keys + at);
+      at += m;
+    }
+    r = r1 > r ? r1 : r + 1;
+  }
+  if (st == GR_OK && n > texels)
+    st = gr_buffer_write(s->ctx, s->o_surface, 0, (n - texels) * sizeof(float), f);
+  free(keys), free(f), free(vals);
   return st;
 }
 
-/* The exposure of n faces (or samples) at pos, nrm in the pieces'
- * combined view into s->o_surface: each piece's from its own view, the
- * minimum over the pieces (snow_accumulation_object_exposure). Waits. */
+/* This piece's exposure of nv faces (or samples) at pos, nrm from its own
+ * view into s->o_surface from first on (snow_accumulation_object_exposure;
+ * the pieces' minimum is the combined view's). Enqueues only. */
 gr_status gr_snac_object_exposure(gr_snow_accumulation *s, cl_mem pos, cl_mem nrm, cl_int nv,
-                                  const gr_snac_view *v, const float dir[3]) {
-  gr_status st = gr_snac_point_buffer(s, (size_t)nv);
-  if (st != GR_OK)
-    return st;
+                                  cl_int first, const gr_snac_view *v, const float dir[3]) {
+  if (nv == 0)
+    return GR_OK;
   cl_int vw = v->vw, vh = v->vh;
   const gr_snac_arg a[] = {GR_SNAC_MEM("pos", pos),
                            GR_SNAC_MEM("nrm", nrm),
@@ -233,25 +285,11 @@ gr_status gr_snac_object_exposure(gr_snow_accumulation *s, cl_mem pos, cl_mem nr
                            GR_SNAC_VAL("vw", vw),
                            GR_SNAC_VAL("vh", vh),
                            GR_SNAC_MEM("view", s->view),
+                           GR_SNAC_VAL("first", first),
                            GR_SNAC_MEM("exposure", s->o_surface)};
-  st = gr_snac_args(s, s->object_exposure, a, sizeof(a) / sizeof(a[0]));
+  gr_status st = gr_snac_args(s, s->object_exposure, a, sizeof(a) / sizeof(a[0]));
   if (st == GR_OK)
     st = gr_enqueue_1d(s->ctx, s->object_exposure, (size_t)nv);
-  float *f = malloc((size_t)nv * sizeof(float));
-  double *d = malloc((size_t)nv * sizeof(double));
-  if (st == GR_OK && (!f || !d))
-    st = gr_set_error(s->ctx, GR_ERR_OUT_OF_MEMORY, "Out of host memory.");
-  if (st == GR_OK)
-    st = gr_buffer_read(s->ctx, s->o_surface, 0, (size_t)nv * sizeof(float), f);
-  for (cl_int k = 0; st == GR_OK && k < nv; ++k)
-    d[k] = -(double)f[k];
-  if (st == GR_OK)
-    st = gr_snac_allreduce(s, d, (size_t)nv, GR_REDUCE_MAX);
-  for (cl_int k = 0; st == GR_OK && k < nv; ++k)
-    f[k] = (float)-d[k];
-  if (st == GR_OK)
-    st = gr_buffer_write(s->ctx, s->o_surface, 0, (size_t)nv * sizeof(float), f);
-  free(f), free(d);
   return st;
 }
 

@@ -374,8 +374,10 @@ GR_API gr_status gr_snow_accumulation_reset(gr_snow_accumulation *s);
  * view, bit for bit, whatever the split. Only the texels that can differ
  * and are read are combined. A piece's cells, and its grid points' rays,
  * fall in a band of view rows that its rows and the view box's heights
- * bound; elsewhere its view holds the objects alone, the same on every
- * piece. So the pieces agree (a GR_REDUCE_MAX of 2 values per view row:
+ * bound, and it draws the objects into that band only (the first piece
+ * from the view's first row on, the last up to its last row: every row has
+ * the objects in some piece's view); elsewhere its view holds objects
+ * alone. So the pieces agree (a GR_REDUCE_MAX of 2 values per view row:
  * the highest and lowest piece whose band covers it) on the rows two or
  * more bands cover, a band about as wide as the ring plus the relief times
  * the snow's slope along y, and combine those rows alone (in calls of at
@@ -384,7 +386,8 @@ GR_API gr_status gr_snow_accumulation_reset(gr_snow_accumulation *s);
  * their exposure (a point is exposed when every piece's view leaves it
  * exposed) is combined per face and sample, GR_REDUCE_MAX of minus
  * the exposure, or, where that is more values, the view rows under the
- * objects are combined too. At 1024^2 with ExposureResolution 1024 and two
+ * objects are combined too; the rows and the points go in one allreduce
+ * (one read-back and one write) a step. At 1024^2 with ExposureResolution 1024 and two
  * pieces, graupel-bench's scene reduces about 0.37 MB a step per piece
  * instead of the whole view's 8 MB. This happens in the steps where the
  * terrain is drawn at all: where the surface rises slower than the snow
@@ -473,6 +476,8 @@ typedef struct gr_snow_accumulation_timing {
   double apply_ms;    /**< increment and stability on the grid */
   double objects_ms;  /**< exposure, growth and stability of the faces and samples */
   double host_ms;     /**< the view's extent and the direction, on the host */
+  double combine_ms;  /**< a piece's share with the others: its view's shared rows, the
+                           objects' values and the halo exchange (0 on a whole grid) */
 } gr_snow_accumulation_timing;
 
 /** Switches per-stage timing on (non-zero; the sums restart) or off. */
