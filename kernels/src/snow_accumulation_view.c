@@ -138,6 +138,27 @@ void gr_snac_object_rows(const gr_snow_accumulation *s, const gr_snac_view *v, i
     *hi = v->vh - 1;
 }
 
+/* The view's rows marked in rows (vh of them, vw texels each) copied
+ * between the device and keys, packed run by run in order: read (write 0)
+ * or written back (write 1). */
+static gr_status gr_snac_view_rows(gr_snow_accumulation *s, const unsigned char *rows, size_t vh,
+                                   size_t vw, cl_int *keys, int write) {
+  gr_status st = GR_OK;
+  for (size_t r = 0, at = 0; st == GR_OK && r < vh;) {
+    size_t r1 = r;
+    while (r1 < vh && rows[r1])
+      ++r1;
+    if (r1 > r) {
+      size_t off = r * vw * sizeof(cl_int), m = (r1 - r) * vw;
+      st = write ? gr_buffer_write(s->ctx, s->view, off, m * sizeof(cl_int), keys + at)
+                 : gr_buffer_read(s->ctx, s->view, off, m * sizeof(cl_int), keys + at);
+      at += m;
+    }
+    r = r1 > r ? r1 : r + 1;
+  }
+  return st;
+}
+
 /* The pieces' views combined, texel by texel, with a maximum (ints travel
  * exactly as doubles), in the rows where that can change a texel that a
  * piece reads. A piece draws its local cells (ring included) into rows of
@@ -221,18 +242,8 @@ gr_status gr_snac_view_reduce(gr_snow_accumulation *s, const gr_snac_view *v, co
   double *vals = malloc(n * sizeof(double));
   if (!keys || !f || !vals)
     st = gr_set_error(s->ctx, GR_ERR_OUT_OF_MEMORY, "Out of host memory.");
-  /* The runs of rows, in order. */
-  for (size_t r = 0, at = 0; st == GR_OK && r < vh;) {
-    size_t r1 = r;
-    while (r1 < vh && rows[r1])
-      ++r1;
-    if (r1 > r) {
-      size_t m = (r1 - r) * vw;
-      st = gr_buffer_read(s->ctx, s->view, r * vw * sizeof(cl_int), m * sizeof(cl_int), keys + at);
-      at += m;
-    }
-    r = r1 > r ? r1 : r + 1;
-  }
+  if (st == GR_OK)
+    st = gr_snac_view_rows(s, rows, vh, vw, keys, 0);
   if (st == GR_OK && n > texels)
     st = gr_buffer_read(s->ctx, s->o_surface, 0, (n - texels) * sizeof(float), f);
   for (size_t q = 0; st == GR_OK && q < texels; ++q)
@@ -245,17 +256,8 @@ gr_status gr_snac_view_reduce(gr_snow_accumulation *s, const gr_snac_view *v, co
     keys[q] = (cl_int)vals[q];
   for (size_t q = texels; st == GR_OK && q < n; ++q)
     f[q - texels] = (float)-vals[q];
-  for (size_t r = 0, at = 0; st == GR_OK && r < vh;) {
-    size_t r1 = r;
-    while (r1 < vh && rows[r1])
-      ++r1;
-    if (r1 > r) {
-      size_t m = (r1 - r) * vw;
-      st = gr_buffer_write(s->ctx, s->view, r * vw * sizeof(cl_int), m * sizeof(cl_int), keys + at);
-      at += m;
-    }
-    r = r1 > r ? r1 : r + 1;
-  }
+  if (st == GR_OK)
+    st = gr_snac_view_rows(s, rows, vh, vw, keys, 1);
   if (st == GR_OK && n > texels)
     st = gr_buffer_write(s->ctx, s->o_surface, 0, (n - texels) * sizeof(float), f);
   free(keys), free(f), free(vals);
