@@ -111,11 +111,11 @@ struct split_team {
   const gr_bench_core *core;
   int k, n, steps;
   split_barrier barrier;
-  double *slots;     /* k * SPLIT_SLOTS */
-  void **mail[2];    /* [parity][2 * rank + (0 south, 1 north)] */
+  double *slots;       /* k * SPLIT_SLOTS */
+  void **mail[2];      /* [parity][2 * rank + (0 south, 1 north)] */
   cl_mem *mail_mem[2]; /* the pinned buffer behind each mailbox, or NULL (malloc'ed) */
-  float **gathered;  /* --verify: every output of the whole grid, or NULL */
-  char summary[400]; /* the first piece's summary line */
+  float **gathered;    /* --verify: every output of the whole grid, or NULL */
+  char summary[400];   /* the first piece's summary line */
 };
 
 static void member_fail(split_member *m, gr_status st, const char *what) {
@@ -221,10 +221,10 @@ static int mailbox_alloc(split_member *m, int p, int i, size_t bytes) {
     cl_int err = CL_SUCCESS;
     cl_mem buf = clCreateBuffer(gr_context_cl(m->ctx), CL_MEM_ALLOC_HOST_PTR | CL_MEM_READ_WRITE,
                                 bytes, NULL, &err);
-    void *at = err == CL_SUCCESS ? clEnqueueMapBuffer(gr_context_queue(m->ctx), buf, CL_TRUE,
-                                                      CL_MAP_READ | CL_MAP_WRITE, 0, bytes, 0,
-                                                      NULL, NULL, &err)
-                                 : NULL;
+    void *at = err == CL_SUCCESS
+                   ? clEnqueueMapBuffer(gr_context_queue(m->ctx), buf, CL_TRUE,
+                                        CL_MAP_READ | CL_MAP_WRITE, 0, bytes, 0, NULL, NULL, &err)
+                   : NULL;
     if (at && err == CL_SUCCESS) {
       t->mail[p][i] = at;
       t->mail_mem[p][i] = buf;

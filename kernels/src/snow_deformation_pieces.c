@@ -137,8 +137,8 @@ static gr_status gr_snow_rect(gr_snow_deformation *s, cl_mem buf, size_t x0, siz
   cl_bool block = wait ? CL_TRUE : CL_FALSE;
   cl_int err = write ? clEnqueueWriteBufferRect(q, buf, block, origin, host_origin, region, pitch,
                                                 0, w * f, 0, host, 0, NULL, NULL)
-                     : clEnqueueReadBufferRect(q, buf, block, origin, host_origin, region, pitch,
-                                               0, w * f, 0, host, 0, NULL, NULL);
+                     : clEnqueueReadBufferRect(q, buf, block, origin, host_origin, region, pitch, 0,
+                                               w * f, 0, host, 0, NULL, NULL);
   return gr_cl_check(s->ctx, err,
                      write ? "Writing a halo strip to the device"
                            : "Reading part of a field back from the device");

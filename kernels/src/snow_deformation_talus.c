@@ -477,8 +477,8 @@ typedef struct gr_snow_relax_run {
    * whether it is empty (a piece with none of the window) */
   int before[GR_SNOW_CHECK_LAG + 1], empty[GR_SNOW_CHECK_LAG + 1];
   int launched, started, read, it_launched, done;
-  int it;    /* the iterations the relaxation counts */
-  int stale; /* a piece: the ring's points gone stale since its last exchange */
+  int it;       /* the iterations the relaxation counts */
+  int stale;    /* a piece: the ring's points gone stale since its last exchange */
   int cx0, cx1; /* a piece: the columns its launches wrote since then (cx0 > cx1: none) */
 } gr_snow_relax_run;
 
